@@ -1,0 +1,97 @@
+//! `cablemap bench`: solver speed on thesis-grid routings.
+//!
+//! Each sampled routing is stepped through the sweep's tension ladder
+//! (21 tensions from 1.0 to 2.0 N) on one thread, exactly as the sweep does,
+//! and the median time per solve over routings is reported for gravity on
+//! and off. Timing is by wall clock on a shared machine: the median over
+//! many routings keeps one noisy neighbour from moving the figure.
+
+use crate::model::{Actuator, Routing, Simulator, SolverOptions};
+use serde::Serialize;
+use std::time::Instant;
+
+/// Figures of one benchmark configuration.
+#[derive(Debug, Clone, Serialize)]
+pub struct BenchFigures {
+    /// What was measured.
+    pub label: String,
+    /// Routings sampled.
+    pub routings: usize,
+    /// Solves per routing (tension ladder).
+    pub tensions: usize,
+    /// Median over routings of the mean time per solve, µs.
+    pub median_us_per_solve: f64,
+    /// 10th and 90th percentile over routings, µs per solve.
+    pub p10_us_per_solve: f64,
+    /// See `p10_us_per_solve`.
+    pub p90_us_per_solve: f64,
+    /// Mean integration passes per solve.
+    pub mean_passes: f64,
+    /// Solves that failed.
+    pub failures: usize,
+}
+
+/// A deterministic sample of `count` routings from the thesis grid
+/// (9 levels ±0.8 r), spread over the grid by a multiplicative walk.
+pub fn sample_thesis_routings(count: usize, radius_mm: f64) -> Vec<[f64; 5]> {
+    let total = 9usize.pow(5);
+    (0..count)
+        .map(|k| {
+            let mut idx = (k * 7919 + 13) % total;
+            std::array::from_fn(|_| {
+                let level = idx % 9;
+                idx /= 9;
+                (level as f64 - 4.0) * 0.2 * radius_mm
+            })
+        })
+        .collect()
+}
+
+/// Times continuation solves: for each routing, `tensions` evenly spaced
+/// from `tension_min_n` to `tension_max_n`.
+pub fn bench_solver(
+    actuator: &Actuator,
+    options: &SolverOptions,
+    routings: &[[f64; 5]],
+    tension_min_n: f64,
+    tension_max_n: f64,
+    tensions: usize,
+    label: &str,
+) -> Result<BenchFigures, crate::Error> {
+    let mut sim = Simulator::new(actuator, options)?;
+    let ladder: Vec<f64> = (0..tensions)
+        .map(|k| tension_min_n + (tension_max_n - tension_min_n) * k as f64 / (tensions.max(2) - 1) as f64)
+        .collect();
+    let mut per_solve = Vec::with_capacity(routings.len());
+    let mut a = [0.0; 4];
+    let (mut passes, mut solves, mut failures) = (0u64, 0u64, 0usize);
+    for y in routings {
+        let routing = Routing::new(y, actuator.length_mm, actuator.radius_mm)?;
+        let start = Instant::now();
+        sim.set_routing(&routing);
+        for &t in &ladder {
+            match sim.solve(t) {
+                Ok(pose) => {
+                    sim.coefficients_into(&mut a);
+                    passes += u64::from(pose.iterations);
+                    solves += 1;
+                }
+                Err(_) => failures += 1,
+            }
+        }
+        per_solve.push(start.elapsed().as_secs_f64() * 1e6 / ladder.len() as f64);
+    }
+    std::hint::black_box(a);
+    per_solve.sort_by(f64::total_cmp);
+    let q = |p: f64| per_solve[((per_solve.len() - 1) as f64 * p).round() as usize];
+    Ok(BenchFigures {
+        label: label.to_string(),
+        routings: routings.len(),
+        tensions,
+        median_us_per_solve: q(0.5),
+        p10_us_per_solve: q(0.1),
+        p90_us_per_solve: q(0.9),
+        mean_passes: passes as f64 / solves.max(1) as f64,
+        failures,
+    })
+}

@@ -1,0 +1,102 @@
+//! Command-line front ends: argument structs (clap) and the functions that
+//! run each command. `main.rs` only parses and dispatches.
+
+pub mod bench;
+pub mod simulate;
+
+use crate::model::{Actuator, SolverOptions};
+use clap::Args;
+
+/// Actuator parameter overrides shared by every command that simulates.
+/// Defaults are the thesis's (model-notes §1).
+#[derive(Debug, Clone, Args, Default)]
+pub struct ActuatorArgs {
+    /// Rod length L, mm [default 65].
+    #[arg(long, value_name = "MM")]
+    pub length_mm: Option<f64>,
+    /// Rod radius r, mm [default 5].
+    #[arg(long, value_name = "MM")]
+    pub radius_mm: Option<f64>,
+    /// Axial rigidity EA, N [default 26.6964].
+    #[arg(long, value_name = "N")]
+    pub ea_n: Option<f64>,
+    /// Shear rigidity GA, N [default 1.70866].
+    #[arg(long, value_name = "N")]
+    pub ga_n: Option<f64>,
+    /// Bending rigidity EI, N·mm² [default 115.117].
+    #[arg(long, value_name = "N_MM2")]
+    pub ei_n_mm2: Option<f64>,
+    /// Material density, g/cm³ [default 1.07].
+    #[arg(long, value_name = "G_CM3")]
+    pub density_g_cm3: Option<f64>,
+    /// Turn self-weight off (the thesis's rod hangs: gravity is on by default).
+    #[arg(long)]
+    pub no_gravity: bool,
+    /// Gravity direction from the clamp axis, rad (clamp tilt) [default 0].
+    #[arg(long, value_name = "RAD", allow_hyphen_values = true)]
+    pub gravity_direction_rad: Option<f64>,
+    /// Scale on the nominal self-weight [default 1].
+    #[arg(long, value_name = "K")]
+    pub gravity_scale: Option<f64>,
+    /// Material stiffening α: moment EI·u·(1 + α (r u)²) [default 0].
+    #[arg(long, value_name = "ALPHA")]
+    pub stiffening_alpha: Option<f64>,
+    /// Clamp rotational stiffness k_θ, N·mm/rad [default: rigid clamp].
+    #[arg(long, value_name = "N_MM_PER_RAD")]
+    pub clamp_stiffness: Option<f64>,
+    /// Channel offset δ added to every y_i, mm [default 0].
+    #[arg(long, value_name = "MM", allow_hyphen_values = true)]
+    pub channel_offset_mm: Option<f64>,
+    /// RK4 steps per knot span of the routing (even) [default 24].
+    #[arg(long, value_name = "N")]
+    pub steps_per_span: Option<usize>,
+}
+
+impl ActuatorArgs {
+    /// Applies the overrides on top of `base`.
+    pub fn apply(&self, base: &Actuator) -> Actuator {
+        let mut a = base.clone();
+        let set = |slot: &mut f64, v: Option<f64>| {
+            if let Some(v) = v {
+                *slot = v;
+            }
+        };
+        set(&mut a.length_mm, self.length_mm);
+        set(&mut a.radius_mm, self.radius_mm);
+        set(&mut a.ea_n, self.ea_n);
+        set(&mut a.ga_n, self.ga_n);
+        set(&mut a.ei_n_mm2, self.ei_n_mm2);
+        set(&mut a.density_g_cm3, self.density_g_cm3);
+        set(&mut a.gravity.direction_rad, self.gravity_direction_rad);
+        set(&mut a.gravity.scale, self.gravity_scale);
+        set(&mut a.effects.stiffening_alpha, self.stiffening_alpha);
+        set(&mut a.effects.channel_offset_mm, self.channel_offset_mm);
+        if self.no_gravity {
+            a.gravity.enabled = false;
+        }
+        if self.clamp_stiffness.is_some() {
+            a.effects.clamp_stiffness_n_mm_per_rad = self.clamp_stiffness;
+        }
+        a
+    }
+
+    /// Solver options with the step override.
+    pub fn solver_options(&self, base: &SolverOptions) -> SolverOptions {
+        let mut o = base.clone();
+        if let Some(n) = self.steps_per_span {
+            o.steps_per_span = n;
+        }
+        o
+    }
+}
+
+/// Parses "a,b,c" into numbers, naming the offending item.
+pub fn parse_list(text: &str, what: &str) -> anyhow::Result<Vec<f64>> {
+    text.split(',')
+        .map(|item| {
+            item.trim()
+                .parse::<f64>()
+                .map_err(|_| anyhow::anyhow!("{what}: '{}' is not a number (expected a comma-separated list like 1,-2,0.5,0,3)", item.trim()))
+        })
+        .collect()
+}

@@ -1,0 +1,122 @@
+//! `cablemap simulate`: one actuator, one tension.
+
+use super::{parse_list, ActuatorArgs};
+use crate::model::{simulate, Actuator, Routing, Simulation, SolverOptions, STATUS_OK};
+use crate::plot::{draw_bodies, BodyDrawing};
+use anyhow::Context;
+use clap::Args;
+use plotters::style::full_palette::BLUE_800;
+use serde_json::json;
+use std::io::Write;
+use std::path::PathBuf;
+
+/// Arguments of `cablemap simulate`.
+#[derive(Debug, Clone, Args)]
+pub struct SimulateArgs {
+    /// Routing control points y0,y1,y2,y3,y4 in mm (each |y_i| < r).
+    #[arg(long, value_name = "Y0,Y1,Y2,Y3,Y4", allow_hyphen_values = true)]
+    pub routing: String,
+    /// Cable tension, N (≥ 0).
+    #[arg(long, value_name = "N", allow_hyphen_values = true)]
+    pub tension: f64,
+    /// Highest Legendre order n of the curvature coefficients a_0..a_n.
+    #[arg(long, default_value_t = 3)]
+    pub order: usize,
+    /// Print one JSON object instead of a report.
+    #[arg(long)]
+    pub json: bool,
+    /// Write the centreline and cable path as CSV.
+    #[arg(long, value_name = "FILE")]
+    pub csv: Option<PathBuf>,
+    /// Draw the deformed body, channel and tip as PNG.
+    #[arg(long, value_name = "FILE")]
+    pub png: Option<PathBuf>,
+    #[command(flatten)]
+    pub actuator: ActuatorArgs,
+}
+
+/// The JSON object other tools rely on (names shared with sweep columns).
+pub fn simulation_json(sim: &Simulation) -> serde_json::Value {
+    let p = &sim.pose;
+    json!({
+        "status": STATUS_OK,
+        "routing_mm": sim.routing_mm,
+        "tension_n": p.tension_n,
+        "tip_x_mm": p.tip_x_mm,
+        "tip_y_mm": p.tip_y_mm,
+        "tip_angle_rad": p.tip_angle_rad,
+        "tip_frame_angle_rad": p.tip_frame_angle_rad,
+        "base_angle_rad": p.base_angle_rad,
+        "length_mm": p.length_mm,
+        "a": sim.a,
+        "iterations": p.iterations,
+    })
+}
+
+/// Writes the centreline CSV (one row per solver node).
+pub fn write_centreline_csv(path: &std::path::Path, sim: &Simulation) -> anyhow::Result<()> {
+    let mut out = String::from(
+        "s_mm,x_mm,y_mm,frame_angle_rad,tangent_angle_rad,arc_length_mm,v1,v2,u_per_mm,channel_y_mm,cable_x_mm,cable_y_mm\n",
+    );
+    for c in &sim.centreline {
+        out.push_str(&format!(
+            "{},{},{},{},{},{},{},{},{},{},{},{}\n",
+            c.s_mm, c.x_mm, c.y_mm, c.frame_angle_rad, c.tangent_angle_rad, c.arc_length_mm, c.v1, c.v2, c.u_per_mm,
+            c.channel_y_mm, c.cable_x_mm, c.cable_y_mm
+        ));
+    }
+    crate::io::write_atomic(path, out.as_bytes()).with_context(|| format!("writing centreline CSV {}", path.display()))
+}
+
+/// A drawing of a simulated body.
+pub fn body_drawing(sim: &Simulation, radius_mm: f64, label: String, colour: plotters::style::RGBColor) -> BodyDrawing {
+    BodyDrawing {
+        centreline: sim.centreline.iter().map(|c| (c.x_mm, c.y_mm)).collect(),
+        frame_angle_rad: sim.centreline.iter().map(|c| c.frame_angle_rad).collect(),
+        cable: sim.centreline.iter().map(|c| (c.cable_x_mm, c.cable_y_mm)).collect(),
+        radius_mm,
+        label,
+        colour,
+    }
+}
+
+/// Runs `cablemap simulate`.
+pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
+    let actuator = args.actuator.apply(&Actuator::default());
+    actuator.validate()?;
+    let options = args.actuator.solver_options(&SolverOptions::default());
+    let y = parse_list(&args.routing, "--routing")?;
+    let routing = Routing::new(&y, actuator.length_mm, actuator.radius_mm).context("--routing")?;
+    let sim = simulate(&actuator, &options, &routing, args.tension, args.order)
+        .with_context(|| format!("simulating routing {y:?} at {} N", args.tension))?;
+    if let Some(path) = &args.csv {
+        write_centreline_csv(path, &sim)?;
+    }
+    if let Some(path) = &args.png {
+        let title = format!("routing [{}] mm, tension {:.3} N", fmt_list(&y), args.tension);
+        let drawing = body_drawing(&sim, actuator.radius_mm, "body (outline at ±r), cable in red".into(), BLUE_800);
+        draw_bodies(path, &title, &[drawing], &[])?;
+    }
+    let stdout = std::io::stdout();
+    let mut out = stdout.lock();
+    if args.json {
+        writeln!(out, "{}", simulation_json(&sim))?;
+        return Ok(());
+    }
+    let p = &sim.pose;
+    writeln!(out, "routing        [{}] mm", fmt_list(&y))?;
+    writeln!(out, "tension        {:.6} N   (gravity {})", p.tension_n, if actuator.gravity.enabled { "on" } else { "off" })?;
+    writeln!(out, "tip            x = {:.6} mm, y = {:.6} mm", p.tip_x_mm, p.tip_y_mm)?;
+    writeln!(out, "tip angle      {:.8} rad ({:.4}°)", p.tip_angle_rad, p.tip_angle_rad.to_degrees())?;
+    writeln!(out, "base angle     {:.8} rad ({:.4}°)", p.base_angle_rad, p.base_angle_rad.to_degrees())?;
+    writeln!(out, "length ℓ       {:.6} mm", p.length_mm)?;
+    for (i, a) in sim.a.iter().enumerate() {
+        writeln!(out, "a_{i:<12} {a:.8e} mm^-{}", i + 1)?;
+    }
+    writeln!(out, "iterations     {} integration pass(es)", p.iterations)?;
+    Ok(())
+}
+
+fn fmt_list(v: &[f64]) -> String {
+    v.iter().map(|x| format!("{x}")).collect::<Vec<_>>().join(", ")
+}

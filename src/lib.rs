@@ -1,0 +1,35 @@
+//! cablemap: configuration design of planar cable-driven soft actuators.
+//!
+//! The pipeline runs one way: [`model`] (routing, rod, effects, solver) →
+//! [`shape`] (Legendre curvature coefficients) → sweep → reduce → design
+//! and calibrate. Each layer has its own error enum, joined here.
+
+pub mod bench;
+pub mod cli;
+pub mod io;
+pub mod model;
+pub mod plot;
+pub mod shape;
+
+/// Any error of the library, by layer.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// Invalid routing.
+    #[error(transparent)]
+    Routing(#[from] model::RoutingError),
+    /// Invalid actuator parameters.
+    #[error(transparent)]
+    Parameter(#[from] model::ParameterError),
+    /// A solve failed.
+    #[error(transparent)]
+    Solve(#[from] model::SolveFailure),
+    /// Shape coefficients could not be computed.
+    #[error(transparent)]
+    Shape(#[from] shape::ShapeError),
+    /// Drawing a picture.
+    #[error(transparent)]
+    Plot(#[from] plot::PlotError),
+    /// Reading or writing a file.
+    #[error("{context}: {source}")]
+    Io { context: String, source: std::io::Error },
+}

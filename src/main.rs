@@ -1,0 +1,36 @@
+//! The `cablemap` command: parses arguments and calls the library.
+
+use cablemap::cli;
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+/// Design planar cable-driven soft actuators: simulate, sweep, map, design.
+#[derive(Debug, Parser)]
+#[command(name = "cablemap", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Simulate one actuator at one tension: tip pose, shape coefficients, centreline.
+    Simulate(cli::simulate::SimulateArgs),
+    /// Print solver timings (median µs per solve, single thread).
+    Bench(cli::bench::BenchArgs),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match &cli.command {
+        Command::Simulate(args) => cli::simulate::run(args),
+        Command::Bench(args) => cli::bench::run(args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -1,0 +1,212 @@
+//! Actuator parameters (thesis Table 2.1, model-notes §1) and the optional
+//! physical effects the thesis model leaves out (model-notes §6).
+
+use serde::{Deserialize, Serialize};
+
+/// Standard gravity, m/s².
+pub const STANDARD_GRAVITY_M_S2: f64 = 9.81;
+
+/// Why a parameter set was rejected.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ParameterError {
+    /// A parameter that must be positive and finite is not.
+    #[error("parameter {name} = {value} must be a positive, finite number")]
+    NotPositive { name: &'static str, value: f64 },
+    /// A parameter that must be finite is not, or lies outside its range.
+    #[error("parameter {name} = {value} is out of range: {expected}")]
+    OutOfRange { name: &'static str, value: f64, expected: &'static str },
+}
+
+/// Self-weight of the rod.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Gravity {
+    /// Whether self-weight acts at all (the thesis's rod hangs: on by default).
+    pub enabled: bool,
+    /// Direction of gravity in the plane, measured from the clamp axis (+x)
+    /// toward +y, rad. 0 is a rod hanging straight down from its clamp; a
+    /// tilted clamp turns the rod against gravity.
+    pub direction_rad: f64,
+    /// Scale k on the nominal weight ρ·π r²·g (model-notes §6: gravity effect).
+    pub scale: f64,
+    /// Acceleration of gravity, m/s².
+    pub g_m_s2: f64,
+}
+
+impl Default for Gravity {
+    fn default() -> Self {
+        Self { enabled: true, direction_rad: 0.0, scale: 1.0, g_m_s2: STANDARD_GRAVITY_M_S2 }
+    }
+}
+
+/// Direction of the last tension change, which decides the sign of friction.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum LoadDirection {
+    /// Tension rising: friction opposes the cable sliding toward the base.
+    #[default]
+    Load,
+    /// Tension falling: friction acts the other way.
+    Unload,
+}
+
+impl LoadDirection {
+    /// σ in dτ/ds = −σ μ τ |ψ'|: +1 loading, −1 unloading.
+    pub fn sign(self) -> f64 {
+        match self {
+            LoadDirection::Load => 1.0,
+            LoadDirection::Unload => -1.0,
+        }
+    }
+}
+
+/// Physical effects beyond the thesis model, each with one parameter
+/// (model-notes §6). All default to "off" (the thesis model).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Effects {
+    /// Cable–channel friction coefficient μ (capstan law along the channel).
+    pub friction_mu: f64,
+    /// Whether the tension was last rising or falling (sign of friction).
+    pub load_direction: LoadDirection,
+    /// Material stiffening α: bending moment EI·u·(1 + α (r u)²).
+    pub stiffening_alpha: f64,
+    /// Rotational stiffness of the clamp k_θ, N·mm/rad; `None` is a rigid clamp.
+    pub clamp_stiffness_n_mm_per_rad: Option<f64>,
+    /// Channel offset δ: the built channel sits at y_c + δ, mm.
+    pub channel_offset_mm: f64,
+}
+
+impl Default for Effects {
+    fn default() -> Self {
+        Self {
+            friction_mu: 0.0,
+            load_direction: LoadDirection::Load,
+            stiffening_alpha: 0.0,
+            clamp_stiffness_n_mm_per_rad: None,
+            channel_offset_mm: 0.0,
+        }
+    }
+}
+
+/// The actuator: geometry, rigidities, material and effects. Defaults are
+/// the thesis's fitted values (Table 2.1) for Dragon Skin 10 Medium.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Actuator {
+    /// Rod length L, mm.
+    pub length_mm: f64,
+    /// Rod radius r, mm.
+    pub radius_mm: f64,
+    /// Axial rigidity EA, N.
+    pub ea_n: f64,
+    /// Shear rigidity GA, N.
+    pub ga_n: f64,
+    /// Bending rigidity EI, N·mm².
+    pub ei_n_mm2: f64,
+    /// Material density, g/cm³.
+    pub density_g_cm3: f64,
+    /// Self-weight.
+    pub gravity: Gravity,
+    /// Effects beyond the thesis model.
+    pub effects: Effects,
+}
+
+impl Default for Actuator {
+    fn default() -> Self {
+        Self {
+            length_mm: 65.0,
+            radius_mm: 5.0,
+            ea_n: 26.6964,
+            ga_n: 1.70866,
+            ei_n_mm2: 115.117,
+            density_g_cm3: 1.07,
+            gravity: Gravity::default(),
+            effects: Effects::default(),
+        }
+    }
+}
+
+impl Actuator {
+    /// Weight per unit length along the gravity direction, N/mm, including
+    /// the gravity scale; 0 when gravity is off.
+    pub fn weight_n_per_mm(&self) -> f64 {
+        if !self.gravity.enabled {
+            return 0.0;
+        }
+        // ρ [g/cm³] = ρ·1e-6 kg/mm³; area π r² mm²; g m/s² → N/mm.
+        let mass_kg_per_mm = self.density_g_cm3 * 1e-6 * std::f64::consts::PI * self.radius_mm.powi(2);
+        self.gravity.scale * mass_kg_per_mm * self.gravity.g_m_s2
+    }
+
+    /// Checks every parameter; the solver calls this before it starts.
+    pub fn validate(&self) -> Result<(), ParameterError> {
+        let positive = [
+            ("length_mm", self.length_mm),
+            ("radius_mm", self.radius_mm),
+            ("ea_n", self.ea_n),
+            ("ga_n", self.ga_n),
+            ("ei_n_mm2", self.ei_n_mm2),
+        ];
+        for (name, value) in positive {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(ParameterError::NotPositive { name, value });
+            }
+        }
+        let non_negative = [
+            ("density_g_cm3", self.density_g_cm3),
+            ("gravity.g_m_s2", self.gravity.g_m_s2),
+            ("gravity.scale", self.gravity.scale),
+            ("effects.friction_mu", self.effects.friction_mu),
+            ("effects.stiffening_alpha", self.effects.stiffening_alpha),
+        ];
+        for (name, value) in non_negative {
+            if !(value.is_finite() && value >= 0.0) {
+                return Err(ParameterError::OutOfRange { name, value, expected: "a finite number ≥ 0" });
+            }
+        }
+        if !self.gravity.direction_rad.is_finite() {
+            return Err(ParameterError::OutOfRange {
+                name: "gravity.direction_rad",
+                value: self.gravity.direction_rad,
+                expected: "a finite angle in rad",
+            });
+        }
+        if let Some(k) = self.effects.clamp_stiffness_n_mm_per_rad {
+            if !(k.is_finite() && k > 0.0) {
+                return Err(ParameterError::NotPositive { name: "effects.clamp_stiffness_n_mm_per_rad", value: k });
+            }
+        }
+        let delta = self.effects.channel_offset_mm;
+        if !(delta.is_finite() && delta.abs() < self.radius_mm) {
+            return Err(ParameterError::OutOfRange {
+                name: "effects.channel_offset_mm",
+                value: delta,
+                expected: "|δ| below the radius",
+            });
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn default_weight_matches_model_notes() {
+        let w = Actuator::default().weight_n_per_mm();
+        assert!((w - 8.244088901733995e-4).abs() < 1e-15, "{w}");
+        let mut off = Actuator::default();
+        off.gravity.enabled = false;
+        assert_eq!(off.weight_n_per_mm(), 0.0);
+    }
+
+    #[test]
+    fn validation_names_the_parameter() {
+        let mut a = Actuator::default();
+        a.ei_n_mm2 = -1.0;
+        let e = a.validate().unwrap_err().to_string();
+        assert!(e.contains("ei_n_mm2"), "{e}");
+    }
+}

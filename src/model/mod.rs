@@ -1,0 +1,10 @@
+//! The physical model: routing, actuator parameters and effects, and the
+//! static rod–cable solver.
+
+pub mod actuator;
+pub mod routing;
+pub mod solver;
+
+pub use actuator::{Actuator, Effects, Gravity, ParameterError};
+pub use routing::{Routing, RoutingError};
+pub use solver::{simulate, CentrelinePoint, Simulation, Simulator, SolveFailure, SolverOptions, TipPose, STATUS_OK};

@@ -1,0 +1,683 @@
+//! Static solver for the coupled Cosserat rod–cable model (Rucker & Webster
+//! 2011) in the equilibrium-at-a-cut form of model-notes §3b.
+//!
+//! Cutting the rod at s and taking the distal part as a free body gives the
+//! strains at s from the cable tension τ(s), the cable direction in the body
+//! frame, and the loads of distributed external forces beyond the cut. Writing
+//! the cable direction as t_c = (cos α, sin α) leaves one scalar equation per
+//! point (t_c ∥ v + u × r_c + r_c'), solved by Newton. The centreline then
+//! follows by integrating forward from the clamp (classical RK4 on each knot
+//! span of the routing, where the routing is a polynomial).
+//!
+//! Gravity's moment beyond the cut, M_W(s), depends on the distal shape; it
+//! obeys M_W' = w (L − s)(y' cos β − x' sin β) with M_W(L) = 0, so its value at
+//! the clamp is the one unknown of a scalar shooting (secant, warm-started
+//! across a continuation in tension). Without distributed loads there is no
+//! shooting at all.
+//!
+//! Effects (model-notes §6) enter as local terms: the bending law
+//! ([`Simulator::bending_curvature`]), the clamp boundary
+//! ([`Simulator::clamp_angle`]), the routing (channel offset) and the weight.
+//!
+//! The hot path (`integrate`) works in buffers allocated once per
+//! [`Simulator`]; solving allocates nothing.
+
+use super::actuator::{Actuator, ParameterError};
+use super::routing::Routing;
+use crate::shape;
+use serde::{Deserialize, Serialize};
+
+/// Why a solve produced no result. The sweep stores [`SolveFailure::status`].
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SolveFailure {
+    /// The tension is negative or not finite.
+    #[error("tension {0} N is invalid: a cable pulls with a finite tension ≥ 0 N")]
+    InvalidTension(f64),
+    /// The per-point cable-direction equation did not converge.
+    #[error("the cable-direction equation did not converge at s = {s_mm:.3} mm")]
+    CableDirectionNotConverged { s_mm: f64 },
+    /// The cable tangent vanished (v + u × r_c + r_c' = 0 or points backwards).
+    #[error("the cable tangent is degenerate at s = {s_mm:.3} mm")]
+    CableTangentDegenerate { s_mm: f64 },
+    /// Axial stretch fell to zero or below: the rod would collapse.
+    #[error("the rod collapses axially (v1 ≤ 0) at s = {s_mm:.3} mm")]
+    RodCollapsed { s_mm: f64 },
+    /// The shooting on gravity's base moment did not converge.
+    #[error("the shooting on the base moment did not converge after {iterations} passes (residual {residual_n_mm:.3e} N·mm)")]
+    ShootingNotConverged { iterations: u32, residual_n_mm: f64 },
+    /// The clamp-compliance fixed point did not converge.
+    #[error("the clamp rotation did not converge")]
+    ClampNotConverged,
+    /// A non-finite number appeared in the state.
+    #[error("a non-finite value appeared at s = {s_mm:.3} mm")]
+    NonFinite { s_mm: f64 },
+}
+
+impl SolveFailure {
+    /// Short machine-readable status, as stored in sweep rows.
+    pub fn status(&self) -> &'static str {
+        match self {
+            SolveFailure::InvalidTension(_) => "invalid_tension",
+            SolveFailure::CableDirectionNotConverged { .. } => "cable_direction_not_converged",
+            SolveFailure::CableTangentDegenerate { .. } => "cable_tangent_degenerate",
+            SolveFailure::RodCollapsed { .. } => "rod_collapsed",
+            SolveFailure::ShootingNotConverged { .. } => "shooting_not_converged",
+            SolveFailure::ClampNotConverged => "clamp_not_converged",
+            SolveFailure::NonFinite { .. } => "non_finite",
+        }
+    }
+}
+
+/// Status string of a successful solve.
+pub const STATUS_OK: &str = "ok";
+
+/// Numerical settings of the solver.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SolverOptions {
+    /// RK4 steps on each of the routing's two knot spans (even, ≥ 2).
+    pub steps_per_span: usize,
+    /// Last Newton step accepted for the cable angle α, rad (the error left
+    /// is of the order of its square).
+    pub angle_tolerance_rad: f64,
+    /// Convergence of gravity's moment at the tip, N·mm. 1e-8 N·mm leaves a
+    /// curvature error of about 1e-10 /mm (δm/EI): far below the solver's
+    /// discretisation error.
+    pub moment_tolerance_n_mm: f64,
+    /// Most shooting passes before giving up.
+    pub max_shooting_passes: u32,
+}
+
+impl Default for SolverOptions {
+    fn default() -> Self {
+        Self { steps_per_span: 24, angle_tolerance_rad: 1e-7, moment_tolerance_n_mm: 1e-8, max_shooting_passes: 30 }
+    }
+}
+
+/// The scalar results of one solve.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct TipPose {
+    /// Tension the solve was for, N.
+    pub tension_n: f64,
+    /// Tip position along the clamp axis, mm.
+    pub tip_x_mm: f64,
+    /// Tip position across the clamp axis, mm.
+    pub tip_y_mm: f64,
+    /// Tangent angle of the centreline at the tip from the clamp axis, rad
+    /// (continuous from the clamp, not wrapped).
+    pub tip_angle_rad: f64,
+    /// Angle of the tip cross-section's axis (frame angle φ(L)), rad.
+    pub tip_frame_angle_rad: f64,
+    /// Tangent angle of the centreline at the clamp, rad (non-zero with shear).
+    pub base_angle_rad: f64,
+    /// Deformed arc length ℓ of the centreline, mm.
+    pub length_mm: f64,
+    /// Integration passes used (1 without distributed loads).
+    pub iterations: u32,
+}
+
+/// One point of a solved centreline.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct CentrelinePoint {
+    /// Reference arc length s, mm.
+    pub s_mm: f64,
+    /// Position, mm.
+    pub x_mm: f64,
+    /// Position, mm.
+    pub y_mm: f64,
+    /// Frame angle φ, rad.
+    pub frame_angle_rad: f64,
+    /// Centreline tangent angle θ = φ + atan2(v2, v1), rad.
+    pub tangent_angle_rad: f64,
+    /// Deformed arc length from the clamp σ, mm.
+    pub arc_length_mm: f64,
+    /// Axial stretch v1.
+    pub v1: f64,
+    /// Shear v2.
+    pub v2: f64,
+    /// Curvature u, 1/mm.
+    pub u_per_mm: f64,
+    /// Channel offset y_c in the body frame, mm.
+    pub channel_y_mm: f64,
+    /// Cable position in the plane, mm.
+    pub cable_x_mm: f64,
+    /// Cable position in the plane, mm.
+    pub cable_y_mm: f64,
+}
+
+/// Integration state: position, frame angle, gravity's distal moment, arc length.
+#[derive(Debug, Clone, Copy, Default)]
+struct State {
+    x: f64,
+    y: f64,
+    phi: f64,
+    moment: f64,
+    sigma: f64,
+}
+
+impl State {
+    fn axpy(self, h: f64, d: &State) -> State {
+        State {
+            x: self.x + h * d.x,
+            y: self.y + h * d.y,
+            phi: self.phi + h * d.phi,
+            moment: self.moment + h * d.moment,
+            sigma: self.sigma + h * d.sigma,
+        }
+    }
+    fn is_finite(&self) -> bool {
+        self.x.is_finite() && self.y.is_finite() && self.phi.is_finite() && self.moment.is_finite() && self.sigma.is_finite()
+    }
+}
+
+/// Strains at one point.
+#[derive(Debug, Clone, Copy, Default)]
+struct Strains {
+    v1: f64,
+    v2: f64,
+    u: f64,
+}
+
+/// Channel sample (y_c, dy_c/ds) at one stage point.
+#[derive(Debug, Clone, Copy, Default)]
+struct ChannelSample {
+    y: f64,
+    dy: f64,
+}
+
+/// Warm-start memory of a continuation in tension.
+#[derive(Debug, Clone, Copy, Default)]
+struct Continuation {
+    /// Previous converged (tension, base moment) pairs, newest first.
+    history: [(f64, f64); 3],
+    solved: usize,
+    /// Secant slopes dM(L)/dM(0) of the last two solves, newest first.
+    slopes: [f64; 2],
+}
+
+/// A reusable solver for one actuator: set a routing, then solve tensions
+/// (in rising order for the best warm starts). Holds all buffers it needs.
+#[derive(Debug, Clone)]
+pub struct Simulator {
+    actuator: Actuator,
+    options: SolverOptions,
+    weight_n_per_mm: f64,
+    gravity_cos: f64,
+    gravity_sin: f64,
+    routing: Option<Routing>,
+    /// Channel at the 2N+1 stage points of each span, span 0 then span 1.
+    channel: Vec<ChannelSample>,
+    /// Cable direction (cos α, sin α) at each stage point, kept as the Newton start.
+    cable_dir: Vec<(f64, f64)>,
+    /// Step length on each span, mm.
+    step_mm: [f64; 2],
+    /// Span starts, mm.
+    span_start_mm: [f64; 2],
+    /// Per-node results of the last pass (2N+1 nodes per span, the knot shared).
+    nodes_state: Vec<State>,
+    nodes_strain: Vec<Strains>,
+    /// Scratch for shape coefficients.
+    theta: Vec<f64>,
+    speed: Vec<f64>,
+    sigma: Vec<f64>,
+    continuation: Continuation,
+    last: Option<TipPose>,
+}
+
+impl Simulator {
+    /// Creates a solver for `actuator`; fails on invalid parameters.
+    pub fn new(actuator: &Actuator, options: &SolverOptions) -> Result<Self, ParameterError> {
+        actuator.validate()?;
+        if options.steps_per_span < 2 || options.steps_per_span % 2 != 0 {
+            return Err(ParameterError::OutOfRange {
+                name: "steps_per_span",
+                value: options.steps_per_span as f64,
+                expected: "an even number ≥ 2",
+            });
+        }
+        let n = options.steps_per_span;
+        let nodes = 2 * n + 1;
+        let beta = actuator.gravity.direction_rad;
+        Ok(Self {
+            actuator: actuator.clone(),
+            options: options.clone(),
+            weight_n_per_mm: actuator.weight_n_per_mm(),
+            gravity_cos: beta.cos(),
+            gravity_sin: beta.sin(),
+            routing: None,
+            channel: vec![ChannelSample::default(); 2 * (2 * n + 1)],
+            cable_dir: vec![(1.0, 0.0); 2 * (2 * n + 1)],
+            step_mm: [0.0; 2],
+            span_start_mm: [0.0; 2],
+            nodes_state: vec![State::default(); nodes],
+            nodes_strain: vec![Strains::default(); nodes],
+            theta: vec![0.0; nodes],
+            speed: vec![0.0; nodes],
+            sigma: vec![0.0; nodes],
+            continuation: Continuation::default(),
+            last: None,
+        })
+    }
+
+    /// The actuator this solver was built for.
+    pub fn actuator(&self) -> &Actuator {
+        &self.actuator
+    }
+
+    /// Validates `y_mm` against the actuator and sets it as the routing.
+    pub fn set_routing_mm(&mut self, y_mm: &[f64]) -> Result<(), super::routing::RoutingError> {
+        let routing = Routing::new(y_mm, self.actuator.length_mm, self.actuator.radius_mm)?;
+        self.set_routing(&routing);
+        Ok(())
+    }
+
+    /// Sets the routing (precomputing the channel at every stage point) and
+    /// forgets the warm start.
+    pub fn set_routing(&mut self, routing: &Routing) {
+        let delta = self.actuator.effects.channel_offset_mm;
+        let built = if delta != 0.0 { routing.shifted(delta) } else { routing.clone() };
+        let n = self.options.steps_per_span;
+        let knot = built.knot_mm();
+        let length = self.actuator.length_mm;
+        self.span_start_mm = [0.0, knot];
+        self.step_mm = [knot / n as f64, (length - knot) / n as f64];
+        for span in 0..2 {
+            for j in 0..=2 * n {
+                let s = self.span_start_mm[span] + 0.5 * j as f64 * self.step_mm[span];
+                let c = built.channel_at(s);
+                self.channel[span * (2 * n + 1) + j] = ChannelSample { y: c.y_mm, dy: c.dy_ds };
+            }
+        }
+        self.cable_dir.iter_mut().for_each(|d| *d = (1.0, 0.0));
+        self.routing = Some(built);
+        self.continuation = Continuation::default();
+        self.last = None;
+    }
+
+    /// Forgets the warm start (the next solve starts cold).
+    pub fn reset_warm_start(&mut self) {
+        self.continuation = Continuation::default();
+        self.cable_dir.iter_mut().for_each(|d| *d = (1.0, 0.0));
+    }
+
+    /// Curvature u from the bending moment `m` (N·mm) and du/dm. Linear
+    /// (m = EI u) unless material stiffening makes it m = EI u (1 + α (r u)²).
+    #[inline]
+    fn bending_curvature(&self, m: f64) -> (f64, f64) {
+        let ei = self.actuator.ei_n_mm2;
+        let alpha = self.actuator.effects.stiffening_alpha;
+        if alpha == 0.0 {
+            return (m / ei, 1.0 / ei);
+        }
+        // Monotone cubic EI (u + c u³) = m, c = α r²: Newton from the linear guess.
+        let c = alpha * self.actuator.radius_mm.powi(2);
+        let mut u = m / ei;
+        for _ in 0..60 {
+            let f = ei * (u + c * u * u * u) - m;
+            let df = ei * (1.0 + 3.0 * c * u * u);
+            let du = f / df;
+            u -= du;
+            if du.abs() <= 1e-15 * (1.0 + u.abs()) {
+                break;
+            }
+        }
+        (u, 1.0 / (ei * (1.0 + 3.0 * c * u * u)))
+    }
+
+    /// Solves the cut equations at one point for the cable angle α and the
+    /// strains, starting Newton from the direction `dir0` = (cos α, sin α);
+    /// `(sp, cp)` = sin, cos of φ. Returns the strains and (cos α, sin α).
+    ///
+    /// Newton converges quadratically, so once a step is below
+    /// `angle_tolerance_rad` the remaining error is of the order of its
+    /// square: the strains are then corrected to first order in that step
+    /// instead of being re-evaluated (one sin/cos per iteration).
+    #[inline]
+    #[allow(clippy::too_many_arguments)]
+    fn strains_at(
+        &self,
+        s: f64,
+        ch: ChannelSample,
+        (sp, cp): (f64, f64),
+        moment: f64,
+        tension: f64,
+        dir0: (f64, f64),
+    ) -> Result<(Strains, (f64, f64)), SolveFailure> {
+        let a = &self.actuator;
+        let (ea, ga) = (a.ea_n, a.ga_n);
+        // Weight beyond the cut, in the body frame: Rᵀ W.
+        let wl = self.weight_n_per_mm * (a.length_mm - s);
+        let w1 = wl * (cp * self.gravity_cos + sp * self.gravity_sin);
+        let w2 = wl * (cp * self.gravity_sin - sp * self.gravity_cos);
+        let (mut ca, mut sa) = dir0;
+        for _ in 0..50 {
+            let v1 = 1.0 + (w1 - tension * ca) / ea;
+            let v2 = (w2 - tension * sa) / ga;
+            let (u, du_dm) = self.bending_curvature(tension * ch.y * ca + moment);
+            let p = v1 - u * ch.y;
+            let q = v2 + ch.dy;
+            let g = p * sa - q * ca;
+            // Derivatives of v1, v2, u with respect to α.
+            let dv1 = tension * sa / ea;
+            let dv2 = -tension * ca / ga;
+            let du = -tension * ch.y * sa * du_dm;
+            let dg = (dv1 - du * ch.y) * sa + p * ca - dv2 * ca + q * sa;
+            let step = g / dg;
+            if !step.is_finite() {
+                return Err(SolveFailure::CableTangentDegenerate { s_mm: s });
+            }
+            let (ca_next, sa_next) = rotate((ca, sa), -step);
+            if step.abs() <= self.options.angle_tolerance_rad {
+                let e = Strains { v1: v1 - dv1 * step, v2: v2 - dv2 * step, u: u - du * step };
+                // α and α + π both solve g = 0; the cable runs along +t_c.
+                let along = p * ca + q * sa;
+                if along <= 1e-12 {
+                    return Err(SolveFailure::CableTangentDegenerate { s_mm: s });
+                }
+                if e.v1 <= 0.0 {
+                    return Err(SolveFailure::RodCollapsed { s_mm: s });
+                }
+                return Ok((e, (ca_next, sa_next)));
+            }
+            (ca, sa) = (ca_next, sa_next);
+        }
+        Err(SolveFailure::CableDirectionNotConverged { s_mm: s })
+    }
+
+    /// Right-hand side of the forward ODE at stage point `k` (index into the
+    /// channel samples).
+    #[inline]
+    /// `(cp, sp)` are cos φ, sin φ of the state.
+    fn derivative(
+        &mut self,
+        s: f64,
+        k: usize,
+        st: &State,
+        (cp, sp): (f64, f64),
+        tension: f64,
+    ) -> Result<(State, Strains), SolveFailure> {
+        let (e, dir) = self.strains_at(s, self.channel[k], (sp, cp), st.moment, tension, self.cable_dir[k])?;
+        self.cable_dir[k] = dir;
+        let dx = e.v1 * cp - e.v2 * sp;
+        let dy = e.v1 * sp + e.v2 * cp;
+        let wl = self.weight_n_per_mm * (self.actuator.length_mm - s);
+        let d = State {
+            x: dx,
+            y: dy,
+            phi: e.u,
+            moment: wl * (dy * self.gravity_cos - dx * self.gravity_sin),
+            sigma: (e.v1 * e.v1 + e.v2 * e.v2).sqrt(),
+        };
+        Ok((d, e))
+    }
+
+    /// Frame angle at the clamp: 0 for a rigid clamp; with clamp compliance
+    /// φ(0) = m(0)/k_θ with m(0) the bending moment there (fixed point, as
+    /// m(0) depends on φ(0) only through the weight's direction).
+    fn clamp_angle(&mut self, moment0: f64, tension: f64) -> Result<f64, SolveFailure> {
+        let Some(k_theta) = self.actuator.effects.clamp_stiffness_n_mm_per_rad else {
+            return Ok(0.0);
+        };
+        let ch = self.channel[0];
+        let mut phi: f64 = 0.0;
+        for _ in 0..100 {
+            let (_, (ca, _)) = self.strains_at(0.0, ch, phi.sin_cos(), moment0, tension, self.cable_dir[0])?;
+            let m = tension * ch.y * ca + moment0;
+            let next = m / k_theta;
+            if (next - phi).abs() < 1e-14 {
+                return Ok(next);
+            }
+            phi = next;
+        }
+        Err(SolveFailure::ClampNotConverged)
+    }
+
+    /// One forward pass from the clamp with base moment `moment0`; records
+    /// the nodes and returns gravity's moment left at the tip (0 at the solution).
+    fn integrate(&mut self, tension: f64, moment0: f64) -> Result<f64, SolveFailure> {
+        let n = self.options.steps_per_span;
+        let mut st = State { phi: self.clamp_angle(moment0, tension)?, moment: moment0, ..State::default() };
+        for span in 0..2 {
+            let h = self.step_mm[span];
+            let base = span * (2 * n + 1);
+            for step in 0..n {
+                let s = self.span_start_mm[span] + step as f64 * h;
+                let k = base + 2 * step;
+                // One sin/cos per step; the stages rotate it by small angles.
+                let (sp, cp) = st.phi.sin_cos();
+                let (d1, e1) = self.derivative(s, k, &st, (cp, sp), tension)?;
+                let node = span * n + step;
+                self.nodes_state[node] = st;
+                self.nodes_strain[node] = e1;
+                let s2 = st.axpy(0.5 * h, &d1);
+                let (d2, _) = self.derivative(s + 0.5 * h, k + 1, &s2, rotate((cp, sp), 0.5 * h * d1.phi), tension)?;
+                let s3 = st.axpy(0.5 * h, &d2);
+                let (d3, _) = self.derivative(s + 0.5 * h, k + 1, &s3, rotate((cp, sp), 0.5 * h * d2.phi), tension)?;
+                let s4 = st.axpy(h, &d3);
+                let (d4, _) = self.derivative(s + h, k + 2, &s4, rotate((cp, sp), h * d3.phi), tension)?;
+                st = State {
+                    x: st.x + h / 6.0 * (d1.x + 2.0 * d2.x + 2.0 * d3.x + d4.x),
+                    y: st.y + h / 6.0 * (d1.y + 2.0 * d2.y + 2.0 * d3.y + d4.y),
+                    phi: st.phi + h / 6.0 * (d1.phi + 2.0 * d2.phi + 2.0 * d3.phi + d4.phi),
+                    moment: st.moment + h / 6.0 * (d1.moment + 2.0 * d2.moment + 2.0 * d3.moment + d4.moment),
+                    sigma: st.sigma + h / 6.0 * (d1.sigma + 2.0 * d2.sigma + 2.0 * d3.sigma + d4.sigma),
+                };
+                if !st.is_finite() {
+                    return Err(SolveFailure::NonFinite { s_mm: s + h });
+                }
+            }
+        }
+        // Tip node.
+        let k_tip = 2 * (2 * n + 1) - 1;
+        let (sp, cp) = st.phi.sin_cos();
+        let (_, e) = self.derivative(self.actuator.length_mm, k_tip, &st, (cp, sp), tension)?;
+        let tip = 2 * n;
+        self.nodes_state[tip] = st;
+        self.nodes_strain[tip] = e;
+        Ok(st.moment)
+    }
+
+    /// Solves the statics for `tension_n` (N) on the current routing,
+    /// warm-started from the previous solves of this routing.
+    ///
+    /// # Panics
+    /// If no routing was set.
+    pub fn solve(&mut self, tension_n: f64) -> Result<TipPose, SolveFailure> {
+        assert!(self.routing.is_some(), "Simulator::solve called before set_routing");
+        if !(tension_n.is_finite() && tension_n >= 0.0) {
+            return Err(SolveFailure::InvalidTension(tension_n));
+        }
+        let result = self.solve_inner(tension_n);
+        match &result {
+            Ok(pose) => self.last = Some(*pose),
+            Err(_) => {
+                self.last = None;
+                self.reset_warm_start();
+            }
+        }
+        result
+    }
+
+    fn solve_inner(&mut self, tension: f64) -> Result<TipPose, SolveFailure> {
+        let has_moment = self.weight_n_per_mm != 0.0;
+        let mut passes = 1u32;
+        if has_moment {
+            let c = self.continuation;
+            // Predict the base moment from the last solves: the Lagrange
+            // polynomial through up to three previous (tension, moment) pairs.
+            let known = &c.history[..c.solved.min(3)];
+            let mut m0 = 0.0;
+            for (i, &(ti, mi)) in known.iter().enumerate() {
+                let mut weight = 1.0;
+                for (j, &(tj, _)) in known.iter().enumerate() {
+                    if i != j {
+                        weight *= (tension - tj) / (ti - tj);
+                    }
+                }
+                m0 += weight * mi;
+            }
+            if !m0.is_finite() {
+                // Repeated tensions: fall back to the newest solution.
+                m0 = known.first().map_or(0.0, |h| h.1);
+            }
+            // dM(L)/dM(0) is near 1 (the weight's moment hardly depends on
+            // it) and drifts slowly with tension: extrapolate it linearly.
+            let mut slope = match c.solved {
+                0 => 1.0,
+                1 => c.slopes[0],
+                _ => {
+                    let (t1, t2) = (c.history[0].0, c.history[1].0);
+                    c.slopes[0] + (c.slopes[0] - c.slopes[1]) / (t1 - t2) * (tension - t1)
+                }
+            };
+            if !(slope.is_finite() && slope.abs() > 1e-3) {
+                slope = 1.0;
+            }
+            let mut f0 = self.integrate(tension, m0)?;
+            let mut prev: Option<(f64, f64)> = None;
+            while f0.abs() > self.options.moment_tolerance_n_mm {
+                if passes >= self.options.max_shooting_passes {
+                    return Err(SolveFailure::ShootingNotConverged { iterations: passes, residual_n_mm: f0 });
+                }
+                if let Some((mp, fp)) = prev {
+                    let secant = (f0 - fp) / (m0 - mp);
+                    if secant.is_finite() && secant != 0.0 {
+                        slope = secant;
+                    }
+                }
+                prev = Some((m0, f0));
+                m0 -= f0 / slope;
+                f0 = self.integrate(tension, m0)?;
+                passes += 1;
+            }
+            let cont = &mut self.continuation;
+            cont.history.rotate_right(1);
+            cont.history[0] = (tension, m0);
+            cont.solved += 1;
+            cont.slopes = [slope, cont.slopes[0]];
+        } else {
+            self.integrate(tension, 0.0)?;
+        }
+        let n_nodes = self.nodes_state.len();
+        let base = self.nodes_state[0];
+        let tip = self.nodes_state[n_nodes - 1];
+        let (e0, et) = (self.nodes_strain[0], self.nodes_strain[n_nodes - 1]);
+        Ok(TipPose {
+            tension_n: tension,
+            tip_x_mm: tip.x,
+            tip_y_mm: tip.y,
+            tip_angle_rad: tip.phi + et.v2.atan2(et.v1),
+            tip_frame_angle_rad: tip.phi,
+            base_angle_rad: base.phi + e0.v2.atan2(e0.v1),
+            length_mm: tip.sigma,
+            iterations: passes,
+        })
+    }
+
+    /// Legendre curvature coefficients a_0 … a_{n−1} (n = `out.len()`) of the
+    /// last successful solve, by the exact definition (model-notes §4),
+    /// computed from the solver's nodes without allocating.
+    ///
+    /// # Panics
+    /// If the last solve failed or none was made.
+    pub fn coefficients_into(&mut self, out: &mut [f64]) {
+        assert!(self.last.is_some(), "coefficients_into needs a successful solve");
+        for (i, (st, e)) in self.nodes_state.iter().zip(&self.nodes_strain).enumerate() {
+            self.theta[i] = st.phi + e.v2.atan2(e.v1);
+            self.speed[i] = e.v1.hypot(e.v2);
+            self.sigma[i] = st.sigma;
+        }
+        // Nodes are evenly spaced in s: the knot is at L/2 for the clamped
+        // spline with evenly spaced control points.
+        let h = self.step_mm[0];
+        debug_assert!((self.step_mm[0] - self.step_mm[1]).abs() < 1e-12);
+        shape::legendre_from_tangent(&self.theta, &self.sigma, &self.speed, h, out);
+    }
+
+    /// The centreline of the last successful solve, clamp to tip.
+    pub fn centreline(&self) -> Vec<CentrelinePoint> {
+        assert!(self.last.is_some(), "centreline needs a successful solve");
+        let n = self.options.steps_per_span;
+        (0..self.nodes_state.len())
+            .map(|i| {
+                let (span, j) = if i < n { (0, i) } else { (1, i - n) };
+                let s = self.span_start_mm[span] + j as f64 * self.step_mm[span];
+                let k = span * (2 * n + 1) + 2 * j;
+                let st = self.nodes_state[i];
+                let e = self.nodes_strain[i];
+                let yc = self.channel[k].y;
+                let (sp, cp) = st.phi.sin_cos();
+                CentrelinePoint {
+                    s_mm: s,
+                    x_mm: st.x,
+                    y_mm: st.y,
+                    frame_angle_rad: st.phi,
+                    tangent_angle_rad: st.phi + e.v2.atan2(e.v1),
+                    arc_length_mm: st.sigma,
+                    v1: e.v1,
+                    v2: e.v2,
+                    u_per_mm: e.u,
+                    channel_y_mm: yc,
+                    cable_x_mm: st.x - sp * yc,
+                    cable_y_mm: st.y + cp * yc,
+                }
+            })
+            .collect()
+    }
+}
+
+/// Rotates the unit vector (cos a, sin a) by `delta` rad. Small angles (the
+/// usual case: Newton corrections, RK4 stage offsets) use a Taylor series
+/// accurate to rounding, which is several times cheaper than sin/cos.
+#[inline]
+fn rotate((c, s): (f64, f64), delta: f64) -> (f64, f64) {
+    let (sd, cd) = if delta.abs() < 0.125 {
+        let d2 = delta * delta;
+        // Errors below δ¹⁰/10! and δ¹¹/11!: < 1e-16 for |δ| < 1/8.
+        let cd = 1.0 - d2 / 2.0 * (1.0 - d2 / 12.0 * (1.0 - d2 / 30.0 * (1.0 - d2 / 56.0 * (1.0 - d2 / 90.0))));
+        let sd = delta * (1.0 - d2 / 6.0 * (1.0 - d2 / 20.0 * (1.0 - d2 / 42.0 * (1.0 - d2 / 72.0 * (1.0 - d2 / 110.0)))));
+        (sd, cd)
+    } else {
+        delta.sin_cos()
+    };
+    (c * cd - s * sd, s * cd + c * sd)
+}
+
+/// Everything about one solved actuator: the pose, the coefficients and the
+/// centreline. Convenience for single solves (allocates).
+#[derive(Debug, Clone, Serialize)]
+pub struct Simulation {
+    /// Routing control points, mm.
+    pub routing_mm: [f64; 5],
+    /// Tip pose and length.
+    pub pose: TipPose,
+    /// a_0 … a_n, 1/mm^(i+1).
+    pub a: Vec<f64>,
+    /// Centreline from clamp to tip.
+    pub centreline: Vec<CentrelinePoint>,
+}
+
+/// Solves one actuator at `tension_n`, stepping up from a low tension by
+/// continuation so that large deformations start from a nearby solution.
+pub fn simulate(
+    actuator: &Actuator,
+    options: &SolverOptions,
+    routing: &Routing,
+    tension_n: f64,
+    order: usize,
+) -> Result<Simulation, crate::Error> {
+    let mut sim = Simulator::new(actuator, options)?;
+    sim.set_routing(routing);
+    // A ladder of tensions: cheap, and it keeps Newton and the shooting in
+    // their basin for curled-up shapes.
+    let rungs = if tension_n.is_finite() { ((tension_n / 0.25).ceil() as usize).max(1) } else { 1 };
+    let mut pose = None;
+    for k in 1..=rungs {
+        let t = tension_n * k as f64 / rungs as f64;
+        pose = Some(sim.solve(t)?);
+    }
+    let pose = pose.expect("at least one rung");
+    let mut a = vec![0.0; order + 1];
+    sim.coefficients_into(&mut a);
+    Ok(Simulation { routing_mm: routing.control_points_mm(), pose, a, centreline: sim.centreline() })
+}

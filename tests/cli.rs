@@ -1,0 +1,81 @@
+//! The `cablemap` binary as a user runs it.
+
+use std::process::Command;
+
+fn cablemap() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_cablemap"))
+}
+
+fn run(args: &[&str]) -> (bool, String, String) {
+    let out = cablemap().args(args).output().expect("runs");
+    (out.status.success(), String::from_utf8_lossy(&out.stdout).into(), String::from_utf8_lossy(&out.stderr).into())
+}
+
+#[test]
+fn simulate_json_has_the_documented_fields() {
+    let (ok, stdout, stderr) = run(&["simulate", "--routing", "1,-2,4,4,-4", "--tension", "0.77", "--json", "--order", "4"]);
+    assert!(ok, "{stderr}");
+    let v: serde_json::Value = serde_json::from_str(stdout.trim()).unwrap();
+    assert_eq!(v["status"], "ok");
+    for key in ["tip_x_mm", "tip_y_mm", "tip_angle_rad", "base_angle_rad", "length_mm"] {
+        assert!(v[key].is_f64(), "{key} missing in {v}");
+    }
+    assert_eq!(v["a"].as_array().unwrap().len(), 5);
+    // Reference case (gravity.json, first case).
+    assert!((v["tip_x_mm"].as_f64().unwrap() - 60.5535722675456).abs() < 1e-3);
+}
+
+#[test]
+fn simulate_no_gravity_changes_the_result() {
+    let (_, with, _) = run(&["simulate", "--routing", "1,-2,4,4,-4", "--tension", "0.77", "--json"]);
+    let (_, without, _) = run(&["simulate", "--routing", "1,-2,4,4,-4", "--tension", "0.77", "--json", "--no-gravity"]);
+    let a: serde_json::Value = serde_json::from_str(with.trim()).unwrap();
+    let b: serde_json::Value = serde_json::from_str(without.trim()).unwrap();
+    assert!((a["tip_x_mm"].as_f64().unwrap() - b["tip_x_mm"].as_f64().unwrap()).abs() > 1e-3);
+}
+
+#[test]
+fn simulate_writes_csv_and_png() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("c.csv");
+    let png = dir.path().join("c.png");
+    let (ok, stdout, stderr) = run(&[
+        "simulate", "--routing", "0,4,1,2,-2", "--tension", "1.7", "--csv", csv.to_str().unwrap(), "--png", png.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stderr}");
+    assert!(stdout.contains("tip"));
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let mut lines = text.lines();
+    assert!(lines.next().unwrap().starts_with("s_mm,x_mm,y_mm"));
+    assert_eq!(lines.count(), 49, "one row per solver node");
+    let bytes = std::fs::read(&png).unwrap();
+    assert_eq!(&bytes[1..4], b"PNG");
+    assert!(bytes.len() > 10_000, "picture has content");
+}
+
+#[test]
+fn bad_input_gets_a_clear_message_and_a_failure_exit() {
+    let cases: &[(&[&str], &str)] = &[
+        (&["simulate", "--routing", "1,2,3", "--tension", "1"], "exactly 5 control points"),
+        (&["simulate", "--routing", "1,2,3,4,5", "--tension", "1"], "outside the body"),
+        (&["simulate", "--routing", "1,2,x,4,1", "--tension", "1"], "'x' is not a number"),
+        (&["simulate", "--routing", "1,2,3,4,1", "--tension", "-1"], "tension -1 N is invalid"),
+        (&["simulate", "--routing", "1,2,3,4,1", "--tension", "1", "--ei-n-mm2", "0"], "ei_n_mm2"),
+        (&["simulate", "--routing", "1,2,3,4,1", "--tension", "1", "--steps-per-span", "3"], "steps_per_span"),
+        (&["simulate", "--routing", "1,2,3,4,1"], "--tension"),
+    ];
+    for (args, needle) in cases {
+        let (ok, _, stderr) = run(args);
+        assert!(!ok, "{args:?} should fail");
+        assert!(stderr.contains(needle), "{args:?}: stderr {stderr:?} lacks {needle:?}");
+    }
+}
+
+#[test]
+fn bench_prints_figures() {
+    let (ok, stdout, stderr) = run(&["bench", "--routings", "5", "--json"]);
+    assert!(ok, "{stderr}");
+    let v: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    assert_eq!(v.as_array().unwrap().len(), 2);
+    assert!(v[0]["median_us_per_solve"].as_f64().unwrap() > 0.0);
+}
