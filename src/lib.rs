@@ -6,6 +6,7 @@
 
 pub mod bench;
 pub mod cli;
+pub mod design;
 pub mod io;
 pub mod model;
 pub mod plot;
@@ -29,6 +30,9 @@ pub enum Error {
     /// Drawing a picture.
     #[error(transparent)]
     Plot(#[from] plot::PlotError),
+    /// Feasibility check or design.
+    #[error(transparent)]
+    Design(#[from] design::DesignError),
     /// Reading or writing a file.
     #[error("{context}: {source}")]
     Io { context: String, source: std::io::Error },

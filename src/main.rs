@@ -16,6 +16,8 @@ struct Cli {
 enum Command {
     /// Simulate one actuator at one tension: tip pose, shape coefficients, centreline.
     Simulate(cli::simulate::SimulateArgs),
+    /// Design the cable routing and tension for a target shape (thesis eq. 3.17).
+    Design(cli::design::DesignArgs),
     /// Print solver timings (median µs per solve, single thread).
     Bench(cli::bench::BenchArgs),
 }
@@ -25,6 +27,7 @@ fn main() -> ExitCode {
     let result = match &cli.command {
         Command::Simulate(args) => cli::simulate::run(args),
         Command::Bench(args) => cli::bench::run(args),
+        Command::Design(args) => cli::design::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

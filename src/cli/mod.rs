@@ -2,6 +2,7 @@
 //! run each command. `main.rs` only parses and dispatches.
 
 pub mod bench;
+pub mod design;
 pub mod simulate;
 
 use crate::model::{Actuator, SolverOptions};
