@@ -2,7 +2,7 @@
 //! drawing of the body with its channel (for making a mould), and a PNG of
 //! the achieved shape over the target.
 
-use super::objective::{Evaluation, Objective};
+use super::objective::{Evaluation, LengthBasis, Objective};
 use super::target::Component;
 use super::DesignError;
 use crate::model::{simulate, Routing};
@@ -152,8 +152,13 @@ pub fn shape_png(path: &Path, objective: &Objective, eval: &Evaluation) -> Resul
         vec![crate::cli::simulate::body_drawing(&sim, act.radius_mm, "achieved body (outline at ±r), cable in red".into(), BLUE_800)];
     let target = &objective.target;
     if target.highest_order().is_some() {
-        let a: Vec<f64> = (0..eval.a.len()).map(|k| target.get(Component::A(k)).unwrap_or(eval.a[k])).collect();
         let pose = &eval.pose;
+        // Drawing needs the coefficients over the drawn (deformed) length ℓ.
+        let to_deformed = match objective.length_basis {
+            LengthBasis::Deformed => 1.0,
+            LengthBasis::Rest => act.length_mm / pose.length_mm,
+        };
+        let a: Vec<f64> = (0..eval.a.len()).map(|k| to_deformed * target.get(Component::A(k)).unwrap_or(eval.a[k])).collect();
         let pts = centreline_from_coefficients(&a, pose.length_mm, pose.base_angle_rad, 121);
         let angles: Vec<f64> = pts.windows(2).map(|w| (w[1][1] - w[0][1]).atan2(w[1][0] - w[0][0])).collect();
         let mut frame = angles.clone();
