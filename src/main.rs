@@ -18,6 +18,8 @@ enum Command {
     Simulate(cli::simulate::SimulateArgs),
     /// Design the cable routing and tension for a target shape (thesis eq. 3.17).
     Design(cli::design::DesignArgs),
+    /// Is a target shape reachable? Verdict from a feasibility map, with the nearest designs.
+    Feasible(cli::feasible::FeasibleArgs),
     /// Print solver timings (median µs per solve, single thread).
     Bench(cli::bench::BenchArgs),
 }
@@ -28,6 +30,7 @@ fn main() -> ExitCode {
         Command::Simulate(args) => cli::simulate::run(args),
         Command::Bench(args) => cli::bench::run(args),
         Command::Design(args) => cli::design::run(args),
+        Command::Feasible(args) => cli::feasible::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

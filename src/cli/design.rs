@@ -119,14 +119,21 @@ pub fn run(args: &DesignArgs) -> anyhow::Result<()> {
     if let Some(m) = &map {
         m.check_actuator(&objective.actuator)?;
     }
-    let seeds = match &map {
-        Some(m) => m.nearest_designs(&objective.target, &objective.weights, 2 * args.starts)?.into_iter().map(|d| d.seed()).collect(),
-        None => Vec::new(),
+    // With a map: its verdict first (reported, not enforced: the optimiser
+    // still returns the closest design), and its nearest designs as seeds.
+    let feasibility = match &map {
+        Some(m) => Some(design::feasible::check(m, &objective.target, &objective.weights, 2 * args.starts)?),
+        None => None,
     };
+    let seeds: Vec<design::Seed> =
+        feasibility.iter().flat_map(|f| f.nearest.iter().map(|d| d.seed())).collect();
     let search = SearchOptions { starts: args.starts, ..SearchOptions::default() };
     let outcome = optimise::design(&objective, &search, &seeds)?;
     let results = compare(&objective, &outcome.best, args.tolerance_pct);
-    let value = design_json(&objective, &outcome, &results);
+    let mut value = design_json(&objective, &outcome, &results);
+    if let Some(f) = &feasibility {
+        value["feasibility"] = serde_json::json!({ "verdict": f.verdict, "reasons": f.reasons, "map": args.map });
+    }
     if let Some(dir) = &args.out {
         design::export::write_all(dir, &objective, &outcome.best, &value)?;
     }
@@ -135,6 +142,9 @@ pub fn run(args: &DesignArgs) -> anyhow::Result<()> {
     if args.json {
         writeln!(out, "{value}")?;
         return Ok(());
+    }
+    if let Some(f) = &feasibility {
+        writeln!(out, "map verdict  {}: {}\n", f.verdict.as_str(), f.reasons.join("; "))?;
     }
     write!(out, "{}", report(&objective, &outcome, &results, args.tolerance_pct))?;
     if let Some(dir) = &args.out {

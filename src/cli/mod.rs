@@ -3,6 +3,7 @@
 
 pub mod bench;
 pub mod design;
+pub mod feasible;
 pub mod simulate;
 
 use crate::model::{Actuator, SolverOptions};
