@@ -223,6 +223,16 @@ mod tests {
     }
 
     #[test]
+    fn rest_basis_scales_by_deformed_over_rest_length() {
+        let mut a = [0.02, -0.01, 0.005];
+        LengthBasis::Deformed.convert(&mut a, 60.0, 65.0);
+        assert_eq!(a, [0.02, -0.01, 0.005]);
+        LengthBasis::Rest.convert(&mut a, 60.0, 65.0);
+        let s = 60.0 / 65.0;
+        assert_eq!(a, [0.02 * s, -0.01 * s, 0.005 * s]);
+    }
+
+    #[test]
     fn bounds_are_checked() {
         assert!(Bounds::thesis(5.0, 1.0, 2.0).validate(5.0).is_ok());
         assert!(Bounds { max_offset_mm: 5.0, tension_min_n: 1.0, tension_max_n: 2.0 }.validate(5.0).is_err());

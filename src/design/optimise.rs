@@ -451,3 +451,70 @@ pub fn compare(objective: &Objective, eval: &Evaluation, tolerance_pct: f64) -> 
         })
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::design::{Bounds, Target, Weights};
+    use crate::model::{Actuator, SolverOptions};
+
+    fn objective() -> Objective {
+        let act = Actuator::default();
+        let bounds = Bounds::thesis(act.radius_mm, 1.0, 2.0);
+        Objective::new(act, SolverOptions::default(), Target::parse("x=50,y=5").unwrap(), Weights::default(), bounds).unwrap()
+    }
+
+    #[test]
+    fn the_bounds_transformation_round_trips_and_stays_inside() {
+        let obj = objective();
+        let p = Problem {
+            objective: &obj,
+            sim: RefCell::new(obj.simulator()),
+            z: DVector::zeros(6),
+            current: RefCell::new(None),
+            best: RefCell::new(None),
+            evaluations: Cell::new(0),
+            max_evaluations: 10,
+        };
+        let y = [4.99, -4.99, 0.0, 1.234, -3.0];
+        let (y2, t2) = p.design_of(&p.z_of(&y, 1.7));
+        for (a, b) in y.iter().zip(&y2) {
+            assert!((a - b).abs() < 1e-12);
+        }
+        assert!((t2 - 1.7).abs() < 1e-12);
+        for z in [-100.0, -1.6, 0.3, 1.5708, 7.0] {
+            let (y, t) = p.design_of(&DVector::from_element(6, z));
+            assert!(y.iter().all(|v| v.abs() <= obj.bounds.max_offset_mm) && (1.0..=2.0).contains(&t));
+        }
+    }
+
+    #[test]
+    fn diverse_skips_grid_neighbours_but_not_distinct_designs() {
+        let seed = |y: [f64; 5], t: f64| (0.0, Seed { routing_mm: y, tension_n: t, source: SeedSource::Grid });
+        let ranked = [
+            seed([0.0, 0.0, 0.0, 0.0, 0.0], 1.0),
+            seed([0.0, 0.0, 0.0, 0.0, 0.0], 2.0),
+            seed([2.0, 0.0, 0.0, 0.0, 0.0], 1.0),
+            seed([2.0, 2.0, 0.0, 0.0, 0.0], 1.0),
+            seed([-4.0, 0.0, 0.0, 0.0, 4.0], 1.5),
+        ];
+        let picked = diverse(&ranked, 10, 2.0);
+        assert_eq!(picked.len(), 3, "{picked:?}");
+        assert_eq!(picked[1].routing_mm, [2.0, 2.0, 0.0, 0.0, 0.0]);
+        assert_eq!(picked[2].routing_mm, [-4.0, 0.0, 0.0, 0.0, 4.0]);
+        assert_eq!(diverse(&ranked, 1, 2.0).len(), 1);
+    }
+
+    #[test]
+    fn mirrored_negates_lateral_quantities() {
+        let obj = objective();
+        let mut sim = obj.simulator();
+        let e = obj.evaluate(&mut sim, &[1.0, -2.0, 3.0, 0.5, -1.5], 1.4).unwrap();
+        let m = obj.evaluate(&mut sim, &[-1.0, 2.0, -3.0, -0.5, 1.5], 1.4).unwrap();
+        let mm = mirrored(&e);
+        assert!((mm.pose.tip_y_mm - m.pose.tip_y_mm).abs() < 1e-9 && (mm.pose.tip_x_mm - m.pose.tip_x_mm).abs() < 1e-9);
+        for (a, b) in mm.a.iter().zip(&m.a) {
+            assert!((a - b).abs() < 1e-9);
+        }
+    }
+}

@@ -88,19 +88,14 @@ impl Target {
     /// Parses `x=50,y=5,a0=-0.025,a1=-0.06,a2=0.015` (any subset, any order).
     pub fn parse(text: &str) -> Result<Self, DesignError> {
         let mut components = Vec::new();
-        for item in text.split(',').map(str::trim).filter(|s| !s.is_empty()) {
-            let (key, value) = item.split_once('=').ok_or_else(|| DesignError::BadTarget(format!(
-                "'{item}' is not KEY=VALUE; write e.g. --target x=50,y=5,a0=-0.025,a1=-0.06,a2=0.015"
-            )))?;
-            let component = Component::parse(key).ok_or_else(|| DesignError::BadTarget(format!(
-                "unknown component '{}'; use x, y (tip, mm) or a0 … a{MAX_ORDER} (curvature coefficients, 1/mm)",
-                key.trim()
-            )))?;
-            let value: f64 = value.trim().parse().ok().filter(|v: &f64| v.is_finite()).ok_or_else(|| {
-                DesignError::BadTarget(format!("{}: '{}' is not a finite number", key.trim(), value.trim()))
-            })?;
+        for (key, component, value) in parse_pairs(text, "e.g. --target x=50,y=5,a0=-0.025,a1=-0.06,a2=0.015")
+            .map_err(DesignError::BadTarget)?
+        {
+            if !value.is_finite() {
+                return Err(DesignError::BadTarget(format!("{key}: '{value}' is not a finite number")));
+            }
             if components.iter().any(|(c, _)| *c == component) {
-                return Err(DesignError::BadTarget(format!("{} is given twice", key.trim())));
+                return Err(DesignError::BadTarget(format!("{key} is given twice")));
             }
             components.push((component, value));
         }
@@ -153,15 +148,12 @@ impl Weights {
     /// thesis defaults). Weights must be finite and ≥ 0.
     pub fn parse(text: &str) -> Result<Self, DesignError> {
         let mut overrides: Vec<(Component, f64)> = Vec::new();
-        for item in text.split(',').map(str::trim).filter(|s| !s.is_empty()) {
-            let (key, value) = item.split_once('=').ok_or_else(|| {
-                DesignError::BadWeights(format!("'{item}' is not KEY=VALUE; write e.g. --weights x=1,y=1,a0=100,a1=50,a2=25"))
-            })?;
-            let component = Component::parse(key)
-                .ok_or_else(|| DesignError::BadWeights(format!("unknown component '{}'; use x, y, a0, a1, …", key.trim())))?;
-            let value: f64 = value.trim().parse().ok().filter(|v: &f64| v.is_finite() && *v >= 0.0).ok_or_else(|| {
-                DesignError::BadWeights(format!("{}: '{}' is not a finite weight ≥ 0", key.trim(), value.trim()))
-            })?;
+        for (key, component, value) in
+            parse_pairs(text, "e.g. --weights x=1,y=1,a0=100,a1=50,a2=25").map_err(DesignError::BadWeights)?
+        {
+            if !(value.is_finite() && value >= 0.0) {
+                return Err(DesignError::BadWeights(format!("{key}: '{value}' is not a finite weight ≥ 0")));
+            }
             overrides.retain(|(c, _)| *c != component);
             overrides.push((component, value));
         }
@@ -190,6 +182,24 @@ impl Weights {
         }
         Ok(())
     }
+}
+
+/// Splits `KEY=VALUE,…` into (key, component, number); `example` completes
+/// the error messages.
+fn parse_pairs(text: &str, example: &str) -> Result<Vec<(String, Component, f64)>, String> {
+    text.split(',')
+        .map(str::trim)
+        .filter(|s| !s.is_empty())
+        .map(|item| {
+            let (key, value) = item.split_once('=').ok_or_else(|| format!("'{item}' is not KEY=VALUE; write {example}"))?;
+            let key = key.trim();
+            let component = Component::parse(key).ok_or_else(|| {
+                format!("unknown component '{key}'; use x, y (tip, mm) or a0 … a{MAX_ORDER} (curvature coefficients, 1/mm)")
+            })?;
+            let number: f64 = value.trim().parse().map_err(|_| format!("{key}: '{}' is not a finite number", value.trim()))?;
+            Ok((key.to_string(), component, number))
+        })
+        .collect()
 }
 
 /// Relative error of an achieved value, %, in the thesis's convention
