@@ -60,21 +60,47 @@ fn simulated(routing: &str, tension: &str) -> [f64; 5] {
     [v["tip_x_mm"].as_f64().unwrap(), v["tip_y_mm"].as_f64().unwrap(), a[0].as_f64().unwrap(), a[1].as_f64().unwrap(), a[2].as_f64().unwrap()]
 }
 
+/// Recovers `(routing, tension)` from its simulated (x, y, a0, a1, a2).
+fn assert_recovered(routing: &str, tension: &str) {
+    let [x, y, a0, a1, a2] = simulated(routing, tension);
+    let target = format!("x={x},y={y},a0={a0},a1={a1},a2={a2}");
+    let (v, took) = design_json(&["--target", &target]);
+    assert!(took <= Duration::from_secs(10), "took {took:?}");
+    let got = |k: &str| v[k].as_f64().unwrap();
+    assert!((got("tip_x_mm") - x).abs() < 1e-3 && (got("tip_y_mm") - y).abs() < 1e-3, "{routing} @ {tension}: {v}");
+    for (k, want) in [a0, a1, a2].iter().enumerate() {
+        assert!((v["a"][k].as_f64().unwrap() - want).abs() < 1e-5, "{routing} @ {tension}: {v}");
+    }
+    assert_eq!(v["met"], true);
+}
+
 #[test]
 fn recovers_simulated_designs_off_the_grid() {
     // Control points and tensions off any sweep grid (levels are multiples of 0.2 r = 1 mm).
     for (routing, tension) in [("1.3,-2.7,3.1,0.4,-1.9", "1.37"), ("-3.3,2.2,-0.7,4.1,3.6", "1.81"), ("4.45,4.45,-0.35,-4.45,2.15", "1.03")] {
-        let [x, y, a0, a1, a2] = simulated(routing, tension);
-        let target = format!("x={x},y={y},a0={a0},a1={a1},a2={a2}");
-        let (v, took) = design_json(&["--target", &target]);
-        assert!(took <= Duration::from_secs(10), "took {took:?}");
-        let got = |k: &str| v[k].as_f64().unwrap();
-        let a: Vec<f64> = v["a"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
-        assert!((got("tip_x_mm") - x).abs() < 1e-3 && (got("tip_y_mm") - y).abs() < 1e-3, "{routing}: {v}");
-        for (got, want) in a.iter().zip([a0, a1, a2]) {
-            assert!((got - want).abs() < 1e-5, "{routing}: a {a:?} vs {:?}", [a0, a1, a2]);
-        }
-        assert_eq!(v["met"], true);
+        assert_recovered(routing, tension);
+    }
+}
+
+#[test]
+fn recovers_random_designs_including_bound_active_ones() {
+    // A fixed pseudo-random sample (LCG), plus designs on the tension bounds
+    // and near the body surface, where the bounds transformation is flat.
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let mut uniform = |lo: f64, hi: f64| {
+        state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+        lo + (hi - lo) * ((state >> 11) as f64 / (1u64 << 53) as f64)
+    };
+    let mut cases: Vec<(String, String)> = (0..3)
+        .map(|_| {
+            let y: Vec<String> = (0..5).map(|_| format!("{:.3}", uniform(-4.9, 4.9))).collect();
+            (y.join(","), format!("{:.3}", uniform(1.0, 2.0)))
+        })
+        .collect();
+    cases.push(("4.95,-4.95,4.95,-4.95,4.95".into(), "2.0".into()));
+    cases.push(("-2.5,0.3,4.9,1.1,-4.9".into(), "1.0".into()));
+    for (routing, tension) in &cases {
+        assert_recovered(routing, tension);
     }
 }
 

@@ -121,10 +121,19 @@ pub fn run(args: &DesignArgs) -> anyhow::Result<()> {
     }
     // With a map: its verdict first (reported, not enforced: the optimiser
     // still returns the closest design), and its nearest designs as seeds.
-    let feasibility = match &map {
+    let mut feasibility = match &map {
         Some(m) => Some(design::feasible::check(m, &objective.target, &objective.weights, 2 * args.starts)?),
         None => None,
     };
+    if let Some(f) = feasibility.as_mut() {
+        if objective.length_basis == LengthBasis::Rest && objective.target.highest_order().is_some() {
+            f.reasons.push(
+                "the map's coefficients are over the deformed length ℓ while this target's are over the rest length L \
+                 (smaller by ℓ/L, ~7 % at 2 N): the coefficient checks are approximate"
+                    .into(),
+            );
+        }
+    }
     let seeds: Vec<design::Seed> =
         feasibility.iter().flat_map(|f| f.nearest.iter().map(|d| d.seed())).collect();
     let search = SearchOptions { starts: args.starts, ..SearchOptions::default() };

@@ -314,12 +314,12 @@ impl MapDir {
         self.index.get(&(ix, iy)).map(|&i| &self.cells[i])
     }
 
-    /// Column index range of cells containing x (all columns when x is None).
+    /// Column index of the cells containing x (None when x is None: every column).
     pub fn column_of(&self, x_mm: Option<f64>) -> Option<i32> {
         x_mm.map(|x| self.cell_index(x, self.summary.x_min_mm) as i32)
     }
 
-    /// Row index of cells containing y.
+    /// Row index of the cells containing y (None when y is None: every row).
     pub fn row_of(&self, y_mm: Option<f64>) -> Option<i32> {
         y_mm.map(|y| self.cell_index(y, self.summary.y_min_mm) as i32)
     }

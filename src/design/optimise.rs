@@ -330,7 +330,12 @@ pub fn refine(objective: &Objective, seed: &Seed, max_evaluations: usize) -> (Op
         seed_cost,
         cost: best.as_ref().map_or(f64::INFINITY, |b| b.0),
         evaluations: problem.evaluations.get(),
-        termination: format!("{:?}", report.termination),
+        termination: if problem.evaluations.get() >= max_evaluations {
+            // The budget stop surfaces from the solver as a residual failure.
+            "evaluation budget reached".to_string()
+        } else {
+            format!("{:?}", report.termination)
+        },
     };
     (best, start)
 }
