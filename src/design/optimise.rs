@@ -23,6 +23,7 @@ use nalgebra::{DMatrix, DVector, Dyn, Owned};
 use rayon::prelude::*;
 use serde::Serialize;
 use std::cell::{Cell, RefCell};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 /// Settings of the multi-start search.
@@ -150,13 +151,17 @@ pub fn grid_seeds(objective: &Objective, search: &SearchOptions) -> Vec<(f64, Se
                     Err(_) => return out,
                 };
                 sim.set_routing(&routing);
-                // One continuation ladder per routing covers every grid tension.
-                let top = *tensions.last().expect("non-empty");
-                let rungs = ((top / super::objective::LADDER_STEP_N).ceil() as usize).max(1);
-                let mut ladder: Vec<f64> = (1..=rungs).map(|k| top * k as f64 / rungs as f64).collect();
-                ladder.extend(&tensions);
-                ladder.sort_by(f64::total_cmp);
-                ladder.dedup_by(|p, q| (*p - *q).abs() < 1e-12);
+                // The grid tensions in rising order form the continuation
+                // ladder; the first is solved cold (see `Objective::evaluate`),
+                // or climbed to from low tension if that fails.
+                let first = tensions[0];
+                let mut ladder: Vec<f64> = tensions.clone();
+                if sim.solve(first).is_err() {
+                    sim.set_routing(&routing);
+                    let rungs = ((first / super::objective::LADDER_STEP_N).ceil() as usize).max(1);
+                    ladder.splice(0..0, (1..rungs).map(|k| first * k as f64 / rungs as f64));
+                }
+                // (After a cold success the first rung repeats as a converged warm start.)
                 for t in ladder {
                     let Ok(pose) = sim.solve(t) else { return out };
                     if tensions.iter().any(|g| (g - t).abs() < 1e-12) {
@@ -209,7 +214,14 @@ struct Problem<'a> {
     best: RefCell<Option<(f64, Evaluation)>>,
     evaluations: Cell<usize>,
     max_evaluations: usize,
+    /// Raised by whichever start first reaches [`COST_FLOOR`]: the others stop.
+    stop: &'a AtomicBool,
 }
+
+/// An objective this small is an exact fit: errors near 1e-10 mm and
+/// 1e-11 /mm, below the solver's own discretisation error. Reaching it ends
+/// the search (without it, a zero-residual problem keeps LM iterating).
+pub const COST_FLOOR: f64 = 1e-20;
 
 /// Finite-difference step in z (a few 1e-5 mm in y): large against the
 /// solver's convergence noise (~1e-10 in a_i), small against curvature.
@@ -264,8 +276,13 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
     }
 
     fn residuals(&self) -> Option<DVector<f64>> {
-        if self.evaluations.get() >= self.max_evaluations {
-            // Out of budget: stop the solver (the best design is kept).
+        let exact = self.best.borrow().as_ref().is_some_and(|(c, _)| *c <= COST_FLOOR);
+        if exact {
+            self.stop.store(true, Ordering::Relaxed);
+        }
+        if exact || self.stop.load(Ordering::Relaxed) || self.evaluations.get() >= self.max_evaluations {
+            // Exact fit here or elsewhere, or out of budget: returning no
+            // residuals stops the solver (the best design is kept).
             return None;
         }
         if let Some(r) = self.current.borrow().as_ref() {
@@ -304,7 +321,9 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
 
 /// Refines one seed with bounded Levenberg–Marquardt; returns the best design
 /// it saw (None if not even the seed could be simulated).
-pub fn refine(objective: &Objective, seed: &Seed, max_evaluations: usize) -> (Option<(f64, Evaluation)>, StartReport) {
+///
+/// `stop` is shared between parallel starts: set once any start fits exactly.
+pub fn refine(objective: &Objective, seed: &Seed, max_evaluations: usize, stop: &AtomicBool) -> (Option<(f64, Evaluation)>, StartReport) {
     let mut problem = Problem {
         objective,
         sim: RefCell::new(objective.simulator()),
@@ -313,6 +332,7 @@ pub fn refine(objective: &Objective, seed: &Seed, max_evaluations: usize) -> (Op
         best: RefCell::new(None),
         evaluations: Cell::new(0),
         max_evaluations,
+        stop,
     };
     let mut s = *seed;
     objective.bounds.clamp(&mut s.routing_mm, &mut s.tension_n);
@@ -330,8 +350,12 @@ pub fn refine(objective: &Objective, seed: &Seed, max_evaluations: usize) -> (Op
         seed_cost,
         cost: best.as_ref().map_or(f64::INFINITY, |b| b.0),
         evaluations: problem.evaluations.get(),
-        termination: if problem.evaluations.get() >= max_evaluations {
-            // The budget stop surfaces from the solver as a residual failure.
+        // Our own stops surface from the solver as residual failures.
+        termination: if best.as_ref().is_some_and(|(c, _)| *c <= COST_FLOOR) {
+            "exact fit (objective at the noise floor)".to_string()
+        } else if stop.load(Ordering::Relaxed) {
+            "stopped: another start fitted exactly".to_string()
+        } else if problem.evaluations.get() >= max_evaluations {
             "evaluation budget reached".to_string()
         } else {
             format!("{:?}", report.termination)
@@ -387,9 +411,10 @@ pub fn design(objective: &Objective, search: &SearchOptions, extra_seeds: &[Seed
     if seeds.is_empty() {
         return Err(DesignError::NoSeed);
     }
+    let stop = AtomicBool::new(false);
     // Pass 1: a short look from every seed.
     let mut first: Vec<(Option<(f64, Evaluation)>, StartReport)> =
-        seeds.par_iter().map(|seed| refine(objective, seed, EXPLORE_EVALUATIONS)).collect();
+        seeds.par_iter().map(|seed| refine(objective, seed, EXPLORE_EVALUATIONS, &stop)).collect();
     first.sort_by(|p, q| p.1.cost.total_cmp(&q.1.cost));
     // Pass 2: converge the most promising, continuing from where pass 1 stopped.
     let continued: Vec<(f64, Seed)> = first
@@ -398,9 +423,13 @@ pub fn design(objective: &Objective, search: &SearchOptions, extra_seeds: &[Seed
             best.as_ref().map(|(c, e)| (*c, Seed { routing_mm: e.routing_mm, tension_n: e.tension_n, source: report.seed.source }))
         })
         .collect();
-    let finalists = diverse(&continued, search.starts, 0.0);
-    let mut results: Vec<(Option<(f64, Evaluation)>, StartReport)> =
-        finalists.par_iter().map(|seed| refine(objective, seed, search.max_evaluations)).collect();
+    let finalists = if stop.load(Ordering::Relaxed) { Vec::new() } else { diverse(&continued, search.starts, 0.0) };
+    let mut results: Vec<(Option<(f64, Evaluation)>, StartReport)> = if finalists.is_empty() {
+        // An exact fit already (or nothing to continue): pass 1 is the answer.
+        first.clone()
+    } else {
+        finalists.par_iter().map(|seed| refine(objective, seed, search.max_evaluations, &stop)).collect()
+    };
     // Report each finalist against the seed it came from.
     for (result, finalist) in results.iter_mut().zip(&finalists) {
         if let Some((_, origin)) = first.iter().find(|(b, _)| {
@@ -480,6 +509,7 @@ mod tests {
             best: RefCell::new(None),
             evaluations: Cell::new(0),
             max_evaluations: 10,
+            stop: &AtomicBool::new(false),
         };
         let y = [4.99, -4.99, 0.0, 1.234, -3.0];
         let (y2, t2) = p.design_of(&p.z_of(&y, 1.7));
