@@ -517,7 +517,7 @@ mod tests {
             assert!((a - b).abs() < 1e-12);
         }
         assert!((t2 - 1.7).abs() < 1e-12);
-        for z in [-100.0, -1.6, 0.3, 1.5708, 7.0] {
+        for z in [-100.0, -1.6, 0.3, std::f64::consts::FRAC_PI_2, 7.0] {
             let (y, t) = p.design_of(&DVector::from_element(6, z));
             assert!(y.iter().all(|v| v.abs() <= obj.bounds.max_offset_mm) && (1.0..=2.0).contains(&t));
         }

@@ -104,7 +104,7 @@ impl Target {
                 "the target is empty; give at least one of x, y, a0, a1, … e.g. --target x=50,y=5".into(),
             ));
         }
-        components.sort_by(|a, b| a.0.cmp(&b.0));
+        components.sort_by_key(|c| c.0);
         Ok(Self { components })
     }
 
@@ -131,16 +131,10 @@ impl Target {
 }
 
 /// Weights λ of eq. 3.17, one per target component.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Default, Serialize)]
 pub struct Weights {
     /// (component, λ) pairs for components whose weight was given explicitly.
     overrides: Vec<(Component, f64)>,
-}
-
-impl Default for Weights {
-    fn default() -> Self {
-        Self { overrides: Vec::new() }
-    }
 }
 
 impl Weights {
