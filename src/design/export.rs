@@ -48,7 +48,7 @@ pub fn channel_csv(routing: &Routing) -> String {
 pub fn mould_svg(routing: &Routing, radius_mm: f64, channel_diameter_mm: f64, tension_n: f64) -> String {
     let length = routing.length_mm();
     let margin = 10.0;
-    let (w, h) = (length + 2.0 * margin, 2.0 * radius_mm + 2.0 * margin + 12.0);
+    let (w, h) = (length + 2.0 * margin, 2.0 * radius_mm + 2.0 * margin + 16.0);
     // Model (s, y) → page (margin + s, margin + r − y).
     let px = |s: f64| margin + s;
     let py = |y: f64| margin + radius_mm - y;
@@ -110,12 +110,17 @@ pub fn mould_svg(routing: &Routing, radius_mm: f64, channel_diameter_mm: f64, te
         px(10.0)
     );
     let ys = routing.control_points_mm().iter().map(|y| format!("{y:.3}")).collect::<Vec<_>>().join(", ");
-    let _ = writeln!(
-        svg,
-        r#"<text x="{}" y="{}" font-size="2.2">10 mm · L = {length} mm, r = {radius_mm} mm · y0..y4 = [{ys}] mm · τ = {tension_n:.3} N · clamp on the left</text>"#,
-        px(12.0),
-        bar_y + 0.8
-    );
+    // Short lines at 2 mm so the notes stay inside the page at 1:1.
+    let notes = [
+        "10 mm".to_string(),
+        format!("L = {length} mm, r = {radius_mm} mm, channel Ø {channel_diameter_mm} mm; clamp on the left"),
+        format!("y0..y4 = [{ys}] mm"),
+        format!("tension {tension_n:.3} N"),
+    ];
+    let _ = writeln!(svg, r#"<text x="{}" y="{}" font-size="2">{}</text>"#, px(11.0), bar_y + 0.7, notes[0]);
+    for (i, line) in notes[1..].iter().enumerate() {
+        let _ = writeln!(svg, r#"<text x="{}" y="{}" font-size="2">{line}</text>"#, px(0.0), bar_y + 3.5 + 2.6 * i as f64);
+    }
     svg.push_str("</svg>\n");
     svg
 }
@@ -207,7 +212,7 @@ mod tests {
     fn mould_svg_is_true_scale() {
         let r = Routing::new(&[0.0, 1.0, 2.0, 1.0, 0.0], 65.0, 5.0).unwrap();
         let svg = mould_svg(&r, 5.0, 1.0, 1.5);
-        assert!(svg.contains(r#"width="85mm""#) && svg.contains(r#"viewBox="0 0 85 42""#), "{svg}");
+        assert!(svg.contains(r#"width="85mm""#) && svg.contains(r#"viewBox="0 0 85 46""#), "{svg}");
         assert!(svg.contains(r#"<rect id="body" x="10" y="10" width="65" height="10""#));
         assert_eq!(svg.matches("class=\"control-point\"").count(), 5);
     }
