@@ -41,6 +41,9 @@ pub struct DesignArgs {
     /// Number of seeds refined to convergence (3× as many are explored briefly).
     #[arg(long, default_value_t = 8)]
     pub starts: usize,
+    /// Most simulator evaluations per converging start.
+    #[arg(long, default_value_t = SearchOptions::default().max_evaluations)]
+    pub max_evaluations: usize,
     /// A component counts as met when its error is within this many percent.
     #[arg(long, default_value_t = 5.0)]
     pub tolerance_pct: f64,
@@ -136,7 +139,7 @@ pub fn run(args: &DesignArgs) -> anyhow::Result<()> {
     }
     let seeds: Vec<design::Seed> =
         feasibility.iter().flat_map(|f| f.nearest.iter().map(|d| d.seed())).collect();
-    let search = SearchOptions { starts: args.starts, ..SearchOptions::default() };
+    let search = SearchOptions { starts: args.starts, max_evaluations: args.max_evaluations, ..SearchOptions::default() };
     let outcome = optimise::design(&objective, &search, &seeds)?;
     let results = compare(&objective, &outcome.best, args.tolerance_pct);
     let mut value = design_json(&objective, &outcome, &results);
