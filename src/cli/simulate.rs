@@ -111,7 +111,7 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     writeln!(out, "base angle     {:.8} rad ({:.4}°)", p.base_angle_rad, p.base_angle_rad.to_degrees())?;
     writeln!(out, "length ℓ       {:.6} mm", p.length_mm)?;
     for (i, a) in sim.a.iter().enumerate() {
-        writeln!(out, "a_{i:<12} {a:.8e} mm^-{}", i + 1)?;
+        writeln!(out, "a_{i:<12} {a:.8e} mm^-1")?;
     }
     writeln!(out, "iterations     {} integration pass(es)", p.iterations)?;
     Ok(())
