@@ -730,3 +730,90 @@ mod tests {
         assert!(e.to_string().contains("ascending"), "{e}");
     }
 }
+
+#[cfg(test)]
+mod picture_tests {
+    use super::*;
+    use crate::model::{Actuator, Routing, Simulator, SolverOptions};
+    use arrow::array::{ArrayRef, Float64Array, Int64Array, StringArray};
+    use arrow::datatypes::{DataType, Field, Schema};
+    use std::sync::Arc;
+
+    /// A small real run: 3 levels per control point, 4 tensions, as one batch.
+    fn small_run() -> RecordBatch {
+        let actuator = Actuator::default();
+        let mut sim = Simulator::new(&actuator, &SolverOptions::default()).unwrap();
+        let (mut ids, mut status, mut ys, mut t, mut out) = (vec![], vec![], vec![[0.0; 5]; 0], vec![], vec![]);
+        for id in 0..243i64 {
+            let mut k = id;
+            let y: [f64; 5] = std::array::from_fn(|_| {
+                let level = (k % 3) as f64 - 1.0;
+                k /= 3;
+                level * 3.0
+            });
+            sim.set_routing(&Routing::new(&y, 65.0, 5.0).unwrap());
+            for tension in [1.0, 1.3, 1.6, 2.0] {
+                let pose = sim.solve(tension).unwrap();
+                let mut a = [0.0; 3];
+                sim.coefficients_into(&mut a);
+                ids.push(id);
+                status.push("ok");
+                ys.push(y);
+                t.push(tension);
+                out.push([pose.tip_x_mm, pose.tip_y_mm, pose.tip_angle_rad, a[0], a[1], a[2]]);
+            }
+        }
+        let mut fields = vec![Field::new("routing_id", DataType::Int64, false), Field::new("status", DataType::Utf8, false)];
+        let mut cols: Vec<ArrayRef> = vec![Arc::new(Int64Array::from(ids)), Arc::new(StringArray::from(status))];
+        for k in 0..5 {
+            fields.push(Field::new(format!("y{k}_mm"), DataType::Float64, false));
+            cols.push(Arc::new(Float64Array::from(ys.iter().map(|y| y[k]).collect::<Vec<_>>())));
+        }
+        fields.push(Field::new("tension_n", DataType::Float64, false));
+        cols.push(Arc::new(Float64Array::from(t)));
+        for (j, name) in ["tip_x_mm", "tip_y_mm", "tip_angle_rad", "a0", "a1", "a2"].iter().enumerate() {
+            fields.push(Field::new(*name, DataType::Float64, true));
+            cols.push(Arc::new(Float64Array::from(out.iter().map(|o| o[j]).collect::<Vec<_>>())));
+        }
+        RecordBatch::try_new(Arc::new(Schema::new(fields)), cols).unwrap()
+    }
+
+    #[test]
+    fn map_directory_has_tables_and_non_blank_pictures() {
+        let b = small_run();
+        let info = RunInfo {
+            mirrored: false,
+            order: 2,
+            tension_range_n: [1.0, 2.0],
+            radius_mm: 5.0,
+            length_mm: 65.0,
+            run_dir: "small".into(),
+            spec_hash: "h".into(),
+        };
+        let map = reduce_batches(&info, &ReduceOptions::default(), || Ok(vec![Ok(b.clone())].into_iter())).unwrap();
+        let dir = std::env::var_os("CABLEMAP_KEEP_MAP").map(std::path::PathBuf::from);
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = dir.unwrap_or_else(|| tmp.path().to_path_buf());
+        let pictures = write_map(&dir, &map, &Actuator::default(), &SolverOptions::default()).unwrap();
+        assert_eq!(pictures.len(), 1 + 3 * 3 + 1);
+        for p in &pictures {
+            let img = image::open(dir.join(&p.file)).unwrap().to_rgb8();
+            let expected = if p.file == "modes.png" { (1800, 2000) } else { (900, 760) };
+            assert_eq!(img.dimensions(), expected, "{}", p.file);
+            // Not blank: many distinct colours and a good share of non-white pixels.
+            let non_white = img.pixels().filter(|px| px.0 != [255, 255, 255]).count();
+            let mut colours: Vec<[u8; 3]> = img.pixels().map(|px| px.0).collect();
+            colours.sort_unstable();
+            colours.dedup();
+            assert!(non_white * 50 > img.pixels().len(), "{}: {non_white} non-white pixels", p.file);
+            assert!(colours.len() > 20, "{}: only {} colours", p.file, colours.len());
+        }
+        let html = std::fs::read_to_string(dir.join("index.html")).unwrap();
+        for p in &pictures {
+            assert!(html.contains(&format!("src=\"{}\"", p.file)));
+        }
+        for table in ["cells.parquet", "modes.parquet", "designs.parquet", "summary.json"] {
+            assert!(dir.join(table).exists(), "{table}");
+        }
+    }
+}

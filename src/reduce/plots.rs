@@ -100,7 +100,8 @@ fn draw_colour_bar(area: &Area, path: &Path, range: (f64, f64), label: &str, sca
     let fmt = move |v: &f64| -> String {
         match scale {
             Scale::Log => format!("{:.0}", 10f64.powf(*v)),
-            _ if v.abs() < 1e-3 && *v != 0.0 => format!("{v:.1e}"),
+            _ if v.abs() < 1e-9 * (hi - lo) => "0".to_string(),
+            _ if v.abs() < 1e-3 => format!("{v:.1e}"),
             _ => format!("{v:.4}"),
         }
     };
@@ -167,7 +168,7 @@ pub fn draw_modes(path: &Path, map: &MapData, shapes: &[Option<BodyDrawing>]) ->
     for m in 0..MODES {
         let panel = &panels[m];
         let mode = &map.modes[m];
-        let (map_area, shape_area) = panel.split_horizontally(400);
+        let (map_area, shape_area) = panel.split_horizontally(360);
         let cells: Vec<(i32, i32, f64)> =
             map.cells.iter().filter(|c| c.modes[m] > 0).map(|c| (c.ix, c.iy, (c.modes[m] as f64).log10())).collect();
         let fmt = |(lo, hi): (f64, f64)| -> String {
@@ -181,8 +182,9 @@ pub fn draw_modes(path: &Path, map: &MapData, shapes: &[Option<BodyDrawing>]) ->
         let values: Vec<f64> = cells.iter().map(|c| c.2).collect();
         let range = if values.is_empty() { (0.0, 1.0) } else { value_range(&values, Scale::Linear) };
         draw_cells(&map_area, path, &map.summary, &caption, &cells, range, 12)?;
-        if let Some(Some(shape)) = shapes.get(m) {
-            draw_shape(&shape_area, path, shape)?;
+        if let (Some(Some(shape)), Some(rep)) = (shapes.get(m), &mode.representative) {
+            let caption = format!("τ = {:.2} N", rep.tension_n);
+            draw_shape(&shape_area, path, shape, &caption)?;
         }
     }
     root.present().map_err(|e| PlotError::new(path, e))?;
@@ -190,18 +192,28 @@ pub fn draw_modes(path: &Path, map: &MapData, shapes: &[Option<BodyDrawing>]) ->
 }
 
 /// A small drawing of a body outline and cable (mode panels).
-fn draw_shape(area: &Area, path: &Path, shape: &BodyDrawing) -> Result<(), PlotError> {
+fn draw_shape(area: &Area, path: &Path, shape: &BodyDrawing, caption: &str) -> Result<(), PlotError> {
     let (l, r) = shape.outline();
+    // Equal scale on both axes: one mm per pixel factor for the whole panel
+    // (plot area ≈ panel less label areas and margins).
+    let (w, h) = area.dim_in_pixel();
+    let (pw, ph) = (w.saturating_sub(55).max(1) as f64, h.saturating_sub(75).max(1) as f64);
+    let extent = l.iter().chain(&r).map(|p| p.1.abs()).fold(0.0, f64::max) + 3.0;
+    let depth = l.iter().chain(&r).map(|p| p.0).fold(0.0, f64::max) + 5.0;
+    let mm_per_px = (depth / ph).max(2.0 * extent / pw);
+    let lateral = 0.5 * mm_per_px * pw;
     let mut chart = ChartBuilder::on(area)
         .margin(10)
-        .caption("representative", (FONT, 13))
+        .caption(caption, (FONT, 12))
         .x_label_area_size(20)
         .y_label_area_size(25)
-        .build_cartesian_2d(-70.0..70.0, -75.0..5.0)
+        .build_cartesian_2d(-lateral..lateral, -(mm_per_px * ph - 5.0)..5.0)
         .map_err(|e| PlotError::new(path, e))?;
     chart
         .configure_mesh()
         .disable_mesh()
+        .x_labels(3)
+        .x_label_formatter(&|v| format!("{v:.0}"))
         .label_style((FONT, 10))
         .y_label_formatter(&|v| format!("{:.0}", -v + 0.0))
         .draw()
