@@ -8,7 +8,7 @@ use crate::model::Actuator;
 use arrow::array::{Array, AsArray, RecordBatch};
 use arrow::datatypes::{Float64Type, Int32Type, Int64Type};
 use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
@@ -18,56 +18,9 @@ pub const MODES: usize = 12;
 /// Highest coefficient order with per-cell statistics in `cells.parquet`.
 pub const CELL_STATS_ORDER: usize = 2;
 
-/// Mode boundaries: a_0 split into 4 ranges by 3 values, a_1 into 3 by 2.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct ModeBoundaries {
-    /// Three increasing a_0 boundaries, 1/mm.
-    pub a0: Vec<f64>,
-    /// Two increasing a_1 boundaries, 1/mm.
-    pub a1: Vec<f64>,
-}
-
-impl ModeBoundaries {
-    /// The range index of `value` among increasing `bounds` (0 … bounds.len()).
-    fn range(bounds: &[f64], value: f64) -> usize {
-        bounds.iter().filter(|b| value >= **b).count()
-    }
-
-    /// a_0 range index (0…3) of `a0`.
-    pub fn a0_range(&self, a0: f64) -> usize {
-        Self::range(&self.a0, a0)
-    }
-
-    /// a_1 range index (0…2) of `a1`.
-    pub fn a1_range(&self, a1: f64) -> usize {
-        Self::range(&self.a1, a1)
-    }
-}
-
-/// The fields of `summary.json` that `feasible` and `design` use (others are ignored).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Summary {
-    /// Cell size, mm.
-    pub cell_mm: f64,
-    /// Lower-left corner of cell (0, 0), mm.
-    pub x_min_mm: f64,
-    /// Lower-left corner of cell (0, 0), mm.
-    pub y_min_mm: f64,
-    /// Grid size in cells along x.
-    pub nx: i64,
-    /// Grid size in cells along y.
-    pub ny: i64,
-    /// Highest coefficient order n of the run.
-    pub order: usize,
-    /// Characteristic-mode boundaries.
-    pub mode_boundaries: ModeBoundaries,
-    /// [τ_l, τ_u] of the run, N.
-    pub tension_range_n: [f64; 2],
-    /// Rod radius of the run, mm.
-    pub radius_mm: f64,
-    /// Rod length of the run, mm.
-    pub length_mm: f64,
-}
+/// `summary.json`, read with the reducer's own type so that the contract
+/// has one definition.
+pub type Summary = crate::reduce::MapSummary;
 
 /// Statistics of one coefficient in one cell.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -243,10 +196,10 @@ impl MapDir {
         })?;
         let summary: Summary =
             serde_json::from_str(&text).map_err(|e| map_error(&summary_path, format!("does not match the map contract: {e}")))?;
-        let mb = &summary.mode_boundaries;
-        if mb.a0.len() != 3 || mb.a1.len() != 2 || !mb.a0.windows(2).all(|w| w[0] <= w[1]) || mb.a1[0] > mb.a1[1] {
-            return Err(map_error(&summary_path, "mode_boundaries must hold 3 increasing a0 values and 2 increasing a1 values"));
-        }
+        summary
+            .mode_boundaries
+            .validate()
+            .map_err(|e| map_error(&summary_path, format!("mode_boundaries: {e}")))?;
         if !(summary.cell_mm > 0.0 && summary.cell_mm.is_finite()) {
             return Err(map_error(&summary_path, format!("cell_mm must be positive, got {}", summary.cell_mm)));
         }
@@ -300,13 +253,6 @@ impl MapDir {
     /// The cell index containing coordinate `v` along an axis starting at `min` (may be off the grid).
     fn cell_index(&self, v: f64, min: f64) -> i64 {
         ((v - min) / self.summary.cell_mm).floor() as i64
-    }
-
-    /// The (ix, iy) of the cell containing the tip (x, y), mm, or None off the grid.
-    pub fn cell_of(&self, x_mm: f64, y_mm: f64) -> Option<(i32, i32)> {
-        let ix = self.cell_index(x_mm, self.summary.x_min_mm);
-        let iy = self.cell_index(y_mm, self.summary.y_min_mm);
-        ((0..self.summary.nx).contains(&ix) && (0..self.summary.ny).contains(&iy)).then_some((ix as i32, iy as i32))
     }
 
     /// The non-empty cell at (ix, iy), if any.
