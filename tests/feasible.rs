@@ -28,7 +28,7 @@ fn a_simulated_design_inside_its_cells_percentiles_is_feasible_and_nearest() {
     let d = designs
         .iter()
         .filter_map(|d| map.cell(d.ix, d.iy).map(|c| (d, c)))
-        .filter(|(d, c)| c.count >= 20 && (0..3).all(|k| c.a[k].p10 < d.a[k] && d.a[k] < c.a[k].p90))
+        .filter(|(d, c)| c.count >= 20 && (0..3).all(|k| c.coefficients[k].p10 < d.a[k] && d.a[k] < c.coefficients[k].p90))
         .map(|(d, _)| d)
         .next()
         .expect("some design lies inside its cell's percentiles");
@@ -38,7 +38,7 @@ fn a_simulated_design_inside_its_cells_percentiles_is_feasible_and_nearest() {
     let nearest = &v["nearest"][0];
     assert!(nearest["distance"].as_f64().unwrap() < 1e-9, "{v}");
     let routing: Vec<f64> = nearest["routing_mm"].as_array().unwrap().iter().map(|y| y.as_f64().unwrap()).collect();
-    assert_eq!(routing, d.routing_mm.to_vec());
+    assert_eq!(routing, d.y_mm.to_vec());
     assert!(v["mode"]["mode"].as_u64().unwrap() < 12);
     assert!(v["mode"]["count_in_cell"].as_i64().unwrap() >= 1);
 }
@@ -67,9 +67,9 @@ fn a_coefficient_beyond_the_cells_percentiles_but_seen_nearby_is_borderline() {
     let cell = map
         .cells
         .iter()
-        .find(|c| c.count >= 10 && c.a[0].max > c.a[0].p90 + 1e-3)
+        .find(|c| c.count >= 10 && c.coefficients[0].max > c.coefficients[0].p90 + 1e-3)
         .expect("a cell with an a0 tail");
-    let a0 = 0.5 * (cell.a[0].p90 + cell.a[0].max);
+    let a0 = 0.5 * (cell.coefficients[0].p90 + cell.coefficients[0].max);
     let v = feasible(&format!("x={},y={},a0={a0}", cell.x_mm, cell.y_mm));
     assert_eq!(v["verdict"], "borderline", "{v}");
     assert_eq!(v["coefficients"][0]["within_percentiles"], false);

@@ -85,15 +85,16 @@ pub fn text(r: &FeasibilityReport) -> String {
         (None, _) => s.push_str(&format!("mode      one of {:?} (give a0 and a1 to pin it down)\n", m.candidates)),
     }
     s.push_str("nearest simulated designs (weighted distance):\n");
-    for d in &r.nearest {
+    for near in &r.nearest {
+        let d = &near.design;
         s.push_str(&format!(
             "  y = [{}] mm, τ = {:.3} N → tip ({:.2}, {:.2}) mm, a = [{}]  (distance {:.4})\n",
-            d.routing_mm.iter().map(|v| format!("{v:.2}")).collect::<Vec<_>>().join(", "),
+            d.y_mm.iter().map(|v| format!("{v:.2}")).collect::<Vec<_>>().join(", "),
             d.tension_n,
             d.tip_x_mm,
             d.tip_y_mm,
             d.a.iter().map(|v| format!("{v:.4}")).collect::<Vec<_>>().join(", "),
-            d.distance
+            near.distance
         ));
     }
     s

@@ -143,13 +143,13 @@ pub fn check(map: &MapDir, target: &Target, weights: &Weights, nearest: usize) -
             unchecked.join(", ")
         ));
     }
-    let in_percentiles = |c: &Cell, k: usize, v: f64| c.a[k].p10 <= v && v <= c.a[k].p90;
+    let in_percentiles = |c: &Cell, k: usize, v: f64| c.coefficients[k].p10 <= v && v <= c.coefficients[k].p90;
     let coefficients: Vec<CoefficientCheck> = checked
         .iter()
         .map(|&(k, v)| {
-            let lo = neighbourhood.iter().map(|c| c.a[k].min).fold(f64::INFINITY, f64::min);
-            let hi = neighbourhood.iter().map(|c| c.a[k].max).fold(f64::NEG_INFINITY, f64::max);
-            let cell = if single { selected.first().map(|c| c.a[k]) } else { None };
+            let lo = neighbourhood.iter().map(|c| c.coefficients[k].min).fold(f64::INFINITY, f64::min);
+            let hi = neighbourhood.iter().map(|c| c.coefficients[k].max).fold(f64::NEG_INFINITY, f64::max);
+            let cell = if single { selected.first().map(|c| c.coefficients[k]) } else { None };
             CoefficientCheck {
                 component: format!("a{k}"),
                 target: v,

@@ -13,7 +13,7 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 /// Number of characteristic modes (a_0 in 4 ranges × a_1 in 3).
-pub const MODES: usize = 12;
+pub use crate::reduce::MODES;
 
 /// Highest coefficient order with per-cell statistics in `cells.parquet`.
 pub const CELL_STATS_ORDER: usize = 2;
@@ -22,93 +22,58 @@ pub const CELL_STATS_ORDER: usize = 2;
 /// has one definition.
 pub type Summary = crate::reduce::MapSummary;
 
-/// Statistics of one coefficient in one cell.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct CoefficientStats {
-    /// 10th percentile.
-    pub p10: f64,
-    /// 90th percentile.
-    pub p90: f64,
-    /// Smallest value seen.
-    pub min: f64,
-    /// Largest value seen.
-    pub max: f64,
-}
+/// One non-empty cell of `cells.parquet` (the reducer's own type).
+pub type Cell = crate::reduce::CellStats;
 
-/// One non-empty cell of `cells.parquet`.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct Cell {
-    /// Column index.
-    pub ix: i32,
-    /// Row index.
-    pub iy: i32,
-    /// Cell centre, mm.
-    pub x_mm: f64,
-    /// Cell centre, mm.
-    pub y_mm: f64,
-    /// Simulations whose tip fell in the cell.
-    pub count: i64,
-    /// Statistics of a_0 … a_k, k ≤ min(order, 2).
-    pub a: Vec<CoefficientStats>,
-    /// Simulations of the cell in each mode.
-    pub modes: [i64; MODES],
-}
+/// Statistics of one coefficient in one cell (the reducer's own type).
+pub type CoefficientStats = crate::reduce::CoefficientStats;
 
-/// One simulated design of `designs.parquet`.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct MapDesign {
-    /// Cell column.
-    pub ix: i32,
-    /// Cell row.
-    pub iy: i32,
-    /// Routing id in the sweep.
-    pub routing_id: i64,
-    /// Whether the row is the mirror image of a simulated routing.
-    pub mirrored: bool,
-    /// Control points y0…y4, mm.
-    pub routing_mm: [f64; 5],
-    /// Tension, N.
-    pub tension_n: f64,
-    /// Tip position, mm.
-    pub tip_x_mm: f64,
-    /// Tip position, mm.
-    pub tip_y_mm: f64,
-    /// Tip tangent angle, rad.
-    pub tip_angle_rad: f64,
-    /// a_0 … a_order, 1/mm.
-    pub a: Vec<f64>,
-}
+/// One simulated design of `designs.parquet` (the reducer's own type).
+pub type MapDesign = crate::reduce::Design;
 
-impl MapDesign {
-    /// The value of `component` (None for an order the map does not store).
-    pub fn value(&self, component: Component) -> Option<f64> {
-        match component {
-            Component::TipX => Some(self.tip_x_mm),
-            Component::TipY => Some(self.tip_y_mm),
-            Component::A(k) => self.a.get(k).copied(),
-        }
-    }
-
-    /// As a starting design for the optimiser.
-    pub fn seed(&self) -> Seed {
-        Seed { routing_mm: self.routing_mm, tension_n: self.tension_n, source: SeedSource::Map }
+/// The value of `component` in a map design (None for an order the map does not store).
+pub fn design_value(d: &MapDesign, component: Component) -> Option<f64> {
+    match component {
+        Component::TipX => Some(d.tip_x_mm),
+        Component::TipY => Some(d.tip_y_mm),
+        Component::A(k) => d.a.get(k).copied(),
     }
 }
 
 /// A design with its weighted distance to a target.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct NearDesign {
     /// The design.
-    #[serde(flatten)]
     pub design: MapDesign,
     /// √(Σ λ_j (c_j − t_j)²) over the target's components the map stores.
     pub distance: f64,
 }
 
-impl std::ops::Deref for NearDesign {
-    type Target = MapDesign;
-    fn deref(&self) -> &MapDesign {
-        &self.design
+impl NearDesign {
+    /// As a starting design for the optimiser.
+    pub fn seed(&self) -> Seed {
+        Seed { routing_mm: self.design.y_mm, tension_n: self.design.tension_n, source: SeedSource::Map }
+    }
+}
+
+/// JSON with the names `design` uses (`routing_mm`, `tension_n`, `tip_x_mm`, …).
+impl Serialize for NearDesign {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let d = &self.design;
+        serde_json::json!({
+            "routing_mm": d.y_mm,
+            "tension_n": d.tension_n,
+            "tip_x_mm": d.tip_x_mm,
+            "tip_y_mm": d.tip_y_mm,
+            "tip_angle_rad": d.tip_angle_rad,
+            "a": d.a,
+            "ix": d.ix,
+            "iy": d.iy,
+            "routing_id": d.routing_id,
+            "mirrored": d.mirrored,
+            "distance": self.distance,
+        })
+        .serialize(s)
     }
 }
 
@@ -226,7 +191,7 @@ impl MapDir {
                     x_mm: x[r],
                     y_mm: y[r],
                     count: count[r],
-                    a: stats.iter().map(|s| CoefficientStats { p10: s[0][r], p90: s[1][r], min: s[2][r], max: s[3][r] }).collect(),
+                    coefficients: stats.iter().map(|s| CoefficientStats { p10: s[0][r], p90: s[1][r], min: s[2][r], max: s[3][r] }).collect(),
                     modes: std::array::from_fn(|m| modes[m][r]),
                 });
             }
@@ -288,7 +253,7 @@ impl MapDir {
                     iy: iy[r],
                     routing_id: id[r],
                     mirrored: mirrored[r],
-                    routing_mm: std::array::from_fn(|i| ys[i][r]),
+                    y_mm: std::array::from_fn(|i| ys[i][r]),
                     tension_n: t[r],
                     tip_x_mm: x[r],
                     tip_y_mm: y[r],
@@ -311,7 +276,7 @@ impl MapDir {
                 let distance = target
                     .components
                     .iter()
-                    .filter_map(|(c, t)| d.value(*c).map(|v| weights.get(*c) * (v - t).powi(2)))
+                    .filter_map(|(c, t)| design_value(&d, *c).map(|v| weights.get(*c) * (v - t).powi(2)))
                     .sum::<f64>()
                     .sqrt();
                 NearDesign { design: d, distance }
