@@ -116,3 +116,11 @@ fn a_directory_that_is_not_a_map_is_named() {
     assert!(!ok);
     assert!(stderr.contains("summary.json") && stderr.contains("cablemap reduce"), "{stderr}");
 }
+
+#[test]
+fn design_refuses_a_map_made_for_another_rod() {
+    let (map, _) = common::map();
+    let (ok, _, stderr) = run(&["design", "--map", map.to_str().unwrap(), "--target", "x=50,y=5", "--length-mm", "70"]);
+    assert!(!ok);
+    assert!(stderr.contains("the map was made for a rod of L = 65 mm"), "{stderr}");
+}
