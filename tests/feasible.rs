@@ -124,3 +124,18 @@ fn design_refuses_a_map_made_for_another_rod() {
     assert!(!ok);
     assert!(stderr.contains("the map was made for a rod of L = 65 mm"), "{stderr}");
 }
+
+#[test]
+fn table_5_1_target_ii_with_map_seeds_meets_the_thesis_errors() {
+    let (map, _) = common::map();
+    let started = std::time::Instant::now();
+    let (ok, stdout, stderr) = run(&[
+        "design", "--map", map.to_str().unwrap(), "--target", "x=10,y=50,a0=0.015,a1=-0.07,a2=-0.03", "--length-basis", "rest", "--json",
+    ]);
+    assert!(ok, "{stderr}");
+    assert!(started.elapsed() <= std::time::Duration::from_secs(10));
+    let v: Value = serde_json::from_str(stdout.trim()).unwrap();
+    for (key, thesis) in [("x", 0.02), ("y", 0.12), ("a0", 12.7), ("a1", 1.86), ("a2", 4.33)] {
+        assert!(v["error_pct"][key].as_f64().unwrap().abs() <= thesis, "{key}: {v}");
+    }
+}

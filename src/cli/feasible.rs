@@ -57,7 +57,7 @@ pub fn text(r: &FeasibilityReport) -> String {
     let t = &r.tip_cell;
     let idx = |v: Option<i32>| v.map_or("any".to_string(), |v| v.to_string());
     s.push_str(&format!(
-        "tip cell  ix = {}, iy = {}: {} simulations ({} with its neighbours)\n",
+        "tip cell  ix = {}, iy = {}: {} simulation(s) ({} with its neighbours)\n",
         idx(t.ix),
         idx(t.iy),
         t.count,

@@ -173,7 +173,8 @@ pub fn check(map: &MapDir, target: &Target, weights: &Weights, nearest: usize) -
         reasons.insert(
             0,
             format!(
-                "{} = {} lies outside everything the map saw in and around the {where_} ([{:.5}, {:.5}])",
+                "{} = {} lies outside everything the map saw in and around the {where_} ([{:.5}, {:.5}]); \
+                 the map samples a grid of designs, so a design between its grid points may still reach it: `design` will tell",
                 out.component,
                 out.target,
                 out.neighbourhood_min.unwrap_or(f64::NAN),
