@@ -18,6 +18,10 @@ enum Command {
     Simulate(cli::simulate::SimulateArgs),
     /// Print solver timings (median µs per solve, single thread).
     Bench(cli::bench::BenchArgs),
+    /// Sweep a routing grid through a tension ladder into Parquet chunks (sharded, resumable).
+    Sweep(cli::sweep::SweepArgs),
+    /// Report a sweep directory: rows done per shard, failures, completeness.
+    Status(cli::sweep::StatusArgs),
 }
 
 fn main() -> ExitCode {
@@ -25,6 +29,8 @@ fn main() -> ExitCode {
     let result = match &cli.command {
         Command::Simulate(args) => cli::simulate::run(args),
         Command::Bench(args) => cli::bench::run(args),
+        Command::Sweep(args) => cli::sweep::run(args),
+        Command::Status(args) => cli::sweep::run_status_command(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -3,6 +3,7 @@
 
 pub mod bench;
 pub mod simulate;
+pub mod sweep;
 
 use crate::model::{Actuator, SolverOptions};
 use clap::Args;
