@@ -427,3 +427,46 @@ fn bad_specs_are_rejected_before_anything_is_written() {
     let (ok, _, stderr) = sweep(&tmp.path().join("missing.toml"), &tmp.path().join("o"), &[]);
     assert!(!ok && stderr.contains("missing.toml"), "{stderr}");
 }
+
+#[test]
+fn failed_solves_keep_their_inputs_and_have_null_outputs() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("run");
+    let spec = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/python/failures.toml");
+    let (ok, stdout, stderr) = sweep(Path::new(spec), &dir, &[]);
+    assert!(ok, "{stderr}");
+    assert!(stdout.contains("shooting_not_converged"), "{stdout}");
+    let run = open_run(&dir, Completeness::Complete).unwrap();
+    let counts = run.status_counts();
+    let failed = counts.get("shooting_not_converged").copied().unwrap_or(0);
+    assert!(failed > 0 && counts.get("ok").copied().unwrap_or(0) > 0, "{counts:?}");
+    let mut seen_failed = 0;
+    for batch in run.batches() {
+        let batch = batch.unwrap();
+        let status = batch.column_by_name("status").unwrap().as_string::<i32>();
+        let iterations = batch.column_by_name("iterations").unwrap().as_primitive::<Int32Type>();
+        assert_eq!(iterations.null_count(), 0);
+        for r in 0..batch.num_rows() {
+            let ok = status.value(r) == "ok";
+            for name in ["tip_x_mm", "tip_y_mm", "tip_angle_rad", "base_angle_rad", "length_mm", "a0", "a3", "centreline_x_mm"] {
+                assert_eq!(batch.column_by_name(name).unwrap().is_null(r), !ok, "{name} row {r} ({})", status.value(r));
+            }
+            for name in ["routing_id", "y0_mm", "y4_mm", "tension_n"] {
+                assert!(!batch.column_by_name(name).unwrap().is_null(r));
+            }
+            if ok {
+                assert!(iterations.value(r) >= 1);
+            } else {
+                assert_eq!(iterations.value(r), 0);
+                seen_failed += 1;
+            }
+        }
+    }
+    assert_eq!(seen_failed, failed);
+    let (ok, status, _) = run_cmd_status(&dir);
+    assert!(ok && status.contains(&format!("shooting_not_converged {failed}")), "{status}");
+}
+
+fn run_cmd_status(dir: &Path) -> (bool, String, String) {
+    run(&["status", dir.to_str().unwrap()])
+}
