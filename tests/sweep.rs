@@ -138,6 +138,16 @@ fn quick_sweep_has_every_row_once_with_the_documented_columns() {
         assert!(y == &mirror || !routings.contains(&mirror), "both {y:?} and its mirror kept");
     }
     assert!(run.batches_projected(&["nope"]).is_err());
+    // Chunk by chunk (the unit for parallel readers), projected.
+    let mut rows = 0;
+    for i in 0..run.chunk_count() {
+        for batch in run.chunk_batches(i, Some(&["status", "a1"])).unwrap() {
+            let batch = batch.unwrap();
+            assert_eq!(batch.schema().fields().iter().map(|f| f.name().as_str()).collect::<Vec<_>>(), ["status", "a1"]);
+            rows += batch.num_rows();
+        }
+    }
+    assert_eq!((rows, run.chunk_count()), (610, 8));
 }
 
 #[test]

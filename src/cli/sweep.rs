@@ -20,7 +20,7 @@ pub struct SweepArgs {
     #[arg(long, value_name = "I")]
     pub shard: Option<u64>,
     /// Number of shards the sweep is split into (the same for every shard and every resume).
-    #[arg(long, value_name = "N", default_value_t = 1)]
+    #[arg(long, value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..))]
     pub shards: u64,
     /// Worker threads [default: $SLURM_CPUS_PER_TASK, else one per core].
     #[arg(long, value_name = "T")]
@@ -59,18 +59,18 @@ fn env_number<T: std::str::FromStr>(name: &str) -> anyhow::Result<Option<T>> {
     }
 }
 
-/// Shard index: `--shard`, else SLURM's array task id, else the Kubernetes
-/// Indexed Job's completion index, else 0.
-fn shard_index(args: &SweepArgs) -> anyhow::Result<u64> {
+/// Shard index and where it came from: `--shard`, else SLURM's array task
+/// id, else the Kubernetes Indexed Job's completion index, else 0.
+fn shard_index(args: &SweepArgs) -> anyhow::Result<(u64, &'static str)> {
     if let Some(s) = args.shard {
-        return Ok(s);
+        return Ok((s, "--shard"));
     }
     for name in ["SLURM_ARRAY_TASK_ID", "JOB_COMPLETION_INDEX"] {
         if let Some(s) = env_number(name)? {
-            return Ok(s);
+            return Ok((s, name));
         }
     }
-    Ok(0)
+    Ok((0, "default"))
 }
 
 /// Runs `cablemap sweep`.
@@ -92,7 +92,14 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
     } else {
         ProgressMode::Auto
     };
-    let options = SweepOptions { shard: shard_index(args)?, shards: args.shards, threads, progress };
+    let (shard, source) = shard_index(args)?;
+    anyhow::ensure!(
+        shard < args.shards,
+        "shard {shard} (from {source}) is out of range for --shards {}: shards are numbered 0..N-1 and every shard \
+         needs the same --shards N (for a SLURM array use --array=0-{{N-1}})",
+        args.shards
+    );
+    let options = SweepOptions { shard, shards: args.shards, threads, progress };
     let summary = run_sweep(&spec, &args.out, &options)?;
     let status = run_status(&args.out).with_context(|| format!("checking {} after the sweep", args.out.display()))?;
     if args.json {

@@ -102,13 +102,7 @@ impl SweepRun {
 
     /// Written rows per status (`ok` and failure statuses).
     pub fn status_counts(&self) -> BTreeMap<String, u64> {
-        let mut counts = BTreeMap::new();
-        for c in &self.chunks {
-            for (s, n) in &c.status_counts {
-                *counts.entry(s.clone()).or_insert(0) += n;
-            }
-        }
-        counts
+        super::store::total_status_counts(&self.chunks)
     }
 
     /// The complete chunk files, in chunk order.
@@ -128,11 +122,36 @@ impl SweepRun {
     }
 
     /// Like [`Self::batches`], decoding only the named columns (in schema
-    /// order). Unknown names are an error.
+    /// order, whatever the order of `columns`). Unknown names are an error.
     pub fn batches_projected<'a>(
         &'a self,
         columns: &[&str],
     ) -> Result<impl Iterator<Item = Result<RecordBatch, SweepError>> + 'a, SweepError> {
+        Ok(self.stream(Some(self.projection(columns)?)))
+    }
+
+    /// Number of complete chunk files (the unit for reading in parallel).
+    pub fn chunk_count(&self) -> usize {
+        self.chunks.len()
+    }
+
+    /// The rows of the `index`-th complete chunk file (0 ≤ index <
+    /// [`Self::chunk_count`]), optionally only the named columns. Chunks
+    /// are independent, so a reader can process them in parallel, e.g.
+    /// `(0..run.chunk_count()).into_par_iter().map(|i| run.chunk_batches(i, Some(&cols)))`.
+    pub fn chunk_batches(
+        &self,
+        index: usize,
+        columns: Option<&[&str]>,
+    ) -> Result<impl Iterator<Item = Result<RecordBatch, SweepError>> + '_, SweepError> {
+        let projection = columns.map(|c| self.projection(c)).transpose()?;
+        let chunk = &self.chunks[index];
+        let reader = open_chunk(&chunk.path, &self.schema(), projection.as_deref())?;
+        Ok(reader.map(move |b| b.map_err(|source| SweepError::Arrow { context: format!("reading {}", chunk.path.display()), source })))
+    }
+
+    /// Root column indices of `columns`, sorted.
+    fn projection(&self, columns: &[&str]) -> Result<Vec<usize>, SweepError> {
         let schema = self.schema();
         let mut indices = Vec::with_capacity(columns.len());
         for name in columns {
@@ -147,7 +166,7 @@ impl SweepRun {
         }
         indices.sort_unstable();
         indices.dedup();
-        Ok(self.stream(Some(indices)))
+        Ok(indices)
     }
 
     fn stream(&self, projection: Option<Vec<usize>>) -> impl Iterator<Item = Result<RecordBatch, SweepError>> + '_ {

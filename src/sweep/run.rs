@@ -15,7 +15,7 @@ use super::enumerate::SweepPlan;
 use super::progress::{Progress, ProgressMode};
 use super::schema::{arrow_schema, build_batch, SolvedRouting, SolvedRow};
 use super::spec::SweepSpec;
-use super::store::{ChunkInfo, RunDir};
+use super::store::{total_status_counts, ChunkInfo, RunDir};
 use super::SweepError;
 use crate::model::{Routing, Simulator, STATUS_OK};
 use rayon::prelude::*;
@@ -76,7 +76,7 @@ pub struct SweepSummary {
 impl SweepSummary {
     /// Rows of this shard whose solve failed.
     pub fn failures(&self) -> u64 {
-        self.status_counts.iter().filter(|(s, _)| s.as_str() != STATUS_OK).map(|(_, n)| n).sum()
+        super::store::failures(&self.status_counts)
     }
 }
 
@@ -160,12 +160,7 @@ pub fn run_sweep(spec: &SweepSpec, dir: &Path, options: &SweepOptions) -> Result
     })?;
     progress.finish();
 
-    let mut status_counts = BTreeMap::new();
-    for info in done.iter().copied().chain(&written) {
-        for (status, n) in &info.status_counts {
-            *status_counts.entry(status.clone()).or_insert(0) += n;
-        }
-    }
+    let status_counts = total_status_counts(done.iter().copied().chain(&written));
     let rows_written: u64 = written.iter().map(|c| c.rows).sum();
     let wall_s = started.elapsed().as_secs_f64();
     Ok(SweepSummary {

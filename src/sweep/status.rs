@@ -2,9 +2,8 @@
 //! failures by status, chunks in progress, and whether the run is complete.
 
 use super::enumerate::SweepPlan;
-use super::store::{Manifest, RunDir};
+use super::store::{failures, total_status_counts, Manifest, RunDir};
 use super::SweepError;
-use crate::model::STATUS_OK;
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -50,7 +49,7 @@ pub struct RunStatus {
 impl RunStatus {
     /// Written rows whose solve failed.
     pub fn failures(&self) -> u64 {
-        self.status_counts.iter().filter(|(s, _)| s.as_str() != STATUS_OK).map(|(_, n)| n).sum()
+        failures(&self.status_counts)
     }
 }
 
@@ -71,18 +70,13 @@ pub fn run_status(dir: &Path) -> Result<RunStatus, SweepError> {
             failures: 0,
         })
         .collect();
-    let mut status_counts = BTreeMap::new();
     for info in scan.chunks.values() {
         let entry = &mut per_shard[plan.chunk_shard(info.chunk, shards) as usize];
         entry.chunks_done += 1;
         entry.rows_done += info.rows;
-        for (status, n) in &info.status_counts {
-            *status_counts.entry(status.clone()).or_insert(0) += n;
-            if status != STATUS_OK {
-                entry.failures += n;
-            }
-        }
+        entry.failures += failures(&info.status_counts);
     }
+    let status_counts = total_status_counts(scan.chunks.values());
     let rows_done = per_shard.iter().map(|s| s.rows_done).sum();
     Ok(RunStatus {
         dir: dir.to_path_buf(),

@@ -111,6 +111,22 @@ pub struct ChunkInfo {
     pub status_counts: BTreeMap<String, u64>,
 }
 
+/// Rows per status, summed over chunks.
+pub fn total_status_counts<'a>(chunks: impl IntoIterator<Item = &'a ChunkInfo>) -> BTreeMap<String, u64> {
+    let mut counts = BTreeMap::new();
+    for chunk in chunks {
+        for (status, n) in &chunk.status_counts {
+            *counts.entry(status.clone()).or_insert(0) += n;
+        }
+    }
+    counts
+}
+
+/// Rows of failed solves (status other than `ok`) in a status count.
+pub fn failures(counts: &BTreeMap<String, u64>) -> u64 {
+    counts.iter().filter(|(s, _)| s.as_str() != crate::model::STATUS_OK).map(|(_, n)| n).sum()
+}
+
 /// Paths of a run directory.
 #[derive(Debug, Clone)]
 pub struct RunDir {
