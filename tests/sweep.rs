@@ -292,6 +292,26 @@ fn shards_from_flags_and_cluster_variables_make_up_the_single_run() {
     let per_shard: u64 = v["shards"].as_array().unwrap().iter().map(|s| s["rows_done"].as_u64().unwrap()).sum();
     assert_eq!(per_shard, 610);
 
+    // All shards started at once into a new directory (an array job
+    // starting): they race to create the manifest, and all succeed.
+    let together = tmp.path().join("together");
+    let children: Vec<_> = (0..4)
+        .map(|i| {
+            cablemap()
+                .args(["sweep", QUICK, "--out", together.to_str().unwrap(), "--shards", "4", "--quiet", "--threads", "1"])
+                .env("SLURM_ARRAY_TASK_ID", i.to_string())
+                .stdout(Stdio::null())
+                .stderr(Stdio::piped())
+                .spawn()
+                .unwrap()
+        })
+        .collect();
+    for child in children {
+        let out = child.wait_with_output().unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    }
+    assert_eq!(read_rows(&together, Completeness::Complete), reference);
+
     // Resuming with another shard count is refused.
     let (ok, _, stderr) = sweep(Path::new(QUICK), &sharded, &["--shards", "2"]);
     assert!(!ok && stderr.contains("rerun with --shards 3"), "{stderr}");
@@ -355,10 +375,8 @@ fn foreign_and_corrupt_files_are_reported_and_left_alone() {
     // A stray file in the dataset folder.
     std::fs::write(shards.join("notes.txt"), "mine").unwrap();
     let before = snapshot(&dir);
-    for args in [vec!["status", dir.to_str().unwrap()]] {
-        let (ok, _, stderr) = run(&args);
-        assert!(!ok && stderr.contains("notes.txt") && stderr.contains("not written by cablemap"), "{stderr}");
-    }
+    let (ok, _, stderr) = run_cmd_status(&dir);
+    assert!(!ok && stderr.contains("notes.txt") && stderr.contains("not written by cablemap"), "{stderr}");
     let (ok, _, stderr) = sweep(Path::new(QUICK), &dir, &[]);
     assert!(!ok && stderr.contains("notes.txt"), "{stderr}");
     assert_eq!(snapshot(&dir), before);

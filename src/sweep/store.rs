@@ -216,13 +216,14 @@ impl RunDir {
         Ok(existing)
     }
 
-    /// A directory without a manifest must be empty (apart from manifests
-    /// being published by a concurrent task): anything else was not written
-    /// by cablemap, and a sweep must not mix its files with it.
+    /// A directory without a manifest may hold only what a concurrent task
+    /// of the same run is creating (the manifest, its temporary file, the
+    /// shard folder, whose chunks [`Self::scan`] then checks): anything else
+    /// was not written by cablemap, and a sweep must not mix its files with it.
     fn check_fresh_dir(&self) -> Result<(), SweepError> {
         for entry in list_dir(&self.root)? {
             let name = entry.to_string_lossy();
-            if !is_manifest_temp(&name) {
+            if name != MANIFEST && name != SHARDS_DIR && !is_manifest_temp(&name) {
                 return Err(SweepError::NotARunDir { dir: self.root.clone(), entry: name.into_owned() });
             }
         }
@@ -233,7 +234,9 @@ impl RunDir {
     /// unless one exists. Returns false when another process won.
     fn publish_manifest(&self, manifest: &Manifest) -> Result<bool, SweepError> {
         let path = self.manifest_path();
-        let tmp = self.root.join(format!(".{MANIFEST}.tmp-{}", std::process::id()));
+        // Array tasks on different hosts can share a pid: add the time.
+        let nanos = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.subsec_nanos());
+        let tmp = self.root.join(format!(".{MANIFEST}.tmp-{}-{nanos}", std::process::id()));
         let text = serde_json::to_string_pretty(manifest).expect("manifest serialises") + "\n";
         let io = |what: &str, source| SweepError::Io { context: format!("{what} {}", path.display()), source };
         {
