@@ -2,7 +2,7 @@
 //! terminal; plain log lines at most every few seconds otherwise (cluster
 //! jobs and CI, where a bar would be hidden or garble the log).
 
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressState, ProgressStyle};
 use std::io::IsTerminal;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Mutex;
@@ -41,8 +41,11 @@ impl Progress {
             ProgressMode::Auto if std::io::stderr().is_terminal() => {
                 let bar = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
                 bar.set_style(
-                    ProgressStyle::with_template("{prefix} [{bar:40}] {human_pos}/{human_len} rows {per_sec} ETA {eta}")
+                    ProgressStyle::with_template("{prefix} [{wide_bar}] {human_pos}/{human_len} rows, {rate}, ETA {eta}")
                         .expect("valid template")
+                        .with_key("rate", |state: &ProgressState, w: &mut dyn std::fmt::Write| {
+                            let _ = write!(w, "{:.0} solves/s", state.per_sec());
+                        })
                         .progress_chars("=> "),
                 );
                 bar.set_prefix(label.clone());

@@ -122,7 +122,6 @@ pub fn run_sweep(spec: &SweepSpec, dir: &Path, options: &SweepOptions) -> Result
     let threads = pool.current_num_threads();
 
     let label = format!("sweep shard {shard}/{shards}");
-    let progress = Progress::new(options.progress, label.clone(), shard_rows, rows_skipped);
     if options.progress != ProgressMode::Quiet {
         eprintln!(
             "{label}: {} of {} chunks to do ({} rows of {shard_rows}; {} already written), {threads} threads, output {}",
@@ -133,6 +132,7 @@ pub fn run_sweep(spec: &SweepSpec, dir: &Path, options: &SweepOptions) -> Result
             dir.display()
         );
     }
+    let progress = Progress::new(options.progress, label, shard_rows, rows_skipped);
 
     let prototype = Simulator::new(&spec.actuator, &spec.solver)?;
     let tensions = spec.tensions_n();
