@@ -408,6 +408,17 @@ fn foreign_and_corrupt_files_are_reported_and_left_alone() {
     assert!(!ok && stderr.contains("does not belong to this sweep"), "{stderr}");
     assert_eq!(snapshot(&dir), before);
 
+    std::fs::remove_file(shards.join("chunk-000002.parquet")).unwrap();
+
+    // A stray file beside the manifest.
+    std::fs::write(dir.join("extra.csv"), "a,b").unwrap();
+    let (ok, _, stderr) = sweep(Path::new(QUICK), &dir, &[]);
+    assert!(!ok && stderr.contains("extra.csv") && stderr.contains("not written by cablemap"), "{stderr}");
+    std::fs::remove_file(dir.join("extra.csv")).unwrap();
+    let (ok, stdout, stderr) = sweep(Path::new(QUICK), &dir, &[]);
+    assert!(ok && stdout.contains("80 rows solved"), "{stdout}{stderr}");
+    assert_eq!(read_rows(&dir, Completeness::Complete).len(), 610);
+
     // A damaged manifest.
     let dir2 = tmp.path().join("run2");
     assert!(sweep(Path::new(QUICK), &dir2, &[]).0);

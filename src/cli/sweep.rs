@@ -25,7 +25,7 @@ pub struct SweepArgs {
     /// Worker threads [default: $SLURM_CPUS_PER_TASK, else one per core].
     #[arg(long, value_name = "T")]
     pub threads: Option<usize>,
-    /// Seconds between progress lines when stderr is not a terminal.
+    /// Seconds between progress lines when stderr is not a terminal [default: 10].
     #[arg(long, value_name = "S")]
     pub log_interval_s: Option<f64>,
     /// No progress output.

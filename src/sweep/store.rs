@@ -423,3 +423,27 @@ fn count_statuses(batch: &RecordBatch) -> BTreeMap<String, u64> {
     }
     counts
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn chunk_names_round_trip_and_nothing_else_matches() {
+        assert_eq!(parse_chunk_name(&chunk_file_name(12)), Some(12));
+        assert_eq!(parse_chunk_name(&chunk_file_name(1_234_567)), Some(1_234_567));
+        for name in ["chunk-12.parquet", "chunk-000012.parquet.bak", "chunk-00001x.parquet", "xchunk-000012.parquet", "chunk-0000012.parquet"] {
+            assert_eq!(parse_chunk_name(name), None, "{name}");
+        }
+        assert_eq!(temp_chunk(".chunk-000007.parquet.tmp-4242"), Some(7));
+        assert_eq!(temp_chunk("chunk-000007.parquet.tmp-4242"), None);
+        assert_eq!(temp_chunk(".chunk-000007.parquet.tmp-42x"), None);
+        assert!(is_manifest_temp(".manifest.json.tmp-12-345"));
+    }
+
+    #[test]
+    fn failures_count_everything_but_ok() {
+        let counts: BTreeMap<String, u64> = [("ok".to_string(), 5), ("rod_collapsed".into(), 2), ("non_finite".into(), 1)].into();
+        assert_eq!(failures(&counts), 3);
+    }
+}
