@@ -9,6 +9,7 @@ pub mod cli;
 pub mod io;
 pub mod model;
 pub mod plot;
+pub mod reduce;
 pub mod shape;
 pub mod sweep;
 
@@ -27,6 +28,9 @@ pub enum Error {
     /// Shape coefficients could not be computed.
     #[error(transparent)]
     Shape(#[from] shape::ShapeError),
+    /// Reducing a run into maps.
+    #[error(transparent)]
+    Reduce(#[from] reduce::ReduceError),
     /// Drawing a picture.
     #[error(transparent)]
     Plot(#[from] plot::PlotError),
