@@ -513,3 +513,30 @@ fn failed_solves_keep_their_inputs_and_have_null_outputs() {
 fn run_cmd_status(dir: &Path) -> (bool, String, String) {
     run(&["status", dir.to_str().unwrap()])
 }
+
+/// The contract between the stages: the reducer reads a sweep through
+/// `open_run` (mirror de-duplication undone there: 2·122 − 1 routings).
+#[test]
+fn the_reducer_reads_a_sweep_through_open_run() {
+    use cablemap::reduce::{reduce_batches, ReduceError, ReduceOptions, RunInfo};
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("run");
+    assert!(sweep(Path::new(QUICK), &dir, &[]).0);
+    let run = open_run(&dir, Completeness::Complete).unwrap();
+    let spec = run.spec();
+    let info = RunInfo {
+        mirrored: spec.grid.mirror_dedup,
+        order: spec.output.order,
+        tension_range_n: [spec.tension.min_n, spec.tension.max_n],
+        radius_mm: spec.actuator.radius_mm,
+        length_mm: spec.actuator.length_mm,
+        run_dir: dir.display().to_string(),
+        spec_hash: run.manifest().spec_sha256.clone(),
+    };
+    let map = reduce_batches(&info, &ReduceOptions::default(), || {
+        Ok(run.batches().map(|b| b.map_err(|e| ReduceError::Read(e.to_string()))))
+    })
+    .unwrap();
+    assert_eq!(map.summary.rows_total, (2 * 122 - 1) * 5);
+    assert_eq!(map.summary.rows_converged, map.summary.rows_total);
+}
