@@ -21,3 +21,7 @@ bin=$(cargo metadata --format-version 1 --no-deps | "$venv/bin/python" -c 'impor
 "$bin" sweep jobs/quick.toml --out "$work/quick" --quiet
 "$bin" sweep tests/python/failures.toml --out "$work/failures" --quiet
 "$venv/bin/python" tests/python/check_sweep.py "$work/quick" "$work/failures"
+
+echo "== Python read-back of maps (pandas, polars)"
+"$bin" reduce "$work/quick" --out "$work/quick-map" --json > /dev/null
+"$venv/bin/python" tests/python/check_maps.py "$work/quick-map"

@@ -2,6 +2,7 @@
 //! run each command. `main.rs` only parses and dispatches.
 
 pub mod bench;
+pub mod reduce;
 pub mod simulate;
 pub mod sweep;
 
