@@ -328,8 +328,11 @@ fn centreline_columns_are_lists_of_solver_nodes() {
         "[grid]\nlevels = 2\n[tension]\ncount = 2\n[output]\ncentreline = true\norder = 5\nchunk_routings = 7\n",
     );
     let dir = tmp.path().join("run");
-    let (ok, _, stderr) = sweep(&spec, &dir, &[]);
+    let (ok, stdout, stderr) = sweep(&spec, &dir, &["--json"]);
     assert!(ok, "{stderr}");
+    let v: serde_json::Value = serde_json::from_str(stdout.trim()).unwrap();
+    assert_eq!((v["summary"]["rows_written"].as_u64(), v["summary"]["status_counts"]["ok"].as_u64()), (Some(32), Some(32)));
+    assert_eq!((v["run"]["complete"].as_bool(), v["run"]["rows_total"].as_u64()), (Some(true), Some(32)));
     let run = open_run(&dir, Completeness::Complete).unwrap();
     assert_eq!(run.rows_done(), 16 * 2);
     for batch in run.batches() {

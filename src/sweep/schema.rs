@@ -29,7 +29,8 @@ pub const CENTRELINE_X_MM: &str = "centreline_x_mm";
 /// Optional centreline y positions (list of f64, mm; clamp to tip).
 pub const CENTRELINE_Y_MM: &str = "centreline_y_mm";
 
-/// Name of the coefficient column a_i (`a0`, `a1`, …; nullable f64, mm^−(i+1)).
+/// Name of the coefficient column a_i (`a0`, `a1`, …; nullable f64, mm⁻¹: κ = Σ a_i P_i(t)
+/// with t dimensionless, so every a_i is a curvature).
 pub fn coefficient_column(i: usize) -> String {
     format!("a{i}")
 }
