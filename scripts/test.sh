@@ -24,4 +24,4 @@ bin=$(cargo metadata --format-version 1 --no-deps | "$venv/bin/python" -c 'impor
 
 echo "== Python read-back of maps (pandas, polars)"
 "$bin" reduce "$work/quick" --out "$work/quick-map" --json > /dev/null
-"$venv/bin/python" tests/python/check_maps.py "$work/quick-map"
+"$venv/bin/python" tests/python/check_maps.py "$work/quick-map" "$work/quick"
