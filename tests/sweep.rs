@@ -521,25 +521,12 @@ fn run_cmd_status(dir: &Path) -> (bool, String, String) {
 /// `open_run` (mirror de-duplication undone there: 2·122 − 1 routings).
 #[test]
 fn the_reducer_reads_a_sweep_through_open_run() {
-    use cablemap::reduce::{reduce_batches, ReduceError, ReduceOptions, RunInfo};
+    use cablemap::reduce::{reduce_run, ReduceOptions};
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path().join("run");
     assert!(sweep(Path::new(QUICK), &dir, &[]).0);
-    let run = open_run(&dir, Completeness::Complete).unwrap();
-    let spec = run.spec();
-    let info = RunInfo {
-        mirrored: spec.grid.mirror_dedup,
-        order: spec.output.order,
-        tension_range_n: [spec.tension.min_n, spec.tension.max_n],
-        radius_mm: spec.actuator.radius_mm,
-        length_mm: spec.actuator.length_mm,
-        run_dir: dir.display().to_string(),
-        spec_hash: run.manifest().spec_sha256.clone(),
-    };
-    let map = reduce_batches(&info, &ReduceOptions::default(), || {
-        Ok(run.batches().map(|b| b.map_err(|e| ReduceError::Read(e.to_string()))))
-    })
-    .unwrap();
+    let (map, spec) = reduce_run(&dir, false, &ReduceOptions::default()).unwrap();
+    assert_eq!(spec, *open_run(&dir, Completeness::Complete).unwrap().spec());
     assert_eq!(map.summary.rows_total, (2 * 122 - 1) * 5);
     assert_eq!(map.summary.rows_converged, map.summary.rows_total);
 }
