@@ -22,6 +22,14 @@ enum Command {
     Feasible(cli::feasible::FeasibleArgs),
     /// Print solver timings (median µs per solve, single thread).
     Bench(cli::bench::BenchArgs),
+    /// Sweep a routing grid through a tension ladder into Parquet chunks (sharded, resumable).
+    Sweep(cli::sweep::SweepArgs),
+    /// Report a sweep directory: rows done per shard, failures, completeness.
+    Status(cli::sweep::StatusArgs),
+    /// Bin a sweep into feasibility maps: Parquet tables, PNG pictures, index.html.
+    Reduce(cli::reduce::ReduceArgs),
+    /// The main job: sweep (resumable) then reduce; the thesis sweep when no SPEC is given.
+    Map(cli::reduce::MapArgs),
 }
 
 fn main() -> ExitCode {
@@ -31,6 +39,10 @@ fn main() -> ExitCode {
         Command::Bench(args) => cli::bench::run(args),
         Command::Design(args) => cli::design::run(args),
         Command::Feasible(args) => cli::feasible::run(args),
+        Command::Sweep(args) => cli::sweep::run(args),
+        Command::Status(args) => cli::sweep::run_status_command(args),
+        Command::Reduce(args) => cli::reduce::run(args),
+        Command::Map(args) => cli::reduce::run_map(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -4,7 +4,9 @@
 pub mod bench;
 pub mod design;
 pub mod feasible;
+pub mod reduce;
 pub mod simulate;
+pub mod sweep;
 
 use crate::model::{Actuator, SolverOptions};
 use clap::Args;
