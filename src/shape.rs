@@ -64,7 +64,7 @@ fn quadrature_weight(i: usize, n: usize) -> f64 {
     if n < 4 {
         return if i == 0 || i == n - 1 { 0.5 } else { 1.0 };
     }
-    let simpson_end = if intervals % 2 == 0 { intervals } else { intervals - 3 };
+    let simpson_end = if intervals.is_multiple_of(2) { intervals } else { intervals - 3 };
     let mut w = 0.0;
     if i <= simpson_end && simpson_end > 0 {
         w += if i == 0 || i == simpson_end {
@@ -247,7 +247,7 @@ pub fn thesis_coefficients(points: &[[f64; 2]], order: usize, n_d: usize) -> Res
     // Invert eq. (3.12): b_i = ℓ/2 (a_{i−1}/(2i−1) − a_{i+1}/(2i+3)).
     let mut a = vec![0.0; order + 2];
     for i in (1..=order + 1).rev() {
-        let above = if i + 1 <= order { a[i + 1] / (2 * i + 3) as f64 } else { 0.0 };
+        let above = if i < order { a[i + 1] / (2 * i + 3) as f64 } else { 0.0 };
         a[i - 1] = (2 * i - 1) as f64 * (2.0 * b[i] / length + above);
     }
     a.truncate(order + 1);

@@ -37,7 +37,7 @@ fn value_range(values: &[f64], scale: Scale) -> (f64, f64) {
         let m = lo.abs().max(hi.abs());
         (lo, hi) = (-m, m);
     }
-    if !(hi > lo) {
+    if hi.partial_cmp(&lo) != Some(std::cmp::Ordering::Greater) {
         hi = lo + 1e-12_f64.max(lo.abs() * 1e-6);
     }
     (lo, hi)
@@ -165,9 +165,7 @@ pub fn draw_modes(path: &Path, map: &MapData, shapes: &[Option<BodyDrawing>]) ->
     ))
     .map_err(|e| PlotError::new(path, e))?;
     let panels = body.split_evenly((4, 3));
-    for m in 0..MODES {
-        let panel = &panels[m];
-        let mode = &map.modes[m];
+    for (m, (panel, mode)) in panels.iter().zip(&map.modes).enumerate().take(MODES) {
         let (map_area, shape_area) = panel.split_horizontally(360);
         let cells: Vec<(i32, i32, f64)> =
             map.cells.iter().filter(|c| c.modes[m] > 0).map(|c| (c.ix, c.iy, (c.modes[m] as f64).log10())).collect();
