@@ -72,6 +72,20 @@ impl Effect {
         }
     }
 
+    /// The effect's value on `a` if it is switched on there (a fit then
+    /// starts from it), `None` if `a` has the thesis model's value.
+    pub fn current(self, a: &Actuator) -> Option<f64> {
+        let v = match self {
+            Effect::Friction => a.effects.friction_mu,
+            Effect::Gravity => return (a.gravity.enabled && a.gravity.scale != 1.0 && a.gravity.scale > 0.0).then_some(a.gravity.scale),
+            Effect::Stiffening => a.effects.stiffening_alpha,
+            Effect::ClampCompliance => return a.effects.clamp_stiffness_n_mm_per_rad,
+            Effect::ChannelOffset => a.effects.channel_offset_mm,
+            Effect::Creep => a.effects.creep_fraction,
+        };
+        (v != 0.0).then_some(v)
+    }
+
     /// Starting value of the fit.
     pub fn start(self) -> f64 {
         match self {

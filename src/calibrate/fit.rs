@@ -160,6 +160,30 @@ pub fn rms_per_routing(
         .collect()
 }
 
+/// Pseudo-inverse of the symmetric matrix `a` by eigen-decomposition,
+/// ignoring directions with eigenvalue below 1e-12 of the largest, and
+/// which parameters lean on those ignored directions.
+fn pseudo_inverse(a: &DMatrix<f64>) -> (DMatrix<f64>, Vec<bool>) {
+    let p = a.nrows();
+    let eig = a.clone().symmetric_eigen();
+    let top = eig.eigenvalues.amax();
+    let mut inv = DMatrix::<f64>::zeros(p, p);
+    let mut unidentified = vec![false; p];
+    for (i, &l) in eig.eigenvalues.iter().enumerate() {
+        let v = eig.eigenvectors.column(i);
+        if l > 1e-12 * top && l > 0.0 {
+            inv += v * v.transpose() / l;
+        } else {
+            for k in 0..p {
+                if v[k].abs() > 1e-3 {
+                    unidentified[k] = true;
+                }
+            }
+        }
+    }
+    (inv, unidentified)
+}
+
 /// The fit problem: maps the unconstrained coordinates to an actuator.
 struct Problem<'a> {
     base: &'a Actuator,
@@ -209,7 +233,9 @@ impl Problem<'_> {
 }
 
 /// Fits the rigidities (and `spec.effects`) of `base` to the rows of
-/// `groups`. Effects already set on `base` but not fitted stay as they are.
+/// `groups`, starting from `base`'s values (an effect switched off on `base`
+/// starts from [`Effect::start`]). Effects set on `base` but not fitted stay
+/// as they are.
 pub fn fit(
     base: &Actuator,
     options: &SolverOptions,
@@ -226,7 +252,7 @@ pub fn fit(
     base.validate()?;
     let problem = Problem { base, options, data, groups, spec };
     let mut x: Vec<f64> = vec![base.ea_n.ln(), base.ga_n.ln(), base.ei_n_mm2.ln()];
-    x.extend(spec.effects.iter().map(|e| e.to_internal(e.start())));
+    x.extend(spec.effects.iter().map(|e| e.to_internal(e.current(base).unwrap_or_else(|| e.start()))));
     let p = x.len();
     let mut r = problem.residuals(&x)?;
     let n = r.len();
@@ -299,13 +325,20 @@ pub fn fit(
         let (sum, count) = r.iter().skip(c).step_by(3).fold((0.0, 0usize), |(s, k), v| (s + v * v, k + 1));
         sum / (count as f64 * dof_share)
     });
-    let cov = jtj.clone().try_inverse().map(|inv| {
-        let mut meat = DMatrix::<f64>::zeros(p, p);
-        for (i, row) in j.row_iter().enumerate() {
-            meat += row.transpose() * row * channel_var[i % 3];
+    let (inv, unidentified) = pseudo_inverse(&jtj);
+    let mut meat = DMatrix::<f64>::zeros(p, p);
+    for (i, row) in j.row_iter().enumerate() {
+        meat += row.transpose() * row * channel_var[i % 3];
+    }
+    let mut cov = &inv * meat * &inv;
+    // A parameter the data cannot determine (a rigidity run off to where it
+    // no longer matters) has no finite standard error.
+    for (k, &bad) in unidentified.iter().enumerate() {
+        if bad {
+            cov[(k, k)] = f64::INFINITY;
         }
-        &inv * meat * &inv
-    });
+    }
+    let cov = Some(cov);
     let (_, predictions) = problem.evaluate(&x)?;
     let actuator = problem.actuator(&x);
     let mut names: Vec<String> = vec!["ea_n".into(), "ga_n".into(), "ei_n_mm2".into()];
@@ -320,7 +353,10 @@ pub fn fit(
         .map(|k| FittedParameter {
             name: names[k].clone(),
             value: values[k],
-            se: cov.as_ref().map_or(f64::INFINITY, |c| derivs[k].abs() * c[(k, k)].max(0.0).sqrt()),
+            se: match cov.as_ref().map(|c| c[(k, k)]) {
+                Some(v) if v.is_finite() => derivs[k].abs() * v.max(0.0).sqrt(),
+                _ => f64::INFINITY,
+            },
         })
         .collect();
     let correlation = (0..p)

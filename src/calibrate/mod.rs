@@ -4,7 +4,7 @@
 //! missing effect.
 
 pub mod data;
-// pub mod diagnose;
+pub mod diagnose;
 pub mod effect;
 pub mod fit;
 pub mod predict;
