@@ -18,6 +18,12 @@ enum Command {
     Simulate(cli::simulate::SimulateArgs),
     /// Print solver timings (median µs per solve, single thread).
     Bench(cli::bench::BenchArgs),
+    /// Fit EA, GA, EI (and optionally effects) to measurements (thesis eq. 2.14).
+    Calibrate(cli::calibrate::CalibrateArgs),
+    /// Find, name and add the effect the model is missing; report and plots.
+    Diagnose(cli::diagnose::DiagnoseArgs),
+    /// Generate measurement files from the model with a hidden effect and noise.
+    Synth(cli::synth::SynthArgs),
 }
 
 fn main() -> ExitCode {
@@ -25,6 +31,9 @@ fn main() -> ExitCode {
     let result = match &cli.command {
         Command::Simulate(args) => cli::simulate::run(args),
         Command::Bench(args) => cli::bench::run(args),
+        Command::Calibrate(args) => cli::calibrate::run(args),
+        Command::Diagnose(args) => cli::diagnose::run(args),
+        Command::Synth(args) => cli::synth::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

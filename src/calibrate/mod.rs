@@ -8,7 +8,7 @@ pub mod diagnose;
 pub mod effect;
 pub mod fit;
 pub mod predict;
-// pub mod report;
+pub mod report;
 pub mod rng;
 pub mod synth;
 

@@ -1,7 +1,7 @@
 //! `cablemap simulate`: one actuator, one tension.
 
 use super::{parse_list, ActuatorArgs};
-use crate::model::{simulate, Actuator, Routing, Simulation, SolverOptions, STATUS_OK};
+use crate::model::{simulate_held, Actuator, Hold, LoadDirection, Routing, Simulation, SolverOptions, STATUS_OK};
 use crate::plot::{draw_bodies, BodyDrawing};
 use anyhow::Context;
 use clap::Args;
@@ -31,6 +31,12 @@ pub struct SimulateArgs {
     /// Draw the deformed body, channel and tip as PNG.
     #[arg(long, value_name = "FILE")]
     pub png: Option<PathBuf>,
+    /// Direction of the last tension change (sign of friction): load or unload.
+    #[arg(long, value_name = "DIR", default_value = "load", value_parser = ["load", "unload"])]
+    pub direction: String,
+    /// Seconds held at the tension before the reading, from a virgin rod (creep).
+    #[arg(long, value_name = "S", default_value_t = 0.0)]
+    pub dwell_s: f64,
     #[command(flatten)]
     pub actuator: ActuatorArgs,
 }
@@ -87,7 +93,9 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     let options = args.actuator.solver_options(&SolverOptions::default());
     let y = parse_list(&args.routing, "--routing")?;
     let routing = Routing::new(&y, actuator.length_mm, actuator.radius_mm).context("--routing")?;
-    let sim = simulate(&actuator, &options, &routing, args.tension, args.order)
+    let direction = if args.direction == "unload" { LoadDirection::Unload } else { LoadDirection::Load };
+    let hold = Hold { direction, dwell_s: args.dwell_s };
+    let sim = simulate_held(&actuator, &options, &routing, args.tension, args.order, hold)
         .with_context(|| format!("simulating routing {y:?} at {} N", args.tension))?;
     if let Some(path) = &args.csv {
         write_centreline_csv(path, &sim)?;
