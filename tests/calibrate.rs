@@ -206,3 +206,27 @@ fn diagnose_names_the_hidden_effect() {
     }
     assert!(failures.is_empty(), "{failures:#?}");
 }
+
+#[test]
+fn simulate_uses_the_new_effects() {
+    let base = ["simulate", "--routing", "1,2,3,3,2", "--tension", "1.5", "--json"];
+    let tip = |extra: &[&str]| -> f64 {
+        let mut args = base.to_vec();
+        args.extend_from_slice(extra);
+        let (ok, stdout, stderr) = cablemap(&args);
+        assert!(ok, "{stderr}");
+        json(&stdout)["tip_angle_rad"].as_f64().unwrap()
+    };
+    let plain = tip(&[]);
+    let load = tip(&["--friction-mu", "0.1"]);
+    let unload = tip(&["--friction-mu", "0.1", "--direction", "unload"]);
+    assert!(load < plain && plain < unload, "{load} {plain} {unload}");
+    let instant = tip(&["--creep-fraction", "0.3"]);
+    let held = tip(&["--creep-fraction", "0.3", "--dwell-s", "20"]);
+    let held_default = tip(&["--creep-fraction", "0.3", "--creep-hold-s", "20"]);
+    assert!((instant - plain).abs() < 1e-12 && held > plain + 0.05, "{instant} {held}");
+    // Equal to within the shooting tolerance (the warm starts differ).
+    assert!((held - held_default).abs() < 1e-7, "{held} {held_default}");
+    let (ok, _, stderr) = cablemap(&["simulate", "--routing", "1,2,3,3,2", "--tension", "1", "--creep-fraction", "1.5"]);
+    assert!(!ok && stderr.contains("creep_fraction"), "{stderr}");
+}

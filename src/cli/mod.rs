@@ -59,6 +59,9 @@ pub struct ActuatorArgs {
     /// Creep time constant T, s [default 10].
     #[arg(long, value_name = "S")]
     pub creep_time_s: Option<f64>,
+    /// Creep: seconds each tension is held on a fresh rod in sweeps and design [default 0].
+    #[arg(long, value_name = "S")]
+    pub creep_hold_s: Option<f64>,
     /// RK4 steps per knot span of the routing (even) [default 24].
     #[arg(long, value_name = "N")]
     pub steps_per_span: Option<usize>,
@@ -86,6 +89,7 @@ impl ActuatorArgs {
         set(&mut a.effects.friction_mu, self.friction_mu);
         set(&mut a.effects.creep_fraction, self.creep_fraction);
         set(&mut a.effects.creep_time_s, self.creep_time_s);
+        set(&mut a.effects.creep_hold_s, self.creep_hold_s);
         if self.no_gravity {
             a.gravity.enabled = false;
         }

@@ -34,9 +34,10 @@ pub struct SimulateArgs {
     /// Direction of the last tension change (sign of friction): load or unload.
     #[arg(long, value_name = "DIR", default_value = "load", value_parser = ["load", "unload"])]
     pub direction: String,
-    /// Seconds held at the tension before the reading, from a virgin rod (creep).
-    #[arg(long, value_name = "S", default_value_t = 0.0)]
-    pub dwell_s: f64,
+    /// Seconds held at the tension before the reading, from a rod with no
+    /// load history (creep) [default: --creep-hold-s, else 0].
+    #[arg(long, value_name = "S")]
+    pub dwell_s: Option<f64>,
     #[command(flatten)]
     pub actuator: ActuatorArgs,
 }
@@ -94,7 +95,7 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     let y = parse_list(&args.routing, "--routing")?;
     let routing = Routing::new(&y, actuator.length_mm, actuator.radius_mm).context("--routing")?;
     let direction = if args.direction == "unload" { LoadDirection::Unload } else { LoadDirection::Load };
-    let hold = Hold { direction, dwell_s: args.dwell_s };
+    let hold = Hold { direction, dwell_s: args.dwell_s.unwrap_or(actuator.effects.creep_hold_s) };
     let sim = simulate_held(&actuator, &options, &routing, args.tension, args.order, hold)
         .with_context(|| format!("simulating routing {y:?} at {} N", args.tension))?;
     if let Some(path) = &args.csv {

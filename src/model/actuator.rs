@@ -86,6 +86,10 @@ pub struct Effects {
     /// Time constant T of the creep's dashpot, s (the curvature relaxes
     /// like exp(−(1 − f) t / T) at a held moment).
     pub creep_time_s: f64,
+    /// For solves outside a measured protocol (simulate, sweep, design):
+    /// how long each tension is held on a rod with no load history before
+    /// the shape is taken, s. 0 gives the instantaneous (elastic) shape.
+    pub creep_hold_s: f64,
 }
 
 impl Default for Effects {
@@ -98,6 +102,7 @@ impl Default for Effects {
             channel_offset_mm: 0.0,
             creep_fraction: 0.0,
             creep_time_s: DEFAULT_CREEP_TIME_S,
+            creep_hold_s: 0.0,
         }
     }
 }
@@ -201,6 +206,10 @@ impl Actuator {
         let t = self.effects.creep_time_s;
         if !(t.is_finite() && t > 0.0) {
             return Err(ParameterError::NotPositive { name: "effects.creep_time_s", value: t });
+        }
+        let hold = self.effects.creep_hold_s;
+        if !(hold.is_finite() && hold >= 0.0) {
+            return Err(ParameterError::OutOfRange { name: "effects.creep_hold_s", value: hold, expected: "a finite time ≥ 0 s" });
         }
         let delta = self.effects.channel_offset_mm;
         if !(delta.is_finite() && delta.abs() < self.radius_mm) {

@@ -266,6 +266,10 @@ pub struct Simulator {
     creep_decay: f64,
     /// Extra compliance of the held step, f (1 − E)/((1 − f) EI), 1/(N·mm²).
     creep_gain: f64,
+    /// Whether every solve starts from a rod with no load history (the
+    /// default, held `effects.creep_hold_s`), or follows a protocol set by
+    /// [`Simulator::set_hold`].
+    virgin_holds: bool,
 }
 
 /// How a solve is held: the direction of the last tension change (friction)
@@ -318,6 +322,13 @@ impl Simulator {
             dwell_s: 0.0,
             creep_decay: 1.0,
             creep_gain: 0.0,
+            virgin_holds: true,
+        })
+        .and_then(|mut sim: Simulator| {
+            let hold = Hold { direction: actuator.effects.load_direction, dwell_s: actuator.effects.creep_hold_s };
+            sim.set_hold(hold)?;
+            sim.virgin_holds = true;
+            Ok(sim)
         })
     }
 
@@ -370,9 +381,14 @@ impl Simulator {
     }
 
     /// Sets how the next solves are held: the load direction (sign of
-    /// friction) and the dwell time before the reading (creep). A dwell of
-    /// 0 s leaves the creep history unchanged.
+    /// friction) and the dwell time before the reading (creep). From then
+    /// on solves follow a protocol: the creep history carries over from
+    /// solve to solve (a dwell of 0 s leaves it unchanged).
+    ///
+    /// Without this call every solve is held `effects.creep_hold_s` on a
+    /// rod with no load history, in `effects.load_direction`.
     pub fn set_hold(&mut self, hold: Hold) -> Result<(), ParameterError> {
+        self.virgin_holds = false;
         if !(hold.dwell_s.is_finite() && hold.dwell_s >= 0.0) {
             return Err(ParameterError::OutOfRange { name: "dwell_s", value: hold.dwell_s, expected: "a finite time ≥ 0 s" });
         }
@@ -679,6 +695,9 @@ impl Simulator {
         if !(tension_n.is_finite() && tension_n >= 0.0) {
             return Err(SolveFailure::InvalidTension(tension_n));
         }
+        if self.virgin_holds && self.actuator.effects.creep_fraction > 0.0 {
+            self.reset_history();
+        }
         let result = self.solve_inner(tension_n);
         match &result {
             Ok(pose) => self.last = Some(*pose),
@@ -768,7 +787,7 @@ impl Simulator {
         let base = self.nodes_state[0];
         let tip = self.nodes_state[n_nodes - 1];
         let (e0, et) = (self.nodes_strain[0], self.nodes_strain[n_nodes - 1]);
-        if self.actuator.effects.creep_fraction > 0.0 && self.dwell_s > 0.0 {
+        if self.actuator.effects.creep_fraction > 0.0 && self.dwell_s > 0.0 && !self.virgin_holds {
             self.advance_creep();
         }
         Ok(TipPose {
@@ -877,7 +896,7 @@ pub fn simulate(
     tension_n: f64,
     order: usize,
 ) -> Result<Simulation, crate::Error> {
-    let hold = Hold { direction: actuator.effects.load_direction, dwell_s: 0.0 };
+    let hold = Hold { direction: actuator.effects.load_direction, dwell_s: actuator.effects.creep_hold_s };
     simulate_held(actuator, options, routing, tension_n, order, hold)
 }
 
@@ -1008,6 +1027,20 @@ mod tests {
         sim.set_hold(Hold { direction: LoadDirection::Load, dwell_s: 1e4 }).unwrap();
         let relaxed = sim.solve(tau).unwrap();
         assert!((relaxed.tip_angle_rad - m / (ei * (1.0 - f)) * a.length_mm).abs() < 1e-9);
+        // Outside a protocol (sweeps, design) every tension is held
+        // `creep_hold_s` on a fresh rod: the same as the first held step.
+        let mut fresh = straight(
+            |a| {
+                a.effects.creep_fraction = f;
+                a.effects.creep_time_s = t_s;
+                a.effects.creep_hold_s = d1;
+            },
+            d,
+        );
+        for _ in 0..3 {
+            let pose = ladder(&mut fresh, tau);
+            assert!((pose.tip_angle_rad - u1 * a.length_mm).abs() < 1e-9);
+        }
     }
 
     #[test]
