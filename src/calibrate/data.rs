@@ -488,6 +488,42 @@ mod tests {
     }
 
     #[test]
+    fn reads_parquet_like_csv() {
+        use arrow::array::{ArrayRef, Float64Array, Int64Array, StringArray};
+        use arrow::record_batch::RecordBatch;
+        use std::sync::Arc;
+        let f = |v: Vec<f64>| Arc::new(Float64Array::from(v)) as ArrayRef;
+        let mut cols: Vec<(&str, ArrayRef)> = vec![
+            ("measurement", Arc::new(Int64Array::from(vec![1, 2]))),
+            ("routing", Arc::new(StringArray::from(vec!["a", "a"]))),
+        ];
+        for name in ["y0_mm", "y1_mm", "y2_mm", "y3_mm", "y4_mm"] {
+            cols.push((name, f(vec![1.5, 1.5])));
+        }
+        cols.push(("tension_n", f(vec![0.0, 0.7])));
+        cols.push(("direction", Arc::new(StringArray::from(vec!["rest", "load"]))));
+        cols.push(("step", Arc::new(Int64Array::from(vec![0, 1]))));
+        cols.push(("dwell_s", f(vec![5.0, 5.0])));
+        cols.push(("tip_x_mm", f(vec![65.0, 61.25])));
+        cols.push(("tip_y_mm", f(vec![0.0, 0.1 + 0.2])));
+        cols.push(("tip_angle_rad", f(vec![0.0, 0.5])));
+        let batch = RecordBatch::try_from_iter(cols).unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("m.parquet");
+        let file = std::fs::File::create(&path).unwrap();
+        let mut w = parquet::arrow::ArrowWriter::try_new(file, batch.schema(), None).unwrap();
+        w.write(&batch).unwrap();
+        w.close().unwrap();
+        let d = read_measurements(&path).unwrap();
+        assert_eq!(d.rows.len(), 2);
+        assert_eq!(d.rows[1].tip_y_mm, 0.1 + 0.2, "floats survive exactly");
+        assert_eq!(d.rows[1].direction, Direction::Load);
+        std::fs::write(&path, b"not parquet").unwrap();
+        let e = read_measurements(&path).unwrap_err().to_string();
+        assert!(e.contains("m.parquet") && e.contains("Parquet"), "{e}");
+    }
+
+    #[test]
     fn errors_name_the_row_and_column() {
         let missing = parse("measurement,routing\n1,a\n").unwrap_err().to_string();
         assert!(missing.contains("y0_mm"), "{missing}");
