@@ -161,14 +161,24 @@ fn markdown(data_path: &Path, data: &Dataset, d: &Diagnosis, after_label: &str) 
     out
 }
 
-fn pe(path: &Path) -> impl Fn(String) -> PlotError + '_ {
-    move |e| PlotError::new(path, e)
+type Chart<'a, 'b> = ChartContext<'a, BitMapBackend<'b>, Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>>;
+
+/// Draws the series legend of `chart` at `position` in `font_size` points.
+fn draw_legend<'a, 'b: 'a>(chart: &mut Chart<'a, 'b>, path: &Path, position: SeriesLabelPosition, font_size: u32) -> Result<(), PlotError> {
+    chart
+        .configure_series_labels()
+        .position(position)
+        .label_font((FONT, font_size))
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()
+        .map_err(|e| PlotError::new(path, e))
 }
 
 fn residual_plot(path: &Path, data: &Dataset, groups: &[RoutingGroup], d: &Diagnosis, after: &str, w: f64) -> Result<(), PlotError> {
     register_fonts();
     let root = BitMapBackend::new(path, (1100, 800)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| pe(path)(e.to_string()))?;
+    root.fill(&WHITE).map_err(|e| PlotError::new(path, e))?;
     let panels = root.split_evenly((2, 1));
     let order: Vec<usize> = groups.iter().flat_map(|g| g.rows.iter().copied()).collect();
     let series = |preds: &[Option<Prediction>]| -> Vec<[f64; 3]> {
@@ -184,7 +194,7 @@ fn residual_plot(path: &Path, data: &Dataset, groups: &[RoutingGroup], d: &Diagn
             .x_label_area_size(35)
             .y_label_area_size(60)
             .build_cartesian_2d(-0.5..order.len() as f64 - 0.5, -lim..lim)
-            .map_err(|e| pe(path)(e.to_string()))?;
+            .map_err(|e| PlotError::new(path, e))?;
         chart
             .configure_mesh()
             .x_desc("reading (routings in protocol order)")
@@ -192,11 +202,11 @@ fn residual_plot(path: &Path, data: &Dataset, groups: &[RoutingGroup], d: &Diagn
             .label_style((FONT, 13))
             .axis_desc_style((FONT, 14))
             .draw()
-            .map_err(|e| pe(path)(e.to_string()))?;
+            .map_err(|e| PlotError::new(path, e))?;
         for (c, (name, colour)) in [("Δx", BLUE), ("Δy", GREEN), ("Δθ·w", RGBColor(230, 120, 0))].into_iter().enumerate() {
             chart
                 .draw_series(res.iter().enumerate().map(|(k, r)| Circle::new((k as f64, r[c]), 3, colour.filled())))
-                .map_err(|e| pe(path)(e.to_string()))?
+                .map_err(|e| PlotError::new(path, e))?
                 .label(name)
                 .legend(move |(x, y)| Circle::new((x + 8, y), 4, colour.filled()));
         }
@@ -205,17 +215,11 @@ fn residual_plot(path: &Path, data: &Dataset, groups: &[RoutingGroup], d: &Diagn
         for g in groups {
             k += g.rows.len();
             let x = k as f64 - 0.5;
-            chart.draw_series(LineSeries::new(vec![(x, -lim), (x, lim)], BLACK.mix(0.3))).map_err(|e| pe(path)(e.to_string()))?;
+            chart.draw_series(LineSeries::new(vec![(x, -lim), (x, lim)], BLACK.mix(0.3))).map_err(|e| PlotError::new(path, e))?;
         }
-        chart
-            .configure_series_labels()
-            .label_font((FONT, 13))
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .draw()
-            .map_err(|e| pe(path)(e.to_string()))?;
+        draw_legend(&mut chart, path, SeriesLabelPosition::UpperRight, 13)?;
     }
-    root.present().map_err(|e| pe(path)(e.to_string()))
+    root.present().map_err(|e| PlotError::new(path, e))
 }
 
 fn loop_plot(path: &Path, data: &Dataset, groups: &[RoutingGroup], d: &Diagnosis, after: &str) -> Result<(), PlotError> {
@@ -223,7 +227,7 @@ fn loop_plot(path: &Path, data: &Dataset, groups: &[RoutingGroup], d: &Diagnosis
     let cols = groups.len().clamp(1, 3);
     let rows = groups.len().div_ceil(cols).max(1);
     let root = BitMapBackend::new(path, (420 * cols as u32, 360 * rows as u32)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| pe(path)(e.to_string()))?;
+    root.fill(&WHITE).map_err(|e| PlotError::new(path, e))?;
     let panels = root.split_evenly((rows, cols));
     let orange = RGBColor(230, 120, 0);
     for (panel, g) in panels.iter().zip(groups) {
@@ -243,7 +247,7 @@ fn loop_plot(path: &Path, data: &Dataset, groups: &[RoutingGroup], d: &Diagnosis
             .x_label_area_size(35)
             .y_label_area_size(50)
             .build_cartesian_2d(-0.02 * tmax..tmax, (lo - pad)..(hi + pad))
-            .map_err(|e| pe(path)(e.to_string()))?;
+            .map_err(|e| PlotError::new(path, e))?;
         chart
             .configure_mesh()
             .x_desc("tension (N)")
@@ -251,34 +255,27 @@ fn loop_plot(path: &Path, data: &Dataset, groups: &[RoutingGroup], d: &Diagnosis
             .label_style((FONT, 12))
             .axis_desc_style((FONT, 13))
             .draw()
-            .map_err(|e| pe(path)(e.to_string()))?;
+            .map_err(|e| PlotError::new(path, e))?;
         chart
             .draw_series(LineSeries::new(base, BLUE.stroke_width(2)))
-            .map_err(|e| pe(path)(e.to_string()))?
+            .map_err(|e| PlotError::new(path, e))?
             .label("thesis model")
             .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], BLUE.stroke_width(2)));
         chart
             .draw_series(LineSeries::new(ext, orange.stroke_width(2)))
-            .map_err(|e| pe(path)(e.to_string()))?
+            .map_err(|e| PlotError::new(path, e))?
             .label(after.to_string())
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], orange.stroke_width(2)));
         for (dir, colour, label) in [(Direction::Load, BLACK, "measured, load"), (Direction::Unload, RED, "measured, unload"), (Direction::Rest, RGBColor(120, 120, 120), "measured, rest")] {
             chart
                 .draw_series(measured.iter().filter(|m| m.2 == dir).map(|m| Circle::new((m.0, m.1), 4, colour.filled())))
-                .map_err(|e| pe(path)(e.to_string()))?
+                .map_err(|e| PlotError::new(path, e))?
                 .label(label)
                 .legend(move |(x, y)| Circle::new((x + 8, y), 4, colour.filled()));
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
-            .label_font((FONT, 11))
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .draw()
-            .map_err(|e| pe(path)(e.to_string()))?;
+        draw_legend(&mut chart, path, SeriesLabelPosition::UpperLeft, 11)?;
     }
-    root.present().map_err(|e| pe(path)(e.to_string()))
+    root.present().map_err(|e| PlotError::new(path, e))
 }
 
 fn shape_plot(
@@ -309,14 +306,14 @@ fn shape_plot(
     let span = (x1 - x0).max(y1 - y0) + 10.0;
     let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
     let root = BitMapBackend::new(path, (850, 850)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| pe(path)(e.to_string()))?;
+    root.fill(&WHITE).map_err(|e| PlotError::new(path, e))?;
     let mut chart = ChartBuilder::on(&root)
         .caption("shapes at the top tension: measured vs simulated", (FONT, 20))
         .margin(12)
         .x_label_area_size(40)
         .y_label_area_size(50)
         .build_cartesian_2d((cx - span / 2.0)..(cx + span / 2.0), (cy - span / 2.0)..(cy + span / 2.0))
-        .map_err(|e| pe(path)(e.to_string()))?;
+        .map_err(|e| PlotError::new(path, e))?;
     chart
         .configure_mesh()
         .x_desc("y (mm, lateral)")
@@ -325,41 +322,34 @@ fn shape_plot(
         .label_style((FONT, 13))
         .axis_desc_style((FONT, 14))
         .draw()
-        .map_err(|e| pe(path)(e.to_string()))?;
+        .map_err(|e| PlotError::new(path, e))?;
     let orange = RGBColor(230, 120, 0);
     for (k, &(g, i)) in picks.iter().enumerate() {
         let first = k == 0;
-        let s = chart.draw_series(LineSeries::new(line(&d.baseline_predictions, i), BLUE.stroke_width(2))).map_err(|e| pe(path)(e.to_string()))?;
+        let s = chart.draw_series(LineSeries::new(line(&d.baseline_predictions, i), BLUE.stroke_width(2))).map_err(|e| PlotError::new(path, e))?;
         if first {
             s.label("thesis model").legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], BLUE.stroke_width(2)));
         }
-        let s = chart.draw_series(LineSeries::new(line(&d.extended_predictions, i), orange.stroke_width(2))).map_err(|e| pe(path)(e.to_string()))?;
+        let s = chart.draw_series(LineSeries::new(line(&d.extended_predictions, i), orange.stroke_width(2))).map_err(|e| PlotError::new(path, e))?;
         if first {
             s.label(after.to_string()).legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], orange.stroke_width(2)));
         }
         let m = &data.rows[i];
         let s = chart
             .draw_series(std::iter::once(Cross::new((m.tip_y_mm, -m.tip_x_mm), 7, BLACK.stroke_width(2))))
-            .map_err(|e| pe(path)(e.to_string()))?;
+            .map_err(|e| PlotError::new(path, e))?;
         if first {
             s.label("measured tip").legend(|(x, y)| Cross::new((x + 8, y), 5, BLACK.stroke_width(2)));
         }
         if let Some(points) = centrelines.and_then(|c| c.get(&m.measurement)) {
             chart
                 .draw_series(points.iter().map(|p| Circle::new((p[1], -p[0]), 2, BLACK.mix(0.6).filled())))
-                .map_err(|e| pe(path)(e.to_string()))?;
+                .map_err(|e| PlotError::new(path, e))?;
         }
         chart
             .draw_series(std::iter::once(Text::new(g.routing.clone(), (m.tip_y_mm + 2.0, -m.tip_x_mm + 2.0), (FONT, 13))))
-            .map_err(|e| pe(path)(e.to_string()))?;
+            .map_err(|e| PlotError::new(path, e))?;
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::LowerLeft)
-        .label_font((FONT, 13))
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()
-        .map_err(|e| pe(path)(e.to_string()))?;
-    root.present().map_err(|e| pe(path)(e.to_string()))
+    draw_legend(&mut chart, path, SeriesLabelPosition::LowerLeft, 13)?;
+    root.present().map_err(|e| PlotError::new(path, e))
 }

@@ -630,6 +630,19 @@ impl Simulator {
         Ok(passes)
     }
 
+    /// Friction: updates the tension profile from the last pass and re-solves
+    /// with `repass` (returning its passes) until the profile settles.
+    fn settle_friction(&mut self, mut repass: impl FnMut(&mut Self) -> Result<u32, SolveFailure>) -> Result<u32, SolveFailure> {
+        let mut passes = 0;
+        for _ in 0..FRICTION_MAX_PASSES {
+            if self.update_tension_ratio() < FRICTION_TOLERANCE {
+                return Ok(passes);
+            }
+            passes += repass(self)?;
+        }
+        Err(SolveFailure::FrictionNotConverged)
+    }
+
     /// Recomputes the friction tension profile τ(s)/τ(0) from the cable
     /// angles of the last pass (capstan law between neighbouring nodes,
     /// exact for a constant |ψ'| between them); returns the largest change.
@@ -746,19 +759,8 @@ impl Simulator {
                 slope = 1.0;
             }
             passes = self.shoot(tension, &mut m0, &mut slope)?;
-            // Friction: re-shoot with the updated tension profile until it settles.
             if has_friction {
-                let mut settled = false;
-                for _ in 0..FRICTION_MAX_PASSES {
-                    if self.update_tension_ratio() < FRICTION_TOLERANCE {
-                        settled = true;
-                        break;
-                    }
-                    passes += self.shoot(tension, &mut m0, &mut slope)?;
-                }
-                if !settled {
-                    return Err(SolveFailure::FrictionNotConverged);
-                }
+                passes += self.settle_friction(|sim| sim.shoot(tension, &mut m0, &mut slope))?;
             }
             let cont = &mut self.continuation;
             cont.history.rotate_right(1);
@@ -769,18 +771,7 @@ impl Simulator {
             self.integrate(tension, 0.0)?;
             passes = 1;
             if has_friction {
-                let mut settled = false;
-                for _ in 0..FRICTION_MAX_PASSES {
-                    if self.update_tension_ratio() < FRICTION_TOLERANCE {
-                        settled = true;
-                        break;
-                    }
-                    self.integrate(tension, 0.0)?;
-                    passes += 1;
-                }
-                if !settled {
-                    return Err(SolveFailure::FrictionNotConverged);
-                }
+                passes += self.settle_friction(|sim| sim.integrate(tension, 0.0).map(|_| 1))?;
             }
         }
         let n_nodes = self.nodes_state.len();
