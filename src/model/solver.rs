@@ -270,6 +270,8 @@ pub struct Simulator {
     /// default, held `effects.creep_hold_s`), or follows a protocol set by
     /// [`Simulator::set_hold`].
     virgin_holds: bool,
+    /// Whether passes record cable angles and moments (friction or creep on).
+    records_profile: bool,
 }
 
 /// How a solve is held: the direction of the last tension change (friction)
@@ -323,6 +325,7 @@ impl Simulator {
             creep_decay: 1.0,
             creep_gain: 0.0,
             virgin_holds: true,
+            records_profile: actuator.effects.friction_mu > 0.0 || actuator.effects.creep_fraction > 0.0,
         })
         .and_then(|mut sim: Simulator| {
             let hold = Hold { direction: actuator.effects.load_direction, dwell_s: actuator.effects.creep_hold_s };
@@ -513,8 +516,11 @@ impl Simulator {
         let creep_offset = self.creep_offset(k);
         let (e, dir) = self.strains_at(s, ch, (sp, cp), st.moment, local_tension, self.cable_dir[k], creep_offset)?;
         self.cable_dir[k] = dir;
-        self.cable_global[k] = (cp * dir.0 - sp * dir.1, sp * dir.0 + cp * dir.1);
-        self.bending_moment[k] = local_tension * ch.y * dir.0 + st.moment;
+        // Only friction (cable angles) and creep (moments) need these.
+        if self.records_profile {
+            self.cable_global[k] = (cp * dir.0 - sp * dir.1, sp * dir.0 + cp * dir.1);
+            self.bending_moment[k] = local_tension * ch.y * dir.0 + st.moment;
+        }
         let dx = e.v1 * cp - e.v2 * sp;
         let dy = e.v1 * sp + e.v2 * cp;
         let wl = self.weight_n_per_mm * (self.actuator.length_mm - s);
