@@ -10,6 +10,7 @@ pub mod cli;
 pub mod io;
 pub mod model;
 pub mod plot;
+pub mod reduce;
 pub mod shape;
 
 /// Any error of the library, by layer.
@@ -30,6 +31,9 @@ pub enum Error {
     /// Calibration and diagnosis.
     #[error(transparent)]
     Calibrate(#[from] calibrate::CalibrateError),
+    /// Reducing a run into maps.
+    #[error(transparent)]
+    Reduce(#[from] reduce::ReduceError),
     /// Drawing a picture.
     #[error(transparent)]
     Plot(#[from] plot::PlotError),

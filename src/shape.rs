@@ -38,7 +38,7 @@ pub struct ShapeCoefficients {
     pub base_angle_rad: f64,
     /// Tangent angle at the last point, rad (continuous, not wrapped).
     pub tip_angle_rad: f64,
-    /// a_0 … a_n: a_i in mm^−(i+1).
+    /// a_0 … a_n, mm⁻¹ (every a_i is a curvature: t is dimensionless).
     pub a: Vec<f64>,
 }
 

@@ -22,6 +22,14 @@ pub struct SimulateArgs {
     /// Highest Legendre order n of the curvature coefficients a_0..a_n.
     #[arg(long, default_value_t = 3)]
     pub order: usize,
+    /// How a_i are computed: `exact` (the definition, from the solver's
+    /// tangent angles) or `thesis` (thesis §3.3: tangent angles resampled at
+    /// --n-d equal arc-length intervals, discrete Legendre vectors, eq. 3.12).
+    #[arg(long, value_enum, default_value_t = CoefficientRoute::Exact)]
+    pub coefficients: CoefficientRoute,
+    /// Intervals n_d of the thesis route.
+    #[arg(long, default_value_t = 40)]
+    pub n_d: usize,
     /// Print one JSON object instead of a report.
     #[arg(long)]
     pub json: bool,
@@ -40,6 +48,15 @@ pub struct SimulateArgs {
     pub dwell_s: Option<f64>,
     #[command(flatten)]
     pub actuator: ActuatorArgs,
+}
+
+/// Which definition of the curvature coefficients to report.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum CoefficientRoute {
+    /// a_i = (2i+1)/ℓ ∫ P_i dθ, exactly (model-notes §4).
+    Exact,
+    /// The thesis's discrete route (§3.3, eq. 3.12), from the centreline points.
+    Thesis,
 }
 
 /// The JSON object other tools rely on (names shared with sweep columns).
@@ -96,8 +113,12 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     let routing = Routing::new(&y, actuator.length_mm, actuator.radius_mm).context("--routing")?;
     let direction = if args.direction == "unload" { LoadDirection::Unload } else { LoadDirection::Load };
     let hold = Hold { direction, dwell_s: args.dwell_s.unwrap_or(actuator.effects.creep_hold_s) };
-    let sim = simulate_held(&actuator, &options, &routing, args.tension, args.order, hold)
+    let mut sim = simulate_held(&actuator, &options, &routing, args.tension, args.order, hold)
         .with_context(|| format!("simulating routing {y:?} at {} N", args.tension))?;
+    if args.coefficients == CoefficientRoute::Thesis {
+        let points: Vec<[f64; 2]> = sim.centreline.iter().map(|c| [c.x_mm, c.y_mm]).collect();
+        sim.a = crate::shape::thesis_coefficients(&points, args.order, args.n_d).context("thesis coefficient route")?.a;
+    }
     if let Some(path) = &args.csv {
         write_centreline_csv(path, &sim)?;
     }
@@ -120,7 +141,7 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     writeln!(out, "base angle     {:.8} rad ({:.4}°)", p.base_angle_rad, p.base_angle_rad.to_degrees())?;
     writeln!(out, "length ℓ       {:.6} mm", p.length_mm)?;
     for (i, a) in sim.a.iter().enumerate() {
-        writeln!(out, "a_{i:<12} {a:.8e} mm^-{}", i + 1)?;
+        writeln!(out, "a_{i:<12} {a:.8e} mm^-1")?;
     }
     writeln!(out, "iterations     {} integration pass(es)", p.iterations)?;
     Ok(())

@@ -878,7 +878,7 @@ pub struct Simulation {
     pub routing_mm: [f64; 5],
     /// Tip pose and length.
     pub pose: TipPose,
-    /// a_0 … a_n, 1/mm^(i+1).
+    /// a_0 … a_n, mm⁻¹ (κ = Σ a_i P_i(t) with dimensionless t, so every a_i is a curvature).
     pub a: Vec<f64>,
     /// Centreline from clamp to tip.
     pub centreline: Vec<CentrelinePoint>,
