@@ -307,22 +307,8 @@ fn shape_plot(
     let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
     let root = BitMapBackend::new(path, (850, 850)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| PlotError::new(path, e))?;
-    let mut chart = ChartBuilder::on(&root)
-        .caption("shapes at the top tension: measured vs simulated", (FONT, 20))
-        .margin(12)
-        .x_label_area_size(40)
-        .y_label_area_size(50)
-        .build_cartesian_2d((cx - span / 2.0)..(cx + span / 2.0), (cy - span / 2.0)..(cy + span / 2.0))
-        .map_err(|e| PlotError::new(path, e))?;
-    chart
-        .configure_mesh()
-        .x_desc("y (mm, lateral)")
-        .y_desc("x (mm, along the clamp axis, downward)")
-        .y_label_formatter(&|v| format!("{:.0}", -v + 0.0))
-        .label_style((FONT, 13))
-        .axis_desc_style((FONT, 14))
-        .draw()
-        .map_err(|e| PlotError::new(path, e))?;
+    let title = "shapes at the top tension: measured vs simulated";
+    let mut chart = crate::plot::hanging_chart(&root, path, title, (cx - span / 2.0, cx + span / 2.0), (cy - span / 2.0, cy + span / 2.0))?;
     let orange = RGBColor(230, 120, 0);
     for (k, &(g, i)) in picks.iter().enumerate() {
         let first = k == 0;
