@@ -230,3 +230,28 @@ fn simulate_uses_the_new_effects() {
     let (ok, _, stderr) = cablemap(&["simulate", "--routing", "1,2,3,3,2", "--tension", "1", "--creep-fraction", "1.5"]);
     assert!(!ok && stderr.contains("creep_fraction"), "{stderr}");
 }
+
+#[test]
+fn diagnose_adds_a_second_effect_stepwise() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = dir.path().join("two.csv");
+    let t = truth_args();
+    let mut extra: Vec<&str> = vec!["--seed", "3", "--effect", "friction", "--magnitude", "0.08", "--channel-offset-mm", "0.4"];
+    extra.extend(t.iter().map(|s| s.as_str()));
+    synth(&data, &extra);
+    let (ok, stdout, stderr) = cablemap(&["diagnose", data.to_str().unwrap(), "--holdout", "arc", "--no-report", "--json"]);
+    assert!(ok, "{stderr}");
+    let v = json(&stdout);
+    let effects = v["effects"].as_array().unwrap();
+    let names: Vec<&str> = effects.iter().map(|e| e["effect"].as_str().unwrap()).collect();
+    let mut sorted = names.clone();
+    sorted.sort();
+    assert_eq!(sorted, ["channel_offset", "friction"], "{v}");
+    assert_eq!(v["verdict"], names[0]);
+    for (e, want) in effects.iter().map(|e| (e, if e["effect"] == "friction" { 0.08 } else { 0.4 })) {
+        let got = e["parameter"].as_f64().unwrap();
+        assert!(((got - want) / want).abs() < 0.25, "{e}");
+    }
+    let (before, after) = (v["holdout_rms_before"].as_f64().unwrap(), v["holdout_rms_after"].as_f64().unwrap());
+    assert!(before > 1.5 * after, "{before} → {after}");
+}

@@ -453,3 +453,40 @@ pub fn residual_diagnostics(
         per_routing: rms_per_routing(data, groups, predictions, w),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn cand(effect: Effect, delta_bic: f64, plausible: bool) -> Candidate {
+        Candidate {
+            rank: 0,
+            effect: effect.name(),
+            parameter_name: effect.parameter_name(),
+            parameter: 1.0,
+            parameter_se: 0.1,
+            delta_bic,
+            rms_mm: 1.0,
+            plausible,
+            error: None,
+        }
+    }
+
+    #[test]
+    fn the_criterion_names_refuses_or_calls_it_ambiguous() {
+        let spec = DiagnoseSpec::default();
+        let named = |c: &[Candidate]| match decide(c, &spec) {
+            Decision::None => "none".to_string(),
+            Decision::Named(e) => e.name().to_string(),
+            Decision::Ambiguous(a, b) => format!("{}|{}", a.name(), b.name()),
+        };
+        use Effect::*;
+        assert_eq!(named(&[cand(Friction, -50.0, true), cand(Creep, -30.0, true)]), "friction");
+        assert_eq!(named(&[cand(Friction, -50.0, true), cand(Creep, -45.0, true)]), "friction|creep");
+        assert_eq!(named(&[cand(Friction, -9.0, true), cand(Creep, 3.0, true)]), "none");
+        // An implausible value is passed over, for naming and as runner-up.
+        assert_eq!(named(&[cand(Gravity, -80.0, false), cand(Friction, -50.0, true), cand(Creep, -20.0, true)]), "friction");
+        assert_eq!(named(&[cand(Friction, -50.0, true), cand(Gravity, -48.0, false)]), "friction");
+        assert_eq!(named(&[]), "none");
+    }
+}

@@ -78,7 +78,7 @@ pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
     }
     writeln!(out, "verdict: {}", d.verdict)?;
     for n in &d.named {
-        writeln!(out, "  {} {} = {:.6} ± {:.3e} (ΔBIC {:.1})", n.effect, n.parameter_name, n.parameter, n.parameter_se, n.delta_bic)?;
+        writeln!(out, "  {} {} = {} ± {:.3e} (ΔBIC {:.1})", n.effect, n.parameter_name, value(n.parameter), n.parameter_se, n.delta_bic)?;
     }
     if let Some(m) = &d.separating_measurement {
         writeln!(out, "  cannot tell {} from {}: {m}", d.ambiguous_between[0], d.ambiguous_between[1])?;
@@ -87,11 +87,11 @@ pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
     for c in &d.candidates {
         writeln!(
             out,
-            "  {}. {:<17} {:<30} {:>12.5} ± {:<10.3e} ΔBIC {:>9.2}{}",
+            "  {}. {:<17} {:<30} {:>12} ± {:<10.3e} ΔBIC {:>9.2}{}",
             c.rank,
             c.effect,
             c.parameter_name,
-            c.parameter,
+            value(c.parameter),
             c.parameter_se,
             c.delta_bic,
             if c.plausible { "" } else { "  (implausible or failed)" }
@@ -105,4 +105,13 @@ pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
         writeln!(out, "report: {}", p.display())?;
     }
     Ok(())
+}
+
+/// A parameter value for the summary: fixed point unless very large or small.
+fn value(v: f64) -> String {
+    if v != 0.0 && v.is_finite() && !(1e-4..1e6).contains(&v.abs()) {
+        format!("{v:.5e}")
+    } else {
+        format!("{v:.5}")
+    }
 }
