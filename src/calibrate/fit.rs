@@ -363,7 +363,9 @@ pub fn fit(
         .map(|a| {
             (0..p)
                 .map(|b| match &cov {
-                    Some(c) => c[(a, b)] / (c[(a, a)] * c[(b, b)]).sqrt(),
+                    // No correlation is defined with an undetermined parameter.
+                    Some(c) if c[(a, a)].is_finite() && c[(b, b)].is_finite() => c[(a, b)] / (c[(a, a)] * c[(b, b)]).sqrt(),
+                    Some(_) => f64::NAN,
                     None => f64::NAN,
                 })
                 .collect()
