@@ -87,3 +87,40 @@ pub fn predict(
     }
     Ok(out)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::calibrate::data::Measurement;
+
+    fn rest_row(routing: &str, tilt: f64) -> Measurement {
+        Measurement {
+            measurement: 1,
+            routing: routing.into(),
+            y_mm: [0.0; 5],
+            tension_n: 0.0,
+            direction: Direction::Rest,
+            step: 0,
+            dwell_s: 0.0,
+            tip_x_mm: 0.0,
+            tip_y_mm: 0.0,
+            tip_angle_rad: 0.0,
+            clamp_tilt_rad: tilt,
+            row: 1,
+        }
+    }
+
+    #[test]
+    fn a_tilted_clamp_lets_the_rod_sag_against_the_tilt() {
+        // Clamp axis turned toward +y from the vertical: in the clamp's frame
+        // gravity points toward −y, so the unloaded rod sags toward −y.
+        let data = Dataset { rows: vec![rest_row("t", 0.3)] };
+        let groups = data.groups();
+        let p = predict(&Actuator::default(), &SolverOptions::default(), &data, &groups, false).unwrap();
+        let pose = p[0].as_ref().unwrap().pose;
+        assert!(pose.tip_y_mm < -0.1 && pose.tip_angle_rad < 0.0, "{pose:?}");
+        let level = Dataset { rows: vec![rest_row("t", 0.0)] };
+        let p0 = predict(&Actuator::default(), &SolverOptions::default(), &level, &level.groups(), false).unwrap();
+        assert!(p0[0].as_ref().unwrap().pose.tip_y_mm.abs() < 1e-12);
+    }
+}
