@@ -26,9 +26,22 @@ pub fn write_report(
         .map_err(|source| CalibrateError::Io { context: format!("creating report directory {}", dir.display()), source })?;
     let groups = data.groups();
     let after_label = model_label(&d.extended);
-    residual_plot(&dir.join("residuals.png"), data, &groups, d, &after_label, angle_weight_mm_per_deg)?;
-    loop_plot(&dir.join("loops.png"), data, &groups, d, &after_label)?;
-    shape_plot(&dir.join("shapes.png"), data, &groups, d, centrelines, &after_label)?;
+    // Each picture is drawn to a temporary file and renamed into place, so
+    // a failure never leaves a half-drawn picture over an older report.
+    let atomic = |name: &str, draw: &dyn Fn(&Path) -> Result<(), PlotError>| -> Result<(), CalibrateError> {
+        let tmp = dir.join(format!(".tmp-{}-{name}", std::process::id()));
+        let result = draw(&tmp);
+        if let Err(e) = result {
+            let _ = std::fs::remove_file(&tmp);
+            return Err(e.into());
+        }
+        std::fs::rename(&tmp, dir.join(name))
+            .map_err(|source| CalibrateError::Io { context: format!("writing {}", dir.join(name).display()), source })
+    };
+    atomic("residuals.png", &|p| residual_plot(p, data, &groups, d, &after_label, angle_weight_mm_per_deg))?;
+    atomic("loops.png", &|p| loop_plot(p, data, &groups, d, &after_label))?;
+    atomic("shapes.png", &|p| shape_plot(p, data, &groups, d, centrelines, &after_label))?;
+    crate::io::sync_dir(dir);
     let md = markdown(data_path, data, d, &after_label);
     let path = dir.join("report.md");
     crate::io::write_atomic(&path, md.as_bytes())

@@ -31,6 +31,9 @@ pub struct SynthSpec {
     pub rest_dwell_s: f64,
     /// Clamp axis from the vertical, rad.
     pub clamp_tilt_rad: f64,
+    /// Per-routing clamp tilt overriding `clamp_tilt_rad`, rad (routing id →
+    /// tilt): a tilted repeat is how gravity is told apart from other effects.
+    pub routing_tilts_rad: std::collections::BTreeMap<String, f64>,
     /// Standard deviation of the noise on tip x and y, mm.
     pub noise_mm: f64,
     /// Standard deviation of the noise on the tip angle, degrees.
@@ -62,6 +65,7 @@ impl Default for SynthSpec {
             step_dwell_s: 5.0,
             rest_dwell_s: 30.0,
             clamp_tilt_rad: 0.0,
+            routing_tilts_rad: Default::default(),
             noise_mm: 0.4,
             noise_deg: 1.0,
             seed: 1,
@@ -102,6 +106,10 @@ pub fn synthesize(spec: &SynthSpec, points: usize) -> Result<(Dataset, Centrelin
     let steps = protocol(spec);
     let mut data = Dataset::default();
     for (id, y) in &spec.routings {
+        let clamp_tilt_rad = spec.routing_tilts_rad.get(id).copied().unwrap_or(spec.clamp_tilt_rad);
+        if !clamp_tilt_rad.is_finite() {
+            return Err(CalibrateError::Invalid(format!("routing {id}: clamp tilt {clamp_tilt_rad} must be finite")));
+        }
         for (k, &(tension_n, direction, dwell_s)) in steps.iter().enumerate() {
             let measurement = data.rows.len() as i64 + 1;
             data.rows.push(Measurement {
@@ -115,7 +123,7 @@ pub fn synthesize(spec: &SynthSpec, points: usize) -> Result<(Dataset, Centrelin
                 tip_x_mm: 0.0,
                 tip_y_mm: 0.0,
                 tip_angle_rad: 0.0,
-                clamp_tilt_rad: spec.clamp_tilt_rad,
+                clamp_tilt_rad,
                 row: measurement as usize,
             });
         }

@@ -9,6 +9,7 @@ use crate::model::routing::CONTROL_POINTS;
 use crate::model::{Actuator, SolverOptions};
 use anyhow::{bail, Context};
 use clap::Args;
+use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 /// Arguments of `cablemap synth`.
@@ -32,7 +33,9 @@ pub struct SynthArgs {
     /// Noise on the tip angle (standard deviation), degrees.
     #[arg(long, default_value_t = 1.0)]
     pub noise_deg: f64,
-    /// Routings as "id:y0,y1,y2,y3,y4;id:…" (mm) [default: base_offset, s_curve, straight, tip_bend, arc].
+    /// Routings as "id:y0,y1,y2,y3,y4;id:…" (mm), each optionally with its
+    /// own clamp tilt "id:y0,…,y4@TILT_RAD" [default: base_offset, s_curve,
+    /// straight, tip_bend, arc].
     #[arg(long, allow_hyphen_values = true)]
     pub routings: Option<String>,
     /// Top tension τ_u, N.
@@ -60,12 +63,25 @@ pub struct SynthArgs {
     pub actuator: ActuatorArgs,
 }
 
-/// Parses "id:y0,…,y4;id:…".
-pub fn parse_routings(text: &str) -> anyhow::Result<Vec<(String, [f64; CONTROL_POINTS])>> {
+/// Routings parsed from `--routings`, with the per-routing clamp tilts.
+type ParsedRoutings = (Vec<(String, [f64; CONTROL_POINTS])>, BTreeMap<String, f64>);
+
+/// Parses "id:y0,…,y4[@tilt];id:…".
+pub fn parse_routings(text: &str) -> anyhow::Result<ParsedRoutings> {
     let mut out = Vec::new();
+    let mut tilts = BTreeMap::new();
     for item in text.split(';').filter(|s| !s.trim().is_empty()) {
-        let Some((id, ys)) = item.split_once(':') else {
-            bail!("--routings: '{item}' should look like id:y0,y1,y2,y3,y4");
+        let Some((id, rest)) = item.split_once(':') else {
+            bail!("--routings: '{item}' should look like id:y0,y1,y2,y3,y4 (optionally @tilt_rad)");
+        };
+        let ys = match rest.split_once('@') {
+            Some((ys, tilt)) => {
+                let t = tilt.trim().parse::<f64>().ok().filter(|t| t.is_finite());
+                let Some(t) = t else { bail!("--routings {id}: clamp tilt '{tilt}' is not a number (rad)") };
+                tilts.insert(id.trim().to_string(), t);
+                ys
+            }
+            None => rest,
         };
         let y = parse_list(ys, &format!("--routings {id}"))?;
         let y: [f64; CONTROL_POINTS] = y
@@ -76,7 +92,7 @@ pub fn parse_routings(text: &str) -> anyhow::Result<Vec<(String, [f64; CONTROL_P
     if out.is_empty() {
         bail!("--routings: no routing given");
     }
-    Ok(out)
+    Ok((out, tilts))
 }
 
 /// Runs `cablemap synth`.
@@ -95,13 +111,15 @@ pub fn run(args: &SynthArgs) -> anyhow::Result<()> {
         bail!("--magnitude needs --effect");
     }
     actuator.validate().context("the true actuator")?;
+    let (routings, routing_tilts_rad) = match &args.routings {
+        Some(t) => parse_routings(t)?,
+        None => (default_routings(), BTreeMap::new()),
+    };
     let spec = SynthSpec {
         actuator,
         options: args.actuator.solver_options(&SolverOptions::default()),
-        routings: match &args.routings {
-            Some(t) => parse_routings(t)?,
-            None => default_routings(),
-        },
+        routings,
+        routing_tilts_rad,
         max_tension_n: args.max_tension,
         load_steps: args.load_steps,
         step_dwell_s: args.step_dwell_s,
