@@ -92,7 +92,7 @@ impl SolveFailure {
 /// Most re-integrations while the friction tension profile settles.
 const FRICTION_MAX_PASSES: usize = 60;
 /// Largest change of τ(s)/τ(0) accepted as settled.
-const FRICTION_TOLERANCE: f64 = 1e-12;
+const FRICTION_TOLERANCE: f64 = 1e-10;
 
 /// Status string of a successful solve.
 pub const STATUS_OK: &str = "ok";
