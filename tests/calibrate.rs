@@ -118,8 +118,8 @@ fn diagnose_writes_a_report_with_plots() {
 /// shrinks at least 1.5×. Prints the confusion matrix.
 #[test]
 fn diagnose_names_the_hidden_effect() {
-    // (effect, magnitude, approximate detection limit where ΔBIC ≈ −10 with
-    // this protocol and noise; measured with `diagnose`)
+    // (effect, magnitude): about five times the probes near the detection
+    // limit listed in docs/measurements.md (default protocol and noise).
     let cases: [(&str, f64); 7] = [
         ("none", 0.0),
         ("friction", 0.08),
