@@ -1,7 +1,7 @@
 //! cablemap: configuration design of planar cable-driven soft actuators.
 //!
 //! The pipeline runs one way: [`model`] (routing, rod, effects, solver) →
-//! [`shape`] (Legendre curvature coefficients) → sweep → reduce → design
+//! [`shape`] (Legendre curvature coefficients) → [`sweep`] → reduce → design
 //! and calibrate. Each layer has its own error enum, joined here.
 
 pub mod bench;
@@ -12,6 +12,7 @@ pub mod model;
 pub mod plot;
 pub mod reduce;
 pub mod shape;
+pub mod sweep;
 
 /// Any error of the library, by layer.
 #[derive(Debug, thiserror::Error)]
@@ -37,6 +38,9 @@ pub enum Error {
     /// Drawing a picture.
     #[error(transparent)]
     Plot(#[from] plot::PlotError),
+    /// Running, checking or reading a sweep.
+    #[error(transparent)]
+    Sweep(#[from] sweep::SweepError),
     /// Reading or writing a file.
     #[error("{context}: {source}")]
     Io { context: String, source: std::io::Error },

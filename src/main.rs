@@ -18,6 +18,14 @@ enum Command {
     Simulate(cli::simulate::SimulateArgs),
     /// Print solver timings (median µs per solve, single thread).
     Bench(cli::bench::BenchArgs),
+    /// Sweep a routing grid through a tension ladder into Parquet chunks (sharded, resumable).
+    Sweep(cli::sweep::SweepArgs),
+    /// Report a sweep directory: rows done per shard, failures, completeness.
+    Status(cli::sweep::StatusArgs),
+    /// Bin a sweep into feasibility maps: Parquet tables, PNG pictures, index.html.
+    Reduce(cli::reduce::ReduceArgs),
+    /// The main job: sweep (resumable) then reduce; the thesis sweep when no SPEC is given.
+    Map(cli::reduce::MapArgs),
     /// Fit EA, GA, EI (and optionally effects) to measurements (thesis eq. 2.14).
     Calibrate(cli::calibrate::CalibrateArgs),
     /// Find, name and add the effect the model is missing; report and plots.
@@ -31,6 +39,10 @@ fn main() -> ExitCode {
     let result = match &cli.command {
         Command::Simulate(args) => cli::simulate::run(args),
         Command::Bench(args) => cli::bench::run(args),
+        Command::Sweep(args) => cli::sweep::run(args),
+        Command::Status(args) => cli::sweep::run_status_command(args),
+        Command::Reduce(args) => cli::reduce::run(args),
+        Command::Map(args) => cli::reduce::run_map(args),
         Command::Calibrate(args) => cli::calibrate::run(args),
         Command::Diagnose(args) => cli::diagnose::run(args),
         Command::Synth(args) => cli::synth::run(args),

@@ -4,7 +4,9 @@
 pub mod bench;
 pub mod calibrate;
 pub mod diagnose;
+pub mod reduce;
 pub mod simulate;
+pub mod sweep;
 pub mod synth;
 
 use crate::model::{Actuator, SolverOptions};

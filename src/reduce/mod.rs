@@ -817,3 +817,42 @@ mod picture_tests {
         }
     }
 }
+
+/// Columns the reducer reads from a sweep (docs/schema.md).
+fn needed_columns(order: usize) -> Vec<String> {
+    let mut cols: Vec<String> = ["routing_id", "status", "y0_mm", "y1_mm", "y2_mm", "y3_mm", "y4_mm", "tension_n", "tip_x_mm", "tip_y_mm", "tip_angle_rad"]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    cols.extend((0..=order).map(|k| format!("a{k}")));
+    cols
+}
+
+/// Reduces the sweep run in `run_dir` (refusing an unfinished run unless
+/// `partial`). Returns the map and the run's spec (for drawing).
+pub fn reduce_run(
+    run_dir: &std::path::Path,
+    partial: bool,
+    options: &ReduceOptions,
+) -> Result<(MapData, crate::sweep::SweepSpec), crate::Error> {
+    use crate::sweep::{open_run, Completeness};
+    let completeness = if partial { Completeness::AllowPartial } else { Completeness::Complete };
+    let run = open_run(run_dir, completeness)?;
+    let spec = run.spec().clone();
+    let info = RunInfo {
+        mirrored: spec.grid.mirror_dedup,
+        order: spec.output.order,
+        tension_range_n: [spec.tension.min_n, spec.tension.max_n],
+        radius_mm: spec.actuator.radius_mm,
+        length_mm: spec.actuator.length_mm,
+        run_dir: run_dir.display().to_string(),
+        spec_hash: run.manifest().spec_sha256.clone(),
+    };
+    let columns = needed_columns(info.order);
+    let names: Vec<&str> = columns.iter().map(String::as_str).collect();
+    let map = reduce_batches(&info, options, || {
+        let batches = run.batches_projected(&names).map_err(|e| ReduceError::Read(e.to_string()))?;
+        Ok(batches.map(|b| b.map_err(|e| ReduceError::Read(e.to_string()))))
+    })?;
+    Ok((map, spec))
+}

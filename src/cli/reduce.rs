@@ -1,0 +1,134 @@
+//! `cablemap reduce` and `cablemap map` (sweep then reduce: the main job).
+
+use crate::reduce::{reduce_run, write_map, MapData, ModeBoundaries, ReduceOptions};
+use anyhow::Context;
+use clap::Args;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Map options shared by `reduce` and `map`.
+#[derive(Debug, Clone, Args)]
+pub struct MapOptionArgs {
+    /// Grid cell size, mm.
+    #[arg(long, value_name = "MM", default_value_t = 1.0)]
+    pub cell_mm: f64,
+    /// Explicit a_0 boundaries of the modes: three ascending values (mm⁻¹)
+    /// [default: 25/50/75 % quantiles of the data].
+    #[arg(long, value_name = "B1,B2,B3", allow_hyphen_values = true)]
+    pub a0_bounds: Option<String>,
+    /// Explicit a_1 boundaries of the modes: two ascending values (mm⁻¹)
+    /// [default: 1/3 and 2/3 quantiles of the data].
+    #[arg(long, value_name = "C1,C2", allow_hyphen_values = true)]
+    pub a1_bounds: Option<String>,
+    /// Simulated designs kept per cell in designs.parquet.
+    #[arg(long, value_name = "N", default_value_t = 16)]
+    pub designs_per_cell: usize,
+    /// Print the summary as JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+impl MapOptionArgs {
+    fn options(&self) -> anyhow::Result<ReduceOptions> {
+        let mode_boundaries = match (&self.a0_bounds, &self.a1_bounds) {
+            (None, None) => None,
+            (Some(a0), Some(a1)) => {
+                let a0 = super::parse_list(a0, "--a0-bounds")?;
+                let a1 = super::parse_list(a1, "--a1-bounds")?;
+                anyhow::ensure!(a0.len() == 3, "--a0-bounds needs three values (4 ranges of a_0), got {}", a0.len());
+                anyhow::ensure!(a1.len() == 2, "--a1-bounds needs two values (3 ranges of a_1), got {}", a1.len());
+                Some(ModeBoundaries { a0: [a0[0], a0[1], a0[2]], a1: [a1[0], a1[1]] })
+            }
+            _ => anyhow::bail!("give both --a0-bounds and --a1-bounds, or neither (quantiles of the data)"),
+        };
+        Ok(ReduceOptions { cell_mm: self.cell_mm, mode_boundaries, designs_per_cell: self.designs_per_cell })
+    }
+}
+
+/// Arguments of `cablemap reduce`.
+#[derive(Debug, Clone, Args)]
+pub struct ReduceArgs {
+    /// Run directory of a sweep.
+    #[arg(value_name = "RUN_DIR")]
+    pub run: PathBuf,
+    /// Map directory to write (tables, PNGs, index.html).
+    #[arg(long, value_name = "MAP_DIR")]
+    pub out: PathBuf,
+    /// Map an unfinished run (only its complete chunks).
+    #[arg(long)]
+    pub partial: bool,
+    #[command(flatten)]
+    pub map: MapOptionArgs,
+}
+
+/// Reduces `run` into `out` and prints a summary.
+pub fn reduce_into(run: &Path, out: &Path, partial: bool, args: &MapOptionArgs) -> anyhow::Result<MapData> {
+    let options = args.options()?;
+    let start = Instant::now();
+    let (map, spec) = reduce_run(run, partial, &options).with_context(|| format!("reducing {}", run.display()))?;
+    let reduced_s = start.elapsed().as_secs_f64();
+    std::fs::create_dir_all(out).with_context(|| format!("creating map directory {}", out.display()))?;
+    let pictures = write_map(out, &map, &spec.actuator, &spec.solver)?;
+    let total_s = start.elapsed().as_secs_f64();
+    let s = &map.summary;
+    if args.json {
+        println!(
+            "{}",
+            serde_json::json!({ "summary": s, "map_dir": out, "pictures": pictures.iter().map(|p| &p.file).collect::<Vec<_>>(),
+                "reduce_s": reduced_s, "total_s": total_s })
+        );
+    } else {
+        println!(
+            "map {}: {} simulations ({} converged, {} failed{}) in {} cells of {} mm; modes by {}: a0 {:?}, a1 {:?}",
+            out.display(),
+            s.rows_total,
+            s.rows_converged,
+            s.rows_failed,
+            if s.mirrored { ", mirrored half restored" } else { "" },
+            s.cells,
+            s.cell_mm,
+            s.mode_boundaries_source,
+            s.mode_boundaries.a0,
+            s.mode_boundaries.a1
+        );
+        println!("reduced in {reduced_s:.2} s, tables and {} pictures written in {total_s:.2} s; open {}", pictures.len(), out.join("index.html").display());
+    }
+    Ok(map)
+}
+
+/// Runs `cablemap reduce`.
+pub fn run(args: &ReduceArgs) -> anyhow::Result<()> {
+    reduce_into(&args.run, &args.out, args.partial, &args.map).map(|_| ())
+}
+
+/// Arguments of `cablemap map`.
+#[derive(Debug, Clone, Args)]
+pub struct MapArgs {
+    /// Job spec (TOML); the built-in thesis spec (jobs/thesis.toml) when omitted.
+    #[arg(value_name = "SPEC")]
+    pub spec: Option<PathBuf>,
+    /// Output directory: the sweep goes to DIR/run, the maps to DIR/map.
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// Worker threads [default: one per core].
+    #[arg(long, value_name = "T")]
+    pub threads: Option<usize>,
+    #[command(flatten)]
+    pub map: MapOptionArgs,
+}
+
+/// Runs `cablemap map`: the sweep (resumable) then the reduction.
+pub fn run_map(args: &MapArgs) -> anyhow::Result<()> {
+    let sweep_args = super::sweep::SweepArgs {
+        spec: args.spec.clone(),
+        out: args.out.join("run"),
+        shard: Some(0),
+        shards: 1,
+        threads: args.threads,
+        log_interval_s: None,
+        quiet: false,
+        json: false,
+    };
+    super::sweep::run(&sweep_args)?;
+    reduce_into(&args.out.join("run"), &args.out.join("map"), false, &args.map).map(|_| ())
+}

@@ -1,0 +1,185 @@
+//! `cablemap sweep` and `cablemap status`: front ends of [`crate::sweep`].
+
+use crate::sweep::progress::ProgressMode;
+use crate::sweep::{run_status, run_sweep, RunStatus, SweepOptions, SweepSpec, SweepSummary};
+use anyhow::Context;
+use clap::Args;
+use std::path::PathBuf;
+use std::time::Duration;
+
+/// Arguments of `cablemap sweep`.
+#[derive(Debug, Clone, Args)]
+pub struct SweepArgs {
+    /// Job spec (TOML); the built-in thesis spec (jobs/thesis.toml) when omitted.
+    #[arg(value_name = "SPEC")]
+    pub spec: Option<PathBuf>,
+    /// Run directory: manifest.json and shards/*.parquet. Re-running resumes.
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// This process's shard, 0-based [default: $SLURM_ARRAY_TASK_ID, else $JOB_COMPLETION_INDEX, else 0].
+    #[arg(long, value_name = "I")]
+    pub shard: Option<u64>,
+    /// Number of shards the sweep is split into (the same for every shard and every resume).
+    #[arg(long, value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..))]
+    pub shards: u64,
+    /// Worker threads [default: $SLURM_CPUS_PER_TASK, else one per core].
+    #[arg(long, value_name = "T")]
+    pub threads: Option<usize>,
+    /// Seconds between progress lines when stderr is not a terminal [default: 10].
+    #[arg(long, value_name = "S")]
+    pub log_interval_s: Option<f64>,
+    /// No progress output.
+    #[arg(long)]
+    pub quiet: bool,
+    /// Print the summary as JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Arguments of `cablemap status`.
+#[derive(Debug, Clone, Args)]
+pub struct StatusArgs {
+    /// Run directory of a sweep.
+    #[arg(value_name = "DIR")]
+    pub dir: PathBuf,
+    /// Print the status as JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Reads a non-negative integer from an environment variable, naming it on error.
+fn env_number<T: std::str::FromStr>(name: &str) -> anyhow::Result<Option<T>> {
+    match std::env::var(name) {
+        Ok(v) if !v.trim().is_empty() => v
+            .trim()
+            .parse()
+            .map(Some)
+            .map_err(|_| anyhow::anyhow!("environment variable {name} = '{v}' is not a non-negative integer")),
+        _ => Ok(None),
+    }
+}
+
+/// Shard index and where it came from: `--shard`, else SLURM's array task
+/// id, else the Kubernetes Indexed Job's completion index, else 0.
+fn shard_index(args: &SweepArgs) -> anyhow::Result<(u64, &'static str)> {
+    if let Some(s) = args.shard {
+        return Ok((s, "--shard"));
+    }
+    for name in ["SLURM_ARRAY_TASK_ID", "JOB_COMPLETION_INDEX"] {
+        if let Some(s) = env_number(name)? {
+            return Ok((s, name));
+        }
+    }
+    Ok((0, "default"))
+}
+
+/// Runs `cablemap sweep`.
+pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
+    let spec = match &args.spec {
+        Some(path) => SweepSpec::load(path)?,
+        None => SweepSpec::thesis(),
+    };
+    let threads = match args.threads {
+        Some(t) => Some(t),
+        None => env_number::<usize>("SLURM_CPUS_PER_TASK")?,
+    };
+    anyhow::ensure!(threads != Some(0), "--threads must be at least 1");
+    let progress = if args.quiet {
+        ProgressMode::Quiet
+    } else if let Some(s) = args.log_interval_s {
+        anyhow::ensure!(s.is_finite() && s >= 0.0, "--log-interval-s must be a number of seconds ≥ 0");
+        ProgressMode::Log(Duration::from_secs_f64(s))
+    } else {
+        ProgressMode::Auto
+    };
+    let (shard, source) = shard_index(args)?;
+    anyhow::ensure!(
+        shard < args.shards,
+        "shard {shard} (from {source}) is out of range for --shards {}: shards are numbered 0..N-1 and every shard \
+         needs the same --shards N (for a SLURM array use --array=0-{{N-1}})",
+        args.shards
+    );
+    let options = SweepOptions { shard, shards: args.shards, threads, progress };
+    let summary = run_sweep(&spec, &args.out, &options)?;
+    let status = run_status(&args.out).with_context(|| format!("checking {} after the sweep", args.out.display()))?;
+    if args.json {
+        println!("{}", serde_json::json!({ "summary": summary, "run": status_json(&status) }));
+    } else {
+        print_summary(&summary, &status);
+    }
+    Ok(())
+}
+
+fn print_summary(s: &SweepSummary, status: &RunStatus) {
+    println!(
+        "shard {}/{}: {} rows solved and written, {} already done ({} partial chunks redone), {:.2} s wall, {:.0} solves/s, {} threads",
+        s.shard, s.shards, s.rows_written, s.rows_skipped, s.partial_chunks_removed, s.wall_s, s.solves_per_s, s.threads
+    );
+    println!("shard {}/{} statuses: {}", s.shard, s.shards, fmt_counts(&s.status_counts));
+    println!(
+        "run {}: {}/{} rows, {}",
+        status.dir.display(),
+        status.rows_done,
+        status.rows_total,
+        if status.complete { "complete" } else { "partial (other shards not done yet)" }
+    );
+}
+
+fn fmt_counts(counts: &std::collections::BTreeMap<String, u64>) -> String {
+    if counts.is_empty() {
+        return "(no rows)".into();
+    }
+    counts.iter().map(|(s, n)| format!("{s} {n}")).collect::<Vec<_>>().join(", ")
+}
+
+fn status_json(s: &RunStatus) -> serde_json::Value {
+    serde_json::json!({
+        "dir": s.dir,
+        "spec_sha256": s.manifest.spec_sha256,
+        "tool_version": s.manifest.tool_version,
+        "rows_done": s.rows_done,
+        "rows_total": s.rows_total,
+        "failures": s.failures(),
+        "status_counts": s.status_counts,
+        "chunks_in_progress": s.chunks_in_progress,
+        "complete": s.complete,
+        "shards": s.shards,
+    })
+}
+
+/// Runs `cablemap status`.
+pub fn run_status_command(args: &StatusArgs) -> anyhow::Result<()> {
+    let s = run_status(&args.dir)?;
+    if args.json {
+        println!("{}", status_json(&s));
+        return Ok(());
+    }
+    let m = &s.manifest;
+    println!("run        {}", s.dir.display());
+    println!("spec       sha256 {} (cablemap {})", m.spec_sha256, m.tool_version);
+    println!(
+        "sweep      {} routings x {} tensions = {} rows in {} chunks, {} shard(s)",
+        m.routings, m.tensions, m.total_rows, m.chunks, m.shards
+    );
+    println!("{:>6} {:>14} {:>22} {:>9}", "shard", "chunks", "rows", "failures");
+    for sh in &s.shards {
+        println!(
+            "{:>6} {:>14} {:>22} {:>9}",
+            sh.shard,
+            format!("{}/{}", sh.chunks_done, sh.chunks_total),
+            format!("{}/{}", sh.rows_done, sh.rows_total),
+            sh.failures
+        );
+    }
+    println!("statuses   {}", fmt_counts(&s.status_counts));
+    if s.chunks_in_progress > 0 {
+        println!("in flight  {} chunk(s) being written or left by an interrupted run (redone on resume)", s.chunks_in_progress);
+    }
+    println!(
+        "state      {}: {}/{} rows",
+        if s.complete { "complete" } else { "partial" },
+        s.rows_done,
+        s.rows_total
+    );
+    Ok(())
+}

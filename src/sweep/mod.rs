@@ -1,0 +1,88 @@
+//! The sharded, resumable sweep: every routing of a grid solved through a
+//! tension ladder, written as Parquet chunks (thesis Ch. 4, model-notes §5).
+//!
+//! - [`spec`]: the TOML job spec and its hash.
+//! - [`enumerate`]: routing ids, mirror de-duplication, chunks and shards.
+//! - [`schema`]: the row schema (`docs/schema.md`) and batch building.
+//! - [`store`]: the run directory: manifest, atomic chunk files, checks.
+//! - [`run`]: the engine (parallel solving, resume, progress, summary).
+//! - [`status`]: done/total per shard, failures, completeness.
+//! - [`read`]: **the reader other stages use**: [`read::open_run`] checks a
+//!   run directory and streams its rows as Arrow record batches.
+
+pub mod enumerate;
+pub mod progress;
+pub mod read;
+pub mod run;
+pub mod schema;
+pub mod spec;
+pub mod status;
+pub mod store;
+
+pub use enumerate::SweepPlan;
+pub use read::{open_run, Completeness, SweepRun};
+pub use run::{run_sweep, SweepOptions, SweepSummary};
+pub use spec::SweepSpec;
+pub use status::{run_status, RunStatus};
+
+use std::path::PathBuf;
+
+/// Why a sweep, a status query or a read failed. Messages name the file or
+/// setting and what to do.
+#[derive(Debug, thiserror::Error)]
+pub enum SweepError {
+    /// The job spec is malformed or invalid.
+    #[error("bad sweep spec {origin}: {message}")]
+    BadSpec { origin: String, message: String },
+    /// Shard index or count out of range.
+    #[error("shard {shard} of {shards} is out of range: use 0 ≤ shard < shards (shards ≥ 1)")]
+    BadShard { shard: u64, shards: u64 },
+    /// A thread count of 0 or unparsable.
+    #[error("invalid thread count: {0}")]
+    BadThreads(String),
+    /// DIR exists, has no manifest and is not empty.
+    #[error("{} is not a cablemap sweep directory (it has no manifest.json but holds '{entry}'): give a new or empty directory to --out", dir.display())]
+    NotARunDir { dir: PathBuf, entry: String },
+    /// DIR has no manifest (reading or status).
+    #[error("{} holds no sweep: {} is missing (run `cablemap sweep SPEC --out {}` first)", dir.display(), dir.join(store::MANIFEST).display(), dir.display())]
+    NoRun { dir: PathBuf },
+    /// The manifest is unreadable.
+    #[error("manifest {} is damaged: {message}. Restore it, or start the sweep in a new directory", path.display())]
+    CorruptManifest { path: PathBuf, message: String },
+    /// DIR belongs to a run of another spec.
+    #[error("{} holds a sweep of a different spec (sha256 {existing}; this spec is {wanted}): use another --out directory, or the spec that run was started with", dir.display())]
+    SpecMismatch { dir: PathBuf, existing: String, wanted: String },
+    /// DIR was written by another version of cablemap.
+    #[error("{} was written by cablemap {existing}, this is {}: finish it with that version or use a new --out directory", dir.display(), store::TOOL_VERSION)]
+    VersionMismatch { dir: PathBuf, existing: String },
+    /// DIR was started with another shard count.
+    #[error("{} belongs to a sweep split into {existing} shards, not {wanted}: rerun with --shards {existing}", dir.display())]
+    ShardCountMismatch { dir: PathBuf, existing: u64, wanted: u64 },
+    /// A file in DIR that cablemap did not write.
+    #[error("{} was not written by cablemap sweep: move it out of the run directory, then rerun", path.display())]
+    ForeignFile { path: PathBuf },
+    /// A chunk-named file from another job.
+    #[error("{} does not belong to this sweep ({reason}): move it out of the run directory, then rerun", path.display())]
+    ForeignChunk { path: PathBuf, reason: String },
+    /// A chunk file that cannot be read.
+    #[error("chunk file {} is damaged ({message}): delete it and rerun the sweep to recompute that chunk", path.display())]
+    CorruptChunk { path: PathBuf, message: String },
+    /// The run is not complete and the caller asked for a complete one.
+    #[error("sweep in {} is incomplete ({done} of {total} rows): rerun the sweep command to finish it, or read it as partial", dir.display())]
+    Incomplete { dir: PathBuf, done: u64, total: u64 },
+    /// The solver rejected the actuator.
+    #[error(transparent)]
+    Parameter(#[from] crate::model::ParameterError),
+    /// A routing of the grid was rejected.
+    #[error(transparent)]
+    Routing(#[from] crate::model::RoutingError),
+    /// Parquet encoding or decoding.
+    #[error("{context}: {source}")]
+    Parquet { context: String, source: parquet::errors::ParquetError },
+    /// Arrow decoding.
+    #[error("{context}: {source}")]
+    Arrow { context: String, source: arrow::error::ArrowError },
+    /// A file operation.
+    #[error("{context}: {source}")]
+    Io { context: String, source: std::io::Error },
+}

@@ -1,0 +1,218 @@
+//! The sweep engine: solves one shard's chunks in parallel and writes each
+//! chunk as soon as it is complete. Re-running the same command resumes:
+//! chunk files already in place are checked and skipped, temporary files of
+//! this shard's interrupted chunks are deleted and those chunks redone, so
+//! the output never holds a duplicate or a missing row.
+//!
+//! Parallelism is two-level with rayon: chunks in parallel, and the routings
+//! of a chunk in parallel (so a shard with a single chunk still uses every
+//! thread). Each worker has its own [`Simulator`]; a routing is solved cold
+//! through its rising tension ladder (continuation), independent of every
+//! other routing, so results do not depend on threads or shards. Memory is
+//! bounded by the chunks in flight, not by the number of rows.
+
+use super::enumerate::SweepPlan;
+use super::progress::{Progress, ProgressMode};
+use super::schema::{arrow_schema, build_batch, SolvedRouting, SolvedRow};
+use super::spec::SweepSpec;
+use super::store::{total_status_counts, ChunkInfo, RunDir};
+use super::SweepError;
+use crate::model::{Routing, Simulator, STATUS_OK};
+use rayon::prelude::*;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// How to run a sweep.
+#[derive(Debug, Clone)]
+pub struct SweepOptions {
+    /// This process's shard, 0-based.
+    pub shard: u64,
+    /// Number of shards the sweep is split into.
+    pub shards: u64,
+    /// Worker threads (`None`: one per core).
+    pub threads: Option<usize>,
+    /// Progress display.
+    pub progress: ProgressMode,
+}
+
+impl Default for SweepOptions {
+    fn default() -> Self {
+        Self { shard: 0, shards: 1, threads: None, progress: ProgressMode::Auto }
+    }
+}
+
+/// What a sweep invocation did.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct SweepSummary {
+    /// The run directory.
+    pub dir: PathBuf,
+    /// This shard.
+    pub shard: u64,
+    /// Shard count.
+    pub shards: u64,
+    /// Worker threads used.
+    pub threads: usize,
+    /// Rows this shard owns.
+    pub shard_rows: u64,
+    /// Rows solved and written by this invocation.
+    pub rows_written: u64,
+    /// Rows found already written (resumed).
+    pub rows_skipped: u64,
+    /// Chunk files written by this invocation.
+    pub chunks_written: u64,
+    /// Chunk files found already written.
+    pub chunks_skipped: u64,
+    /// Temporary files of interrupted chunks that were removed.
+    pub partial_chunks_removed: u64,
+    /// Rows per status over this shard (all of its rows).
+    pub status_counts: BTreeMap<String, u64>,
+    /// Wall time of this invocation, s.
+    pub wall_s: f64,
+    /// Rows written per second of wall time.
+    pub solves_per_s: f64,
+}
+
+impl SweepSummary {
+    /// Rows of this shard whose solve failed.
+    pub fn failures(&self) -> u64 {
+        super::store::failures(&self.status_counts)
+    }
+}
+
+/// Runs (or resumes) shard `options.shard` of `spec` into `dir`.
+pub fn run_sweep(spec: &SweepSpec, dir: &Path, options: &SweepOptions) -> Result<SweepSummary, SweepError> {
+    let started = Instant::now();
+    spec.validate().map_err(|message| SweepError::BadSpec { origin: "(in memory)".into(), message })?;
+    let (shard, shards) = (options.shard, options.shards);
+    if shards == 0 || shard >= shards {
+        return Err(SweepError::BadShard { shard, shards });
+    }
+    if options.threads == Some(0) {
+        return Err(SweepError::BadThreads("0: use at least 1 thread".into()));
+    }
+    let run = RunDir::new(dir);
+    let manifest = run.create_or_check(spec, shards)?;
+    let plan = SweepPlan::new(spec);
+    let scan = run.scan(&manifest)?;
+
+    // This shard's temporaries are from an interrupted run of it (one
+    // process per shard): its chunks are redone from scratch.
+    let mut partial_chunks_removed = 0;
+    for (chunk, path) in &scan.temporaries {
+        if plan.chunk_shard(*chunk, shards) == shard {
+            match std::fs::remove_file(path) {
+                Ok(()) => partial_chunks_removed += 1,
+                Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+                Err(source) => return Err(SweepError::Io { context: format!("removing {}", path.display()), source }),
+            }
+        }
+    }
+    let own: Vec<u64> = plan.shard_chunks(shard, shards).collect();
+    let done: Vec<&ChunkInfo> = own.iter().filter_map(|c| scan.chunks.get(c)).collect();
+    let pending: Vec<u64> = own.iter().copied().filter(|c| !scan.chunks.contains_key(c)).collect();
+    let rows_skipped: u64 = done.iter().map(|c| c.rows).sum();
+    let shard_rows = plan.shard_rows(shard, shards);
+
+    let mut builder = rayon::ThreadPoolBuilder::new();
+    if let Some(n) = options.threads {
+        builder = builder.num_threads(n);
+    }
+    let pool = builder.build().map_err(|e| SweepError::BadThreads(e.to_string()))?;
+    let threads = pool.current_num_threads();
+
+    let label = format!("sweep shard {shard}/{shards}");
+    if options.progress != ProgressMode::Quiet {
+        eprintln!(
+            "{label}: {} of {} chunks to do ({} rows of {shard_rows}; {} already written), {threads} threads, output {}",
+            pending.len(),
+            own.len(),
+            shard_rows - rows_skipped,
+            rows_skipped,
+            dir.display()
+        );
+    }
+    let progress = Progress::new(options.progress, label, shard_rows, rows_skipped);
+
+    let prototype = Simulator::new(&spec.actuator, &spec.solver)?;
+    let tensions = spec.tensions_n();
+    let schema = arrow_schema(spec);
+    let written: Vec<ChunkInfo> = pool.install(|| {
+        pending
+            .par_iter()
+            .map(|&chunk| {
+                let routings = plan
+                    .chunk_ids(chunk)
+                    .into_par_iter()
+                    .map_init(
+                        || prototype.clone(),
+                        |sim, id| {
+                            let solved = solve_routing(sim, &plan, spec, &tensions, id);
+                            progress.add(tensions.len() as u64);
+                            solved
+                        },
+                    )
+                    .collect::<Result<Vec<_>, _>>()?;
+                let batch = build_batch(&schema, spec.output.order, spec.output.centreline, &routings);
+                run.write_chunk(&manifest, chunk, &batch)
+            })
+            .collect::<Result<Vec<_>, _>>()
+    })?;
+    progress.finish();
+
+    let status_counts = total_status_counts(done.iter().copied().chain(&written));
+    let rows_written: u64 = written.iter().map(|c| c.rows).sum();
+    let wall_s = started.elapsed().as_secs_f64();
+    Ok(SweepSummary {
+        dir: dir.to_path_buf(),
+        shard,
+        shards,
+        threads,
+        shard_rows,
+        rows_written,
+        rows_skipped,
+        chunks_written: written.len() as u64,
+        chunks_skipped: done.len() as u64,
+        partial_chunks_removed,
+        status_counts,
+        wall_s,
+        solves_per_s: rows_written as f64 / wall_s.max(1e-9),
+    })
+}
+
+/// Solves routing `id` through the tension ladder.
+fn solve_routing(
+    sim: &mut Simulator,
+    plan: &SweepPlan,
+    spec: &SweepSpec,
+    tensions_n: &[f64],
+    id: u64,
+) -> Result<SolvedRouting, SweepError> {
+    let y_mm = plan.routing_mm(id);
+    let routing = Routing::new(&y_mm, spec.actuator.length_mm, spec.actuator.radius_mm)?;
+    sim.set_routing(&routing);
+    let rows = tensions_n.iter().map(|&t| solve_row(sim, t, spec.output.order, spec.output.centreline)).collect();
+    Ok(SolvedRouting { id, y_mm, rows })
+}
+
+/// One solve as a row: outputs only for a successful, finite solve.
+fn solve_row(sim: &mut Simulator, tension_n: f64, order: usize, centreline: bool) -> SolvedRow {
+    let failed = |status| SolvedRow { tension_n, status, pose: None, a: Vec::new(), centreline: None };
+    match sim.solve(tension_n) {
+        Ok(pose) => {
+            let mut a = vec![0.0; order + 1];
+            sim.coefficients_into(&mut a);
+            let scalars = [pose.tip_x_mm, pose.tip_y_mm, pose.tip_angle_rad, pose.base_angle_rad, pose.length_mm];
+            if !scalars.iter().chain(&a).all(|v| v.is_finite()) {
+                // Stored as a failure so that outputs are never NaN.
+                return failed(crate::model::SolveFailure::NonFinite { s_mm: f64::NAN }.status());
+            }
+            let centreline = centreline.then(|| {
+                let points = sim.centreline();
+                (points.iter().map(|p| p.x_mm).collect(), points.iter().map(|p| p.y_mm).collect())
+            });
+            SolvedRow { tension_n, status: STATUS_OK, pose: Some(pose), a, centreline }
+        }
+        Err(failure) => failed(failure.status()),
+    }
+}

@@ -1,0 +1,282 @@
+//! The sweep job spec: a TOML file naming the actuator, the solver settings,
+//! the routing grid, the tension ladder and what to store. Unknown fields
+//! are rejected so that a typo never silently falls back to a default.
+//!
+//! ```toml
+//! [actuator]            # model::Actuator; omitted fields keep the thesis values
+//! [actuator.gravity]
+//! enabled = true
+//! [solver]              # model::SolverOptions
+//! steps_per_span = 24
+//! [grid]
+//! levels = 9            # levels per control point
+//! extent_r = 0.8        # levels evenly spaced from −0.8 r to +0.8 r
+//! mirror_dedup = true   # keep one routing of each mirror pair
+//! [tension]
+//! min_n = 1.0
+//! max_n = 2.0
+//! count = 21
+//! [output]
+//! order = 3             # store a0 … a3
+//! centreline = false    # store centreline_x_mm / centreline_y_mm lists
+//! chunk_routings = 256  # routings per Parquet chunk file
+//! ```
+
+use super::SweepError;
+use crate::model::{Actuator, SolverOptions};
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+use std::path::Path;
+
+/// The thesis sweep (thesis Ch. 4, model-notes §5): `jobs/thesis.toml`,
+/// built into the binary as the default spec.
+pub const THESIS_SPEC_TOML: &str = include_str!("../../jobs/thesis.toml");
+
+/// Most levels per control point (the grid has levels⁵ routings).
+pub const MAX_LEVELS: u32 = 99;
+/// Highest Legendre order stored.
+pub const MAX_ORDER: usize = 12;
+
+/// A complete sweep job. Every section may be omitted (thesis defaults).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields, default)]
+pub struct SweepSpec {
+    /// Actuator parameters and effects.
+    pub actuator: Actuator,
+    /// Numerical settings of the solver.
+    pub solver: SolverOptions,
+    /// The grid of routings.
+    pub grid: GridSpec,
+    /// The tension ladder each routing is solved through.
+    pub tension: TensionSpec,
+    /// What each row stores and how rows are grouped into files.
+    pub output: OutputSpec,
+}
+
+/// The routing grid: every control point y0…y4 takes one of `levels`
+/// values evenly spaced over [−extent_r·r, +extent_r·r].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct GridSpec {
+    /// Levels per control point (1 gives the straight routing only).
+    pub levels: u32,
+    /// Half-width of the levels as a fraction of the radius r (< 1: the
+    /// channel must stay inside the body).
+    pub extent_r: f64,
+    /// Keep one routing of each mirror pair (y ↦ −y gives the mirrored
+    /// shape, so its row carries no new information). Needs a
+    /// mirror-symmetric actuator: no channel offset, gravity along the axis.
+    pub mirror_dedup: bool,
+}
+
+impl Default for GridSpec {
+    fn default() -> Self {
+        Self { levels: 9, extent_r: 0.8, mirror_dedup: true }
+    }
+}
+
+/// Tensions: `count` values evenly spaced from `min_n` to `max_n`, solved in
+/// rising order (continuation) for each routing.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct TensionSpec {
+    /// Lowest tension, N.
+    pub min_n: f64,
+    /// Highest tension, N.
+    pub max_n: f64,
+    /// Number of tensions (1 needs min_n = max_n).
+    pub count: u32,
+}
+
+impl Default for TensionSpec {
+    fn default() -> Self {
+        Self { min_n: 1.0, max_n: 2.0, count: 21 }
+    }
+}
+
+/// What is stored.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct OutputSpec {
+    /// Highest Legendre order n: columns a0 … an.
+    pub order: usize,
+    /// Store the centreline of each solve as list columns.
+    pub centreline: bool,
+    /// Routings per chunk file (each chunk is written atomically; a resumed
+    /// run redoes at most the chunks that were in progress).
+    pub chunk_routings: u32,
+}
+
+impl Default for OutputSpec {
+    fn default() -> Self {
+        Self { order: 3, centreline: false, chunk_routings: 256 }
+    }
+}
+
+impl SweepSpec {
+    /// The thesis sweep (the built-in default).
+    pub fn thesis() -> Self {
+        Self::from_toml(THESIS_SPEC_TOML, "built-in thesis spec").expect("jobs/thesis.toml is valid")
+    }
+
+    /// Parses and validates a spec; `origin` names it in errors.
+    pub fn from_toml(text: &str, origin: &str) -> Result<Self, SweepError> {
+        let spec: SweepSpec =
+            toml::from_str(text).map_err(|e| SweepError::BadSpec { origin: origin.to_string(), message: e.to_string() })?;
+        spec.validate().map_err(|message| SweepError::BadSpec { origin: origin.to_string(), message })?;
+        Ok(spec)
+    }
+
+    /// Reads, parses and validates a spec file.
+    pub fn load(path: &Path) -> Result<Self, SweepError> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|source| SweepError::Io { context: format!("reading spec {}", path.display()), source })?;
+        Self::from_toml(&text, &path.display().to_string())
+    }
+
+    /// Checks every setting; the message names the field and what to do.
+    pub fn validate(&self) -> Result<(), String> {
+        self.actuator.validate().map_err(|e| format!("[actuator] {e}"))?;
+        crate::model::Simulator::new(&self.actuator, &self.solver).map_err(|e| format!("[solver] {e}"))?;
+        let g = &self.grid;
+        if g.levels == 0 || g.levels > MAX_LEVELS {
+            return Err(format!("[grid] levels = {} must be between 1 and {MAX_LEVELS}", g.levels));
+        }
+        if !(g.extent_r.is_finite() && g.extent_r >= 0.0 && g.extent_r < 1.0) {
+            return Err(format!(
+                "[grid] extent_r = {} puts levels beyond ±r (outside the body): use a fraction 0 ≤ extent_r < 1",
+                g.extent_r
+            ));
+        }
+        let delta = self.actuator.effects.channel_offset_mm;
+        if (g.extent_r * self.actuator.radius_mm).abs() + delta.abs() >= self.actuator.radius_mm {
+            return Err(format!(
+                "[grid] extent_r = {} with channel_offset_mm = {delta} puts the channel beyond ±r: reduce one of them",
+                g.extent_r
+            ));
+        }
+        if g.mirror_dedup {
+            let gravity = &self.actuator.gravity;
+            let tilted = gravity.enabled && gravity.scale != 0.0 && gravity.direction_rad.sin().abs() > 1e-12;
+            if delta != 0.0 || tilted {
+                return Err("[grid] mirror_dedup = true needs a mirror-symmetric actuator (channel_offset_mm = 0 and \
+                            gravity along the clamp axis): set mirror_dedup = false"
+                    .into());
+            }
+        }
+        let t = &self.tension;
+        if !(t.min_n.is_finite() && t.min_n >= 0.0) {
+            return Err(format!("[tension] min_n = {} must be a finite tension ≥ 0 N", t.min_n));
+        }
+        if !(t.max_n.is_finite() && t.max_n >= t.min_n) {
+            return Err(format!("[tension] max_n = {} must be finite and ≥ min_n = {}", t.max_n, t.min_n));
+        }
+        if t.count == 0 {
+            return Err("[tension] count = 0: at least one tension is needed".into());
+        }
+        if t.count == 1 && t.max_n != t.min_n {
+            return Err("[tension] count = 1 needs min_n = max_n (or give count ≥ 2)".into());
+        }
+        let o = &self.output;
+        if o.order > MAX_ORDER {
+            return Err(format!("[output] order = {} is above the supported {MAX_ORDER}", o.order));
+        }
+        if o.chunk_routings == 0 {
+            return Err("[output] chunk_routings = 0: a chunk needs at least one routing".into());
+        }
+        Ok(())
+    }
+
+    /// The tension ladder, N, in rising order.
+    pub fn tensions_n(&self) -> Vec<f64> {
+        let t = &self.tension;
+        if t.count == 1 {
+            return vec![t.min_n];
+        }
+        let steps = f64::from(t.count - 1);
+        (0..t.count).map(|k| t.min_n + (t.max_n - t.min_n) * f64::from(k) / steps).collect()
+    }
+
+    /// The level values of one control point, mm, ascending; symmetric
+    /// about 0 bit for bit (level i and levels−1−i are exact negatives).
+    pub fn levels_mm(&self) -> Vec<f64> {
+        let n = self.grid.levels;
+        if n == 1 {
+            return vec![0.0];
+        }
+        let half = self.grid.extent_r * self.actuator.radius_mm;
+        let d = f64::from(n - 1);
+        (0..n).map(|i| half * (2.0 * f64::from(i) - d) / d).collect()
+    }
+
+    /// The spec with every default filled in, as compact JSON: what the
+    /// hash covers and what every output file records.
+    pub fn canonical_json(&self) -> String {
+        serde_json::to_string(self).expect("spec serialises")
+    }
+
+    /// SHA-256 of [`Self::canonical_json`], hex. Two specs with the same
+    /// meaning (whatever their formatting) have the same hash.
+    pub fn hash_hex(&self) -> String {
+        let digest = Sha256::digest(self.canonical_json().as_bytes());
+        digest.iter().map(|b| format!("{b:02x}")).collect()
+    }
+
+    /// Parses the canonical JSON written by [`Self::canonical_json`].
+    pub fn from_canonical_json(text: &str) -> Result<Self, serde_json::Error> {
+        serde_json::from_str(text)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn err(text: &str) -> String {
+        SweepSpec::from_toml(text, "test").unwrap_err().to_string()
+    }
+
+    #[test]
+    fn thesis_spec_is_the_default() {
+        let s = SweepSpec::thesis();
+        assert_eq!(s, SweepSpec::default());
+        assert_eq!(s.levels_mm(), vec![-4.0, -3.0, -2.0, -1.0, 0.0, 1.0, 2.0, 3.0, 4.0]);
+        let t = s.tensions_n();
+        assert_eq!(t.len(), 21);
+        assert_eq!((t[0], t[20]), (1.0, 2.0));
+        assert!((t[1] - 1.05).abs() < 1e-15);
+    }
+
+    #[test]
+    fn levels_are_exactly_symmetric() {
+        let mut s = SweepSpec::default();
+        s.grid.levels = 7;
+        s.grid.extent_r = 0.73;
+        let l = s.levels_mm();
+        for i in 0..7 {
+            assert_eq!(l[i], -l[6 - i]);
+        }
+    }
+
+    #[test]
+    fn bad_specs_name_the_problem() {
+        assert!(err("[grid]\nlevles = 3\n").contains("unknown field `levles`"));
+        assert!(err("[grid]\nextent_r = 1.2\n").contains("beyond ±r"));
+        assert!(err("[tension]\nmin_n = -1.0\n").contains("min_n = -1"));
+        assert!(err("[tension]\ncount = 0\n").contains("count = 0"));
+        assert!(err("[output]\nchunk_routings = 0\n").contains("chunk_routings"));
+        assert!(err("[actuator]\nea_n = -3.0\n").contains("ea_n"));
+        assert!(err("[actuator.effects]\nchannel_offset_mm = 0.5\n").contains("mirror_dedup"));
+        assert!(err("[tension]\nmin_n = 2.0\nmax_n = 1.0\n").contains("max_n"));
+    }
+
+    #[test]
+    fn hash_ignores_formatting_but_not_meaning() {
+        let a = SweepSpec::from_toml("[tension]\ncount = 5\n", "a").unwrap();
+        let b = SweepSpec::from_toml("[tension]\n  count   = 5 # five\n", "b").unwrap();
+        let c = SweepSpec::from_toml("[tension]\ncount = 6\n", "c").unwrap();
+        assert_eq!(a.hash_hex(), b.hash_hex());
+        assert_ne!(a.hash_hex(), c.hash_hex());
+        assert_eq!(SweepSpec::from_canonical_json(&a.canonical_json()).unwrap(), a);
+    }
+}

@@ -1,0 +1,449 @@
+//! The run directory on disk: the manifest, the chunk files and their
+//! checks.
+//!
+//! ```text
+//! DIR/manifest.json              what the run is: spec, hash, tool version, counts
+//! DIR/shards/chunk-000000.parquet  one file per chunk, complete or absent
+//! DIR/shards/.chunk-000001.parquet.tmp-PID   a chunk being written (dot: readers skip it)
+//! ```
+//!
+//! Every file appears under its final name only when complete (written to a
+//! temporary name in the same folder, fsynced, renamed). The manifest is
+//! created with a hard link, which fails if another process (a concurrent
+//! array task) created it first; the loser checks it matches instead.
+
+use super::enumerate::SweepPlan;
+use super::spec::SweepSpec;
+use super::SweepError;
+use arrow::record_batch::RecordBatch;
+use parquet::arrow::ArrowWriter;
+use parquet::basic::{Compression, ZstdLevel};
+use parquet::file::metadata::{KeyValue, ParquetMetaDataReader};
+use parquet::file::properties::WriterProperties;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::fs::File;
+use std::path::{Path, PathBuf};
+
+/// Format tag of manifests and chunk files.
+pub const FORMAT: &str = "cablemap-sweep/1";
+/// Version of the tool writing the files.
+pub const TOOL_VERSION: &str = env!("CARGO_PKG_VERSION");
+/// Manifest file name in DIR.
+pub const MANIFEST: &str = "manifest.json";
+/// Folder of chunk files in DIR (only Parquet chunks live there, so any
+/// Parquet reader can read the folder as one dataset).
+pub const SHARDS_DIR: &str = "shards";
+
+/// Key-value metadata keys of each chunk file's footer.
+pub mod keys {
+    /// [`super::FORMAT`].
+    pub const FORMAT: &str = "cablemap.format";
+    /// Tool version.
+    pub const VERSION: &str = "cablemap.version";
+    /// SHA-256 of the canonical spec JSON.
+    pub const SPEC_SHA256: &str = "cablemap.spec_sha256";
+    /// The canonical spec JSON.
+    pub const SPEC: &str = "cablemap.spec";
+    /// Chunk index.
+    pub const CHUNK: &str = "cablemap.chunk";
+    /// Rows in the file.
+    pub const ROWS: &str = "cablemap.rows";
+    /// JSON object: rows per status.
+    pub const STATUS_COUNTS: &str = "cablemap.status_counts";
+}
+
+/// The run's manifest (`DIR/manifest.json`). Written once, never changed.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Manifest {
+    /// [`FORMAT`].
+    pub format: String,
+    /// Version of the tool that created the run.
+    pub tool_version: String,
+    /// SHA-256 of the canonical spec JSON.
+    pub spec_sha256: String,
+    /// The spec with every default filled in.
+    pub spec: SweepSpec,
+    /// Shards the run is split into.
+    pub shards: u64,
+    /// Routings in the sweep.
+    pub routings: u64,
+    /// Tensions per routing.
+    pub tensions: u64,
+    /// Routings per chunk.
+    pub chunk_routings: u64,
+    /// Chunk files when complete.
+    pub chunks: u64,
+    /// Rows when complete.
+    pub total_rows: u64,
+}
+
+impl Manifest {
+    /// The manifest of a run of `spec` in `shards` shards.
+    pub fn new(spec: &SweepSpec, shards: u64) -> Self {
+        let plan = SweepPlan::new(spec);
+        Self {
+            format: FORMAT.into(),
+            tool_version: TOOL_VERSION.into(),
+            spec_sha256: spec.hash_hex(),
+            spec: spec.clone(),
+            shards,
+            routings: plan.routings,
+            tensions: plan.tensions,
+            chunk_routings: plan.chunk_routings,
+            chunks: plan.chunks,
+            total_rows: plan.total_rows(),
+        }
+    }
+}
+
+/// What a chunk file's footer says.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ChunkInfo {
+    /// Chunk index.
+    pub chunk: u64,
+    /// Path of the file.
+    pub path: PathBuf,
+    /// Rows in the file.
+    pub rows: u64,
+    /// Rows per status.
+    pub status_counts: BTreeMap<String, u64>,
+}
+
+/// Rows per status, summed over chunks.
+pub fn total_status_counts<'a>(chunks: impl IntoIterator<Item = &'a ChunkInfo>) -> BTreeMap<String, u64> {
+    let mut counts = BTreeMap::new();
+    for chunk in chunks {
+        for (status, n) in &chunk.status_counts {
+            *counts.entry(status.clone()).or_insert(0) += n;
+        }
+    }
+    counts
+}
+
+/// Rows of failed solves (status other than `ok`) in a status count.
+pub fn failures(counts: &BTreeMap<String, u64>) -> u64 {
+    counts.iter().filter(|(s, _)| s.as_str() != crate::model::STATUS_OK).map(|(_, n)| n).sum()
+}
+
+/// Paths of a run directory.
+#[derive(Debug, Clone)]
+pub struct RunDir {
+    root: PathBuf,
+}
+
+impl RunDir {
+    /// A run directory at `root` (nothing is touched).
+    pub fn new(root: &Path) -> Self {
+        Self { root: root.to_path_buf() }
+    }
+
+    /// DIR.
+    pub fn root(&self) -> &Path {
+        &self.root
+    }
+
+    /// DIR/manifest.json.
+    pub fn manifest_path(&self) -> PathBuf {
+        self.root.join(MANIFEST)
+    }
+
+    /// DIR/shards.
+    pub fn shards_dir(&self) -> PathBuf {
+        self.root.join(SHARDS_DIR)
+    }
+
+    /// Final path of chunk `chunk`.
+    pub fn chunk_path(&self, chunk: u64) -> PathBuf {
+        self.shards_dir().join(chunk_file_name(chunk))
+    }
+
+    /// Reads and parses the manifest; `Ok(None)` when there is none.
+    pub fn read_manifest(&self) -> Result<Option<Manifest>, SweepError> {
+        let path = self.manifest_path();
+        let text = match std::fs::read_to_string(&path) {
+            Ok(t) => t,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+            Err(source) => return Err(SweepError::Io { context: format!("reading {}", path.display()), source }),
+        };
+        let manifest: Manifest =
+            serde_json::from_str(&text).map_err(|e| SweepError::CorruptManifest { path: path.clone(), message: e.to_string() })?;
+        if manifest.format != FORMAT {
+            return Err(SweepError::CorruptManifest {
+                path,
+                message: format!("format '{}' is not '{FORMAT}'", manifest.format),
+            });
+        }
+        Ok(Some(manifest))
+    }
+
+    /// Creates DIR and its manifest for a new run, or checks that an
+    /// existing run is the same job (spec, tool version, shard count).
+    /// Returns the manifest in force.
+    pub fn create_or_check(&self, spec: &SweepSpec, shards: u64) -> Result<Manifest, SweepError> {
+        let io = |what: &str, source| SweepError::Io { context: format!("{what} {}", self.root.display()), source };
+        std::fs::create_dir_all(&self.root).map_err(|e| io("creating output directory", e))?;
+        let wanted = Manifest::new(spec, shards);
+        let existing = match self.read_manifest()? {
+            Some(m) => m,
+            None => {
+                self.check_fresh_dir()?;
+                match self.publish_manifest(&wanted)? {
+                    true => wanted.clone(),
+                    // Another process created it between our look and our link.
+                    false => self.read_manifest()?.ok_or_else(|| SweepError::CorruptManifest {
+                        path: self.manifest_path(),
+                        message: "vanished while being read".into(),
+                    })?,
+                }
+            }
+        };
+        if existing.spec_sha256 != wanted.spec_sha256 {
+            return Err(SweepError::SpecMismatch {
+                dir: self.root.clone(),
+                existing: existing.spec_sha256,
+                wanted: wanted.spec_sha256,
+            });
+        }
+        if existing.tool_version != TOOL_VERSION {
+            return Err(SweepError::VersionMismatch { dir: self.root.clone(), existing: existing.tool_version });
+        }
+        if existing.shards != shards {
+            return Err(SweepError::ShardCountMismatch { dir: self.root.clone(), existing: existing.shards, wanted: shards });
+        }
+        std::fs::create_dir_all(self.shards_dir()).map_err(|e| io("creating shard folder in", e))?;
+        Ok(existing)
+    }
+
+    /// A directory without a manifest may hold only what a concurrent task
+    /// of the same run is creating (the manifest, its temporary file, the
+    /// shard folder, whose chunks [`Self::scan`] then checks): anything else
+    /// was not written by cablemap, and a sweep must not mix its files with it.
+    fn check_fresh_dir(&self) -> Result<(), SweepError> {
+        for entry in list_dir(&self.root)? {
+            let name = entry.to_string_lossy();
+            if name != MANIFEST && name != SHARDS_DIR && !is_manifest_temp(&name) {
+                return Err(SweepError::NotARunDir { dir: self.root.clone(), entry: name.into_owned() });
+            }
+        }
+        Ok(())
+    }
+
+    /// Writes the manifest under a temporary name and links it into place
+    /// unless one exists. Returns false when another process won.
+    fn publish_manifest(&self, manifest: &Manifest) -> Result<bool, SweepError> {
+        let path = self.manifest_path();
+        // Array tasks on different hosts can share a pid: add the time.
+        let nanos = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.subsec_nanos());
+        let tmp = self.root.join(format!(".{MANIFEST}.tmp-{}-{nanos}", std::process::id()));
+        let text = serde_json::to_string_pretty(manifest).expect("manifest serialises") + "\n";
+        let io = |what: &str, source| SweepError::Io { context: format!("{what} {}", path.display()), source };
+        {
+            use std::io::Write;
+            let mut f = File::create(&tmp).map_err(|e| io("writing", e))?;
+            f.write_all(text.as_bytes()).and_then(|_| f.sync_all()).map_err(|e| io("writing", e))?;
+        }
+        let linked = std::fs::hard_link(&tmp, &path);
+        let _ = std::fs::remove_file(&tmp);
+        crate::io::sync_dir(&self.root);
+        match linked {
+            Ok(()) => Ok(true),
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => Ok(false),
+            Err(e) => Err(io("creating", e)),
+        }
+    }
+
+    /// Lists DIR/shards: verified chunk files (footer checked against the
+    /// manifest) and temporary files. Anything else is an error, as is a
+    /// chunk file that is unreadable or belongs to another job.
+    pub fn scan(&self, manifest: &Manifest) -> Result<Scan, SweepError> {
+        for entry in list_dir(&self.root)? {
+            let name = entry.to_string_lossy();
+            if name != MANIFEST && name != SHARDS_DIR && !is_manifest_temp(&name) {
+                return Err(SweepError::ForeignFile { path: self.root.join(&entry) });
+            }
+        }
+        let plan = SweepPlan::new(&manifest.spec);
+        let mut scan = Scan::default();
+        let shards_dir = self.shards_dir();
+        let mut names = match list_dir(&shards_dir) {
+            Ok(n) => n,
+            Err(SweepError::Io { source, .. }) if source.kind() == std::io::ErrorKind::NotFound => Vec::new(),
+            Err(e) => return Err(e),
+        };
+        names.sort();
+        for entry in names {
+            let path = shards_dir.join(&entry);
+            let name = entry.to_string_lossy();
+            if let Some(chunk) = temp_chunk(&name) {
+                scan.temporaries.push((chunk, path));
+                continue;
+            }
+            match parse_chunk_name(&name) {
+                Some(chunk) if chunk < manifest.chunks && path.is_file() => {
+                    scan.chunks.insert(chunk, check_chunk(&path, chunk, manifest, plan.chunk_rows(chunk))?);
+                }
+                _ => return Err(SweepError::ForeignFile { path }),
+            }
+        }
+        Ok(scan)
+    }
+
+    /// Writes one chunk atomically: temporary file, footer, fsync, rename,
+    /// directory fsync.
+    pub fn write_chunk(&self, manifest: &Manifest, chunk: u64, batch: &RecordBatch) -> Result<ChunkInfo, SweepError> {
+        let path = self.chunk_path(chunk);
+        let tmp = self.shards_dir().join(format!(".{}.tmp-{}", chunk_file_name(chunk), std::process::id()));
+        let io = |source| SweepError::Io { context: format!("writing {}", tmp.display()), source };
+        let status_counts = count_statuses(batch);
+        let kv = |k: &str, v: String| KeyValue::new(k.to_string(), v);
+        let metadata = vec![
+            kv(keys::FORMAT, FORMAT.into()),
+            kv(keys::VERSION, TOOL_VERSION.into()),
+            kv(keys::SPEC_SHA256, manifest.spec_sha256.clone()),
+            kv(keys::SPEC, manifest.spec.canonical_json()),
+            kv(keys::CHUNK, chunk.to_string()),
+            kv(keys::ROWS, batch.num_rows().to_string()),
+            kv(keys::STATUS_COUNTS, serde_json::to_string(&status_counts).expect("counts serialise")),
+        ];
+        let props = WriterProperties::builder()
+            .set_compression(Compression::ZSTD(ZstdLevel::try_new(3).expect("valid zstd level")))
+            .set_max_row_group_row_count(Some(batch.num_rows().max(1)))
+            .set_created_by(format!("cablemap {TOOL_VERSION}"))
+            .set_key_value_metadata(Some(metadata))
+            .build();
+        let file = File::create(&tmp).map_err(io)?;
+        let written = (|| {
+            let mut writer = ArrowWriter::try_new(file, batch.schema(), Some(props))?;
+            writer.write(batch)?;
+            writer.into_inner()
+        })();
+        let file = written.map_err(|e| {
+            let _ = std::fs::remove_file(&tmp);
+            SweepError::Parquet { context: format!("writing {}", tmp.display()), source: e }
+        })?;
+        file.sync_all().map_err(io)?;
+        drop(file);
+        std::fs::rename(&tmp, &path).map_err(io)?;
+        crate::io::sync_dir(&self.shards_dir());
+        Ok(ChunkInfo { chunk, path, rows: batch.num_rows() as u64, status_counts })
+    }
+}
+
+/// What [`RunDir::scan`] found.
+#[derive(Debug, Clone, Default)]
+pub struct Scan {
+    /// Complete, verified chunk files by index.
+    pub chunks: BTreeMap<u64, ChunkInfo>,
+    /// Temporary files (chunk index, path): chunks being written now or
+    /// left by an interrupted run.
+    pub temporaries: Vec<(u64, PathBuf)>,
+}
+
+/// `chunk-000012.parquet`.
+pub fn chunk_file_name(chunk: u64) -> String {
+    format!("chunk-{chunk:06}.parquet")
+}
+
+/// The chunk index of a final chunk file name.
+pub fn parse_chunk_name(name: &str) -> Option<u64> {
+    let digits = name.strip_prefix("chunk-")?.strip_suffix(".parquet")?;
+    if digits.len() < 6 || !digits.bytes().all(|b| b.is_ascii_digit()) {
+        return None;
+    }
+    let chunk: u64 = digits.parse().ok()?;
+    (chunk_file_name(chunk) == name).then_some(chunk)
+}
+
+/// The chunk index of a temporary chunk file name (`.chunk-….parquet.tmp-PID`).
+fn temp_chunk(name: &str) -> Option<u64> {
+    let rest = name.strip_prefix('.')?;
+    let (final_name, pid) = rest.split_once(".tmp-")?;
+    pid.bytes().all(|b| b.is_ascii_digit()).then_some(())?;
+    parse_chunk_name(final_name)
+}
+
+fn is_manifest_temp(name: &str) -> bool {
+    name.starts_with(&format!(".{MANIFEST}.tmp-"))
+}
+
+fn list_dir(dir: &Path) -> Result<Vec<std::ffi::OsString>, SweepError> {
+    let io = |source| SweepError::Io { context: format!("listing {}", dir.display()), source };
+    std::fs::read_dir(dir).map_err(io)?.map(|e| e.map(|e| e.file_name()).map_err(io)).collect()
+}
+
+/// Reads a chunk file's footer and checks it is chunk `chunk` of this run
+/// with `rows` rows.
+pub fn check_chunk(path: &Path, chunk: u64, manifest: &Manifest, rows: u64) -> Result<ChunkInfo, SweepError> {
+    let file =
+        File::open(path).map_err(|source| SweepError::Io { context: format!("opening {}", path.display()), source })?;
+    let meta = ParquetMetaDataReader::new()
+        .parse_and_finish(&file)
+        .map_err(|e| SweepError::CorruptChunk { path: path.to_path_buf(), message: e.to_string() })?;
+    let kv: BTreeMap<&str, &str> = meta
+        .file_metadata()
+        .key_value_metadata()
+        .map(|v| v.iter().filter_map(|k| Some((k.key.as_str(), k.value.as_deref()?))).collect())
+        .unwrap_or_default();
+    let foreign = |reason: String| SweepError::ForeignChunk { path: path.to_path_buf(), reason };
+    if kv.get(keys::FORMAT) != Some(&FORMAT) {
+        return Err(foreign(format!("it has no '{}' = '{FORMAT}' metadata", keys::FORMAT)));
+    }
+    if kv.get(keys::SPEC_SHA256) != Some(&manifest.spec_sha256.as_str()) {
+        return Err(foreign(format!(
+            "it was written for spec {} but this run's spec is {}",
+            kv.get(keys::SPEC_SHA256).unwrap_or(&"(none)"),
+            manifest.spec_sha256
+        )));
+    }
+    if kv.get(keys::CHUNK).and_then(|c| c.parse::<u64>().ok()) != Some(chunk) {
+        return Err(foreign(format!("its metadata names chunk {:?}, not {chunk}", kv.get(keys::CHUNK))));
+    }
+    let file_rows = meta.file_metadata().num_rows();
+    if file_rows != rows as i64 {
+        return Err(SweepError::CorruptChunk {
+            path: path.to_path_buf(),
+            message: format!("it holds {file_rows} rows where chunk {chunk} has {rows}"),
+        });
+    }
+    let status_counts = kv
+        .get(keys::STATUS_COUNTS)
+        .and_then(|s| serde_json::from_str(s).ok())
+        .ok_or_else(|| SweepError::CorruptChunk { path: path.to_path_buf(), message: "status counts unreadable".into() })?;
+    Ok(ChunkInfo { chunk, path: path.to_path_buf(), rows, status_counts })
+}
+
+fn count_statuses(batch: &RecordBatch) -> BTreeMap<String, u64> {
+    let mut counts = BTreeMap::new();
+    let column = batch.column_by_name(super::schema::STATUS).expect("status column");
+    let strings = column.as_any().downcast_ref::<arrow::array::StringArray>().expect("status is utf8");
+    for s in strings.iter().flatten() {
+        *counts.entry(s.to_string()).or_insert(0) += 1;
+    }
+    counts
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn chunk_names_round_trip_and_nothing_else_matches() {
+        assert_eq!(parse_chunk_name(&chunk_file_name(12)), Some(12));
+        assert_eq!(parse_chunk_name(&chunk_file_name(1_234_567)), Some(1_234_567));
+        for name in ["chunk-12.parquet", "chunk-000012.parquet.bak", "chunk-00001x.parquet", "xchunk-000012.parquet", "chunk-0000012.parquet"] {
+            assert_eq!(parse_chunk_name(name), None, "{name}");
+        }
+        assert_eq!(temp_chunk(".chunk-000007.parquet.tmp-4242"), Some(7));
+        assert_eq!(temp_chunk("chunk-000007.parquet.tmp-4242"), None);
+        assert_eq!(temp_chunk(".chunk-000007.parquet.tmp-42x"), None);
+        assert!(is_manifest_temp(".manifest.json.tmp-12-345"));
+    }
+
+    #[test]
+    fn failures_count_everything_but_ok() {
+        let counts: BTreeMap<String, u64> = [("ok".to_string(), 5), ("rod_collapsed".into(), 2), ("non_finite".into(), 1)].into();
+        assert_eq!(failures(&counts), 3);
+    }
+}
