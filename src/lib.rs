@@ -7,6 +7,7 @@
 pub mod bench;
 pub mod calibrate;
 pub mod cli;
+pub mod design;
 pub mod io;
 pub mod model;
 pub mod plot;
@@ -38,6 +39,9 @@ pub enum Error {
     /// Drawing a picture.
     #[error(transparent)]
     Plot(#[from] plot::PlotError),
+    /// Feasibility check or design.
+    #[error(transparent)]
+    Design(#[from] design::DesignError),
     /// Running, checking or reading a sweep.
     #[error(transparent)]
     Sweep(#[from] sweep::SweepError),

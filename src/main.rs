@@ -16,6 +16,10 @@ struct Cli {
 enum Command {
     /// Simulate one actuator at one tension: tip pose, shape coefficients, centreline.
     Simulate(cli::simulate::SimulateArgs),
+    /// Design the cable routing and tension for a target shape (thesis eq. 3.17).
+    Design(cli::design::DesignArgs),
+    /// Is a target shape reachable? Verdict from a feasibility map, with the nearest designs.
+    Feasible(cli::feasible::FeasibleArgs),
     /// Print solver timings (median µs per solve, single thread).
     Bench(cli::bench::BenchArgs),
     /// Sweep a routing grid through a tension ladder into Parquet chunks (sharded, resumable).
@@ -39,6 +43,8 @@ fn main() -> ExitCode {
     let result = match &cli.command {
         Command::Simulate(args) => cli::simulate::run(args),
         Command::Bench(args) => cli::bench::run(args),
+        Command::Design(args) => cli::design::run(args),
+        Command::Feasible(args) => cli::feasible::run(args),
         Command::Sweep(args) => cli::sweep::run(args),
         Command::Status(args) => cli::sweep::run_status_command(args),
         Command::Reduce(args) => cli::reduce::run(args),

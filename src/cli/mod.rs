@@ -3,7 +3,9 @@
 
 pub mod bench;
 pub mod calibrate;
+pub mod design;
 pub mod diagnose;
+pub mod feasible;
 pub mod reduce;
 pub mod simulate;
 pub mod sweep;

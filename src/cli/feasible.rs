@@ -1,0 +1,101 @@
+//! `cablemap feasible`: the map's verdict on a target (thesis §4.2).
+
+use crate::design::feasible::{check, FeasibilityReport};
+use crate::design::map::MapDir;
+use crate::design::{Target, Weights};
+use clap::Args;
+use std::io::Write;
+use std::path::PathBuf;
+
+/// Arguments of `cablemap feasible`.
+#[derive(Debug, Clone, Args)]
+pub struct FeasibleArgs {
+    /// Feasibility map directory (`cablemap reduce` output).
+    #[arg(long, value_name = "MAP_DIR")]
+    pub map: PathBuf,
+    /// Target, any subset of x, y (tip, mm) and a0, a1, … (1/mm),
+    /// e.g. x=50,y=5,a0=-0.025,a1=-0.06,a2=0.015.
+    #[arg(long, value_name = "K=V,…", allow_hyphen_values = true)]
+    pub target: String,
+    /// Weights λ for the distance to the nearest designs [defaults x=1,y=1,a0=100,a1=50,a2=25].
+    #[arg(long, value_name = "K=V,…")]
+    pub weights: Option<String>,
+    /// How many nearest simulated designs to list.
+    #[arg(long, default_value_t = 5)]
+    pub nearest: usize,
+    /// Print one JSON object instead of a report.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Runs `cablemap feasible`.
+pub fn run(args: &FeasibleArgs) -> anyhow::Result<()> {
+    let map = MapDir::open(&args.map)?;
+    let target = Target::parse(&args.target)?;
+    let weights = match &args.weights {
+        Some(w) => Weights::parse(w)?,
+        None => Weights::default(),
+    };
+    weights.check_against(&target)?;
+    let report = check(&map, &target, &weights, args.nearest)?;
+    let stdout = std::io::stdout();
+    let mut out = stdout.lock();
+    if args.json {
+        writeln!(out, "{}", serde_json::to_value(&report)?)?;
+    } else {
+        write!(out, "{}", text(&report))?;
+    }
+    Ok(())
+}
+
+/// The text report.
+pub fn text(r: &FeasibilityReport) -> String {
+    let mut s = format!("verdict   {}\n", r.verdict.as_str().to_uppercase());
+    for reason in &r.reasons {
+        s.push_str(&format!("          - {reason}\n"));
+    }
+    let t = &r.tip_cell;
+    let idx = |v: Option<i32>| v.map_or("any".to_string(), |v| v.to_string());
+    s.push_str(&format!(
+        "tip cell  ix = {}, iy = {}: {} simulation(s) ({} with its neighbours)\n",
+        idx(t.ix),
+        idx(t.iy),
+        t.count,
+        t.neighbourhood_count
+    ));
+    if !r.coefficients.is_empty() {
+        s.push_str(&format!("{:<6}{:>12}{:>12}{:>12}{:>12}{:>12}\n", "", "target", "cell p10", "cell p90", "near min", "near max"));
+        let f = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.5}"));
+        for c in &r.coefficients {
+            s.push_str(&format!(
+                "{:<6}{:>12.5}{:>12}{:>12}{:>12}{:>12}\n",
+                c.component,
+                c.target,
+                f(c.cell_p10),
+                f(c.cell_p90),
+                f(c.neighbourhood_min),
+                f(c.neighbourhood_max)
+            ));
+        }
+    }
+    let m = &r.mode;
+    match (m.mode, m.count_in_cell) {
+        (Some(mode), Some(n)) => s.push_str(&format!("mode      {mode} (a0 range {}, a1 range {}); {n} simulations of the tip cell in it\n", mode / 3, mode % 3)),
+        (Some(mode), None) => s.push_str(&format!("mode      {mode} (a0 range {}, a1 range {})\n", mode / 3, mode % 3)),
+        (None, _) => s.push_str(&format!("mode      one of {:?} (give a0 and a1 to pin it down)\n", m.candidates)),
+    }
+    s.push_str("nearest simulated designs (weighted distance):\n");
+    for near in &r.nearest {
+        let d = &near.design;
+        s.push_str(&format!(
+            "  y = [{}] mm, τ = {:.3} N → tip ({:.2}, {:.2}) mm, a = [{}]  (distance {:.4})\n",
+            d.y_mm.iter().map(|v| format!("{v:.2}")).collect::<Vec<_>>().join(", "),
+            d.tension_n,
+            d.tip_x_mm,
+            d.tip_y_mm,
+            d.a.iter().map(|v| format!("{v:.4}")).collect::<Vec<_>>().join(", "),
+            near.distance
+        ));
+    }
+    s
+}

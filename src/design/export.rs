@@ -1,0 +1,219 @@
+//! Exports of a design: JSON, the channel centreline as CSV, a 1:1 SVG
+//! drawing of the body with its channel (for making a mould), and a PNG of
+//! the achieved shape over the target.
+
+use super::objective::{Evaluation, LengthBasis, Objective};
+use super::target::Component;
+use super::DesignError;
+use crate::model::{simulate, Routing};
+use crate::plot::{draw_bodies, BodyDrawing};
+use crate::shape::centreline_from_coefficients;
+use plotters::style::full_palette::{BLUE_800, GREEN_700};
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// Spacing of the channel CSV and SVG samples along the rod, mm.
+pub const CHANNEL_STEP_MM: f64 = 0.25;
+
+fn io_error(context: String) -> impl FnOnce(std::io::Error) -> DesignError {
+    move |source| DesignError::Io { context, source }
+}
+
+/// Channel centreline samples (s, y_c(s), dy_c/ds) from clamp to tip.
+pub fn channel_samples(routing: &Routing) -> Vec<(f64, f64, f64)> {
+    let length = routing.length_mm();
+    let n = (length / CHANNEL_STEP_MM).ceil() as usize;
+    (0..=n)
+        .map(|i| {
+            let s = length * i as f64 / n as f64;
+            let c = routing.channel_at(s);
+            (s, c.y_mm, c.dy_ds)
+        })
+        .collect()
+}
+
+/// The channel centreline as CSV: `s_mm,y_mm,dy_ds` (s along the straight
+/// body from the clamp, y lateral from the body axis).
+pub fn channel_csv(routing: &Routing) -> String {
+    let mut out = String::from("s_mm,y_mm,dy_ds\n");
+    for (s, y, d) in channel_samples(routing) {
+        let _ = writeln!(out, "{s:.4},{y:.6},{d:.6}");
+    }
+    out
+}
+
+/// A 1:1 drawing of the straight body (L × 2r) with its channel, in mm
+/// (`width="…mm"` with a viewBox in mm, so it prints at true size). The
+/// clamp end is on the left; y grows upward as in the model.
+pub fn mould_svg(routing: &Routing, radius_mm: f64, channel_diameter_mm: f64, tension_n: f64) -> String {
+    let length = routing.length_mm();
+    let margin = 10.0;
+    let (w, h) = (length + 2.0 * margin, 2.0 * radius_mm + 2.0 * margin + 16.0);
+    // Model (s, y) → page (margin + s, margin + r − y).
+    let px = |s: f64| margin + s;
+    let py = |y: f64| margin + radius_mm - y;
+    let mut svg = String::new();
+    let _ = writeln!(svg, r#"<?xml version="1.0" encoding="UTF-8"?>"#);
+    let _ = writeln!(
+        svg,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}mm" height="{h}mm" viewBox="0 0 {w} {h}" font-family="sans-serif">"#
+    );
+    let _ = writeln!(svg, "<title>cablemap mould drawing, 1:1, units mm</title>");
+    // Body outline.
+    let _ = writeln!(
+        svg,
+        r#"<rect id="body" x="{}" y="{}" width="{length}" height="{}" fill="none" stroke="black" stroke-width="0.2"/>"#,
+        px(0.0),
+        py(radius_mm),
+        2.0 * radius_mm
+    );
+    // Body axis.
+    let _ = writeln!(
+        svg,
+        r#"<line id="axis" x1="{}" y1="{}" x2="{}" y2="{}" stroke="grey" stroke-width="0.1" stroke-dasharray="2 1"/>"#,
+        px(0.0),
+        py(0.0),
+        px(length),
+        py(0.0)
+    );
+    // Clamp face.
+    let _ = writeln!(
+        svg,
+        r#"<line id="clamp" x1="{0}" y1="{1}" x2="{0}" y2="{2}" stroke="black" stroke-width="0.8"/>"#,
+        px(0.0),
+        py(radius_mm + 2.0),
+        py(-radius_mm - 2.0)
+    );
+    let points: String =
+        channel_samples(routing).iter().map(|(s, y, _)| format!("{:.4},{:.4}", px(*s), py(*y))).collect::<Vec<_>>().join(" ");
+    // The channel at its real width, then its centreline.
+    let _ = writeln!(
+        svg,
+        r#"<polyline id="channel" points="{points}" fill="none" stroke="red" stroke-opacity="0.35" stroke-width="{channel_diameter_mm}" stroke-linecap="round"/>"#
+    );
+    let _ = writeln!(svg, r#"<polyline id="channel-centreline" points="{points}" fill="none" stroke="red" stroke-width="0.1"/>"#);
+    for (i, y) in routing.control_points_mm().iter().enumerate() {
+        let s = i as f64 * length / 4.0;
+        let _ = writeln!(
+            svg,
+            r#"<circle class="control-point" cx="{:.4}" cy="{:.4}" r="0.35" fill="none" stroke="blue" stroke-width="0.1"/>"#,
+            px(s),
+            py(*y)
+        );
+    }
+    // 10 mm scale bar to check the print scale.
+    let bar_y = py(-radius_mm) + 6.0;
+    let _ = writeln!(
+        svg,
+        r#"<line id="scale-10mm" x1="{}" y1="{bar_y}" x2="{}" y2="{bar_y}" stroke="black" stroke-width="0.4"/>"#,
+        px(0.0),
+        px(10.0)
+    );
+    let ys = routing.control_points_mm().iter().map(|y| format!("{y:.3}")).collect::<Vec<_>>().join(", ");
+    // Short lines at 2 mm so the notes stay inside the page at 1:1.
+    let notes = [
+        "10 mm".to_string(),
+        format!("L = {length} mm, r = {radius_mm} mm, channel Ø {channel_diameter_mm} mm; clamp on the left"),
+        format!("y0..y4 = [{ys}] mm"),
+        format!("tension {tension_n:.3} N"),
+    ];
+    let _ = writeln!(svg, r#"<text x="{}" y="{}" font-size="2">{}</text>"#, px(11.0), bar_y + 0.7, notes[0]);
+    for (i, line) in notes[1..].iter().enumerate() {
+        let _ = writeln!(svg, r#"<text x="{}" y="{}" font-size="2">{line}</text>"#, px(0.0), bar_y + 3.5 + 2.6 * i as f64);
+    }
+    svg.push_str("</svg>\n");
+    svg
+}
+
+/// Writes design.json, channel.csv, mould.svg and shape.png into `dir`
+/// (created if missing).
+pub fn write_all(dir: &Path, objective: &Objective, eval: &Evaluation, json: &serde_json::Value) -> Result<(), DesignError> {
+    std::fs::create_dir_all(dir).map_err(io_error(format!("creating {}", dir.display())))?;
+    let write = |name: &str, bytes: &[u8]| {
+        let p = dir.join(name);
+        crate::io::write_atomic(&p, bytes).map_err(io_error(format!("writing {}", p.display())))
+    };
+    let pretty = serde_json::to_string_pretty(json).expect("JSON values serialise");
+    write("design.json", (pretty + "\n").as_bytes())?;
+    let act = &objective.actuator;
+    let routing = Routing::new(&eval.routing_mm, act.length_mm, act.radius_mm).expect("designs lie inside the body");
+    write("channel.csv", channel_csv(&routing).as_bytes())?;
+    // The thesis's channel: a PTFE tube of 1 mm outer diameter (§5.2).
+    write("mould.svg", mould_svg(&routing, act.radius_mm, 1.0, eval.tension_n).as_bytes())?;
+    shape_png(&dir.join("shape.png"), objective, eval)
+}
+
+/// Draws the achieved body over the target: the target tip as a cross and,
+/// when the target has curvature coefficients, the target shape. The target
+/// states no length or base angle, so its shape is drawn with the achieved
+/// design's ℓ and θ_0 (coefficients the target omits are the achieved ones).
+pub fn shape_png(path: &Path, objective: &Objective, eval: &Evaluation) -> Result<(), DesignError> {
+    let act = &objective.actuator;
+    let routing = Routing::new(&eval.routing_mm, act.length_mm, act.radius_mm).expect("designs lie inside the body");
+    let sim = simulate(act, &objective.options, &routing, eval.tension_n, objective.target.order()).map_err(|e| {
+        DesignError::Io { context: format!("re-simulating the design for {}", path.display()), source: std::io::Error::other(e.to_string()) }
+    })?;
+    let mut bodies =
+        vec![crate::cli::simulate::body_drawing(&sim, act.radius_mm, "achieved body (outline at ±r), cable in red".into(), BLUE_800)];
+    let target = &objective.target;
+    if target.highest_order().is_some() {
+        let pose = &eval.pose;
+        // Drawing needs the coefficients over the drawn (deformed) length ℓ.
+        let to_deformed = match objective.length_basis {
+            LengthBasis::Deformed => 1.0,
+            LengthBasis::Rest => act.length_mm / pose.length_mm,
+        };
+        let a: Vec<f64> = (0..eval.a.len()).map(|k| to_deformed * target.get(Component::A(k)).unwrap_or(eval.a[k])).collect();
+        let pts = centreline_from_coefficients(&a, pose.length_mm, pose.base_angle_rad, 121);
+        let angles: Vec<f64> = pts.windows(2).map(|w| (w[1][1] - w[0][1]).atan2(w[1][0] - w[0][0])).collect();
+        let mut frame = angles.clone();
+        frame.push(*angles.last().unwrap_or(&0.0));
+        bodies.push(BodyDrawing {
+            centreline: pts.iter().map(|p| (p[0], p[1])).collect(),
+            frame_angle_rad: frame,
+            cable: Vec::new(),
+            radius_mm: 0.0,
+            label: "target shape (target a_i; achieved ℓ and base angle)".into(),
+            colour: GREEN_700,
+        });
+    }
+    let tips: Vec<(f64, f64)> = match (target.get(Component::TipX), target.get(Component::TipY)) {
+        (Some(x), Some(y)) => vec![(x, y)],
+        _ => Vec::new(),
+    };
+    let title = format!(
+        "design: y = [{}] mm, τ = {:.3} N",
+        eval.routing_mm.iter().map(|y| format!("{y:.2}")).collect::<Vec<_>>().join(", "),
+        eval.tension_n
+    );
+    draw_bodies(path, &title, &bodies, &tips)?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn channel_csv_follows_the_spline_from_clamp_to_tip() {
+        let r = Routing::new(&[1.0, -2.0, 3.0, 0.5, -4.0], 65.0, 5.0).unwrap();
+        let csv = channel_csv(&r);
+        let rows: Vec<Vec<f64>> =
+            csv.lines().skip(1).map(|l| l.split(',').map(|v| v.parse().unwrap()).collect()).collect();
+        assert_eq!(rows.first().unwrap()[0], 0.0);
+        assert!((rows.last().unwrap()[0] - 65.0).abs() < 1e-9);
+        // Clamped spline: interpolates the end control points.
+        assert!((rows.first().unwrap()[1] - 1.0).abs() < 1e-9);
+        assert!((rows.last().unwrap()[1] + 4.0).abs() < 1e-9);
+        assert!(rows.iter().all(|row| row[1].abs() <= 4.0 + 1e-9));
+    }
+
+    #[test]
+    fn mould_svg_is_true_scale() {
+        let r = Routing::new(&[0.0, 1.0, 2.0, 1.0, 0.0], 65.0, 5.0).unwrap();
+        let svg = mould_svg(&r, 5.0, 1.0, 1.5);
+        assert!(svg.contains(r#"width="85mm""#) && svg.contains(r#"viewBox="0 0 85 46""#), "{svg}");
+        assert!(svg.contains(r#"<rect id="body" x="10" y="10" width="65" height="10""#));
+        assert_eq!(svg.matches("class=\"control-point\"").count(), 5);
+    }
+}

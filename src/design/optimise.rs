@@ -1,0 +1,555 @@
+//! Minimising eq. 3.17: multi-start Levenberg–Marquardt over the routing
+//! y_0…y_4 and the tension τ, inside box bounds.
+//!
+//! Bounds by transformation: the solver works on unbounded z ∈ R⁶ with
+//! y_i = Y sin z_i and τ = τ_l + (τ_u − τ_l)(1 + sin w)/2, so every trial
+//! point is a valid design (the simulator rejects routings outside the body)
+//! and a bound-active optimum is a stationary point of the transformed
+//! problem (the thesis's Target II sits at τ ≈ τ_u). A sine rather than tanh
+//! keeps the map well conditioned near the bounds instead of flattening
+//! exponentially, so the solver can still leave a bound it touched.
+//!
+//! Starts come from a coarse grid of simulated designs of our own (5 levels
+//! per control point, 5 tensions; half the routings simulated, the rest
+//! mirrored) and optionally from a map's nearest designs. The best few are
+//! refined in parallel and the lowest cost wins.
+
+use super::objective::{Evaluation, Objective};
+use super::target::Component;
+use super::DesignError;
+use crate::model::{Routing, Simulator, SolveFailure};
+use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
+use nalgebra::{DMatrix, DVector, Dyn, Owned};
+use rayon::prelude::*;
+use serde::Serialize;
+use std::cell::{Cell, RefCell};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+/// Settings of the multi-start search.
+#[derive(Debug, Clone, Serialize)]
+pub struct SearchOptions {
+    /// Levels per control point of the seed grid, as fractions of the
+    /// largest offset (symmetric about 0).
+    pub grid_levels: Vec<f64>,
+    /// Tensions of the seed grid, as fractions of [τ_l, τ_u].
+    pub grid_tension_fractions: Vec<f64>,
+    /// How many of the best seeds to refine.
+    pub starts: usize,
+    /// Most simulator evaluations per refinement.
+    pub max_evaluations: usize,
+}
+
+impl Default for SearchOptions {
+    fn default() -> Self {
+        Self {
+            grid_levels: vec![-0.8, -0.4, 0.0, 0.4, 0.8],
+            grid_tension_fractions: vec![0.0, 0.25, 0.5, 0.75, 1.0],
+            starts: 8,
+            max_evaluations: 1500,
+        }
+    }
+}
+
+/// A starting design for a refinement.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Seed {
+    /// Control points, mm.
+    pub routing_mm: [f64; 5],
+    /// Tension, N.
+    pub tension_n: f64,
+    /// Where it came from.
+    pub source: SeedSource,
+}
+
+/// Origin of a seed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SeedSource {
+    /// The built-in seed grid.
+    Grid,
+    /// A simulated design from a feasibility map's `designs.parquet`.
+    Map,
+}
+
+/// One refinement's outcome.
+#[derive(Debug, Clone, Serialize)]
+pub struct StartReport {
+    /// The seed it started from.
+    pub seed: Seed,
+    /// Objective at the seed.
+    pub seed_cost: f64,
+    /// Objective at the end (inf if nothing converged).
+    pub cost: f64,
+    /// Simulator evaluations used.
+    pub evaluations: usize,
+    /// Why Levenberg–Marquardt stopped.
+    pub termination: String,
+}
+
+/// The result of a multi-start design.
+#[derive(Debug, Clone, Serialize)]
+pub struct DesignOutcome {
+    /// The best design found.
+    pub best: Evaluation,
+    /// Its objective (eq. 3.17).
+    pub cost: f64,
+    /// Every refinement, best first.
+    pub starts: Vec<StartReport>,
+    /// Seed designs simulated (grid and map).
+    pub seeds_simulated: usize,
+    /// Wall time, s.
+    pub seconds: f64,
+}
+
+/// Mirrors an evaluation (negated routing): model-notes §3, mirror symmetry.
+fn mirrored(e: &Evaluation) -> Evaluation {
+    let mut m = e.clone();
+    m.routing_mm = e.routing_mm.map(|y| -y);
+    m.pose.tip_y_mm = -e.pose.tip_y_mm;
+    m.pose.tip_angle_rad = -e.pose.tip_angle_rad;
+    m.pose.tip_frame_angle_rad = -e.pose.tip_frame_angle_rad;
+    m.pose.base_angle_rad = -e.pose.base_angle_rad;
+    m.a.iter_mut().for_each(|a| *a = -*a);
+    m
+}
+
+/// Simulates the seed grid and returns every design with its cost, best first.
+pub fn grid_seeds(objective: &Objective, search: &SearchOptions) -> Vec<(f64, Seed)> {
+    let b = objective.bounds;
+    let levels: Vec<f64> = search.grid_levels.iter().map(|f| f * b.max_offset_mm).collect();
+    let mut tensions: Vec<f64> =
+        search.grid_tension_fractions.iter().map(|f| b.tension_min_n + f * (b.tension_max_n - b.tension_min_n)).collect();
+    tensions.sort_by(f64::total_cmp);
+    tensions.dedup();
+    let nl = levels.len();
+    let total = nl.pow(5);
+    // Keep one routing of each mirror pair: the one whose first non-zero
+    // control point is positive (the all-zero routing is its own mirror).
+    let canonical = |idx: usize| -> Option<[f64; 5]> {
+        let mut y = [0.0; 5];
+        let mut k = idx;
+        for v in y.iter_mut() {
+            *v = levels[k % nl];
+            k /= nl;
+        }
+        match y.iter().find(|v| **v != 0.0) {
+            Some(v) if *v < 0.0 => None,
+            _ => Some(y),
+        }
+    };
+    let order = objective.target.order();
+    let mut seeds: Vec<(f64, Seed)> = (0..total)
+        .into_par_iter()
+        .filter_map(canonical)
+        .map_init(
+            || (objective.simulator(), vec![0.0; order + 1]),
+            |(sim, a), y| {
+                let mut out = Vec::with_capacity(2 * tensions.len());
+                let routing = match Routing::new(&y, objective.actuator.length_mm, objective.actuator.radius_mm) {
+                    Ok(r) => r,
+                    Err(_) => return out,
+                };
+                sim.set_routing(&routing);
+                // The grid tensions in rising order form the continuation
+                // ladder; the first is solved cold (see `Objective::evaluate`),
+                // or climbed to from low tension if that fails.
+                let first = tensions[0];
+                let mut ladder: Vec<f64> = tensions.clone();
+                if sim.solve(first).is_err() {
+                    sim.set_routing(&routing);
+                    let rungs = ((first / super::objective::LADDER_STEP_N).ceil() as usize).max(1);
+                    ladder.splice(0..0, (1..rungs).map(|k| first * k as f64 / rungs as f64));
+                }
+                // (After a cold success the first rung repeats as a converged warm start.)
+                for t in ladder {
+                    let Ok(pose) = sim.solve(t) else { return out };
+                    if tensions.iter().any(|g| (g - t).abs() < 1e-12) {
+                        sim.coefficients_into(a);
+                        objective.length_basis.convert(a, pose.length_mm, objective.actuator.length_mm);
+                        let e = Evaluation { routing_mm: y, tension_n: t, pose, a: a.clone() };
+                        let m = mirrored(&e);
+                        out.push((objective.cost(&e), Seed { routing_mm: y, tension_n: t, source: SeedSource::Grid }));
+                        if m.routing_mm != y {
+                            out.push((objective.cost(&m), Seed { routing_mm: m.routing_mm, tension_n: t, source: SeedSource::Grid }));
+                        }
+                    }
+                }
+                out
+            },
+        )
+        .flatten()
+        .collect();
+    seeds.sort_by(|p, q| p.0.total_cmp(&q.0));
+    seeds
+}
+
+/// Evaluates extra seeds (e.g. from a map) under this objective, best first;
+/// seeds outside the bounds are clamped into them.
+pub fn evaluate_seeds(objective: &Objective, seeds: &[Seed]) -> Vec<(f64, Seed)> {
+    let mut out: Vec<(f64, Seed)> = seeds
+        .par_iter()
+        .map_init(
+            || objective.simulator(),
+            |sim, s| {
+                let mut s = *s;
+                objective.bounds.clamp(&mut s.routing_mm, &mut s.tension_n);
+                objective.evaluate(sim, &s.routing_mm, s.tension_n).ok().map(|e| (objective.cost(&e), s))
+            },
+        )
+        .flatten()
+        .collect();
+    out.sort_by(|p, q| p.0.total_cmp(&q.0));
+    out
+}
+
+/// The least-squares problem in transformed variables z (see module docs).
+struct Problem<'a> {
+    objective: &'a Objective,
+    sim: RefCell<Simulator>,
+    z: DVector<f64>,
+    /// Residuals at `z`, filled on first use.
+    current: RefCell<Option<Option<DVector<f64>>>>,
+    /// Best design seen so far (LM may stop on a rejected trial point).
+    best: RefCell<Option<(f64, Evaluation)>>,
+    evaluations: Cell<usize>,
+    max_evaluations: usize,
+    /// Raised by whichever start first reaches [`COST_FLOOR`]: the others stop.
+    stop: &'a AtomicBool,
+}
+
+/// An objective this small is an exact fit: errors near 1e-10 mm and
+/// 1e-11 /mm, below the solver's own discretisation error. Reaching it ends
+/// the search (without it, a zero-residual problem keeps LM iterating).
+pub const COST_FLOOR: f64 = 1e-20;
+
+/// Finite-difference step in z (a few 1e-5 mm in y): large against the
+/// solver's convergence noise (~1e-10 in a_i), small against curvature.
+const FD_STEP: f64 = 2e-6;
+
+impl Problem<'_> {
+    fn design_of(&self, z: &DVector<f64>) -> ([f64; 5], f64) {
+        let b = self.objective.bounds;
+        let y = std::array::from_fn(|i| b.max_offset_mm * z[i].sin());
+        let tension = b.tension_min_n + (b.tension_max_n - b.tension_min_n) * 0.5 * (1.0 + z[5].sin());
+        (y, tension)
+    }
+
+    fn z_of(&self, y: &[f64; 5], tension: f64) -> DVector<f64> {
+        let b = self.objective.bounds;
+        let mut z = DVector::zeros(6);
+        for i in 0..5 {
+            z[i] = (y[i] / b.max_offset_mm).clamp(-1.0, 1.0).asin();
+        }
+        let span = b.tension_max_n - b.tension_min_n;
+        z[5] = if span > 0.0 { (2.0 * (tension - b.tension_min_n) / span - 1.0).clamp(-1.0, 1.0).asin() } else { 0.0 };
+        z
+    }
+
+    fn residuals_at(&self, z: &DVector<f64>) -> Result<DVector<f64>, SolveFailure> {
+        self.evaluations.set(self.evaluations.get() + 1);
+        let (y, tension) = self.design_of(z);
+        let e = self.objective.evaluate(&mut self.sim.borrow_mut(), &y, tension)?;
+        let mut r = DVector::zeros(self.objective.residual_count());
+        self.objective.residuals_into(&e, r.as_mut_slice());
+        let cost = r.norm_squared();
+        let mut best = self.best.borrow_mut();
+        if best.as_ref().is_none_or(|(c, _)| cost < *c) {
+            *best = Some((cost, e));
+        }
+        Ok(r)
+    }
+}
+
+impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
+    type ResidualStorage = Owned<f64, Dyn>;
+    type JacobianStorage = Owned<f64, Dyn, Dyn>;
+    type ParameterStorage = Owned<f64, Dyn>;
+
+    fn set_params(&mut self, z: &DVector<f64>) {
+        self.z.copy_from(z);
+        *self.current.borrow_mut() = None;
+    }
+
+    fn params(&self) -> DVector<f64> {
+        self.z.clone()
+    }
+
+    fn residuals(&self) -> Option<DVector<f64>> {
+        let exact = self.best.borrow().as_ref().is_some_and(|(c, _)| *c <= COST_FLOOR);
+        if exact {
+            self.stop.store(true, Ordering::Relaxed);
+        }
+        if exact || self.stop.load(Ordering::Relaxed) || self.evaluations.get() >= self.max_evaluations {
+            // Exact fit here or elsewhere, or out of budget: returning no
+            // residuals stops the solver (the best design is kept).
+            return None;
+        }
+        if let Some(r) = self.current.borrow().as_ref() {
+            return r.clone();
+        }
+        let r = match self.residuals_at(&self.z) {
+            Ok(r) => Some(r),
+            // A trial point the model cannot solve: a huge residual makes LM
+            // reject the step and shrink its trust region instead of stopping.
+            Err(_) => Some(DVector::from_element(self.objective.residual_count(), 1e6)),
+        };
+        *self.current.borrow_mut() = Some(r.clone());
+        r
+    }
+
+    fn jacobian(&self) -> Option<DMatrix<f64>> {
+        let r0 = self.residuals()?;
+        let m = r0.len();
+        let mut jac = DMatrix::zeros(m, 6);
+        for j in 0..6 {
+            let mut z = self.z.clone();
+            z[j] += FD_STEP;
+            let column = match self.residuals_at(&z) {
+                Ok(r) => (r - &r0) / FD_STEP,
+                Err(_) => {
+                    // Forward point unsolvable: try the backward difference.
+                    z[j] -= 2.0 * FD_STEP;
+                    (&r0 - self.residuals_at(&z).ok()?) / FD_STEP
+                }
+            };
+            jac.set_column(j, &column);
+        }
+        Some(jac)
+    }
+}
+
+/// Refines one seed with bounded Levenberg–Marquardt; returns the best design
+/// it saw (None if not even the seed could be simulated).
+///
+/// `stop` is shared between parallel starts: set once any start fits exactly.
+pub fn refine(objective: &Objective, seed: &Seed, max_evaluations: usize, stop: &AtomicBool) -> (Option<(f64, Evaluation)>, StartReport) {
+    let mut problem = Problem {
+        objective,
+        sim: RefCell::new(objective.simulator()),
+        z: DVector::zeros(6),
+        current: RefCell::new(None),
+        best: RefCell::new(None),
+        evaluations: Cell::new(0),
+        max_evaluations,
+        stop,
+    };
+    let mut s = *seed;
+    objective.bounds.clamp(&mut s.routing_mm, &mut s.tension_n);
+    problem.z = problem.z_of(&s.routing_mm, s.tension_n);
+    let seed_cost = problem.residuals().map_or(f64::INFINITY, |r| r.norm_squared());
+    let (problem, report) = LevenbergMarquardt::new()
+        .with_ftol(1e-14)
+        .with_xtol(1e-12)
+        .with_gtol(1e-14)
+        .with_patience(max_evaluations / 7 + 1)
+        .minimize(problem);
+    let best = problem.best.into_inner();
+    let start = StartReport {
+        seed: s,
+        seed_cost,
+        cost: best.as_ref().map_or(f64::INFINITY, |b| b.0),
+        evaluations: problem.evaluations.get(),
+        // Our own stops surface from the solver as residual failures.
+        termination: if best.as_ref().is_some_and(|(c, _)| *c <= COST_FLOOR) {
+            "exact fit (objective at the noise floor)".to_string()
+        } else if stop.load(Ordering::Relaxed) {
+            "stopped: another start fitted exactly".to_string()
+        } else if problem.evaluations.get() >= max_evaluations {
+            "evaluation budget reached".to_string()
+        } else {
+            format!("{:?}", report.termination)
+        },
+    };
+    (best, start)
+}
+
+/// Picks up to `count` seeds from `ranked` (best first), skipping any within
+/// one grid step of a seed already picked, so that the starts explore
+/// different basins instead of one basin's neighbours.
+fn diverse(ranked: &[(f64, Seed)], count: usize, step_mm: f64) -> Vec<Seed> {
+    let mut picked: Vec<Seed> = Vec::with_capacity(count);
+    for (_, s) in ranked {
+        if picked.len() == count {
+            break;
+        }
+        let near = picked.iter().any(|p| {
+            p.routing_mm.iter().zip(&s.routing_mm).map(|(a, b)| (a - b).abs()).sum::<f64>() <= 1.01 * step_mm
+        });
+        if !near {
+            picked.push(*s);
+        }
+    }
+    picked
+}
+
+/// Evaluation budget of the first, exploratory pass of each start.
+pub const EXPLORE_EVALUATIONS: usize = 100;
+
+/// Designs for `objective`: simulates the seed grid (plus `extra_seeds`,
+/// e.g. a map's nearest designs, which get up to half of the starts),
+/// explores 3 × `search.starts` diverse seeds with a short budget, then
+/// refines the best `search.starts` of those to convergence in parallel and
+/// returns the best.
+pub fn design(objective: &Objective, search: &SearchOptions, extra_seeds: &[Seed]) -> Result<DesignOutcome, DesignError> {
+    let started = Instant::now();
+    let step_mm = search
+        .grid_levels
+        .windows(2)
+        .map(|w| (w[1] - w[0]).abs())
+        .fold(f64::INFINITY, f64::min)
+        .min(1.0)
+        * objective.bounds.max_offset_mm;
+    let explore = 3 * search.starts;
+    let mapped = evaluate_seeds(objective, extra_seeds);
+    let mut seeds = diverse(&mapped, explore.div_ceil(2), step_mm);
+    let grid = grid_seeds(objective, search);
+    let seeds_simulated = extra_seeds.len() + grid.len();
+    let mut merged: Vec<(f64, Seed)> = seeds.iter().map(|s| (f64::NEG_INFINITY, *s)).collect();
+    merged.extend(grid);
+    seeds = diverse(&merged, explore, step_mm);
+    if seeds.is_empty() {
+        return Err(DesignError::NoSeed);
+    }
+    let stop = AtomicBool::new(false);
+    // Pass 1: a short look from every seed.
+    let mut first: Vec<(Option<(f64, Evaluation)>, StartReport)> =
+        seeds.par_iter().map(|seed| refine(objective, seed, EXPLORE_EVALUATIONS, &stop)).collect();
+    first.sort_by(|p, q| p.1.cost.total_cmp(&q.1.cost));
+    // Pass 2: converge the most promising, continuing from where pass 1 stopped.
+    let continued: Vec<(f64, Seed)> = first
+        .iter()
+        .filter_map(|(best, report)| {
+            best.as_ref().map(|(c, e)| (*c, Seed { routing_mm: e.routing_mm, tension_n: e.tension_n, source: report.seed.source }))
+        })
+        .collect();
+    let finalists = if stop.load(Ordering::Relaxed) { Vec::new() } else { diverse(&continued, search.starts, 0.0) };
+    let mut results: Vec<(Option<(f64, Evaluation)>, StartReport)> = if finalists.is_empty() {
+        // An exact fit already (or nothing to continue): pass 1 is the answer.
+        first.clone()
+    } else {
+        finalists.par_iter().map(|seed| refine(objective, seed, search.max_evaluations, &stop)).collect()
+    };
+    // Report each finalist against the seed it came from.
+    for (result, finalist) in results.iter_mut().zip(&finalists) {
+        if let Some((_, origin)) = first.iter().find(|(b, _)| {
+            b.as_ref().is_some_and(|(_, e)| e.routing_mm == finalist.routing_mm && e.tension_n == finalist.tension_n)
+        }) {
+            result.1.evaluations += origin.evaluations;
+            result.1.seed_cost = origin.seed_cost;
+            result.1.seed = origin.seed;
+        }
+    }
+    results.sort_by(|p, q| p.1.cost.total_cmp(&q.1.cost));
+    let starts: Vec<StartReport> = results.iter().map(|r| r.1.clone()).collect();
+    let (cost, best) = results.into_iter().find_map(|r| r.0).ok_or(DesignError::NoSeed)?;
+    Ok(DesignOutcome { best, cost, starts, seeds_simulated, seconds: started.elapsed().as_secs_f64() })
+}
+
+/// Per-component comparison of a design with its target.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ComponentResult {
+    /// Which component.
+    pub component: Component,
+    /// Requested value.
+    pub target: f64,
+    /// Achieved value.
+    pub achieved: f64,
+    /// 100 (achieved − target)/|target|, % (None for a zero target).
+    pub error_pct: Option<f64>,
+    /// Whether the component is met within the tolerance.
+    pub met: bool,
+}
+
+/// Compares `eval` with the objective's target. A component is met when its
+/// relative error is within `tolerance_pct`; a zero target is judged against
+/// a natural scale instead (the rod length L for positions, 1/L for
+/// curvature coefficients: one radian of bending over the rod).
+pub fn compare(objective: &Objective, eval: &Evaluation, tolerance_pct: f64) -> Vec<ComponentResult> {
+    let length = objective.actuator.length_mm;
+    objective
+        .target
+        .components
+        .iter()
+        .map(|&(component, target)| {
+            let achieved = eval.value(component).expect("order covers the target");
+            let error_pct = super::target::error_pct(achieved, target);
+            let met = match error_pct {
+                Some(e) => e.abs() <= tolerance_pct,
+                None => {
+                    let scale = if matches!(component, Component::A(_)) { 1.0 / length } else { length };
+                    (achieved - target).abs() <= tolerance_pct / 100.0 * scale
+                }
+            };
+            ComponentResult { component, target, achieved, error_pct, met }
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::design::{Bounds, Target, Weights};
+    use crate::model::{Actuator, SolverOptions};
+
+    fn objective() -> Objective {
+        let act = Actuator::default();
+        let bounds = Bounds::thesis(act.radius_mm, 1.0, 2.0);
+        Objective::new(act, SolverOptions::default(), Target::parse("x=50,y=5").unwrap(), Weights::default(), bounds).unwrap()
+    }
+
+    #[test]
+    fn the_bounds_transformation_round_trips_and_stays_inside() {
+        let obj = objective();
+        let p = Problem {
+            objective: &obj,
+            sim: RefCell::new(obj.simulator()),
+            z: DVector::zeros(6),
+            current: RefCell::new(None),
+            best: RefCell::new(None),
+            evaluations: Cell::new(0),
+            max_evaluations: 10,
+            stop: &AtomicBool::new(false),
+        };
+        let y = [4.99, -4.99, 0.0, 1.234, -3.0];
+        let (y2, t2) = p.design_of(&p.z_of(&y, 1.7));
+        for (a, b) in y.iter().zip(&y2) {
+            assert!((a - b).abs() < 1e-12);
+        }
+        assert!((t2 - 1.7).abs() < 1e-12);
+        for z in [-100.0, -1.6, 0.3, std::f64::consts::FRAC_PI_2, 7.0] {
+            let (y, t) = p.design_of(&DVector::from_element(6, z));
+            assert!(y.iter().all(|v| v.abs() <= obj.bounds.max_offset_mm) && (1.0..=2.0).contains(&t));
+        }
+    }
+
+    #[test]
+    fn diverse_skips_grid_neighbours_but_not_distinct_designs() {
+        let seed = |y: [f64; 5], t: f64| (0.0, Seed { routing_mm: y, tension_n: t, source: SeedSource::Grid });
+        let ranked = [
+            seed([0.0, 0.0, 0.0, 0.0, 0.0], 1.0),
+            seed([0.0, 0.0, 0.0, 0.0, 0.0], 2.0),
+            seed([2.0, 0.0, 0.0, 0.0, 0.0], 1.0),
+            seed([2.0, 2.0, 0.0, 0.0, 0.0], 1.0),
+            seed([-4.0, 0.0, 0.0, 0.0, 4.0], 1.5),
+        ];
+        let picked = diverse(&ranked, 10, 2.0);
+        assert_eq!(picked.len(), 3, "{picked:?}");
+        assert_eq!(picked[1].routing_mm, [2.0, 2.0, 0.0, 0.0, 0.0]);
+        assert_eq!(picked[2].routing_mm, [-4.0, 0.0, 0.0, 0.0, 4.0]);
+        assert_eq!(diverse(&ranked, 1, 2.0).len(), 1);
+    }
+
+    #[test]
+    fn mirrored_negates_lateral_quantities() {
+        let obj = objective();
+        let mut sim = obj.simulator();
+        let e = obj.evaluate(&mut sim, &[1.0, -2.0, 3.0, 0.5, -1.5], 1.4).unwrap();
+        let m = obj.evaluate(&mut sim, &[-1.0, 2.0, -3.0, -0.5, 1.5], 1.4).unwrap();
+        let mm = mirrored(&e);
+        assert!((mm.pose.tip_y_mm - m.pose.tip_y_mm).abs() < 1e-9 && (mm.pose.tip_x_mm - m.pose.tip_x_mm).abs() < 1e-9);
+        for (a, b) in mm.a.iter().zip(&m.a) {
+            assert!((a - b).abs() < 1e-9);
+        }
+    }
+}
