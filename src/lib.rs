@@ -5,6 +5,7 @@
 //! and calibrate. Each layer has its own error enum, joined here.
 
 pub mod bench;
+pub mod calibrate;
 pub mod cli;
 pub mod design;
 pub mod io;
@@ -29,6 +30,9 @@ pub enum Error {
     /// Shape coefficients could not be computed.
     #[error(transparent)]
     Shape(#[from] shape::ShapeError),
+    /// Calibration and diagnosis.
+    #[error(transparent)]
+    Calibrate(#[from] calibrate::CalibrateError),
     /// Reducing a run into maps.
     #[error(transparent)]
     Reduce(#[from] reduce::ReduceError),

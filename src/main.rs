@@ -30,6 +30,12 @@ enum Command {
     Reduce(cli::reduce::ReduceArgs),
     /// The main job: sweep (resumable) then reduce; the thesis sweep when no SPEC is given.
     Map(cli::reduce::MapArgs),
+    /// Fit EA, GA, EI (and optionally effects) to measurements (thesis eq. 2.14).
+    Calibrate(cli::calibrate::CalibrateArgs),
+    /// Find, name and add the effect the model is missing; report and plots.
+    Diagnose(cli::diagnose::DiagnoseArgs),
+    /// Generate measurement files from the model with a hidden effect and noise.
+    Synth(cli::synth::SynthArgs),
 }
 
 fn main() -> ExitCode {
@@ -43,6 +49,9 @@ fn main() -> ExitCode {
         Command::Status(args) => cli::sweep::run_status_command(args),
         Command::Reduce(args) => cli::reduce::run(args),
         Command::Map(args) => cli::reduce::run_map(args),
+        Command::Calibrate(args) => cli::calibrate::run(args),
+        Command::Diagnose(args) => cli::diagnose::run(args),
+        Command::Synth(args) => cli::synth::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

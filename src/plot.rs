@@ -2,6 +2,7 @@
 //! design. The font is compiled into the binary (DejaVu Sans, see
 //! `assets/README.md`), so pictures never depend on the machine's fonts.
 
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use plotters::style::FontStyle;
 use std::path::Path;
@@ -94,21 +95,22 @@ fn bounds(bodies: &[BodyDrawing], extra: &[(f64, f64)]) -> ((f64, f64), (f64, f6
     ((cx - span / 2.0, cx + span / 2.0), (cy - span / 2.0, cy + span / 2.0))
 }
 
-/// Draws deformed actuators (body outline, channel/cable, tip marker) with
-/// the clamp axis pointing down the page (the rod hangs), axes in mm.
-/// `targets` adds crosses (e.g. target tips).
-pub fn draw_bodies(path: &Path, title: &str, bodies: &[BodyDrawing], targets: &[(f64, f64)]) -> Result<(), PlotError> {
-    register_fonts();
-    let root = BitMapBackend::new(path, (800, 800)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| PlotError::new(path, e))?;
-    let ((x0, x1), (y0, y1)) = bounds(bodies, targets);
-    // Page coordinates: horizontal = y (lateral), vertical = −x (hanging).
-    let mut chart = ChartBuilder::on(&root)
+/// A chart of a hanging rod in page coordinates: horizontal = y (lateral,
+/// `lateral_mm`), vertical = −x (the clamp axis pointing down the page,
+/// `page_vertical_mm` = range of −x), axes labelled in mm.
+pub fn hanging_chart<'a, 'b>(
+    root: &'a DrawingArea<BitMapBackend<'b>, plotters::coord::Shift>,
+    path: &Path,
+    title: &str,
+    lateral_mm: (f64, f64),
+    page_vertical_mm: (f64, f64),
+) -> Result<ChartContext<'a, BitMapBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>, PlotError> {
+    let mut chart = ChartBuilder::on(root)
         .caption(title, (FONT, 22))
         .margin(15)
         .x_label_area_size(45)
         .y_label_area_size(55)
-        .build_cartesian_2d(y0..y1, -x1..-x0)
+        .build_cartesian_2d(lateral_mm.0..lateral_mm.1, page_vertical_mm.0..page_vertical_mm.1)
         .map_err(|e| PlotError::new(path, e))?;
     chart
         .configure_mesh()
@@ -119,6 +121,18 @@ pub fn draw_bodies(path: &Path, title: &str, bodies: &[BodyDrawing], targets: &[
         .axis_desc_style((FONT, 16))
         .draw()
         .map_err(|e| PlotError::new(path, e))?;
+    Ok(chart)
+}
+
+/// Draws deformed actuators (body outline, channel/cable, tip marker) with
+/// the clamp axis pointing down the page (the rod hangs), axes in mm.
+/// `targets` adds crosses (e.g. target tips).
+pub fn draw_bodies(path: &Path, title: &str, bodies: &[BodyDrawing], targets: &[(f64, f64)]) -> Result<(), PlotError> {
+    register_fonts();
+    let root = BitMapBackend::new(path, (800, 800)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| PlotError::new(path, e))?;
+    let ((x0, x1), (y0, y1)) = bounds(bodies, targets);
+    let mut chart = hanging_chart(&root, path, title, (y0, y1), (-x1, -x0))?;
     let page = |pts: &[(f64, f64)]| -> Vec<(f64, f64)> { pts.iter().map(|&(x, y)| (y, -x)).collect() };
     // The clamp.
     chart

@@ -2,11 +2,14 @@
 //! run each command. `main.rs` only parses and dispatches.
 
 pub mod bench;
+pub mod calibrate;
 pub mod design;
+pub mod diagnose;
 pub mod feasible;
 pub mod reduce;
 pub mod simulate;
 pub mod sweep;
+pub mod synth;
 
 use crate::model::{Actuator, SolverOptions};
 use clap::Args;
@@ -51,6 +54,18 @@ pub struct ActuatorArgs {
     /// Channel offset δ added to every y_i, mm [default 0].
     #[arg(long, value_name = "MM", allow_hyphen_values = true)]
     pub channel_offset_mm: Option<f64>,
+    /// Cable–channel friction coefficient μ (capstan law) [default 0].
+    #[arg(long, value_name = "MU")]
+    pub friction_mu: Option<f64>,
+    /// Creep: fraction f of the bending rigidity that relaxes (0 ≤ f < 1) [default 0].
+    #[arg(long, value_name = "F")]
+    pub creep_fraction: Option<f64>,
+    /// Creep time constant T, s [default 10].
+    #[arg(long, value_name = "S")]
+    pub creep_time_s: Option<f64>,
+    /// Creep: seconds each tension is held on a fresh rod in sweeps and design [default 0].
+    #[arg(long, value_name = "S")]
+    pub creep_hold_s: Option<f64>,
     /// RK4 steps per knot span of the routing (even) [default 24].
     #[arg(long, value_name = "N")]
     pub steps_per_span: Option<usize>,
@@ -75,6 +90,10 @@ impl ActuatorArgs {
         set(&mut a.gravity.scale, self.gravity_scale);
         set(&mut a.effects.stiffening_alpha, self.stiffening_alpha);
         set(&mut a.effects.channel_offset_mm, self.channel_offset_mm);
+        set(&mut a.effects.friction_mu, self.friction_mu);
+        set(&mut a.effects.creep_fraction, self.creep_fraction);
+        set(&mut a.effects.creep_time_s, self.creep_time_s);
+        set(&mut a.effects.creep_hold_s, self.creep_hold_s);
         if self.no_gravity {
             a.gravity.enabled = false;
         }

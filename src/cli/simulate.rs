@@ -1,7 +1,7 @@
 //! `cablemap simulate`: one actuator, one tension.
 
 use super::{parse_list, ActuatorArgs};
-use crate::model::{simulate, Actuator, Routing, Simulation, SolverOptions, STATUS_OK};
+use crate::model::{simulate_held, Actuator, Hold, LoadDirection, Routing, Simulation, SolverOptions, STATUS_OK};
 use crate::plot::{draw_bodies, BodyDrawing};
 use anyhow::Context;
 use clap::Args;
@@ -39,6 +39,13 @@ pub struct SimulateArgs {
     /// Draw the deformed body, channel and tip as PNG.
     #[arg(long, value_name = "FILE")]
     pub png: Option<PathBuf>,
+    /// Direction of the last tension change (sign of friction): load or unload.
+    #[arg(long, value_name = "DIR", default_value = "load", value_parser = ["load", "unload"])]
+    pub direction: String,
+    /// Seconds held at the tension before the reading, from a rod with no
+    /// load history (creep) [default: --creep-hold-s, else 0].
+    #[arg(long, value_name = "S")]
+    pub dwell_s: Option<f64>,
     #[command(flatten)]
     pub actuator: ActuatorArgs,
 }
@@ -104,7 +111,9 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     let options = args.actuator.solver_options(&SolverOptions::default());
     let y = parse_list(&args.routing, "--routing")?;
     let routing = Routing::new(&y, actuator.length_mm, actuator.radius_mm).context("--routing")?;
-    let mut sim = simulate(&actuator, &options, &routing, args.tension, args.order)
+    let direction = if args.direction == "unload" { LoadDirection::Unload } else { LoadDirection::Load };
+    let hold = Hold { direction, dwell_s: args.dwell_s.unwrap_or(actuator.effects.creep_hold_s) };
+    let mut sim = simulate_held(&actuator, &options, &routing, args.tension, args.order, hold)
         .with_context(|| format!("simulating routing {y:?} at {} N", args.tension))?;
     if args.coefficients == CoefficientRoute::Thesis {
         let points: Vec<[f64; 2]> = sim.centreline.iter().map(|c| [c.x_mm, c.y_mm]).collect();

@@ -3,6 +3,9 @@
 
 use serde::{Deserialize, Serialize};
 
+/// Default creep time constant T, s.
+pub const DEFAULT_CREEP_TIME_S: f64 = 10.0;
+
 /// Standard gravity, m/s².
 pub const STANDARD_GRAVITY_M_S2: f64 = 9.81;
 
@@ -75,6 +78,18 @@ pub struct Effects {
     pub clamp_stiffness_n_mm_per_rad: Option<f64>,
     /// Channel offset δ: the built channel sits at y_c + δ, mm.
     pub channel_offset_mm: f64,
+    /// Viscoelastic creep in bending (standard linear solid): the fraction f
+    /// of the instantaneous bending rigidity that relaxes, 0 ≤ f < 1. Held
+    /// long enough at a moment m, the curvature creeps from m/EI to
+    /// m/(EI (1 − f)).
+    pub creep_fraction: f64,
+    /// Time constant T of the creep's dashpot, s (the curvature relaxes
+    /// like exp(−(1 − f) t / T) at a held moment).
+    pub creep_time_s: f64,
+    /// For solves outside a measured protocol (simulate, sweep, design):
+    /// how long each tension is held on a rod with no load history before
+    /// the shape is taken, s. 0 gives the instantaneous (elastic) shape.
+    pub creep_hold_s: f64,
 }
 
 impl Default for Effects {
@@ -85,6 +100,9 @@ impl Default for Effects {
             stiffening_alpha: 0.0,
             clamp_stiffness_n_mm_per_rad: None,
             channel_offset_mm: 0.0,
+            creep_fraction: 0.0,
+            creep_time_s: DEFAULT_CREEP_TIME_S,
+            creep_hold_s: 0.0,
         }
     }
 }
@@ -176,6 +194,22 @@ impl Actuator {
             if !(k.is_finite() && k > 0.0) {
                 return Err(ParameterError::NotPositive { name: "effects.clamp_stiffness_n_mm_per_rad", value: k });
             }
+        }
+        let f = self.effects.creep_fraction;
+        if !(f.is_finite() && (0.0..1.0).contains(&f)) {
+            return Err(ParameterError::OutOfRange {
+                name: "effects.creep_fraction",
+                value: f,
+                expected: "0 ≤ f < 1 (the fraction of the bending rigidity that relaxes)",
+            });
+        }
+        let t = self.effects.creep_time_s;
+        if !(t.is_finite() && t > 0.0) {
+            return Err(ParameterError::NotPositive { name: "effects.creep_time_s", value: t });
+        }
+        let hold = self.effects.creep_hold_s;
+        if !(hold.is_finite() && hold >= 0.0) {
+            return Err(ParameterError::OutOfRange { name: "effects.creep_hold_s", value: hold, expected: "a finite time ≥ 0 s" });
         }
         let delta = self.effects.channel_offset_mm;
         if !(delta.is_finite() && delta.abs() < self.radius_mm) {

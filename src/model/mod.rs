@@ -5,6 +5,6 @@ pub mod actuator;
 pub mod routing;
 pub mod solver;
 
-pub use actuator::{Actuator, Effects, Gravity, ParameterError};
+pub use actuator::{Actuator, Effects, Gravity, LoadDirection, ParameterError};
 pub use routing::{Routing, RoutingError};
-pub use solver::{simulate, CentrelinePoint, Simulation, Simulator, SolveFailure, SolverOptions, TipPose, STATUS_OK};
+pub use solver::{simulate, simulate_held, CentrelinePoint, Hold, Simulation, Simulator, SolveFailure, SolverOptions, TipPose, STATUS_OK};

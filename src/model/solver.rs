@@ -19,10 +19,27 @@
 //! ([`Simulator::bending_curvature`]), the clamp boundary
 //! ([`Simulator::clamp_angle`]), the routing (channel offset) and the weight.
 //!
+//! Two effects carry state beyond one point:
+//! - **Cable–channel friction** (capstan law dτ/ds = −σ μ τ |ψ'|, ψ the
+//!   cable's global angle φ + α, σ = +1 loading and −1 unloading): the tension
+//!   profile τ(s)/τ(0) is held at every stage point and updated from the
+//!   cable angles of the last pass until it stops changing (a fixed point that
+//!   contracts like μ·|Δψ|; warm-started from the previous solve). The cut
+//!   equations hold unchanged with τ(s) at the cut, because friction acts
+//!   inside the distal free body.
+//! - **Viscoelastic creep in bending** (standard linear solid): the moment is
+//!   m = EI (u − f q) with an internal curvature q obeying T q̇ = u − q. Each
+//!   solve is one step of a protocol: the tension jumps, then is held for the
+//!   dwell time d with m(s) taken as constant over the hold. That makes the
+//!   law at the end of the hold local and linear,
+//!   u = m/EI · (1 + f (1 − E)/(1 − f)) + f E q₀,  E = exp(−(1 − f) d / T),
+//!   and q is advanced in closed form after the solve. The history q(s) lives
+//!   in the simulator; `set_routing` and `reset_history` clear it.
+//!
 //! The hot path (`integrate`) works in buffers allocated once per
 //! [`Simulator`]; solving allocates nothing.
 
-use super::actuator::{Actuator, ParameterError};
+use super::actuator::{Actuator, LoadDirection, ParameterError};
 use super::routing::Routing;
 use crate::shape;
 use serde::{Deserialize, Serialize};
@@ -51,6 +68,9 @@ pub enum SolveFailure {
     /// A non-finite number appeared in the state.
     #[error("a non-finite value appeared at s = {s_mm:.3} mm")]
     NonFinite { s_mm: f64 },
+    /// The friction tension profile did not settle.
+    #[error("the cable tension profile with friction did not converge")]
+    FrictionNotConverged,
 }
 
 impl SolveFailure {
@@ -64,9 +84,15 @@ impl SolveFailure {
             SolveFailure::ShootingNotConverged { .. } => "shooting_not_converged",
             SolveFailure::ClampNotConverged => "clamp_not_converged",
             SolveFailure::NonFinite { .. } => "non_finite",
+            SolveFailure::FrictionNotConverged => "friction_not_converged",
         }
     }
 }
+
+/// Most re-integrations while the friction tension profile settles.
+const FRICTION_MAX_PASSES: usize = 60;
+/// Largest change of τ(s)/τ(0) accepted as settled.
+const FRICTION_TOLERANCE: f64 = 1e-10;
 
 /// Status string of a successful solve.
 pub const STATUS_OK: &str = "ok";
@@ -143,6 +169,8 @@ pub struct CentrelinePoint {
     pub cable_x_mm: f64,
     /// Cable position in the plane, mm.
     pub cable_y_mm: f64,
+    /// Cable tension at this point, N (varies along s with friction).
+    pub cable_tension_n: f64,
 }
 
 /// Integration state: position, frame angle, gravity's distal moment, arc length.
@@ -222,6 +250,38 @@ pub struct Simulator {
     sigma: Vec<f64>,
     continuation: Continuation,
     last: Option<TipPose>,
+    /// Friction sign σ of the next solves: +1 loading, −1 unloading.
+    friction_sign: f64,
+    /// Cable tension at each stage point relative to the base tension.
+    tension_ratio: Vec<f64>,
+    /// Cable's global direction (cos ψ, sin ψ) at each stage point, last pass.
+    cable_global: Vec<(f64, f64)>,
+    /// Bending moment at each stage point in the last pass, N·mm.
+    bending_moment: Vec<f64>,
+    /// Creep's internal curvature q at each stage point, 1/mm.
+    creep_q: Vec<f64>,
+    /// Dwell before the reading of the next solves, s.
+    dwell_s: f64,
+    /// E = exp(−(1 − f) d / T) for the current dwell.
+    creep_decay: f64,
+    /// Extra compliance of the held step, f (1 − E)/((1 − f) EI), 1/(N·mm²).
+    creep_gain: f64,
+    /// Whether every solve starts from a rod with no load history (the
+    /// default, held `effects.creep_hold_s`), or follows a protocol set by
+    /// [`Simulator::set_hold`].
+    virgin_holds: bool,
+    /// Whether passes record cable angles and moments (friction or creep on).
+    records_profile: bool,
+}
+
+/// How a solve is held: the direction of the last tension change (friction)
+/// and the dwell before the reading (creep).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct Hold {
+    /// Tension rising (load) or falling (unload).
+    pub direction: LoadDirection,
+    /// Seconds held at the tension before the reading.
+    pub dwell_s: f64,
 }
 
 impl Simulator {
@@ -256,6 +316,22 @@ impl Simulator {
             sigma: vec![0.0; nodes],
             continuation: Continuation::default(),
             last: None,
+            friction_sign: actuator.effects.load_direction.sign(),
+            tension_ratio: vec![1.0; 2 * (2 * n + 1)],
+            cable_global: vec![(1.0, 0.0); 2 * (2 * n + 1)],
+            bending_moment: vec![0.0; 2 * (2 * n + 1)],
+            creep_q: vec![0.0; 2 * (2 * n + 1)],
+            dwell_s: 0.0,
+            creep_decay: 1.0,
+            creep_gain: 0.0,
+            virgin_holds: true,
+            records_profile: actuator.effects.friction_mu > 0.0 || actuator.effects.creep_fraction > 0.0,
+        })
+        .and_then(|mut sim: Simulator| {
+            let hold = Hold { direction: actuator.effects.load_direction, dwell_s: actuator.effects.creep_hold_s };
+            sim.set_hold(hold)?;
+            sim.virgin_holds = true;
+            Ok(sim)
         })
     }
 
@@ -288,16 +364,49 @@ impl Simulator {
                 self.channel[span * (2 * n + 1) + j] = ChannelSample { y: c.y_mm, dy: c.dy_ds };
             }
         }
-        self.cable_dir.iter_mut().for_each(|d| *d = (1.0, 0.0));
         self.routing = Some(built);
-        self.continuation = Continuation::default();
+        self.reset_warm_start();
+        self.reset_history();
         self.last = None;
     }
 
-    /// Forgets the warm start (the next solve starts cold).
+    /// Forgets the warm start (the next solve starts cold). The creep
+    /// history is physical state and is kept.
     pub fn reset_warm_start(&mut self) {
         self.continuation = Continuation::default();
         self.cable_dir.iter_mut().for_each(|d| *d = (1.0, 0.0));
+        self.tension_ratio.iter_mut().for_each(|r| *r = 1.0);
+    }
+
+    /// Forgets the load history (creep): the material is as new, unloaded.
+    pub fn reset_history(&mut self) {
+        self.creep_q.iter_mut().for_each(|q| *q = 0.0);
+    }
+
+    /// Sets how the next solves are held: the load direction (sign of
+    /// friction) and the dwell time before the reading (creep). From then
+    /// on solves follow a protocol: the creep history carries over from
+    /// solve to solve (a dwell of 0 s leaves it unchanged).
+    ///
+    /// Without this call every solve is held `effects.creep_hold_s` on a
+    /// rod with no load history, in `effects.load_direction`.
+    pub fn set_hold(&mut self, hold: Hold) -> Result<(), ParameterError> {
+        self.virgin_holds = false;
+        if !(hold.dwell_s.is_finite() && hold.dwell_s >= 0.0) {
+            return Err(ParameterError::OutOfRange { name: "dwell_s", value: hold.dwell_s, expected: "a finite time ≥ 0 s" });
+        }
+        self.friction_sign = hold.direction.sign();
+        self.dwell_s = hold.dwell_s;
+        let e = &self.actuator.effects;
+        let f = e.creep_fraction;
+        if f > 0.0 {
+            self.creep_decay = (-(1.0 - f) * hold.dwell_s / e.creep_time_s).exp();
+            self.creep_gain = f * (1.0 - self.creep_decay) / ((1.0 - f) * self.actuator.ei_n_mm2);
+        } else {
+            self.creep_decay = 1.0;
+            self.creep_gain = 0.0;
+        }
+        Ok(())
     }
 
     /// Curvature u from the bending moment `m` (N·mm) and du/dm. Linear
@@ -326,7 +435,9 @@ impl Simulator {
 
     /// Solves the cut equations at one point for the cable angle α and the
     /// strains, starting Newton from the direction `dir0` = (cos α, sin α);
-    /// `(sp, cp)` = sin, cos of φ. Returns the strains and (cos α, sin α).
+    /// `(sp, cp)` = sin, cos of φ; `tension` is the cable tension at the cut
+    /// and `creep_offset` the creep's held curvature f E q₀ (1/mm). Returns
+    /// the strains and (cos α, sin α).
     ///
     /// Newton converges quadratically, so once a step is below
     /// `angle_tolerance_rad` the remaining error is of the order of its
@@ -342,6 +453,7 @@ impl Simulator {
         moment: f64,
         tension: f64,
         dir0: (f64, f64),
+        creep_offset: f64,
     ) -> Result<(Strains, (f64, f64)), SolveFailure> {
         let a = &self.actuator;
         let (ea, ga) = (a.ea_n, a.ga_n);
@@ -353,7 +465,10 @@ impl Simulator {
         for _ in 0..50 {
             let v1 = 1.0 + (w1 - tension * ca) / ea;
             let v2 = (w2 - tension * sa) / ga;
-            let (u, du_dm) = self.bending_curvature(tension * ch.y * ca + moment);
+            let m = tension * ch.y * ca + moment;
+            let (u_el, du_dm_el) = self.bending_curvature(m);
+            let u = u_el + self.creep_gain * m + creep_offset;
+            let du_dm = du_dm_el + self.creep_gain;
             let p = v1 - u * ch.y;
             let q = v2 + ch.dy;
             let g = p * sa - q * ca;
@@ -396,8 +511,16 @@ impl Simulator {
         (cp, sp): (f64, f64),
         tension: f64,
     ) -> Result<(State, Strains), SolveFailure> {
-        let (e, dir) = self.strains_at(s, self.channel[k], (sp, cp), st.moment, tension, self.cable_dir[k])?;
+        let ch = self.channel[k];
+        let local_tension = tension * self.tension_ratio[k];
+        let creep_offset = self.creep_offset(k);
+        let (e, dir) = self.strains_at(s, ch, (sp, cp), st.moment, local_tension, self.cable_dir[k], creep_offset)?;
         self.cable_dir[k] = dir;
+        // Only friction (cable angles) and creep (moments) need these.
+        if self.records_profile {
+            self.cable_global[k] = (cp * dir.0 - sp * dir.1, sp * dir.0 + cp * dir.1);
+            self.bending_moment[k] = local_tension * ch.y * dir.0 + st.moment;
+        }
         let dx = e.v1 * cp - e.v2 * sp;
         let dy = e.v1 * sp + e.v2 * cp;
         let wl = self.weight_n_per_mm * (self.actuator.length_mm - s);
@@ -411,6 +534,17 @@ impl Simulator {
         Ok((d, e))
     }
 
+    /// The creep's held curvature f E q₀ at stage point `k`, 1/mm.
+    #[inline]
+    fn creep_offset(&self, k: usize) -> f64 {
+        let f = self.actuator.effects.creep_fraction;
+        if f == 0.0 {
+            0.0
+        } else {
+            f * self.creep_decay * self.creep_q[k]
+        }
+    }
+
     /// Frame angle at the clamp: 0 for a rigid clamp; with clamp compliance
     /// φ(0) = m(0)/k_θ with m(0) the bending moment there (fixed point, as
     /// m(0) depends on φ(0) only through the weight's direction).
@@ -421,7 +555,8 @@ impl Simulator {
         let ch = self.channel[0];
         let mut phi: f64 = 0.0;
         for _ in 0..100 {
-            let (_, (ca, _)) = self.strains_at(0.0, ch, phi.sin_cos(), moment0, tension, self.cable_dir[0])?;
+            let (_, (ca, _)) =
+                self.strains_at(0.0, ch, phi.sin_cos(), moment0, tension, self.cable_dir[0], self.creep_offset(0))?;
             let m = tension * ch.y * ca + moment0;
             let next = m / k_theta;
             if (next - phi).abs() < 1e-14 {
@@ -477,6 +612,98 @@ impl Simulator {
         Ok(st.moment)
     }
 
+    /// Secant shooting on gravity's base moment `m0` from the given guess
+    /// and slope dM(L)/dM(0) (both updated in place). Returns the passes used.
+    fn shoot(&mut self, tension: f64, m0: &mut f64, slope: &mut f64) -> Result<u32, SolveFailure> {
+        let mut passes = 1u32;
+        let mut f0 = self.integrate(tension, *m0)?;
+        let mut prev: Option<(f64, f64)> = None;
+        while f0.abs() > self.options.moment_tolerance_n_mm {
+            if passes >= self.options.max_shooting_passes {
+                return Err(SolveFailure::ShootingNotConverged { iterations: passes, residual_n_mm: f0 });
+            }
+            if let Some((mp, fp)) = prev {
+                let secant = (f0 - fp) / (*m0 - mp);
+                if secant.is_finite() && secant != 0.0 {
+                    *slope = secant;
+                }
+            }
+            prev = Some((*m0, f0));
+            *m0 -= f0 / *slope;
+            f0 = self.integrate(tension, *m0)?;
+            passes += 1;
+        }
+        Ok(passes)
+    }
+
+    /// Friction: updates the tension profile from the last pass and re-solves
+    /// with `repass` (returning its passes) until the profile settles.
+    fn settle_friction(&mut self, mut repass: impl FnMut(&mut Self) -> Result<u32, SolveFailure>) -> Result<u32, SolveFailure> {
+        let mut passes = 0;
+        for _ in 0..FRICTION_MAX_PASSES {
+            if self.update_tension_ratio() < FRICTION_TOLERANCE {
+                return Ok(passes);
+            }
+            passes += repass(self)?;
+        }
+        Err(SolveFailure::FrictionNotConverged)
+    }
+
+    /// Recomputes the friction tension profile τ(s)/τ(0) from the cable
+    /// angles of the last pass (capstan law between neighbouring nodes,
+    /// exact for a constant |ψ'| between them); returns the largest change.
+    ///
+    /// Only the nodes (accepted RK4 states) are used, not the predictor
+    /// stages; the stage point between two nodes gets their geometric mean.
+    fn update_tension_ratio(&mut self) -> f64 {
+        let n = self.options.steps_per_span;
+        let span_len = 2 * n + 1;
+        let k_node = |node: usize| -> usize {
+            // Span 0's last node is the same point as span 1's first.
+            if node < n {
+                2 * node
+            } else {
+                span_len + 2 * (node - n)
+            }
+        };
+        let mu = self.actuator.effects.friction_mu * self.friction_sign;
+        let mut change: f64 = 0.0;
+        let mut ratio = 1.0;
+        let mut prev_dir = self.cable_global[k_node(0)];
+        let mut set = |ratio_vec: &mut Vec<f64>, k: usize, value: f64| {
+            change = change.max((ratio_vec[k] - value).abs());
+            ratio_vec[k] = value;
+        };
+        set(&mut self.tension_ratio, 0, 1.0);
+        for node in 1..=2 * n {
+            let dir = self.cable_global[k_node(node)];
+            let turn = (prev_dir.0 * dir.1 - prev_dir.1 * dir.0).atan2(prev_dir.0 * dir.0 + prev_dir.1 * dir.1);
+            let next = ratio * (-mu * turn.abs()).exp();
+            let k = k_node(node);
+            let mid = (ratio * next).sqrt();
+            set(&mut self.tension_ratio, k_node(node - 1) + 1, mid);
+            set(&mut self.tension_ratio, k, next);
+            if node == n {
+                set(&mut self.tension_ratio, 2 * n, next);
+            }
+            ratio = next;
+            prev_dir = dir;
+        }
+        change
+    }
+
+    /// Advances the creep's internal curvature over the hold just solved:
+    /// q ← q∞ + (q − q∞) E with q∞ = m/(EI (1 − f)).
+    fn advance_creep(&mut self) {
+        let f = self.actuator.effects.creep_fraction;
+        let scale = 1.0 / (self.actuator.ei_n_mm2 * (1.0 - f));
+        let e = self.creep_decay;
+        for (q, &m) in self.creep_q.iter_mut().zip(&self.bending_moment) {
+            let q_inf = m * scale;
+            *q = q_inf + (*q - q_inf) * e;
+        }
+    }
+
     /// Solves the statics for `tension_n` (N) on the current routing,
     /// warm-started from the previous solves of this routing.
     ///
@@ -486,6 +713,9 @@ impl Simulator {
         assert!(self.routing.is_some(), "Simulator::solve called before set_routing");
         if !(tension_n.is_finite() && tension_n >= 0.0) {
             return Err(SolveFailure::InvalidTension(tension_n));
+        }
+        if self.virgin_holds && self.actuator.effects.creep_fraction > 0.0 {
+            self.reset_history();
         }
         let result = self.solve_inner(tension_n);
         match &result {
@@ -500,7 +730,8 @@ impl Simulator {
 
     fn solve_inner(&mut self, tension: f64) -> Result<TipPose, SolveFailure> {
         let has_moment = self.weight_n_per_mm != 0.0;
-        let mut passes = 1u32;
+        let has_friction = self.actuator.effects.friction_mu > 0.0 && tension > 0.0;
+        let mut passes;
         if has_moment {
             let c = self.continuation;
             // Predict the base moment from the last solves: the Lagrange
@@ -533,22 +764,9 @@ impl Simulator {
             if !(slope.is_finite() && slope.abs() > 1e-3) {
                 slope = 1.0;
             }
-            let mut f0 = self.integrate(tension, m0)?;
-            let mut prev: Option<(f64, f64)> = None;
-            while f0.abs() > self.options.moment_tolerance_n_mm {
-                if passes >= self.options.max_shooting_passes {
-                    return Err(SolveFailure::ShootingNotConverged { iterations: passes, residual_n_mm: f0 });
-                }
-                if let Some((mp, fp)) = prev {
-                    let secant = (f0 - fp) / (m0 - mp);
-                    if secant.is_finite() && secant != 0.0 {
-                        slope = secant;
-                    }
-                }
-                prev = Some((m0, f0));
-                m0 -= f0 / slope;
-                f0 = self.integrate(tension, m0)?;
-                passes += 1;
+            passes = self.shoot(tension, &mut m0, &mut slope)?;
+            if has_friction {
+                passes += self.settle_friction(|sim| sim.shoot(tension, &mut m0, &mut slope))?;
             }
             let cont = &mut self.continuation;
             cont.history.rotate_right(1);
@@ -557,11 +775,18 @@ impl Simulator {
             cont.slopes = [slope, cont.slopes[0]];
         } else {
             self.integrate(tension, 0.0)?;
+            passes = 1;
+            if has_friction {
+                passes += self.settle_friction(|sim| sim.integrate(tension, 0.0).map(|_| 1))?;
+            }
         }
         let n_nodes = self.nodes_state.len();
         let base = self.nodes_state[0];
         let tip = self.nodes_state[n_nodes - 1];
         let (e0, et) = (self.nodes_strain[0], self.nodes_strain[n_nodes - 1]);
+        if self.actuator.effects.creep_fraction > 0.0 && self.dwell_s > 0.0 && !self.virgin_holds {
+            self.advance_creep();
+        }
         Ok(TipPose {
             tension_n: tension,
             tip_x_mm: tip.x,
@@ -598,6 +823,7 @@ impl Simulator {
     pub fn centreline(&self) -> Vec<CentrelinePoint> {
         assert!(self.last.is_some(), "centreline needs a successful solve");
         let n = self.options.steps_per_span;
+        let tension = self.last.map_or(0.0, |p| p.tension_n);
         (0..self.nodes_state.len())
             .map(|i| {
                 let (span, j) = if i < n { (0, i) } else { (1, i - n) };
@@ -620,6 +846,7 @@ impl Simulator {
                     channel_y_mm: yc,
                     cable_x_mm: st.x - sp * yc,
                     cable_y_mm: st.y + cp * yc,
+                    cable_tension_n: tension * self.tension_ratio[k],
                 }
             })
             .collect()
@@ -666,6 +893,21 @@ pub fn simulate(
     tension_n: f64,
     order: usize,
 ) -> Result<Simulation, crate::Error> {
+    let hold = Hold { direction: actuator.effects.load_direction, dwell_s: actuator.effects.creep_hold_s };
+    simulate_held(actuator, options, routing, tension_n, order, hold)
+}
+
+/// Like [`simulate`], with the final tension reached in direction
+/// `hold.direction` (friction) and held for `hold.dwell_s` from a virgin
+/// rod (creep); the ladder below it is loaded without dwell.
+pub fn simulate_held(
+    actuator: &Actuator,
+    options: &SolverOptions,
+    routing: &Routing,
+    tension_n: f64,
+    order: usize,
+    hold: Hold,
+) -> Result<Simulation, crate::Error> {
     let mut sim = Simulator::new(actuator, options)?;
     sim.set_routing(routing);
     // A ladder of tensions: cheap, and it keeps Newton and the shooting in
@@ -674,10 +916,164 @@ pub fn simulate(
     let mut pose = None;
     for k in 1..=rungs {
         let t = tension_n * k as f64 / rungs as f64;
+        if k == rungs {
+            sim.set_hold(hold)?;
+        }
         pose = Some(sim.solve(t)?);
     }
     let pose = pose.expect("at least one rung");
     let mut a = vec![0.0; order + 1];
     sim.coefficients_into(&mut a);
     Ok(Simulation { routing_mm: routing.control_points_mm(), pose, a, centreline: sim.centreline() })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Thesis rod without gravity on a straight routing y_i = `d_mm`: the
+    /// cable direction is α = 0 everywhere, so the effects have closed forms.
+    fn straight(effects: impl FnOnce(&mut Actuator), d_mm: f64) -> Simulator {
+        let mut a = Actuator::default();
+        a.gravity.enabled = false;
+        effects(&mut a);
+        let mut sim = Simulator::new(&a, &SolverOptions::default()).unwrap();
+        sim.set_routing_mm(&[d_mm; 5]).unwrap();
+        sim
+    }
+
+    fn ladder(sim: &mut Simulator, tension: f64) -> TipPose {
+        let mut pose = None;
+        for k in 1..=8 {
+            pose = Some(sim.solve(tension * k as f64 / 8.0).unwrap());
+        }
+        pose.unwrap()
+    }
+
+    #[test]
+    fn friction_matches_the_capstan_closed_form() {
+        // ψ' = u = τ(s) d / EI and dτ/ds = −σ μ τ ψ' give
+        // τ(s) = τ0 / (1 + σ μ τ0 d s / EI), φ(L) = σ ln(1 + σ μ τ0 d L / EI) / μ.
+        let (mu, tau, d) = (0.1, 2.0, 4.0);
+        let a = Actuator::default();
+        for direction in [LoadDirection::Load, LoadDirection::Unload] {
+            let sigma = direction.sign();
+            let mut sim = straight(|a| a.effects.friction_mu = mu, d);
+            sim.set_hold(Hold { direction, dwell_s: 0.0 }).unwrap();
+            let pose = ladder(&mut sim, tau);
+            let expected = sigma * (1.0 + sigma * mu * tau * d * a.length_mm / a.ei_n_mm2).ln() / mu;
+            assert!((pose.tip_angle_rad - expected).abs() < 2e-4, "{direction:?}: {} vs {expected}", pose.tip_angle_rad);
+            let line = sim.centreline();
+            let tip = line.last().unwrap();
+            let tip_tension = tau / (1.0 + sigma * mu * tau * d * a.length_mm / a.ei_n_mm2);
+            assert!((tip.cable_tension_n - tip_tension).abs() < 1e-4, "{} vs {tip_tension}", tip.cable_tension_n);
+        }
+        // Without friction the profile is flat and load = unload.
+        let mut sim = straight(|_| {}, d);
+        let pose = ladder(&mut sim, tau);
+        assert!((pose.tip_angle_rad - tau * d * a.length_mm / a.ei_n_mm2).abs() < 1e-6);
+    }
+
+    #[test]
+    fn friction_makes_a_hysteresis_loop_on_a_curved_routing_with_gravity() {
+        let mut a = Actuator::default();
+        a.effects.friction_mu = 0.2;
+        let mut sim = Simulator::new(&a, &SolverOptions::default()).unwrap();
+        sim.set_routing_mm(&[1.0, -2.0, 4.0, 4.0, -4.0]).unwrap();
+        let load = ladder(&mut sim, 1.5);
+        sim.set_hold(Hold { direction: LoadDirection::Unload, dwell_s: 0.0 }).unwrap();
+        let unload = sim.solve(1.5).unwrap();
+        // Unloading, the distal tension is higher: the rod bends further.
+        assert!((unload.tip_y_mm - load.tip_y_mm).abs() > 0.5, "{load:?} {unload:?}");
+        let line = sim.centreline();
+        assert!(line.last().unwrap().cable_tension_n > 1.5);
+    }
+
+    #[test]
+    fn creep_follows_the_standard_linear_solid() {
+        let (f, t_s, tau, d) = (0.3, 10.0, 1.0, 3.0);
+        let a = Actuator::default();
+        let mut sim = straight(
+            |a| {
+                a.effects.creep_fraction = f;
+                a.effects.creep_time_s = t_s;
+            },
+            d,
+        );
+        let (d1, d2) = (7.0, 4.0);
+        let m = tau * d;
+        let ei = a.ei_n_mm2;
+        // Load step held d1 from a virgin rod (the ladder below holds 0 s).
+        for k in 1..8 {
+            sim.solve(tau * k as f64 / 8.0).unwrap();
+        }
+        sim.set_hold(Hold { direction: LoadDirection::Load, dwell_s: d1 }).unwrap();
+        let held = sim.solve(tau).unwrap();
+        let e1 = (-(1.0 - f) * d1 / t_s).exp();
+        let u1 = m / ei * (1.0 + f * (1.0 - e1) / (1.0 - f));
+        assert!((held.tip_angle_rad - u1 * a.length_mm).abs() < 1e-9, "{} vs {}", held.tip_angle_rad, u1 * a.length_mm);
+        // Released and held d2: the residual bend of the recovering dashpot.
+        sim.set_hold(Hold { direction: LoadDirection::Unload, dwell_s: d2 }).unwrap();
+        let rest = sim.solve(0.0).unwrap();
+        let q1 = m / (ei * (1.0 - f)) * (1.0 - e1);
+        let e2 = (-(1.0 - f) * d2 / t_s).exp();
+        assert!((rest.tip_angle_rad - f * e2 * q1 * a.length_mm).abs() < 1e-9, "{}", rest.tip_angle_rad);
+        assert!(rest.tip_angle_rad > 0.01);
+        // A long hold reaches the relaxed rigidity EI (1 − f).
+        sim.reset_history();
+        sim.set_hold(Hold { direction: LoadDirection::Load, dwell_s: 1e4 }).unwrap();
+        let relaxed = sim.solve(tau).unwrap();
+        assert!((relaxed.tip_angle_rad - m / (ei * (1.0 - f)) * a.length_mm).abs() < 1e-9);
+        // Outside a protocol (sweeps, design) every tension is held
+        // `creep_hold_s` on a fresh rod: the same as the first held step.
+        let mut fresh = straight(
+            |a| {
+                a.effects.creep_fraction = f;
+                a.effects.creep_time_s = t_s;
+                a.effects.creep_hold_s = d1;
+            },
+            d,
+        );
+        for _ in 0..3 {
+            let pose = ladder(&mut fresh, tau);
+            assert!((pose.tip_angle_rad - u1 * a.length_mm).abs() < 1e-9);
+        }
+    }
+
+    #[test]
+    fn clamp_compliance_rotates_the_rod_rigidly() {
+        let (k_theta, tau, d) = (40.0, 1.2, 2.5);
+        let stiff = ladder(&mut straight(|_| {}, d), tau);
+        let soft = ladder(&mut straight(|a| a.effects.clamp_stiffness_n_mm_per_rad = Some(k_theta), d), tau);
+        let phi0 = tau * d / k_theta;
+        let (s, c) = phi0.sin_cos();
+        assert!((soft.tip_angle_rad - stiff.tip_angle_rad - phi0).abs() < 1e-9);
+        assert!((soft.tip_x_mm - (c * stiff.tip_x_mm - s * stiff.tip_y_mm)).abs() < 1e-9);
+        assert!((soft.tip_y_mm - (s * stiff.tip_x_mm + c * stiff.tip_y_mm)).abs() < 1e-9);
+        // No moment at the clamp (y_c(0) = 0, no gravity): no rotation.
+        let mut a = Actuator::default();
+        a.gravity.enabled = false;
+        let route = [0.0, 2.0, 3.0, 1.0, 2.0];
+        let mut rigid = Simulator::new(&a, &SolverOptions::default()).unwrap();
+        rigid.set_routing_mm(&route).unwrap();
+        a.effects.clamp_stiffness_n_mm_per_rad = Some(k_theta);
+        let mut compliant = Simulator::new(&a, &SolverOptions::default()).unwrap();
+        compliant.set_routing_mm(&route).unwrap();
+        assert!((ladder(&mut rigid, tau).tip_y_mm - ladder(&mut compliant, tau).tip_y_mm).abs() < 1e-12);
+    }
+
+    #[test]
+    fn stiffening_and_channel_offset_follow_their_laws() {
+        // Straight routing: constant moment τ d, curvature solves EI (u + α r² u³) = τ d.
+        let (alpha, tau, d) = (2.0, 2.0, 3.0);
+        let a = Actuator::default();
+        let pose = ladder(&mut straight(|a| a.effects.stiffening_alpha = alpha, d), tau);
+        let u = pose.tip_angle_rad / a.length_mm;
+        let m = a.ei_n_mm2 * (u + alpha * a.radius_mm.powi(2) * u.powi(3));
+        assert!((m - tau * d).abs() < 1e-6, "{m}");
+        // Channel offset δ on y_i = d is the routing y_i = d + δ.
+        let shifted = ladder(&mut straight(|a| a.effects.channel_offset_mm = 0.5, d), tau);
+        let direct = ladder(&mut straight(|_| {}, d + 0.5), tau);
+        assert!((shifted.tip_y_mm - direct.tip_y_mm).abs() < 1e-12);
+    }
 }

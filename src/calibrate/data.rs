@@ -1,0 +1,550 @@
+//! Measurement files (`docs/measurements.md`): one row per tip reading, as
+//! CSV or Parquet, and an optional file of measured centreline points.
+//!
+//! Both formats go through one table of text cells, so every check (missing
+//! columns, malformed or impossible values, inconsistent routings) is the
+//! same and every error names the file, the row and the column.
+
+use super::CalibrateError;
+use crate::model::routing::CONTROL_POINTS;
+use std::collections::{BTreeMap, HashMap};
+use std::path::Path;
+
+/// Columns every measurement file must have.
+pub const REQUIRED_COLUMNS: [&str; 15] = [
+    "measurement",
+    "routing",
+    "y0_mm",
+    "y1_mm",
+    "y2_mm",
+    "y3_mm",
+    "y4_mm",
+    "tension_n",
+    "direction",
+    "step",
+    "dwell_s",
+    "tip_x_mm",
+    "tip_y_mm",
+    "tip_angle_rad",
+    "clamp_tilt_rad",
+];
+/// Number of columns of [`REQUIRED_COLUMNS`] that are required; the rest are optional.
+const N_REQUIRED: usize = 14;
+
+/// Direction of the step that led to a reading.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Direction {
+    /// Tension raised to this value.
+    Load,
+    /// Tension lowered to this value.
+    Unload,
+    /// No tension (before loading or after unloading).
+    Rest,
+}
+
+impl Direction {
+    /// The name used in files.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Direction::Load => "load",
+            Direction::Unload => "unload",
+            Direction::Rest => "rest",
+        }
+    }
+}
+
+/// One tip reading.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Measurement {
+    /// Measurement id (unique in the file).
+    pub measurement: i64,
+    /// Routing id.
+    pub routing: String,
+    /// Routing control points y0..y4, mm.
+    pub y_mm: [f64; CONTROL_POINTS],
+    /// Cable tension at the base, N.
+    pub tension_n: f64,
+    /// Direction of the step.
+    pub direction: Direction,
+    /// Order within the routing's protocol.
+    pub step: i64,
+    /// Seconds held at the tension before the reading.
+    pub dwell_s: f64,
+    /// Measured tip position along the clamp axis, mm.
+    pub tip_x_mm: f64,
+    /// Measured tip position across the clamp axis, mm.
+    pub tip_y_mm: f64,
+    /// Measured tip tangent angle from the clamp axis, rad.
+    pub tip_angle_rad: f64,
+    /// Clamp axis from the vertical, rad (toward +y positive).
+    pub clamp_tilt_rad: f64,
+    /// Row in the file (1 = first data row), for messages.
+    pub row: usize,
+}
+
+/// The readings of one routing, in protocol order.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RoutingGroup {
+    /// Routing id.
+    pub routing: String,
+    /// Control points, mm.
+    pub y_mm: [f64; CONTROL_POINTS],
+    /// Clamp tilt, rad.
+    pub clamp_tilt_rad: f64,
+    /// Indices into [`Dataset::rows`], sorted by step.
+    pub rows: Vec<usize>,
+}
+
+/// A validated measurement file.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Dataset {
+    /// Rows in file order.
+    pub rows: Vec<Measurement>,
+}
+
+impl Dataset {
+    /// Routings in order of first appearance, each with its rows by step.
+    pub fn groups(&self) -> Vec<RoutingGroup> {
+        let mut order: Vec<String> = Vec::new();
+        let mut by_id: HashMap<&str, Vec<usize>> = HashMap::new();
+        for (i, m) in self.rows.iter().enumerate() {
+            by_id.entry(&m.routing).or_insert_with(|| {
+                order.push(m.routing.clone());
+                Vec::new()
+            });
+            by_id.get_mut(m.routing.as_str()).expect("inserted").push(i);
+        }
+        order
+            .into_iter()
+            .map(|id| {
+                let mut rows = by_id.remove(id.as_str()).expect("known id");
+                rows.sort_by_key(|&i| self.rows[i].step);
+                let first = &self.rows[rows[0]];
+                RoutingGroup { routing: id, y_mm: first.y_mm, clamp_tilt_rad: first.clamp_tilt_rad, rows }
+            })
+            .collect()
+    }
+
+    /// Routing ids in order of first appearance.
+    pub fn routing_ids(&self) -> Vec<String> {
+        self.groups().into_iter().map(|g| g.routing).collect()
+    }
+}
+
+/// A table of text cells with a header, as read from CSV or Parquet.
+struct Table {
+    header: Vec<String>,
+    rows: Vec<Vec<String>>,
+}
+
+/// Reads a measurement file; `.parquet` files are read as Parquet, anything
+/// else as CSV.
+pub fn read_measurements(path: &Path) -> Result<Dataset, CalibrateError> {
+    let table = read_table(path)?;
+    parse_measurements(path, &table)
+}
+
+fn read_table(path: &Path) -> Result<Table, CalibrateError> {
+    let is_parquet = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("parquet"));
+    if is_parquet {
+        read_parquet_table(path)
+    } else {
+        let text = std::fs::read_to_string(path)
+            .map_err(|source| CalibrateError::Io { context: format!("reading {}", path.display()), source })?;
+        parse_csv(path, &text)
+    }
+}
+
+/// Splits CSV text into cells: comma-separated, fields optionally in double
+/// quotes ("" inside quotes is a quote), blank lines skipped.
+fn parse_csv(path: &Path, text: &str) -> Result<Table, CalibrateError> {
+    let mut lines = text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty());
+    let Some((_, head)) = lines.next() else {
+        return Err(CalibrateError::Empty { path: path.display().to_string() });
+    };
+    let header: Vec<String> = split_csv_line(head.trim_start_matches('\u{feff}'))
+        .map_err(|message| CalibrateError::Malformed { path: path.display().to_string(), row: 0, message })?
+        .into_iter()
+        .map(|h| h.trim().to_string())
+        .collect();
+    let mut rows = Vec::new();
+    for (data_row, (_, line)) in lines.enumerate() {
+        let row = data_row + 1;
+        let cells = split_csv_line(line)
+            .map_err(|message| CalibrateError::Malformed { path: path.display().to_string(), row, message })?;
+        if cells.len() != header.len() {
+            return Err(CalibrateError::Malformed {
+                path: path.display().to_string(),
+                row,
+                message: format!("{} fields, but the header has {}", cells.len(), header.len()),
+            });
+        }
+        rows.push(cells);
+    }
+    Ok(Table { header, rows })
+}
+
+fn split_csv_line(line: &str) -> Result<Vec<String>, String> {
+    let mut cells = Vec::new();
+    let mut cell = String::new();
+    let mut chars = line.chars().peekable();
+    let mut quoted = false;
+    let mut was_quoted = false;
+    while let Some(c) = chars.next() {
+        match (quoted, c) {
+            (true, '"') if chars.peek() == Some(&'"') => {
+                chars.next();
+                cell.push('"');
+            }
+            (true, '"') => quoted = false,
+            (true, _) => cell.push(c),
+            (false, '"') if cell.trim().is_empty() && !was_quoted => {
+                cell.clear();
+                quoted = true;
+                was_quoted = true;
+            }
+            (false, ',') => {
+                cells.push(std::mem::take(&mut cell));
+                was_quoted = false;
+            }
+            (false, '"') => return Err("a quote in the middle of an unquoted field".into()),
+            (false, _) => cell.push(c),
+        }
+    }
+    if quoted {
+        return Err("a quoted field is not closed".into());
+    }
+    cells.push(cell);
+    Ok(cells.into_iter().map(|c| c.trim().to_string()).collect())
+}
+
+fn read_parquet_table(path: &Path) -> Result<Table, CalibrateError> {
+    use arrow::util::display::{ArrayFormatter, FormatOptions};
+    use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
+    let err = |message: String| CalibrateError::Malformed { path: path.display().to_string(), row: 0, message };
+    let file = std::fs::File::open(path)
+        .map_err(|source| CalibrateError::Io { context: format!("opening {}", path.display()), source })?;
+    let reader = ParquetRecordBatchReaderBuilder::try_new(file)
+        .map_err(|e| err(format!("not a readable Parquet file: {e}")))?
+        .build()
+        .map_err(|e| err(format!("not a readable Parquet file: {e}")))?;
+    let mut header: Option<Vec<String>> = None;
+    let mut rows = Vec::new();
+    let options = FormatOptions::default().with_null("");
+    for batch in reader {
+        let batch = batch.map_err(|e| err(format!("reading Parquet data: {e}")))?;
+        let names: Vec<String> = batch.schema().fields().iter().map(|f| f.name().clone()).collect();
+        header.get_or_insert(names);
+        let formatters = batch
+            .columns()
+            .iter()
+            .map(|c| ArrayFormatter::try_new(c.as_ref(), &options))
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(|e| err(format!("unsupported column type: {e}")))?;
+        for i in 0..batch.num_rows() {
+            rows.push(formatters.iter().map(|f| f.value(i).to_string()).collect());
+        }
+    }
+    let Some(header) = header else {
+        return Err(CalibrateError::Empty { path: path.display().to_string() });
+    };
+    Ok(Table { header, rows })
+}
+
+/// Column lookup that names what is missing.
+fn column_index(path: &Path, table: &Table, name: &str) -> Result<usize, CalibrateError> {
+    table.header.iter().position(|h| h == name).ok_or_else(|| CalibrateError::MissingColumn {
+        path: path.display().to_string(),
+        column: name.to_string(),
+        found: table.header.join(","),
+    })
+}
+
+struct Cells<'a> {
+    path: &'a Path,
+    row: usize,
+    cells: &'a [String],
+}
+
+impl Cells<'_> {
+    fn bad(&self, column: &str, value: &str, expected: &str) -> CalibrateError {
+        CalibrateError::BadValue {
+            path: self.path.display().to_string(),
+            row: self.row,
+            column: column.to_string(),
+            value: value.to_string(),
+            expected: expected.to_string(),
+        }
+    }
+    fn text(&self, idx: usize, column: &str) -> Result<&str, CalibrateError> {
+        let v = self.cells[idx].as_str();
+        if v.is_empty() {
+            return Err(self.bad(column, v, "a value (the cell is empty)"));
+        }
+        Ok(v)
+    }
+    fn float(&self, idx: usize, column: &str) -> Result<f64, CalibrateError> {
+        let v = self.text(idx, column)?;
+        match v.parse::<f64>() {
+            Ok(x) if x.is_finite() => Ok(x),
+            _ => Err(self.bad(column, v, "a finite number")),
+        }
+    }
+    fn int(&self, idx: usize, column: &str) -> Result<i64, CalibrateError> {
+        let v = self.text(idx, column)?;
+        v.parse::<i64>().map_err(|_| self.bad(column, v, "an integer"))
+    }
+}
+
+fn parse_measurements(path: &Path, table: &Table) -> Result<Dataset, CalibrateError> {
+    let mut idx = [usize::MAX; REQUIRED_COLUMNS.len()];
+    for (slot, name) in idx.iter_mut().zip(REQUIRED_COLUMNS).take(N_REQUIRED) {
+        *slot = column_index(path, table, name)?;
+    }
+    let tilt_idx = table.header.iter().position(|h| h == "clamp_tilt_rad");
+    if table.rows.is_empty() {
+        return Err(CalibrateError::Empty { path: path.display().to_string() });
+    }
+    let mut rows = Vec::with_capacity(table.rows.len());
+    let mut ids: HashMap<i64, usize> = HashMap::new();
+    let mut steps: HashMap<(String, i64), usize> = HashMap::new();
+    let mut routings: BTreeMap<String, ([f64; CONTROL_POINTS], f64, usize)> = BTreeMap::new();
+    for (i, cells) in table.rows.iter().enumerate() {
+        let c = Cells { path, row: i + 1, cells };
+        let col = |k: usize| REQUIRED_COLUMNS[k];
+        let measurement = c.int(idx[0], col(0))?;
+        let routing = c.text(idx[1], col(1))?.to_string();
+        let mut y_mm = [0.0; CONTROL_POINTS];
+        for (j, y) in y_mm.iter_mut().enumerate() {
+            *y = c.float(idx[2 + j], col(2 + j))?;
+        }
+        let tension_n = c.float(idx[7], col(7))?;
+        if tension_n < 0.0 {
+            return Err(c.bad(col(7), &cells[idx[7]], "a tension ≥ 0 N (a cable cannot push)"));
+        }
+        let direction = match c.text(idx[8], col(8))?.to_ascii_lowercase().as_str() {
+            "load" => Direction::Load,
+            "unload" => Direction::Unload,
+            "rest" => Direction::Rest,
+            _ => return Err(c.bad(col(8), &cells[idx[8]], "one of load, unload, rest")),
+        };
+        if direction == Direction::Rest && tension_n != 0.0 {
+            return Err(c.bad(col(7), &cells[idx[7]], "0 on a rest row (direction = rest means no tension)"));
+        }
+        let step = c.int(idx[9], col(9))?;
+        let dwell_s = c.float(idx[10], col(10))?;
+        if dwell_s < 0.0 {
+            return Err(c.bad(col(10), &cells[idx[10]], "a dwell time ≥ 0 s"));
+        }
+        let tip_x_mm = c.float(idx[11], col(11))?;
+        let tip_y_mm = c.float(idx[12], col(12))?;
+        let tip_angle_rad = c.float(idx[13], col(13))?;
+        if tip_angle_rad.abs() > 4.0 * std::f64::consts::PI {
+            return Err(c.bad(col(13), &cells[idx[13]], "an angle in radians (|θ| ≤ 4π); was it given in degrees?"));
+        }
+        let clamp_tilt_rad = match tilt_idx {
+            Some(k) if !cells[k].is_empty() => c.float(k, "clamp_tilt_rad")?,
+            _ => 0.0,
+        };
+        if let Some(first) = ids.insert(measurement, c.row) {
+            return Err(CalibrateError::Inconsistent {
+                path: path.display().to_string(),
+                row: c.row,
+                message: format!("measurement id {measurement} already used on row {first}; ids must be unique"),
+            });
+        }
+        if let Some(first) = steps.insert((routing.clone(), step), c.row) {
+            return Err(CalibrateError::Inconsistent {
+                path: path.display().to_string(),
+                row: c.row,
+                message: format!("routing '{routing}' has step {step} twice (rows {first} and {}); steps order the protocol", c.row),
+            });
+        }
+        match routings.get(&routing) {
+            Some((y0, t0, first)) if *y0 != y_mm || *t0 != clamp_tilt_rad => {
+                return Err(CalibrateError::Inconsistent {
+                    path: path.display().to_string(),
+                    row: c.row,
+                    message: format!(
+                        "routing '{routing}' has control points {y_mm:?} mm and clamp tilt {clamp_tilt_rad} rad here but {y0:?} mm and {t0} rad on row {first}; give each routing its own id"
+                    ),
+                });
+            }
+            Some(_) => {}
+            None => {
+                routings.insert(routing.clone(), (y_mm, clamp_tilt_rad, c.row));
+            }
+        }
+        rows.push(Measurement {
+            measurement,
+            routing,
+            y_mm,
+            tension_n,
+            direction,
+            step,
+            dwell_s,
+            tip_x_mm,
+            tip_y_mm,
+            tip_angle_rad,
+            clamp_tilt_rad,
+            row: c.row,
+        });
+    }
+    Ok(Dataset { rows })
+}
+
+/// Writes a measurement file as CSV (all columns, full precision).
+pub fn measurements_csv(data: &Dataset) -> String {
+    let mut out = REQUIRED_COLUMNS.join(",");
+    out.push('\n');
+    for m in &data.rows {
+        let y: Vec<String> = m.y_mm.iter().map(|v| v.to_string()).collect();
+        out.push_str(&format!(
+            "{},{},{},{},{},{},{},{},{},{},{}\n",
+            m.measurement,
+            quote(&m.routing),
+            y.join(","),
+            m.tension_n,
+            m.direction.as_str(),
+            m.step,
+            m.dwell_s,
+            m.tip_x_mm,
+            m.tip_y_mm,
+            m.tip_angle_rad,
+            m.clamp_tilt_rad,
+        ));
+    }
+    out
+}
+
+fn quote(text: &str) -> String {
+    if text.contains([',', '"']) {
+        format!("\"{}\"", text.replace('"', "\"\""))
+    } else {
+        text.to_string()
+    }
+}
+
+/// Measured centreline points of one reading, clamp first, mm.
+pub type CentrelinePoints = BTreeMap<i64, Vec<[f64; 2]>>;
+
+/// Reads a centreline file (`measurement,x_mm,y_mm`, points in order from
+/// the clamp); every measurement id must exist in `data`.
+pub fn read_centrelines(path: &Path, data: &Dataset) -> Result<CentrelinePoints, CalibrateError> {
+    let table = read_table(path)?;
+    let m_idx = column_index(path, &table, "measurement")?;
+    let x_idx = column_index(path, &table, "x_mm")?;
+    let y_idx = column_index(path, &table, "y_mm")?;
+    let known: std::collections::HashSet<i64> = data.rows.iter().map(|m| m.measurement).collect();
+    let mut out = CentrelinePoints::new();
+    for (i, cells) in table.rows.iter().enumerate() {
+        let c = Cells { path, row: i + 1, cells };
+        let id = c.int(m_idx, "measurement")?;
+        if !known.contains(&id) {
+            return Err(c.bad("measurement", &cells[m_idx], "the id of a row in the measurement file"));
+        }
+        let p = [c.float(x_idx, "x_mm")?, c.float(y_idx, "y_mm")?];
+        out.entry(id).or_default().push(p);
+    }
+    Ok(out)
+}
+
+/// Writes centreline points as CSV.
+pub fn centrelines_csv(points: &CentrelinePoints) -> String {
+    let mut out = String::from("measurement,x_mm,y_mm\n");
+    for (id, pts) in points {
+        for p in pts {
+            out.push_str(&format!("{id},{},{}\n", p[0], p[1]));
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const HEADER: &str = "measurement,routing,y0_mm,y1_mm,y2_mm,y3_mm,y4_mm,tension_n,direction,step,dwell_s,tip_x_mm,tip_y_mm,tip_angle_rad";
+
+    fn parse(text: &str) -> Result<Dataset, CalibrateError> {
+        let p = Path::new("m.csv");
+        parse_measurements(p, &parse_csv(p, text)?)
+    }
+
+    #[test]
+    fn reads_a_file_with_extra_columns_and_quotes() {
+        let text = format!(
+            "{HEADER},note\n1,\"a,b\",1,1,1,1,1,0,rest,0,5,65,0,0,\"x \"\"y\"\"\"\n2,\"a,b\",1,1,1,1,1,0.5,load,1,5,60,10,0.3,\n"
+        );
+        let d = parse(&text).unwrap();
+        assert_eq!(d.rows.len(), 2);
+        assert_eq!(d.rows[0].routing, "a,b");
+        assert_eq!(d.rows[1].direction, Direction::Load);
+        assert_eq!(d.groups().len(), 1);
+        // Round trip through the writer.
+        let again = parse(&measurements_csv(&d)).unwrap();
+        assert_eq!(again.rows.iter().map(|r| r.tip_y_mm).collect::<Vec<_>>(), vec![0.0, 10.0]);
+    }
+
+    #[test]
+    fn reads_parquet_like_csv() {
+        use arrow::array::{ArrayRef, Float64Array, Int64Array, StringArray};
+        use arrow::record_batch::RecordBatch;
+        use std::sync::Arc;
+        let f = |v: Vec<f64>| Arc::new(Float64Array::from(v)) as ArrayRef;
+        let mut cols: Vec<(&str, ArrayRef)> = vec![
+            ("measurement", Arc::new(Int64Array::from(vec![1, 2]))),
+            ("routing", Arc::new(StringArray::from(vec!["a", "a"]))),
+        ];
+        for name in ["y0_mm", "y1_mm", "y2_mm", "y3_mm", "y4_mm"] {
+            cols.push((name, f(vec![1.5, 1.5])));
+        }
+        cols.push(("tension_n", f(vec![0.0, 0.7])));
+        cols.push(("direction", Arc::new(StringArray::from(vec!["rest", "load"]))));
+        cols.push(("step", Arc::new(Int64Array::from(vec![0, 1]))));
+        cols.push(("dwell_s", f(vec![5.0, 5.0])));
+        cols.push(("tip_x_mm", f(vec![65.0, 61.25])));
+        cols.push(("tip_y_mm", f(vec![0.0, 0.1 + 0.2])));
+        cols.push(("tip_angle_rad", f(vec![0.0, 0.5])));
+        let batch = RecordBatch::try_from_iter(cols).unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("m.parquet");
+        let file = std::fs::File::create(&path).unwrap();
+        let mut w = parquet::arrow::ArrowWriter::try_new(file, batch.schema(), None).unwrap();
+        w.write(&batch).unwrap();
+        w.close().unwrap();
+        let d = read_measurements(&path).unwrap();
+        assert_eq!(d.rows.len(), 2);
+        assert_eq!(d.rows[1].tip_y_mm, 0.1 + 0.2, "floats survive exactly");
+        assert_eq!(d.rows[1].direction, Direction::Load);
+        std::fs::write(&path, b"not parquet").unwrap();
+        let e = read_measurements(&path).unwrap_err().to_string();
+        assert!(e.contains("m.parquet") && e.contains("Parquet"), "{e}");
+    }
+
+    #[test]
+    fn errors_name_the_row_and_column() {
+        let missing = parse("measurement,routing\n1,a\n").unwrap_err().to_string();
+        assert!(missing.contains("y0_mm"), "{missing}");
+        let cases = [
+            ("1,a,1,1,1,1,1,-1,load,1,5,60,10,0.3", "row 1", "tension_n"),
+            ("1,a,1,1,1,1,1,1,sideways,1,5,60,10,0.3", "row 1", "direction"),
+            ("1,a,1,1,1,1,1,1,rest,1,5,60,10,0.3", "row 1", "tension_n"),
+            ("1,a,1,1,x,1,1,1,load,1,5,60,10,0.3", "row 1", "y2_mm"),
+            ("1,a,1,1,1,1,1,1,load,1,5,60,10,45", "row 1", "tip_angle_rad"),
+            ("1,a,1,1,1,1,1,1,load,1,5,60,,0.3", "row 1", "tip_y_mm"),
+            ("1,a,1,1,1,1,1,1,load,1,5,60,10", "row 1", "fields"),
+        ];
+        for (line, row, what) in cases {
+            let e = parse(&format!("{HEADER}\n{line}\n")).unwrap_err().to_string();
+            assert!(e.contains(row) && e.contains(what), "{line}: {e}");
+        }
+        let dup = parse(&format!("{HEADER}\n1,a,1,1,1,1,1,1,load,1,5,60,10,0.3\n2,a,1,1,1,1,1,1,load,1,5,60,10,0.3\n"));
+        assert!(dup.unwrap_err().to_string().contains("step 1 twice"));
+        let clash = parse(&format!("{HEADER}\n1,a,1,1,1,1,1,1,load,1,5,60,10,0.3\n2,a,2,1,1,1,1,1,load,2,5,60,10,0.3\n"));
+        let e = clash.unwrap_err().to_string();
+        assert!(e.contains("row 2") && e.contains("own id"), "{e}");
+        assert!(matches!(parse(""), Err(CalibrateError::Empty { .. })));
+    }
+}

@@ -1,0 +1,55 @@
+//! Calibration and the model-discrepancy workflow (issue 6): measurement
+//! files, synthetic data with a hidden effect, the fit of EA, GA, EI (thesis
+//! eq. 2.14) with or without extra effects, and the diagnosis that names the
+//! missing effect.
+
+pub mod data;
+pub mod diagnose;
+pub mod effect;
+pub mod fit;
+pub mod predict;
+pub mod report;
+pub mod rng;
+pub mod synth;
+
+pub use data::{read_measurements, Dataset, Direction, Measurement};
+pub use effect::Effect;
+pub use fit::{fit, FitResult, FitSpec};
+
+/// Errors of the calibration layer.
+#[derive(Debug, thiserror::Error)]
+pub enum CalibrateError {
+    /// A file could not be read or written.
+    #[error("{context}: {source}")]
+    Io { context: String, source: std::io::Error },
+    /// The file has no data rows.
+    #[error("{path}: the file has no data rows; give a header line and at least one measurement")]
+    Empty { path: String },
+    /// A required column is missing.
+    #[error("{path}: missing column '{column}' (found: {found}); see docs/measurements.md for the required columns")]
+    MissingColumn { path: String, column: String, found: String },
+    /// A cell does not hold what its column needs.
+    #[error("{path}: row {row}, column '{column}': '{value}' is not valid, expected {expected}")]
+    BadValue { path: String, row: usize, column: String, value: String, expected: String },
+    /// A row cannot be split into fields (or the file cannot be decoded).
+    #[error("{path}: row {row}: {message}")]
+    Malformed { path: String, row: usize, message: String },
+    /// Rows contradict each other.
+    #[error("{path}: row {row}: {message}")]
+    Inconsistent { path: String, row: usize, message: String },
+    /// A routing in the data is not a valid routing for the actuator.
+    #[error("routing '{routing}' (first on row {row}): {source}")]
+    Routing { routing: String, row: usize, source: crate::model::RoutingError },
+    /// The model could not be solved for a measurement.
+    #[error("routing '{routing}', row {row} ({tension_n} N): {source}")]
+    Solve { routing: String, row: usize, tension_n: f64, source: crate::model::SolveFailure },
+    /// Invalid actuator or fit settings.
+    #[error(transparent)]
+    Parameter(#[from] crate::model::ParameterError),
+    /// The request cannot be carried out on this data.
+    #[error("{0}")]
+    Invalid(String),
+    /// Drawing a plot.
+    #[error(transparent)]
+    Plot(#[from] crate::plot::PlotError),
+}

@@ -1,0 +1,126 @@
+//! Simulating measurement rows: each routing's rows are solved in protocol
+//! order with one [`Simulator`], so tensions reuse warm starts and the load
+//! history (friction direction, creep) follows the experiment.
+
+use super::data::{Dataset, Direction, RoutingGroup};
+use super::CalibrateError;
+use crate::model::{Actuator, CentrelinePoint, Hold, LoadDirection, Routing, Simulator, SolverOptions, TipPose};
+use rayon::prelude::*;
+
+/// The model's answer for one row.
+#[derive(Debug, Clone)]
+pub struct Prediction {
+    /// Tip pose.
+    pub pose: TipPose,
+    /// Centreline, if asked for.
+    pub centreline: Option<Vec<CentrelinePoint>>,
+}
+
+/// The actuator of one routing group: the clamp tilt turns gravity the
+/// other way in the clamp's frame (gravity direction −tilt from the axis).
+pub fn group_actuator(actuator: &Actuator, group: &RoutingGroup) -> Actuator {
+    let mut a = actuator.clone();
+    a.gravity.direction_rad -= group.clamp_tilt_rad;
+    a
+}
+
+/// Solves the rows of one routing in protocol order, from an unloaded,
+/// virgin rod (no creep history) at the first row.
+pub fn predict_group(
+    actuator: &Actuator,
+    options: &SolverOptions,
+    data: &Dataset,
+    group: &RoutingGroup,
+    keep_centrelines: bool,
+) -> Result<Vec<Prediction>, CalibrateError> {
+    let a = group_actuator(actuator, group);
+    let first_row = data.rows[group.rows[0]].row;
+    let routing = Routing::new(&group.y_mm, a.length_mm, a.radius_mm)
+        .map_err(|source| CalibrateError::Routing { routing: group.routing.clone(), row: first_row, source })?;
+    let mut sim = Simulator::new(&a, options)?;
+    sim.set_routing(&routing);
+    let mut out = Vec::with_capacity(group.rows.len());
+    for &i in &group.rows {
+        let m = &data.rows[i];
+        // At rest the tension is 0 and the friction sign does not matter.
+        let direction = if m.direction == Direction::Load { LoadDirection::Load } else { LoadDirection::Unload };
+        let hold = Hold { direction, dwell_s: m.dwell_s };
+        let fail = |source| CalibrateError::Solve { routing: group.routing.clone(), row: m.row, tension_n: m.tension_n, source };
+        sim.set_hold(hold)?;
+        let pose = match sim.solve(m.tension_n) {
+            Ok(p) => p,
+            Err(_) => {
+                // A large jump left Newton's basin: climb from zero in small
+                // steps without dwell (which leaves the creep history alone).
+                sim.set_hold(Hold { direction: LoadDirection::Load, dwell_s: 0.0 })?;
+                let rungs = (m.tension_n / 0.05).ceil().max(1.0) as usize;
+                for k in 1..rungs {
+                    sim.solve(m.tension_n * k as f64 / rungs as f64).map_err(fail)?;
+                }
+                sim.set_hold(hold)?;
+                sim.solve(m.tension_n).map_err(fail)?
+            }
+        };
+        out.push(Prediction { pose, centreline: keep_centrelines.then(|| sim.centreline()) });
+    }
+    Ok(out)
+}
+
+/// Solves every row of `groups` (in parallel over routings); the result is
+/// indexed like `data.rows`, `None` for rows of routings not in `groups`.
+pub fn predict(
+    actuator: &Actuator,
+    options: &SolverOptions,
+    data: &Dataset,
+    groups: &[RoutingGroup],
+    keep_centrelines: bool,
+) -> Result<Vec<Option<Prediction>>, CalibrateError> {
+    let per_group: Vec<Vec<Prediction>> = groups
+        .par_iter()
+        .map(|g| predict_group(actuator, options, data, g, keep_centrelines))
+        .collect::<Result<_, _>>()?;
+    let mut out = vec![None; data.rows.len()];
+    for (g, preds) in groups.iter().zip(per_group) {
+        for (&i, p) in g.rows.iter().zip(preds) {
+            out[i] = Some(p);
+        }
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::calibrate::data::Measurement;
+
+    fn rest_row(routing: &str, tilt: f64) -> Measurement {
+        Measurement {
+            measurement: 1,
+            routing: routing.into(),
+            y_mm: [0.0; 5],
+            tension_n: 0.0,
+            direction: Direction::Rest,
+            step: 0,
+            dwell_s: 0.0,
+            tip_x_mm: 0.0,
+            tip_y_mm: 0.0,
+            tip_angle_rad: 0.0,
+            clamp_tilt_rad: tilt,
+            row: 1,
+        }
+    }
+
+    #[test]
+    fn a_tilted_clamp_lets_the_rod_sag_against_the_tilt() {
+        // Clamp axis turned toward +y from the vertical: in the clamp's frame
+        // gravity points toward −y, so the unloaded rod sags toward −y.
+        let data = Dataset { rows: vec![rest_row("t", 0.3)] };
+        let groups = data.groups();
+        let p = predict(&Actuator::default(), &SolverOptions::default(), &data, &groups, false).unwrap();
+        let pose = p[0].as_ref().unwrap().pose;
+        assert!(pose.tip_y_mm < -0.1 && pose.tip_angle_rad < 0.0, "{pose:?}");
+        let level = Dataset { rows: vec![rest_row("t", 0.0)] };
+        let p0 = predict(&Actuator::default(), &SolverOptions::default(), &level, &level.groups(), false).unwrap();
+        assert!(p0[0].as_ref().unwrap().pose.tip_y_mm.abs() < 1e-12);
+    }
+}

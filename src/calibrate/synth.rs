@@ -1,0 +1,192 @@
+//! Synthetic measurements from the model, with a hidden effect and noise:
+//! how users and tests get data in which an effect is known to be hidden.
+//!
+//! Protocol per routing (model-notes §6): rest; load in equal steps to the
+//! top tension; unload in the same steps; rest again. Each step is held for
+//! the step dwell, the two rest states for the rest dwell.
+
+use super::data::{CentrelinePoints, Dataset, Direction, Measurement, RoutingGroup};
+use super::predict::predict_group;
+use super::rng::Rng;
+use super::CalibrateError;
+use crate::model::routing::CONTROL_POINTS;
+use crate::model::{Actuator, SolverOptions};
+
+/// What to generate.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SynthSpec {
+    /// The true actuator, hidden effects included.
+    pub actuator: Actuator,
+    /// Solver settings.
+    pub options: SolverOptions,
+    /// Routings: (id, y0..y4 in mm).
+    pub routings: Vec<(String, [f64; CONTROL_POINTS])>,
+    /// Top tension τ_u, N.
+    pub max_tension_n: f64,
+    /// Loading steps from rest to τ_u (the unloading uses the same levels).
+    pub load_steps: usize,
+    /// Dwell before each loaded reading, s.
+    pub step_dwell_s: f64,
+    /// Dwell before each rest reading, s.
+    pub rest_dwell_s: f64,
+    /// Clamp axis from the vertical, rad.
+    pub clamp_tilt_rad: f64,
+    /// Per-routing clamp tilt overriding `clamp_tilt_rad`, rad (routing id →
+    /// tilt): a tilted repeat is how gravity is told apart from other effects.
+    pub routing_tilts_rad: std::collections::BTreeMap<String, f64>,
+    /// Standard deviation of the noise on tip x and y, mm.
+    pub noise_mm: f64,
+    /// Standard deviation of the noise on the tip angle, degrees.
+    pub noise_deg: f64,
+    /// Noise seed.
+    pub seed: u64,
+}
+
+/// Default routings: one with y_c(0) ≠ 0, an S-curve, a straight one, one
+/// with y_c(0) = 0 and an arc (a good held-out routing).
+pub fn default_routings() -> Vec<(String, [f64; CONTROL_POINTS])> {
+    vec![
+        ("base_offset".into(), [3.0, 2.5, 2.0, 1.5, 1.0]),
+        ("s_curve".into(), [-2.0, -3.0, 0.0, 3.0, 3.5]),
+        ("straight".into(), [2.0; 5]),
+        ("tip_bend".into(), [0.0, 0.5, 1.5, 3.0, 4.0]),
+        ("arc".into(), [1.5, 3.0, 2.5, 2.0, 3.0]),
+    ]
+}
+
+impl Default for SynthSpec {
+    fn default() -> Self {
+        Self {
+            actuator: Actuator::default(),
+            options: SolverOptions::default(),
+            routings: default_routings(),
+            max_tension_n: 2.0,
+            load_steps: 5,
+            step_dwell_s: 5.0,
+            rest_dwell_s: 30.0,
+            clamp_tilt_rad: 0.0,
+            routing_tilts_rad: Default::default(),
+            noise_mm: 0.4,
+            noise_deg: 1.0,
+            seed: 1,
+        }
+    }
+}
+
+/// The protocol of one routing: (tension N, direction, dwell s) in order.
+pub fn protocol(spec: &SynthSpec) -> Vec<(f64, Direction, f64)> {
+    let n = spec.load_steps;
+    let level = |k: usize| spec.max_tension_n * k as f64 / n as f64;
+    let mut steps = vec![(0.0, Direction::Rest, spec.rest_dwell_s)];
+    steps.extend((1..=n).map(|k| (level(k), Direction::Load, spec.step_dwell_s)));
+    steps.extend((1..n).rev().map(|k| (level(k), Direction::Unload, spec.step_dwell_s)));
+    steps.push((0.0, Direction::Rest, spec.rest_dwell_s));
+    steps
+}
+
+/// Generates the measurements (and noisy centreline points of every
+/// reading, `points` per reading, when `points > 0`).
+pub fn synthesize(spec: &SynthSpec, points: usize) -> Result<(Dataset, CentrelinePoints), CalibrateError> {
+    if !(spec.max_tension_n.is_finite() && spec.max_tension_n > 0.0) || spec.load_steps == 0 {
+        return Err(CalibrateError::Invalid(format!(
+            "the protocol needs a top tension > 0 N and at least one load step (got {} N, {} steps)",
+            spec.max_tension_n, spec.load_steps
+        )));
+    }
+    for (name, v) in [("noise_mm", spec.noise_mm), ("noise_deg", spec.noise_deg), ("step_dwell_s", spec.step_dwell_s), ("rest_dwell_s", spec.rest_dwell_s)] {
+        if !(v.is_finite() && v >= 0.0) {
+            return Err(CalibrateError::Invalid(format!("{name} = {v} must be a finite number ≥ 0")));
+        }
+    }
+    if spec.routings.is_empty() {
+        return Err(CalibrateError::Invalid("give at least one routing".into()));
+    }
+    spec.actuator.validate()?;
+    // Noise-free rows first (the measured fields are filled below).
+    let steps = protocol(spec);
+    let mut data = Dataset::default();
+    for (id, y) in &spec.routings {
+        let clamp_tilt_rad = spec.routing_tilts_rad.get(id).copied().unwrap_or(spec.clamp_tilt_rad);
+        if !clamp_tilt_rad.is_finite() {
+            return Err(CalibrateError::Invalid(format!("routing {id}: clamp tilt {clamp_tilt_rad} must be finite")));
+        }
+        for (k, &(tension_n, direction, dwell_s)) in steps.iter().enumerate() {
+            let measurement = data.rows.len() as i64 + 1;
+            data.rows.push(Measurement {
+                measurement,
+                routing: id.clone(),
+                y_mm: *y,
+                tension_n,
+                direction,
+                step: k as i64,
+                dwell_s,
+                tip_x_mm: 0.0,
+                tip_y_mm: 0.0,
+                tip_angle_rad: 0.0,
+                clamp_tilt_rad,
+                row: measurement as usize,
+            });
+        }
+    }
+    let mut rng = Rng::new(spec.seed);
+    let mut centrelines = CentrelinePoints::new();
+    let groups: Vec<RoutingGroup> = data.groups();
+    for g in &groups {
+        let preds = predict_group(&spec.actuator, &spec.options, &data, g, points > 0)?;
+        for (&i, p) in g.rows.iter().zip(preds) {
+            let m = &mut data.rows[i];
+            m.tip_x_mm = p.pose.tip_x_mm + spec.noise_mm * rng.normal();
+            m.tip_y_mm = p.pose.tip_y_mm + spec.noise_mm * rng.normal();
+            m.tip_angle_rad = p.pose.tip_angle_rad + spec.noise_deg.to_radians() * rng.normal();
+            if let Some(line) = p.centreline {
+                let pts = resample(&line.iter().map(|c| [c.x_mm, c.y_mm]).collect::<Vec<_>>(), points);
+                let noisy = pts.into_iter().map(|[x, y]| [x + spec.noise_mm * rng.normal(), y + spec.noise_mm * rng.normal()]);
+                centrelines.insert(m.measurement, noisy.collect());
+            }
+        }
+    }
+    Ok((data, centrelines))
+}
+
+/// `count` points at equal index spacing along a polyline (clamp and tip included).
+fn resample(line: &[[f64; 2]], count: usize) -> Vec<[f64; 2]> {
+    if count < 2 || line.len() < 2 {
+        return line.iter().take(count).copied().collect();
+    }
+    (0..count)
+        .map(|k| {
+            let t = k as f64 * (line.len() - 1) as f64 / (count - 1) as f64;
+            let i = (t.floor() as usize).min(line.len() - 2);
+            let f = t - i as f64;
+            [line[i][0] * (1.0 - f) + line[i + 1][0] * f, line[i][1] * (1.0 - f) + line[i + 1][1] * f]
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn protocol_rests_loads_unloads_and_rests() {
+        let spec = SynthSpec { load_steps: 3, ..SynthSpec::default() };
+        let p = protocol(&spec);
+        let dirs: Vec<_> = p.iter().map(|s| s.1).collect();
+        use Direction::*;
+        assert_eq!(dirs, vec![Rest, Load, Load, Load, Unload, Unload, Rest]);
+        assert!((p[3].0 - 2.0).abs() < 1e-15 && p[4].0 < p[3].0);
+    }
+
+    #[test]
+    fn noise_free_data_is_the_model_and_noise_has_its_size() {
+        let clean = SynthSpec { noise_mm: 0.0, noise_deg: 0.0, routings: default_routings()[..2].to_vec(), ..SynthSpec::default() };
+        let (d0, _) = synthesize(&clean, 0).unwrap();
+        let noisy = SynthSpec { noise_mm: 0.4, noise_deg: 1.0, ..clean.clone() };
+        let (d1, _) = synthesize(&noisy, 0).unwrap();
+        let dx: Vec<f64> = d0.rows.iter().zip(&d1.rows).map(|(a, b)| b.tip_x_mm - a.tip_x_mm).collect();
+        let rms = (dx.iter().map(|v| v * v).sum::<f64>() / dx.len() as f64).sqrt();
+        assert!((0.2..0.7).contains(&rms), "{rms}");
+        // Same seed, same data.
+        assert_eq!(synthesize(&noisy, 0).unwrap().0, d1);
+    }
+}

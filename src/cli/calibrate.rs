@@ -1,0 +1,105 @@
+//! `cablemap calibrate DATA`: fits EA, GA, EI (thesis eq. 2.14) to
+//! measurements and reports them with standard errors, correlations and the
+//! RMS error per routing.
+
+use super::ActuatorArgs;
+use crate::calibrate::diagnose::{fit_json, split_holdout};
+use crate::calibrate::fit::rms_per_routing;
+use crate::calibrate::predict::predict;
+use crate::calibrate::{fit, read_measurements, Effect, FitSpec};
+use crate::model::{Actuator, SolverOptions};
+use anyhow::bail;
+use clap::Args;
+use std::io::Write;
+use std::path::PathBuf;
+
+/// Arguments of `cablemap calibrate`.
+#[derive(Debug, Clone, Args)]
+pub struct CalibrateArgs {
+    /// Measurement file (CSV, or Parquet by its .parquet extension); see docs/measurements.md.
+    pub data: PathBuf,
+    /// Leave this routing out of the fit and report the error on it.
+    #[arg(long, value_name = "ROUTING")]
+    pub holdout: Option<String>,
+    /// Weight of the tip angle in mm per degree (1: 1° counts like 1 mm).
+    #[arg(long, default_value_t = 1.0, value_name = "MM_PER_DEG")]
+    pub angle_weight: f64,
+    /// Also fit this effect's parameter (repeatable): friction, gravity, stiffening, clamp_compliance, channel_offset, creep.
+    #[arg(long = "effect", value_name = "EFFECT")]
+    pub effects: Vec<String>,
+    /// Print one JSON object instead of a report.
+    #[arg(long)]
+    pub json: bool,
+    /// Starting values and fixed parameters.
+    #[command(flatten)]
+    pub actuator: ActuatorArgs,
+}
+
+/// Parses effect names, naming the bad one.
+pub fn parse_effects(names: &[String]) -> anyhow::Result<Vec<Effect>> {
+    let mut out = Vec::new();
+    for n in names {
+        let Some(e) = Effect::parse(n) else {
+            let all: Vec<&str> = Effect::ALL.iter().map(|e| e.name()).collect();
+            bail!("--effect {n}: unknown effect; use one of {}", all.join(", "));
+        };
+        if !out.contains(&e) {
+            out.push(e);
+        }
+    }
+    Ok(out)
+}
+
+/// Runs `cablemap calibrate`.
+pub fn run(args: &CalibrateArgs) -> anyhow::Result<()> {
+    let base = args.actuator.apply(&Actuator::default());
+    base.validate()?;
+    let options = args.actuator.solver_options(&SolverOptions::default());
+    let data = read_measurements(&args.data)?;
+    let (train, held) = split_holdout(&data, args.holdout.as_deref())?;
+    let spec = FitSpec { effects: parse_effects(&args.effects)?, angle_weight_mm_per_deg: args.angle_weight };
+    let result = fit(&base, &options, &data, &train, &spec)?;
+    let holdout_rms = match &held {
+        Some(g) => {
+            let g = std::slice::from_ref(g);
+            let preds = predict(&result.actuator, &options, &data, g, false)?;
+            Some(rms_per_routing(&data, g, &preds, args.angle_weight)[0].clone())
+        }
+        None => None,
+    };
+    let stdout = std::io::stdout();
+    let mut out = stdout.lock();
+    if args.json {
+        let mut v = fit_json(&result);
+        v["holdout"] = serde_json::to_value(&holdout_rms)?;
+        writeln!(out, "{v}")?;
+        return Ok(());
+    }
+    writeln!(out, "fit of {} readings on {} routings (eq. 2.14, θ weight {} mm/°)", result.n_residuals / 3, train.len(), args.angle_weight)?;
+    for p in &result.parameters {
+        writeln!(out, "  {:<30} {:>14.6} ± {:<12.4e}", p.name, p.value, p.se)?;
+    }
+    writeln!(out, "correlations:")?;
+    write!(out, "  {:<30}", "")?;
+    for p in &result.parameters {
+        write!(out, " {:>9}", &p.name[..p.name.len().min(9)])?;
+    }
+    writeln!(out)?;
+    for (p, row) in result.parameters.iter().zip(&result.correlation) {
+        write!(out, "  {:<30}", p.name)?;
+        for c in row {
+            write!(out, " {c:>+9.3}")?;
+        }
+        writeln!(out)?;
+    }
+    writeln!(out, "RMS per routing (x, y in mm and θ weighted, together; then tip position and angle):")?;
+    for r in &result.per_routing {
+        writeln!(out, "  {:<20} {:>3} rows  {:>8.4} mm   {:>8.4} mm  {:>8.4}°", r.routing, r.rows, r.rms_mm, r.rms_position_mm, r.rms_angle_deg)?;
+    }
+    if let Some(r) = holdout_rms {
+        writeln!(out, "  {:<20} {:>3} rows  {:>8.4} mm   {:>8.4} mm  {:>8.4}°  (held out)", r.routing, r.rows, r.rms_mm, r.rms_position_mm, r.rms_angle_deg)?;
+    }
+    writeln!(out, "overall RMS {:.4} mm, {} iterations{}", result.rms_mm, result.iterations, if result.converged { "" } else { " (iteration cap reached)" })?;
+    writeln!(out, "cable stretch is not fitted: under tension control it is not identifiable")?;
+    Ok(())
+}
