@@ -170,6 +170,8 @@ pub fn draw_bodies(path: &Path, title: &str, bodies: &[BodyDrawing], targets: &[
     }
     chart
         .configure_series_labels()
+        // Bodies hang down from the clamp at the top centre: the top corner is free.
+        .position(SeriesLabelPosition::UpperRight)
         .label_font((FONT, 14))
         .background_style(WHITE.mix(0.8))
         .border_style(BLACK)
