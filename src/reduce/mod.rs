@@ -315,16 +315,22 @@ where
     if samples.is_empty() {
         return Err(ReduceError::Empty { failed: rows_failed });
     }
-    // Mode boundaries: explicit, or quantiles of the converged rows.
+    // Quantiles of a_0 and a_1 over the converged rows, sorted once: they
+    // give the default mode boundaries and the spreads (interquartile
+    // ranges) that scale the distance to a mode's median.
+    let sorted = |k: usize| -> Vec<f64> {
+        let mut v: Vec<f64> = samples.iter().map(|s| s.a[k]).collect();
+        v.sort_unstable_by(f64::total_cmp);
+        v
+    };
+    let (a0, a1) = (sorted(0), sorted(1));
+    let q0 = [0.25, 0.5, 0.75].map(|p| quantile_sorted(&a0, p));
+    let q1 = [0.25, 1.0 / 3.0, 2.0 / 3.0, 0.75].map(|p| quantile_sorted(&a1, p));
+    drop((a0, a1));
+    let (s0, s1) = ((q0[2] - q0[0]).max(1e-12), (q1[3] - q1[0]).max(1e-12));
     let (boundaries, source) = match options.mode_boundaries {
         Some(b) => (b, "explicit"),
-        None => {
-            let a0: Vec<f64> = samples.iter().map(|s| s.a[0]).collect();
-            let a1: Vec<f64> = samples.iter().map(|s| s.a[1]).collect();
-            let q0 = quantiles(&a0, &[0.25, 0.5, 0.75]);
-            let q1 = quantiles(&a1, &[1.0 / 3.0, 2.0 / 3.0]);
-            (ModeBoundaries { a0: [q0[0], q0[1], q0[2]], a1: [q1[0], q1[1]] }, "quantiles")
-        }
+        None => (ModeBoundaries { a0: [q0[0], q0[1], q0[2]], a1: [q1[1], q1[2]] }, "quantiles"),
     };
     // The grid.
     let cell = options.cell_mm;
@@ -401,12 +407,6 @@ where
     }
     // Modes: counts and the sample nearest each mode's median (a_0, a_1),
     // distances scaled by the spread of each coefficient over the run.
-    let spread = |k: usize| -> f64 {
-        let v: Vec<f64> = samples.iter().map(|s| s.a[k]).collect();
-        let q = quantiles(&v, &[0.25, 0.75]);
-        (q[1] - q[0]).max(1e-12)
-    };
-    let (s0, s1) = (spread(0), spread(1));
     let mut by_mode: Vec<Vec<&Sample>> = vec![Vec::new(); MODES];
     for s in &samples {
         by_mode[boundaries.mode(s.a[0], s.a[1])].push(s);

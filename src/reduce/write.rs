@@ -23,8 +23,7 @@ impl Table {
         self.columns.push(Arc::new(Float64Array::from(values)));
     }
     fn f64_all(&mut self, name: &str, values: Vec<f64>) {
-        self.fields.push(Field::new(name, DataType::Float64, false));
-        self.columns.push(Arc::new(Float64Array::from(values)));
+        self.f64(name, values.into_iter().map(Some).collect());
     }
     fn i32(&mut self, name: &str, values: Vec<i32>) {
         self.fields.push(Field::new(name, DataType::Int32, false));
