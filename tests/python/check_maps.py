@@ -10,25 +10,11 @@ any failure.
 
 import json
 import sys
-import traceback
 from pathlib import Path
 
 import pandas as pd
 import polars as pl
-
-results = []
-
-
-def check(fn):
-    try:
-        fn()
-        results.append(True)
-        print(f"PASS {fn.__name__}")
-    except Exception:  # noqa: BLE001 - report every failure and go on
-        results.append(False)
-        print(f"FAIL {fn.__name__}")
-        traceback.print_exc(file=sys.stdout)
-
+from harness import finish, run_check
 
 d = Path(sys.argv[1])
 summary = json.loads((d / "summary.json").read_text())
@@ -112,8 +98,5 @@ checks = [cells_pandas, cells_polars, modes_both, designs_both]
 if len(sys.argv) > 2:
     checks.append(percentiles_match_a_pandas_reference)
 for fn in checks:
-    check(fn)
-passed = sum(results)
-failed = len(results) - passed
-print(f"python: {passed} passed, {failed} failed")
-sys.exit(1 if failed else 0)
+    run_check(fn.__name__, fn)
+sys.exit(finish())

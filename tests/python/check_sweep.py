@@ -9,32 +9,21 @@ any failure.
 
 import json
 import sys
-import traceback
 from pathlib import Path
 
 import pandas as pd
 import polars as pl
 import pyarrow as pa
 import pyarrow.parquet as pq
+from harness import finish, run_check
 
 POSE = ["tip_x_mm", "tip_y_mm", "tip_angle_rad", "base_angle_rad", "length_mm"]
 Y = [f"y{i}_mm" for i in range(5)]
 
-results = []
-
-
 def check(name):
     def wrap(fn):
         def run(*args):
-            label = f"{name} [{args[0].name}]"
-            try:
-                fn(*args)
-                results.append(True)
-                print(f"PASS {label}")
-            except Exception:  # noqa: BLE001 - report every failure and go on
-                results.append(False)
-                print(f"FAIL {label}")
-                traceback.print_exc(file=sys.stdout)
+            run_check(f"{name} [{args[0].name}]", fn, *args)
 
         return run
 
@@ -127,10 +116,7 @@ def main():
         check_pyarrow(run)
         check_pandas(run)
         check_polars(run)
-    passed = sum(results)
-    failed = len(results) - passed
-    print(f"python: {passed} passed, {failed} failed")
-    return 1 if failed else 0
+    return finish()
 
 
 if __name__ == "__main__":
