@@ -72,7 +72,7 @@ pub fn bench_solver(
         for &t in &ladder {
             match sim.solve(t) {
                 Ok(pose) => {
-                    sim.coefficients_into(&mut a);
+                    sim.coefficients_into(crate::shape::LengthBasis::default(), &mut a);
                     passes += u64::from(pose.iterations);
                     solves += 1;
                 }

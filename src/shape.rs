@@ -2,8 +2,11 @@
 //! model-notes §4).
 //!
 //! With θ(σ) the tangent angle along the deformed centreline of length ℓ and
-//! t = 2σ/ℓ − 1, the curvature κ(t) = dθ/dσ = Σ a_i P_i(t), so
-//! a_i = (2i + 1)/ℓ ∫ P_i dθ. Integrating by parts,
+//! t = 2σ/ℓ − 1, the curvature κ(t) = dθ/dσ = Σ a_i^def P_i(t), so
+//! a_i^def = (2i + 1)/ℓ ∫ P_i dθ: the deformed-length basis. The thesis's
+//! basis (the default everywhere, [`LengthBasis::Rest`]) normalises by the
+//! rest length L instead, a_i = a_i^def · ℓ/L (see [`LengthBasis`]).
+//! Integrating by parts,
 //! a_i = (2i + 1)/ℓ [θ_e − (−1)^i θ_0 − ∫_{−1}^{1} θ P_i'(t) dt],
 //! which needs tangent angles but no second derivatives: that is the exact
 //! route used here. The thesis's own route (§3.3: tangent angles resampled at
@@ -13,7 +16,90 @@
 //! Everything works from sampled centrelines (points only), so simulated and
 //! measured shapes are treated alike.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
+
+/// The length that normalises the curvature coefficients: κ = Σ a_i P_i(t)
+/// per unit of which length.
+///
+/// The thesis writes t = (2s − L)/L with s ∈ [0, L] the rod's own length
+/// parameter (eqs. 3.2, 3.5) and converts with L/2 in eq. 3.12, so its a_i
+/// are per unit **rest** length: a_i = (2i + 1)/L ∫ P_i dθ, a_0 = (θ_e − θ_0)/L.
+/// Evidence: in this basis thesis Table 5.1's Target I is met exactly (all
+/// five components, τ = 2.00 N), in the deformed basis neither target is
+/// reachable (docs/model.md). The deformed-length basis (a_i^def, per unit of
+/// the deformed length ℓ) stays available as an option: a_i = a_i^def · ℓ/L.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LengthBasis {
+    /// Per unit rest length L: the thesis's basis and the default.
+    #[default]
+    Rest,
+    /// Per unit deformed centreline length ℓ.
+    Deformed,
+}
+
+impl LengthBasis {
+    /// Both bases, default first.
+    pub const ALL: [LengthBasis; 2] = [LengthBasis::Rest, LengthBasis::Deformed];
+
+    /// The name used in files, JSON and on the command line.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            LengthBasis::Rest => "rest",
+            LengthBasis::Deformed => "deformed",
+        }
+    }
+
+    /// One line saying what the coefficients are, for captions and reports.
+    pub fn describe(self) -> &'static str {
+        match self {
+            LengthBasis::Rest => "per unit rest length L (the thesis's basis)",
+            LengthBasis::Deformed => "per unit deformed length ℓ",
+        }
+    }
+
+    /// Factor that turns deformed-length coefficients into this basis:
+    /// ℓ/L for the rest basis, 1 for the deformed one.
+    #[inline]
+    pub fn factor_from_deformed(self, deformed_length_mm: f64, rest_length_mm: f64) -> f64 {
+        match self {
+            LengthBasis::Rest => deformed_length_mm / rest_length_mm,
+            LengthBasis::Deformed => 1.0,
+        }
+    }
+
+    /// Converts deformed-length coefficients `a` into this basis in place.
+    #[inline]
+    pub fn convert_from_deformed(self, a: &mut [f64], deformed_length_mm: f64, rest_length_mm: f64) {
+        let factor = self.factor_from_deformed(deformed_length_mm, rest_length_mm);
+        if factor != 1.0 {
+            a.iter_mut().for_each(|v| *v *= factor);
+        }
+    }
+}
+
+impl std::fmt::Display for LengthBasis {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// A basis name that is neither `rest` (alias `thesis`) nor `deformed`.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("unknown length basis '{0}': use 'rest' (the thesis's basis, per unit rest length; alias 'thesis') or 'deformed' (per unit deformed length)")]
+pub struct UnknownLengthBasis(pub String);
+
+impl std::str::FromStr for LengthBasis {
+    type Err = UnknownLengthBasis;
+
+    fn from_str(text: &str) -> Result<Self, Self::Err> {
+        match text.trim().to_ascii_lowercase().as_str() {
+            "rest" | "thesis" => Ok(LengthBasis::Rest),
+            "deformed" => Ok(LengthBasis::Deformed),
+            _ => Err(UnknownLengthBasis(text.to_string())),
+        }
+    }
+}
 
 /// Why coefficients could not be computed from a centreline.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -38,8 +124,26 @@ pub struct ShapeCoefficients {
     pub base_angle_rad: f64,
     /// Tangent angle at the last point, rad (continuous, not wrapped).
     pub tip_angle_rad: f64,
-    /// a_0 … a_n, mm⁻¹ (every a_i is a curvature: t is dimensionless).
+    /// a_0 … a_n, mm⁻¹ (every a_i is a curvature: t is dimensionless), in
+    /// `length_basis`.
     pub a: Vec<f64>,
+    /// The length the coefficients are per unit of.
+    pub length_basis: LengthBasis,
+}
+
+impl ShapeCoefficients {
+    /// The same shape with its coefficients in `basis`; `rest_length_mm` is
+    /// the rod's rest length L (for a measured shape, the rod's known length).
+    pub fn in_basis(mut self, basis: LengthBasis, rest_length_mm: f64) -> Self {
+        if basis != self.length_basis {
+            // Back to the deformed basis, then into `basis`.
+            let to_deformed = 1.0 / self.length_basis.factor_from_deformed(self.length_mm, rest_length_mm);
+            let factor = to_deformed * basis.factor_from_deformed(self.length_mm, rest_length_mm);
+            self.a.iter_mut().for_each(|v| *v *= factor);
+            self.length_basis = basis;
+        }
+        self
+    }
 }
 
 /// Legendre polynomials P_0..P_{n−1} and their derivatives at `t`, by the
@@ -149,7 +253,8 @@ fn derivative_4th(f: impl Fn(usize) -> f64, i: usize, n: usize) -> f64 {
     }
 }
 
-/// Exact-route coefficients a_0 … a_order from centreline points alone
+/// Exact-route coefficients a_0 … a_order (deformed-length basis: convert
+/// with [`ShapeCoefficients::in_basis`]) from centreline points alone
 /// (clamp first). The point index is the curve parameter: tangents and
 /// speeds come from fourth-order finite differences, arc length from a
 /// fourth-order cumulative rule, so smoothly spaced points (simulated or
@@ -187,7 +292,13 @@ pub fn coefficients_from_points(points: &[[f64; 2]], order: usize) -> Result<Sha
     }
     let mut a = vec![0.0; order + 1];
     legendre_from_tangent(&theta, &sigma, &speed, 1.0, &mut a);
-    Ok(ShapeCoefficients { length_mm: sigma[n - 1], base_angle_rad: theta[0], tip_angle_rad: theta[n - 1], a })
+    Ok(ShapeCoefficients {
+        length_mm: sigma[n - 1],
+        base_angle_rad: theta[0],
+        tip_angle_rad: theta[n - 1],
+        a,
+        length_basis: LengthBasis::Deformed,
+    })
 }
 
 fn wrap_pi(a: f64) -> f64 {
@@ -199,7 +310,9 @@ fn wrap_pi(a: f64) -> f64 {
 /// equal arc-length intervals (linear interpolation of the points), take the
 /// tangent angle of each interval, project onto discrete Legendre vectors
 /// (sampled P_i, orthogonalised on the n_d interval midpoints) for b_0 …
-/// b_{order+1}, and invert eq. (3.12) with a_i = 0 beyond `order`.
+/// b_{order+1}, and invert eq. (3.12) with a_i = 0 beyond `order`. The
+/// result is in the deformed-length basis (ℓ/2 in eq. 3.12); the thesis's
+/// own numbers are that times ℓ/L ([`ShapeCoefficients::in_basis`]).
 pub fn thesis_coefficients(points: &[[f64; 2]], order: usize, n_d: usize) -> Result<ShapeCoefficients, ShapeError> {
     check_points(points, 2)?;
     if n_d < order + 2 {
@@ -254,7 +367,7 @@ pub fn thesis_coefficients(points: &[[f64; 2]], order: usize, n_d: usize) -> Res
     let a1 = if order >= 1 { a[1] } else { 0.0 };
     let base = b[0] - length / 2.0 * (a[0] - a1 / 3.0);
     let tip = base + length * a[0];
-    Ok(ShapeCoefficients { length_mm: length, base_angle_rad: base, tip_angle_rad: tip, a })
+    Ok(ShapeCoefficients { length_mm: length, base_angle_rad: base, tip_angle_rad: tip, a, length_basis: LengthBasis::Deformed })
 }
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {
@@ -319,6 +432,36 @@ pub fn centreline_from_coefficients(a: &[f64], length_mm: f64, base_angle_rad: f
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn rest_basis_is_the_default_and_scales_by_deformed_over_rest_length() {
+        assert_eq!(LengthBasis::default(), LengthBasis::Rest);
+        let mut a = [0.02, -0.01, 0.005];
+        LengthBasis::Deformed.convert_from_deformed(&mut a, 60.0, 65.0);
+        assert_eq!(a, [0.02, -0.01, 0.005]);
+        LengthBasis::Rest.convert_from_deformed(&mut a, 60.0, 65.0);
+        let s = 60.0 / 65.0;
+        assert_eq!(a, [0.02 * s, -0.01 * s, 0.005 * s]);
+        assert_eq!("thesis".parse::<LengthBasis>().unwrap(), LengthBasis::Rest);
+        assert_eq!(" Deformed ".parse::<LengthBasis>().unwrap(), LengthBasis::Deformed);
+        assert!("rst".parse::<LengthBasis>().unwrap_err().to_string().contains("'rest'"));
+        for b in LengthBasis::ALL {
+            assert_eq!(b.as_str().parse::<LengthBasis>().unwrap(), b);
+            assert_eq!(serde_json::to_string(&b).unwrap(), format!("\"{b}\""));
+        }
+    }
+
+    #[test]
+    fn rest_basis_a0_is_the_turning_angle_over_the_rest_length() {
+        // A known shape of deformed length 60 mm on a rod of rest length 65 mm.
+        let pts = centreline_from_coefficients(&[0.02, -0.01], 60.0, 0.05, 1001);
+        let c = coefficients_from_points(&pts, 2).unwrap().in_basis(LengthBasis::Rest, 65.0);
+        assert_eq!(c.length_basis, LengthBasis::Rest);
+        assert!((c.a[0] - (c.tip_angle_rad - c.base_angle_rad) / 65.0).abs() < 1e-12);
+        let back = c.clone().in_basis(LengthBasis::Deformed, 65.0);
+        assert!((back.a[0] - 0.02).abs() < 1e-9 && (back.a[1] + 0.01).abs() < 1e-9);
+        assert_eq!(c.clone().in_basis(LengthBasis::Rest, 65.0), c);
+    }
 
     #[test]
     fn quadrature_weights_integrate_cubics_exactly() {

@@ -1,22 +1,17 @@
-//! Physics checks against the independent reference solver
-//! (`../shared/reference/*.json`, full 3-D Rucker–Webster ODE by shooting)
-//! and against the straight-routing analytic solution (model-notes §3).
+//! Physics checks against the independent reference solver (full 3-D
+//! Rucker–Webster ODE by shooting; the values are copied into
+//! `tests/data/reference/`, see its README) and against the straight-routing
+//! analytic solution (model-notes §3).
 
 use cablemap::model::{simulate, Actuator, Routing, SolverOptions};
+use cablemap::shape::LengthBasis;
 use proptest::prelude::*;
 use serde_json::Value;
 use std::path::PathBuf;
 
-fn reference_dir() -> PathBuf {
-    std::env::var_os("CABLEMAP_REFERENCE_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/reference"))
-}
-
 fn load(name: &str) -> Vec<Value> {
-    let path = reference_dir().join(name);
-    let text = std::fs::read_to_string(&path)
-        .unwrap_or_else(|e| panic!("reference file {} missing ({e}); set CABLEMAP_REFERENCE_DIR", path.display()));
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/reference").join(name);
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("reference file {} missing ({e})", path.display()));
     let v: Value = serde_json::from_str(&text).unwrap();
     v["cases"].as_array().unwrap().clone()
 }
@@ -41,7 +36,8 @@ fn check_file(name: &str) {
         let y: Vec<f64> = case["routing_mm"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
         let tension = case["tension_N"].as_f64().unwrap();
         let routing = Routing::new(&y, a.length_mm, a.radius_mm).unwrap();
-        let sim = simulate(&a, &SolverOptions::default(), &routing, tension, 3).unwrap();
+        let sim = simulate(&a, &SolverOptions::default(), &routing, tension, 3, LengthBasis::Rest).unwrap();
+        let deformed = simulate(&a, &SolverOptions::default(), &routing, tension, 3, LengthBasis::Deformed).unwrap();
         let p = sim.pose;
         let f = |k: &str| case[k].as_f64().unwrap();
         let tip_err = (p.tip_x_mm - f("tip_x_mm")).hypot(p.tip_y_mm - f("tip_y_mm"));
@@ -50,8 +46,13 @@ fn check_file(name: &str) {
             .max((p.tip_frame_angle_rad - f("tip_frame_angle_rad")).abs())
             .max((p.base_angle_rad - f("base_tangent_angle_rad")).abs());
         let len_err = (p.length_mm - f("deformed_length_mm")).abs();
-        let a_ref: Vec<f64> = case["a_per_mm"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
-        let a_err = (0..4).map(|i| (sim.a[i] - a_ref[i]).abs()).fold(0.0, f64::max);
+        let list = |k: &str| -> Vec<f64> { case[k].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect() };
+        // The default basis is the thesis's (per unit rest length); the
+        // deformed basis is the option.
+        let (a_thesis, a_deformed) = (list("a_thesis_per_mm"), list("a_per_mm"));
+        let a_err = (0..4)
+            .map(|i| (sim.a[i] - a_thesis[i]).abs().max((deformed.a[i] - a_deformed[i]).abs()))
+            .fold(0.0, f64::max);
         worst = [worst[0].max(tip_err), worst[1].max(angle_err), worst[2].max(a_err), worst[3].max(len_err)];
         let ctx = format!("{name}: routing {y:?}, tension {tension}");
         assert!(tip_err < 1e-3, "{ctx}: tip off by {tip_err} mm");
@@ -88,7 +89,7 @@ fn straight_routing_matches_the_analytic_arc() {
     let a = no_gravity();
     for (d, tau) in [(4.0, 2.0), (-2.5, 1.3), (1.0, 0.4)] {
         let routing = Routing::new(&[d; 5], a.length_mm, a.radius_mm).unwrap();
-        let sim = simulate(&a, &SolverOptions::default(), &routing, tau, 3).unwrap();
+        let sim = simulate(&a, &SolverOptions::default(), &routing, tau, 3, LengthBasis::Deformed).unwrap();
         let kappa = tau * d / a.ei_n_mm2;
         let v1 = 1.0 - tau / a.ea_n;
         let l = a.length_mm;
@@ -97,10 +98,14 @@ fn straight_routing_matches_the_analytic_arc() {
         // Constant curvature per deformed length, κ/v1: a_0 has it, the rest vanish.
         assert!((sim.a[0] - kappa / v1).abs() < 1e-9, "a0 {} vs {}", sim.a[0], kappa / v1);
         assert!(sim.a[1..].iter().all(|v| v.abs() < 1e-9), "{:?}", sim.a);
+        // Per unit rest length (the thesis's basis): the turning angle κL over L.
+        let rest = simulate(&a, &SolverOptions::default(), &routing, tau, 3, LengthBasis::Rest).unwrap();
+        assert!((rest.a[0] - kappa).abs() < 1e-9, "rest a0 {} vs {kappa}", rest.a[0]);
+        assert!(rest.a[1..].iter().all(|v| v.abs() < 1e-9), "{:?}", rest.a);
     }
     // The number model-notes §3 quotes.
     let routing = Routing::new(&[4.0; 5], 65.0, 5.0).unwrap();
-    let sim = simulate(&a, &SolverOptions::default(), &routing, 2.0, 1).unwrap();
+    let sim = simulate(&a, &SolverOptions::default(), &routing, 2.0, 1, LengthBasis::Deformed).unwrap();
     assert!((sim.pose.tip_x_mm + 13.058685).abs() < 1e-6 && (sim.pose.tip_y_mm - 15.894155).abs() < 1e-6);
 }
 
@@ -108,11 +113,11 @@ fn straight_routing_matches_the_analytic_arc() {
 fn zero_tension_gives_the_straight_rod() {
     let a = no_gravity();
     let routing = Routing::new(&[1.0, -3.0, 2.0, 4.0, -4.0], 65.0, 5.0).unwrap();
-    let sim = simulate(&a, &SolverOptions::default(), &routing, 0.0, 3).unwrap();
+    let sim = simulate(&a, &SolverOptions::default(), &routing, 0.0, 3, LengthBasis::Deformed).unwrap();
     assert!((sim.pose.tip_x_mm - 65.0).abs() < 1e-12 && sim.pose.tip_y_mm.abs() < 1e-12);
     assert!(sim.a.iter().all(|v| v.abs() < 1e-12));
     // With gravity the hanging rod only stretches under its own weight.
-    let sim = simulate(&Actuator::default(), &SolverOptions::default(), &routing, 0.0, 3).unwrap();
+    let sim = simulate(&Actuator::default(), &SolverOptions::default(), &routing, 0.0, 3, LengthBasis::Rest).unwrap();
     let w = Actuator::default().weight_n_per_mm();
     let stretch = w * 65.0 * 65.0 / 2.0 / Actuator::default().ea_n;
     assert!((sim.pose.tip_x_mm - 65.0 - stretch).abs() < 1e-9 && sim.pose.tip_y_mm.abs() < 1e-12);
@@ -131,8 +136,8 @@ proptest! {
         a.gravity.enabled = gravity;
         let opts = SolverOptions::default();
         let r = Routing::new(&y, 65.0, 5.0).unwrap();
-        let m = simulate(&a, &opts, &r, tension, 3).unwrap();
-        let n = simulate(&a, &opts, &r.mirrored(), tension, 3).unwrap();
+        let m = simulate(&a, &opts, &r, tension, 3, LengthBasis::Rest).unwrap();
+        let n = simulate(&a, &opts, &r.mirrored(), tension, 3, LengthBasis::Rest).unwrap();
         prop_assert!((m.pose.tip_x_mm - n.pose.tip_x_mm).abs() < 1e-9);
         prop_assert!((m.pose.tip_y_mm + n.pose.tip_y_mm).abs() < 1e-9);
         prop_assert!((m.pose.tip_angle_rad + n.pose.tip_angle_rad).abs() < 1e-9);

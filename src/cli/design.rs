@@ -1,7 +1,6 @@
 //! `cablemap design`: routing and tension for a target shape (eq. 3.17).
 
-use super::ActuatorArgs;
-use crate::design::objective::LengthBasis;
+use super::{ActuatorArgs, LengthBasisArgs};
 use crate::design::{self, compare, map::MapDir, optimise, Bounds, ComponentResult, DesignOutcome, Objective, SearchOptions, Target, Weights};
 use crate::model::{Actuator, SolverOptions};
 use clap::Args;
@@ -34,10 +33,8 @@ pub struct DesignArgs {
     /// A channel of diameter d breaks the surface beyond r − d/2.
     #[arg(long, value_name = "MM")]
     pub max_offset_mm: Option<f64>,
-    /// Length that normalises the curvature coefficients: `deformed` (ℓ, model-notes §4,
-    /// the maps) or `rest` (L, the thesis's eq. 3.12; use it to compare with Table 5.1).
-    #[arg(long, value_enum, default_value_t = LengthBasis::Deformed)]
-    pub length_basis: LengthBasis,
+    #[command(flatten)]
+    pub basis: LengthBasisArgs,
     /// Number of seeds refined to convergence (3× as many are explored briefly).
     #[arg(long, default_value_t = 8)]
     pub starts: usize,
@@ -82,7 +79,7 @@ fn objective(args: &DesignArgs, map: Option<&MapDir>) -> anyhow::Result<Objectiv
     if args.starts == 0 {
         anyhow::bail!("--starts must be at least 1");
     }
-    Ok(Objective::new(actuator, options, target, weights, bounds)?.with_length_basis(args.length_basis))
+    Ok(Objective::new(actuator, options, target, weights, bounds)?.with_length_basis(args.basis.length_basis))
 }
 
 /// The JSON object of a design (also written as design.json).
@@ -124,19 +121,10 @@ pub fn run(args: &DesignArgs) -> anyhow::Result<()> {
     }
     // With a map: its verdict first (reported, not enforced: the optimiser
     // still returns the closest design), and its nearest designs as seeds.
-    let mut feasibility = match &map {
-        Some(m) => Some(design::feasible::check(m, &objective.target, &objective.weights, 2 * args.starts)?),
+    let feasibility = match &map {
+        Some(m) => Some(design::feasible::check(m, &objective.target, objective.length_basis, &objective.weights, 2 * args.starts)?),
         None => None,
     };
-    if let Some(f) = feasibility.as_mut() {
-        if objective.length_basis == LengthBasis::Rest && objective.target.highest_order().is_some() {
-            f.reasons.push(
-                "the map's coefficients are over the deformed length ℓ while this target's are over the rest length L \
-                 (smaller by ℓ/L, ~7 % at 2 N): the coefficient checks are approximate"
-                    .into(),
-            );
-        }
-    }
     let seeds: Vec<design::Seed> =
         feasibility.iter().flat_map(|f| f.nearest.iter().map(|d| d.seed())).collect();
     let search = SearchOptions { starts: args.starts, max_evaluations: args.max_evaluations, ..SearchOptions::default() };
@@ -203,6 +191,7 @@ pub fn report(objective: &Objective, outcome: &DesignOutcome, results: &[Compone
         e.tension_n, objective.bounds.tension_min_n, objective.bounds.tension_max_n
     ));
     s.push_str(&format!("shape        a = [{}] 1/mm\n", e.a.iter().map(|a| format!("{a:.6}")).collect::<Vec<_>>().join(", ")));
+    s.push_str(&format!("basis        a_i {} (--length-basis {})\n", objective.length_basis.describe(), objective.length_basis));
     s.push_str(&format!(
         "objective    {:.3e}   ({} seed designs simulated, {} refined, {:.2} s)\n",
         outcome.cost,

@@ -26,6 +26,8 @@ pub struct FeasibleArgs {
     /// Print one JSON object instead of a report.
     #[arg(long)]
     pub json: bool,
+    #[command(flatten)]
+    pub basis: super::LengthBasisArgs,
 }
 
 /// Runs `cablemap feasible`.
@@ -37,7 +39,7 @@ pub fn run(args: &FeasibleArgs) -> anyhow::Result<()> {
         None => Weights::default(),
     };
     weights.check_against(&target)?;
-    let report = check(&map, &target, &weights, args.nearest)?;
+    let report = check(&map, &target, args.basis.length_basis, &weights, args.nearest)?;
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
     if args.json {
@@ -64,6 +66,7 @@ pub fn text(r: &FeasibilityReport) -> String {
         t.neighbourhood_count
     ));
     if !r.coefficients.is_empty() {
+        s.push_str(&format!("basis     a_i in 1/mm, {} (the map's basis)\n", r.length_basis.describe()));
         s.push_str(&format!("{:<6}{:>12}{:>12}{:>12}{:>12}{:>12}\n", "", "target", "cell p10", "cell p90", "near min", "near max"));
         let f = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.5}"));
         for c in &r.coefficients {

@@ -12,6 +12,7 @@ pub mod sweep;
 pub mod synth;
 
 use crate::model::{Actuator, SolverOptions};
+use crate::shape::LengthBasis;
 use clap::Args;
 
 /// Actuator parameter overrides shared by every command that simulates.
@@ -111,6 +112,16 @@ impl ActuatorArgs {
         }
         o
     }
+}
+
+/// The length the curvature coefficients a_i are per unit of, shared by
+/// every command that prints or compares coefficients.
+#[derive(Debug, Clone, Copy, Args)]
+pub struct LengthBasisArgs {
+    /// Curvature coefficients a_i per unit `rest` length L (the thesis's basis, eq. 3.2: the
+    /// default) or per unit `deformed` length ℓ (a_i·L/ℓ) [default: rest].
+    #[arg(long, value_name = "rest|deformed", default_value = "rest")]
+    pub length_basis: LengthBasis,
 }
 
 /// Parses "a,b,c" into numbers, naming the offending item.

@@ -79,7 +79,7 @@ pub fn reduce_into(run: &Path, out: &Path, partial: bool, args: &MapOptionArgs) 
         );
     } else {
         println!(
-            "map {}: {} simulations ({} converged, {} failed{}) in {} cells of {} mm; modes by {}: a0 {:?}, a1 {:?}",
+            "map {}: {} simulations ({} converged, {} failed{}) in {} cells of {} mm; modes by {}: a0 {:?}, a1 {:?} (mm⁻¹, {} basis)",
             out.display(),
             s.rows_total,
             s.rows_converged,
@@ -89,7 +89,8 @@ pub fn reduce_into(run: &Path, out: &Path, partial: bool, args: &MapOptionArgs) 
             s.cell_mm,
             s.mode_boundaries_source,
             s.mode_boundaries.a0,
-            s.mode_boundaries.a1
+            s.mode_boundaries.a1,
+            s.length_basis
         );
         println!("reduced in {reduced_s:.2} s, tables and {} pictures written in {total_s:.2} s; open {}", pictures.len(), out.join("index.html").display());
     }

@@ -1,6 +1,6 @@
 //! `cablemap simulate`: one actuator, one tension.
 
-use super::{parse_list, ActuatorArgs};
+use super::{parse_list, ActuatorArgs, LengthBasisArgs};
 use crate::model::{simulate_held, Actuator, Hold, LoadDirection, Routing, Simulation, SolverOptions, STATUS_OK};
 use crate::plot::{draw_bodies, BodyDrawing};
 use anyhow::Context;
@@ -47,6 +47,8 @@ pub struct SimulateArgs {
     #[arg(long, value_name = "S")]
     pub dwell_s: Option<f64>,
     #[command(flatten)]
+    pub basis: LengthBasisArgs,
+    #[command(flatten)]
     pub actuator: ActuatorArgs,
 }
 
@@ -73,6 +75,7 @@ pub fn simulation_json(sim: &Simulation) -> serde_json::Value {
         "base_angle_rad": p.base_angle_rad,
         "length_mm": p.length_mm,
         "a": sim.a,
+        "length_basis": sim.length_basis,
         "iterations": p.iterations,
     })
 }
@@ -113,11 +116,15 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     let routing = Routing::new(&y, actuator.length_mm, actuator.radius_mm).context("--routing")?;
     let direction = if args.direction == "unload" { LoadDirection::Unload } else { LoadDirection::Load };
     let hold = Hold { direction, dwell_s: args.dwell_s.unwrap_or(actuator.effects.creep_hold_s) };
-    let mut sim = simulate_held(&actuator, &options, &routing, args.tension, args.order, hold)
+    let basis = args.basis.length_basis;
+    let mut sim = simulate_held(&actuator, &options, &routing, args.tension, args.order, basis, hold)
         .with_context(|| format!("simulating routing {y:?} at {} N", args.tension))?;
     if args.coefficients == CoefficientRoute::Thesis {
         let points: Vec<[f64; 2]> = sim.centreline.iter().map(|c| [c.x_mm, c.y_mm]).collect();
-        sim.a = crate::shape::thesis_coefficients(&points, args.order, args.n_d).context("thesis coefficient route")?.a;
+        sim.a = crate::shape::thesis_coefficients(&points, args.order, args.n_d)
+            .context("thesis coefficient route")?
+            .in_basis(basis, actuator.length_mm)
+            .a;
     }
     if let Some(path) = &args.csv {
         write_centreline_csv(path, &sim)?;
@@ -140,6 +147,7 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     writeln!(out, "tip angle      {:.8} rad ({:.4}°)", p.tip_angle_rad, p.tip_angle_rad.to_degrees())?;
     writeln!(out, "base angle     {:.8} rad ({:.4}°)", p.base_angle_rad, p.base_angle_rad.to_degrees())?;
     writeln!(out, "length ℓ       {:.6} mm", p.length_mm)?;
+    writeln!(out, "coefficients   a_i {}", basis.describe())?;
     for (i, a) in sim.a.iter().enumerate() {
         writeln!(out, "a_{i:<12} {a:.8e} mm^-1")?;
     }

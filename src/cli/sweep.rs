@@ -137,6 +137,7 @@ fn status_json(s: &RunStatus) -> serde_json::Value {
         "dir": s.dir,
         "spec_sha256": s.manifest.spec_sha256,
         "tool_version": s.manifest.tool_version,
+        "length_basis": s.manifest.length_basis,
         "rows_done": s.rows_done,
         "rows_total": s.rows_total,
         "failures": s.failures(),
@@ -161,6 +162,7 @@ pub fn run_status_command(args: &StatusArgs) -> anyhow::Result<()> {
         "sweep      {} routings x {} tensions = {} rows in {} chunks, {} shard(s)",
         m.routings, m.tensions, m.total_rows, m.chunks, m.shards
     );
+    println!("a_i        orders 0..={}, {}", m.spec.output.order, m.length_basis.describe());
     println!("{:>6} {:>14} {:>22} {:>9}", "shard", "chunks", "rows", "failures");
     for sh in &s.shards {
         println!(

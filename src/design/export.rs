@@ -2,7 +2,7 @@
 //! drawing of the body with its channel (for making a mould), and a PNG of
 //! the achieved shape over the target.
 
-use super::objective::{Evaluation, LengthBasis, Objective};
+use super::objective::{Evaluation, Objective};
 use super::target::Component;
 use super::DesignError;
 use crate::model::{simulate, Routing};
@@ -150,7 +150,7 @@ pub fn write_all(dir: &Path, objective: &Objective, eval: &Evaluation, json: &se
 pub fn shape_png(path: &Path, objective: &Objective, eval: &Evaluation) -> Result<(), DesignError> {
     let act = &objective.actuator;
     let routing = Routing::new(&eval.routing_mm, act.length_mm, act.radius_mm).expect("designs lie inside the body");
-    let sim = simulate(act, &objective.options, &routing, eval.tension_n, objective.target.order()).map_err(|e| {
+    let sim = simulate(act, &objective.options, &routing, eval.tension_n, objective.target.order(), objective.length_basis).map_err(|e| {
         DesignError::Io { context: format!("re-simulating the design for {}", path.display()), source: std::io::Error::other(e.to_string()) }
     })?;
     let mut bodies =
@@ -159,10 +159,7 @@ pub fn shape_png(path: &Path, objective: &Objective, eval: &Evaluation) -> Resul
     if target.highest_order().is_some() {
         let pose = &eval.pose;
         // Drawing needs the coefficients over the drawn (deformed) length ℓ.
-        let to_deformed = match objective.length_basis {
-            LengthBasis::Deformed => 1.0,
-            LengthBasis::Rest => act.length_mm / pose.length_mm,
-        };
+        let to_deformed = 1.0 / objective.length_basis.factor_from_deformed(pose.length_mm, act.length_mm);
         let a: Vec<f64> = (0..eval.a.len()).map(|k| to_deformed * target.get(Component::A(k)).unwrap_or(eval.a[k])).collect();
         let pts = centreline_from_coefficients(&a, pose.length_mm, pose.base_angle_rad, 121);
         let angles: Vec<f64> = pts.windows(2).map(|w| (w[1][1] - w[0][1]).atan2(w[1][0] - w[0][0])).collect();

@@ -6,6 +6,7 @@
 use super::map::{Cell, MapDir, NearDesign, CELL_STATS_ORDER, MODES};
 use super::target::{Component, Target, Weights};
 use super::DesignError;
+use crate::shape::LengthBasis;
 use serde::Serialize;
 
 /// The three verdicts.
@@ -98,10 +99,15 @@ pub struct FeasibilityReport {
     pub mode: ModeCheck,
     /// Nearest simulated designs (weighted distance), nearest first.
     pub nearest: Vec<NearDesign>,
+    /// The length the coefficients (target, map, designs) are per unit of.
+    pub length_basis: LengthBasis,
 }
 
-/// Judges `target` against `map`; `nearest` designs are listed.
-pub fn check(map: &MapDir, target: &Target, weights: &Weights, nearest: usize) -> Result<FeasibilityReport, DesignError> {
+/// Judges `target` against `map`; `nearest` designs are listed. The
+/// target's coefficients are per unit of `basis`; a map made in the other
+/// basis is refused when the target has coefficients ([`MapDir::check_length_basis`]).
+pub fn check(map: &MapDir, target: &Target, basis: LengthBasis, weights: &Weights, nearest: usize) -> Result<FeasibilityReport, DesignError> {
+    map.check_length_basis(basis, target)?;
     let x = target.get(Component::TipX);
     let y = target.get(Component::TipY);
     let column = map.column_of(x);
@@ -207,7 +213,16 @@ pub fn check(map: &MapDir, target: &Target, weights: &Weights, nearest: usize) -
             Verdict::Borderline
         }
     };
-    Ok(FeasibilityReport { verdict, reasons, tip_cell, coefficients, unchecked, mode, nearest: map.nearest_designs(target, weights, nearest)? })
+    Ok(FeasibilityReport {
+        verdict,
+        reasons,
+        tip_cell,
+        coefficients,
+        unchecked,
+        mode,
+        nearest: map.nearest_designs(target, weights, nearest)?,
+        length_basis: map.summary.length_basis,
+    })
 }
 
 fn mode_check(map: &MapDir, target: &Target, cell: Option<&Cell>) -> ModeCheck {

@@ -5,6 +5,7 @@ use super::optimise::{Seed, SeedSource};
 use super::target::{Component, Target, Weights};
 use super::DesignError;
 use crate::model::Actuator;
+use crate::shape::LengthBasis;
 use arrow::array::{Array, AsArray, RecordBatch};
 use arrow::datatypes::{Float64Type, Int32Type, Int64Type};
 use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
@@ -213,6 +214,27 @@ impl MapDir {
             ));
         }
         Ok(())
+    }
+
+    /// Refuses a target whose coefficients are in another basis than the
+    /// map's. There is no exact conversion: a_i change by ℓ/L, and ℓ differs
+    /// from design to design within a cell, so percentiles do not convert.
+    /// A target without coefficients is judged in either basis.
+    pub fn check_length_basis(&self, basis: LengthBasis, target: &Target) -> Result<(), DesignError> {
+        let map_basis = self.summary.length_basis;
+        if map_basis == basis || target.highest_order().is_none() {
+            return Ok(());
+        }
+        Err(map_error(
+            &self.path,
+            format!(
+                "the map's coefficients are {} ({map_basis} basis) but the target's are {} ({basis} basis); they differ \
+                 by ℓ/L, which varies from design to design, so they cannot be compared: give the target in the map's \
+                 basis (length basis '{map_basis}'), or reduce a sweep made with [output] length_basis = \"{basis}\"",
+                map_basis.describe(),
+                basis.describe()
+            ),
+        ))
     }
 
     /// The cell index containing coordinate `v` along an axis starting at `min` (may be off the grid).

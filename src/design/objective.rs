@@ -4,6 +4,7 @@
 use super::target::{Component, Target, Weights};
 use super::DesignError;
 use crate::model::{Actuator, Routing, Simulator, SolveFailure, SolverOptions, TipPose};
+use crate::shape::LengthBasis;
 use serde::Serialize;
 
 /// Box bounds of the design variables: |y_i| ≤ `max_offset_mm`,
@@ -90,36 +91,9 @@ pub struct Objective {
     pub weights: Weights,
     /// Box bounds on y_i and τ.
     pub bounds: Bounds,
-    /// Which length normalises the curvature coefficients.
+    /// Which length normalises the curvature coefficients (default: the
+    /// thesis's rest length).
     pub length_basis: LengthBasis,
-}
-
-/// The length that normalises t ∈ [−1, 1] along the rod in κ(t) = Σ a_i P_i(t).
-///
-/// The project defines a_i over the deformed centreline length ℓ
-/// (model-notes §4; the maps use it). The thesis writes t = (2s − L)/L with
-/// the rest length L and recovers a_i from the θ coefficients by eq. 3.12
-/// with L/2, so its a_i are the deformed-length ones scaled by ℓ/L (the rod
-/// shortens by ~7 % at 2 N: EA = 26.7 N). Comparing with Table 5.1 needs the
-/// thesis's basis.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, clap::ValueEnum)]
-#[serde(rename_all = "snake_case")]
-pub enum LengthBasis {
-    /// a_i over the deformed length ℓ (model-notes §4, the maps).
-    #[default]
-    Deformed,
-    /// a_i over the rest length L, as the thesis's eq. 3.12 (a_i · ℓ/L).
-    Rest,
-}
-
-impl LengthBasis {
-    /// Converts deformed-length coefficients `a` in place.
-    pub fn convert(&self, a: &mut [f64], deformed_length_mm: f64, rest_length_mm: f64) {
-        if *self == LengthBasis::Rest {
-            let scale = deformed_length_mm / rest_length_mm;
-            a.iter_mut().for_each(|v| *v *= scale);
-        }
-    }
 }
 
 /// Largest tension step of the continuation ladder used when a cold solve
@@ -133,7 +107,7 @@ impl Objective {
         actuator.validate()?;
         weights.check_against(&target)?;
         bounds.validate(actuator.radius_mm)?;
-        Ok(Self { actuator, options, target, weights, bounds, length_basis: LengthBasis::Deformed })
+        Ok(Self { actuator, options, target, weights, bounds, length_basis: LengthBasis::default() })
     }
 
     /// The same objective with coefficients in `basis`.
@@ -178,8 +152,7 @@ impl Objective {
             }
         };
         let mut a = vec![0.0; self.target.order() + 1];
-        sim.coefficients_into(&mut a);
-        self.length_basis.convert(&mut a, pose.length_mm, self.actuator.length_mm);
+        sim.coefficients_into(self.length_basis, &mut a);
         Ok(Evaluation { routing_mm: *routing_mm, tension_n, pose, a })
     }
 
@@ -220,16 +193,6 @@ mod tests {
         let text = format!("x={},a0={}", e.pose.tip_x_mm, e.a[0] + 0.01);
         let off = Objective::new(actuator, SolverOptions::default(), Target::parse(&text).unwrap(), Weights::default(), bounds).unwrap();
         assert!((off.cost(&e2) - 0.01).abs() < 1e-9);
-    }
-
-    #[test]
-    fn rest_basis_scales_by_deformed_over_rest_length() {
-        let mut a = [0.02, -0.01, 0.005];
-        LengthBasis::Deformed.convert(&mut a, 60.0, 65.0);
-        assert_eq!(a, [0.02, -0.01, 0.005]);
-        LengthBasis::Rest.convert(&mut a, 60.0, 65.0);
-        let s = 60.0 / 65.0;
-        assert_eq!(a, [0.02 * s, -0.01 * s, 0.005 * s]);
     }
 
     #[test]

@@ -165,8 +165,7 @@ pub fn grid_seeds(objective: &Objective, search: &SearchOptions) -> Vec<(f64, Se
                 for t in ladder {
                     let Ok(pose) = sim.solve(t) else { return out };
                     if tensions.iter().any(|g| (g - t).abs() < 1e-12) {
-                        sim.coefficients_into(a);
-                        objective.length_basis.convert(a, pose.length_mm, objective.actuator.length_mm);
+                        sim.coefficients_into(objective.length_basis, a);
                         let e = Evaluation { routing_mm: y, tension_n: t, pose, a: a.clone() };
                         let m = mirrored(&e);
                         out.push((objective.cost(&e), Seed { routing_mm: y, tension_n: t, source: SeedSource::Grid }));

@@ -41,7 +41,7 @@
 
 use super::actuator::{Actuator, LoadDirection, ParameterError};
 use super::routing::Routing;
-use crate::shape;
+use crate::shape::{self, LengthBasis};
 use serde::{Deserialize, Serialize};
 
 /// Why a solve produced no result. The sweep stores [`SolveFailure::status`].
@@ -800,12 +800,12 @@ impl Simulator {
     }
 
     /// Legendre curvature coefficients a_0 … a_{n−1} (n = `out.len()`) of the
-    /// last successful solve, by the exact definition (model-notes §4),
-    /// computed from the solver's nodes without allocating.
+    /// last successful solve in `basis`, by the exact definition
+    /// (model-notes §4), computed from the solver's nodes without allocating.
     ///
     /// # Panics
     /// If the last solve failed or none was made.
-    pub fn coefficients_into(&mut self, out: &mut [f64]) {
+    pub fn coefficients_into(&mut self, basis: LengthBasis, out: &mut [f64]) {
         assert!(self.last.is_some(), "coefficients_into needs a successful solve");
         for (i, (st, e)) in self.nodes_state.iter().zip(&self.nodes_strain).enumerate() {
             self.theta[i] = st.phi + e.v2.atan2(e.v1);
@@ -817,6 +817,8 @@ impl Simulator {
         let h = self.step_mm[0];
         debug_assert!((self.step_mm[0] - self.step_mm[1]).abs() < 1e-12);
         shape::legendre_from_tangent(&self.theta, &self.sigma, &self.speed, h, out);
+        let deformed_length_mm = self.sigma[self.sigma.len() - 1] - self.sigma[0];
+        basis.convert_from_deformed(out, deformed_length_mm, self.actuator.length_mm);
     }
 
     /// The centreline of the last successful solve, clamp to tip.
@@ -878,8 +880,11 @@ pub struct Simulation {
     pub routing_mm: [f64; 5],
     /// Tip pose and length.
     pub pose: TipPose,
-    /// a_0 … a_n, mm⁻¹ (κ = Σ a_i P_i(t) with dimensionless t, so every a_i is a curvature).
+    /// a_0 … a_n, mm⁻¹ (κ = Σ a_i P_i(t) with dimensionless t, so every a_i
+    /// is a curvature), in `length_basis`.
     pub a: Vec<f64>,
+    /// The length the coefficients are per unit of.
+    pub length_basis: LengthBasis,
     /// Centreline from clamp to tip.
     pub centreline: Vec<CentrelinePoint>,
 }
@@ -892,9 +897,10 @@ pub fn simulate(
     routing: &Routing,
     tension_n: f64,
     order: usize,
+    basis: LengthBasis,
 ) -> Result<Simulation, crate::Error> {
     let hold = Hold { direction: actuator.effects.load_direction, dwell_s: actuator.effects.creep_hold_s };
-    simulate_held(actuator, options, routing, tension_n, order, hold)
+    simulate_held(actuator, options, routing, tension_n, order, basis, hold)
 }
 
 /// Like [`simulate`], with the final tension reached in direction
@@ -906,6 +912,7 @@ pub fn simulate_held(
     routing: &Routing,
     tension_n: f64,
     order: usize,
+    basis: LengthBasis,
     hold: Hold,
 ) -> Result<Simulation, crate::Error> {
     let mut sim = Simulator::new(actuator, options)?;
@@ -923,8 +930,8 @@ pub fn simulate_held(
     }
     let pose = pose.expect("at least one rung");
     let mut a = vec![0.0; order + 1];
-    sim.coefficients_into(&mut a);
-    Ok(Simulation { routing_mm: routing.control_points_mm(), pose, a, centreline: sim.centreline() })
+    sim.coefficients_into(basis, &mut a);
+    Ok(Simulation { routing_mm: routing.control_points_mm(), pose, a, length_basis: basis, centreline: sim.centreline() })
 }
 
 #[cfg(test)]

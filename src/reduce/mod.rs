@@ -14,6 +14,7 @@ pub mod write;
 use arrow::record_batch::RecordBatch;
 use columns::RowColumns;
 use serde::{Deserialize, Serialize};
+use crate::shape::LengthBasis;
 use stats::{quantile_sorted, quantiles};
 use std::collections::{BTreeMap, HashMap};
 
@@ -60,10 +61,12 @@ pub struct RunInfo {
     pub run_dir: String,
     /// Hash of the run's spec.
     pub spec_hash: String,
+    /// The length the run's a_i are per unit of.
+    pub length_basis: LengthBasis,
 }
 
 /// Boundaries of the characteristic modes: a_0 split into 4 ranges by three
-/// values, a_1 into 3 by two (mm⁻¹, mm⁻²).
+/// values, a_1 into 3 by two (both mm⁻¹, in the run's length basis).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct ModeBoundaries {
     /// Ascending a_0 boundaries.
@@ -163,6 +166,16 @@ pub struct MapSummary {
     pub run_dir: String,
     /// Hash of the run's spec.
     pub spec_hash: String,
+    /// The length the coefficients (statistics, mode boundaries, designs)
+    /// are per unit of: `rest` (the thesis's basis) or `deformed`. Maps
+    /// written before this field existed were in the deformed basis.
+    #[serde(default = "basis_of_maps_without_the_field")]
+    pub length_basis: LengthBasis,
+}
+
+/// Maps written before `length_basis` was recorded had deformed-length a_i.
+fn basis_of_maps_without_the_field() -> LengthBasis {
+    LengthBasis::Deformed
 }
 
 /// Statistics of one coefficient in one cell.
@@ -522,6 +535,7 @@ where
         length_mm: info.length_mm,
         run_dir: info.run_dir.clone(),
         spec_hash: info.spec_hash.clone(),
+        length_basis: info.length_basis,
     };
     Ok(MapData { summary, cells, modes, designs })
 }
@@ -559,7 +573,7 @@ pub fn write_map(
         let stats = |f: &dyn Fn(&CoefficientStats) -> f64| -> Vec<(i32, i32, f64)> {
             map.cells.iter().map(|c| (c.ix, c.iy, f(&c.coefficients[k]))).collect()
         };
-        let unit = format!("a{k} ({COEFFICIENT_UNIT})");
+        let unit = format!("a{k} ({COEFFICIENT_UNIT}, {} basis)", s.length_basis);
         for (name, what, values, scale) in [
             ("p10", "10th percentile", stats(&|c| c.p10), Scale::Symmetric),
             ("p90", "90th percentile", stats(&|c| c.p90), Scale::Symmetric),
@@ -568,10 +582,16 @@ pub fn write_map(
             let file = format!("a{k}_{name}.png");
             let title = format!("a{k}: {what} per cell");
             draw_heatmap(&dir.join(&file), s, &title, &unit, &values, scale)?;
+            // Thesis Fig. 4.2 shows a0, Fig. 4.3 a1; the thesis has no a2 map.
+            let figure = match k {
+                0 => " (as thesis Fig. 4.2)",
+                1 => " (as thesis Fig. 4.3)",
+                _ => "",
+            };
+            let basis = s.length_basis.describe();
             let explanation = match name {
-                "gap" => format!("Spread of a{k} among the configurations reaching each cell: a large gap means more than one mode of deformation reaches it."),
-                _ => format!("The {what} of a{k} over the simulations whose tip falls in each cell (thesis Fig. 4.{})."
-                    , if k == 0 { 2 } else { 3 }),
+                "gap" => format!("Spread of a{k} ({COEFFICIENT_UNIT}, {basis}) among the configurations reaching each cell: a large gap means more than one mode of deformation reaches it{figure}."),
+                _ => format!("The {what} of a{k} ({COEFFICIENT_UNIT}, {basis}) over the simulations whose tip falls in each cell{figure}."),
             };
             pictures.push(Picture { file, title, explanation });
         }
@@ -583,7 +603,7 @@ pub fn write_map(
         .map(|m| {
             let d = m.representative.as_ref()?;
             let routing = crate::model::Routing::new(&d.y_mm, actuator.length_mm, actuator.radius_mm).ok()?;
-            let sim = crate::model::simulate(actuator, solver, &routing, d.tension_n, 1).ok()?;
+            let sim = crate::model::simulate(actuator, solver, &routing, d.tension_n, 1, crate::shape::LengthBasis::default()).ok()?;
             Some(crate::cli::simulate::body_drawing(&sim, actuator.radius_mm, format!("mode {}", m.mode), plotters::style::full_palette::BLUE_800))
         })
         .collect();
@@ -591,7 +611,10 @@ pub fn write_map(
     pictures.push(Picture {
         file: "modes.png".into(),
         title: "Characteristic modes (thesis Fig. 4.4)".into(),
-        explanation: "a0 split into 4 ranges (rows) and a1 into 3 (columns); each panel maps where that combination occurs and draws the simulation nearest the mode's median coefficients.".into(),
+        explanation: format!(
+            "a0 split into 4 ranges (rows) and a1 into 3 (columns), a_i {}; each panel maps where that combination occurs and draws the simulation nearest the mode's median coefficients.",
+            s.length_basis.describe()
+        ),
     });
     plots::write_index(dir, s, &pictures)?;
     Ok(pictures)
@@ -639,6 +662,7 @@ mod tests {
             length_mm: 65.0,
             run_dir: "test".into(),
             spec_hash: "x".into(),
+            length_basis: LengthBasis::Rest,
         }
     }
 
@@ -755,7 +779,7 @@ mod picture_tests {
             for tension in [1.0, 1.3, 1.6, 2.0] {
                 let pose = sim.solve(tension).unwrap();
                 let mut a = [0.0; 3];
-                sim.coefficients_into(&mut a);
+                sim.coefficients_into(crate::shape::LengthBasis::default(), &mut a);
                 ids.push(id);
                 status.push("ok");
                 ys.push(y);
@@ -789,6 +813,7 @@ mod picture_tests {
             length_mm: 65.0,
             run_dir: "small".into(),
             spec_hash: "h".into(),
+            length_basis: LengthBasis::Rest,
         };
         let map = reduce_batches(&info, &ReduceOptions::default(), || Ok(vec![Ok(b.clone())].into_iter())).unwrap();
         let dir = std::env::var_os("CABLEMAP_KEEP_MAP").map(std::path::PathBuf::from);
@@ -812,6 +837,9 @@ mod picture_tests {
         for p in &pictures {
             assert!(html.contains(&format!("src=\"{}\"", p.file)));
         }
+        // Every a_i is a curvature (mm⁻¹) and the page names the basis.
+        assert!(!html.contains("mm⁻²") && html.contains("per unit rest length L (the thesis's basis)"), "{html}");
+        assert!(pictures.iter().filter(|p| p.file.starts_with("a2")).all(|p| !p.explanation.contains("Fig.")));
         for table in ["cells.parquet", "modes.parquet", "designs.parquet", "summary.json"] {
             assert!(dir.join(table).exists(), "{table}");
         }
@@ -847,6 +875,7 @@ pub fn reduce_run(
         length_mm: spec.actuator.length_mm,
         run_dir: run_dir.display().to_string(),
         spec_hash: run.manifest().spec_sha256.clone(),
+        length_basis: spec.output.length_basis,
     };
     let columns = needed_columns(info.order);
     let names: Vec<&str> = columns.iter().map(String::as_str).collect();

@@ -233,13 +233,16 @@ pub fn write_index(dir: &Path, summary: &MapSummary, pictures: &[Picture]) -> Re
     );
     html.push_str(&format!(
         "<p>{} simulations ({} converged, {} failed){}, binned on a {} mm grid of tip positions ({} non-empty cells). \
-         Mode boundaries ({}): a0 {:?} mm⁻¹, a1 {:?} mm⁻². Data: <code>{}</code>. Tables: cells.parquet, modes.parquet, designs.parquet, summary.json.</p>\n",
+         Coefficients a_i are curvatures in mm⁻¹, {} (length basis <code>{}</code>). \
+         Mode boundaries ({}): a0 {:?} mm⁻¹, a1 {:?} mm⁻¹. Data: <code>{}</code>. Tables: cells.parquet, modes.parquet, designs.parquet, summary.json.</p>\n",
         summary.rows_total,
         summary.rows_converged,
         summary.rows_failed,
         if summary.mirrored { ", mirrored half restored" } else { "" },
         summary.cell_mm,
         summary.cells,
+        summary.length_basis.describe(),
+        summary.length_basis,
         summary.mode_boundaries_source,
         summary.mode_boundaries.a0,
         summary.mode_boundaries.a1,

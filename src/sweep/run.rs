@@ -14,7 +14,7 @@
 use super::enumerate::SweepPlan;
 use super::progress::{Progress, ProgressMode};
 use super::schema::{arrow_schema, build_batch, SolvedRouting, SolvedRow};
-use super::spec::SweepSpec;
+use super::spec::{OutputSpec, SweepSpec};
 use super::store::{total_status_counts, ChunkInfo, RunDir};
 use super::SweepError;
 use crate::model::{Routing, Simulator, STATUS_OK};
@@ -191,23 +191,23 @@ fn solve_routing(
     let y_mm = plan.routing_mm(id);
     let routing = Routing::new(&y_mm, spec.actuator.length_mm, spec.actuator.radius_mm)?;
     sim.set_routing(&routing);
-    let rows = tensions_n.iter().map(|&t| solve_row(sim, t, spec.output.order, spec.output.centreline)).collect();
+    let rows = tensions_n.iter().map(|&t| solve_row(sim, t, &spec.output)).collect();
     Ok(SolvedRouting { id, y_mm, rows })
 }
 
 /// One solve as a row: outputs only for a successful, finite solve.
-fn solve_row(sim: &mut Simulator, tension_n: f64, order: usize, centreline: bool) -> SolvedRow {
+fn solve_row(sim: &mut Simulator, tension_n: f64, output: &OutputSpec) -> SolvedRow {
     let failed = |status| SolvedRow { tension_n, status, pose: None, a: Vec::new(), centreline: None };
     match sim.solve(tension_n) {
         Ok(pose) => {
-            let mut a = vec![0.0; order + 1];
-            sim.coefficients_into(&mut a);
+            let mut a = vec![0.0; output.order + 1];
+            sim.coefficients_into(output.length_basis, &mut a);
             let scalars = [pose.tip_x_mm, pose.tip_y_mm, pose.tip_angle_rad, pose.base_angle_rad, pose.length_mm];
             if !scalars.iter().chain(&a).all(|v| v.is_finite()) {
                 // Stored as a failure so that outputs are never NaN.
                 return failed(crate::model::SolveFailure::NonFinite { s_mm: f64::NAN }.status());
             }
-            let centreline = centreline.then(|| {
+            let centreline = output.centreline.then(|| {
                 let points = sim.centreline();
                 (points.iter().map(|p| p.x_mm).collect(), points.iter().map(|p| p.y_mm).collect())
             });

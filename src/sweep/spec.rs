@@ -18,12 +18,14 @@
 //! count = 21
 //! [output]
 //! order = 3             # store a0 … a3
+//! length_basis = "rest" # a_i per unit rest length (thesis); or "deformed"
 //! centreline = false    # store centreline_x_mm / centreline_y_mm lists
 //! chunk_routings = 256  # routings per Parquet chunk file
 //! ```
 
 use super::SweepError;
 use crate::model::{Actuator, SolverOptions};
+use crate::shape::LengthBasis;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use std::path::Path;
@@ -100,6 +102,9 @@ impl Default for TensionSpec {
 pub struct OutputSpec {
     /// Highest Legendre order n: columns a0 … an.
     pub order: usize,
+    /// The length the a_i columns are per unit of: `rest` (the thesis's
+    /// basis, the default) or `deformed`.
+    pub length_basis: LengthBasis,
     /// Store the centreline of each solve as list columns.
     pub centreline: bool,
     /// Routings per chunk file (each chunk is written atomically; a resumed
@@ -109,7 +114,7 @@ pub struct OutputSpec {
 
 impl Default for OutputSpec {
     fn default() -> Self {
-        Self { order: 3, centreline: false, chunk_routings: 256 }
+        Self { order: 3, length_basis: LengthBasis::default(), centreline: false, chunk_routings: 256 }
     }
 }
 

@@ -14,6 +14,7 @@
 
 use super::enumerate::SweepPlan;
 use super::spec::SweepSpec;
+use crate::shape::LengthBasis;
 use super::SweepError;
 use arrow::record_batch::RecordBatch;
 use parquet::arrow::ArrowWriter;
@@ -25,8 +26,10 @@ use std::collections::BTreeMap;
 use std::fs::File;
 use std::path::{Path, PathBuf};
 
-/// Format tag of manifests and chunk files.
-pub const FORMAT: &str = "cablemap-sweep/1";
+/// Format tag of manifests and chunk files. Version 2: the a_i columns are
+/// in the basis the manifest names (`length_basis`, the thesis's rest-length
+/// basis by default); version 1 runs had deformed-length a_i and no such field.
+pub const FORMAT: &str = "cablemap-sweep/2";
 /// Version of the tool writing the files.
 pub const TOOL_VERSION: &str = env!("CARGO_PKG_VERSION");
 /// Manifest file name in DIR.
@@ -51,6 +54,8 @@ pub mod keys {
     pub const ROWS: &str = "cablemap.rows";
     /// JSON object: rows per status.
     pub const STATUS_COUNTS: &str = "cablemap.status_counts";
+    /// The length the a_i columns are per unit of: `rest` or `deformed`.
+    pub const LENGTH_BASIS: &str = "cablemap.length_basis";
 }
 
 /// The run's manifest (`DIR/manifest.json`). Written once, never changed.
@@ -65,6 +70,9 @@ pub struct Manifest {
     pub spec_sha256: String,
     /// The spec with every default filled in.
     pub spec: SweepSpec,
+    /// The length the a_i columns are per unit of (the spec's
+    /// `output.length_basis`, repeated here for readers of the manifest).
+    pub length_basis: LengthBasis,
     /// Shards the run is split into.
     pub shards: u64,
     /// Routings in the sweep.
@@ -88,6 +96,7 @@ impl Manifest {
             tool_version: TOOL_VERSION.into(),
             spec_sha256: spec.hash_hex(),
             spec: spec.clone(),
+            length_basis: spec.output.length_basis,
             shards,
             routings: plan.routings,
             tensions: plan.tensions,
@@ -172,7 +181,20 @@ impl RunDir {
         if manifest.format != FORMAT {
             return Err(SweepError::CorruptManifest {
                 path,
-                message: format!("format '{}' is not '{FORMAT}'", manifest.format),
+                message: format!(
+                    "format '{}' is not '{FORMAT}' (a run made by another cablemap version; version 1 runs stored a_i \
+                     per unit deformed length: sweep again into a new directory)",
+                    manifest.format
+                ),
+            });
+        }
+        if manifest.length_basis != manifest.spec.output.length_basis {
+            return Err(SweepError::CorruptManifest {
+                path,
+                message: format!(
+                    "length_basis '{}' disagrees with the spec's output.length_basis '{}'",
+                    manifest.length_basis, manifest.spec.output.length_basis
+                ),
             });
         }
         Ok(Some(manifest))
@@ -306,6 +328,7 @@ impl RunDir {
             kv(keys::CHUNK, chunk.to_string()),
             kv(keys::ROWS, batch.num_rows().to_string()),
             kv(keys::STATUS_COUNTS, serde_json::to_string(&status_counts).expect("counts serialise")),
+            kv(keys::LENGTH_BASIS, manifest.length_basis.to_string()),
         ];
         let props = WriterProperties::builder()
             .set_compression(Compression::ZSTD(ZstdLevel::try_new(3).expect("valid zstd level")))

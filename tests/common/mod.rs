@@ -48,7 +48,7 @@ pub fn simulate_rows() -> Vec<Row> {
                 continue;
             }
             let mut a = [0.0; 3];
-            sim.coefficients_into(&mut a);
+            sim.coefficients_into(cablemap::shape::LengthBasis::Rest, &mut a);
             rows.push(Row { routing_id: id as i64, y_mm: y, tension_n: t, tip_x_mm: p.tip_x_mm, tip_y_mm: p.tip_y_mm, tip_angle_rad: p.tip_angle_rad, a });
         }
     }
@@ -86,6 +86,7 @@ pub fn write_map(dir: &Path, rows: &[Row]) {
         length_mm: 65.0,
         run_dir: "tests/common (simulated in the test)".into(),
         spec_hash: "test".into(),
+        length_basis: cablemap::shape::LengthBasis::Rest,
     };
     let b = batch(rows);
     let map = reduce_batches(&info, &ReduceOptions::default(), || Ok(vec![Ok(b.clone())].into_iter())).unwrap();
