@@ -106,3 +106,42 @@ fn thesis_coefficient_route_converges_to_the_exact_one_with_order() {
     assert!(at8 < 5e-4, "order 8: {at8}");
     assert!(at8 < at2 / 10.0);
 }
+
+/// `simulate --json` as a user runs it, on every single-cable reference case
+/// (tests/data/reference): by default the a_i are the thesis's (per unit rest
+/// length, `a_thesis_per_mm`); with `--length-basis deformed`, `a_per_mm`.
+#[test]
+fn simulate_json_coefficients_match_the_reference_in_both_bases() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/reference");
+    let mut checked = 0;
+    for file in ["no-gravity.json", "gravity.json", "large-deformation.json"] {
+        let doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join(file)).unwrap()).unwrap();
+        for case in doc["cases"].as_array().unwrap() {
+            let routing: Vec<String> = case["routing_mm"].as_array().unwrap().iter().map(|v| v.to_string()).collect();
+            let routing = routing.join(",");
+            let tension = case["tension_N"].to_string();
+            let mut args = vec!["simulate", "--routing", &routing, "--tension", &tension, "--json"];
+            if case["gravity_N_per_mm"].as_f64().unwrap() == 0.0 {
+                args.push("--no-gravity");
+            }
+            for (basis, key) in [(None, "a_thesis_per_mm"), (Some("deformed"), "a_per_mm")] {
+                let mut all = args.clone();
+                if let Some(b) = basis {
+                    all.extend(["--length-basis", b]);
+                }
+                let (ok, stdout, stderr) = run(&all);
+                assert!(ok, "{file} {routing} @ {tension}: {stderr}");
+                let v: serde_json::Value = serde_json::from_str(stdout.trim()).unwrap();
+                assert_eq!(v["length_basis"], basis.unwrap_or("rest"));
+                let want = case[key].as_array().unwrap();
+                for (i, w) in want.iter().enumerate() {
+                    let got = v["a"][i].as_f64().unwrap();
+                    let w = w.as_f64().unwrap();
+                    assert!((got - w).abs() < 1e-5, "{file} {routing} @ {tension}, {key}[{i}]: {got} vs {w}");
+                }
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked >= 32, "only {checked} reference checks");
+}
