@@ -35,6 +35,8 @@ def cells_pandas():
     assert (c[modes].sum(axis=1) == c["count"]).all()
     assert int(c["count"].sum()) == summary["rows_converged"]
     assert len(c) == summary["cells"]
+    # The map's coefficients are in the thesis's basis (per unit rest length) by default.
+    assert summary["length_basis"] == "rest", summary["length_basis"]
 
 
 def cells_polars():

@@ -105,6 +105,9 @@ def check_polars(run):
     meta = pl.read_parquet_metadata(first)
     assert meta["cablemap.spec_sha256"] == m["spec_sha256"]
     assert json.loads(meta["cablemap.spec"])["tension"] == m["spec"]["tension"]
+    # The coefficient basis is recorded in the manifest and every footer.
+    assert m["length_basis"] == m["spec"]["output"]["length_basis"] == "rest", m["length_basis"]
+    assert meta["cablemap.length_basis"] == m["length_basis"]
 
 
 def main():
