@@ -7,6 +7,7 @@
 //! that; the second pass fetches the full rows of the picked designs.
 
 mod columns;
+pub mod explorer;
 pub mod plots;
 pub mod stats;
 pub mod write;
@@ -616,7 +617,7 @@ pub fn write_map(
             s.length_basis.describe()
         ),
     });
-    plots::write_index(dir, s, &pictures)?;
+    explorer::write_explorer(dir, map, actuator, &shapes, &pictures)?;
     Ok(pictures)
 }
 
@@ -823,8 +824,9 @@ mod picture_tests {
         assert_eq!(pictures.len(), 1 + 3 * 3 + 1);
         for p in &pictures {
             let img = image::open(dir.join(&p.file)).unwrap().to_rgb8();
-            let expected = if p.file == "modes.png" { (1800, 2000) } else { (900, 760) };
-            assert_eq!(img.dimensions(), expected, "{}", p.file);
+            // Sized from the map's extent at equal aspect (plots.rs checks the aspect).
+            let (w, h) = img.dimensions();
+            assert!(w >= 600 && h >= 400 && w <= 2400 && h <= 4000, "{}: {w}×{h}", p.file);
             // Not blank: many distinct colours and a good share of non-white pixels.
             let non_white = img.pixels().filter(|px| px.0 != [255, 255, 255]).count();
             let mut colours: Vec<[u8; 3]> = img.pixels().map(|px| px.0).collect();
@@ -834,11 +836,18 @@ mod picture_tests {
             assert!(colours.len() > 20, "{}: only {} colours", p.file, colours.len());
         }
         let html = std::fs::read_to_string(dir.join("index.html")).unwrap();
+        assert!(html.contains("<script src=\"explorer-data.js\">"));
+        let data = std::fs::read_to_string(dir.join(explorer::DATA_FILE)).unwrap();
+        let json = data.trim().strip_prefix("// Written by `cablemap reduce`: the map explorer's data (index.html).\nwindow.CABLEMAP_MAP = ").unwrap();
+        let v: serde_json::Value = serde_json::from_str(json.strip_suffix(';').unwrap()).unwrap();
         for p in &pictures {
-            assert!(html.contains(&format!("src=\"{}\"", p.file)));
+            assert!(v["pictures"].as_array().unwrap().iter().any(|f| f["file"] == p.file.as_str()), "{}", p.file);
         }
+        assert_eq!(v["cells"]["ix"].as_array().unwrap().len(), map.cells.len());
+        assert_eq!(v["designs"]["ix"].as_array().unwrap().len(), map.designs.len());
         // Every a_i is a curvature (mm⁻¹) and the page names the basis.
-        assert!(!html.contains("mm⁻²") && html.contains("per unit rest length L (the thesis's basis)"), "{html}");
+        assert!(!html.contains("mm⁻²") && !data.contains("mm⁻²"));
+        assert_eq!(v["length_basis_description"], "per unit rest length L (the thesis's basis)");
         assert!(pictures.iter().filter(|p| p.file.starts_with("a2")).all(|p| !p.explanation.contains("Fig.")));
         for table in ["cells.parquet", "modes.parquet", "designs.parquet", "summary.json"] {
             assert!(dir.join(table).exists(), "{table}");

@@ -1,9 +1,10 @@
-//! PNG pictures of the maps and the index page that shows them.
+//! PNG pictures of the maps (for papers; the explorer page draws its own).
 //!
 //! Axes follow the actuator drawings: the lateral tip coordinate y runs
-//! across the page, the clamp axis x runs down (the rod hangs), both in mm.
+//! across the page, the clamp axis x runs down (the rod hangs), both in mm,
+//! at equal aspect: one mm across is one mm down.
 
-use super::{MapData, MapSummary, ReduceError, MODES};
+use super::{MapData, MapSummary, MODES};
 use crate::plot::{register_fonts, BodyDrawing, PlotError, FONT};
 use plotters::prelude::*;
 use plotters::style::colors::colormaps::ViridisRGB;
@@ -43,30 +44,101 @@ fn value_range(values: &[f64], scale: Scale) -> (f64, f64) {
     (lo, hi)
 }
 
-fn colour(v: f64, lo: f64, hi: f64) -> RGBColor {
-    ViridisRGB.get_color_normalized(v.clamp(lo, hi) as f32, lo as f32, hi as f32)
+/// Blue–white–red, centred on zero (ColorBrewer RdBu, reversed): signed
+/// coefficients read at a glance, zero is white.
+const DIVERGING: [(u8, u8, u8); 11] = [
+    (5, 48, 97),
+    (33, 102, 172),
+    (67, 147, 195),
+    (146, 197, 222),
+    (209, 229, 240),
+    (247, 247, 247),
+    (253, 219, 199),
+    (244, 165, 130),
+    (214, 96, 77),
+    (178, 24, 43),
+    (103, 0, 31),
+];
+
+fn diverging(t: f64) -> RGBColor {
+    let t = t.clamp(0.0, 1.0) * (DIVERGING.len() - 1) as f64;
+    let i = (t.floor() as usize).min(DIVERGING.len() - 2);
+    let f = t - i as f64;
+    let mix = |a: u8, b: u8| (f64::from(a) + f * (f64::from(b) - f64::from(a))).round() as u8;
+    let (a, b) = (DIVERGING[i], DIVERGING[i + 1]);
+    RGBColor(mix(a.0, b.0), mix(a.1, b.1), mix(a.2, b.2))
+}
+
+/// The colour of `v` on `scale` over (lo, hi): diverging for signed values
+/// (symmetric scales), viridis for counts and spreads.
+fn colour(v: f64, (lo, hi): (f64, f64), scale: Scale) -> RGBColor {
+    match scale {
+        Scale::Symmetric => diverging((v - lo) / (hi - lo)),
+        _ => ViridisRGB.get_color_normalized(v.clamp(lo, hi) as f32, lo as f32, hi as f32),
+    }
 }
 
 type Area<'a> = DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>;
 
-/// Draws cells coloured by value on `area` (no colour bar).
+/// The mm extent every map shows (the grid, the clamp at the origin and the
+/// rest tip at (L, 0)) and the pixels a map of it takes at equal aspect:
+/// one mm across is one mm down.
+#[derive(Debug, Clone, Copy)]
+struct Frame {
+    /// Clamp-axis range (down the page), mm.
+    x: (f64, f64),
+    /// Lateral range (across the page), mm.
+    y: (f64, f64),
+}
+
+/// Pixels around a map's plot area: tick labels left and below.
+const MAP_MARGIN: u32 = 8;
+
+impl Frame {
+    fn of(summary: &MapSummary) -> Self {
+        let c = summary.cell_mm;
+        let (x0, y0) = (summary.x_min_mm, summary.y_min_mm);
+        let (x1, y1) = (x0 + summary.nx as f64 * c, y0 + summary.ny as f64 * c);
+        Self { x: (x0.min(-2.0), x1.max(summary.length_mm + 2.0)), y: (y0.min(-2.0), y1.max(2.0)) }
+    }
+
+    /// Size of a map area (plot plus label areas) whose plot is `plot_w`
+    /// pixels wide.
+    fn area_size(&self, plot_w: u32, label_size: u32) -> (u32, u32) {
+        let px_per_mm = f64::from(plot_w) / (self.y.1 - self.y.0);
+        let plot_h = (px_per_mm * (self.x.1 - self.x.0)).round() as u32;
+        (plot_w + y_label_area(label_size) + 2 * MAP_MARGIN, plot_h + x_label_area(label_size) + 2 * MAP_MARGIN)
+    }
+}
+
+fn x_label_area(label_size: u32) -> u32 {
+    label_size * 3
+}
+
+fn y_label_area(label_size: u32) -> u32 {
+    label_size * 3 + 8
+}
+
+/// Draws cells coloured by value on `area` (sized by [`Frame::area_size`]),
+/// the clamp and the rest tip, and `overlay` (a body in the same mm frame).
+#[allow(clippy::too_many_arguments)]
 fn draw_cells(
     area: &Area,
     path: &Path,
     summary: &MapSummary,
-    caption: &str,
     cells: &[(i32, i32, f64)],
     range: (f64, f64),
+    scale: Scale,
     label_size: u32,
+    overlay: Option<&BodyDrawing>,
 ) -> Result<(), PlotError> {
+    let frame = Frame::of(summary);
     let (x0, y0, c) = (summary.x_min_mm, summary.y_min_mm, summary.cell_mm);
-    let (x1, y1) = (x0 + summary.nx as f64 * c, y0 + summary.ny as f64 * c);
     let mut chart = ChartBuilder::on(area)
-        .caption(caption, (FONT, label_size + 4))
-        .margin(8)
-        .x_label_area_size(label_size * 3)
-        .y_label_area_size(label_size * 3 + 5)
-        .build_cartesian_2d(y0..y1, -x1..-x0)
+        .margin(MAP_MARGIN)
+        .x_label_area_size(x_label_area(label_size))
+        .y_label_area_size(y_label_area(label_size))
+        .build_cartesian_2d(frame.y.0..frame.y.1, -frame.x.1..-frame.x.0)
         .map_err(|e| PlotError::new(path, e))?;
     chart
         .configure_mesh()
@@ -74,59 +146,117 @@ fn draw_cells(
         .x_desc("tip y (mm)")
         .y_desc("tip x (mm, down)")
         .y_label_formatter(&|v| format!("{:.0}", -v + 0.0))
+        .x_label_formatter(&|v| format!("{v:.0}"))
         .label_style((FONT, label_size))
-        .axis_desc_style((FONT, label_size + 1))
+        .axis_desc_style((FONT, label_size))
         .draw()
         .map_err(|e| PlotError::new(path, e))?;
     chart
         .draw_series(cells.iter().map(|&(ix, iy, v)| {
             let (xa, ya) = (x0 + ix as f64 * c, y0 + iy as f64 * c);
-            Rectangle::new([(ya, -xa), (ya + c, -(xa + c))], colour(v, range.0, range.1).filled())
+            Rectangle::new([(ya, -xa), (ya + c, -(xa + c))], colour(v, range, scale).filled())
         }))
         .map_err(|e| PlotError::new(path, e))?;
+    // The clamp (a bar at the origin) and the rest tip (a circle at (L, 0)).
+    let r = summary.radius_mm * 1.6;
+    chart.draw_series(std::iter::once(Rectangle::new([(-r, 0.6), (r, 0.0)], BLACK.filled()))).map_err(|e| PlotError::new(path, e))?;
+    chart
+        .draw_series(std::iter::once(Circle::new((0.0, -summary.length_mm), 4, BLACK.stroke_width(1))))
+        .map_err(|e| PlotError::new(path, e))?;
+    if let Some(body) = overlay {
+        let (left, right) = body.outline();
+        let page = |pts: &[(f64, f64)]| -> Vec<(f64, f64)> { pts.iter().map(|&(x, y)| (y, -x)).collect() };
+        for side in [&left, &right] {
+            chart.draw_series(LineSeries::new(page(side), body.colour.stroke_width(2))).map_err(|e| PlotError::new(path, e))?;
+        }
+        chart.draw_series(LineSeries::new(page(&body.cable), RED.stroke_width(1))).map_err(|e| PlotError::new(path, e))?;
+    }
     Ok(())
 }
 
-/// Draws a vertical colour bar for `range` labelled `label`.
-fn draw_colour_bar(area: &Area, path: &Path, range: (f64, f64), label: &str, scale: Scale) -> Result<(), PlotError> {
+/// Draws a colour bar for `range` labelled `label`: vertical on a tall
+/// area, horizontal on a wide one.
+fn draw_colour_bar(area: &Area, path: &Path, range: (f64, f64), label: &str, scale: Scale, font: u32) -> Result<(), PlotError> {
     let (lo, hi) = range;
-    let mut chart = ChartBuilder::on(area)
-        .margin_top(40)
-        .margin_bottom(50)
-        .margin_right(10)
-        .y_label_area_size(70)
-        .build_cartesian_2d(0.0..1.0, lo..hi)
-        .map_err(|e| PlotError::new(path, e))?;
     let fmt = move |v: &f64| -> String {
         match scale {
-            Scale::Log => format!("{:.0}", 10f64.powf(*v)),
+            // Three significant digits: a short log range must not read "1 1 2 2".
+            Scale::Log => {
+                let n = 10f64.powf(*v);
+                let digits = (2 - n.log10().floor() as i32).max(0) as usize;
+                format!("{n:.digits$}")
+            }
             _ if v.abs() < 1e-9 * (hi - lo) => "0".to_string(),
             _ if v.abs() < 1e-3 => format!("{v:.1e}"),
             _ => format!("{v:.4}"),
         }
     };
-    chart
-        .configure_mesh()
-        .disable_mesh()
-        .disable_x_axis()
-        .y_desc(label)
-        .y_label_formatter(&fmt)
-        .label_style((FONT, 13))
-        .axis_desc_style((FONT, 14))
-        .draw()
-        .map_err(|e| PlotError::new(path, e))?;
+    let (w, h) = area.dim_in_pixel();
     let steps = 200;
-    chart
-        .draw_series((0..steps).map(|k| {
-            let a = lo + (hi - lo) * k as f64 / steps as f64;
-            let b = lo + (hi - lo) * (k + 1) as f64 / steps as f64;
-            Rectangle::new([(0.0, a), (1.0, b)], colour(0.5 * (a + b), lo, hi).filled())
-        }))
-        .map_err(|e| PlotError::new(path, e))?;
+    let band = |k: usize| (lo + (hi - lo) * k as f64 / steps as f64, lo + (hi - lo) * (k + 1) as f64 / steps as f64);
+    if h >= w {
+        let mut chart = ChartBuilder::on(area)
+            .margin_top(30)
+            .margin_bottom(40)
+            .margin_right(10)
+            .y_label_area_size(font * 5 + 10)
+            .build_cartesian_2d(0.0..1.0, lo..hi)
+            .map_err(|e| PlotError::new(path, e))?;
+        chart
+            .configure_mesh()
+            .disable_mesh()
+            .disable_x_axis()
+            .y_desc(label)
+            .y_label_formatter(&fmt)
+            .label_style((FONT, font))
+            .axis_desc_style((FONT, font))
+            .draw()
+            .map_err(|e| PlotError::new(path, e))?;
+        chart
+            .draw_series((0..steps).map(|k| {
+                let (a, b) = band(k);
+                Rectangle::new([(0.0, a), (1.0, b)], colour(0.5 * (a + b), range, scale).filled())
+            }))
+            .map_err(|e| PlotError::new(path, e))?;
+    } else {
+        let mut chart = ChartBuilder::on(area)
+            .margin_left(40)
+            .margin_right(40)
+            .margin_top(6)
+            .x_label_area_size(font * 3)
+            .build_cartesian_2d(lo..hi, 0.0..1.0)
+            .map_err(|e| PlotError::new(path, e))?;
+        chart
+            .configure_mesh()
+            .disable_mesh()
+            .disable_y_axis()
+            .x_desc(label)
+            .x_label_formatter(&fmt)
+            .label_style((FONT, font))
+            .axis_desc_style((FONT, font))
+            .draw()
+            .map_err(|e| PlotError::new(path, e))?;
+        chart
+            .draw_series((0..steps).map(|k| {
+                let (a, b) = band(k);
+                Rectangle::new([(a, 0.0), (b, 1.0)], colour(0.5 * (a + b), range, scale).filled())
+            }))
+            .map_err(|e| PlotError::new(path, e))?;
+    }
     Ok(())
 }
 
-/// A map of one value per cell with a colour bar, 900×760 pixels.
+/// Width of a single map's plot area in pixels (the image is sized from it
+/// at equal aspect).
+const HEATMAP_PLOT_W: u32 = 760;
+/// Height of the title strip above a map, pixels.
+const TITLE_H: u32 = 44;
+/// Width of the colour-bar strip right of a map, pixels.
+const BAR_W: u32 = 150;
+
+/// A map of one value per cell with a colour bar, at equal aspect (1 mm
+/// across = 1 mm down); its size follows the map's extent. Returns the
+/// image size in pixels.
 pub fn draw_heatmap(
     path: &Path,
     summary: &MapSummary,
@@ -134,9 +264,12 @@ pub fn draw_heatmap(
     colour_label: &str,
     cells: &[(i32, i32, f64)],
     scale: Scale,
-) -> Result<(), PlotError> {
+) -> Result<(u32, u32), PlotError> {
     register_fonts();
-    let root = BitMapBackend::new(path, (900, 760)).into_drawing_area();
+    let label_size = 17;
+    let (map_w, map_h) = Frame::of(summary).area_size(HEATMAP_PLOT_W, label_size);
+    let size = (map_w + BAR_W, map_h + TITLE_H);
+    let root = BitMapBackend::new(path, size).into_drawing_area();
     root.fill(&WHITE).map_err(|e| PlotError::new(path, e))?;
     let shown: Vec<(i32, i32, f64)> = match scale {
         Scale::Log => cells.iter().map(|&(i, j, v)| (i, j, v.max(1.0).log10())).collect(),
@@ -144,125 +277,132 @@ pub fn draw_heatmap(
     };
     let values: Vec<f64> = shown.iter().map(|c| c.2).collect();
     let range = value_range(&values, scale);
-    let (left, right) = root.split_horizontally(760);
-    draw_cells(&left, path, summary, title, &shown, range, 15)?;
-    draw_colour_bar(&right, path, range, colour_label, scale)?;
+    let (head, body) = root.split_vertically(TITLE_H);
+    head.draw(&Text::new(title.to_string(), (12, 12), (FONT, 22))).map_err(|e| PlotError::new(path, e))?;
+    let (left, right) = body.split_horizontally(map_w);
+    draw_cells(&left, path, summary, &shown, range, scale, label_size, None)?;
+    draw_colour_bar(&right, path, range, colour_label, scale, 15)?;
     root.present().map_err(|e| PlotError::new(path, e))?;
-    Ok(())
+    Ok(size)
 }
 
 /// The 12 characteristic-mode maps in one figure (a_0 ranges down, a_1
-/// ranges across), each with its representative shape drawn beside it.
-pub fn draw_modes(path: &Path, map: &MapData, shapes: &[Option<BodyDrawing>]) -> Result<(), PlotError> {
+/// ranges across), all at equal aspect on one log colour scale, each with
+/// its representative shape drawn in the same mm frame (the clamp at the
+/// origin), so every panel shares its axes. Returns the image size.
+pub fn draw_modes(path: &Path, map: &MapData, shapes: &[Option<BodyDrawing>]) -> Result<(u32, u32), PlotError> {
     register_fonts();
-    let root = BitMapBackend::new(path, (1800, 2000)).into_drawing_area();
+    let label_size = 14;
+    let panel_title_h = 46;
+    let (map_w, map_h) = Frame::of(&map.summary).area_size(430, label_size);
+    let (panel_w, panel_h) = (map_w + 10, map_h + panel_title_h);
+    let (head_h, bar_h) = (56, 80);
+    let size = (3 * panel_w, head_h + 4 * panel_h + bar_h);
+    let root = BitMapBackend::new(path, size).into_drawing_area();
     root.fill(&WHITE).map_err(|e| PlotError::new(path, e))?;
-    let (head, body) = root.split_vertically(60);
+    let (head, rest) = root.split_vertically(head_h);
+    let (body, bar) = rest.split_vertically(4 * panel_h);
     head.draw(&Text::new(
-        "Characteristic modes: tip cells where each (a_0 range, a_1 range) occurs; colour = log10 count; right: representative shape",
-        (20, 20),
-        (FONT, 22),
+        "Characteristic modes: a0 in 4 ranges (rows) × a1 in 3 (columns); colour = simulations of the mode per cell",
+        (12, 8),
+        (FONT, 20),
     ))
     .map_err(|e| PlotError::new(path, e))?;
+    head.draw(&Text::new(
+        format!("blue: the simulation nearest the mode's median (a0, a1), cable in red; a_i in mm⁻¹, {}", map.summary.length_basis.describe()),
+        (12, 32),
+        (FONT, 15),
+    ))
+    .map_err(|e| PlotError::new(path, e))?;
+    let counts: Vec<f64> = map.cells.iter().flat_map(|c| c.modes.iter().filter(|&&n| n > 0).map(|&n| (n as f64).log10())).collect();
+    let range = if counts.is_empty() { (0.0, 1.0) } else { value_range(&counts, Scale::Log) };
+    let range = (0.0_f64.min(range.0), range.1);
     let panels = body.split_evenly((4, 3));
+    let fmt = |(lo, hi): (f64, f64)| -> String {
+        match (lo.is_finite(), hi.is_finite()) {
+            (false, _) => format!("< {hi:.4}"),
+            (_, false) => format!("≥ {lo:.4}"),
+            _ => format!("{lo:.4} … {hi:.4}"),
+        }
+    };
     for (m, (panel, mode)) in panels.iter().zip(&map.modes).enumerate().take(MODES) {
-        let (map_area, shape_area) = panel.split_horizontally(360);
+        let (title, area) = panel.split_vertically(panel_title_h);
+        title
+            .draw(&Text::new(format!("mode {m}  (n = {})", mode.count), (10, 4), (FONT, 17)))
+            .map_err(|e| PlotError::new(path, e))?;
+        let tension = mode.representative.as_ref().map_or(String::new(), |r| format!(", shape at τ = {:.2} N", r.tension_n));
+        title
+            .draw(&Text::new(format!("a0 {}, a1 {}{tension}", fmt(mode.a0_bounds), fmt(mode.a1_bounds)), (10, 25), (FONT, 13)))
+            .map_err(|e| PlotError::new(path, e))?;
         let cells: Vec<(i32, i32, f64)> =
             map.cells.iter().filter(|c| c.modes[m] > 0).map(|c| (c.ix, c.iy, (c.modes[m] as f64).log10())).collect();
-        let fmt = |(lo, hi): (f64, f64)| -> String {
-            match (lo.is_finite(), hi.is_finite()) {
-                (false, _) => format!("< {hi:.4}"),
-                (_, false) => format!("≥ {lo:.4}"),
-                _ => format!("{lo:.4}..{hi:.4}"),
-            }
-        };
-        let caption = format!("mode {m}: a0 {}, a1 {} (n={})", fmt(mode.a0_bounds), fmt(mode.a1_bounds), mode.count);
-        let values: Vec<f64> = cells.iter().map(|c| c.2).collect();
-        let range = if values.is_empty() { (0.0, 1.0) } else { value_range(&values, Scale::Linear) };
-        draw_cells(&map_area, path, &map.summary, &caption, &cells, range, 12)?;
-        if let (Some(Some(shape)), Some(rep)) = (shapes.get(m), &mode.representative) {
-            let caption = format!("τ = {:.2} N", rep.tension_n);
-            draw_shape(&shape_area, path, shape, &caption)?;
+        let overlay = shapes.get(m).and_then(Option::as_ref);
+        draw_cells(&area, path, &map.summary, &cells, range, Scale::Log, label_size, overlay)?;
+    }
+    draw_colour_bar(&bar, path, range, "simulations of the mode per cell (log scale, all panels)", Scale::Log, 15)?;
+    root.present().map_err(|e| PlotError::new(path, e))?;
+    Ok(size)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::reduce::ModeBoundaries;
+    use crate::shape::LengthBasis;
+
+    fn summary() -> MapSummary {
+        MapSummary {
+            cell_mm: 5.0,
+            x_min_mm: 20.0,
+            y_min_mm: -40.0,
+            nx: 10,
+            ny: 16,
+            order: 2,
+            mirrored: false,
+            rows_total: 3,
+            rows_converged: 3,
+            rows_failed: 0,
+            failed_by_status: Default::default(),
+            mode_boundaries: ModeBoundaries { a0: [-0.01, 0.0, 0.01], a1: [-0.01, 0.01] },
+            mode_boundaries_source: "explicit".into(),
+            cells: 3,
+            tension_range_n: [1.0, 2.0],
+            radius_mm: 5.0,
+            length_mm: 65.0,
+            run_dir: "test".into(),
+            spec_hash: "h".into(),
+            length_basis: LengthBasis::Rest,
         }
     }
-    root.present().map_err(|e| PlotError::new(path, e))?;
-    Ok(())
-}
 
-/// A small drawing of a body outline and cable (mode panels).
-fn draw_shape(area: &Area, path: &Path, shape: &BodyDrawing, caption: &str) -> Result<(), PlotError> {
-    let (l, r) = shape.outline();
-    // Equal scale on both axes: one mm per pixel factor for the whole panel
-    // (plot area ≈ panel less label areas and margins).
-    let (w, h) = area.dim_in_pixel();
-    let (pw, ph) = (w.saturating_sub(55).max(1) as f64, h.saturating_sub(75).max(1) as f64);
-    let extent = l.iter().chain(&r).map(|p| p.1.abs()).fold(0.0, f64::max) + 3.0;
-    let depth = l.iter().chain(&r).map(|p| p.0).fold(0.0, f64::max) + 5.0;
-    let mm_per_px = (depth / ph).max(2.0 * extent / pw);
-    let lateral = 0.5 * mm_per_px * pw;
-    let mut chart = ChartBuilder::on(area)
-        .margin(10)
-        .caption(caption, (FONT, 12))
-        .x_label_area_size(20)
-        .y_label_area_size(25)
-        .build_cartesian_2d(-lateral..lateral, -(mm_per_px * ph - 5.0)..5.0)
-        .map_err(|e| PlotError::new(path, e))?;
-    chart
-        .configure_mesh()
-        .disable_mesh()
-        .x_labels(3)
-        .x_label_formatter(&|v| format!("{v:.0}"))
-        .label_style((FONT, 10))
-        .y_label_formatter(&|v| format!("{:.0}", -v + 0.0))
-        .draw()
-        .map_err(|e| PlotError::new(path, e))?;
-    let page = |pts: &[(f64, f64)]| -> Vec<(f64, f64)> { pts.iter().map(|&(x, y)| (y, -x)).collect() };
-    for side in [&l, &r] {
-        chart.draw_series(LineSeries::new(page(side), shape.colour.stroke_width(2))).map_err(|e| PlotError::new(path, e))?;
+    #[test]
+    fn a_cell_is_drawn_square_one_mm_across_equals_one_mm_down() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("map.png");
+        // The largest value (one cell) gets the top of the diverging ramp.
+        let cells = [(2, 3, 1.0), (5, 9, -0.5), (7, 1, 0.2)];
+        draw_heatmap(&path, &summary(), "test", "v", &cells, Scale::Symmetric).unwrap();
+        let img = image::open(&path).unwrap().to_rgb8();
+        let top = DIVERGING[DIVERGING.len() - 1];
+        // Pixels of that colour left of the colour bar: the one cell.
+        let hits: Vec<(u32, u32)> = img
+            .enumerate_pixels()
+            .filter(|p| p.2 .0 == [top.0, top.1, top.2] && p.0 < img.width() - BAR_W)
+            .map(|p| (p.0, p.1))
+            .collect();
+        assert!(hits.len() > 400, "cell of {} px", hits.len());
+        let (mut xs, mut ys): (Vec<u32>, Vec<u32>) = hits.into_iter().unzip();
+        xs.sort_unstable();
+        ys.sort_unstable();
+        let (cw, ch) = (xs[xs.len() - 1] - xs[0] + 1, ys[ys.len() - 1] - ys[0] + 1);
+        assert!(cw.abs_diff(ch) <= 1, "cell drawn {cw}×{ch} px: not square");
     }
-    chart.draw_series(LineSeries::new(page(&shape.cable), RED.stroke_width(1))).map_err(|e| PlotError::new(path, e))?;
-    Ok(())
-}
 
-/// Writes index.html showing every picture with its explanation.
-pub fn write_index(dir: &Path, summary: &MapSummary, pictures: &[Picture]) -> Result<(), ReduceError> {
-    let mut html = String::from(
-        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>cablemap feasibility maps</title>\n\
-         <style>body{font-family:sans-serif;max-width:1000px;margin:auto}img{max-width:100%;border:1px solid #ccc}</style></head><body>\n\
-         <h1>Feasibility maps</h1>\n",
-    );
-    html.push_str(&format!(
-        "<p>{} simulations ({} converged, {} failed){}, binned on a {} mm grid of tip positions ({} non-empty cells). \
-         Coefficients a_i are curvatures in mm⁻¹, {} (length basis <code>{}</code>). \
-         Mode boundaries ({}): a0 {:?} mm⁻¹, a1 {:?} mm⁻¹. Data: <code>{}</code>. Tables: cells.parquet, modes.parquet, designs.parquet, summary.json.</p>\n",
-        summary.rows_total,
-        summary.rows_converged,
-        summary.rows_failed,
-        if summary.mirrored { ", mirrored half restored" } else { "" },
-        summary.cell_mm,
-        summary.cells,
-        summary.length_basis.describe(),
-        summary.length_basis,
-        summary.mode_boundaries_source,
-        summary.mode_boundaries.a0,
-        summary.mode_boundaries.a1,
-        html_escape(&summary.run_dir)
-    ));
-    for p in pictures {
-        html.push_str(&format!(
-            "<h2>{}</h2>\n<p>{}</p>\n<img src=\"{}\" alt=\"{}\">\n",
-            html_escape(&p.title),
-            html_escape(&p.explanation),
-            html_escape(&p.file),
-            html_escape(&p.title)
-        ));
+    #[test]
+    fn zero_is_white_on_the_signed_scale() {
+        assert_eq!(colour(0.0, (-1.0, 1.0), Scale::Symmetric), RGBColor(247, 247, 247));
+        let neg = colour(-1.0, (-1.0, 1.0), Scale::Symmetric);
+        let pos = colour(1.0, (-1.0, 1.0), Scale::Symmetric);
+        assert!(neg.2 > neg.0 && pos.0 > pos.2, "negative blue, positive red: {neg:?} {pos:?}");
     }
-    html.push_str("</body></html>\n");
-    let path = dir.join("index.html");
-    crate::io::write_atomic(&path, html.as_bytes())
-        .map_err(|e| ReduceError::Write { path: path.display().to_string(), message: e.to_string() })
-}
-
-fn html_escape(s: &str) -> String {
-    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
 }
