@@ -143,6 +143,15 @@ fn text_output_is_a_table_5_1() {
     assert!(lines[0].contains("x_e [mm]") && lines[0].contains("a_2 [1/mm]"), "{stdout}");
     assert!(lines[1].starts_with("Target") && lines[2].starts_with("Achieved") && lines[3].starts_with("Error"), "{stdout}");
     assert!(stdout.contains("every component met"), "{stdout}");
+    // The routing line pastes into simulate: run it and get the same tip.
+    let line = stdout.lines().find(|l| l.starts_with("routing")).unwrap();
+    let args: Vec<&str> = line.split_whitespace().skip_while(|w| *w != "--routing").collect();
+    let mut sim = vec!["simulate", "--json"];
+    sim.extend(&args);
+    let (ok, out, err) = run(&sim);
+    assert!(ok, "{line}: {err}");
+    let v: Value = serde_json::from_str(out.trim()).unwrap();
+    assert!((v["tip_x_mm"].as_f64().unwrap() - 50.0).abs() < 0.01 && (v["tip_y_mm"].as_f64().unwrap() - 5.0).abs() < 0.01, "{v}");
 }
 
 #[test]

@@ -83,6 +83,7 @@ fn text_report_names_the_verdict() {
     assert!(ok, "{stderr}");
     assert!(stdout.starts_with("verdict   UNREACHABLE"), "{stdout}");
     assert!(stdout.contains("nearest simulated designs"));
+    assert!(stdout.contains("the rod is 65 mm long"), "{stdout}");
 }
 
 #[test]

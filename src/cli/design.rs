@@ -182,9 +182,11 @@ pub fn report(objective: &Objective, outcome: &DesignOutcome, results: &[Compone
     s.push('\n');
     let e = &outcome.best;
     s.push('\n');
+    // Pasteable into `simulate` and `design`: --routing takes a plain comma list.
     s.push_str(&format!(
-        "routing      y0..y4 = [{}] mm\n",
-        e.routing_mm.iter().map(|y| format!("{y:.4}")).collect::<Vec<_>>().join(", ")
+        "routing      y0..y4 (mm): --routing {} --tension {:.4}\n",
+        e.routing_mm.iter().map(|y| format!("{y:.4}")).collect::<Vec<_>>().join(","),
+        e.tension_n
     ));
     s.push_str(&format!(
         "tension      {:.4} N   (bounds {} … {} N)\n",

@@ -213,6 +213,10 @@ pub fn check(map: &MapDir, target: &Target, basis: LengthBasis, weights: &Weight
             Verdict::Borderline
         }
     };
+    let length = map.summary.length_mm;
+    if x.is_some_and(|x| x.abs() > length) {
+        reasons.push(format!("the rod is {length} mm long: no tip lies {} mm from the clamp along its axis", x.unwrap_or(0.0)));
+    }
     Ok(FeasibilityReport {
         verdict,
         reasons,
