@@ -58,10 +58,25 @@ impl MeshBuilder {
         }
     }
 
-    /// Adds quad a, b, c, d (counter-clockwise seen from outside) as two triangles.
+    /// Adds quad a, b, c, d (counter-clockwise seen from outside) as two
+    /// triangles. The diagonal runs through the corner nearest the plane
+    /// y = 0 (then lowest x, then z): a rule the mirror y → −y keeps, so a
+    /// mirrored routing gives exactly the mirrored triangles.
     pub fn quad(&mut self, a: Point, b: Point, c: Point, d: Point) {
-        self.triangle(a, b, c);
-        self.triangle(a, c, d);
+        let key = |p: &Point| (p[1].abs(), p[0], p[2]);
+        let less = |p: &Point, q: &Point| {
+            let (kp, kq) = (key(p), key(q));
+            kp.0.total_cmp(&kq.0).then(kp.1.total_cmp(&kq.1)).then(kp.2.total_cmp(&kq.2)).is_lt()
+        };
+        let corners = [a, b, c, d];
+        let first = (1..4).fold(0, |best, k| if less(&corners[k], &corners[best]) { k } else { best });
+        if first % 2 == 0 {
+            self.triangle(a, b, c);
+            self.triangle(a, c, d);
+        } else {
+            self.triangle(a, b, d);
+            self.triangle(b, c, d);
+        }
     }
 
     /// The mesh built so far.
