@@ -25,3 +25,10 @@ bin=$(cargo metadata --format-version 1 --no-deps | "$venv/bin/python" -c 'impor
 echo "== Python read-back of maps (pandas, polars)"
 "$bin" reduce "$work/quick" --out "$work/quick-map" --json > /dev/null
 "$venv/bin/python" tests/python/check_maps.py "$work/quick-map" "$work/quick"
+
+echo "== Python read-back of moulds (trimesh)"
+if ! "$venv/bin/python" -c "import trimesh" 2>/dev/null; then
+    "$venv/bin/python" -m pip install --quiet --disable-pip-version-check trimesh numpy
+fi
+"$bin" mould --routing 1,-2,3,0.5,-3 --out "$work/mould" > /dev/null
+"$venv/bin/python" tests/python/check_moulds.py "$work/mould"
