@@ -53,7 +53,7 @@ fn mould_writes_closed_stl_with_the_channel_where_the_routing_puts_it() {
         let report = mesh.check();
         assert!(report.is_watertight(), "mould{number}.stl: {report:?}");
         assert_eq!(report.shell_volumes_mm3.len(), 2, "two parts per plate");
-        let parts = summary["files"][number - 1][1].as_array().unwrap();
+        let parts = summary["files"][number - 1]["parts"].as_array().unwrap();
         let listed: f64 = parts.iter().map(|p| p["volume_mm3"].as_f64().unwrap()).sum();
         assert!((report.volume_mm3 - listed).abs() < 1e-4 * listed, "{} vs {listed}", report.volume_mm3);
         assert!(mesh.bounds_mm().0[2].abs() < 1e-6, "parts stand on z = 0");
@@ -63,8 +63,9 @@ fn mould_writes_closed_stl_with_the_channel_where_the_routing_puts_it() {
     // The lid (second part of mould1.stl) as read from the file: its crest
     // follows y_c(s), turned over (y → −y) and moved by the listed offset.
     let (_, mesh) = read_stl(&out.join("mould1.stl"));
-    let lid_entry = &summary["files"][0][1][1];
-    assert_eq!(lid_entry["part"], "Lid");
+    assert_eq!(summary["files"][0]["file"], "mould1.stl");
+    let lid_entry = &summary["files"][0]["parts"][1];
+    assert_eq!(lid_entry["part"], "lid");
     let off: Vec<f64> = lid_entry["offset_mm"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
     let routing = Routing::new(&ys, 65.0, 5.0).unwrap();
     let mut worst: f64 = 0.0;

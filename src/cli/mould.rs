@@ -95,8 +95,9 @@ pub fn report(dir: &Path, s: &crate::mould::MouldSummary) -> String {
         s.params.clamp_mm,
         s.params.tube_diameter_mm
     ));
-    for (file, parts) in &s.files {
-        let desc: Vec<String> = parts
+    for f in &s.files {
+        let desc: Vec<String> = f
+            .parts
             .iter()
             .map(|p| {
                 format!(
@@ -108,7 +109,7 @@ pub fn report(dir: &Path, s: &crate::mould::MouldSummary) -> String {
                 )
             })
             .collect();
-        out.push_str(&format!("{file:<12} {}\n", desc.join(", ")));
+        out.push_str(&format!("{:<12} {}\n", f.file, desc.join(", ")));
     }
     out.push_str(&format!(
         "cavity 1     {:.1} mm³ (half body minus half channel {:.1} mm³)\ncavity 2     {:.1} mm³ (body {:.1} mm³)\n",

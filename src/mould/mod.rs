@@ -87,6 +87,7 @@ pub enum MouldError {
 
 /// One printed part.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
 pub enum PartKind {
     /// The lower half trough (both castings).
     Tray,
@@ -610,6 +611,15 @@ pub struct PlacedPart {
     pub watertight: bool,
 }
 
+/// One STL file: its name and the parts on its plate.
+#[derive(Debug, Clone, Serialize)]
+pub struct MouldFile {
+    /// File name (mould1.stl, mould2.stl).
+    pub file: String,
+    /// The parts, in file order.
+    pub parts: Vec<PlacedPart>,
+}
+
 /// What `write_all` wrote (also saved as mould.json).
 #[derive(Debug, Clone, Serialize)]
 pub struct MouldSummary {
@@ -623,8 +633,8 @@ pub struct MouldSummary {
     pub params: MouldParams,
     /// Channel length inside the body (clamp block + arc), mm.
     pub channel_length_mm: f64,
-    /// Per file: parts, offsets, volumes.
-    pub files: Vec<(String, Vec<PlacedPart>)>,
+    /// The STL files with their parts.
+    pub files: Vec<MouldFile>,
     /// Cavity of mould 1 measured on the meshes (half body minus half channel), mm³.
     pub mould1_cavity_mm3: f64,
     /// The half body with its groove, π r² (L + c)/2 − π ρ²/2 · channel length, mm³.
@@ -723,7 +733,7 @@ impl MouldSet {
             let path = dir.join(&name);
             crate::io::write_atomic(&path, &stl::to_bytes(&mesh, &title)).map_err(io(format!("writing {}", path.display())))?;
             preview::write_png(&dir.join(format!("mould{number}.png")), self, number)?;
-            files.push((name, placed));
+            files.push(MouldFile { file: name, parts: placed });
         }
         let path = dir.join("channel.csv");
         crate::io::write_atomic(&path, crate::design::export::channel_csv(routing).as_bytes())

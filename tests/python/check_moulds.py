@@ -42,7 +42,8 @@ def check_cavities():
     assert abs(summary["mould2_body_mm3"] - np.pi * r * r * (length + clamp)) < 1e-6 * summary["mould2_body_mm3"]
 
 
-for name, parts in summary["files"]:
-    run_check(f"{name} loads closed with the reported volume (trimesh)", check_file, name, parts)
+for entry in summary["files"]:
+    name = entry["file"]
+    run_check(f"{name} loads closed with the reported volume (trimesh)", check_file, name, entry["parts"])
 run_check("cavity volumes match the body", check_cavities)
 sys.exit(finish())
