@@ -43,3 +43,10 @@ else
     echo "!!!!!!!! SKIPPED: the map explorer's browser check did not run: chromium and chromedriver are not"
     echo "!!!!!!!! installed and cannot be installed here (needs root and apt-get: apt-get install chromium chromium-driver)"
 fi
+
+echo "== Python read-back of moulds (trimesh)"
+if ! "$venv/bin/python" -c "import trimesh" 2>/dev/null; then
+    "$venv/bin/python" -m pip install --quiet --disable-pip-version-check trimesh numpy
+fi
+"$bin" mould --routing 1,-2,3,0.5,-3 --out "$work/mould" > /dev/null
+"$venv/bin/python" tests/python/check_moulds.py "$work/mould"

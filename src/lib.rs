@@ -10,6 +10,7 @@ pub mod cli;
 pub mod design;
 pub mod io;
 pub mod model;
+pub mod mould;
 pub mod plot;
 pub mod reduce;
 pub mod shape;
@@ -45,6 +46,9 @@ pub enum Error {
     /// Running, checking or reading a sweep.
     #[error(transparent)]
     Sweep(#[from] sweep::SweepError),
+    /// Building or writing moulds.
+    #[error(transparent)]
+    Mould(#[from] mould::MouldError),
     /// Reading or writing a file.
     #[error("{context}: {source}")]
     Io { context: String, source: std::io::Error },

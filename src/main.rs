@@ -20,6 +20,8 @@ enum Command {
     Design(cli::design::DesignArgs),
     /// Is a target shape reachable? Verdict from a feasibility map, with the nearest designs.
     Feasible(cli::feasible::FeasibleArgs),
+    /// Printable moulds (binary STL, mm) for a routing: tray, lid with the channel's protrusion, cover.
+    Mould(cli::mould::MouldArgs),
     /// Print solver timings (median µs per solve, single thread).
     Bench(cli::bench::BenchArgs),
     /// Sweep a routing grid through a tension ladder into Parquet chunks (sharded, resumable).
@@ -45,6 +47,7 @@ fn main() -> ExitCode {
         Command::Bench(args) => cli::bench::run(args),
         Command::Design(args) => cli::design::run(args),
         Command::Feasible(args) => cli::feasible::run(args),
+        Command::Mould(args) => cli::mould::run(args),
         Command::Sweep(args) => cli::sweep::run(args),
         Command::Status(args) => cli::sweep::run_status_command(args),
         Command::Reduce(args) => cli::reduce::run(args),

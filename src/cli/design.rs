@@ -50,6 +50,12 @@ pub struct DesignArgs {
     /// Write design.json, channel.csv, mould.svg (1:1, mm) and shape.png into this directory.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
+    /// With --out: also write the printable moulds (mould1.stl, mould2.stl, previews,
+    /// mould.json; see `cablemap mould`), with the mould options below.
+    #[arg(long, requires = "out")]
+    pub moulds: bool,
+    #[command(flatten)]
+    pub mould: super::mould::MouldParamArgs,
     #[command(flatten)]
     pub actuator: ActuatorArgs,
 }
@@ -134,8 +140,14 @@ pub fn run(args: &DesignArgs) -> anyhow::Result<()> {
     if let Some(f) = &feasibility {
         value["feasibility"] = serde_json::json!({ "verdict": f.verdict, "reasons": f.reasons, "map": args.map });
     }
+    let mut moulds = None;
     if let Some(dir) = &args.out {
         design::export::write_all(dir, &objective, &outcome.best, &value)?;
+        if args.moulds {
+            let act = &objective.actuator;
+            let routing = crate::model::Routing::new(&outcome.best.routing_mm, act.length_mm, act.radius_mm)?;
+            moulds = Some(super::mould::write_moulds(dir, &routing, act.radius_mm, &args.mould)?);
+        }
     }
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
@@ -149,6 +161,9 @@ pub fn run(args: &DesignArgs) -> anyhow::Result<()> {
     write!(out, "{}", report(&objective, &outcome, &results, args.tolerance_pct))?;
     if let Some(dir) = &args.out {
         writeln!(out, "exported design.json, channel.csv, mould.svg, shape.png to {}", dir.display())?;
+    }
+    if let (Some(dir), Some(summary)) = (&args.out, &moulds) {
+        write!(out, "{}", super::mould::report(dir, summary))?;
     }
     Ok(())
 }

@@ -6,6 +6,7 @@ pub mod calibrate;
 pub mod design;
 pub mod diagnose;
 pub mod feasible;
+pub mod mould;
 pub mod reduce;
 pub mod simulate;
 pub mod sweep;

@@ -1,0 +1,141 @@
+//! `cablemap mould`: printable moulds (binary STL) for a routing.
+
+use super::{parse_list, ActuatorArgs};
+use crate::model::{Actuator, Routing};
+use crate::mould::{MouldParams, MouldSet};
+use clap::Args;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// Mould parameters shared by `mould` and `design --moulds`.
+#[derive(Debug, Clone, Args)]
+pub struct MouldParamArgs {
+    /// Wall and floor thickness around the cavity, mm.
+    #[arg(long, value_name = "MM", default_value_t = MouldParams::default().wall_mm)]
+    pub wall_mm: f64,
+    /// Outer diameter of the PTFE tube that forms the channel, mm (thesis §5.2: 1).
+    #[arg(long, value_name = "MM", default_value_t = MouldParams::default().tube_diameter_mm)]
+    pub tube_diameter_mm: f64,
+    /// Play between mating printed features (pins in holes, tube notches), mm.
+    #[arg(long, value_name = "MM", default_value_t = MouldParams::default().clearance_mm)]
+    pub clearance_mm: f64,
+    /// Clamp block: body cast before the clamp face (s < 0) for the clamp to hold, mm; 0 for none.
+    #[arg(long, value_name = "MM", default_value_t = MouldParams::default().clamp_mm)]
+    pub clamp_mm: f64,
+    /// Least silicone between the channel and the body surface, mm.
+    #[arg(long, value_name = "MM", default_value_t = MouldParams::default().min_skin_mm)]
+    pub min_skin_mm: f64,
+}
+
+impl MouldParamArgs {
+    /// The parameters.
+    pub fn params(&self) -> MouldParams {
+        MouldParams {
+            wall_mm: self.wall_mm,
+            tube_diameter_mm: self.tube_diameter_mm,
+            clearance_mm: self.clearance_mm,
+            clamp_mm: self.clamp_mm,
+            min_skin_mm: self.min_skin_mm,
+            ..MouldParams::default()
+        }
+    }
+}
+
+/// Arguments of `cablemap mould`.
+#[derive(Debug, Clone, Args)]
+pub struct MouldArgs {
+    /// Control-point offsets y0..y4, mm, e.g. 1,-2,0.5,0,3.
+    #[arg(long, value_name = "Y0,..,Y4", allow_hyphen_values = true, conflicts_with = "design", required_unless_present = "design")]
+    pub routing: Option<String>,
+    /// A design.json written by `cablemap design --out`: its routing and actuator.
+    #[arg(long, value_name = "FILE")]
+    pub design: Option<PathBuf>,
+    /// Directory for mould1.stl, mould2.stl, mould1.png, mould2.png, channel.csv, mould.json.
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// Print mould.json instead of a report.
+    #[arg(long)]
+    pub json: bool,
+    #[command(flatten)]
+    pub mould: MouldParamArgs,
+    #[command(flatten)]
+    pub actuator: ActuatorArgs,
+}
+
+/// Reads the routing and actuator of a design.json.
+fn read_design(path: &Path) -> anyhow::Result<(Vec<f64>, Actuator)> {
+    let text = std::fs::read_to_string(path).map_err(|e| anyhow::anyhow!("reading {}: {e}", path.display()))?;
+    let v: serde_json::Value = serde_json::from_str(&text)
+        .map_err(|e| anyhow::anyhow!("{} is not JSON ({e}); give a design.json written by `cablemap design --out`", path.display()))?;
+    let routing: Vec<f64> = v
+        .get("routing_mm")
+        .and_then(|r| serde_json::from_value(r.clone()).ok())
+        .ok_or_else(|| anyhow::anyhow!("{} has no numeric routing_mm list; give a design.json written by `cablemap design --out`", path.display()))?;
+    let actuator: Actuator = match v.get("actuator") {
+        Some(a) => serde_json::from_value(a.clone()).map_err(|e| anyhow::anyhow!("{}: bad actuator object: {e}", path.display()))?,
+        None => Actuator::default(),
+    };
+    Ok((routing, actuator))
+}
+
+/// Builds and writes the moulds; returns the report text.
+pub fn write_moulds(dir: &Path, routing: &Routing, radius_mm: f64, args: &MouldParamArgs) -> anyhow::Result<crate::mould::MouldSummary> {
+    let set = MouldSet::new(routing, radius_mm, &args.params())?;
+    Ok(set.write_all(dir)?)
+}
+
+/// A short text report of written moulds.
+pub fn report(dir: &Path, s: &crate::mould::MouldSummary) -> String {
+    let mut out = String::new();
+    out.push_str(&format!(
+        "moulds for y0..y4 = [{}] mm, L = {} mm, r = {} mm, clamp block {} mm, tube Ø {} mm\n",
+        s.routing_mm.iter().map(|y| format!("{y:.3}")).collect::<Vec<_>>().join(", "),
+        s.length_mm,
+        s.radius_mm,
+        s.params.clamp_mm,
+        s.params.tube_diameter_mm
+    ));
+    for f in &s.files {
+        let desc: Vec<String> = f
+            .parts
+            .iter()
+            .map(|p| {
+                format!(
+                    "{} '{}' {:.1} cm³{}",
+                    p.part.name(),
+                    p.letter,
+                    p.volume_mm3 / 1000.0,
+                    if p.watertight { "" } else { " NOT WATERTIGHT" }
+                )
+            })
+            .collect();
+        out.push_str(&format!("{:<12} {}\n", f.file, desc.join(", ")));
+    }
+    out.push_str(&format!(
+        "cavity 1     {:.1} mm³ (half body minus half channel {:.1} mm³)\ncavity 2     {:.1} mm³ (body {:.1} mm³)\n",
+        s.mould1_cavity_mm3, s.mould1_body_mm3, s.mould2_cavity_mm3, s.mould2_body_mm3
+    ));
+    out.push_str(&format!("wrote mould1.stl, mould2.stl, mould1.png, mould2.png, channel.csv, mould.json to {}\n", dir.display()));
+    out
+}
+
+/// Runs `cablemap mould`.
+pub fn run(args: &MouldArgs) -> anyhow::Result<()> {
+    let (ys, base) = match (&args.routing, &args.design) {
+        (Some(r), _) => (parse_list(r, "--routing")?, Actuator::default()),
+        (None, Some(d)) => read_design(d)?,
+        (None, None) => anyhow::bail!("give --routing y0,..,y4 or --design design.json"),
+    };
+    let actuator = args.actuator.apply(&base);
+    actuator.validate()?;
+    let routing = Routing::new(&ys, actuator.length_mm, actuator.radius_mm)?;
+    let summary = write_moulds(&args.out, &routing, actuator.radius_mm, &args.mould)?;
+    let stdout = std::io::stdout();
+    let mut out = stdout.lock();
+    if args.json {
+        writeln!(out, "{}", serde_json::to_string(&summary)?)?;
+    } else {
+        write!(out, "{}", report(&args.out, &summary))?;
+    }
+    Ok(())
+}
