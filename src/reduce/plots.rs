@@ -174,8 +174,8 @@ fn draw_cells(
     Ok(())
 }
 
-/// Draws a colour bar for `range` labelled `label`: vertical on a tall
-/// area, horizontal on a wide one.
+/// Draws a horizontal colour bar for `range` labelled `label` (under a map
+/// or a figure of maps).
 fn draw_colour_bar(area: &Area, path: &Path, range: (f64, f64), label: &str, scale: Scale, font: u32) -> Result<(), PlotError> {
     let (lo, hi) = range;
     let fmt = move |v: &f64| -> String {
@@ -191,58 +191,31 @@ fn draw_colour_bar(area: &Area, path: &Path, range: (f64, f64), label: &str, sca
             _ => format!("{v:.4}"),
         }
     };
-    let (w, h) = area.dim_in_pixel();
+    let mut chart = ChartBuilder::on(area)
+        .margin_left(40)
+        .margin_right(40)
+        .margin_top(6)
+        .x_label_area_size(font * 3)
+        .build_cartesian_2d(lo..hi, 0.0..1.0)
+        .map_err(|e| PlotError::new(path, e))?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .disable_y_axis()
+        .x_desc(label)
+        .x_label_formatter(&fmt)
+        .label_style((FONT, font))
+        .axis_desc_style((FONT, font))
+        .draw()
+        .map_err(|e| PlotError::new(path, e))?;
     let steps = 200;
-    let band = |k: usize| (lo + (hi - lo) * k as f64 / steps as f64, lo + (hi - lo) * (k + 1) as f64 / steps as f64);
-    if h >= w {
-        let mut chart = ChartBuilder::on(area)
-            .margin_top(30)
-            .margin_bottom(40)
-            .margin_right(10)
-            .y_label_area_size(font * 5 + 10)
-            .build_cartesian_2d(0.0..1.0, lo..hi)
-            .map_err(|e| PlotError::new(path, e))?;
-        chart
-            .configure_mesh()
-            .disable_mesh()
-            .disable_x_axis()
-            .y_desc(label)
-            .y_label_formatter(&fmt)
-            .label_style((FONT, font))
-            .axis_desc_style((FONT, font))
-            .draw()
-            .map_err(|e| PlotError::new(path, e))?;
-        chart
-            .draw_series((0..steps).map(|k| {
-                let (a, b) = band(k);
-                Rectangle::new([(0.0, a), (1.0, b)], colour(0.5 * (a + b), range, scale).filled())
-            }))
-            .map_err(|e| PlotError::new(path, e))?;
-    } else {
-        let mut chart = ChartBuilder::on(area)
-            .margin_left(40)
-            .margin_right(40)
-            .margin_top(6)
-            .x_label_area_size(font * 3)
-            .build_cartesian_2d(lo..hi, 0.0..1.0)
-            .map_err(|e| PlotError::new(path, e))?;
-        chart
-            .configure_mesh()
-            .disable_mesh()
-            .disable_y_axis()
-            .x_desc(label)
-            .x_label_formatter(&fmt)
-            .label_style((FONT, font))
-            .axis_desc_style((FONT, font))
-            .draw()
-            .map_err(|e| PlotError::new(path, e))?;
-        chart
-            .draw_series((0..steps).map(|k| {
-                let (a, b) = band(k);
-                Rectangle::new([(a, 0.0), (b, 1.0)], colour(0.5 * (a + b), range, scale).filled())
-            }))
-            .map_err(|e| PlotError::new(path, e))?;
-    }
+    chart
+        .draw_series((0..steps).map(|k| {
+            let a = lo + (hi - lo) * k as f64 / steps as f64;
+            let b = lo + (hi - lo) * (k + 1) as f64 / steps as f64;
+            Rectangle::new([(a, 0.0), (b, 1.0)], colour(0.5 * (a + b), range, scale).filled())
+        }))
+        .map_err(|e| PlotError::new(path, e))?;
     Ok(())
 }
 
@@ -251,8 +224,8 @@ fn draw_colour_bar(area: &Area, path: &Path, range: (f64, f64), label: &str, sca
 const HEATMAP_PLOT_W: u32 = 760;
 /// Height of the title strip above a map, pixels.
 const TITLE_H: u32 = 44;
-/// Width of the colour-bar strip right of a map, pixels.
-const BAR_W: u32 = 150;
+/// Height of the colour-bar strip under a map, pixels.
+const BAR_H: u32 = 80;
 
 /// A map of one value per cell with a colour bar, at equal aspect (1 mm
 /// across = 1 mm down); its size follows the map's extent. Returns the
@@ -268,7 +241,7 @@ pub fn draw_heatmap(
     register_fonts();
     let label_size = 17;
     let (map_w, map_h) = Frame::of(summary).area_size(HEATMAP_PLOT_W, label_size);
-    let size = (map_w + BAR_W, map_h + TITLE_H);
+    let size = (map_w, TITLE_H + map_h + BAR_H);
     let root = BitMapBackend::new(path, size).into_drawing_area();
     root.fill(&WHITE).map_err(|e| PlotError::new(path, e))?;
     let shown: Vec<(i32, i32, f64)> = match scale {
@@ -279,9 +252,9 @@ pub fn draw_heatmap(
     let range = value_range(&values, scale);
     let (head, body) = root.split_vertically(TITLE_H);
     head.draw(&Text::new(title.to_string(), (12, 12), (FONT, 22))).map_err(|e| PlotError::new(path, e))?;
-    let (left, right) = body.split_horizontally(map_w);
-    draw_cells(&left, path, summary, &shown, range, scale, label_size, None)?;
-    draw_colour_bar(&right, path, range, colour_label, scale, 15)?;
+    let (map_area, bar) = body.split_vertically(map_h);
+    draw_cells(&map_area, path, summary, &shown, range, scale, label_size, None)?;
+    draw_colour_bar(&bar, path, range, colour_label, scale, 15)?;
     root.present().map_err(|e| PlotError::new(path, e))?;
     Ok(size)
 }
@@ -384,10 +357,10 @@ mod tests {
         draw_heatmap(&path, &summary(), "test", "v", &cells, Scale::Symmetric).unwrap();
         let img = image::open(&path).unwrap().to_rgb8();
         let top = DIVERGING[DIVERGING.len() - 1];
-        // Pixels of that colour left of the colour bar: the one cell.
+        // Pixels of that colour above the colour bar: the one cell.
         let hits: Vec<(u32, u32)> = img
             .enumerate_pixels()
-            .filter(|p| p.2 .0 == [top.0, top.1, top.2] && p.0 < img.width() - BAR_W)
+            .filter(|p| p.2 .0 == [top.0, top.1, top.2] && p.1 < img.height() - BAR_H)
             .map(|p| (p.0, p.1))
             .collect();
         assert!(hits.len() > 400, "cell of {} px", hits.len());
