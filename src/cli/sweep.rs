@@ -112,8 +112,8 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
 
 fn print_summary(s: &SweepSummary, status: &RunStatus) {
     println!(
-        "shard {}/{}: {} rows solved and written, {} already done ({} partial chunks redone), {:.2} s wall, {:.0} solves/s, {} threads",
-        s.shard, s.shards, s.rows_written, s.rows_skipped, s.partial_chunks_removed, s.wall_s, s.solves_per_s, s.threads
+        "shard {}/{}: {} rows solved and written, {} already done ({} abandoned partial chunks removed, {} damaged chunks redone), {:.2} s wall, {:.0} solves/s, {} threads",
+        s.shard, s.shards, s.rows_written, s.rows_skipped, s.partial_chunks_removed, s.damaged_chunks_redone, s.wall_s, s.solves_per_s, s.threads
     );
     println!("shard {}/{} statuses: {}", s.shard, s.shards, fmt_counts(&s.status_counts));
     println!(
@@ -142,6 +142,7 @@ fn status_json(s: &RunStatus) -> serde_json::Value {
         "failures": s.failures(),
         "status_counts": s.status_counts,
         "chunks_in_progress": s.chunks_in_progress,
+        "damaged": s.damaged,
         "complete": s.complete,
         "shards": s.shards,
     })
@@ -172,6 +173,9 @@ pub fn run_status_command(args: &StatusArgs) -> anyhow::Result<()> {
         );
     }
     println!("statuses   {}", fmt_counts(&s.status_counts));
+    for d in &s.damaged {
+        println!("damaged    {} ({}): rerun its shard's sweep command to move it aside and recompute it", d.path.display(), d.reason);
+    }
     if s.chunks_in_progress > 0 {
         println!("in flight  {} chunk(s) being written or left by an interrupted run (redone on resume)", s.chunks_in_progress);
     }

@@ -1,8 +1,12 @@
 //! The sweep engine: solves one shard's chunks in parallel and writes each
 //! chunk as soon as it is complete. Re-running the same command resumes:
-//! chunk files already in place are checked and skipped, temporary files of
-//! this shard's interrupted chunks are deleted and those chunks redone, so
-//! the output never holds a duplicate or a missing row.
+//! chunk files already in place are checked (footer and checksum) and
+//! skipped, damaged ones are moved to DIR/damaged and redone, missing ones
+//! are computed, so the output never holds a duplicate or a missing row.
+//! Temporary files are removed only when abandoned ([`crate::io::is_abandoned`]:
+//! their writer's lock is gone): a locked one belongs to a live copy of the
+//! same shard (a retried pod, a requeued array task), whose writes are unique
+//! to it and idempotent.
 //!
 //! Parallelism is two-level with rayon: chunks in parallel, and the routings
 //! of a chunk in parallel (so a shard with a single chunk still uses every
@@ -63,8 +67,10 @@ pub struct SweepSummary {
     pub chunks_written: u64,
     /// Chunk files found already written.
     pub chunks_skipped: u64,
-    /// Temporary files of interrupted chunks that were removed.
+    /// Abandoned temporary files of interrupted chunks that were removed.
     pub partial_chunks_removed: u64,
+    /// Damaged chunk files of this shard moved to DIR/damaged and recomputed.
+    pub damaged_chunks_redone: u64,
     /// Rows per status over this shard (all of its rows).
     pub status_counts: BTreeMap<String, u64>,
     /// Wall time of this invocation, s.
@@ -96,16 +102,41 @@ pub fn run_sweep(spec: &SweepSpec, dir: &Path, options: &SweepOptions) -> Result
     let plan = SweepPlan::new(spec);
     let scan = run.scan(&manifest)?;
 
-    // This shard's temporaries are from an interrupted run of it (one
-    // process per shard): its chunks are redone from scratch.
+    // Temporaries: an abandoned one is left by a killed writer; a locked one
+    // is a live copy of this shard writing right now (its name is unique to
+    // it), so it is left alone. Either way the chunk is absent and redone.
     let mut partial_chunks_removed = 0;
-    for (chunk, path) in &scan.temporaries {
-        if plan.chunk_shard(*chunk, shards) == shard {
+    for (_, path) in &scan.temporaries {
+        if crate::io::is_abandoned(path) {
             match std::fs::remove_file(path) {
                 Ok(()) => partial_chunks_removed += 1,
                 Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
                 Err(source) => return Err(SweepError::Io { context: format!("removing {}", path.display()), source }),
             }
+        }
+    }
+    // Damaged chunks of this shard are moved aside and redone; those of
+    // other shards are named (their own shard's rerun redoes them).
+    let mut damaged_chunks_redone = 0;
+    for damaged in &scan.damaged {
+        let owner = plan.chunk_shard(damaged.chunk, shards);
+        if owner == shard {
+            let to = run.move_aside(damaged)?;
+            damaged_chunks_redone += 1;
+            if options.progress != ProgressMode::Quiet || to.is_some() {
+                eprintln!(
+                    "sweep shard {shard}/{shards}: chunk {} is damaged ({}): moved to {} and recomputing it",
+                    damaged.path.display(),
+                    damaged.reason,
+                    to.map_or_else(|| "(already moved)".into(), |p| p.display().to_string())
+                );
+            }
+        } else {
+            eprintln!(
+                "sweep shard {shard}/{shards}: warning: chunk {} of shard {owner} is damaged ({}): rerun shard {owner} to recompute it",
+                damaged.path.display(),
+                damaged.reason
+            );
         }
     }
     let own: Vec<u64> = plan.shard_chunks(shard, shards).collect();
@@ -174,6 +205,7 @@ pub fn run_sweep(spec: &SweepSpec, dir: &Path, options: &SweepOptions) -> Result
         chunks_written: written.len() as u64,
         chunks_skipped: done.len() as u64,
         partial_chunks_removed,
+        damaged_chunks_redone,
         status_counts,
         wall_s,
         solves_per_s: rows_written as f64 / wall_s.max(1e-9),
