@@ -113,7 +113,14 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     let routing = Routing::new(&y, actuator.length_mm, actuator.radius_mm).context("--routing")?;
     let direction = if args.direction == "unload" { LoadDirection::Unload } else { LoadDirection::Load };
     let hold = Hold { direction, dwell_s: args.dwell_s.unwrap_or(actuator.effects.creep_hold_s) };
-    let mut sim = simulate_held(&actuator, &options, &routing, args.tension, args.order, hold)
+    // The thesis route computes its own coefficients from the centreline
+    // (its order is limited by n_d, checked there), so the solver's exact
+    // ones are only needed up to what the steps resolve.
+    let exact_order = match args.coefficients {
+        CoefficientRoute::Exact => args.order,
+        CoefficientRoute::Thesis => args.order.min(crate::model::resolution::max_order(options.steps_per_span)),
+    };
+    let mut sim = simulate_held(&actuator, &options, &routing, args.tension, exact_order, hold)
         .with_context(|| format!("simulating routing {y:?} at {} N", args.tension))?;
     if args.coefficients == CoefficientRoute::Thesis {
         let points: Vec<[f64; 2]> = sim.centreline.iter().map(|c| [c.x_mm, c.y_mm]).collect();

@@ -18,6 +18,10 @@ pub enum ParameterError {
     /// A parameter that must be finite is not, or lies outside its range.
     #[error("parameter {name} = {value} is out of range: {expected}")]
     OutOfRange { name: &'static str, value: f64, expected: &'static str },
+    /// A coefficient order the discretisation does not resolve
+    /// ([`crate::model::resolution`]).
+    #[error("{0}")]
+    Unresolved(String),
 }
 
 /// Self-weight of the rod.

@@ -378,9 +378,15 @@ impl RunDir {
             }
             match parse_chunk_name(&name) {
                 Some(chunk) if chunk < manifest.chunks && path.is_file() => {
-                    let checked = self
-                        .verify_checksum(chunk, &path)
-                        .and_then(|()| check_chunk(&path, chunk, manifest, plan.chunk_rows(chunk)));
+                    // A file of another job is refused (left for the user to
+                    // move) even when its checksum fails; any other failure
+                    // marks the chunk damaged.
+                    let footer = check_chunk(&path, chunk, manifest, plan.chunk_rows(chunk));
+                    let checked = match (self.verify_checksum(chunk, &path), footer) {
+                        (_, Err(e @ SweepError::ForeignChunk { .. })) => Err(e),
+                        (Err(e), _) => Err(e),
+                        (Ok(()), footer) => footer,
+                    };
                     match checked {
                         Ok(info) => {
                             scan.chunks.insert(chunk, info);
