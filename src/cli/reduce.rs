@@ -113,6 +113,9 @@ pub struct MapArgs {
     /// Worker threads [default: one per core].
     #[arg(long, value_name = "T")]
     pub threads: Option<usize>,
+    /// Run a sweep of more than 10⁹ rows (refused otherwise, as a likely typo).
+    #[arg(long)]
+    pub allow_large: bool,
     #[command(flatten)]
     pub map: MapOptionArgs,
 }
@@ -127,6 +130,7 @@ pub fn run_map(args: &MapArgs) -> anyhow::Result<()> {
         threads: args.threads,
         log_interval_s: None,
         quiet: false,
+        allow_large: args.allow_large,
         json: false,
     };
     super::sweep::run(&sweep_args)?;

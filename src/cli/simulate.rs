@@ -50,6 +50,9 @@ pub struct SimulateArgs {
     pub actuator: ActuatorArgs,
 }
 
+/// Most resampling intervals of the thesis route.
+pub const MAX_N_D: usize = 100_000;
+
 /// Which definition of the curvature coefficients to report.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum CoefficientRoute {
@@ -109,6 +112,11 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     let actuator = args.actuator.apply(&Actuator::default());
     actuator.validate()?;
     let options = args.actuator.solver_options(&SolverOptions::default());
+    anyhow::ensure!(
+        args.n_d <= MAX_N_D,
+        "--n-d {} is more than {MAX_N_D} intervals (the thesis uses 40; the solver has only 2 × steps-per-span nodes to resample)",
+        args.n_d
+    );
     let y = parse_list(&args.routing, "--routing")?;
     let routing = Routing::new(&y, actuator.length_mm, actuator.radius_mm).context("--routing")?;
     let direction = if args.direction == "unload" { LoadDirection::Unload } else { LoadDirection::Load };

@@ -31,6 +31,9 @@ pub struct SweepArgs {
     /// No progress output.
     #[arg(long)]
     pub quiet: bool,
+    /// Run a sweep of more than 10⁹ rows (refused otherwise, as a likely typo).
+    #[arg(long)]
+    pub allow_large: bool,
     /// Print the summary as JSON.
     #[arg(long)]
     pub json: bool,
@@ -76,7 +79,16 @@ fn shard_index(args: &SweepArgs) -> anyhow::Result<(u64, &'static str)> {
 /// Runs `cablemap sweep`.
 pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
     let spec = match &args.spec {
-        Some(path) => SweepSpec::load(path)?,
+        Some(path) => {
+            let spec = SweepSpec::load(path)?;
+            if std::fs::read_to_string(path).is_ok_and(|t| SweepSpec::is_blank_toml(&t)) {
+                eprintln!(
+                    "note: {} sets nothing: running the built-in thesis sweep (jobs/thesis.toml) with every default",
+                    path.display()
+                );
+            }
+            spec
+        }
         None => SweepSpec::thesis(),
     };
     let threads = match args.threads {
@@ -88,7 +100,8 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
         ProgressMode::Quiet
     } else if let Some(s) = args.log_interval_s {
         anyhow::ensure!(s.is_finite() && s >= 0.0, "--log-interval-s must be a number of seconds ≥ 0");
-        ProgressMode::Log(Duration::from_secs_f64(s))
+        // Anything over a year means "practically never"; Duration cannot hold 1e20 s.
+        ProgressMode::Log(Duration::from_secs_f64(s.min(3.2e7)))
     } else {
         ProgressMode::Auto
     };
@@ -99,7 +112,7 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
          needs the same --shards N (for a SLURM array use --array=0-{{N-1}})",
         args.shards
     );
-    let options = SweepOptions { shard, shards: args.shards, threads, progress };
+    let options = SweepOptions { shard, shards: args.shards, threads, progress, allow_large: args.allow_large };
     let summary = run_sweep(&spec, &args.out, &options)?;
     let status = run_status(&args.out).with_context(|| format!("checking {} after the sweep", args.out.display()))?;
     if args.json {

@@ -288,11 +288,12 @@ impl Simulator {
     /// Creates a solver for `actuator`; fails on invalid parameters.
     pub fn new(actuator: &Actuator, options: &SolverOptions) -> Result<Self, ParameterError> {
         actuator.validate()?;
-        if options.steps_per_span < 2 || options.steps_per_span % 2 != 0 {
+        // The upper bound keeps a typo (2e9 steps) from exhausting memory.
+        if options.steps_per_span < 2 || options.steps_per_span % 2 != 0 || options.steps_per_span > 100_000 {
             return Err(ParameterError::OutOfRange {
                 name: "steps_per_span",
                 value: options.steps_per_span as f64,
-                expected: "an even number ≥ 2",
+                expected: "an even number from 2 to 100000",
             });
         }
         let n = options.steps_per_span;

@@ -38,11 +38,28 @@ pub struct SweepOptions {
     pub threads: Option<usize>,
     /// Progress display.
     pub progress: ProgressMode,
+    /// Accept a sweep of more than [`super::spec::MAX_ROWS`] rows.
+    pub allow_large: bool,
 }
 
 impl Default for SweepOptions {
     fn default() -> Self {
-        Self { shard: 0, shards: 1, threads: None, progress: ProgressMode::Auto }
+        Self { shard: 0, shards: 1, threads: None, progress: ProgressMode::Auto, allow_large: false }
+    }
+}
+
+/// Most worker threads per core: more only adds switching (10 000 threads
+/// made a 610-solve job take over a minute), so larger requests are capped.
+pub const MAX_THREADS_PER_CORE: usize = 4;
+
+/// The thread count to use for a request of `requested` threads (`None`:
+/// one per core), capped at [`MAX_THREADS_PER_CORE`] per core. Returns the
+/// count and whether it was capped.
+pub fn capped_threads(requested: Option<usize>) -> (Option<usize>, bool) {
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    match requested {
+        Some(n) if n > MAX_THREADS_PER_CORE * cores => (Some(MAX_THREADS_PER_CORE * cores), true),
+        other => (other, false),
     }
 }
 
@@ -97,6 +114,15 @@ pub fn run_sweep(spec: &SweepSpec, dir: &Path, options: &SweepOptions) -> Result
     if options.threads == Some(0) {
         return Err(SweepError::BadThreads("0: use at least 1 thread".into()));
     }
+    spec.check_size(options.allow_large).map_err(|message| SweepError::BadSpec { origin: "(size)".into(), message })?;
+    let (threads_wanted, capped) = capped_threads(options.threads);
+    if capped && options.progress != ProgressMode::Quiet {
+        eprintln!(
+            "sweep: --threads {} is more than {MAX_THREADS_PER_CORE} per core; using {}",
+            options.threads.unwrap_or(0),
+            threads_wanted.unwrap_or(0)
+        );
+    }
     let run = RunDir::new(dir);
     let manifest = run.create_or_check(spec, shards)?;
     let plan = SweepPlan::new(spec);
@@ -146,7 +172,7 @@ pub fn run_sweep(spec: &SweepSpec, dir: &Path, options: &SweepOptions) -> Result
     let shard_rows = plan.shard_rows(shard, shards);
 
     let mut builder = rayon::ThreadPoolBuilder::new();
-    if let Some(n) = options.threads {
+    if let Some(n) = threads_wanted {
         builder = builder.num_threads(n);
     }
     let pool = builder.build().map_err(|e| SweepError::BadThreads(e.to_string()))?;
