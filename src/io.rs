@@ -162,6 +162,24 @@ pub fn fmt_num(v: f64) -> String {
     }
 }
 
+/// Reads a UTF-8 text file. A file in another encoding (Latin-1, UTF-16
+/// from a spreadsheet) is an error saying so and how to fix it, instead of
+/// the bare "stream did not contain valid UTF-8".
+pub fn read_utf8(path: &Path) -> std::io::Result<String> {
+    let bytes = std::fs::read(path)?;
+    String::from_utf8(bytes).map_err(|e| {
+        let at = e.utf8_error().valid_up_to();
+        std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            format!(
+                "the file is not UTF-8 text (invalid byte 0x{:02x} at offset {at}): save it as UTF-8, e.g. \
+                 `iconv -f latin1 -t utf-8 FILE > FILE.utf8`",
+                e.as_bytes()[at]
+            ),
+        )
+    })
+}
+
 /// SHA-256 of a file's bytes, hex.
 pub fn sha256_file(path: &Path) -> std::io::Result<String> {
     use sha2::{Digest, Sha256};

@@ -164,7 +164,7 @@ impl MapDir {
     /// (`designs.parquet` is read on demand).
     pub fn open(dir: &Path) -> Result<Self, DesignError> {
         let summary_path = dir.join("summary.json");
-        let text = std::fs::read_to_string(&summary_path).map_err(|e| {
+        let text = crate::io::read_utf8(&summary_path).map_err(|e| {
             map_error(&summary_path, format!("cannot read ({e}); give the directory written by `cablemap reduce RUN_DIR --out MAP_DIR`"))
         })?;
         let summary: Summary =

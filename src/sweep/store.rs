@@ -252,7 +252,7 @@ impl RunDir {
     /// Reads and parses the manifest; `Ok(None)` when there is none.
     pub fn read_manifest(&self) -> Result<Option<Manifest>, SweepError> {
         let path = self.manifest_path();
-        let text = match std::fs::read_to_string(&path) {
+        let text = match crate::io::read_utf8(&path) {
             Ok(t) => t,
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
             Err(source) => return Err(SweepError::Io { context: format!("reading {}", path.display()), source }),
