@@ -341,3 +341,73 @@ fn cell_indices_never_wrap() {
         assert!(!stderr.contains("000000000000"), "{stderr}");
     }
 }
+
+/// A small tmpfs mounted for one test, unmounted when dropped.
+struct TinyDisk {
+    path: PathBuf,
+    _dir: tempfile::TempDir,
+}
+
+impl TinyDisk {
+    /// A `size_kib` tmpfs, or None (with a loud warning) where mounting is not allowed.
+    fn mount(size_kib: u32) -> Option<Self> {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("disk");
+        std::fs::create_dir(&path).unwrap();
+        let ok = Command::new("mount")
+            .args(["-t", "tmpfs", "-o", &format!("size={size_kib}k"), "tmpfs", s(&path)])
+            .stderr(Stdio::null())
+            .status()
+            .is_ok_and(|st| st.success());
+        if !ok {
+            eprintln!("WARNING: cannot mount a tmpfs here (needs root): the full-disk test was NOT run");
+            return None;
+        }
+        Some(Self { path, _dir: dir })
+    }
+}
+
+impl Drop for TinyDisk {
+    fn drop(&mut self) {
+        let _ = Command::new("umount").arg(&self.path).status();
+    }
+}
+
+#[test]
+fn a_full_disk_is_reported_leaves_no_temporaries_and_the_run_resumes() {
+    let Some(disk) = TinyDisk::mount(64) else { return };
+    let fill = disk.path.join("fill");
+    // Full: not even the manifest fits.
+    std::fs::write(&fill, vec![0u8; 64 * 1024]).unwrap_or(());
+    let dir = disk.path.join("run");
+    let (ok, _, stderr) = sweep(Path::new(QUICK), &dir);
+    assert!(!ok && stderr.contains("No space left on device"), "{stderr}");
+    assert_eq!(stderr.matches("No space left").count(), 1, "{stderr}");
+    let leftovers = |d: &Path| -> Vec<PathBuf> {
+        let mut out = Vec::new();
+        let mut stack = vec![d.to_path_buf()];
+        while let Some(d) = stack.pop() {
+            for e in std::fs::read_dir(&d).into_iter().flatten() {
+                let p = e.unwrap().path();
+                if p.is_dir() {
+                    stack.push(p);
+                } else if p.file_name().unwrap().to_string_lossy().contains(".tmp-") {
+                    out.push(p);
+                }
+            }
+        }
+        out
+    };
+    assert!(leftovers(&disk.path).is_empty(), "{:?}", leftovers(&disk.path));
+    // Nearly full: some chunks fit, then the disk fills mid-run.
+    std::fs::remove_file(&fill).unwrap();
+    std::fs::write(&fill, vec![0u8; 40 * 1024]).unwrap();
+    let (ok, _, stderr) = sweep(Path::new(QUICK), &dir);
+    assert!(!ok && stderr.contains("No space left on device"), "{stderr}");
+    assert!(leftovers(&disk.path).is_empty(), "{:?}", leftovers(&disk.path));
+    // Space freed: the same command finishes the run, every chunk verified.
+    std::fs::remove_file(&fill).unwrap();
+    let (ok, stdout, stderr) = sweep(Path::new(QUICK), &dir);
+    assert!(ok && stdout.contains("complete"), "{stdout}{stderr}");
+    assert_eq!(open_run(&dir, Completeness::Complete).unwrap().rows_done(), 610);
+}

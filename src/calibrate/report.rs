@@ -30,7 +30,8 @@ pub fn write_report(
     // Each picture is drawn to a temporary file and renamed into place, so
     // a failure never leaves a half-drawn picture over an older report.
     let atomic = |name: &str, draw: &dyn Fn(&Path) -> Result<(), PlotError>| -> Result<(), CalibrateError> {
-        let tmp = crate::io::temp_path(&dir.join(name));
+        // The name keeps its extension last: the PNG encoder goes by it.
+        let tmp = dir.join(format!(".tmp-{}-{name}", crate::io::unique_token()));
         let result = draw(&tmp);
         if let Err(e) = result {
             let _ = std::fs::remove_file(&tmp);
