@@ -180,6 +180,34 @@ pub fn read_utf8(path: &Path) -> std::io::Result<String> {
     })
 }
 
+/// Swaps two existing paths atomically (Linux `renameat2` with
+/// `RENAME_EXCHANGE`): a reader of either path sees the old or the new entry,
+/// never a gap. Returns `Ok(false)` where the system or file system cannot
+/// (the caller then falls back on two renames).
+pub fn exchange(a: &Path, b: &Path) -> std::io::Result<bool> {
+    #[cfg(target_os = "linux")]
+    {
+        use std::os::unix::ffi::OsStrExt;
+        let c = |p: &Path| std::ffi::CString::new(p.as_os_str().as_bytes()).map_err(std::io::Error::other);
+        let (ca, cb) = (c(a)?, c(b)?);
+        // SAFETY: both pointers are valid NUL-terminated strings for the call.
+        let rc = unsafe { libc::renameat2(libc::AT_FDCWD, ca.as_ptr(), libc::AT_FDCWD, cb.as_ptr(), libc::RENAME_EXCHANGE) };
+        if rc == 0 {
+            return Ok(true);
+        }
+        let e = std::io::Error::last_os_error();
+        match e.raw_os_error() {
+            Some(libc::EINVAL) | Some(libc::ENOSYS) | Some(libc::EOPNOTSUPP) => Ok(false),
+            _ => Err(e),
+        }
+    }
+    #[cfg(not(target_os = "linux"))]
+    {
+        let _ = (a, b);
+        Ok(false)
+    }
+}
+
 /// SHA-256 of a file's bytes, hex.
 pub fn sha256_file(path: &Path) -> std::io::Result<String> {
     use sha2::{Digest, Sha256};
@@ -225,6 +253,22 @@ mod tests {
         write_atomic(&dir.path().join("f"), b"ok").unwrap();
         assert_eq!(std::fs::read(dir.path().join("f")).unwrap(), b"ok");
         assert_eq!(sha256_file(&dir.path().join("f")).unwrap().len(), 64);
+    }
+
+    #[test]
+    fn exchange_swaps_two_directories_or_says_it_cannot() {
+        let dir = tempfile::tempdir().unwrap();
+        let (a, b) = (dir.path().join("a"), dir.path().join("b"));
+        for (d, f) in [(&a, "from_a"), (&b, "from_b")] {
+            std::fs::create_dir(d).unwrap();
+            std::fs::write(d.join(f), b"x").unwrap();
+        }
+        if exchange(&a, &b).unwrap() {
+            assert!(a.join("from_b").exists() && b.join("from_a").exists());
+        } else {
+            eprintln!("WARNING: this file system cannot exchange atomically; maps are replaced by two renames");
+            assert!(a.join("from_a").exists() && b.join("from_b").exists());
+        }
     }
 
     #[test]

@@ -375,10 +375,11 @@ impl Drop for TinyDisk {
 
 #[test]
 fn a_full_disk_is_reported_leaves_no_temporaries_and_the_run_resumes() {
-    let Some(disk) = TinyDisk::mount(64) else { return };
+    // The quick run needs about 100 KiB (4 KiB blocks).
+    let Some(disk) = TinyDisk::mount(256) else { return };
     let fill = disk.path.join("fill");
     // Full: not even the manifest fits.
-    std::fs::write(&fill, vec![0u8; 64 * 1024]).unwrap_or(());
+    let _ = std::fs::write(&fill, vec![0u8; 256 * 1024]);
     let dir = disk.path.join("run");
     let (ok, _, stderr) = sweep(Path::new(QUICK), &dir);
     assert!(!ok && stderr.contains("No space left on device"), "{stderr}");
@@ -401,7 +402,7 @@ fn a_full_disk_is_reported_leaves_no_temporaries_and_the_run_resumes() {
     assert!(leftovers(&disk.path).is_empty(), "{:?}", leftovers(&disk.path));
     // Nearly full: some chunks fit, then the disk fills mid-run.
     std::fs::remove_file(&fill).unwrap();
-    std::fs::write(&fill, vec![0u8; 40 * 1024]).unwrap();
+    std::fs::write(&fill, vec![0u8; 200 * 1024]).unwrap();
     let (ok, _, stderr) = sweep(Path::new(QUICK), &dir);
     assert!(!ok && stderr.contains("No space left on device"), "{stderr}");
     assert!(leftovers(&disk.path).is_empty(), "{:?}", leftovers(&disk.path));

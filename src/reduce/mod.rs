@@ -629,10 +629,15 @@ pub fn check_map_out(dir: &std::path::Path) -> Result<String, ReduceError> {
 }
 
 /// Moves `staging` to `dir`: directly when `dir` is absent or empty, else
-/// by moving the old map aside first and deleting it after.
+/// by an atomic exchange (Linux), else by moving the old map aside first
+/// and deleting it after (a moment without `dir`, never a mixed one).
 fn replace_dir(staging: &std::path::Path, dir: &std::path::Path, parent: &std::path::Path, name: &str) -> std::io::Result<()> {
     match std::fs::rename(staging, dir) {
         Ok(()) => {}
+        Err(_) if dir.is_dir() && crate::io::exchange(staging, dir)? => {
+            // `staging` now holds the old map.
+            let _ = std::fs::remove_dir_all(staging);
+        }
         Err(_) if dir.is_dir() => {
             let old = parent.join(format!(".{name}.old-{}", crate::io::unique_token()));
             std::fs::rename(dir, &old)?;
