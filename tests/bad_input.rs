@@ -61,6 +61,8 @@ fn orders_the_steps_do_not_resolve_are_refused_with_the_steps_that_would() {
     }
     // The default order is resolved at the default steps.
     assert_eq!(a(&[]).len(), 4);
+    // So is a design target, before the search.
+    refused(&["design", "--target", "x=50,y=5,a9=0.001"], &["order 9", "--steps-per-span 80"]);
     // A sweep spec is checked the same way, before any file is written.
     let tmp = tempfile::tempdir().unwrap();
     let spec = tmp.path().join("o.toml");
