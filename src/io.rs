@@ -2,26 +2,116 @@
 
 use std::fs::File;
 use std::io::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::OnceLock;
 
-/// Writes `bytes` to `path` atomically: a temporary file in the same
-/// directory, fsync, rename into place, fsync the directory. A reader never
-/// sees a half-written file and a crash never corrupts an existing one.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    let dir = match path.parent() {
+/// A temporary file older than this (by modification time) is left over by
+/// a killed writer and may be removed; a younger one may belong to a live
+/// writer (another copy of the same shard, a concurrent reduce) and is left
+/// alone. Writers create their temporaries only once the data is in memory
+/// and write them in seconds, so ten minutes is far beyond any live write.
+pub const STALE_TEMP_S: u64 = 600;
+
+/// A name part unique to this writer: process id, a per-process random
+/// value and a counter. The process id alone is not enough: every container
+/// whose entrypoint is cablemap runs as pid 1, and array tasks on different
+/// hosts share pids.
+pub fn unique_token() -> String {
+    static PROCESS: OnceLock<String> = OnceLock::new();
+    static COUNTER: AtomicU64 = AtomicU64::new(0);
+    let process = PROCESS.get_or_init(|| {
+        use std::hash::{BuildHasher, Hasher};
+        // RandomState is seeded from the OS's random source per process.
+        let mut h = std::collections::hash_map::RandomState::new().build_hasher();
+        let nanos = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_nanos());
+        h.write_u128(nanos);
+        h.write_u32(std::process::id());
+        format!("{}-{:016x}", std::process::id(), h.finish())
+    });
+    format!("{process}-{}", COUNTER.fetch_add(1, Ordering::Relaxed))
+}
+
+/// The temporary path a writer uses for `path`: `.NAME.tmp-TOKEN` in the
+/// same directory (the leading dot hides it from dataset readers).
+pub fn temp_path(path: &Path) -> PathBuf {
+    let dir = parent_dir(path);
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    dir.join(format!(".{name}.tmp-{}", unique_token()))
+}
+
+/// Whether `name` is a temporary file name made by [`temp_path`] (or the
+/// pid-only names of earlier versions) for the file `final_name`.
+pub fn is_temp_of(name: &str, final_name: &str) -> bool {
+    name.strip_prefix('.')
+        .and_then(|r| r.strip_prefix(final_name))
+        .and_then(|r| r.strip_prefix(".tmp-"))
+        .is_some_and(|token| !token.is_empty() && token.bytes().all(|b| b.is_ascii_alphanumeric() || b == b'-'))
+}
+
+/// Creates a writer's temporary file and takes an exclusive lock on it,
+/// held until the file is closed (after its rename). [`is_abandoned`] uses
+/// the lock to tell a live writer's file from a killed writer's: the
+/// kernel drops the lock when the process dies, whatever pid namespace it
+/// ran in.
+pub fn create_locked(path: &Path) -> std::io::Result<File> {
+    let file = File::create(path)?;
+    // A file system without locks falls back on the age rule.
+    let _ = file.try_lock();
+    Ok(file)
+}
+
+/// Whether the temporary file at `path` was left by a writer that is gone:
+/// nobody holds its lock ([`create_locked`]), or, where locks are not
+/// supported, it is older than [`STALE_TEMP_S`]. A file that vanished is
+/// not abandoned (its writer renamed it into place).
+pub fn is_abandoned(path: &Path) -> bool {
+    let Ok(file) = File::open(path) else { return false };
+    match file.try_lock() {
+        Ok(()) => true,
+        Err(std::fs::TryLockError::WouldBlock) => false,
+        Err(std::fs::TryLockError::Error(_)) => is_stale(path),
+    }
+}
+
+/// The file at `path` was last modified more than [`STALE_TEMP_S`] ago.
+pub fn is_stale(path: &Path) -> bool {
+    std::fs::metadata(path)
+        .and_then(|m| m.modified())
+        .ok()
+        .and_then(|t| t.elapsed().ok())
+        .is_some_and(|age| age.as_secs() > STALE_TEMP_S)
+}
+
+fn parent_dir(path: &Path) -> &Path {
+    match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
-    };
-    let name = path.file_name().ok_or_else(|| std::io::Error::other("path has no file name"))?;
-    let tmp = dir.join(format!(".{}.tmp-{}", name.to_string_lossy(), std::process::id()));
-    {
+    }
+}
+
+/// Writes `bytes` to `path` atomically: a temporary file in the same
+/// directory (named uniquely per writer), fsync, rename into place, fsync
+/// the directory. A reader never sees a half-written file, a crash never
+/// corrupts an existing one, and a failed write (a full disk) leaves no
+/// temporary file behind.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let dir = parent_dir(path);
+    if path.file_name().is_none() {
+        return Err(std::io::Error::other("path has no file name"));
+    }
+    let tmp = temp_path(path);
+    let written = (|| {
         let mut f = File::create(&tmp)?;
         f.write_all(bytes)?;
         f.sync_all()?;
-    }
-    std::fs::rename(&tmp, path).inspect_err(|_| {
+        drop(f);
+        std::fs::rename(&tmp, path)
+    })();
+    if written.is_err() {
         let _ = std::fs::remove_file(&tmp);
-    })?;
+    }
+    written?;
     sync_dir(dir);
     Ok(())
 }
@@ -31,5 +121,164 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
 pub fn sync_dir(dir: &Path) {
     if let Ok(d) = File::open(dir) {
         let _ = d.sync_all();
+    }
+}
+
+/// Whether `dir` is a sweep run directory: it has a cablemap sweep
+/// manifest (even a damaged one, as long as it names the format).
+pub fn is_run_dir(dir: &Path) -> bool {
+    std::fs::read(dir.join("manifest.json")).is_ok_and(|b| b.windows(15).any(|w| w == b"cablemap-sweep/"))
+}
+
+/// Refuses an output directory that is a sweep run directory or lies
+/// directly inside one: the run would then hold files cablemap's checks
+/// reject, and be unusable until cleaned by hand. `flag` names the option.
+pub fn check_not_in_run_dir(out: &Path, flag: &str) -> Result<(), String> {
+    let parent = match out.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    for (candidate, inside) in [(out, false), (parent, true)] {
+        if is_run_dir(candidate) {
+            return Err(format!(
+                "{flag} {} {} the sweep run directory {}; writing there would make the run unusable: \
+                 give a directory outside the run",
+                out.display(),
+                if inside { "is inside" } else { "is" },
+                candidate.display()
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// A number for a message: plain for ordinary magnitudes, scientific for
+/// extreme ones (1e308 is not printed as 309 digits).
+pub fn fmt_num(v: f64) -> String {
+    if v != 0.0 && v.is_finite() && !(1e-4..1e9).contains(&v.abs()) {
+        format!("{v:e}")
+    } else {
+        format!("{v}")
+    }
+}
+
+/// Reads a UTF-8 text file. A file in another encoding (Latin-1, UTF-16
+/// from a spreadsheet) is an error saying so and how to fix it, instead of
+/// the bare "stream did not contain valid UTF-8".
+pub fn read_utf8(path: &Path) -> std::io::Result<String> {
+    let bytes = std::fs::read(path)?;
+    String::from_utf8(bytes).map_err(|e| {
+        let at = e.utf8_error().valid_up_to();
+        std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            format!(
+                "the file is not UTF-8 text (invalid byte 0x{:02x} at offset {at}): save it as UTF-8, e.g. \
+                 `iconv -f latin1 -t utf-8 FILE > FILE.utf8`",
+                e.as_bytes()[at]
+            ),
+        )
+    })
+}
+
+/// Swaps two existing paths atomically (Linux `renameat2` with
+/// `RENAME_EXCHANGE`): a reader of either path sees the old or the new entry,
+/// never a gap. Returns `Ok(false)` where the system or file system cannot
+/// (the caller then falls back on two renames).
+pub fn exchange(a: &Path, b: &Path) -> std::io::Result<bool> {
+    #[cfg(target_os = "linux")]
+    {
+        use std::os::unix::ffi::OsStrExt;
+        let c = |p: &Path| std::ffi::CString::new(p.as_os_str().as_bytes()).map_err(std::io::Error::other);
+        let (ca, cb) = (c(a)?, c(b)?);
+        // SAFETY: both pointers are valid NUL-terminated strings for the call.
+        let rc = unsafe { libc::renameat2(libc::AT_FDCWD, ca.as_ptr(), libc::AT_FDCWD, cb.as_ptr(), libc::RENAME_EXCHANGE) };
+        if rc == 0 {
+            return Ok(true);
+        }
+        let e = std::io::Error::last_os_error();
+        match e.raw_os_error() {
+            Some(libc::EINVAL) | Some(libc::ENOSYS) | Some(libc::EOPNOTSUPP) => Ok(false),
+            _ => Err(e),
+        }
+    }
+    #[cfg(not(target_os = "linux"))]
+    {
+        let _ = (a, b);
+        Ok(false)
+    }
+}
+
+/// SHA-256 of a file's bytes, hex.
+pub fn sha256_file(path: &Path) -> std::io::Result<String> {
+    use sha2::{Digest, Sha256};
+    let mut file = File::open(path)?;
+    let mut hasher = Sha256::new();
+    std::io::copy(&mut file, &mut hasher)?;
+    Ok(hex(&hasher.finalize()))
+}
+
+/// Lower-case hex of `bytes`.
+pub fn hex(bytes: &[u8]) -> String {
+    bytes.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tokens_are_unique_and_temp_names_recognised() {
+        let a = unique_token();
+        let b = unique_token();
+        assert_ne!(a, b);
+        let t = temp_path(Path::new("/x/summary.json"));
+        let name = t.file_name().unwrap().to_string_lossy().into_owned();
+        assert!(is_temp_of(&name, "summary.json"), "{name}");
+        assert!(is_temp_of(".summary.json.tmp-1234", "summary.json"));
+        assert!(!is_temp_of(".summary.json.tmp-", "summary.json"));
+        assert!(!is_temp_of("summary.json.tmp-12", "summary.json"));
+        assert!(!is_temp_of(".summary.json.tmp-1/2", "summary.json"));
+    }
+
+    #[test]
+    fn atomic_write_leaves_no_temporary_on_failure() {
+        let dir = tempfile::tempdir().unwrap();
+        // Renaming a file onto a non-empty directory fails after the data is written.
+        let target = dir.path().join("occupied");
+        std::fs::create_dir(&target).unwrap();
+        std::fs::write(target.join("x"), b"x").unwrap();
+        assert!(write_atomic(&target, b"data").is_err());
+        let names: Vec<_> = std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
+        assert_eq!(names, vec![std::ffi::OsString::from("occupied")]);
+        write_atomic(&dir.path().join("f"), b"ok").unwrap();
+        assert_eq!(std::fs::read(dir.path().join("f")).unwrap(), b"ok");
+        assert_eq!(sha256_file(&dir.path().join("f")).unwrap().len(), 64);
+    }
+
+    #[test]
+    fn exchange_swaps_two_directories_or_says_it_cannot() {
+        let dir = tempfile::tempdir().unwrap();
+        let (a, b) = (dir.path().join("a"), dir.path().join("b"));
+        for (d, f) in [(&a, "from_a"), (&b, "from_b")] {
+            std::fs::create_dir(d).unwrap();
+            std::fs::write(d.join(f), b"x").unwrap();
+        }
+        if exchange(&a, &b).unwrap() {
+            assert!(a.join("from_b").exists() && b.join("from_a").exists());
+        } else {
+            eprintln!("WARNING: this file system cannot exchange atomically; maps are replaced by two renames");
+            assert!(a.join("from_a").exists() && b.join("from_b").exists());
+        }
+    }
+
+    #[test]
+    fn a_locked_temporary_is_live_and_an_unlocked_one_abandoned() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join(".x.tmp-1");
+        let file = create_locked(&path).unwrap();
+        assert!(!is_abandoned(&path));
+        drop(file);
+        assert!(is_abandoned(&path));
+        assert!(!is_abandoned(&dir.path().join("gone")));
     }
 }

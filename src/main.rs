@@ -15,32 +15,44 @@ struct Cli {
 #[derive(Debug, Subcommand)]
 enum Command {
     /// Simulate one actuator at one tension: tip pose, shape coefficients, centreline.
+    #[command(allow_negative_numbers = true)]
     Simulate(cli::simulate::SimulateArgs),
     /// Design the cable routing and tension for a target shape (thesis eq. 3.17).
+    #[command(allow_negative_numbers = true)]
     Design(cli::design::DesignArgs),
     /// Is a target shape reachable? Verdict from a feasibility map, with the nearest designs.
+    #[command(allow_negative_numbers = true)]
     Feasible(cli::feasible::FeasibleArgs),
     /// Printable moulds (binary STL, mm) for a routing: tray, lid with the channel's protrusion, cover.
     Mould(cli::mould::MouldArgs),
     /// Print solver timings (median µs per solve, single thread).
+    #[command(allow_negative_numbers = true)]
     Bench(cli::bench::BenchArgs),
     /// Sweep a routing grid through a tension ladder into Parquet chunks (sharded, resumable).
+    #[command(allow_negative_numbers = true)]
     Sweep(cli::sweep::SweepArgs),
     /// Report a sweep directory: rows done per shard, failures, completeness.
+    #[command(allow_negative_numbers = true)]
     Status(cli::sweep::StatusArgs),
     /// Bin a sweep into feasibility maps: Parquet tables, PNG pictures, index.html.
+    #[command(allow_negative_numbers = true)]
     Reduce(cli::reduce::ReduceArgs),
     /// The main job: sweep (resumable) then reduce; the thesis sweep when no SPEC is given.
+    #[command(allow_negative_numbers = true)]
     Map(cli::reduce::MapArgs),
     /// Fit EA, GA, EI (and optionally effects) to measurements (thesis eq. 2.14).
+    #[command(allow_negative_numbers = true)]
     Calibrate(cli::calibrate::CalibrateArgs),
     /// Find, name and add the effect the model is missing; report and plots.
+    #[command(allow_negative_numbers = true)]
     Diagnose(cli::diagnose::DiagnoseArgs),
     /// Generate measurement files from the model with a hidden effect and noise.
+    #[command(allow_negative_numbers = true)]
     Synth(cli::synth::SynthArgs),
 }
 
 fn main() -> ExitCode {
+    restore_sigpipe();
     let cli = Cli::parse();
     let result = match &cli.command {
         Command::Simulate(args) => cli::simulate::run(args),
@@ -59,8 +71,21 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", cli::error_text(&e));
             ExitCode::FAILURE
         }
+    }
+}
+
+/// Rust ignores SIGPIPE, so printing into a closed pipe (`cablemap status
+/// DIR | head -1`) makes `println!` panic. Like other command-line tools,
+/// cablemap instead ends quietly when its reader has gone: the default
+/// action. Work on disk is safe at any moment (atomic files).
+fn restore_sigpipe() {
+    #[cfg(unix)]
+    // SAFETY: called first thing in main, before any thread exists; setting
+    // a signal's disposition to the default has no other effect.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
 }

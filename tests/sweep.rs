@@ -387,21 +387,23 @@ fn foreign_and_corrupt_files_are_reported_and_left_alone() {
     assert_eq!(snapshot(&dir), before);
     std::fs::remove_file(shards.join("notes.txt")).unwrap();
 
-    // A chunk file cut short: the sweep refuses, names it and says what to do.
+    // A chunk file cut short: status and readers name it; the sweep moves it
+    // to DIR/damaged and recomputes exactly that chunk.
     let victim = shards.join("chunk-000003.parquet");
     let good = std::fs::read(&victim).unwrap();
     std::fs::write(&victim, &good[..good.len() / 2]).unwrap();
-    let before = snapshot(&dir);
-    let (ok, _, stderr) = sweep(Path::new(QUICK), &dir, &[]);
-    assert!(!ok && stderr.contains("chunk-000003.parquet") && stderr.contains("damaged") && stderr.contains("delete it"), "{stderr}");
-    assert_eq!(snapshot(&dir), before);
-    assert!(open_run(&dir, Completeness::AllowPartial).is_err());
-    // Following the advice recomputes exactly that chunk.
-    std::fs::remove_file(&victim).unwrap();
+    let (ok, stdout, _) = run_cmd_status(&dir);
+    assert!(ok && stdout.contains("chunk-000003.parquet") && stdout.contains("damaged") && stdout.contains("partial"), "{stdout}");
+    let err = open_run(&dir, Completeness::AllowPartial).unwrap_err().to_string();
+    assert!(err.contains("chunk-000003.parquet") && err.contains("damaged"), "{err}");
     let (ok, stdout, stderr) = sweep(Path::new(QUICK), &dir, &[]);
     assert!(ok, "{stderr}");
-    assert!(stdout.contains("80 rows solved"), "{stdout}");
-    assert_eq!(std::fs::read(&victim).unwrap().len(), good.len());
+    assert!(stderr.contains("chunk-000003.parquet") && stderr.contains("moved to"), "{stderr}");
+    assert!(stdout.contains("80 rows solved") && stdout.contains("1 damaged chunks redone"), "{stdout}");
+    assert_eq!(std::fs::read(&victim).unwrap(), good);
+    let aside: Vec<_> = std::fs::read_dir(dir.join("damaged")).unwrap().map(|e| e.unwrap().path()).collect();
+    assert_eq!(aside.len(), 1);
+    assert_eq!(std::fs::read(&aside[0]).unwrap(), &good[..good.len() / 2]);
 
     // A chunk of another job under a valid chunk name.
     let other_dir = tmp.path().join("other");

@@ -150,7 +150,7 @@ fn read_table(path: &Path) -> Result<Table, CalibrateError> {
     if is_parquet {
         read_parquet_table(path)
     } else {
-        let text = std::fs::read_to_string(path)
+        let text = crate::io::read_utf8(path)
             .map_err(|source| CalibrateError::Io { context: format!("reading {}", path.display()), source })?;
         parse_csv(path, &text)
     }
@@ -168,6 +168,22 @@ fn parse_csv(path: &Path, text: &str) -> Result<Table, CalibrateError> {
         .into_iter()
         .map(|h| h.trim().to_string())
         .collect();
+    if header.len() == 1 {
+        // One column: most likely another delimiter (a spreadsheet's
+        // semicolons, a tab export); say so instead of "missing column".
+        for (sep, name) in [(';', "semicolon"), ('\t', "tab"), ('|', "pipe")] {
+            if head.contains(sep) {
+                return Err(CalibrateError::Malformed {
+                    path: path.display().to_string(),
+                    row: 0,
+                    message: format!(
+                        "the header is one column with {name}s in it: the file looks {name}-separated, but measurement \
+                         CSV files are comma-separated (docs/measurements.md); save or export it with commas"
+                    ),
+                });
+            }
+        }
+    }
     let mut rows = Vec::new();
     for (data_row, (_, line)) in lines.enumerate() {
         let row = data_row + 1;

@@ -263,6 +263,17 @@ pub fn fit(
         )));
     }
     let mut cost: f64 = r.iter().map(|v| v * v).sum();
+    if !cost.is_finite() {
+        // Residuals so large their squares overflow: no step can lower an
+        // infinite cost, and "no step lowers the cost" must not read as a
+        // converged fit.
+        let worst = r.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        return Err(CalibrateError::Invalid(format!(
+            "the measurements are absurdly far from any shape the actuator can take (a weighted residual of {} mm): \
+             check the units (mm and degrees) and the column order of the data",
+            crate::io::fmt_num(worst)
+        )));
+    }
     let mut lambda = 1e-3;
     let mut converged = false;
     let mut iterations = 0;

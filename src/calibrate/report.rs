@@ -22,6 +22,7 @@ pub fn write_report(
     centrelines: Option<&CentrelinePoints>,
     angle_weight_mm_per_deg: f64,
 ) -> Result<PathBuf, CalibrateError> {
+    crate::io::check_not_in_run_dir(dir, "--out").map_err(CalibrateError::Invalid)?;
     std::fs::create_dir_all(dir)
         .map_err(|source| CalibrateError::Io { context: format!("creating report directory {}", dir.display()), source })?;
     let groups = data.groups();
@@ -29,7 +30,8 @@ pub fn write_report(
     // Each picture is drawn to a temporary file and renamed into place, so
     // a failure never leaves a half-drawn picture over an older report.
     let atomic = |name: &str, draw: &dyn Fn(&Path) -> Result<(), PlotError>| -> Result<(), CalibrateError> {
-        let tmp = dir.join(format!(".tmp-{}-{name}", std::process::id()));
+        // The name keeps its extension last: the PNG encoder goes by it.
+        let tmp = dir.join(format!(".tmp-{}-{name}", crate::io::unique_token()));
         let result = draw(&tmp);
         if let Err(e) = result {
             let _ = std::fs::remove_file(&tmp);

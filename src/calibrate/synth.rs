@@ -84,6 +84,11 @@ pub fn protocol(spec: &SynthSpec) -> Vec<(f64, Direction, f64)> {
     steps
 }
 
+/// Most load steps of a synthetic protocol.
+pub const MAX_LOAD_STEPS: usize = 1000;
+/// Most centreline points per synthetic reading.
+pub const MAX_CENTRELINE_POINTS: usize = 10_000;
+
 /// Generates the measurements (and noisy centreline points of every
 /// reading, `points` per reading, when `points > 0`).
 pub fn synthesize(spec: &SynthSpec, points: usize) -> Result<(Dataset, CentrelinePoints), CalibrateError> {
@@ -100,6 +105,19 @@ pub fn synthesize(spec: &SynthSpec, points: usize) -> Result<(Dataset, Centrelin
     }
     if spec.routings.is_empty() {
         return Err(CalibrateError::Invalid("give at least one routing".into()));
+    }
+    // Sizes are checked up front: a typo like 1000000 steps would otherwise
+    // run for hours (every step is a chain of solves) before writing anything.
+    if spec.load_steps > MAX_LOAD_STEPS {
+        return Err(CalibrateError::Invalid(format!(
+            "load_steps = {} is more than the {MAX_LOAD_STEPS} a bench protocol uses: give --load-steps ≤ {MAX_LOAD_STEPS}",
+            spec.load_steps
+        )));
+    }
+    if points > MAX_CENTRELINE_POINTS {
+        return Err(CalibrateError::Invalid(format!(
+            "{points} centreline points per reading is more than {MAX_CENTRELINE_POINTS}: give --centreline-points ≤ {MAX_CENTRELINE_POINTS}"
+        )));
     }
     spec.actuator.validate()?;
     // Noise-free rows first (the measured fields are filled below).

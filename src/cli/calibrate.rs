@@ -50,6 +50,9 @@ pub fn parse_effects(names: &[String]) -> anyhow::Result<Vec<Effect>> {
     Ok(out)
 }
 
+/// Measurement files from this many rows on get a stated cost before fitting.
+const LARGE_DATA_ROWS: usize = 2000;
+
 /// Runs `cablemap calibrate`.
 pub fn run(args: &CalibrateArgs) -> anyhow::Result<()> {
     let base = args.actuator.apply(&Actuator::default());
@@ -58,6 +61,20 @@ pub fn run(args: &CalibrateArgs) -> anyhow::Result<()> {
     let data = read_measurements(&args.data)?;
     let (train, held) = split_holdout(&data, args.holdout.as_deref())?;
     let spec = FitSpec { effects: parse_effects(&args.effects)?, angle_weight_mm_per_deg: args.angle_weight };
+    if data.rows.len() >= LARGE_DATA_ROWS {
+        // A fit re-simulates every reading (1 + parameters) times per
+        // iteration: state the cost of one pass up front for large files,
+        // so a long silent run is expected rather than mistaken for a hang.
+        let started = std::time::Instant::now();
+        predict(&base, &options, &data, &train, false)?;
+        let pass_s = started.elapsed().as_secs_f64();
+        let per_iteration_s = pass_s * (4 + spec.effects.len()) as f64;
+        eprintln!(
+            "calibrate: {} readings; one pass over them takes {pass_s:.1} s, so each fit iteration takes about \
+             {per_iteration_s:.0} s (typically 5-30 iterations, at most 200)",
+            data.rows.len()
+        );
+    }
     let result = fit(&base, &options, &data, &train, &spec)?;
     let holdout_rms = match &held {
         Some(g) => {

@@ -120,6 +120,10 @@ pub fn design_json(objective: &Objective, outcome: &DesignOutcome, results: &[Co
 
 /// Runs `cablemap design`.
 pub fn run(args: &DesignArgs) -> anyhow::Result<()> {
+    if let Some(dir) = &args.out {
+        // Before the search, not after it.
+        crate::io::check_not_in_run_dir(dir, "--out").map_err(anyhow::Error::msg)?;
+    }
     let map = args.map.as_deref().map(MapDir::open).transpose()?;
     let objective = objective(args, map.as_ref())?;
     if let Some(m) = &map {

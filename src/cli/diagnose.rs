@@ -50,6 +50,10 @@ pub struct DiagnoseArgs {
 
 /// Runs `cablemap diagnose`.
 pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
+    if !args.no_report {
+        // Before the fits, not after them.
+        crate::io::check_not_in_run_dir(&args.out, "--out").map_err(anyhow::Error::msg)?;
+    }
     let base = args.actuator.apply(&Actuator::default());
     base.validate()?;
     let options = args.actuator.solver_options(&SolverOptions::default());

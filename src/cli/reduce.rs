@@ -1,6 +1,6 @@
 //! `cablemap reduce` and `cablemap map` (sweep then reduce: the main job).
 
-use crate::reduce::{reduce_run, write_map, MapData, ModeBoundaries, ReduceOptions};
+use crate::reduce::{reduce_run, write_map_replacing, MapData, ModeBoundaries, ReduceOptions};
 use anyhow::Context;
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -64,11 +64,11 @@ pub struct ReduceArgs {
 /// Reduces `run` into `out` and prints a summary.
 pub fn reduce_into(run: &Path, out: &Path, partial: bool, args: &MapOptionArgs) -> anyhow::Result<MapData> {
     let options = args.options()?;
+    crate::reduce::check_map_out(out)?;
     let start = Instant::now();
     let (map, spec) = reduce_run(run, partial, &options).with_context(|| format!("reducing {}", run.display()))?;
     let reduced_s = start.elapsed().as_secs_f64();
-    std::fs::create_dir_all(out).with_context(|| format!("creating map directory {}", out.display()))?;
-    let pictures = write_map(out, &map, &spec.actuator, &spec.solver)?;
+    let pictures = write_map_replacing(out, &map, &spec.actuator, &spec.solver)?;
     let total_s = start.elapsed().as_secs_f64();
     let s = &map.summary;
     if args.json {
@@ -114,6 +114,9 @@ pub struct MapArgs {
     /// Worker threads [default: one per core].
     #[arg(long, value_name = "T")]
     pub threads: Option<usize>,
+    /// Run a sweep of more than 10⁹ rows (refused otherwise, as a likely typo).
+    #[arg(long)]
+    pub allow_large: bool,
     #[command(flatten)]
     pub map: MapOptionArgs,
 }
@@ -128,6 +131,7 @@ pub fn run_map(args: &MapArgs) -> anyhow::Result<()> {
         threads: args.threads,
         log_interval_s: None,
         quiet: false,
+        allow_large: args.allow_large,
         json: false,
     };
     super::sweep::run(&sweep_args)?;

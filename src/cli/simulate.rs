@@ -52,6 +52,9 @@ pub struct SimulateArgs {
     pub actuator: ActuatorArgs,
 }
 
+/// Most resampling intervals of the thesis route.
+pub const MAX_N_D: usize = 100_000;
+
 /// Which definition of the curvature coefficients to report.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum CoefficientRoute {
@@ -112,12 +115,24 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     let actuator = args.actuator.apply(&Actuator::default());
     actuator.validate()?;
     let options = args.actuator.solver_options(&SolverOptions::default());
+    anyhow::ensure!(
+        args.n_d <= MAX_N_D,
+        "--n-d {} is more than {MAX_N_D} intervals (the thesis uses 40; the solver has only 2 × steps-per-span nodes to resample)",
+        args.n_d
+    );
     let y = parse_list(&args.routing, "--routing")?;
     let routing = Routing::new(&y, actuator.length_mm, actuator.radius_mm).context("--routing")?;
     let direction = if args.direction == "unload" { LoadDirection::Unload } else { LoadDirection::Load };
     let hold = Hold { direction, dwell_s: args.dwell_s.unwrap_or(actuator.effects.creep_hold_s) };
+    // The thesis route computes its own coefficients from the centreline
+    // (its order is limited by n_d, checked there), so the solver's exact
+    // ones are only needed up to what the steps resolve.
+    let exact_order = match args.coefficients {
+        CoefficientRoute::Exact => args.order,
+        CoefficientRoute::Thesis => args.order.min(crate::model::resolution::max_order(options.steps_per_span)),
+    };
     let basis = args.basis.length_basis;
-    let mut sim = simulate_held(&actuator, &options, &routing, args.tension, args.order, basis, hold)
+    let mut sim = simulate_held(&actuator, &options, &routing, args.tension, exact_order, basis, hold)
         .with_context(|| format!("simulating routing {y:?} at {} N", args.tension))?;
     if args.coefficients == CoefficientRoute::Thesis {
         let points: Vec<[f64; 2]> = sim.centreline.iter().map(|c| [c.x_mm, c.y_mm]).collect();

@@ -31,6 +31,9 @@ pub struct SweepArgs {
     /// No progress output.
     #[arg(long)]
     pub quiet: bool,
+    /// Run a sweep of more than 10⁹ rows (refused otherwise, as a likely typo).
+    #[arg(long)]
+    pub allow_large: bool,
     /// Print the summary as JSON.
     #[arg(long)]
     pub json: bool,
@@ -76,7 +79,16 @@ fn shard_index(args: &SweepArgs) -> anyhow::Result<(u64, &'static str)> {
 /// Runs `cablemap sweep`.
 pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
     let spec = match &args.spec {
-        Some(path) => SweepSpec::load(path)?,
+        Some(path) => {
+            let spec = SweepSpec::load(path)?;
+            if std::fs::read_to_string(path).is_ok_and(|t| SweepSpec::is_blank_toml(&t)) {
+                eprintln!(
+                    "note: {} sets nothing: running the built-in thesis sweep (jobs/thesis.toml) with every default",
+                    path.display()
+                );
+            }
+            spec
+        }
         None => SweepSpec::thesis(),
     };
     let threads = match args.threads {
@@ -88,7 +100,8 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
         ProgressMode::Quiet
     } else if let Some(s) = args.log_interval_s {
         anyhow::ensure!(s.is_finite() && s >= 0.0, "--log-interval-s must be a number of seconds ≥ 0");
-        ProgressMode::Log(Duration::from_secs_f64(s))
+        // Anything over a year means "practically never"; Duration cannot hold 1e20 s.
+        ProgressMode::Log(Duration::from_secs_f64(s.min(3.2e7)))
     } else {
         ProgressMode::Auto
     };
@@ -99,7 +112,7 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
          needs the same --shards N (for a SLURM array use --array=0-{{N-1}})",
         args.shards
     );
-    let options = SweepOptions { shard, shards: args.shards, threads, progress };
+    let options = SweepOptions { shard, shards: args.shards, threads, progress, allow_large: args.allow_large };
     let summary = run_sweep(&spec, &args.out, &options)?;
     let status = run_status(&args.out).with_context(|| format!("checking {} after the sweep", args.out.display()))?;
     if args.json {
@@ -112,8 +125,8 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
 
 fn print_summary(s: &SweepSummary, status: &RunStatus) {
     println!(
-        "shard {}/{}: {} rows solved and written, {} already done ({} partial chunks redone), {:.2} s wall, {:.0} solves/s, {} threads",
-        s.shard, s.shards, s.rows_written, s.rows_skipped, s.partial_chunks_removed, s.wall_s, s.solves_per_s, s.threads
+        "shard {}/{}: {} rows solved and written, {} already done ({} abandoned partial chunks removed, {} damaged chunks redone), {:.2} s wall, {:.0} solves/s, {} threads",
+        s.shard, s.shards, s.rows_written, s.rows_skipped, s.partial_chunks_removed, s.damaged_chunks_redone, s.wall_s, s.solves_per_s, s.threads
     );
     println!("shard {}/{} statuses: {}", s.shard, s.shards, fmt_counts(&s.status_counts));
     println!(
@@ -143,6 +156,7 @@ fn status_json(s: &RunStatus) -> serde_json::Value {
         "failures": s.failures(),
         "status_counts": s.status_counts,
         "chunks_in_progress": s.chunks_in_progress,
+        "damaged": s.damaged,
         "complete": s.complete,
         "shards": s.shards,
     })
@@ -174,6 +188,9 @@ pub fn run_status_command(args: &StatusArgs) -> anyhow::Result<()> {
         );
     }
     println!("statuses   {}", fmt_counts(&s.status_counts));
+    for d in &s.damaged {
+        println!("damaged    {} ({}): rerun its shard's sweep command to move it aside and recompute it", d.path.display(), d.reason);
+    }
     if s.chunks_in_progress > 0 {
         println!("in flight  {} chunk(s) being written or left by an interrupted run (redone on resume)", s.chunks_in_progress);
     }

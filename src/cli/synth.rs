@@ -15,9 +15,12 @@ use std::path::PathBuf;
 /// Arguments of `cablemap synth`.
 #[derive(Debug, Clone, Args)]
 pub struct SynthArgs {
-    /// Output measurement file (CSV).
+    /// Output measurement file (CSV); an existing file is kept unless --force.
     #[arg(long, value_name = "FILE")]
     pub out: PathBuf,
+    /// Overwrite existing output files.
+    #[arg(long)]
+    pub force: bool,
     /// Hidden effect: none, friction, gravity, stiffening, clamp_compliance, channel_offset or creep.
     #[arg(long, default_value = "none")]
     pub effect: String,
@@ -28,10 +31,10 @@ pub struct SynthArgs {
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Noise on tip x and y (standard deviation), mm.
-    #[arg(long, default_value_t = 0.4)]
+    #[arg(long, default_value_t = 0.4, allow_hyphen_values = true)]
     pub noise_mm: f64,
     /// Noise on the tip angle (standard deviation), degrees.
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
     pub noise_deg: f64,
     /// Routings as "id:y0,y1,y2,y3,y4;id:…" (mm), each optionally with its
     /// own clamp tilt "id:y0,…,y4@TILT_RAD" [default: base_offset, s_curve,
@@ -39,16 +42,16 @@ pub struct SynthArgs {
     #[arg(long, allow_hyphen_values = true)]
     pub routings: Option<String>,
     /// Top tension τ_u, N.
-    #[arg(long, default_value_t = 2.0)]
+    #[arg(long, default_value_t = 2.0, allow_hyphen_values = true)]
     pub max_tension: f64,
     /// Loading steps from rest to τ_u (unloading uses the same levels).
     #[arg(long, default_value_t = 5)]
     pub load_steps: usize,
     /// Dwell before each loaded reading, s.
-    #[arg(long, default_value_t = 5.0)]
+    #[arg(long, default_value_t = 5.0, allow_hyphen_values = true)]
     pub step_dwell_s: f64,
     /// Dwell before each rest reading, s.
-    #[arg(long, default_value_t = 30.0)]
+    #[arg(long, default_value_t = 30.0, allow_hyphen_values = true)]
     pub rest_dwell_s: f64,
     /// Clamp axis from the vertical, rad.
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
@@ -129,6 +132,13 @@ pub fn run(args: &SynthArgs) -> anyhow::Result<()> {
         noise_deg: args.noise_deg,
         seed: args.seed,
     };
+    for path in std::iter::once(&args.out).chain(&args.centreline_out) {
+        anyhow::ensure!(
+            args.force || !path.exists(),
+            "{} exists: synth does not overwrite measurement files; give another --out, or --force to replace it",
+            path.display()
+        );
+    }
     let points = if args.centreline_out.is_some() { args.centreline_points.max(2) } else { 0 };
     let (data, centrelines) = synthesize(&spec, points)?;
     crate::io::write_atomic(&args.out, measurements_csv(&data).as_bytes())

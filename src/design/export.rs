@@ -128,6 +128,10 @@ pub fn mould_svg(routing: &Routing, radius_mm: f64, channel_diameter_mm: f64, te
 /// Writes design.json, channel.csv, mould.svg and shape.png into `dir`
 /// (created if missing).
 pub fn write_all(dir: &Path, objective: &Objective, eval: &Evaluation, json: &serde_json::Value) -> Result<(), DesignError> {
+    crate::io::check_not_in_run_dir(dir, "--out").map_err(|m| DesignError::Io {
+        context: "choosing the export directory".into(),
+        source: std::io::Error::new(std::io::ErrorKind::InvalidInput, m),
+    })?;
     std::fs::create_dir_all(dir).map_err(io_error(format!("creating {}", dir.display())))?;
     let write = |name: &str, bytes: &[u8]| {
         let p = dir.join(name);

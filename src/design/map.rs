@@ -152,12 +152,20 @@ impl<'a> Columns<'a> {
     }
 }
 
+/// Off-grid indices are clamped to ±2³⁰: far outside every map (cells lie in
+/// 0..[`crate::reduce::MAX_CELLS_PER_AXIS`]) and small enough that index
+/// differences cannot overflow.
+fn clamp_index(i: i64) -> i32 {
+    const FAR: i64 = 1 << 30;
+    i.clamp(-FAR, FAR) as i32
+}
+
 impl MapDir {
     /// Opens a map directory: reads `summary.json` and `cells.parquet`
     /// (`designs.parquet` is read on demand).
     pub fn open(dir: &Path) -> Result<Self, DesignError> {
         let summary_path = dir.join("summary.json");
-        let text = std::fs::read_to_string(&summary_path).map_err(|e| {
+        let text = crate::io::read_utf8(&summary_path).map_err(|e| {
             map_error(&summary_path, format!("cannot read ({e}); give the directory written by `cablemap reduce RUN_DIR --out MAP_DIR`"))
         })?;
         let summary: Summary =
@@ -196,6 +204,13 @@ impl MapDir {
                     modes: std::array::from_fn(|m| modes[m][r]),
                 });
             }
+        }
+        let grid = 0..crate::reduce::MAX_CELLS_PER_AXIS as i32;
+        if let Some(c) = cells.iter().find(|c| !grid.contains(&c.ix) || !grid.contains(&c.iy)) {
+            return Err(map_error(
+                &cells_path,
+                format!("cell ({}, {}) lies off the grid 0..{}: the file is damaged; reduce the run again", c.ix, c.iy, grid.end),
+            ));
         }
         let index = cells.iter().enumerate().map(|(i, c)| ((c.ix, c.iy), i)).collect();
         Ok(Self { path: dir.to_path_buf(), summary, cells, index, designs_path: dir.join("designs.parquet") })
@@ -247,14 +262,16 @@ impl MapDir {
         self.index.get(&(ix, iy)).map(|&i| &self.cells[i])
     }
 
-    /// Column index of the cells containing x (None when x is None: every column).
+    /// Column index of the cells containing x (None when x is None: every
+    /// column). A coordinate far off the map gives an index far off the
+    /// grid (clamped, never wrapped onto it).
     pub fn column_of(&self, x_mm: Option<f64>) -> Option<i32> {
-        x_mm.map(|x| self.cell_index(x, self.summary.x_min_mm) as i32)
+        x_mm.map(|x| clamp_index(self.cell_index(x, self.summary.x_min_mm)))
     }
 
     /// Row index of the cells containing y (None when y is None: every row).
     pub fn row_of(&self, y_mm: Option<f64>) -> Option<i32> {
-        y_mm.map(|y| self.cell_index(y, self.summary.y_min_mm) as i32)
+        y_mm.map(|y| clamp_index(self.cell_index(y, self.summary.y_min_mm)))
     }
 
     /// Reads every design of `designs.parquet`.

@@ -13,11 +13,15 @@ pub const STANDARD_GRAVITY_M_S2: f64 = 9.81;
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ParameterError {
     /// A parameter that must be positive and finite is not.
-    #[error("parameter {name} = {value} must be a positive, finite number")]
+    #[error("parameter {name} = {} must be a positive, finite number", crate::io::fmt_num(*value))]
     NotPositive { name: &'static str, value: f64 },
     /// A parameter that must be finite is not, or lies outside its range.
-    #[error("parameter {name} = {value} is out of range: {expected}")]
+    #[error("parameter {name} = {} is out of range: {expected}", crate::io::fmt_num(*value))]
     OutOfRange { name: &'static str, value: f64, expected: &'static str },
+    /// A coefficient order the discretisation does not resolve
+    /// ([`crate::model::resolution`]).
+    #[error("{0}")]
+    Unresolved(String),
 }
 
 /// Self-weight of the rod.

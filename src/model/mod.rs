@@ -3,6 +3,7 @@
 
 pub mod actuator;
 pub mod routing;
+pub mod resolution;
 pub mod solver;
 
 pub use actuator::{Actuator, Effects, Gravity, LoadDirection, ParameterError};

@@ -288,11 +288,12 @@ impl Simulator {
     /// Creates a solver for `actuator`; fails on invalid parameters.
     pub fn new(actuator: &Actuator, options: &SolverOptions) -> Result<Self, ParameterError> {
         actuator.validate()?;
-        if options.steps_per_span < 2 || options.steps_per_span % 2 != 0 {
+        // The upper bound keeps a typo (2e9 steps) from exhausting memory.
+        if options.steps_per_span < 2 || options.steps_per_span % 2 != 0 || options.steps_per_span > 100_000 {
             return Err(ParameterError::OutOfRange {
                 name: "steps_per_span",
                 value: options.steps_per_span as f64,
-                expected: "an even number ≥ 2",
+                expected: "an even number from 2 to 100000",
             });
         }
         let n = options.steps_per_span;
@@ -915,6 +916,7 @@ pub fn simulate_held(
     basis: LengthBasis,
     hold: Hold,
 ) -> Result<Simulation, crate::Error> {
+    super::resolution::check_order(order, options.steps_per_span).map_err(ParameterError::Unresolved)?;
     let mut sim = Simulator::new(actuator, options)?;
     sim.set_routing(routing);
     // A ladder of tensions: cheap, and it keeps Newton and the shooting in

@@ -289,7 +289,7 @@ where
     I: Iterator<Item = Result<RecordBatch, ReduceError>>,
 {
     if !(options.cell_mm.is_finite() && options.cell_mm > 0.0) {
-        return Err(ReduceError::BadOption(format!("cell size {} mm must be positive", options.cell_mm)));
+        return Err(ReduceError::BadOption(format!("cell size {} mm must be positive", crate::io::fmt_num(options.cell_mm))));
     }
     if info.order < 1 {
         return Err(ReduceError::BadOption("the run stores only a_0; modes need a_1: sweep with order ≥ 1".into()));
@@ -346,6 +346,16 @@ where
         Some(b) => (b, "explicit"),
         None => (ModeBoundaries { a0: [q0[0], q0[1], q0[2]], a1: [q1[1], q1[2]] }, "quantiles"),
     };
+    // Quantiles of too few distinct coefficients (a one-routing run) do not
+    // split the modes; a map with such boundaries would be refused by
+    // `feasible` and `design`, so it is refused here, with the fix.
+    boundaries.validate().map_err(|e| {
+        ReduceError::BadOption(format!(
+            "{e}: the run's a0/a1 values are too few or too alike to split into modes by quantiles \
+             (one routing, or a grid whose routings all bend alike); give explicit --a0-bounds B1,B2,B3 and \
+             --a1-bounds C1,C2"
+        ))
+    })?;
     // The grid.
     let cell = options.cell_mm;
     let (mut xmin, mut xmax, mut ymin, mut ymax) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
@@ -357,8 +367,25 @@ where
     }
     let x0 = (xmin / cell).floor() * cell;
     let y0 = (ymin / cell).floor() * cell;
-    let nx = (((xmax - x0) / cell).floor() as usize) + 1;
-    let ny = (((ymax - y0) / cell).floor() as usize) + 1;
+    // Cell indices are i32 in the tables: a cell so small that the reach
+    // spans more than MAX_CELLS_PER_AXIS cells would overflow them (and no
+    // picture of it could be drawn), so it is refused with the smallest
+    // cell that works.
+    let (span_x, span_y) = ((xmax - x0) / cell, (ymax - y0) / cell);
+    let limit = MAX_CELLS_PER_AXIS as f64;
+    if !(x0.is_finite() && y0.is_finite() && span_x < limit && span_y < limit) {
+        let reach = (xmax - xmin).max(ymax - ymin);
+        return Err(ReduceError::BadOption(format!(
+            "--cell-mm {} is too small: the reach ({:.3} × {:.3} mm) would span more than {MAX_CELLS_PER_AXIS} cells per axis; \
+             use --cell-mm ≥ {:.3e}",
+            crate::io::fmt_num(cell),
+            xmax - xmin,
+            ymax - ymin,
+            (reach / (limit - 2.0)).max(f64::MIN_POSITIVE)
+        )));
+    }
+    let nx = (span_x.floor() as usize) + 1;
+    let ny = (span_y.floor() as usize) + 1;
     let cell_of = |s: &Sample| -> (i32, i32) {
         (((s.x - x0) / cell).floor() as i32, ((s.y - y0) / cell).floor() as i32)
     };
@@ -541,12 +568,123 @@ where
     Ok(MapData { summary, cells, modes, designs })
 }
 
+/// Most cells along either axis of a map (cell indices are stored as i32;
+/// 100 000 cells resolve a 100 mm reach to 1 µm).
+pub const MAX_CELLS_PER_AXIS: usize = 100_000;
+
 /// Unit of a_k for labels: κ = Σ a_k P_k(t) with t dimensionless, so every
 /// coefficient is a curvature.
 pub const COEFFICIENT_UNIT: &str = "mm⁻¹";
 
+/// Writes the map directory `dir` as a whole: everything is written into a
+/// staging directory beside it (`.NAME.tmp-TOKEN`), which then replaces
+/// `dir` by rename, so a reader sees the old map or the new one, never a
+/// mix (an interrupted reduce leaves the old map untouched). `dir` must be
+/// new, empty, or an earlier map (it has summary.json); it must not be, or
+/// lie directly inside, a sweep run directory.
+pub fn write_map_replacing(
+    dir: &std::path::Path,
+    map: &MapData,
+    actuator: &crate::model::Actuator,
+    solver: &crate::model::SolverOptions,
+) -> Result<Vec<plots::Picture>, ReduceError> {
+    use std::path::Path;
+    let werr = |path: &Path, message: String| ReduceError::Write { path: path.display().to_string(), message };
+    let name = check_map_out(dir)?;
+    let parent = match dir.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => std::path::PathBuf::from("."),
+    };
+    std::fs::create_dir_all(&parent).map_err(|e| werr(&parent, format!("cannot create ({e})")))?;
+    remove_abandoned_staging(&parent, &name);
+    let staging = parent.join(format!(".{name}.tmp-{}", crate::io::unique_token()));
+    std::fs::create_dir(&staging).map_err(|e| werr(&staging, format!("cannot create ({e})")))?;
+    // Held while writing so that another reduce does not clear it away.
+    let lock = std::fs::File::open(&staging).ok();
+    if let Some(l) = &lock {
+        let _ = l.try_lock();
+    }
+    let written = write_map(&staging, map, actuator, solver).and_then(|pictures| {
+        crate::io::sync_dir(&staging);
+        replace_dir(&staging, dir, &parent, &name).map_err(|e| werr(dir, format!("cannot put the new map in place ({e})")))?;
+        Ok(pictures)
+    });
+    if written.is_err() {
+        let _ = std::fs::remove_dir_all(&staging);
+    }
+    drop(lock);
+    written
+}
+
+/// Checks that `dir` can take a map (see [`write_map_replacing`]) before
+/// any work is done; returns its file name.
+pub fn check_map_out(dir: &std::path::Path) -> Result<String, ReduceError> {
+    use std::path::Path;
+    let werr = |path: &Path, message: String| ReduceError::BadOption(format!("map directory {}: {message}", path.display()));
+    crate::io::check_not_in_run_dir(dir, "--out").map_err(ReduceError::BadOption)?;
+    let name = dir.file_name().map(|n| n.to_string_lossy().into_owned()).filter(|n| n != "." && n != "..");
+    let Some(name) = name else {
+        return Err(werr(dir, "give a map directory by name (not '.' or '..'): it is replaced as a whole".into()));
+    };
+    match std::fs::read_dir(dir) {
+        Ok(mut entries) => {
+            if entries.next().is_some() && !dir.join("summary.json").is_file() {
+                return Err(werr(
+                    dir,
+                    "exists and is not a cablemap map (no summary.json), and a map directory is replaced as a whole: \
+                     give a new directory, or an earlier map to replace"
+                        .into(),
+                ));
+            }
+        }
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+        Err(e) => return Err(werr(dir, format!("cannot be read as a directory ({e})"))),
+    }
+    Ok(name)
+}
+
+/// Moves `staging` to `dir`: directly when `dir` is absent or empty, else
+/// by an atomic exchange (Linux), else by moving the old map aside first
+/// and deleting it after (a moment without `dir`, never a mixed one).
+fn replace_dir(staging: &std::path::Path, dir: &std::path::Path, parent: &std::path::Path, name: &str) -> std::io::Result<()> {
+    match std::fs::rename(staging, dir) {
+        Ok(()) => {}
+        Err(_) if dir.is_dir() && crate::io::exchange(staging, dir)? => {
+            // `staging` now holds the old map.
+            let _ = std::fs::remove_dir_all(staging);
+        }
+        Err(_) if dir.is_dir() => {
+            let old = parent.join(format!(".{name}.old-{}", crate::io::unique_token()));
+            std::fs::rename(dir, &old)?;
+            if let Err(e) = std::fs::rename(staging, dir) {
+                let _ = std::fs::rename(&old, dir);
+                return Err(e);
+            }
+            let _ = std::fs::remove_dir_all(&old);
+        }
+        Err(e) => return Err(e),
+    }
+    crate::io::sync_dir(parent);
+    Ok(())
+}
+
+/// Removes staging and old-map directories of `name` left by killed
+/// reduces (no writer holds their lock, or they are stale).
+fn remove_abandoned_staging(parent: &std::path::Path, name: &str) {
+    let Ok(entries) = std::fs::read_dir(parent) else { return };
+    for entry in entries.flatten() {
+        let file_name = entry.file_name().to_string_lossy().into_owned();
+        let left = crate::io::is_temp_of(&file_name, name)
+            || file_name.strip_prefix(&format!(".{name}.old-")).is_some_and(|t| !t.is_empty());
+        if left && entry.path().is_dir() && crate::io::is_abandoned(&entry.path()) {
+            let _ = std::fs::remove_dir_all(entry.path());
+        }
+    }
+}
+
 /// Writes the whole map directory: tables, pictures and index.html.
 /// `actuator` and `solver` re-simulate the mode representatives for drawing.
+/// Writes in place; [`write_map_replacing`] is what the commands use.
 pub fn write_map(
     dir: &std::path::Path,
     map: &MapData,

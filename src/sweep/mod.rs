@@ -67,6 +67,10 @@ pub enum SweepError {
     /// A chunk file that cannot be read.
     #[error("chunk file {} is damaged ({message}): delete it and rerun the sweep to recompute that chunk", path.display())]
     CorruptChunk { path: PathBuf, message: String },
+    /// Chunk files whose bytes changed since they were written (checksum
+    /// mismatch) or whose footer is unreadable.
+    #[error("{} holds damaged chunk files: {list}. Rerun the sweep command of each named shard (same SPEC, --out, --shards): it moves damaged chunks to {} and recomputes them", dir.display(), dir.join(store::DAMAGED_DIR).display())]
+    DamagedChunks { dir: PathBuf, list: String },
     /// The run is not complete and the caller asked for a complete one.
     #[error("sweep in {} is incomplete ({done} of {total} rows): rerun the sweep command to finish it, or read it as partial", dir.display())]
     Incomplete { dir: PathBuf, done: u64, total: u64 },

@@ -17,7 +17,7 @@
 //! # Ok::<(), cablemap::sweep::SweepError>(())
 //! ```
 //!
-//! [`open_run`] checks the manifest and every chunk footer (spec hash,
+//! [`open_run`] checks the manifest and every chunk (recorded checksum, footer spec hash,
 //! chunk index, row count) before anything is read; batches then stream one
 //! chunk file at a time, in chunk order (routing id, then tension, rising),
 //! so memory does not grow with the number of rows.
@@ -61,6 +61,16 @@ pub fn open_run(dir: &Path, completeness: Completeness) -> Result<SweepRun, Swee
     let run = RunDir::new(dir);
     let manifest = run.read_manifest()?.ok_or_else(|| SweepError::NoRun { dir: dir.to_path_buf() })?;
     let scan = run.scan(&manifest)?;
+    if !scan.damaged.is_empty() {
+        let plan = super::SweepPlan::new(&manifest.spec);
+        let list = scan
+            .damaged
+            .iter()
+            .map(|d| format!("{} (shard {}: {})", d.path.display(), plan.chunk_shard(d.chunk, manifest.shards.max(1)), d.reason))
+            .collect::<Vec<_>>()
+            .join("; ");
+        return Err(SweepError::DamagedChunks { dir: dir.to_path_buf(), list });
+    }
     let chunks: Vec<ChunkInfo> = scan.chunks.into_values().collect();
     let sweep = SweepRun { dir: dir.to_path_buf(), manifest, chunks };
     if completeness == Completeness::Complete && !sweep.is_complete() {

@@ -1,8 +1,12 @@
 //! The sweep engine: solves one shard's chunks in parallel and writes each
 //! chunk as soon as it is complete. Re-running the same command resumes:
-//! chunk files already in place are checked and skipped, temporary files of
-//! this shard's interrupted chunks are deleted and those chunks redone, so
-//! the output never holds a duplicate or a missing row.
+//! chunk files already in place are checked (footer and checksum) and
+//! skipped, damaged ones are moved to DIR/damaged and redone, missing ones
+//! are computed, so the output never holds a duplicate or a missing row.
+//! Temporary files are removed only when abandoned ([`crate::io::is_abandoned`]:
+//! their writer's lock is gone): a locked one belongs to a live copy of the
+//! same shard (a retried pod, a requeued array task), whose writes are unique
+//! to it and idempotent.
 //!
 //! Parallelism is two-level with rayon: chunks in parallel, and the routings
 //! of a chunk in parallel (so a shard with a single chunk still uses every
@@ -34,11 +38,28 @@ pub struct SweepOptions {
     pub threads: Option<usize>,
     /// Progress display.
     pub progress: ProgressMode,
+    /// Accept a sweep of more than [`super::spec::MAX_ROWS`] rows.
+    pub allow_large: bool,
 }
 
 impl Default for SweepOptions {
     fn default() -> Self {
-        Self { shard: 0, shards: 1, threads: None, progress: ProgressMode::Auto }
+        Self { shard: 0, shards: 1, threads: None, progress: ProgressMode::Auto, allow_large: false }
+    }
+}
+
+/// Most worker threads per core: more only adds switching (10 000 threads
+/// made a 610-solve job take over a minute), so larger requests are capped.
+pub const MAX_THREADS_PER_CORE: usize = 4;
+
+/// The thread count to use for a request of `requested` threads (`None`:
+/// one per core), capped at [`MAX_THREADS_PER_CORE`] per core. Returns the
+/// count and whether it was capped.
+pub fn capped_threads(requested: Option<usize>) -> (Option<usize>, bool) {
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    match requested {
+        Some(n) if n > MAX_THREADS_PER_CORE * cores => (Some(MAX_THREADS_PER_CORE * cores), true),
+        other => (other, false),
     }
 }
 
@@ -63,8 +84,10 @@ pub struct SweepSummary {
     pub chunks_written: u64,
     /// Chunk files found already written.
     pub chunks_skipped: u64,
-    /// Temporary files of interrupted chunks that were removed.
+    /// Abandoned temporary files of interrupted chunks that were removed.
     pub partial_chunks_removed: u64,
+    /// Damaged chunk files of this shard moved to DIR/damaged and recomputed.
+    pub damaged_chunks_redone: u64,
     /// Rows per status over this shard (all of its rows).
     pub status_counts: BTreeMap<String, u64>,
     /// Wall time of this invocation, s.
@@ -91,21 +114,55 @@ pub fn run_sweep(spec: &SweepSpec, dir: &Path, options: &SweepOptions) -> Result
     if options.threads == Some(0) {
         return Err(SweepError::BadThreads("0: use at least 1 thread".into()));
     }
+    spec.check_size(options.allow_large).map_err(|message| SweepError::BadSpec { origin: "(size)".into(), message })?;
+    let (threads_wanted, capped) = capped_threads(options.threads);
+    if capped && options.progress != ProgressMode::Quiet {
+        eprintln!(
+            "sweep: --threads {} is more than {MAX_THREADS_PER_CORE} per core; using {}",
+            options.threads.unwrap_or(0),
+            threads_wanted.unwrap_or(0)
+        );
+    }
     let run = RunDir::new(dir);
     let manifest = run.create_or_check(spec, shards)?;
     let plan = SweepPlan::new(spec);
     let scan = run.scan(&manifest)?;
 
-    // This shard's temporaries are from an interrupted run of it (one
-    // process per shard): its chunks are redone from scratch.
+    // Temporaries: an abandoned one is left by a killed writer; a locked one
+    // is a live copy of this shard writing right now (its name is unique to
+    // it), so it is left alone. Either way the chunk is absent and redone.
     let mut partial_chunks_removed = 0;
-    for (chunk, path) in &scan.temporaries {
-        if plan.chunk_shard(*chunk, shards) == shard {
+    for (_, path) in &scan.temporaries {
+        if crate::io::is_abandoned(path) {
             match std::fs::remove_file(path) {
                 Ok(()) => partial_chunks_removed += 1,
                 Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
                 Err(source) => return Err(SweepError::Io { context: format!("removing {}", path.display()), source }),
             }
+        }
+    }
+    // Damaged chunks of this shard are moved aside and redone; those of
+    // other shards are named (their own shard's rerun redoes them).
+    let mut damaged_chunks_redone = 0;
+    for damaged in &scan.damaged {
+        let owner = plan.chunk_shard(damaged.chunk, shards);
+        if owner == shard {
+            let to = run.move_aside(damaged)?;
+            damaged_chunks_redone += 1;
+            if options.progress != ProgressMode::Quiet || to.is_some() {
+                eprintln!(
+                    "sweep shard {shard}/{shards}: chunk {} is damaged ({}): moved to {} and recomputing it",
+                    damaged.path.display(),
+                    damaged.reason,
+                    to.map_or_else(|| "(already moved)".into(), |p| p.display().to_string())
+                );
+            }
+        } else {
+            eprintln!(
+                "sweep shard {shard}/{shards}: warning: chunk {} of shard {owner} is damaged ({}): rerun shard {owner} to recompute it",
+                damaged.path.display(),
+                damaged.reason
+            );
         }
     }
     let own: Vec<u64> = plan.shard_chunks(shard, shards).collect();
@@ -115,7 +172,7 @@ pub fn run_sweep(spec: &SweepSpec, dir: &Path, options: &SweepOptions) -> Result
     let shard_rows = plan.shard_rows(shard, shards);
 
     let mut builder = rayon::ThreadPoolBuilder::new();
-    if let Some(n) = options.threads {
+    if let Some(n) = threads_wanted {
         builder = builder.num_threads(n);
     }
     let pool = builder.build().map_err(|e| SweepError::BadThreads(e.to_string()))?;
@@ -174,6 +231,7 @@ pub fn run_sweep(spec: &SweepSpec, dir: &Path, options: &SweepOptions) -> Result
         chunks_written: written.len() as u64,
         chunks_skipped: done.len() as u64,
         partial_chunks_removed,
+        damaged_chunks_redone,
         status_counts,
         wall_s,
         solves_per_s: rows_written as f64 / wall_s.max(1e-9),

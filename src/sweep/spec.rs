@@ -38,6 +38,14 @@ pub const THESIS_SPEC_TOML: &str = include_str!("../../jobs/thesis.toml");
 pub const MAX_LEVELS: u32 = 99;
 /// Highest Legendre order stored.
 pub const MAX_ORDER: usize = 12;
+/// Most tensions per routing.
+pub const MAX_TENSIONS: u32 = 100_000;
+/// Most RK4 steps per span (memory grows with it; 24 is the default).
+pub const MAX_STEPS_PER_SPAN: usize = 100_000;
+/// Most rows per chunk file (a chunk is built in memory before writing).
+pub const MAX_CHUNK_ROWS: u64 = 2_000_000;
+/// Most rows of a sweep without `--allow-large` (≈1600 × the thesis sweep).
+pub const MAX_ROWS: u64 = 1_000_000_000;
 
 /// A complete sweep job. Every section may be omitted (thesis defaults).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
@@ -134,7 +142,7 @@ impl SweepSpec {
 
     /// Reads, parses and validates a spec file.
     pub fn load(path: &Path) -> Result<Self, SweepError> {
-        let text = std::fs::read_to_string(path)
+        let text = crate::io::read_utf8(path)
             .map_err(|source| SweepError::Io { context: format!("reading spec {}", path.display()), source })?;
         Self::from_toml(&text, &path.display().to_string())
     }
@@ -142,6 +150,18 @@ impl SweepSpec {
     /// Checks every setting; the message names the field and what to do.
     pub fn validate(&self) -> Result<(), String> {
         self.actuator.validate().map_err(|e| format!("[actuator] {e}"))?;
+        // Sizes before anything is allocated for them.
+        if self.solver.steps_per_span > MAX_STEPS_PER_SPAN {
+            return Err(format!(
+                "[solver] steps_per_span = {} is more than {MAX_STEPS_PER_SPAN}: the solver would need more memory than a \
+                 machine has, and {} steps already resolve every supported order",
+                self.solver.steps_per_span,
+                crate::model::resolution::REQUIRED_STEPS_PER_SPAN[crate::model::resolution::MAX_RESOLVED_ORDER]
+            ));
+        }
+        if self.tension.count > MAX_TENSIONS {
+            return Err(format!("[tension] count = {} is more than {MAX_TENSIONS} tensions per routing", self.tension.count));
+        }
         crate::model::Simulator::new(&self.actuator, &self.solver).map_err(|e| format!("[solver] {e}"))?;
         let g = &self.grid;
         if g.levels == 0 || g.levels > MAX_LEVELS {
@@ -186,10 +206,47 @@ impl SweepSpec {
         if o.order > MAX_ORDER {
             return Err(format!("[output] order = {} is above the supported {MAX_ORDER}", o.order));
         }
+        crate::model::resolution::check_order(o.order, self.solver.steps_per_span)
+            .map_err(|e| format!("[output] {}", e.replace("(--steps-per-span", "([solver] steps_per_span =")))?;
         if o.chunk_routings == 0 {
             return Err("[output] chunk_routings = 0: a chunk needs at least one routing".into());
         }
+        let chunk_rows = u64::from(o.chunk_routings) * u64::from(t.count);
+        if chunk_rows > MAX_CHUNK_ROWS {
+            return Err(format!(
+                "[output] chunk_routings = {} × [tension] count = {} gives {chunk_rows} rows per chunk, more than \
+                 {MAX_CHUNK_ROWS} (each chunk is built in memory): lower chunk_routings to ≤ {}",
+                o.chunk_routings,
+                t.count,
+                (MAX_CHUNK_ROWS / u64::from(t.count)).max(1)
+            ));
+        }
         Ok(())
+    }
+
+    /// Checks the size of the whole sweep: more than [`MAX_ROWS`] rows is
+    /// refused (a typo like `levels = 99` means 10¹¹ rows) unless
+    /// `allow_large`, for a deliberate huge job.
+    pub fn check_size(&self, allow_large: bool) -> Result<(), String> {
+        let plan = super::SweepPlan::new(self);
+        let rows = plan.total_rows();
+        if rows > MAX_ROWS && !allow_large {
+            return Err(format!(
+                "the sweep has {rows} rows ({} routings × {} tensions), more than {MAX_ROWS}: check [grid] levels and \
+                 [tension] count, or pass --allow-large if the job is meant to be this big",
+                plan.routings, plan.tensions
+            ));
+        }
+        Ok(())
+    }
+
+    /// Whether a spec file's text sets nothing (empty, or comments only):
+    /// such a spec is the built-in thesis sweep, which the caller should say.
+    pub fn is_blank_toml(text: &str) -> bool {
+        text.lines().all(|l| {
+            let l = l.trim();
+            l.is_empty() || l.starts_with('#')
+        })
     }
 
     /// The tension ladder, N, in rising order.
@@ -261,6 +318,20 @@ mod tests {
         for i in 0..7 {
             assert_eq!(l[i], -l[6 - i]);
         }
+    }
+
+    #[test]
+    fn absurd_sizes_are_refused_before_allocation() {
+        assert!(err("[tension]\ncount = 4000000000\n").contains("count = 4000000000"));
+        assert!(err("[solver]\nsteps_per_span = 4000000000\n").contains("steps_per_span"));
+        assert!(err("[output]\norder = 9\n").contains("steps_per_span = 80"));
+        assert!(err("[tension]\ncount = 100000\n").contains("chunk_routings"));
+        let huge = SweepSpec::from_toml("[grid]\nlevels = 99\n", "t").unwrap();
+        assert!(huge.check_size(false).unwrap_err().contains("--allow-large"));
+        assert!(huge.check_size(true).is_ok());
+        assert!(SweepSpec::thesis().check_size(false).is_ok());
+        assert!(SweepSpec::is_blank_toml("\n# nothing\n  \n"));
+        assert!(!SweepSpec::is_blank_toml("[grid]\n"));
     }
 
     #[test]

@@ -2,7 +2,7 @@
 //! failures by status, chunks in progress, and whether the run is complete.
 
 use super::enumerate::SweepPlan;
-use super::store::{failures, total_status_counts, Manifest, RunDir};
+use super::store::{failures, total_status_counts, DamagedChunk, Manifest, RunDir};
 use super::SweepError;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -42,6 +42,9 @@ pub struct RunStatus {
     pub status_counts: BTreeMap<String, u64>,
     /// Temporary chunk files: chunks being written now, or left by a killed run.
     pub chunks_in_progress: u64,
+    /// Chunk files that failed their checksum or footer check (not counted
+    /// as done; the owning shard's rerun moves them aside and redoes them).
+    pub damaged: Vec<DamagedChunk>,
     /// Every row is written.
     pub complete: bool,
 }
@@ -85,6 +88,7 @@ pub fn run_status(dir: &Path) -> Result<RunStatus, SweepError> {
         rows_total: plan.total_rows(),
         status_counts,
         chunks_in_progress: scan.temporaries.len() as u64,
+        damaged: scan.damaged,
         complete: scan.chunks.len() as u64 == plan.chunks,
         manifest,
     })

@@ -4,13 +4,24 @@
 //! ```text
 //! DIR/manifest.json              what the run is: spec, hash, tool version, counts
 //! DIR/shards/chunk-000000.parquet  one file per chunk, complete or absent
-//! DIR/shards/.chunk-000001.parquet.tmp-PID   a chunk being written (dot: readers skip it)
+//! DIR/shards/.chunk-000001.parquet.tmp-TOKEN  a chunk being written (dot: readers skip it)
+//! DIR/checksums/chunk-000000.parquet.sha256  SHA-256 of the chunk file, written before it
+//! DIR/damaged/chunk-000003.parquet.TOKEN     a chunk that failed its check, moved aside
 //! ```
 //!
 //! Every file appears under its final name only when complete (written to a
-//! temporary name in the same folder, fsynced, renamed). The manifest is
-//! created with a hard link, which fails if another process (a concurrent
-//! array task) created it first; the loser checks it matches instead.
+//! temporary name in the same folder, fsynced, renamed). Temporary names are
+//! unique per writer ([`crate::io::unique_token`]), so two copies of one
+//! shard (a Kubernetes retry, a SLURM requeue, both as pid 1 in their
+//! containers) never share a file; a writer holds a lock on its temporary,
+//! and only unlocked (abandoned) temporaries are ever removed. Each chunk's checksum is
+//! committed before the chunk itself and verified whenever the run is
+//! scanned (status, resume, reduce): a chunk whose bytes changed is reported
+//! as damaged, and the sweep moves it to DIR/damaged and recomputes it.
+//! The manifest is created with a hard link, which fails if another process
+//! (a concurrent array task) created it first; the loser checks it matches
+//! instead. Its spec hash and counts are recomputed on every read, so an
+//! edited manifest is refused.
 
 use super::enumerate::SweepPlan;
 use super::spec::SweepSpec;
@@ -37,6 +48,10 @@ pub const MANIFEST: &str = "manifest.json";
 /// Folder of chunk files in DIR (only Parquet chunks live there, so any
 /// Parquet reader can read the folder as one dataset).
 pub const SHARDS_DIR: &str = "shards";
+/// Folder of chunk checksums in DIR (`chunk-000000.parquet.sha256`).
+pub const CHECKSUMS_DIR: &str = "checksums";
+/// Folder in DIR where damaged chunks are moved before being recomputed.
+pub const DAMAGED_DIR: &str = "damaged";
 
 /// Key-value metadata keys of each chunk file's footer.
 pub mod keys {
@@ -107,6 +122,48 @@ impl Manifest {
     }
 }
 
+impl Manifest {
+    /// Checks that the manifest is self-consistent: the spec hash is the
+    /// hash of the spec it holds and the counts follow from that spec. A
+    /// hand-edited field (a changed `tension.max_n`) fails here instead of
+    /// silently changing what later stages report.
+    pub fn verify(&self) -> Result<(), String> {
+        self.spec.validate().map_err(|e| format!("its spec is invalid ({e})"))?;
+        let hash = self.spec.hash_hex();
+        if hash != self.spec_sha256 {
+            return Err(format!(
+                "its spec hashes to {hash}, not the recorded spec_sha256 {} (the file was edited or damaged)",
+                self.spec_sha256
+            ));
+        }
+        let expected = Manifest { tool_version: self.tool_version.clone(), ..Manifest::new(&self.spec, self.shards) };
+        if self.shards == 0 {
+            return Err("shards = 0".into());
+        }
+        if *self != expected {
+            return Err(format!(
+                "its counts do not follow from its spec (routings {} tensions {} chunk_routings {} chunks {} total_rows {}; \
+                 expected {} {} {} {} {}): the file was edited or damaged",
+                self.routings, self.tensions, self.chunk_routings, self.chunks, self.total_rows,
+                expected.routings, expected.tensions, expected.chunk_routings, expected.chunks, expected.total_rows
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// A chunk file that failed its check: bytes changed since it was
+/// committed, footer unreadable, or wrong row count.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct DamagedChunk {
+    /// Chunk index.
+    pub chunk: u64,
+    /// Path of the file.
+    pub path: PathBuf,
+    /// What is wrong.
+    pub reason: String,
+}
+
 /// What a chunk file's footer says.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ChunkInfo {
@@ -163,6 +220,39 @@ impl RunDir {
         self.root.join(SHARDS_DIR)
     }
 
+    /// DIR/checksums.
+    pub fn checksums_dir(&self) -> PathBuf {
+        self.root.join(CHECKSUMS_DIR)
+    }
+
+    /// DIR/checksums/chunk-….parquet.sha256: the recorded checksum of chunk `chunk`.
+    pub fn checksum_path(&self, chunk: u64) -> PathBuf {
+        self.checksums_dir().join(format!("{}.sha256", chunk_file_name(chunk)))
+    }
+
+    /// Moves a damaged chunk file to DIR/damaged (kept for inspection,
+    /// under a unique name) and forgets its checksum, so the chunk is
+    /// recomputed. A file already gone (another copy of the shard moved it)
+    /// is not an error. Returns where it went.
+    pub fn move_aside(&self, damaged: &DamagedChunk) -> Result<Option<PathBuf>, SweepError> {
+        let dir = self.root.join(DAMAGED_DIR);
+        let io = |what: String, source| SweepError::Io { context: what, source };
+        std::fs::create_dir_all(&dir).map_err(|e| io(format!("creating {}", dir.display()), e))?;
+        let to = dir.join(format!("{}.{}", chunk_file_name(damaged.chunk), crate::io::unique_token()));
+        let moved = match std::fs::rename(&damaged.path, &to) {
+            Ok(()) => Some(to),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => None,
+            Err(e) => return Err(io(format!("moving damaged chunk {} to {}", damaged.path.display(), to.display()), e)),
+        };
+        match std::fs::remove_file(self.checksum_path(damaged.chunk)) {
+            Ok(()) => {}
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+            Err(e) => return Err(io(format!("removing {}", self.checksum_path(damaged.chunk).display()), e)),
+        }
+        crate::io::sync_dir(&self.shards_dir());
+        Ok(moved)
+    }
+
     /// Final path of chunk `chunk`.
     pub fn chunk_path(&self, chunk: u64) -> PathBuf {
         self.shards_dir().join(chunk_file_name(chunk))
@@ -171,7 +261,7 @@ impl RunDir {
     /// Reads and parses the manifest; `Ok(None)` when there is none.
     pub fn read_manifest(&self) -> Result<Option<Manifest>, SweepError> {
         let path = self.manifest_path();
-        let text = match std::fs::read_to_string(&path) {
+        let text = match crate::io::read_utf8(&path) {
             Ok(t) => t,
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
             Err(source) => return Err(SweepError::Io { context: format!("reading {}", path.display()), source }),
@@ -197,6 +287,7 @@ impl RunDir {
                 ),
             });
         }
+        manifest.verify().map_err(|message| SweepError::CorruptManifest { path, message })?;
         Ok(Some(manifest))
     }
 
@@ -235,6 +326,7 @@ impl RunDir {
             return Err(SweepError::ShardCountMismatch { dir: self.root.clone(), existing: existing.shards, wanted: shards });
         }
         std::fs::create_dir_all(self.shards_dir()).map_err(|e| io("creating shard folder in", e))?;
+        std::fs::create_dir_all(self.checksums_dir()).map_err(|e| io("creating checksum folder in", e))?;
         Ok(existing)
     }
 
@@ -245,7 +337,7 @@ impl RunDir {
     fn check_fresh_dir(&self) -> Result<(), SweepError> {
         for entry in list_dir(&self.root)? {
             let name = entry.to_string_lossy();
-            if name != MANIFEST && name != SHARDS_DIR && !is_manifest_temp(&name) {
+            if !is_run_entry(&name) {
                 return Err(SweepError::NotARunDir { dir: self.root.clone(), entry: name.into_owned() });
             }
         }
@@ -256,15 +348,19 @@ impl RunDir {
     /// unless one exists. Returns false when another process won.
     fn publish_manifest(&self, manifest: &Manifest) -> Result<bool, SweepError> {
         let path = self.manifest_path();
-        // Array tasks on different hosts can share a pid: add the time.
-        let nanos = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.subsec_nanos());
-        let tmp = self.root.join(format!(".{MANIFEST}.tmp-{}-{nanos}", std::process::id()));
+        let tmp = crate::io::temp_path(&path);
         let text = serde_json::to_string_pretty(manifest).expect("manifest serialises") + "\n";
         let io = |what: &str, source| SweepError::Io { context: format!("{what} {}", path.display()), source };
-        {
+        let written = (|| {
             use std::io::Write;
-            let mut f = File::create(&tmp).map_err(|e| io("writing", e))?;
-            f.write_all(text.as_bytes()).and_then(|_| f.sync_all()).map_err(|e| io("writing", e))?;
+            let mut f = File::create(&tmp)?;
+            f.write_all(text.as_bytes())?;
+            f.sync_all()
+        })();
+        if let Err(e) = written {
+            // A full disk must not leave a 0-byte temporary behind.
+            let _ = std::fs::remove_file(&tmp);
+            return Err(io("writing", e));
         }
         let linked = std::fs::hard_link(&tmp, &path);
         let _ = std::fs::remove_file(&tmp);
@@ -282,7 +378,7 @@ impl RunDir {
     pub fn scan(&self, manifest: &Manifest) -> Result<Scan, SweepError> {
         for entry in list_dir(&self.root)? {
             let name = entry.to_string_lossy();
-            if name != MANIFEST && name != SHARDS_DIR && !is_manifest_temp(&name) {
+            if !is_run_entry(&name) {
                 return Err(SweepError::ForeignFile { path: self.root.join(&entry) });
             }
         }
@@ -304,7 +400,24 @@ impl RunDir {
             }
             match parse_chunk_name(&name) {
                 Some(chunk) if chunk < manifest.chunks && path.is_file() => {
-                    scan.chunks.insert(chunk, check_chunk(&path, chunk, manifest, plan.chunk_rows(chunk))?);
+                    // A file of another job is refused (left for the user to
+                    // move) even when its checksum fails; any other failure
+                    // marks the chunk damaged.
+                    let footer = check_chunk(&path, chunk, manifest, plan.chunk_rows(chunk));
+                    let checked = match (self.verify_checksum(chunk, &path), footer) {
+                        (_, Err(e @ SweepError::ForeignChunk { .. })) => Err(e),
+                        (Err(e), _) => Err(e),
+                        (Ok(()), footer) => footer,
+                    };
+                    match checked {
+                        Ok(info) => {
+                            scan.chunks.insert(chunk, info);
+                        }
+                        Err(SweepError::CorruptChunk { path, message }) => {
+                            scan.damaged.push(DamagedChunk { chunk, path, reason: message })
+                        }
+                        Err(e) => return Err(e),
+                    }
                 }
                 _ => return Err(SweepError::ForeignFile { path }),
             }
@@ -312,11 +425,31 @@ impl RunDir {
         Ok(scan)
     }
 
-    /// Writes one chunk atomically: temporary file, footer, fsync, rename,
-    /// directory fsync.
+    /// Compares a chunk file's SHA-256 with the one recorded when it was
+    /// committed; a mismatch or a missing record is [`SweepError::CorruptChunk`].
+    fn verify_checksum(&self, chunk: u64, path: &Path) -> Result<(), SweepError> {
+        let corrupt = |message: String| SweepError::CorruptChunk { path: path.to_path_buf(), message };
+        let sum_path = self.checksum_path(chunk);
+        let recorded = match std::fs::read_to_string(&sum_path) {
+            Ok(text) => text.trim().to_string(),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+                return Err(corrupt(format!("no checksum recorded in {}", sum_path.display())))
+            }
+            Err(e) => return Err(SweepError::Io { context: format!("reading {}", sum_path.display()), source: e }),
+        };
+        let actual = crate::io::sha256_file(path)
+            .map_err(|e| SweepError::Io { context: format!("reading {}", path.display()), source: e })?;
+        if actual != recorded {
+            return Err(corrupt(format!("its SHA-256 is {actual}, not the {recorded} recorded when it was written")));
+        }
+        Ok(())
+    }
+
+    /// Writes one chunk atomically: temporary file (unique to this writer),
+    /// footer, fsync, checksum record, rename, directory fsync.
     pub fn write_chunk(&self, manifest: &Manifest, chunk: u64, batch: &RecordBatch) -> Result<ChunkInfo, SweepError> {
         let path = self.chunk_path(chunk);
-        let tmp = self.shards_dir().join(format!(".{}.tmp-{}", chunk_file_name(chunk), std::process::id()));
+        let tmp = crate::io::temp_path(&path);
         let io = |source| SweepError::Io { context: format!("writing {}", tmp.display()), source };
         let status_counts = count_statuses(batch);
         let kv = |k: &str, v: String| KeyValue::new(k.to_string(), v);
@@ -336,7 +469,7 @@ impl RunDir {
             .set_created_by(format!("cablemap {TOOL_VERSION}"))
             .set_key_value_metadata(Some(metadata))
             .build();
-        let file = File::create(&tmp).map_err(io)?;
+        let file = crate::io::create_locked(&tmp).map_err(io)?;
         let written = (|| {
             let mut writer = ArrowWriter::try_new(file, batch.schema(), Some(props))?;
             writer.write(batch)?;
@@ -346,9 +479,23 @@ impl RunDir {
             let _ = std::fs::remove_file(&tmp);
             SweepError::Parquet { context: format!("writing {}", tmp.display()), source: e }
         })?;
-        file.sync_all().map_err(io)?;
-        drop(file);
-        std::fs::rename(&tmp, &path).map_err(io)?;
+        let committed = (|| {
+            file.sync_all()?;
+            // The checksum goes first: a chunk under its final name always
+            // has its record. Two copies of a shard write identical bytes
+            // (results do not depend on threads), so their records agree.
+            let sum = crate::io::sha256_file(&tmp)?;
+            crate::io::write_atomic(&self.checksum_path(chunk), format!("{sum}\n").as_bytes())?;
+            // Renamed while still locked: a cleaner never sees it unlocked
+            // under its temporary name.
+            std::fs::rename(&tmp, &path)?;
+            drop(file);
+            Ok(())
+        })();
+        if let Err(e) = committed {
+            let _ = std::fs::remove_file(&tmp);
+            return Err(io(e));
+        }
         crate::io::sync_dir(&self.shards_dir());
         Ok(ChunkInfo { chunk, path, rows: batch.num_rows() as u64, status_counts })
     }
@@ -362,6 +509,8 @@ pub struct Scan {
     /// Temporary files (chunk index, path): chunks being written now or
     /// left by an interrupted run.
     pub temporaries: Vec<(u64, PathBuf)>,
+    /// Chunk files that failed their check (not in `chunks`).
+    pub damaged: Vec<DamagedChunk>,
 }
 
 /// `chunk-000012.parquet`.
@@ -379,16 +528,21 @@ pub fn parse_chunk_name(name: &str) -> Option<u64> {
     (chunk_file_name(chunk) == name).then_some(chunk)
 }
 
-/// The chunk index of a temporary chunk file name (`.chunk-….parquet.tmp-PID`).
+/// The chunk index of a temporary chunk file name (`.chunk-….parquet.tmp-TOKEN`).
 fn temp_chunk(name: &str) -> Option<u64> {
     let rest = name.strip_prefix('.')?;
-    let (final_name, pid) = rest.split_once(".tmp-")?;
-    pid.bytes().all(|b| b.is_ascii_digit()).then_some(())?;
-    parse_chunk_name(final_name)
+    let (final_name, _) = rest.split_once(".tmp-")?;
+    let chunk = parse_chunk_name(final_name)?;
+    crate::io::is_temp_of(name, final_name).then_some(chunk)
 }
 
 fn is_manifest_temp(name: &str) -> bool {
-    name.starts_with(&format!(".{MANIFEST}.tmp-"))
+    crate::io::is_temp_of(name, MANIFEST)
+}
+
+/// Entries cablemap itself puts at the top of a run directory.
+fn is_run_entry(name: &str) -> bool {
+    [MANIFEST, SHARDS_DIR, CHECKSUMS_DIR, DAMAGED_DIR].contains(&name) || is_manifest_temp(name)
 }
 
 fn list_dir(dir: &Path) -> Result<Vec<std::ffi::OsString>, SweepError> {
@@ -421,7 +575,10 @@ pub fn check_chunk(path: &Path, chunk: u64, manifest: &Manifest, rows: u64) -> R
         )));
     }
     if kv.get(keys::CHUNK).and_then(|c| c.parse::<u64>().ok()) != Some(chunk) {
-        return Err(foreign(format!("its metadata names chunk {:?}, not {chunk}", kv.get(keys::CHUNK))));
+        return Err(foreign(format!(
+            "its metadata names chunk '{}', not {chunk}",
+            kv.get(keys::CHUNK).unwrap_or(&"(none)")
+        )));
     }
     let file_rows = meta.file_metadata().num_rows();
     if file_rows != rows as i64 {
@@ -460,7 +617,8 @@ mod tests {
         }
         assert_eq!(temp_chunk(".chunk-000007.parquet.tmp-4242"), Some(7));
         assert_eq!(temp_chunk("chunk-000007.parquet.tmp-4242"), None);
-        assert_eq!(temp_chunk(".chunk-000007.parquet.tmp-42x"), None);
+        assert_eq!(temp_chunk(".chunk-000007.parquet.tmp-1-00ab12cd34ef5678-3"), Some(7));
+        assert_eq!(temp_chunk(".chunk-000007.parquet.tmp-42/x"), None);
         assert!(is_manifest_temp(".manifest.json.tmp-12-345"));
     }
 

@@ -1,0 +1,264 @@
+//! Bad and extreme input, as the hostile probe of issue 10 gave it: every
+//! case ends in a clear error (or a clearly stated choice) instead of a
+//! panic, an out-of-memory abort, a hang or a silently wrong result.
+
+use std::io::Read;
+use std::path::Path;
+use std::process::{Command, Stdio};
+
+const QUICK: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/jobs/quick.toml");
+
+fn cablemap() -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_cablemap"));
+    for v in ["SLURM_ARRAY_TASK_ID", "JOB_COMPLETION_INDEX", "SLURM_CPUS_PER_TASK"] {
+        c.env_remove(v);
+    }
+    c
+}
+
+fn run(args: &[&str]) -> (bool, String, String) {
+    let out = cablemap().args(args).output().expect("runs");
+    let stderr: String = String::from_utf8_lossy(&out.stderr).into();
+    assert!(!stderr.contains("panicked"), "{args:?} panicked: {stderr}");
+    assert_ne!(out.status.code(), Some(101), "{args:?}: exit 101 (panic)");
+    (out.status.success(), String::from_utf8_lossy(&out.stdout).into(), stderr)
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+fn refused(args: &[&str], needles: &[&str]) -> String {
+    let (ok, stdout, stderr) = run(args);
+    assert!(!ok, "{args:?} was accepted: {stdout}");
+    for n in needles {
+        assert!(stderr.contains(n), "{args:?}: '{n}' not in: {stderr}");
+    }
+    stderr
+}
+
+const R: [&str; 4] = ["--routing", "0,2,-3,4,-2", "--tension", "1.5"];
+
+#[test]
+fn orders_the_steps_do_not_resolve_are_refused_with_the_steps_that_would() {
+    fn sim<'a>(extra: &[&'a str]) -> Vec<&'a str> {
+        [&["simulate"][..], &R, extra].concat()
+    }
+    refused(&sim(&["--order", "12"]), &["order 12 is not resolved at 24 steps", "--steps-per-span 144"]);
+    refused(&sim(&["--order", "100"]), &["highest supported order 16"]);
+    refused(&sim(&["--order", "100000000000"]), &["highest supported order 16"]);
+    // With the steps the message asks for, the coefficients are the converged ones.
+    let a = |extra: &[&str]| -> Vec<f64> {
+        let (ok, out, err) = run(&sim(&[extra, &["--json"][..]].concat()));
+        assert!(ok, "{err}");
+        let v: serde_json::Value = serde_json::from_str(out.trim()).unwrap();
+        v["a"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect()
+    };
+    let at_144 = a(&["--order", "12", "--steps-per-span", "144"]);
+    let at_1024 = a(&["--order", "12", "--steps-per-span", "1024"]);
+    for k in 0..=12 {
+        assert!((at_144[k] - at_1024[k]).abs() <= 5e-5, "a_{k}: {} vs {}", at_144[k], at_1024[k]);
+    }
+    // The default order is resolved at the default steps.
+    assert_eq!(a(&[]).len(), 4);
+    // So is a design target, before the search.
+    refused(&["design", "--target", "x=50,y=5,a9=0.001"], &["order 9", "--steps-per-span 80"]);
+    // A sweep spec is checked the same way, before any file is written.
+    let tmp = tempfile::tempdir().unwrap();
+    let spec = tmp.path().join("o.toml");
+    std::fs::write(&spec, "[output]\norder = 9\n").unwrap();
+    refused(&["sweep", s(&spec), "--out", s(&tmp.path().join("run"))], &["order 9", "steps_per_span = 80"]);
+    assert!(!tmp.path().join("run").exists());
+}
+
+#[test]
+fn absurd_sizes_are_refused_up_front_and_leave_nothing_behind() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("run");
+    for (text, needle) in [
+        ("[tension]\ncount = 4000000000\n", "count = 4000000000"),
+        ("[solver]\nsteps_per_span = 4000000000\n", "steps_per_span = 4000000000"),
+        ("[grid]\nlevels = 99\n", "--allow-large"),
+        ("[grid]\nlevels = 100\n", "levels = 100"),
+        ("[tension]\ncount = 100000\n", "lower chunk_routings"),
+    ] {
+        let spec = tmp.path().join("big.toml");
+        std::fs::write(&spec, text).unwrap();
+        refused(&["sweep", s(&spec), "--out", s(&out)], &[needle]);
+        assert!(!out.exists(), "{text}: a run directory was created");
+    }
+    refused(&["simulate", R[0], R[1], R[2], R[3], "--steps-per-span", "2000000000"], &["steps_per_span", "100000"]);
+    refused(&["simulate", R[0], R[1], R[2], R[3], "--coefficients", "thesis", "--n-d", "1000000000"], &["--n-d", "100000"]);
+    refused(&["synth", "--out", s(&tmp.path().join("m.csv")), "--load-steps", "1000000"], &["--load-steps ≤ 1000"]);
+    assert!(!tmp.path().join("m.csv").exists());
+    let (ok, _, _) = run(&["sweep", QUICK, "--out", s(&tmp.path().join("q")), "--quiet"]);
+    assert!(ok);
+    refused(&["reduce", s(&tmp.path().join("q")), "--out", s(&tmp.path().join("m")), "--cell-mm", "5e-324"], &["too small"]);
+}
+
+#[test]
+fn huge_thread_counts_are_capped_and_huge_log_intervals_do_not_panic() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (ok, stdout, stderr) = run(&["sweep", QUICK, "--out", s(&tmp.path().join("a")), "--threads", "10000"]);
+    assert!(ok, "{stderr}");
+    assert!(stderr.contains("more than 4 per core"), "{stderr}");
+    let cores = std::thread::available_parallelism().unwrap().get();
+    assert!(stdout.contains(&format!("{} threads", 4 * cores)), "{stdout}");
+    let (ok, _, stderr) = run(&["sweep", QUICK, "--out", s(&tmp.path().join("b")), "--log-interval-s", "1e20"]);
+    assert!(ok, "{stderr}");
+}
+
+/// Starts `args`, closes its stdout at once, and returns how it ended.
+fn with_closed_stdout(args: &[&str]) -> (std::process::ExitStatus, String) {
+    let mut child = cablemap().args(args).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap();
+    drop(child.stdout.take());
+    let mut stderr = String::new();
+    child.stderr.take().unwrap().read_to_string(&mut stderr).unwrap();
+    (child.wait().unwrap(), stderr)
+}
+
+#[test]
+fn a_closed_pipe_ends_the_command_quietly_instead_of_panicking() {
+    use std::os::unix::process::ExitStatusExt;
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("run");
+    assert!(run(&["sweep", QUICK, "--out", s(&dir), "--quiet"]).0);
+    for args in [vec!["status", s(&dir)], vec!["sweep", QUICK, "--out", s(&dir), "--quiet"]] {
+        let (status, stderr) = with_closed_stdout(&args);
+        assert!(!stderr.contains("panicked") && status.code() != Some(101), "{args:?}: {status:?} {stderr}");
+        assert!(status.success() || status.signal() == Some(13), "{args:?}: {status:?} {stderr}");
+    }
+    // The run is intact.
+    assert!(run(&["status", s(&dir)]).0);
+}
+
+#[test]
+fn a_blank_spec_says_it_runs_the_thesis_defaults() {
+    let tmp = tempfile::tempdir().unwrap();
+    let spec = tmp.path().join("empty.toml");
+    std::fs::write(&spec, "# nothing yet\n").unwrap();
+    let mut child = cablemap()
+        .args(["sweep", s(&spec), "--out", s(&tmp.path().join("run")), "--threads", "1"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut first = [0u8; 200];
+    let n = child.stderr.as_mut().unwrap().read(&mut first).unwrap();
+    let _ = child.kill(); // the thesis sweep itself is not needed
+    child.wait().unwrap();
+    let text = String::from_utf8_lossy(&first[..n]);
+    assert!(text.contains("sets nothing") && text.contains("thesis"), "{text}");
+}
+
+#[test]
+fn synth_keeps_an_existing_file_unless_forced() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("m.csv");
+    std::fs::write(&out, "precious").unwrap();
+    refused(&["synth", "--out", s(&out)], &["exists", "--force"]);
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), "precious");
+    let (ok, _, stderr) = run(&["synth", "--out", s(&out), "--force"]);
+    assert!(ok, "{stderr}");
+    assert!(std::fs::read_to_string(&out).unwrap().starts_with("measurement,"));
+}
+
+#[test]
+fn negative_numbers_reach_validation_and_get_its_message() {
+    let tmp = tempfile::tempdir().unwrap();
+    refused(&["design", "--target", "x=50,y=5", "--tension-min-n", "-1"], &["τ_l = -1"]);
+    refused(&["synth", "--out", s(&tmp.path().join("m.csv")), "--noise-mm", "-1"], &["noise_mm = -1"]);
+    refused(&[&["simulate"][..], &R, &["--ea-n", "-3"]].concat(), &["ea_n"]);
+}
+
+#[test]
+fn calibrating_absurd_data_is_an_error_not_a_converged_fit() {
+    let tmp = tempfile::tempdir().unwrap();
+    let good = tmp.path().join("m.csv");
+    assert!(run(&["synth", "--out", s(&good)]).0);
+    let text = std::fs::read_to_string(&good).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap();
+    let cols: Vec<&str> = header.split(',').collect();
+    let (ix, iy) = (cols.iter().position(|c| *c == "tip_x_mm").unwrap(), cols.iter().position(|c| *c == "tip_y_mm").unwrap());
+    let mut absurd = format!("{header}\n");
+    for line in lines {
+        let mut cells: Vec<String> = line.split(',').map(String::from).collect();
+        cells[ix] = "1e300".into();
+        cells[iy] = "-1e300".into();
+        absurd.push_str(&(cells.join(",") + "\n"));
+    }
+    let bad = tmp.path().join("absurd.csv");
+    std::fs::write(&bad, absurd).unwrap();
+    let stderr = refused(&["calibrate", s(&bad), "--json"], &["absurdly far", "units"]);
+    assert!(stderr.contains("1e300") && !stderr.contains("00000000000"), "{stderr}");
+}
+
+#[test]
+fn other_delimiters_and_encodings_are_named() {
+    let tmp = tempfile::tempdir().unwrap();
+    let good = tmp.path().join("m.csv");
+    assert!(run(&["synth", "--out", s(&good)]).0);
+    let text = std::fs::read_to_string(&good).unwrap();
+    for (sep, name) in [(";", "semicolon"), ("\t", "tab")] {
+        let path = tmp.path().join(format!("{name}.csv"));
+        std::fs::write(&path, text.replace(',', sep)).unwrap();
+        refused(&["calibrate", s(&path)], &[&format!("{name}-separated"), "comma"]);
+    }
+    let latin1 = tmp.path().join("latin1.toml");
+    std::fs::write(&latin1, b"# r\xe9glage\n[tension]\ncount = 5\n").unwrap();
+    let stderr = refused(&["sweep", s(&latin1), "--out", s(&tmp.path().join("run"))], &["not UTF-8", "iconv"]);
+    assert_eq!(stderr.matches("not UTF-8").count(), 1, "{stderr}");
+    // OS error texts appear once.
+    let stderr = refused(&["sweep", s(&tmp.path().join("missing.toml")), "--out", s(&tmp.path().join("run"))], &["missing.toml"]);
+    assert_eq!(stderr.matches("No such file or directory").count(), 1, "{stderr}");
+}
+
+#[test]
+fn parquet_measurement_files_in_every_standard_codec_are_read() {
+    use arrow::array::{ArrayRef, Float64Array, Int64Array, StringArray};
+    use arrow::record_batch::RecordBatch;
+    use parquet::basic::{BrotliLevel, Compression, GzipLevel, ZstdLevel};
+    use std::sync::Arc;
+    let tmp = tempfile::tempdir().unwrap();
+    let csv = tmp.path().join("m.csv");
+    assert!(run(&["synth", "--out", s(&csv)]).0);
+    let reference = cablemap::calibrate::data::read_measurements(&csv).unwrap();
+    // The CSV as a typed table, as pandas would write it.
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
+    let rows: Vec<Vec<String>> = lines.map(|l| l.split(',').map(String::from).collect()).collect();
+    let columns: Vec<(String, ArrayRef)> = header
+        .iter()
+        .enumerate()
+        .map(|(j, name)| {
+            let cells = rows.iter().map(|r| r[j].clone());
+            let array: ArrayRef = match name.as_str() {
+                "measurement" | "step" => Arc::new(Int64Array::from_iter_values(cells.map(|c| c.parse().unwrap()))),
+                "routing" | "direction" => Arc::new(StringArray::from_iter_values(cells)),
+                _ => Arc::new(Float64Array::from_iter_values(cells.map(|c| c.parse().unwrap()))),
+            };
+            (name.clone(), array)
+        })
+        .collect();
+    let batch = RecordBatch::try_from_iter(columns).unwrap();
+    for (name, codec) in [
+        ("snappy", Compression::SNAPPY),
+        ("gzip", Compression::GZIP(GzipLevel::default())),
+        ("lz4", Compression::LZ4_RAW),
+        ("lz4-hadoop", Compression::LZ4),
+        ("brotli", Compression::BROTLI(BrotliLevel::default())),
+        ("zstd", Compression::ZSTD(ZstdLevel::default())),
+        ("none", Compression::UNCOMPRESSED),
+    ] {
+        let path = tmp.path().join(format!("m-{name}.parquet"));
+        let props = parquet::file::properties::WriterProperties::builder().set_compression(codec).build();
+        let mut w = parquet::arrow::ArrowWriter::try_new(std::fs::File::create(&path).unwrap(), batch.schema(), Some(props)).unwrap();
+        w.write(&batch).unwrap();
+        w.close().unwrap();
+        let read = cablemap::calibrate::data::read_measurements(&path).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(read.rows.len(), reference.rows.len(), "{name}");
+        assert_eq!(format!("{:?}", read.rows), format!("{:?}", reference.rows), "{name}");
+    }
+}
