@@ -81,7 +81,7 @@ mod tests {
                 sim.solve(t).unwrap();
             }
             let mut a = vec![0.0; order + 1];
-            sim.coefficients_into(&mut a);
+            sim.coefficients_into(crate::shape::LengthBasis::Rest, &mut a);
             a
         };
         for order in [5, 9] {
