@@ -124,6 +124,8 @@ pub fn synthesize(spec: &SynthSpec, points: usize) -> Result<(Dataset, Centrelin
                 tip_y_mm: 0.0,
                 tip_angle_rad: 0.0,
                 clamp_tilt_rad,
+                noise_mm: None,
+                noise_deg: None,
                 row: measurement as usize,
             });
         }

@@ -18,12 +18,17 @@ pub struct SynthArgs {
     /// Output measurement file (CSV).
     #[arg(long, value_name = "FILE")]
     pub out: PathBuf,
-    /// Hidden effect: none, friction, gravity, stiffening, clamp_compliance, channel_offset or creep.
+    /// Hidden effect: none, friction, gravity, stiffening, clamp_compliance, channel_offset or creep; or, for testing the
+    /// diagnosis, an effect outside its candidate list: rest_curvature (a rod cured bent) or glue_joint (a stiff segment at the clamp).
     #[arg(long, default_value = "none")]
     pub effect: String,
-    /// The hidden effect's parameter: μ, gravity scale k, α, k_θ (N·mm/rad), δ (mm) or creep fraction f.
+    /// The hidden effect's parameter: μ, gravity scale k, α, k_θ (N·mm/rad), δ (mm), creep fraction f; rest curvature
+    /// (1/mm) or the glue joint's EI factor.
     #[arg(long, allow_hyphen_values = true)]
     pub magnitude: Option<f64>,
+    /// Length of the glue joint from the clamp, mm (with --effect glue_joint).
+    #[arg(long, default_value_t = 5.0, value_name = "MM")]
+    pub glue_length_mm: f64,
     /// Seed of the noise.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -63,6 +68,10 @@ pub struct SynthArgs {
     pub actuator: ActuatorArgs,
 }
 
+/// Effects `synth` can hide that are deliberately not diagnosis candidates,
+/// so that tests can check the diagnosis answers `unexplained` for them.
+pub const OUT_OF_LIBRARY: [&str; 2] = ["rest_curvature", "glue_joint"];
+
 /// Routings parsed from `--routings`, with the per-routing clamp tilts.
 type ParsedRoutings = (Vec<(String, [f64; CONTROL_POINTS])>, BTreeMap<String, f64>);
 
@@ -98,9 +107,20 @@ pub fn parse_routings(text: &str) -> anyhow::Result<ParsedRoutings> {
 /// Runs `cablemap synth`.
 pub fn run(args: &SynthArgs) -> anyhow::Result<()> {
     let mut actuator = args.actuator.apply(&Actuator::default());
-    if args.effect != "none" {
+    if let Some(hidden) = OUT_OF_LIBRARY.iter().find(|h| **h == args.effect) {
+        let Some(m) = args.magnitude else {
+            bail!("--effect {hidden} needs --magnitude ({})", if *hidden == "rest_curvature" { "the rest curvature in 1/mm, e.g. 0.004" } else { "the joint's EI factor, e.g. 5" });
+        };
+        let h = &mut actuator.effects.hidden;
+        if *hidden == "rest_curvature" {
+            h.rest_curvature_per_mm = m;
+        } else {
+            h.base_segment_ei_factor = m;
+            h.base_segment_mm = args.glue_length_mm;
+        }
+    } else if args.effect != "none" {
         let Some(effect) = Effect::parse(&args.effect) else {
-            let names: Vec<&str> = Effect::ALL.iter().map(|e| e.name()).collect();
+            let names: Vec<&str> = Effect::ALL.iter().map(|e| e.name()).chain(OUT_OF_LIBRARY).collect();
             bail!("--effect {}: unknown effect; use none or one of {}", args.effect, names.join(", "));
         };
         let Some(m) = args.magnitude else {
