@@ -629,8 +629,21 @@ pub fn fit(
         iterations += 1;
         let (j, _) = problem.jacobian(&x, &r);
         let rv = DVector::from_column_slice(&r);
-        let a = j.transpose() * &j;
-        let g = j.transpose() * rv;
+        let mut a = j.transpose() * &j;
+        let mut g = j.transpose() * rv;
+        // A coordinate at its bound whose descent direction points outward
+        // is held this iteration (a projected step), so the others can settle.
+        for (k, &idx) in problem.free.iter().enumerate() {
+            let (lo, hi) = bounds[idx];
+            if (x[idx] <= lo + 1e-9 && g[k] > 0.0) || (x[idx] >= hi - 1e-9 && g[k] < 0.0) {
+                g[k] = 0.0;
+                for c in 0..p {
+                    a[(k, c)] = 0.0;
+                    a[(c, k)] = 0.0;
+                }
+                a[(k, k)] = 1.0;
+            }
+        }
         let diag_floor = a.diagonal().max() * 1e-12 + 1e-300;
         let mut accepted = None;
         while lambda < 1e12 {

@@ -164,6 +164,9 @@ pub fn run(args: &CalibrateArgs) -> anyhow::Result<()> {
     if args.json {
         let mut v = fit_json(&result);
         v["holdout"] = serde_json::to_value(&holdout_rms)?;
+        let held: serde_json::Map<String, serde_json::Value> =
+            held_effects.iter().map(|e| (e.parameter_name().to_string(), serde_json::json!(e.current(&start).unwrap_or(0.0)))).collect();
+        v["held_effects"] = serde_json::Value::Object(held);
         writeln!(out, "{v}")?;
         return Ok(());
     }
@@ -183,6 +186,10 @@ pub fn run(args: &CalibrateArgs) -> anyhow::Result<()> {
         } else {
             writeln!(out, "  {:<30} {:>14.6} ± {:<12.4e}", p.name, p.value, p.se)?;
         }
+    }
+    for e in &held_effects {
+        let v = e.current(&start).unwrap_or(0.0);
+        writeln!(out, "  {:<30} {:>14.6}   (held)", e.parameter_name(), v)?;
     }
     writeln!(out, "correlations:")?;
     write!(out, "  {:<30}", "")?;

@@ -2,8 +2,8 @@
 //! hidden effect and noise.
 
 use super::{parse_list, ActuatorArgs};
-use crate::calibrate::data::{centrelines_csv, measurements_csv};
-use crate::calibrate::synth::{default_routings, synthesize, SynthSpec};
+use crate::calibrate::data::{centrelines_csv, markers_csv, measurements_csv};
+use crate::calibrate::synth::{default_routings, synthesize_with_markers, SynthSpec};
 use crate::calibrate::Effect;
 use crate::model::routing::CONTROL_POINTS;
 use crate::model::{Actuator, SolverOptions};
@@ -64,6 +64,13 @@ pub struct SynthArgs {
     /// Centreline points per reading.
     #[arg(long, default_value_t = 21)]
     pub centreline_points: usize,
+    /// Also write markers (measurement,s_mm,offset_mm,x_mm,y_mm) here.
+    #[arg(long, value_name = "FILE")]
+    pub markers_out: Option<PathBuf>,
+    /// Markers as "s:offset;s:offset" in mm (rest arc length, lateral body-frame offset) [default: L/4, L/2, 3L/4 and L on
+    /// alternate sides at the surface].
+    #[arg(long, allow_hyphen_values = true, value_name = "S:OFFSET;…")]
+    pub markers: Option<String>,
     #[command(flatten)]
     pub actuator: ActuatorArgs,
 }
@@ -104,6 +111,22 @@ pub fn parse_routings(text: &str) -> anyhow::Result<ParsedRoutings> {
     Ok((out, tilts))
 }
 
+/// Parses "s:offset;s:offset" (mm).
+fn parse_markers(text: &str) -> anyhow::Result<Vec<(f64, f64)>> {
+    let mut out = Vec::new();
+    for item in text.split(';').filter(|s| !s.trim().is_empty()) {
+        let parsed = item.split_once(':').and_then(|(s, o)| Some((s.trim().parse::<f64>().ok()?, o.trim().parse::<f64>().ok()?)));
+        let Some(m) = parsed else {
+            bail!("--markers: '{item}' should look like s_mm:offset_mm, e.g. 32.5:5");
+        };
+        out.push(m);
+    }
+    if out.is_empty() {
+        bail!("--markers: no marker given");
+    }
+    Ok(out)
+}
+
 /// Runs `cablemap synth`.
 pub fn run(args: &SynthArgs) -> anyhow::Result<()> {
     let mut actuator = args.actuator.apply(&Actuator::default());
@@ -135,7 +158,17 @@ pub fn run(args: &SynthArgs) -> anyhow::Result<()> {
         Some(t) => parse_routings(t)?,
         None => (default_routings(), BTreeMap::new()),
     };
+    let markers = match (&args.markers_out, &args.markers) {
+        (None, Some(_)) => bail!("--markers needs --markers-out FILE"),
+        (None, None) => Vec::new(),
+        (Some(_), Some(text)) => parse_markers(text)?,
+        (Some(_), None) => {
+            let (l, r) = (actuator.length_mm, actuator.radius_mm);
+            vec![(0.25 * l, r), (0.5 * l, -r), (0.75 * l, r), (l, -r)]
+        }
+    };
     let spec = SynthSpec {
+        markers,
         actuator,
         options: args.actuator.solver_options(&SolverOptions::default()),
         routings,
@@ -150,11 +183,14 @@ pub fn run(args: &SynthArgs) -> anyhow::Result<()> {
         seed: args.seed,
     };
     let points = if args.centreline_out.is_some() { args.centreline_points.max(2) } else { 0 };
-    let (data, centrelines) = synthesize(&spec, points)?;
+    let (data, centrelines, markers) = synthesize_with_markers(&spec, points)?;
     crate::io::write_atomic(&args.out, measurements_csv(&data).as_bytes())
         .with_context(|| format!("writing {}", args.out.display()))?;
     if let Some(path) = &args.centreline_out {
         crate::io::write_atomic(path, centrelines_csv(&centrelines).as_bytes()).with_context(|| format!("writing {}", path.display()))?;
+    }
+    if let Some(path) = &args.markers_out {
+        crate::io::write_atomic(path, markers_csv(&markers).as_bytes()).with_context(|| format!("writing {}", path.display()))?;
     }
     eprintln!(
         "wrote {} readings of {} routings to {} (hidden effect: {}{})",
