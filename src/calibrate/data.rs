@@ -580,6 +580,19 @@ mod tests {
     }
 
     #[test]
+    fn reads_static_captures_and_per_row_noise() {
+        let text = format!("{HEADER},noise_mm,noise_deg\n1,a,1,1,1,1,1,0.5,static,0,5,60,10,0.3,0.8,\n2,a,1,1,1,1,1,1.5,Static,1,5,55,20,0.6,,3\n");
+        let d = parse(&text).unwrap();
+        assert_eq!(d.rows[0].direction, Direction::Static);
+        assert_eq!((d.rows[0].noise_mm, d.rows[0].noise_deg), (Some(0.8), None));
+        assert_eq!((d.rows[1].noise_mm, d.rows[1].noise_deg), (None, Some(3.0)));
+        let again = parse(&measurements_csv(&d)).unwrap();
+        assert_eq!(again, Dataset { rows: d.rows.clone() });
+        let bad = parse(&format!("{HEADER},noise_mm\n1,a,1,1,1,1,1,0.5,load,0,5,60,10,0.3,0\n")).unwrap_err().to_string();
+        assert!(bad.contains("noise_mm") && bad.contains("row 1"), "{bad}");
+    }
+
+    #[test]
     fn reads_parquet_like_csv() {
         use arrow::array::{ArrayRef, Float64Array, Int64Array, StringArray};
         use arrow::record_batch::RecordBatch;

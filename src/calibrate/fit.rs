@@ -944,6 +944,68 @@ mod tests {
     }
 
     #[test]
+    fn a_jacobian_step_the_model_cannot_solve_does_not_abort_the_fit() {
+        // A straight, centred channel without gravity: v1 = 1 − τ/EA along
+        // the whole rod, so the rod collapses exactly when EA ≤ τ. Starting
+        // EA just above the top tension puts the Jacobian's minus step past
+        // the collapse; the fit must fall back to a one-sided difference.
+        let mut t = truth();
+        t.gravity.enabled = false;
+        let spec = SynthSpec {
+            actuator: t.clone(),
+            noise_mm: 0.0,
+            noise_deg: 0.0,
+            routings: vec![("z".into(), [0.0; 5])],
+            load_steps: 2,
+            max_tension_n: 2.0,
+            ..SynthSpec::default()
+        };
+        let (data, _) = synthesize(&spec, 0).unwrap();
+        let mut start = t.clone();
+        start.ea_n = 2.0 * (1.0 + 5e-7);
+        // GA and EI do nothing on a straight, unbent rod: hold them.
+        let fs = FitSpec { fixed_rigidities: [false, true, true], ..FitSpec::default() };
+        let r = fit(&start, &SolverOptions::default(), &data, &data.groups(), &fs).unwrap();
+        assert!(r.converged, "{:?}", r.flags);
+        assert!((r.parameters[0].value - 30.0).abs() < 1e-6 * 30.0, "{:?}", r.parameters[0]);
+        assert!(r.parameters[1].fixed && r.parameters[1].se == 0.0 && r.parameters[1].value == t.ga_n);
+    }
+
+    #[test]
+    fn centreline_distances_and_markers_follow_the_geometry() {
+        // A straight centreline along +x from the clamp to 65 mm, frame angle 0.
+        let mut a = Actuator::default();
+        a.gravity.enabled = false;
+        let mut sim = crate::model::Simulator::new(&a, &SolverOptions::default()).unwrap();
+        sim.set_routing_mm(&[0.0; 5]).unwrap();
+        sim.solve(0.0).unwrap();
+        let template = sim.centreline()[0];
+        let line: Vec<CentrelinePoint> =
+            (0..=13).map(|k| 5.0 * k as f64).map(|s| CentrelinePoint { s_mm: s, x_mm: s, y_mm: 0.0, frame_angle_rad: 0.0, ..template }).collect();
+        assert!((signed_distance_to_centreline([10.0, 2.0], &line) - 2.0).abs() < 1e-12);
+        assert!((signed_distance_to_centreline([12.5, -1.5], &line) + 1.5).abs() < 1e-12);
+        // Past the tip the last segment is extended: only the side distance counts.
+        let (d, s) = closest_on_centreline([70.0, -1.0], &line);
+        assert!((d + 1.0).abs() < 1e-12 && (s - 65.0).abs() < 1e-12, "{d} {s}");
+        let m = simulated_marker(&Marker { s_mm: 32.5, offset_mm: 5.0, x_mm: 0.0, y_mm: 0.0 }, &line);
+        assert!((m[0] - 32.5).abs() < 1e-12 && (m[1] - 5.0).abs() < 1e-12, "{m:?}");
+        // Turned by a quarter turn, the offset points along −x.
+        let turned: Vec<CentrelinePoint> = line.iter().map(|p| CentrelinePoint { x_mm: 0.0, y_mm: p.s_mm, frame_angle_rad: std::f64::consts::FRAC_PI_2, ..*p }).collect();
+        let m = simulated_marker(&Marker { s_mm: 20.0, offset_mm: 5.0, x_mm: 0.0, y_mm: 0.0 }, &turned);
+        assert!((m[0] + 5.0).abs() < 1e-12 && (m[1] - 20.0).abs() < 1e-12, "{m:?}");
+    }
+
+    #[test]
+    fn huber_keeps_small_residuals_and_tames_large_ones() {
+        let l = Loss::Huber { k: 3.0 };
+        assert_eq!(l.transform(2.0), 2.0);
+        assert!((l.transform(-50.0).powi(2) - (2.0 * 3.0 * 50.0 - 9.0)).abs() < 1e-9);
+        assert!(l.transform(-50.0) < 0.0);
+        assert_eq!(max_outliers(44), 3);
+        assert_eq!(max_outliers(10), 2);
+    }
+
+    #[test]
     fn noisy_fit_lands_within_its_uncertainty() {
         let t = truth();
         for seed in 1..=3 {

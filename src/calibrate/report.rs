@@ -307,7 +307,7 @@ fn coefficient_section(out: &mut String, data: &Dataset, d: &Diagnosis, centreli
     let _ = writeln!(out, "| routing | reading | tension (N) | shape | {} |\n|---|---|---|---|{}", heads.join(" | "), "---|".repeat(SHAPE_ORDER + 1));
     let cells = |a: &Option<Vec<f64>>| match a {
         Some(a) => a.iter().map(|v| format!("{v:+.5}")).collect::<Vec<_>>().join(" | "),
-        None => vec!["—"; SHAPE_ORDER + 1].join(" | "),
+        None => ["—"; SHAPE_ORDER + 1].join(" | "),
     };
     for (routing, id, t, measured, base, ext) in &rows {
         let _ = writeln!(out, "| {routing} | {id} | {} | measured | {} |", num(*t), cells(measured));
