@@ -412,7 +412,8 @@ fn fit_of(fits: &[(Effect, FitResult)], e: Effect) -> FitResult {
 }
 
 fn chi2_text(f: &FitResult) -> String {
-    format!("χ² = {:.1} on {} dof, χ²/dof = {:.2}, p = {:.1e}", f.chi2, f.dof, f.reduced_chi2, f.p_value)
+    let p = if f.p_value < 1e-99 { "p < 1e-99".to_string() } else { format!("p = {:.1e}", f.p_value) };
+    format!("χ² = {:.1} on {} dof, χ²/dof = {:.2}, {p}", f.chi2, f.dof, f.reduced_chi2)
 }
 
 /// Runs the whole workflow on `data` with `base` as the starting actuator.
@@ -544,7 +545,7 @@ pub fn diagnose(base: &Actuator, options: &SolverOptions, data: &Dataset, spec: 
                 extended = baseline.clone();
                 verdict = "unexplained".into();
                 reason = format!(
-                    "even the best model tried ({}) stays above the stated noise: {} < {:.0e} (chi-square test of the noise-whitened residuals); the data show something no candidate effect describes, or the noise is larger than stated",
+                    "even the best model tried ({}) stays above the stated noise: {}, below {:.0e} (chi-square test of the noise-whitened residuals); the data show something no candidate effect describes, or the noise is larger than stated",
                     model_name(&judged),
                     chi2_text(&judged),
                     spec.alpha

@@ -45,7 +45,7 @@ pub fn write_report(
     atomic("loops.png", &|p| loop_plot(p, data, &groups, d, after_label))?;
     atomic("shapes.png", &|p| shape_plot(p, data, &groups, d, centrelines, after_label))?;
     crate::io::sync_dir(dir);
-    let md = markdown(data_path, data, d, after_label, centrelines);
+    let md = markdown(data_path, data, d, after_label, centrelines, spec.fit.noise.mm);
     let path = dir.join("report.md");
     crate::io::write_atomic(&path, md.as_bytes())
         .map_err(|source| CalibrateError::Io { context: format!("writing {}", path.display()), source })?;
@@ -163,7 +163,7 @@ fn fit_section(out: &mut String, title: &str, f: &FitResult) {
     out.push('\n');
 }
 
-fn markdown(data_path: &Path, data: &Dataset, d: &Diagnosis, after_label: Option<&str>, centrelines: Option<&CentrelinePoints>) -> String {
+fn markdown(data_path: &Path, data: &Dataset, d: &Diagnosis, after_label: Option<&str>, centrelines: Option<&CentrelinePoints>, noise_mm: f64) -> String {
     let mut out = String::new();
     let _ = writeln!(out, "# Model-discrepancy diagnosis\n\nData: `{}` ({} rows, {} routings).\n", data_path.display(), data.rows.len(), data.groups().len());
     out.push_str("## Verdict\n\n");
@@ -252,7 +252,7 @@ fn markdown(data_path: &Path, data: &Dataset, d: &Diagnosis, after_label: Option
         num(d.diagnostics.rest_shift_deg)
     );
     if let Some(c) = centrelines {
-        coefficient_section(&mut out, data, d, c, after_label);
+        coefficient_section(&mut out, data, d, c, after_label, noise_mm);
     }
     out.push_str("## Fits\n\n");
     fit_section(&mut out, "Thesis model (EA, GA, EI)", &d.baseline);
@@ -280,7 +280,29 @@ pub fn shape_coefficients_rest_basis(points: &[[f64; 2]], rest_length_mm: f64, o
 
 /// Measured vs simulated a_0 … a_n at the top tension of each routing with
 /// a measured centreline.
-fn coefficient_section(out: &mut String, data: &Dataset, d: &Diagnosis, centrelines: &CentrelinePoints, after_label: Option<&str>) {
+/// Standard deviation of [`shape_coefficients_rest_basis`] over noisy
+/// copies of the predicted centreline sampled at `count` points (the noise
+/// `noise_mm` on x and y): how much of a measured a_i noise alone explains.
+fn coefficient_noise(prediction: &Option<Prediction>, count: usize, noise_mm: f64, length_mm: f64) -> Option<Vec<f64>> {
+    let line: Vec<[f64; 2]> = prediction.as_ref()?.centreline.as_ref()?.iter().map(|c| [c.x_mm, c.y_mm]).collect();
+    let base = super::synth::resample(&line, count);
+    let mut rng = super::rng::Rng::new(0x5eed);
+    const DRAWS: usize = 40;
+    let mut sum = vec![0.0; SHAPE_ORDER + 1];
+    let mut sum2 = vec![0.0; SHAPE_ORDER + 1];
+    for _ in 0..DRAWS {
+        let noisy: Vec<[f64; 2]> = base.iter().map(|p| [p[0] + noise_mm * rng.normal(), p[1] + noise_mm * rng.normal()]).collect();
+        let a = shape_coefficients_rest_basis(&noisy, length_mm, SHAPE_ORDER).ok()?;
+        for (k, v) in a.iter().enumerate() {
+            sum[k] += v;
+            sum2[k] += v * v;
+        }
+    }
+    let n = DRAWS as f64;
+    Some(sum.iter().zip(&sum2).map(|(s, s2)| ((s2 - s * s / n) / (n - 1.0)).max(0.0).sqrt()).collect())
+}
+
+fn coefficient_section(out: &mut String, data: &Dataset, d: &Diagnosis, centrelines: &CentrelinePoints, after_label: Option<&str>, noise_mm: f64) {
     let length = d.baseline.actuator.length_mm;
     let mut rows = Vec::new();
     for g in data.groups() {
@@ -292,15 +314,17 @@ fn coefficient_section(out: &mut String, data: &Dataset, d: &Diagnosis, centreli
             let line: Vec<[f64; 2]> = preds[i].as_ref()?.centreline.as_ref()?.iter().map(|c| [c.x_mm, c.y_mm]).collect();
             shape_coefficients_rest_basis(&line, length, SHAPE_ORDER).ok()
         };
-        let measured = shape_coefficients_rest_basis(&centrelines[&m.measurement], length, SHAPE_ORDER).ok();
-        rows.push((g.routing.clone(), m.measurement, m.tension_n, measured, simulated(&d.baseline_predictions), simulated(&d.extended_predictions)));
+        let points = &centrelines[&m.measurement];
+        let measured = shape_coefficients_rest_basis(points, length, SHAPE_ORDER).ok();
+        let spread = coefficient_noise(&d.baseline_predictions[i], points.len(), m.noise_mm.unwrap_or(noise_mm), length);
+        rows.push((g.routing.clone(), m.measurement, m.tension_n, measured, spread, simulated(&d.baseline_predictions), simulated(&d.extended_predictions)));
     }
     if rows.is_empty() {
         return;
     }
     let _ = writeln!(
         out,
-        "## Shapes: curvature coefficients, measured vs simulated\n\nLegendre coefficients a_0 … a_{SHAPE_ORDER} (1/mm) in the thesis's basis, per unit rest length L = {} mm (a_i = a_i^deformed · ℓ/L), computed the same way from the measured points and from the simulated centreline, at the top tension of each routing.\n",
+        "## Shapes: curvature coefficients, measured vs simulated\n\nLegendre coefficients a_0 … a_{SHAPE_ORDER} (1/mm) in the thesis's basis, per unit rest length L = {} mm (a_i = a_i^deformed · ℓ/L), computed the same way from the measured points and from the simulated centreline, at the top tension of each routing. The row ± noise is the standard deviation that the stated noise alone gives the measured coefficients (the simulated centreline sampled like the measurement, noised, 40 draws): higher orders from noisy points are mostly noise, which is why the fit uses point distances, not coefficients.\n",
         num(length)
     );
     let heads: Vec<String> = (0..=SHAPE_ORDER).map(|k| format!("a_{k}")).collect();
@@ -309,8 +333,9 @@ fn coefficient_section(out: &mut String, data: &Dataset, d: &Diagnosis, centreli
         Some(a) => a.iter().map(|v| format!("{v:+.5}")).collect::<Vec<_>>().join(" | "),
         None => ["—"; SHAPE_ORDER + 1].join(" | "),
     };
-    for (routing, id, t, measured, base, ext) in &rows {
+    for (routing, id, t, measured, spread, base, ext) in &rows {
         let _ = writeln!(out, "| {routing} | {id} | {} | measured | {} |", num(*t), cells(measured));
+        let _ = writeln!(out, "| | | | ± noise | {} |", cells(spread).replace('+', ""));
         let _ = writeln!(out, "| | | | thesis model | {} |", cells(base));
         if let Some(label) = after_label {
             let _ = writeln!(out, "| | | | {label} | {} |", cells(ext));

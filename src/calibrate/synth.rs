@@ -185,7 +185,7 @@ pub fn synthesize_with_markers(spec: &SynthSpec, points: usize) -> Result<(Datas
 }
 
 /// `count` points at equal index spacing along a polyline (clamp and tip included).
-fn resample(line: &[[f64; 2]], count: usize) -> Vec<[f64; 2]> {
+pub fn resample(line: &[[f64; 2]], count: usize) -> Vec<[f64; 2]> {
     if count < 2 || line.len() < 2 {
         return line.iter().take(count).copied().collect();
     }
