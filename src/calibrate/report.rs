@@ -462,6 +462,10 @@ fn loop_plot(path: &Path, data: &Dataset, groups: &[RoutingGroup], d: &Diagnosis
             (Direction::Rest, RGBColor(120, 120, 120), "measured, rest"),
             (Direction::Static, RGBColor(60, 60, 200), "measured, static"),
         ] {
+            // A legend entry only for kinds of reading this routing has.
+            if !measured.iter().any(|m| m.2 == dir) {
+                continue;
+            }
             chart
                 .draw_series(measured.iter().filter(|m| m.2 == dir).map(|m| Circle::new((m.0, m.1), 4, colour.filled())))
                 .map_err(|e| PlotError::new(path, e))?
