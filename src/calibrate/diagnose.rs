@@ -487,7 +487,16 @@ pub fn diagnose(base: &Actuator, options: &SolverOptions, data: &Dataset, spec: 
                 verdict = "inconclusive".into();
                 "the thesis model is consistent with the noise, but no candidate fit converged to a plausible value, so no effect can be ruled out".to_string()
             }
-            "none" => format!("the thesis model explains the data to within the stated noise ({}) and no candidate effect is warranted", chi2_text(&baseline)),
+            "none" => format!(
+                "{} explains the data to within the stated noise ({}) and no candidate effect is warranted",
+                if spec.held_effects.is_empty() {
+                    "the thesis model".to_string()
+                } else {
+                    let held: Vec<String> = spec.held_effects.iter().map(|e| format!("{} = {}", e.parameter_name(), e.current(base).unwrap_or(0.0))).collect();
+                    format!("the thesis model with {} held", held.join(", "))
+                },
+                chi2_text(&baseline)
+            ),
             "ambiguous" => format!("two effects fit equally well and the better one is consistent with the noise ({})", chi2_text(&judged)),
             _ => format!("the model {} explains the data to within the stated noise ({})", model_name(&extended), chi2_text(&extended)),
         };
