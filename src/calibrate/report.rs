@@ -2,7 +2,7 @@
 //! residual diagnostics, the fitted parameters and three PNG plots
 //! (residuals before/after, load/unload loops, measured vs simulated shapes).
 
-use super::data::{CentrelinePoints, Dataset, Direction, RoutingGroup};
+use super::data::{CentrelinePoints, Dataset, Direction, MarkerPoints, RoutingGroup};
 use super::diagnose::{Candidate, DiagnoseSpec, Diagnosis};
 use super::fit::{row_residual, FitResult};
 use super::predict::Prediction;
@@ -43,7 +43,8 @@ pub fn write_report(
     };
     atomic("residuals.png", &|p| residual_plot(p, data, &groups, d, after_label, angle_weight_mm_per_deg))?;
     atomic("loops.png", &|p| loop_plot(p, data, &groups, d, after_label))?;
-    atomic("shapes.png", &|p| shape_plot(p, data, &groups, d, centrelines, after_label))?;
+    let markers = (!spec.fit.shapes.markers.is_empty()).then_some(&spec.fit.shapes.markers);
+    atomic("shapes.png", &|p| shape_plot(p, data, &groups, d, centrelines, markers, after_label))?;
     crate::io::sync_dir(dir);
     let md = markdown(data_path, data, d, after_label, centrelines, spec.fit.noise.mm);
     let path = dir.join("report.md");
@@ -483,6 +484,7 @@ fn shape_plot(
     groups: &[RoutingGroup],
     d: &Diagnosis,
     centrelines: Option<&CentrelinePoints>,
+    markers: Option<&MarkerPoints>,
     after: Option<&str>,
 ) -> Result<(), PlotError> {
     register_fonts();
@@ -532,6 +534,14 @@ fn shape_plot(
             chart
                 .draw_series(points.iter().map(|p| Circle::new((p[1], -p[0]), 2, BLACK.mix(0.6).filled())))
                 .map_err(|e| PlotError::new(path, e))?;
+        }
+        if let Some(ms) = markers.and_then(|c| c.get(&m.measurement)) {
+            let s = chart
+                .draw_series(ms.iter().map(|p| TriangleMarker::new((p.y_mm, -p.x_mm), 5, RED.filled())))
+                .map_err(|e| PlotError::new(path, e))?;
+            if first {
+                s.label("measured markers").legend(|(x, y)| TriangleMarker::new((x + 8, y), 4, RED.filled()));
+            }
         }
         chart
             .draw_series(std::iter::once(Text::new(g.routing.clone(), (m.tip_y_mm + 2.0, -m.tip_x_mm + 2.0), (FONT, 13))))
