@@ -289,8 +289,8 @@ fn coefficient_noise(prediction: &Option<Prediction>, count: usize, noise_mm: f6
     let base = super::synth::resample(&line, count);
     let mut rng = super::rng::Rng::new(0x5eed);
     const DRAWS: usize = 40;
-    let mut sum = vec![0.0; SHAPE_ORDER + 1];
-    let mut sum2 = vec![0.0; SHAPE_ORDER + 1];
+    let mut sum = [0.0; SHAPE_ORDER + 1];
+    let mut sum2 = [0.0; SHAPE_ORDER + 1];
     for _ in 0..DRAWS {
         let noisy: Vec<[f64; 2]> = base.iter().map(|p| [p[0] + noise_mm * rng.normal(), p[1] + noise_mm * rng.normal()]).collect();
         let a = shape_coefficients_rest_basis(&noisy, length_mm, SHAPE_ORDER).ok()?;
