@@ -41,6 +41,9 @@ pub enum Direction {
     Unload,
     /// No tension (before loading or after unloading).
     Rest,
+    /// An independent capture, not part of one load/unload protocol: the
+    /// model solves it from a virgin, unloaded rod (no history carried over).
+    Static,
 }
 
 impl Direction {
@@ -50,6 +53,7 @@ impl Direction {
             Direction::Load => "load",
             Direction::Unload => "unload",
             Direction::Rest => "rest",
+            Direction::Static => "static",
         }
     }
 }
@@ -79,6 +83,11 @@ pub struct Measurement {
     pub tip_angle_rad: f64,
     /// Clamp axis from the vertical, rad (toward +y positive).
     pub clamp_tilt_rad: f64,
+    /// Noise (standard deviation) of this row's tip x, y and centreline
+    /// points, mm, if the file gives it (else the command's `--noise-mm`).
+    pub noise_mm: Option<f64>,
+    /// Noise of this row's tip angle, degrees, if the file gives it.
+    pub noise_deg: Option<f64>,
     /// Row in the file (1 = first data row), for messages.
     pub row: usize,
 }
@@ -319,6 +328,8 @@ fn parse_measurements(path: &Path, table: &Table) -> Result<Dataset, CalibrateEr
         *slot = column_index(path, table, name)?;
     }
     let tilt_idx = table.header.iter().position(|h| h == "clamp_tilt_rad");
+    let noise_mm_idx = table.header.iter().position(|h| h == "noise_mm");
+    let noise_deg_idx = table.header.iter().position(|h| h == "noise_deg");
     if table.rows.is_empty() {
         return Err(CalibrateError::Empty { path: path.display().to_string() });
     }
@@ -343,7 +354,8 @@ fn parse_measurements(path: &Path, table: &Table) -> Result<Dataset, CalibrateEr
             "load" => Direction::Load,
             "unload" => Direction::Unload,
             "rest" => Direction::Rest,
-            _ => return Err(c.bad(col(8), &cells[idx[8]], "one of load, unload, rest")),
+            "static" => Direction::Static,
+            _ => return Err(c.bad(col(8), &cells[idx[8]], "one of load, unload, rest, static")),
         };
         if direction == Direction::Rest && tension_n != 0.0 {
             return Err(c.bad(col(7), &cells[idx[7]], "0 on a rest row (direction = rest means no tension)"));
@@ -363,6 +375,21 @@ fn parse_measurements(path: &Path, table: &Table) -> Result<Dataset, CalibrateEr
             Some(k) if !cells[k].is_empty() => c.float(k, "clamp_tilt_rad")?,
             _ => 0.0,
         };
+        let noise = |k: Option<usize>, name: &str| -> Result<Option<f64>, CalibrateError> {
+            match k {
+                Some(k) if !cells[k].is_empty() => {
+                    let v = c.float(k, name)?;
+                    if v > 0.0 {
+                        Ok(Some(v))
+                    } else {
+                        Err(c.bad(name, &cells[k], "a noise level > 0 (a standard deviation), or an empty cell for the default"))
+                    }
+                }
+                _ => Ok(None),
+            }
+        };
+        let noise_mm = noise(noise_mm_idx, "noise_mm")?;
+        let noise_deg = noise(noise_deg_idx, "noise_deg")?;
         if let Some(first) = ids.insert(measurement, c.row) {
             return Err(CalibrateError::Inconsistent {
                 path: path.display().to_string(),
@@ -404,6 +431,8 @@ fn parse_measurements(path: &Path, table: &Table) -> Result<Dataset, CalibrateEr
             tip_y_mm,
             tip_angle_rad,
             clamp_tilt_rad,
+            noise_mm,
+            noise_deg,
             row: c.row,
         });
     }
@@ -412,7 +441,11 @@ fn parse_measurements(path: &Path, table: &Table) -> Result<Dataset, CalibrateEr
 
 /// Writes a measurement file as CSV (all columns, full precision).
 pub fn measurements_csv(data: &Dataset) -> String {
+    let with_noise = data.rows.iter().any(|m| m.noise_mm.is_some() || m.noise_deg.is_some());
     let mut out = REQUIRED_COLUMNS.join(",");
+    if with_noise {
+        out.push_str(",noise_mm,noise_deg");
+    }
     out.push('\n');
     for m in &data.rows {
         let y: Vec<String> = m.y_mm.iter().map(|v| v.to_string()).collect();
@@ -430,6 +463,11 @@ pub fn measurements_csv(data: &Dataset) -> String {
             m.tip_angle_rad,
             m.clamp_tilt_rad,
         ));
+        if with_noise {
+            out.pop();
+            let cell = |v: Option<f64>| v.map(|v| v.to_string()).unwrap_or_default();
+            out.push_str(&format!(",{},{}\n", cell(m.noise_mm), cell(m.noise_deg)));
+        }
     }
     out
 }
@@ -464,6 +502,60 @@ pub fn read_centrelines(path: &Path, data: &Dataset) -> Result<CentrelinePoints,
         out.entry(id).or_default().push(p);
     }
     Ok(out)
+}
+
+/// A marker that is not on the centreline: a point fixed to the body at
+/// rest arc length `s_mm` and lateral offset `offset_mm` along the body
+/// frame's second axis (toward the side the channel offsets y_i point to
+/// in the unbent rod), and where it was measured.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Marker {
+    /// Rest arc length from the clamp, mm (0 ≤ s ≤ L).
+    pub s_mm: f64,
+    /// Lateral offset in the body frame, mm.
+    pub offset_mm: f64,
+    /// Measured position along the clamp axis, mm.
+    pub x_mm: f64,
+    /// Measured position across the clamp axis, mm.
+    pub y_mm: f64,
+}
+
+/// Markers of each reading, by measurement id.
+pub type MarkerPoints = BTreeMap<i64, Vec<Marker>>;
+
+/// Reads a marker file (`measurement,s_mm,offset_mm,x_mm,y_mm`); every
+/// measurement id must exist in `data` and 0 ≤ s ≤ `length_mm`.
+pub fn read_markers(path: &Path, data: &Dataset, length_mm: f64) -> Result<MarkerPoints, CalibrateError> {
+    let table = read_table(path)?;
+    let idx: Vec<usize> =
+        ["measurement", "s_mm", "offset_mm", "x_mm", "y_mm"].iter().map(|n| column_index(path, &table, n)).collect::<Result<_, _>>()?;
+    let known: std::collections::HashSet<i64> = data.rows.iter().map(|m| m.measurement).collect();
+    let mut out = MarkerPoints::new();
+    for (i, cells) in table.rows.iter().enumerate() {
+        let c = Cells { path, row: i + 1, cells };
+        let id = c.int(idx[0], "measurement")?;
+        if !known.contains(&id) {
+            return Err(c.bad("measurement", &cells[idx[0]], "the id of a row in the measurement file"));
+        }
+        let s_mm = c.float(idx[1], "s_mm")?;
+        if !(0.0..=length_mm).contains(&s_mm) {
+            return Err(c.bad("s_mm", &cells[idx[1]], &format!("a rest arc length from the clamp, 0 ≤ s ≤ L = {length_mm} mm")));
+        }
+        let marker = Marker { s_mm, offset_mm: c.float(idx[2], "offset_mm")?, x_mm: c.float(idx[3], "x_mm")?, y_mm: c.float(idx[4], "y_mm")? };
+        out.entry(id).or_default().push(marker);
+    }
+    Ok(out)
+}
+
+/// Writes markers as CSV.
+pub fn markers_csv(markers: &MarkerPoints) -> String {
+    let mut out = String::from("measurement,s_mm,offset_mm,x_mm,y_mm\n");
+    for (id, ms) in markers {
+        for m in ms {
+            out.push_str(&format!("{id},{},{},{},{}\n", m.s_mm, m.offset_mm, m.x_mm, m.y_mm));
+        }
+    }
+    out
 }
 
 /// Writes centreline points as CSV.
@@ -501,6 +593,19 @@ mod tests {
         // Round trip through the writer.
         let again = parse(&measurements_csv(&d)).unwrap();
         assert_eq!(again.rows.iter().map(|r| r.tip_y_mm).collect::<Vec<_>>(), vec![0.0, 10.0]);
+    }
+
+    #[test]
+    fn reads_static_captures_and_per_row_noise() {
+        let text = format!("{HEADER},noise_mm,noise_deg\n1,a,1,1,1,1,1,0.5,static,0,5,60,10,0.3,0.8,\n2,a,1,1,1,1,1,1.5,Static,1,5,55,20,0.6,,3\n");
+        let d = parse(&text).unwrap();
+        assert_eq!(d.rows[0].direction, Direction::Static);
+        assert_eq!((d.rows[0].noise_mm, d.rows[0].noise_deg), (Some(0.8), None));
+        assert_eq!((d.rows[1].noise_mm, d.rows[1].noise_deg), (None, Some(3.0)));
+        let again = parse(&measurements_csv(&d)).unwrap();
+        assert_eq!(again, Dataset { rows: d.rows.clone() });
+        let bad = parse(&format!("{HEADER},noise_mm\n1,a,1,1,1,1,1,0.5,load,0,5,60,10,0.3,0\n")).unwrap_err().to_string();
+        assert!(bad.contains("noise_mm") && bad.contains("row 1"), "{bad}");
     }
 
     #[test]

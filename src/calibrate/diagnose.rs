@@ -1,19 +1,29 @@
-//! The model-discrepancy workflow: fit the thesis model, look at where the
+//! The model-discrepancy workflow: fit the thesis model, judge whether it
+//! explains the data to within the measurement noise, look at where the
 //! residuals sit, refit with each candidate effect, name the effect the data
-//! call for (or none, or say which two it cannot tell apart) and show the
-//! gap on a held-out routing before and after.
+//! call for (or none, or say which two it cannot tell apart, or that no
+//! library effect explains the data) and show the gap on a held-out routing
+//! before and after.
 //!
-//! Criterion (stated in every report): with the Gaussian BIC
-//! n ln(RSS/n) + p ln n, an effect is named when its fit lowers the BIC by
-//! at least `threshold` (10) against the model without it, beats the
-//! runner-up by at least `margin` (10) and has a physically plausible value
+//! Adequacy comes before naming: a fit's χ² of the noise-whitened residuals
+//! (outliers set aside) is tested against χ²_dof. The verdict is `none` only
+//! when the thesis model is consistent with the noise (p ≥ `alpha`, 1e-3)
+//! and at least one candidate fit converged; `unexplained` when even the
+//! best model with one or two library effects stays above the noise
+//! (p < `alpha`); `inconclusive` when the thesis-model fit itself did not
+//! converge. Only converged fits with plausible values count as evidence.
+//!
+//! Naming (stated in every report): with the BIC n ln(Σρ/n) + p ln n of the
+//! whitened residuals, an effect is named when its fit lowers the BIC by at
+//! least `threshold` (10) against the model without it, beats the runner-up
+//! by at least `margin` (10) and has a physically plausible value
 //! ([`Effect::plausible`]). Effects are added forward-stepwise by the same
 //! rule (at most `max_effects`).
 
 use super::data::{Dataset, Direction, RoutingGroup};
 use super::effect::Effect;
-use super::fit::{fit, residuals, rms_per_routing, FitResult, FitSpec, RoutingRms};
-use super::predict::predict;
+use super::fit::{closest_on_centreline, fit, residuals, rms_per_routing, FitResult, FitSpec, RoutingRms};
+use super::predict::{predict, Prediction};
 use super::CalibrateError;
 use crate::model::{Actuator, SolverOptions};
 use rayon::prelude::*;
@@ -24,19 +34,25 @@ use serde::Serialize;
 pub struct DiagnoseSpec {
     /// Routing left out of every fit and used to measure the gap.
     pub holdout: Option<String>,
-    /// Weight of the tip angle, mm per degree.
-    pub angle_weight_mm_per_deg: f64,
+    /// Noise, loss, held rigidities, iteration cap, shapes and the angle
+    /// weight of reported RMS values, for every fit (its `effects` are ignored).
+    pub fit: FitSpec,
     /// Required BIC decrease against the model without the effect.
     pub threshold: f64,
     /// Required BIC lead over the runner-up.
     pub margin: f64,
     /// Most effects added.
     pub max_effects: usize,
+    /// A model is consistent with the noise when P(χ²_dof ≥ χ²) ≥ alpha.
+    pub alpha: f64,
+    /// Effects held at given values on the starting actuator (`--fix`):
+    /// part of every model, not candidates.
+    pub held_effects: Vec<Effect>,
 }
 
 impl Default for DiagnoseSpec {
     fn default() -> Self {
-        Self { holdout: None, angle_weight_mm_per_deg: 1.0, threshold: 10.0, margin: 10.0, max_effects: 2 }
+        Self { holdout: None, fit: FitSpec::default(), threshold: 10.0, margin: 10.0, max_effects: 2, alpha: 1e-3, held_effects: Vec::new() }
     }
 }
 
@@ -55,12 +71,46 @@ pub struct Candidate {
     pub parameter_se: f64,
     /// BIC change against the model without the effect (negative: better).
     pub delta_bic: f64,
-    /// RMS residual of the fit, mm.
+    /// RMS tip residual of the fit, mm.
     pub rms_mm: f64,
-    /// Whether the value is physically plausible.
+    /// χ² of the whitened residuals (outliers set aside).
+    pub chi2: f64,
+    /// Its degrees of freedom.
+    pub dof: usize,
+    /// χ²/dof.
+    pub reduced_chi2: f64,
+    /// P(χ²_dof ≥ χ²).
+    pub p_value: f64,
+    /// Whether the fit converged.
+    pub converged: bool,
+    /// Whether the values are physically plausible (effect and rigidities).
     pub plausible: bool,
+    /// Implausible or undetermined values, in words.
+    pub flags: Vec<String>,
     /// Why the fit failed, if it did.
     pub error: Option<String>,
+}
+
+impl Candidate {
+    /// Whether this fit counts as evidence: it ran, converged and its
+    /// values are plausible.
+    pub fn counts(&self) -> bool {
+        self.error.is_none() && self.converged && self.plausible && self.delta_bic.is_finite()
+    }
+
+    /// Why it does not count, in words (None when it does).
+    pub fn failure(&self) -> Option<String> {
+        if let Some(e) = &self.error {
+            return Some(format!("fit failed: {e}"));
+        }
+        if !self.converged {
+            return Some("did not converge".into());
+        }
+        if !self.plausible {
+            return Some(if self.flags.is_empty() { "implausible value".into() } else { self.flags.join("; ") });
+        }
+        None
+    }
 }
 
 /// Residual statistics of one class of rows.
@@ -95,6 +145,23 @@ pub struct ResidualDiagnostics {
     pub per_routing: Vec<RoutingRms>,
 }
 
+/// The residual's signature when no library effect explains the data.
+#[derive(Debug, Clone, Serialize)]
+pub struct Signature {
+    /// The model whose residuals are described.
+    pub model: String,
+    /// By direction and tension band: rows, tip position RMS (mm), tip angle RMS (°).
+    pub by_tension: Vec<(String, usize, f64, f64)>,
+    /// Per routing, worst first: routing, tip position RMS (mm), tip angle RMS (°).
+    pub by_routing: Vec<(String, f64, f64)>,
+    /// Shape residual RMS (mm) in the four quarters of the rod from the
+    /// clamp (centreline points by their closest point, markers by s);
+    /// empty without shape data.
+    pub along_body_mm: Vec<f64>,
+    /// The same in words.
+    pub summary: Vec<String>,
+}
+
 /// A named effect of the final model.
 #[derive(Debug, Clone, Serialize)]
 pub struct NamedEffect {
@@ -113,10 +180,15 @@ pub struct NamedEffect {
 /// The outcome of a diagnosis.
 #[derive(Debug, Clone)]
 pub struct Diagnosis {
-    /// `none`, an effect name, or `ambiguous`.
+    /// `none`, an effect name, `ambiguous`, `unexplained` or `inconclusive`.
     pub verdict: String,
+    /// Why, in one sentence (states the test).
+    pub reason: String,
     /// Effects of the final model, in the order they were added.
     pub named: Vec<NamedEffect>,
+    /// With `unexplained`: library effects that lower the BIC but leave the
+    /// fit above the noise.
+    pub partial_effects: Vec<NamedEffect>,
     /// The two effects the data cannot tell apart, if ambiguous.
     pub ambiguous_between: Vec<&'static str>,
     /// The measurement that would separate them.
@@ -129,6 +201,11 @@ pub struct Diagnosis {
     pub baseline: FitResult,
     /// The final model's fit (the baseline if nothing was named).
     pub extended: FitResult,
+    /// The best model tried (lowest χ² among the fits that count), whose
+    /// residuals the signature describes.
+    pub best: FitResult,
+    /// The residual's signature (with `unexplained`).
+    pub signature: Option<Signature>,
     /// Residual diagnostics of the baseline.
     pub diagnostics: ResidualDiagnostics,
     /// Held-out routing.
@@ -138,11 +215,13 @@ pub struct Diagnosis {
     /// Held-out RMS with the final model, mm.
     pub holdout_rms_after: Option<f64>,
     /// Predictions of every row (held-out included) by the baseline.
-    pub baseline_predictions: Vec<Option<super::predict::Prediction>>,
+    pub baseline_predictions: Vec<Option<Prediction>>,
     /// Predictions of every row by the final model.
-    pub extended_predictions: Vec<Option<super::predict::Prediction>>,
+    pub extended_predictions: Vec<Option<Prediction>>,
     /// The decision rule in words.
     pub criterion: String,
+    /// The noise test's level.
+    pub alpha: f64,
 }
 
 impl Diagnosis {
@@ -151,17 +230,22 @@ impl Diagnosis {
         let first = self.named.first();
         serde_json::json!({
             "verdict": self.verdict,
+            "reason": self.reason,
             "parameter_name": first.map(|n| n.parameter_name),
             "parameter": first.map(|n| n.parameter),
             "parameter_se": first.map(|n| n.parameter_se),
             "effects": self.named,
+            "partial_effects": self.partial_effects,
             "ambiguous_between": self.ambiguous_between,
             "separating_measurement": self.separating_measurement,
             "candidates": self.candidates,
             "second_round": self.second_round,
             "criterion": self.criterion,
+            "alpha": self.alpha,
             "baseline": fit_json(&self.baseline),
             "extended": fit_json(&self.extended),
+            "best": fit_json(&self.best),
+            "signature": self.signature,
             "diagnostics": self.diagnostics,
             "holdout": self.holdout,
             "holdout_rms_before": self.holdout_rms_before,
@@ -171,15 +255,22 @@ impl Diagnosis {
     }
 }
 
-/// A fit as JSON: parameters with SEs, correlations, RMS per routing.
+/// A fit as JSON: parameters with SEs, correlations, χ², RMS per routing.
 pub fn fit_json(f: &FitResult) -> serde_json::Value {
     serde_json::json!({
         "effects": f.effects,
         "parameters": f.parameters,
         "correlation": f.correlation,
-        "rss": f.rss,
+        "loss": f.rss,
         "n_residuals": f.n_residuals,
         "bic": f.bic,
+        "chi2": f.chi2,
+        "dof": f.dof,
+        "reduced_chi2": f.reduced_chi2,
+        "p_value": f.p_value,
+        "outliers": f.outliers,
+        "flags": f.flags,
+        "implausible": f.implausible,
         "rms_mm": f.rms_mm,
         "per_routing": f.per_routing,
         "iterations": f.iterations,
@@ -205,7 +296,7 @@ pub fn split_holdout(data: &Dataset, holdout: Option<&str>) -> Result<(Vec<Routi
     Ok((train, Some(held)))
 }
 
-fn candidate(effect: Effect, reference_bic: f64, result: Result<FitResult, CalibrateError>) -> Candidate {
+fn candidate(effect: Effect, reference_bic: f64, result: &Result<FitResult, CalibrateError>) -> Candidate {
     match result {
         Ok(f) => {
             let p = f.effect_parameter(effect).expect("fitted effect");
@@ -217,7 +308,13 @@ fn candidate(effect: Effect, reference_bic: f64, result: Result<FitResult, Calib
                 parameter_se: p.se,
                 delta_bic: f.bic - reference_bic,
                 rms_mm: f.rms_mm,
-                plausible: effect.plausible(p.value) && p.se.is_finite(),
+                chi2: f.chi2,
+                dof: f.dof,
+                reduced_chi2: f.reduced_chi2,
+                p_value: f.p_value,
+                converged: f.converged,
+                plausible: effect.plausible(p.value) && p.se.is_finite() && !f.implausible,
+                flags: f.flags.clone(),
                 error: None,
             }
         }
@@ -229,7 +326,13 @@ fn candidate(effect: Effect, reference_bic: f64, result: Result<FitResult, Calib
             parameter_se: f64::NAN,
             delta_bic: f64::INFINITY,
             rms_mm: f64::NAN,
+            chi2: f64::NAN,
+            dof: 0,
+            reduced_chi2: f64::NAN,
+            p_value: f64::NAN,
+            converged: false,
             plausible: false,
+            flags: Vec::new(),
             error: Some(e.to_string()),
         },
     }
@@ -243,7 +346,7 @@ enum Decision {
 }
 
 fn decide(ranked: &[Candidate], spec: &DiagnoseSpec) -> Decision {
-    let ok: Vec<&Candidate> = ranked.iter().filter(|c| c.plausible && c.delta_bic.is_finite()).collect();
+    let ok: Vec<&Candidate> = ranked.iter().filter(|c| c.counts()).collect();
     let Some(best) = ok.first() else { return Decision::None };
     if best.delta_bic > -spec.threshold {
         return Decision::None;
@@ -257,7 +360,7 @@ fn decide(ranked: &[Candidate], spec: &DiagnoseSpec) -> Decision {
     }
 }
 
-/// One round: every effect not yet in `base_effects` is refitted with them.
+/// One round: every effect not yet in `base_effects` (nor held) is refitted with them.
 fn round(
     base: &Actuator,
     options: &SolverOptions,
@@ -267,7 +370,8 @@ fn round(
     base_effects: &[Effect],
     reference: &FitResult,
 ) -> (Vec<Candidate>, Vec<(Effect, FitResult)>) {
-    let todo: Vec<Effect> = Effect::ALL.into_iter().filter(|e| !base_effects.contains(e)).collect();
+    let todo: Vec<Effect> =
+        Effect::ALL.into_iter().filter(|e| !base_effects.contains(e) && !spec.held_effects.contains(e)).collect();
     let results: Vec<(Effect, Result<FitResult, CalibrateError>)> = todo
         .par_iter()
         .map(|&e| {
@@ -280,16 +384,15 @@ fn round(
             start.ea_n = base.ea_n;
             start.ga_n = base.ga_n;
             start.ei_n_mm2 = base.ei_n_mm2;
-            let fs = FitSpec { effects, angle_weight_mm_per_deg: spec.angle_weight_mm_per_deg };
+            let fs = FitSpec { effects, ..spec.fit.clone() };
             (e, fit(&start, options, data, train, &fs))
         })
         .collect();
     let mut cands = Vec::new();
     let mut fits = Vec::new();
     for (e, r) in results {
-        let ok = r.as_ref().ok().cloned();
-        cands.push(candidate(e, reference.bic, r));
-        if let Some(f) = ok {
+        cands.push(candidate(e, reference.bic, &r));
+        if let Ok(f) = r {
             fits.push((e, f));
         }
     }
@@ -300,87 +403,207 @@ fn round(
     (cands, fits)
 }
 
+fn named_effect(e: Effect, c: &Candidate) -> NamedEffect {
+    NamedEffect { effect: e.name(), parameter_name: e.parameter_name(), parameter: c.parameter, parameter_se: c.parameter_se, delta_bic: c.delta_bic }
+}
+
+fn fit_of(fits: &[(Effect, FitResult)], e: Effect) -> FitResult {
+    fits.iter().find(|(fe, _)| *fe == e).expect("a candidate that counts was fitted").1.clone()
+}
+
+fn chi2_text(f: &FitResult) -> String {
+    let p = if f.p_value < 1e-99 { "p < 1e-99".to_string() } else { format!("p = {:.1e}", f.p_value) };
+    format!("χ² = {:.1} on {} dof, χ²/dof = {:.2}, {p}", f.chi2, f.dof, f.reduced_chi2)
+}
+
 /// Runs the whole workflow on `data` with `base` as the starting actuator.
 pub fn diagnose(base: &Actuator, options: &SolverOptions, data: &Dataset, spec: &DiagnoseSpec) -> Result<Diagnosis, CalibrateError> {
+    if !(spec.alpha > 0.0 && spec.alpha < 1.0) {
+        return Err(CalibrateError::Invalid(format!("the noise test's level must lie in (0, 1), got {}", spec.alpha)));
+    }
     let (train, held) = split_holdout(data, spec.holdout.as_deref())?;
-    let w = spec.angle_weight_mm_per_deg;
-    let baseline = fit(base, options, data, &train, &FitSpec { effects: Vec::new(), angle_weight_mm_per_deg: w })?;
+    let w = spec.fit.angle_weight_mm_per_deg;
+    let baseline = fit(base, options, data, &train, &FitSpec { effects: Vec::new(), ..spec.fit.clone() })?;
     let diagnostics = residual_diagnostics(data, &train, &baseline.predictions, w);
     let (candidates, fits) = round(base, options, data, &train, spec, &[], &baseline);
-    let mut named = Vec::new();
+    let mut named: Vec<NamedEffect> = Vec::new();
     let mut ambiguous_between = Vec::new();
     let mut separating_measurement = None;
     let mut second_round = Vec::new();
     let mut extended = baseline.clone();
-    let verdict = match decide(&candidates, spec) {
-        Decision::None => "none".to_string(),
+    let mut verdict;
+    // The naming rule on the first round (and a second effect on top).
+    let decision = decide(&candidates, spec);
+    match decision {
+        Decision::None => verdict = "none".to_string(),
         Decision::Ambiguous(a, b) => {
             ambiguous_between = vec![a.name(), b.name()];
             separating_measurement = Some(a.separating_measurement(b).to_string());
-            "ambiguous".to_string()
+            verdict = "ambiguous".to_string();
         }
         Decision::Named(e) => {
-            let f = fits.iter().find(|(fe, _)| *fe == e).expect("named effect was fitted").1.clone();
             let c = candidates.iter().find(|c| c.effect == e.name()).expect("candidate");
-            named.push(NamedEffect {
-                effect: e.name(),
-                parameter_name: e.parameter_name(),
-                parameter: c.parameter,
-                parameter_se: c.parameter_se,
-                delta_bic: c.delta_bic,
-            });
-            extended = f;
-            // Forward-stepwise: is a second effect warranted on top?
+            named.push(named_effect(e, c));
+            extended = fit_of(&fits, e);
             if spec.max_effects > 1 {
                 let (cands2, fits2) = round(base, options, data, &train, spec, &[e], &extended);
                 if let Decision::Named(e2) = decide(&cands2, spec) {
-                    let f2 = fits2.iter().find(|(fe, _)| *fe == e2).expect("fitted").1.clone();
+                    let f2 = fit_of(&fits2, e2);
                     let c2 = cands2.iter().find(|c| c.effect == e2.name()).expect("candidate");
                     // The first effect's value is re-estimated with the second.
                     if let Some(p1) = f2.effect_parameter(e) {
                         named[0].parameter = p1.value;
                         named[0].parameter_se = p1.se;
                     }
-                    named.push(NamedEffect {
-                        effect: e2.name(),
-                        parameter_name: e2.parameter_name(),
-                        parameter: c2.parameter,
-                        parameter_se: c2.parameter_se,
-                        delta_bic: c2.delta_bic,
-                    });
+                    named.push(named_effect(e2, c2));
                     extended = f2;
                 }
                 second_round = cands2;
             }
-            e.name().to_string()
+            verdict = e.name().to_string();
         }
+    }
+    // The model judged against the noise: the named one, or for an
+    // ambiguous pair the better of the two.
+    let mut judged = match decision {
+        Decision::Ambiguous(a, _) => fit_of(&fits, a),
+        _ => extended.clone(),
     };
+    let any_counts = candidates.iter().any(Candidate::counts);
+    let mut partial_effects = Vec::new();
+    let reason;
+    if !baseline.converged {
+        verdict = "inconclusive".into();
+        named.clear();
+        extended = baseline.clone();
+        reason = format!(
+            "the thesis-model fit did not converge ({} iterations{}), so nothing can be concluded; no verdict is drawn from unconverged fits",
+            baseline.iterations,
+            if baseline.flags.is_empty() { String::new() } else { format!("; {}", baseline.flags.join("; ")) }
+        );
+    } else if judged.consistent_with_noise(spec.alpha) {
+        reason = match verdict.as_str() {
+            "none" if !any_counts => {
+                verdict = "inconclusive".into();
+                "the thesis model is consistent with the noise, but no candidate fit converged to a plausible value, so no effect can be ruled out".to_string()
+            }
+            "none" => format!(
+                "{} explains the data to within the stated noise ({}) and no candidate effect is warranted",
+                if spec.held_effects.is_empty() {
+                    "the thesis model".to_string()
+                } else {
+                    let held: Vec<String> = spec.held_effects.iter().map(|e| format!("{} = {}", e.parameter_name(), e.current(base).unwrap_or(0.0))).collect();
+                    format!("the thesis model with {} held", held.join(", "))
+                },
+                chi2_text(&baseline)
+            ),
+            "ambiguous" => format!("two effects fit equally well and the better one is consistent with the noise ({})", chi2_text(&judged)),
+            _ => format!("the model {} explains the data to within the stated noise ({})", model_name(&extended), chi2_text(&extended)),
+        };
+    } else {
+        // Not explained yet: the best one or two library effects.
+        let mut best_pair: Option<(Effect, Effect, FitResult, Candidate, Candidate)> = None;
+        if !matches!(decision, Decision::Named(_)) && spec.max_effects > 1 {
+            if let Some(c1) = candidates.iter().find(|c| c.counts()) {
+                let e1 = Effect::parse(c1.effect).expect("known effect");
+                let f1 = fit_of(&fits, e1);
+                let (cands2, fits2) = round(base, options, data, &train, spec, &[e1], &f1);
+                if let Decision::Named(e2) = decide(&cands2, spec) {
+                    let f2 = fit_of(&fits2, e2);
+                    let c2 = cands2.iter().find(|c| c.effect == e2.name()).expect("candidate").clone();
+                    best_pair = Some((e1, e2, f2, c1.clone(), c2));
+                }
+                second_round = cands2;
+                if f1.chi2 < judged.chi2 {
+                    judged = f1;
+                }
+            }
+        }
+        match best_pair {
+            Some((e1, e2, f2, c1, c2)) if f2.consistent_with_noise(spec.alpha) => {
+                let mut n1 = named_effect(e1, &c1);
+                if let Some(p1) = f2.effect_parameter(e1) {
+                    n1.parameter = p1.value;
+                    n1.parameter_se = p1.se;
+                }
+                named = vec![n1, named_effect(e2, &c2)];
+                ambiguous_between.clear();
+                separating_measurement = None;
+                extended = f2;
+                verdict = e1.name().to_string();
+                reason = format!("the model {} explains the data to within the stated noise ({})", model_name(&extended), chi2_text(&extended));
+            }
+            pair => {
+                if let Some((_, _, f2, _, _)) = pair {
+                    if f2.chi2 < judged.chi2 {
+                        judged = f2;
+                    }
+                }
+                if extended.chi2 < judged.chi2 {
+                    judged = extended.clone();
+                }
+                // The effects that help, kept for the report, named nowhere.
+                partial_effects = std::mem::take(&mut named);
+                if partial_effects.is_empty() {
+                    if let Some(c) = candidates.iter().find(|c| c.counts() && c.delta_bic <= -spec.threshold) {
+                        partial_effects.push(named_effect(Effect::parse(c.effect).expect("known"), c));
+                    }
+                }
+                ambiguous_between.clear();
+                separating_measurement = None;
+                extended = baseline.clone();
+                verdict = "unexplained".into();
+                reason = format!(
+                    "even the best model tried ({}) stays above the stated noise: {}, below {:.0e} (chi-square test of the noise-whitened residuals); the data show something no candidate effect describes, or the noise is larger than stated",
+                    model_name(&judged),
+                    chi2_text(&judged),
+                    spec.alpha
+                );
+            }
+        }
+    }
+    let best = if judged.chi2 <= extended.chi2 { judged } else { extended.clone() };
+    let signature = (verdict == "unexplained").then(|| signature(data, &train, &best, &spec.fit));
     // Predict every row (the held-out routing too) with both models.
     let all = data.groups();
-    let baseline_predictions = predict(&baseline.actuator, options, data, &all, true)?;
-    let extended_predictions = predict(&extended.actuator, options, data, &all, true)?;
+    let keep = true;
+    let baseline_predictions = predict(&baseline.actuator, options, data, &all, keep)?;
+    let extended_predictions = predict(&extended.actuator, options, data, &all, keep)?;
     let (holdout_rms_before, holdout_rms_after) = match &held {
         Some(g) => {
             let g = std::slice::from_ref(g);
-            let rms = |p: &[Option<super::predict::Prediction>]| rms_per_routing(data, g, p, w)[0].rms_mm;
+            let rms = |p: &[Option<Prediction>]| rms_per_routing(data, g, p, w)[0].rms_mm;
             (Some(rms(&baseline_predictions)), Some(rms(&extended_predictions)))
         }
         None => (None, None),
     };
     let criterion = format!(
-        "name an effect when refitting it with EA, GA, EI lowers the BIC (n ln(RSS/n) + p ln n) by at least {} against the model without it, \
-         leads the runner-up by at least {} and has a physically plausible value; add effects forward-stepwise by the same rule (at most {})",
-        spec.threshold, spec.margin, spec.max_effects
+        "residuals are simulated − measured over the noise ({}); adequacy: χ² of these (readings beyond {} σ set aside as outliers, at most 2 or 5 %) \
+         against χ²_dof, consistent when p ≥ {:.0e}; `none` only when the thesis model is consistent and a candidate fit converged, \
+         `unexplained` when the best model with one or two library effects has p < {:.0e}; an effect is named when refitting it with EA, GA, EI lowers the BIC \
+         (n ln(Σρ/n) + p ln n) by at least {} against the model without it, leads the runner-up by at least {} and has physically plausible values; \
+         effects are added forward-stepwise by the same rule (at most {}); only converged fits count",
+        spec.fit.loss.describe(),
+        super::fit::OUTLIER_Z,
+        spec.alpha,
+        spec.alpha,
+        spec.threshold,
+        spec.margin,
+        spec.max_effects
     );
     Ok(Diagnosis {
         verdict,
+        reason,
         named,
+        partial_effects,
         ambiguous_between,
         separating_measurement,
         candidates,
         second_round,
         baseline,
         extended,
+        best,
+        signature,
         diagnostics,
         holdout: held.map(|g| g.routing),
         holdout_rms_before,
@@ -388,22 +611,116 @@ pub fn diagnose(base: &Actuator, options: &SolverOptions, data: &Dataset, spec: 
         baseline_predictions,
         extended_predictions,
         criterion,
+        alpha: spec.alpha,
     })
 }
 
+/// "the thesis model" or "with friction + creep".
+pub fn model_name(f: &FitResult) -> String {
+    if f.effects.is_empty() {
+        "the thesis model".into()
+    } else {
+        format!("with {}", f.effects.iter().map(|e| e.name()).collect::<Vec<_>>().join(" + "))
+    }
+}
+
+/// Where the residuals of `f` sit: by direction and tension, by routing,
+/// along the body (from shapes), with a few sentences.
+pub fn signature(data: &Dataset, groups: &[RoutingGroup], f: &FitResult, spec: &FitSpec) -> Signature {
+    let rows: Vec<usize> = groups.iter().flat_map(|g| g.rows.iter().copied()).collect();
+    let max_t = rows.iter().map(|&i| data.rows[i].tension_n).fold(0.0, f64::max);
+    let err = |i: usize| {
+        let p = &f.predictions[i].as_ref().expect("predicted").pose;
+        let m = &data.rows[i];
+        ((p.tip_x_mm - m.tip_x_mm).hypot(p.tip_y_mm - m.tip_y_mm), (p.tip_angle_rad - m.tip_angle_rad).to_degrees())
+    };
+    let class = |name: &str, keep: &dyn Fn(usize) -> bool| {
+        let picked: Vec<usize> = rows.iter().copied().filter(|&i| keep(i)).collect();
+        let n = picked.len().max(1) as f64;
+        let pos = (picked.iter().map(|&i| err(i).0.powi(2)).sum::<f64>() / n).sqrt();
+        let ang = (picked.iter().map(|&i| err(i).1.powi(2)).sum::<f64>() / n).sqrt();
+        (name.to_string(), picked.len(), pos, ang)
+    };
+    let d = |i: usize| data.rows[i].direction;
+    let t = |i: usize| data.rows[i].tension_n;
+    let by_tension: Vec<(String, usize, f64, f64)> = vec![
+        class("rest (0 N)", &|i| t(i) == 0.0),
+        class("tension ≤ τ_max/2", &|i| t(i) > 0.0 && t(i) <= 0.5 * max_t),
+        class("tension > τ_max/2", &|i| t(i) > 0.5 * max_t),
+        class("load", &|i| d(i) == Direction::Load),
+        class("unload", &|i| d(i) == Direction::Unload),
+        class("static", &|i| d(i) == Direction::Static),
+    ]
+    .into_iter()
+    .filter(|c| c.1 > 0)
+    .collect();
+    let mut by_routing: Vec<(String, f64, f64)> = f.per_routing.iter().map(|r| (r.routing.clone(), r.rms_position_mm, r.rms_angle_deg)).collect();
+    by_routing.sort_by(|a, b| b.1.total_cmp(&a.1));
+    // Along the body: shape residuals binned by quarter of the rest length.
+    let length = f.actuator.length_mm;
+    let (mut ss, mut count) = ([0.0; 4], [0usize; 4]);
+    let mut add = |s_mm: f64, d2: f64| {
+        let q = ((s_mm / length * 4.0).floor().max(0.0) as usize).min(3);
+        ss[q] += d2;
+        count[q] += 1;
+    };
+    for &i in &rows {
+        let id = data.rows[i].measurement;
+        let Some(line) = f.predictions[i].as_ref().and_then(|p| p.centreline.as_deref()) else { continue };
+        for p in spec.shapes.centrelines.get(&id).into_iter().flatten() {
+            let (dist, s_mm) = closest_on_centreline(*p, line);
+            add(s_mm, dist * dist);
+        }
+        for m in spec.shapes.markers.get(&id).into_iter().flatten() {
+            let q = super::fit::simulated_marker(m, line);
+            add(m.s_mm, (q[0] - m.x_mm).powi(2) + (q[1] - m.y_mm).powi(2));
+        }
+    }
+    let along_body_mm: Vec<f64> =
+        if count.iter().sum::<usize>() == 0 { Vec::new() } else { (0..4).map(|q| if count[q] > 0 { (ss[q] / count[q] as f64).sqrt() } else { f64::NAN }).collect() };
+    let mut summary = Vec::new();
+    let get = |name: &str| by_tension.iter().find(|c| c.0.starts_with(name));
+    if let (Some(lo), Some(hi)) = (get("tension ≤"), get("tension >")) {
+        let rest = get("rest");
+        let trend = if hi.2 > 1.5 * lo.2 {
+            "grows with tension"
+        } else if lo.2 > 1.5 * hi.2 {
+            "shrinks with tension"
+        } else {
+            "is about the same at low and high tension"
+        };
+        summary.push(format!(
+            "The tip error {trend}: {}{:.2} mm / {:.2}° at low tension, {:.2} mm / {:.2}° at high tension.",
+            rest.map_or(String::new(), |r| format!("{:.2} mm / {:.2}° at rest, ", r.2, r.3)),
+            lo.2,
+            lo.3,
+            hi.2,
+            hi.3
+        ));
+    }
+    if let (Some(l), Some(u)) = (get("load"), get("unload")) {
+        let what = if (l.2 - u.2).abs() > 0.3 * l.2.max(u.2) { "differs between" } else { "is alike on" };
+        summary.push(format!("It {what} loading ({:.2} mm / {:.2}°) and unloading ({:.2} mm / {:.2}°).", l.2, l.3, u.2, u.3));
+    }
+    if let (Some(worst), Some(best)) = (by_routing.first(), by_routing.last()) {
+        summary.push(format!("Worst routing {} ({:.2} mm / {:.2}°), best {} ({:.2} mm / {:.2}°).", worst.0, worst.1, worst.2, best.0, best.1, best.2));
+    }
+    if !along_body_mm.is_empty() {
+        let cells: Vec<String> = along_body_mm.iter().map(|v| if v.is_finite() { format!("{v:.2}") } else { "—".into() }).collect();
+        summary.push(format!("Along the body (quarters from the clamp to the tip), shape error RMS {} mm.", cells.join(" / ")));
+    }
+    Signature { model: model_name(f), by_tension, by_routing, along_body_mm, summary }
+}
+
 /// Residual statistics of the baseline over the fitted rows.
-pub fn residual_diagnostics(
-    data: &Dataset,
-    groups: &[RoutingGroup],
-    predictions: &[Option<super::predict::Prediction>],
-    w: f64,
-) -> ResidualDiagnostics {
+pub fn residual_diagnostics(data: &Dataset, groups: &[RoutingGroup], predictions: &[Option<Prediction>], w: f64) -> ResidualDiagnostics {
     let r = residuals(data, groups, predictions, w);
     let rows: Vec<usize> = groups.iter().flat_map(|g| g.rows.iter().copied()).collect();
     let max_t = rows.iter().map(|&i| data.rows[i].tension_n).fold(0.0, f64::max);
     let class = |name: &str, keep: &dyn Fn(usize) -> bool| -> ResidualClass {
         let picked: Vec<usize> = (0..rows.len()).filter(|&k| keep(rows[k])).collect();
-        let n = picked.len().max(1) as f64;
+        // An empty class has no mean (NaN, shown as "—"), not −0.
+        let n = picked.len() as f64;
         let sum = |c: usize| picked.iter().map(|&k| r[3 * k + c]).sum::<f64>() / n;
         let ss: f64 = picked.iter().map(|&k| (0..3).map(|c| r[3 * k + c].powi(2)).sum::<f64>()).sum();
         ResidualClass {
@@ -417,13 +734,16 @@ pub fn residual_diagnostics(
     };
     let d = |i: usize| data.rows[i].direction;
     let t = |i: usize| data.rows[i].tension_n;
-    let classes = vec![
+    let mut classes = vec![
         class("load", &|i| d(i) == Direction::Load),
         class("unload", &|i| d(i) == Direction::Unload),
         class("rest", &|i| d(i) == Direction::Rest),
-        class("tension ≤ τ_max/2", &|i| d(i) != Direction::Rest && t(i) <= 0.5 * max_t),
+        class("static", &|i| d(i) == Direction::Static),
+        class("tension ≤ τ_max/2", &|i| t(i) > 0.0 && t(i) <= 0.5 * max_t),
         class("tension > τ_max/2", &|i| t(i) > 0.5 * max_t),
     ];
+    // A static class only when there are static captures.
+    classes.retain(|c| c.class != "static" || c.rows > 0);
     // Loop gap: pairs of load/unload rows at equal tension in a routing.
     let (mut gap, mut pairs) = (0.0, 0usize);
     let (mut shift, mut routings_with_rests) = (0.0, 0usize);
@@ -467,7 +787,13 @@ mod tests {
             parameter_se: 0.1,
             delta_bic,
             rms_mm: 1.0,
+            chi2: 100.0,
+            dof: 100,
+            reduced_chi2: 1.0,
+            p_value: 0.5,
+            converged: true,
             plausible,
+            flags: Vec::new(),
             error: None,
         }
     }
@@ -488,5 +814,9 @@ mod tests {
         assert_eq!(named(&[cand(Gravity, -80.0, false), cand(Friction, -50.0, true), cand(Creep, -20.0, true)]), "friction");
         assert_eq!(named(&[cand(Friction, -50.0, true), cand(Gravity, -48.0, false)]), "friction");
         assert_eq!(named(&[]), "none");
+        // An unconverged fit is no evidence, however good its BIC.
+        let mut stuck = cand(Creep, -90.0, true);
+        stuck.converged = false;
+        assert_eq!(named(&[stuck, cand(Friction, -50.0, true)]), "friction");
     }
 }

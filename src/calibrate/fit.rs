@@ -1,44 +1,178 @@
 //! Least-squares fit of EA, GA, EI (thesis eq. 2.14), optionally together
-//! with effect parameters.
+//! with effect parameters, against the measurements' noise.
 //!
-//! The residuals of a row are the simulated minus measured tip x and y (mm)
-//! and tip angle, the angle in degrees times a weight in mm per degree
-//! (1 by default: 1° counts like 1 mm). Parameters are fitted in
-//! unconstrained coordinates (logs of the rigidities, see
+//! Every residual is simulated minus measured, divided by its noise (σ in mm
+//! for tip x, y, centreline points and markers, σ in degrees for the tip
+//! angle): tip x, y and angle of each reading; for each measured centreline
+//! point, its signed distance to the closest point of the simulated
+//! centreline; for each marker (a point at known rest arc length s and
+//! lateral body-frame offset), its x and y. The fit minimises Σ ρ(z) with
+//! Huber's ρ (quadratic up to `k` σ, linear beyond: a couple of bad readings
+//! cannot pull the fit over) or plain squares.
+//!
+//! Parameters are fitted in unconstrained coordinates (logs of the
+//! rigidities, boxed to 1e-3…1e3 times their start, see
 //! [`Effect::to_internal`]) by Levenberg–Marquardt with a central
-//! finite-difference Jacobian. Standard errors come from σ² (JᵀJ)⁻¹ at the
-//! optimum, with one σ² per measured channel (x, y, θ: different
-//! instruments, different noise) in a sandwich, mapped to the parameters by
+//! finite-difference Jacobian; a difference the model cannot solve falls
+//! back to a one-sided or smaller step rather than aborting the fit. Any
+//! rigidity can be held fixed. Standard errors come from (JᵀJ)⁻¹ with one
+//! variance per kind of residual in a sandwich, mapped to the parameters by
 //! the delta method; correlations from the same matrix.
+//!
+//! Adequacy: χ² of the whitened residuals over the readings that are not
+//! flagged as outliers (|z| > [`OUTLIER_Z`] on some residual, at most
+//! [`max_outliers`] readings), its degrees of freedom and the chance that
+//! noise alone gives a χ² as large ([`stats::chi2_p_value`]).
 //!
 //! The optimiser is written here (about fifty lines) rather than taken from
 //! the `levenberg-marquardt` crate because a trial step whose solve fails
 //! (a rod that collapses at absurd rigidities) must simply be rejected, and
 //! the noise-free tests need the stopping rule to run down to rounding.
 
-use super::data::{Dataset, RoutingGroup};
+use super::data::{CentrelinePoints, Dataset, Marker, MarkerPoints, Measurement, RoutingGroup};
 use super::effect::Effect;
 use super::predict::{predict, Prediction};
+use super::stats;
 use super::CalibrateError;
-use crate::model::{Actuator, SolverOptions};
+use crate::model::{Actuator, CentrelinePoint, SolverOptions};
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 use serde::Serialize;
+use std::sync::Arc;
+
+/// A residual beyond this many σ marks its reading as a possible outlier.
+pub const OUTLIER_Z: f64 = 6.0;
+
+/// Most readings set aside as outliers in the χ² test: two, or 5 % of the
+/// readings if that is more. When more readings are that far off, the model
+/// is wrong, not the readings, and none is set aside.
+pub fn max_outliers(readings: usize) -> usize {
+    2usize.max((0.05 * readings as f64).ceil() as usize)
+}
+
+/// Measurement noise (standard deviations) for rows that do not give their own.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Noise {
+    /// Tip x, y, centreline points and markers, mm.
+    pub mm: f64,
+    /// Tip angle, degrees.
+    pub deg: f64,
+}
+
+impl Default for Noise {
+    /// The noise `cablemap synth` adds by default: 0.4 mm and 1°.
+    fn default() -> Self {
+        Self { mm: 0.4, deg: 1.0 }
+    }
+}
+
+impl Noise {
+    /// Checks that both levels are positive and finite.
+    pub fn validate(&self) -> Result<(), CalibrateError> {
+        for (name, v) in [("--noise-mm", self.mm), ("--noise-deg", self.deg)] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(CalibrateError::Invalid(format!("{name} {v}: the measurement noise must be a standard deviation > 0")));
+            }
+        }
+        Ok(())
+    }
+
+    /// The noise of row `m`, mm and degrees.
+    pub fn of(&self, m: &Measurement) -> (f64, f64) {
+        (m.noise_mm.unwrap_or(self.mm), m.noise_deg.unwrap_or(self.deg))
+    }
+}
+
+/// The loss on whitened residuals z.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Loss {
+    /// Σ z²: ordinary least squares.
+    Squared,
+    /// Huber: z² up to `k`, 2k|z| − k² beyond (`k` in σ).
+    Huber {
+        /// Where the loss turns linear, in σ.
+        k: f64,
+    },
+}
+
+impl Default for Loss {
+    fn default() -> Self {
+        Loss::Huber { k: 3.0 }
+    }
+}
+
+impl Loss {
+    /// The residual whose square is the loss of `z` (sign kept), so that a
+    /// least-squares solver minimises Σ ρ.
+    fn transform(self, z: f64) -> f64 {
+        match self {
+            Loss::Squared => z,
+            Loss::Huber { k } if z.abs() > k => z.signum() * (2.0 * k * z.abs() - k * k).sqrt(),
+            Loss::Huber { .. } => z,
+        }
+    }
+
+    /// A short description for reports.
+    pub fn describe(self) -> String {
+        match self {
+            Loss::Squared => "least squares".into(),
+            Loss::Huber { k } => format!("Huber loss (quadratic up to {k} σ, linear beyond)"),
+        }
+    }
+}
+
+/// Measured shapes that enter the fit besides the tip readings.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ShapeData {
+    /// Measured centreline points by measurement id.
+    pub centrelines: CentrelinePoints,
+    /// Markers by measurement id.
+    pub markers: MarkerPoints,
+}
+
+impl ShapeData {
+    /// Whether there is nothing besides the tips.
+    pub fn is_empty(&self) -> bool {
+        self.centrelines.values().all(|v| v.is_empty()) && self.markers.values().all(|v| v.is_empty())
+    }
+}
 
 /// What to fit.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FitSpec {
     /// Effects fitted together with EA, GA, EI (empty: the thesis model).
     pub effects: Vec<Effect>,
-    /// Weight of the tip angle: mm of residual per degree.
+    /// Weight of the tip angle in the reported mm-equivalent RMS: mm per
+    /// degree (the fit itself weights every residual by its noise).
     pub angle_weight_mm_per_deg: f64,
+    /// Noise of rows that do not give their own.
+    pub noise: Noise,
+    /// Loss on the whitened residuals.
+    pub loss: Loss,
+    /// EA, GA, EI held at the starting actuator's values instead of fitted.
+    pub fixed_rigidities: [bool; 3],
+    /// Most Levenberg–Marquardt iterations.
+    pub max_iterations: usize,
+    /// Centreline points and markers.
+    pub shapes: Arc<ShapeData>,
 }
 
 impl Default for FitSpec {
     fn default() -> Self {
-        Self { effects: Vec::new(), angle_weight_mm_per_deg: 1.0 }
+        Self {
+            effects: Vec::new(),
+            angle_weight_mm_per_deg: 1.0,
+            noise: Noise::default(),
+            loss: Loss::default(),
+            fixed_rigidities: [false; 3],
+            max_iterations: 200,
+            shapes: Arc::new(ShapeData::default()),
+        }
     }
 }
+
+/// Names of the rigidities, as in [`FittedParameter::name`].
+pub const RIGIDITY_NAMES: [&str; 3] = ["ea_n", "ga_n", "ei_n_mm2"];
 
 /// One fitted parameter.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -47,8 +181,10 @@ pub struct FittedParameter {
     pub name: String,
     /// Fitted value.
     pub value: f64,
-    /// Standard error (same unit).
+    /// Standard error (same unit; 0 when held fixed).
     pub se: f64,
+    /// Held at its given value, not fitted.
+    pub fixed: bool,
 }
 
 /// RMS residual of one routing.
@@ -77,19 +213,35 @@ pub struct FitResult {
     pub parameters: Vec<FittedParameter>,
     /// Correlation matrix of the parameters (same order).
     pub correlation: Vec<Vec<f64>>,
-    /// Residual sum of squares, mm².
+    /// The minimised loss Σ ρ(z) of the whitened residuals.
     pub rss: f64,
-    /// Number of residuals (3 per row).
+    /// Number of residuals (3 per reading, 1 per centreline point, 2 per marker).
     pub n_residuals: usize,
-    /// Bayesian information criterion n ln(RSS/n) + p ln n.
+    /// Bayesian information criterion n ln(Σρ/n) + p ln n (p: fitted parameters).
     pub bic: f64,
-    /// RMS over all residuals, mm.
+    /// χ² = Σ z² over the readings not flagged as outliers.
+    pub chi2: f64,
+    /// Degrees of freedom of `chi2`: its residuals minus fitted parameters.
+    pub dof: usize,
+    /// χ² / dof (1 when the model explains the data to within the noise).
+    pub reduced_chi2: f64,
+    /// P(χ²_dof ≥ chi2): the chance of a χ² this large from noise alone.
+    pub p_value: f64,
+    /// Measurement ids of readings set aside as outliers in the χ² test.
+    pub outliers: Vec<i64>,
+    /// Physically implausible or undetermined values, in words.
+    pub flags: Vec<String>,
+    /// Whether some fitted value is physically implausible (axial strain,
+    /// GA → 0, a rigidity at its bound, an effect outside its range).
+    pub implausible: bool,
+    /// RMS over all tip residuals (x, y and weighted θ), mm.
     pub rms_mm: f64,
     /// RMS per routing.
     pub per_routing: Vec<RoutingRms>,
     /// Levenberg–Marquardt iterations.
     pub iterations: usize,
-    /// Whether the stopping rule was met (not the iteration cap).
+    /// Whether the stopping rule was met (not the iteration cap, and the
+    /// Jacobian could be evaluated at the optimum).
     pub converged: bool,
     /// Predictions at the optimum, indexed like the data's rows.
     pub predictions: Vec<Option<Prediction>>,
@@ -101,9 +253,16 @@ impl FitResult {
         let i = self.effects.iter().position(|&e| e == effect)?;
         self.parameters.get(3 + i)
     }
+
+    /// Whether the model is consistent with the noise at level `alpha`
+    /// (p ≥ alpha).
+    pub fn consistent_with_noise(&self, alpha: f64) -> bool {
+        self.p_value >= alpha
+    }
 }
 
-/// Weighted residuals of the rows of `groups`, 3 per row in group order.
+/// Weighted tip residuals of the rows of `groups`, 3 per row in group order
+/// (mm, mm, mm-equivalent), for reports.
 pub fn residuals(
     data: &Dataset,
     groups: &[RoutingGroup],
@@ -160,6 +319,167 @@ pub fn rms_per_routing(
         .collect()
 }
 
+/// Signed distance (mm) from `p` to the polyline `line` (clamp first):
+/// the closest point on it, positive to the left of the direction of
+/// travel. The last segment is extended beyond the tip, so a measured
+/// point past a shorter simulated rod is judged by its side distance (the
+/// tip reading judges the length).
+pub fn signed_distance_to_centreline(p: [f64; 2], line: &[CentrelinePoint]) -> f64 {
+    closest_on_centreline(p, line).0
+}
+
+/// [`signed_distance_to_centreline`] and the rest arc length s (mm) of the
+/// closest point.
+pub fn closest_on_centreline(p: [f64; 2], line: &[CentrelinePoint]) -> (f64, f64) {
+    let mut best = f64::INFINITY;
+    let mut signed = 0.0;
+    let mut s_mm = 0.0;
+    let last = line.len().saturating_sub(2);
+    for (k, w) in line.windows(2).enumerate() {
+        let (ax, ay) = (w[0].x_mm, w[0].y_mm);
+        let (dx, dy) = (w[1].x_mm - ax, w[1].y_mm - ay);
+        let len2 = dx * dx + dy * dy;
+        if len2 == 0.0 {
+            continue;
+        }
+        let mut t = ((p[0] - ax) * dx + (p[1] - ay) * dy) / len2;
+        t = if k == last { t.max(0.0) } else { t.clamp(0.0, 1.0) };
+        let (qx, qy) = (ax + t * dx, ay + t * dy);
+        let d = (p[0] - qx).hypot(p[1] - qy);
+        if d < best {
+            best = d;
+            let cross = dx * (p[1] - ay) - dy * (p[0] - ax);
+            signed = if cross < 0.0 { -d } else { d };
+            s_mm = (w[0].s_mm + t.min(1.0) * (w[1].s_mm - w[0].s_mm)).max(0.0);
+        }
+    }
+    if best.is_finite() {
+        (signed, s_mm)
+    } else {
+        (line.first().map_or(0.0, |c| (p[0] - c.x_mm).hypot(p[1] - c.y_mm)), 0.0)
+    }
+}
+
+/// Where the simulated rod puts `marker`: the centreline point at its rest
+/// arc length (linear between nodes) plus its offset along the body frame's
+/// second axis (−sin φ, cos φ).
+pub fn simulated_marker(marker: &Marker, line: &[CentrelinePoint]) -> [f64; 2] {
+    let k = line.partition_point(|c| c.s_mm < marker.s_mm).clamp(1, line.len() - 1);
+    let (a, b) = (&line[k - 1], &line[k]);
+    let f = if b.s_mm > a.s_mm { ((marker.s_mm - a.s_mm) / (b.s_mm - a.s_mm)).clamp(0.0, 1.0) } else { 0.0 };
+    let lerp = |u: f64, v: f64| u + f * (v - u);
+    let (x, y, phi) = (lerp(a.x_mm, b.x_mm), lerp(a.y_mm, b.y_mm), lerp(a.frame_angle_rad, b.frame_angle_rad));
+    [x - phi.sin() * marker.offset_mm, y + phi.cos() * marker.offset_mm]
+}
+
+/// What a residual measures.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ResidualKind {
+    /// Tip x.
+    TipX,
+    /// Tip y.
+    TipY,
+    /// Tip angle.
+    TipAngle,
+    /// A centreline point's distance to the simulated centreline (point index).
+    Centreline(usize),
+    /// A marker's x (marker index).
+    MarkerX(usize),
+    /// A marker's y (marker index).
+    MarkerY(usize),
+}
+
+impl ResidualKind {
+    /// Kind index for per-kind variances: x, y, θ, centreline, marker.
+    fn channel(self) -> usize {
+        match self {
+            ResidualKind::TipX => 0,
+            ResidualKind::TipY => 1,
+            ResidualKind::TipAngle => 2,
+            ResidualKind::Centreline(_) => 3,
+            ResidualKind::MarkerX(_) | ResidualKind::MarkerY(_) => 4,
+        }
+    }
+}
+
+/// One residual: its reading (index into the data's rows) and what it measures.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Slot {
+    /// Index into [`Dataset::rows`].
+    pub row: usize,
+    /// What it measures.
+    pub kind: ResidualKind,
+}
+
+/// The residuals of `groups`' rows in order: tip x, y, θ, then the row's
+/// centreline points and markers.
+pub fn layout(data: &Dataset, groups: &[RoutingGroup], shapes: &ShapeData) -> Vec<Slot> {
+    let mut out = Vec::new();
+    for g in groups {
+        for &row in &g.rows {
+            out.extend([ResidualKind::TipX, ResidualKind::TipY, ResidualKind::TipAngle].map(|kind| Slot { row, kind }));
+            let id = data.rows[row].measurement;
+            let points = shapes.centrelines.get(&id).map_or(0, |v| v.len());
+            out.extend((0..points).map(|k| Slot { row, kind: ResidualKind::Centreline(k) }));
+            let markers = shapes.markers.get(&id).map_or(0, |v| v.len());
+            out.extend((0..markers).flat_map(|k| [ResidualKind::MarkerX(k), ResidualKind::MarkerY(k)]).map(|kind| Slot { row, kind }));
+        }
+    }
+    out
+}
+
+/// Whitened residuals z (simulated − measured over noise) of `slots`.
+pub fn whitened(data: &Dataset, slots: &[Slot], predictions: &[Option<Prediction>], shapes: &ShapeData, noise: &Noise) -> Vec<f64> {
+    slots
+        .iter()
+        .map(|slot| {
+            let m = &data.rows[slot.row];
+            let pred = predictions[slot.row].as_ref().expect("predicted");
+            let (s_mm, s_deg) = noise.of(m);
+            let line = || pred.centreline.as_deref().expect("centreline kept for shape data");
+            match slot.kind {
+                ResidualKind::TipX => (pred.pose.tip_x_mm - m.tip_x_mm) / s_mm,
+                ResidualKind::TipY => (pred.pose.tip_y_mm - m.tip_y_mm) / s_mm,
+                ResidualKind::TipAngle => (pred.pose.tip_angle_rad - m.tip_angle_rad).to_degrees() / s_deg,
+                ResidualKind::Centreline(k) => {
+                    // The measured point's offset from the model, so simulated − measured is its negative.
+                    -signed_distance_to_centreline(shapes.centrelines[&m.measurement][k], line()) / s_mm
+                }
+                ResidualKind::MarkerX(k) => (simulated_marker(&shapes.markers[&m.measurement][k], line())[0] - shapes.markers[&m.measurement][k].x_mm) / s_mm,
+                ResidualKind::MarkerY(k) => (simulated_marker(&shapes.markers[&m.measurement][k], line())[1] - shapes.markers[&m.measurement][k].y_mm) / s_mm,
+            }
+        })
+        .collect()
+}
+
+/// χ² of whitened residuals `z` with `fitted` parameters: readings with a
+/// residual beyond [`OUTLIER_Z`] are set aside (at most [`max_outliers`]),
+/// the rest give χ², its degrees of freedom and p-value.
+pub fn chi_square(data: &Dataset, slots: &[Slot], z: &[f64], fitted: usize) -> (f64, usize, f64, Vec<i64>) {
+    let mut worst: std::collections::BTreeMap<usize, f64> = Default::default();
+    for (slot, v) in slots.iter().zip(z) {
+        let e = worst.entry(slot.row).or_insert(0.0);
+        *e = e.max(v.abs());
+    }
+    let mut far: Vec<(usize, f64)> = worst.into_iter().filter(|&(_, v)| v > OUTLIER_Z).collect();
+    let readings = slots.iter().filter(|s| s.kind == ResidualKind::TipX).count();
+    if far.len() > max_outliers(readings) {
+        far.clear();
+    }
+    far.sort_by(|a, b| b.1.total_cmp(&a.1));
+    let out_rows: Vec<usize> = far.iter().map(|f| f.0).collect();
+    let (mut chi2, mut n) = (0.0, 0usize);
+    for (slot, v) in slots.iter().zip(z) {
+        if !out_rows.contains(&slot.row) {
+            chi2 += v * v;
+            n += 1;
+        }
+    }
+    let dof = n.saturating_sub(fitted);
+    let p = stats::chi2_p_value(chi2, dof);
+    (chi2, dof, p, out_rows.iter().map(|&r| data.rows[r].measurement).collect())
+}
+
 /// Pseudo-inverse of the symmetric matrix `a` by eigen-decomposition,
 /// ignoring directions with eigenvalue below 1e-12 of the largest, and
 /// which parameters lean on those ignored directions.
@@ -184,6 +504,9 @@ fn pseudo_inverse(a: &DMatrix<f64>) -> (DMatrix<f64>, Vec<bool>) {
     (inv, unidentified)
 }
 
+/// Rigidities may move this factor either way from their start.
+const RIGIDITY_RANGE: f64 = 1e3;
+
 /// The fit problem: maps the unconstrained coordinates to an actuator.
 struct Problem<'a> {
     base: &'a Actuator,
@@ -191,6 +514,9 @@ struct Problem<'a> {
     data: &'a Dataset,
     groups: &'a [RoutingGroup],
     spec: &'a FitSpec,
+    slots: Vec<Slot>,
+    /// Indices of the fitted coordinates.
+    free: Vec<usize>,
 }
 
 impl Problem<'_> {
@@ -205,30 +531,51 @@ impl Problem<'_> {
         a
     }
 
+    /// Whitened residuals and predictions at `x`.
     fn evaluate(&self, x: &[f64]) -> Result<(Vec<f64>, Vec<Option<Prediction>>), CalibrateError> {
         let a = self.actuator(x);
-        let preds = predict(&a, self.options, self.data, self.groups, false)?;
-        Ok((residuals(self.data, self.groups, &preds, self.spec.angle_weight_mm_per_deg), preds))
+        let keep = !self.spec.shapes.is_empty();
+        let preds = predict(&a, self.options, self.data, self.groups, keep)?;
+        let z = whitened(self.data, &self.slots, &preds, &self.spec.shapes, &self.spec.noise);
+        Ok((z, preds))
     }
 
+    /// The residuals the solver squares: the loss's transform of z.
     fn residuals(&self, x: &[f64]) -> Result<Vec<f64>, CalibrateError> {
-        self.evaluate(x).map(|(r, _)| r)
+        self.evaluate(x).map(|(z, _)| z.into_iter().map(|v| self.spec.loss.transform(v)).collect())
     }
 
-    /// Central-difference Jacobian, columns in parallel.
-    fn jacobian(&self, x: &[f64], n: usize) -> Result<DMatrix<f64>, CalibrateError> {
-        const H: f64 = 1e-6;
-        let columns: Vec<Vec<f64>> = (0..x.len())
-            .into_par_iter()
-            .map(|j| {
-                let (mut xp, mut xm) = (x.to_vec(), x.to_vec());
-                xp[j] += H;
-                xm[j] -= H;
-                let (rp, rm) = (self.residuals(&xp)?, self.residuals(&xm)?);
-                Ok(rp.iter().zip(&rm).map(|(a, b)| (a - b) / (2.0 * H)).collect())
+    /// Finite-difference Jacobian over the free coordinates, columns in
+    /// parallel; `r` are the residuals at `x`. A column whose central
+    /// difference cannot be solved falls back to a one-sided difference,
+    /// then to smaller steps; a column that fails every way is zero and
+    /// reported by index.
+    fn jacobian(&self, x: &[f64], r: &[f64]) -> (DMatrix<f64>, Vec<usize>) {
+        let n = r.len();
+        let columns: Vec<Option<Vec<f64>>> = self
+            .free
+            .par_iter()
+            .map(|&j| {
+                let at = |h: f64| {
+                    let mut xh = x.to_vec();
+                    xh[j] += h;
+                    self.residuals(&xh).ok()
+                };
+                let diff = |a: &[f64], b: &[f64], span: f64| a.iter().zip(b).map(|(p, m)| (p - m) / span).collect::<Vec<f64>>();
+                for h in [1e-6, 1e-7, 1e-8] {
+                    match (at(h), at(-h)) {
+                        (Some(rp), Some(rm)) => return Some(diff(&rp, &rm, 2.0 * h)),
+                        (Some(rp), None) => return Some(diff(&rp, r, h)),
+                        (None, Some(rm)) => return Some(diff(r, &rm, h)),
+                        (None, None) => {}
+                    }
+                }
+                None
             })
-            .collect::<Result<_, CalibrateError>>()?;
-        Ok(DMatrix::from_fn(n, x.len(), |i, j| columns[j][i]))
+            .collect();
+        let failed: Vec<usize> = self.free.iter().zip(&columns).filter(|(_, c)| c.is_none()).map(|(&j, _)| j).collect();
+        let j = DMatrix::from_fn(n, self.free.len(), |i, k| columns[k].as_ref().map_or(0.0, |c| c[i]));
+        (j, failed)
     }
 }
 
@@ -249,17 +596,25 @@ pub fn fit(
             spec.angle_weight_mm_per_deg
         )));
     }
+    spec.noise.validate()?;
     base.validate()?;
-    let problem = Problem { base, options, data, groups, spec };
+    let slots = layout(data, groups, &spec.shapes);
     let mut x: Vec<f64> = vec![base.ea_n.ln(), base.ga_n.ln(), base.ei_n_mm2.ln()];
     x.extend(spec.effects.iter().map(|e| e.to_internal(e.current(base).unwrap_or_else(|| e.start()))));
-    let p = x.len();
+    let free: Vec<usize> = (0..x.len()).filter(|&k| k >= 3 || !spec.fixed_rigidities[k]).collect();
+    let bounds: Vec<(f64, f64)> = x
+        .iter()
+        .enumerate()
+        .map(|(k, &v)| if k < 3 { (v - RIGIDITY_RANGE.ln(), v + RIGIDITY_RANGE.ln()) } else { (-50.0, 50.0) })
+        .collect();
+    let problem = Problem { base, options, data, groups, spec, slots, free };
+    let p = problem.free.len();
     let mut r = problem.residuals(&x)?;
     let n = r.len();
     if n <= p {
         return Err(CalibrateError::Invalid(format!(
-            "{n} residuals ({} rows) cannot determine {p} parameters; measure more steps or routings",
-            n / 3
+            "{n} residuals ({} readings) cannot determine {p} parameters; measure more steps or routings, or hold parameters fixed (--fix)",
+            data.rows.len()
         )));
     }
     let mut cost: f64 = r.iter().map(|v| v * v).sum();
@@ -277,13 +632,29 @@ pub fn fit(
     let mut lambda = 1e-3;
     let mut converged = false;
     let mut iterations = 0;
-    const MAX_ITERATIONS: usize = 200;
-    while iterations < MAX_ITERATIONS {
+    if p == 0 {
+        // Everything held: the fit only evaluates the given model.
+        converged = true;
+    }
+    while p > 0 && iterations < spec.max_iterations {
         iterations += 1;
-        let j = problem.jacobian(&x, n)?;
+        let (j, _) = problem.jacobian(&x, &r);
         let rv = DVector::from_column_slice(&r);
-        let a = j.transpose() * &j;
-        let g = j.transpose() * rv;
+        let mut a = j.transpose() * &j;
+        let mut g = j.transpose() * rv;
+        // A coordinate at its bound whose descent direction points outward
+        // is held this iteration (a projected step), so the others can settle.
+        for (k, &idx) in problem.free.iter().enumerate() {
+            let (lo, hi) = bounds[idx];
+            if (x[idx] <= lo + 1e-9 && g[k] > 0.0) || (x[idx] >= hi - 1e-9 && g[k] < 0.0) {
+                g[k] = 0.0;
+                for c in 0..p {
+                    a[(k, c)] = 0.0;
+                    a[(c, k)] = 0.0;
+                }
+                a[(k, k)] = 1.0;
+            }
+        }
         let diag_floor = a.diagonal().max() * 1e-12 + 1e-300;
         let mut accepted = None;
         while lambda < 1e12 {
@@ -296,12 +667,16 @@ pub fn fit(
                 continue;
             };
             let step = chol.solve(&(-&g));
-            let trial: Vec<f64> = x.iter().zip(step.iter()).map(|(a, b)| a + b).collect();
+            let mut trial = x.clone();
+            for (k, &idx) in problem.free.iter().enumerate() {
+                trial[idx] = (x[idx] + step[k]).clamp(bounds[idx].0, bounds[idx].1);
+            }
+            let moved = trial.iter().zip(&x).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
             match problem.residuals(&trial) {
                 Ok(rt) => {
                     let ct: f64 = rt.iter().map(|v| v * v).sum();
                     if ct < cost {
-                        accepted = Some((trial, rt, ct, step.amax()));
+                        accepted = Some((trial, rt, ct, moved));
                         lambda = (lambda / 5.0).max(1e-12);
                         break;
                     }
@@ -326,33 +701,54 @@ pub fn fit(
         }
     }
     // Uncertainties from the Jacobian at the optimum.
-    let j = problem.jacobian(&x, n)?;
+    let (j, failed_columns) = problem.jacobian(&x, &r);
     let jtj = j.transpose() * &j;
-    // x, y and θ are measured by different means with different noise: each
-    // channel gets its own variance from its residuals, and the covariance
-    // is the sandwich (JᵀJ)⁻¹ Jᵀ Σ J (JᵀJ)⁻¹ (σ² (JᵀJ)⁻¹ when they agree).
+    // Residual kinds are measured by different means: each gets its own
+    // variance from its residuals, and the covariance is the sandwich
+    // (JᵀJ)⁻¹ Jᵀ Σ J (JᵀJ)⁻¹ (σ² (JᵀJ)⁻¹ when they agree).
     let dof_share = (n - p) as f64 / n as f64;
-    let channel_var: [f64; 3] = std::array::from_fn(|c| {
-        let (sum, count) = r.iter().skip(c).step_by(3).fold((0.0, 0usize), |(s, k), v| (s + v * v, k + 1));
-        sum / (count as f64 * dof_share)
+    let kind_var: [f64; 5] = std::array::from_fn(|c| {
+        let (sum, count) = problem
+            .slots
+            .iter()
+            .zip(&r)
+            .filter(|(s, _)| s.kind.channel() == c)
+            .fold((0.0, 0usize), |(s, k), (_, v)| (s + v * v, k + 1));
+        if count == 0 {
+            0.0
+        } else {
+            sum / (count as f64 * dof_share)
+        }
     });
     let (inv, unidentified) = pseudo_inverse(&jtj);
     let mut meat = DMatrix::<f64>::zeros(p, p);
     for (i, row) in j.row_iter().enumerate() {
-        meat += row.transpose() * row * channel_var[i % 3];
+        meat += row.transpose() * row * kind_var[problem.slots[i].kind.channel()];
     }
-    let mut cov = &inv * meat * &inv;
+    let mut cov_free = &inv * meat * &inv;
     // A parameter the data cannot determine (a rigidity run off to where it
     // no longer matters) has no finite standard error.
     for (k, &bad) in unidentified.iter().enumerate() {
         if bad {
-            cov[(k, k)] = f64::INFINITY;
+            cov_free[(k, k)] = f64::INFINITY;
         }
     }
-    let cov = Some(cov);
-    let (_, predictions) = problem.evaluate(&x)?;
+    for (k, idx) in problem.free.iter().enumerate() {
+        if failed_columns.contains(idx) {
+            cov_free[(k, k)] = f64::INFINITY;
+        }
+    }
+    // Full covariance, zero for held parameters.
+    let total = x.len();
+    let mut cov = DMatrix::<f64>::zeros(total, total);
+    for (a, &ia) in problem.free.iter().enumerate() {
+        for (b, &ib) in problem.free.iter().enumerate() {
+            cov[(ia, ib)] = cov_free[(a, b)];
+        }
+    }
+    let (z, predictions) = problem.evaluate(&x)?;
     let actuator = problem.actuator(&x);
-    let mut names: Vec<String> = vec!["ea_n".into(), "ga_n".into(), "ei_n_mm2".into()];
+    let mut names: Vec<String> = RIGIDITY_NAMES.iter().map(|s| s.to_string()).collect();
     names.extend(spec.effects.iter().map(|e| e.parameter_name().to_string()));
     let mut values = vec![actuator.ea_n, actuator.ga_n, actuator.ei_n_mm2];
     let mut derivs = values.clone(); // d value / d log value
@@ -360,29 +756,47 @@ pub fn fit(
         values.push(e.from_internal(xi));
         derivs.push(e.derivative(xi));
     }
-    let parameters = (0..p)
+    let is_free = |k: usize| problem.free.contains(&k);
+    let parameters: Vec<FittedParameter> = (0..total)
         .map(|k| FittedParameter {
             name: names[k].clone(),
             value: values[k],
-            se: match cov.as_ref().map(|c| c[(k, k)]) {
-                Some(v) if v.is_finite() => derivs[k].abs() * v.max(0.0).sqrt(),
-                _ => f64::INFINITY,
+            se: if !is_free(k) {
+                0.0
+            } else {
+                match cov[(k, k)] {
+                    v if v.is_finite() => derivs[k].abs() * v.max(0.0).sqrt(),
+                    _ => f64::INFINITY,
+                }
             },
+            fixed: !is_free(k),
         })
         .collect();
-    let correlation = (0..p)
+    let correlation = (0..total)
         .map(|a| {
-            (0..p)
-                .map(|b| match &cov {
-                    // No correlation is defined with an undetermined parameter.
-                    Some(c) if c[(a, a)].is_finite() && c[(b, b)].is_finite() => c[(a, b)] / (c[(a, a)] * c[(b, b)]).sqrt(),
-                    Some(_) => f64::NAN,
-                    None => f64::NAN,
+            (0..total)
+                .map(|b| {
+                    let (va, vb) = (cov[(a, a)], cov[(b, b)]);
+                    // No correlation is defined with an undetermined or held parameter.
+                    if va.is_finite() && vb.is_finite() && va > 0.0 && vb > 0.0 {
+                        cov[(a, b)] / (va * vb).sqrt()
+                    } else {
+                        f64::NAN
+                    }
                 })
                 .collect()
         })
         .collect();
+    let (chi2, dof, p_value, outliers) = chi_square(data, &problem.slots, &z, p);
+    let (mut flags, implausible) = plausibility_flags(data, groups, &parameters, &spec.effects, &x, &bounds, &problem.free);
+    if !failed_columns.is_empty() {
+        converged = false;
+        let names: Vec<&str> = failed_columns.iter().map(|&k| parameters[k].name.as_str()).collect();
+        flags.push(format!("the model could not be solved near the optimum to differentiate by {}", names.join(", ")));
+    }
     let nf = n as f64;
+    let tip = residuals(data, groups, &predictions, spec.angle_weight_mm_per_deg);
+    let tip_rms = (tip.iter().map(|v| v * v).sum::<f64>() / tip.len().max(1) as f64).sqrt();
     Ok(FitResult {
         effects: spec.effects.clone(),
         per_routing: rms_per_routing(data, groups, &predictions, spec.angle_weight_mm_per_deg),
@@ -392,11 +806,121 @@ pub fn fit(
         rss: cost,
         n_residuals: n,
         bic: nf * (cost / nf).max(1e-300).ln() + p as f64 * nf.ln(),
-        rms_mm: (cost / nf).sqrt(),
+        chi2,
+        dof,
+        reduced_chi2: if dof > 0 { chi2 / dof as f64 } else { f64::NAN },
+        p_value,
+        outliers,
+        flags,
+        implausible,
+        rms_mm: tip_rms,
         iterations,
         converged,
         predictions,
     })
+}
+
+/// Parameters held at a given value (`--fix NAME=VALUE`): a rigidity or an
+/// effect's parameter.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Held {
+    /// EA, GA or EI (index 0, 1, 2).
+    Rigidity(usize),
+    /// An effect, held at the value: part of every model, not fitted.
+    Effect(Effect),
+}
+
+/// Parses the NAME of `--fix NAME=VALUE`: EA, GA, EI (any case, or
+/// `ea_n`, `ga_n`, `ei_n_mm2`), an effect's name or its parameter's name.
+pub fn parse_held(name: &str) -> Option<Held> {
+    let lower = name.trim().to_ascii_lowercase();
+    match lower.as_str() {
+        "ea" | "ea_n" => return Some(Held::Rigidity(0)),
+        "ga" | "ga_n" => return Some(Held::Rigidity(1)),
+        "ei" | "ei_n_mm2" => return Some(Held::Rigidity(2)),
+        _ => {}
+    }
+    Effect::ALL.into_iter().find(|e| e.name() == lower || e.parameter_name() == lower).map(Held::Effect)
+}
+
+/// Applies `--fix` values to the starting actuator: returns it with the
+/// values set, which rigidities are held, and which effects are held.
+pub fn apply_held(base: &Actuator, held: &[(Held, f64)]) -> Result<(Actuator, [bool; 3], Vec<Effect>), CalibrateError> {
+    let mut a = base.clone();
+    let mut fixed = [false; 3];
+    let mut effects = Vec::new();
+    for &(h, v) in held {
+        if !v.is_finite() {
+            return Err(CalibrateError::Invalid(format!("--fix: value {v} is not a finite number")));
+        }
+        match h {
+            Held::Rigidity(k) => {
+                *[&mut a.ea_n, &mut a.ga_n, &mut a.ei_n_mm2][k] = v;
+                fixed[k] = true;
+            }
+            Held::Effect(e) => {
+                e.apply(&mut a, v);
+                effects.push(e);
+            }
+        }
+    }
+    a.validate()?;
+    Ok((a, fixed, effects))
+}
+
+/// Largest axial strain τ/EA accepted as plausible at the measured tensions.
+pub const MAX_AXIAL_STRAIN: f64 = 0.2;
+/// GA below this share of EA reads as a shear rigidity run to zero.
+pub const MIN_GA_SHARE_OF_EA: f64 = 0.01;
+
+/// Physically implausible fitted values in words: axial strain beyond
+/// [`MAX_AXIAL_STRAIN`] at the top measured tension, GA → 0, a rigidity at
+/// its bound, an effect outside its plausible range, an undetermined value.
+#[allow(clippy::too_many_arguments)]
+fn plausibility_flags(
+    data: &Dataset,
+    groups: &[RoutingGroup],
+    parameters: &[FittedParameter],
+    effects: &[Effect],
+    x: &[f64],
+    bounds: &[(f64, f64)],
+    free: &[usize],
+) -> (Vec<String>, bool) {
+    let mut flags = Vec::new();
+    let (ea, ga) = (parameters[0].value, parameters[1].value);
+    let top = groups.iter().flat_map(|g| g.rows.iter()).map(|&i| data.rows[i].tension_n).fold(0.0, f64::max);
+    if top / ea > MAX_AXIAL_STRAIN {
+        flags.push(format!(
+            "EA = {ea:.4} N implies {:.0} % axial strain at {top} N (more than {:.0} %): not a plausible rod",
+            100.0 * top / ea,
+            100.0 * MAX_AXIAL_STRAIN
+        ));
+    }
+    if free.contains(&1) && ga < MIN_GA_SHARE_OF_EA * ea {
+        flags.push(format!(
+            "GA = {ga:.3e} N ran toward 0 (below {:.0} % of EA): shear is probably not identifiable here; hold it (--fix GA=VALUE)",
+            100.0 * MIN_GA_SHARE_OF_EA
+        ));
+    }
+    for &k in free {
+        let (lo, hi) = bounds[k];
+        if k < 3 && (x[k] - lo < 1e-6 || hi - x[k] < 1e-6) {
+            flags.push(format!("{} = {:.4e} is at the bound of the search (1e3 × its start either way)", parameters[k].name, parameters[k].value));
+        }
+    }
+    for (i, e) in effects.iter().enumerate() {
+        let v = parameters[3 + i].value;
+        if !e.plausible(v) {
+            flags.push(format!("{} = {v:.4e} is outside the plausible range {}", e.parameter_name(), e.plausible_text()));
+        }
+    }
+    let implausible = !flags.is_empty();
+    for &k in free {
+        if !parameters[k].se.is_finite() {
+            flags.push(format!("{} is not determined by these data (no finite standard error)", parameters[k].name));
+        }
+    }
+    (flags, implausible)
 }
 
 #[cfg(test)]
@@ -428,6 +952,68 @@ mod tests {
             assert!(((p.value - want) / want).abs() < 1e-6, "{}: {} vs {want}", p.name, p.value);
         }
         assert!(result.rms_mm < 1e-6, "{}", result.rms_mm);
+    }
+
+    #[test]
+    fn a_jacobian_step_the_model_cannot_solve_does_not_abort_the_fit() {
+        // A straight, centred channel without gravity: v1 = 1 − τ/EA along
+        // the whole rod, so the rod collapses exactly when EA ≤ τ. Starting
+        // EA just above the top tension puts the Jacobian's minus step past
+        // the collapse; the fit must fall back to a one-sided difference.
+        let mut t = truth();
+        t.gravity.enabled = false;
+        let spec = SynthSpec {
+            actuator: t.clone(),
+            noise_mm: 0.0,
+            noise_deg: 0.0,
+            routings: vec![("z".into(), [0.0; 5])],
+            load_steps: 2,
+            max_tension_n: 2.0,
+            ..SynthSpec::default()
+        };
+        let (data, _) = synthesize(&spec, 0).unwrap();
+        let mut start = t.clone();
+        start.ea_n = 2.0 * (1.0 + 5e-7);
+        // GA and EI do nothing on a straight, unbent rod: hold them.
+        let fs = FitSpec { fixed_rigidities: [false, true, true], ..FitSpec::default() };
+        let r = fit(&start, &SolverOptions::default(), &data, &data.groups(), &fs).unwrap();
+        assert!(r.converged, "{:?}", r.flags);
+        assert!((r.parameters[0].value - 30.0).abs() < 1e-6 * 30.0, "{:?}", r.parameters[0]);
+        assert!(r.parameters[1].fixed && r.parameters[1].se == 0.0 && r.parameters[1].value == t.ga_n);
+    }
+
+    #[test]
+    fn centreline_distances_and_markers_follow_the_geometry() {
+        // A straight centreline along +x from the clamp to 65 mm, frame angle 0.
+        let mut a = Actuator::default();
+        a.gravity.enabled = false;
+        let mut sim = crate::model::Simulator::new(&a, &SolverOptions::default()).unwrap();
+        sim.set_routing_mm(&[0.0; 5]).unwrap();
+        sim.solve(0.0).unwrap();
+        let template = sim.centreline()[0];
+        let line: Vec<CentrelinePoint> =
+            (0..=13).map(|k| 5.0 * k as f64).map(|s| CentrelinePoint { s_mm: s, x_mm: s, y_mm: 0.0, frame_angle_rad: 0.0, ..template }).collect();
+        assert!((signed_distance_to_centreline([10.0, 2.0], &line) - 2.0).abs() < 1e-12);
+        assert!((signed_distance_to_centreline([12.5, -1.5], &line) + 1.5).abs() < 1e-12);
+        // Past the tip the last segment is extended: only the side distance counts.
+        let (d, s) = closest_on_centreline([70.0, -1.0], &line);
+        assert!((d + 1.0).abs() < 1e-12 && (s - 65.0).abs() < 1e-12, "{d} {s}");
+        let m = simulated_marker(&Marker { s_mm: 32.5, offset_mm: 5.0, x_mm: 0.0, y_mm: 0.0 }, &line);
+        assert!((m[0] - 32.5).abs() < 1e-12 && (m[1] - 5.0).abs() < 1e-12, "{m:?}");
+        // Turned by a quarter turn, the offset points along −x.
+        let turned: Vec<CentrelinePoint> = line.iter().map(|p| CentrelinePoint { x_mm: 0.0, y_mm: p.s_mm, frame_angle_rad: std::f64::consts::FRAC_PI_2, ..*p }).collect();
+        let m = simulated_marker(&Marker { s_mm: 20.0, offset_mm: 5.0, x_mm: 0.0, y_mm: 0.0 }, &turned);
+        assert!((m[0] + 5.0).abs() < 1e-12 && (m[1] - 20.0).abs() < 1e-12, "{m:?}");
+    }
+
+    #[test]
+    fn huber_keeps_small_residuals_and_tames_large_ones() {
+        let l = Loss::Huber { k: 3.0 };
+        assert_eq!(l.transform(2.0), 2.0);
+        assert!((l.transform(-50.0).powi(2) - (2.0 * 3.0 * 50.0 - 9.0)).abs() < 1e-9);
+        assert!(l.transform(-50.0) < 0.0);
+        assert_eq!(max_outliers(44), 3);
+        assert_eq!(max_outliers(10), 2);
     }
 
     #[test]

@@ -10,6 +10,7 @@ pub mod fit;
 pub mod predict;
 pub mod report;
 pub mod rng;
+pub mod stats;
 pub mod synth;
 
 pub use data::{read_measurements, Dataset, Direction, Measurement};

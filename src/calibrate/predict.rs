@@ -42,8 +42,14 @@ pub fn predict_group(
     let mut out = Vec::with_capacity(group.rows.len());
     for &i in &group.rows {
         let m = &data.rows[i];
-        // At rest the tension is 0 and the friction sign does not matter.
-        let direction = if m.direction == Direction::Load { LoadDirection::Load } else { LoadDirection::Unload };
+        if m.direction == Direction::Static {
+            // An independent capture: a virgin rod, no history, no warm start.
+            sim.reset_history();
+            sim.reset_warm_start();
+        }
+        // At rest the tension is 0 and the friction sign does not matter; a
+        // static capture is taken as reached by loading.
+        let direction = if matches!(m.direction, Direction::Load | Direction::Static) { LoadDirection::Load } else { LoadDirection::Unload };
         let hold = Hold { direction, dwell_s: m.dwell_s };
         let fail = |source| CalibrateError::Solve { routing: group.routing.clone(), row: m.row, tension_n: m.tension_n, source };
         sim.set_hold(hold)?;
@@ -106,6 +112,8 @@ mod tests {
             tip_y_mm: 0.0,
             tip_angle_rad: 0.0,
             clamp_tilt_rad: tilt,
+            noise_mm: None,
+            noise_deg: None,
             row: 1,
         }
     }
@@ -122,5 +130,32 @@ mod tests {
         let level = Dataset { rows: vec![rest_row("t", 0.0)] };
         let p0 = predict(&Actuator::default(), &SolverOptions::default(), &level, &level.groups(), false).unwrap();
         assert!(p0[0].as_ref().unwrap().pose.tip_y_mm.abs() < 1e-12);
+    }
+
+    #[test]
+    fn static_captures_are_not_chained_as_one_history() {
+        // With creep, a reading after a long hold at a high tension carries
+        // that history in a protocol, but not as an independent capture.
+        let mut a = Actuator::default();
+        a.effects.creep_fraction = 0.3;
+        let row = |id: i64, step: i64, tension_n: f64, direction: Direction, dwell_s: f64| Measurement {
+            measurement: id,
+            step,
+            tension_n,
+            direction,
+            dwell_s,
+            y_mm: [2.0; 5],
+            ..rest_row("r", 0.0)
+        };
+        let angle = |rows: Vec<Measurement>| {
+            let data = Dataset { rows };
+            let p = predict(&a, &SolverOptions::default(), &data, &data.groups(), false).unwrap();
+            p.last().unwrap().as_ref().unwrap().pose.tip_angle_rad
+        };
+        let alone = angle(vec![row(1, 0, 0.5, Direction::Static, 5.0)]);
+        let chained = angle(vec![row(1, 0, 2.0, Direction::Load, 60.0), row(2, 1, 0.5, Direction::Unload, 5.0)]);
+        let independent = angle(vec![row(1, 0, 2.0, Direction::Static, 60.0), row(2, 1, 0.5, Direction::Static, 5.0)]);
+        assert!((independent - alone).abs() < 1e-9, "{independent} vs {alone}");
+        assert!((chained - alone).abs() > 1e-3, "the protocol carries creep: {chained} vs {alone}");
     }
 }

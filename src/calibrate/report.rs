@@ -2,8 +2,8 @@
 //! residual diagnostics, the fitted parameters and three PNG plots
 //! (residuals before/after, load/unload loops, measured vs simulated shapes).
 
-use super::data::{CentrelinePoints, Dataset, Direction, RoutingGroup};
-use super::diagnose::{Candidate, Diagnosis};
+use super::data::{CentrelinePoints, Dataset, Direction, MarkerPoints, RoutingGroup};
+use super::diagnose::{Candidate, DiagnoseSpec, Diagnosis};
 use super::fit::{row_residual, FitResult};
 use super::predict::Prediction;
 use super::CalibrateError;
@@ -19,14 +19,17 @@ pub fn write_report(
     data_path: &Path,
     data: &Dataset,
     d: &Diagnosis,
-    centrelines: Option<&CentrelinePoints>,
-    angle_weight_mm_per_deg: f64,
+    spec: &DiagnoseSpec,
 ) -> Result<PathBuf, CalibrateError> {
     crate::io::check_not_in_run_dir(dir, "--out").map_err(CalibrateError::Invalid)?;
     std::fs::create_dir_all(dir)
         .map_err(|source| CalibrateError::Io { context: format!("creating report directory {}", dir.display()), source })?;
     let groups = data.groups();
-    let after_label = model_label(&d.extended);
+    let angle_weight_mm_per_deg = spec.fit.angle_weight_mm_per_deg;
+    let centrelines = (!spec.fit.shapes.centrelines.is_empty()).then_some(&spec.fit.shapes.centrelines);
+    // The second model in plots and tables, only when it differs from the thesis model.
+    let after_label = (!d.extended.effects.is_empty()).then(|| model_label(&d.extended));
+    let after_label = after_label.as_deref();
     // Each picture is drawn to a temporary file and renamed into place, so
     // a failure never leaves a half-drawn picture over an older report.
     let atomic = |name: &str, draw: &dyn Fn(&Path) -> Result<(), PlotError>| -> Result<(), CalibrateError> {
@@ -40,11 +43,12 @@ pub fn write_report(
         std::fs::rename(&tmp, dir.join(name))
             .map_err(|source| CalibrateError::Io { context: format!("writing {}", dir.join(name).display()), source })
     };
-    atomic("residuals.png", &|p| residual_plot(p, data, &groups, d, &after_label, angle_weight_mm_per_deg))?;
-    atomic("loops.png", &|p| loop_plot(p, data, &groups, d, &after_label))?;
-    atomic("shapes.png", &|p| shape_plot(p, data, &groups, d, centrelines, &after_label))?;
+    atomic("residuals.png", &|p| residual_plot(p, data, &groups, d, after_label, angle_weight_mm_per_deg))?;
+    atomic("loops.png", &|p| loop_plot(p, data, &groups, d, after_label))?;
+    let markers = (!spec.fit.shapes.markers.is_empty()).then_some(&spec.fit.shapes.markers);
+    atomic("shapes.png", &|p| shape_plot(p, data, &groups, d, centrelines, markers, after_label))?;
     crate::io::sync_dir(dir);
-    let md = markdown(data_path, data, d, &after_label);
+    let md = markdown(data_path, data, d, after_label, centrelines, spec.fit.noise.mm);
     let path = dir.join("report.md");
     crate::io::write_atomic(&path, md.as_bytes())
         .map_err(|source| CalibrateError::Io { context: format!("writing {}", path.display()), source })?;
@@ -72,28 +76,66 @@ fn num(v: f64) -> String {
 }
 
 fn candidate_table(out: &mut String, cands: &[Candidate]) {
-    out.push_str("| rank | effect | parameter | value ± SE | ΔBIC | RMS (mm) | plausible |\n|---|---|---|---|---|---|---|\n");
+    out.push_str("| rank | effect | parameter | value ± SE | ΔBIC | χ²/dof | p | tip RMS (mm) | counts as evidence |\n|---|---|---|---|---|---|---|---|---|\n");
     for c in cands {
         let _ = writeln!(
             out,
-            "| {} | {} | `{}` | {} ± {} | {} | {} | {} |",
+            "| {} | {} | `{}` | {} ± {} | {} | {} | {} | {} | {} |",
             c.rank,
             c.effect,
             c.parameter_name,
             num(c.parameter),
             num(c.parameter_se),
             num(c.delta_bic),
+            num(c.reduced_chi2),
+            pval(c.p_value),
             num(c.rms_mm),
-            if c.error.is_some() { "fit failed" } else if c.plausible { "yes" } else { "no" }
+            match c.failure() {
+                None => "yes".to_string(),
+                Some(why) => format!("no: {}", why.replace('|', "/").replace('\n', " ")),
+            }
         );
     }
+}
+
+fn pval(p: f64) -> String {
+    if !p.is_finite() {
+        "—".into()
+    } else if p < 1e-99 {
+        "< 1e-99".into()
+    } else {
+        format!("{p:.2e}")
+    }
+}
+
+/// One line on a fit's adequacy: χ², dof, χ²/dof, p, outliers, convergence.
+fn adequacy_line(f: &FitResult) -> String {
+    let mut line = format!(
+        "χ² = {} on {} degrees of freedom, χ²/dof = {}, p = {}",
+        num(f.chi2),
+        f.dof,
+        num(f.reduced_chi2),
+        pval(f.p_value)
+    );
+    if !f.outliers.is_empty() {
+        let _ = write!(line, "; readings set aside as outliers (measurement ids): {}", f.outliers.iter().map(|i| i.to_string()).collect::<Vec<_>>().join(", "));
+    }
+    if !f.converged {
+        line.push_str("; **did not converge**");
+    }
+    line
 }
 
 fn fit_section(out: &mut String, title: &str, f: &FitResult) {
     let _ = writeln!(out, "### {title}\n");
     out.push_str("| parameter | value | SE |\n|---|---|---|\n");
     for p in &f.parameters {
-        let _ = writeln!(out, "| `{}` | {} | {} |", p.name, num(p.value), num(p.se));
+        let se = if p.fixed { "held".to_string() } else { num(p.se) };
+        let _ = writeln!(out, "| `{}` | {} | {} |", p.name, num(p.value), se);
+    }
+    let _ = writeln!(out, "\nAdequacy: {}.", adequacy_line(f));
+    for flag in &f.flags {
+        let _ = writeln!(out, "\n- ⚠ {flag}");
     }
     out.push_str("\nCorrelations:\n\n|   |");
     for p in &f.parameters {
@@ -111,12 +153,12 @@ fn fit_section(out: &mut String, title: &str, f: &FitResult) {
     }
     let _ = writeln!(
         out,
-        "\nRMS {} mm over {} residuals (BIC {}, {} iterations{}).\n\n| routing | rows | RMS (mm) | tip position RMS (mm) | tip angle RMS (°) |\n|---|---|---|---|---|",
+        "\nTip RMS {} mm; {} residuals (BIC {}, {} iterations{}).\n\n| routing | rows | RMS (mm) | tip position RMS (mm) | tip angle RMS (°) |\n|---|---|---|---|---|",
         num(f.rms_mm),
         f.n_residuals,
         num(f.bic),
         f.iterations,
-        if f.converged { "" } else { ", iteration cap reached" }
+        if f.converged { "" } else { ", not converged" }
     );
     for r in &f.per_routing {
         let _ = writeln!(out, "| {} | {} | {} | {} | {} |", r.routing, r.rows, num(r.rms_mm), num(r.rms_position_mm), num(r.rms_angle_deg));
@@ -124,18 +166,53 @@ fn fit_section(out: &mut String, title: &str, f: &FitResult) {
     out.push('\n');
 }
 
-fn markdown(data_path: &Path, data: &Dataset, d: &Diagnosis, after_label: &str) -> String {
+fn markdown(data_path: &Path, data: &Dataset, d: &Diagnosis, after_label: Option<&str>, centrelines: Option<&CentrelinePoints>, noise_mm: f64) -> String {
     let mut out = String::new();
     let _ = writeln!(out, "# Model-discrepancy diagnosis\n\nData: `{}` ({} rows, {} routings).\n", data_path.display(), data.rows.len(), data.groups().len());
     out.push_str("## Verdict\n\n");
     match d.verdict.as_str() {
-        "none" => out.push_str("**none**: no candidate effect is warranted; the thesis model explains the data to within its noise.\n\n"),
+        "none" => {
+            let _ = writeln!(out, "**none**: {}.\n", d.reason);
+        }
+        "inconclusive" => {
+            let _ = writeln!(out, "**inconclusive**: {}.\n", d.reason);
+        }
+        "unexplained" => {
+            let _ = writeln!(out, "**unexplained**: {}.\n", d.reason);
+            for n in &d.partial_effects {
+                let _ = writeln!(
+                    out,
+                    "- {} helps (`{}` = {} ± {}, ΔBIC {}) but does not explain the data.",
+                    n.effect,
+                    n.parameter_name,
+                    num(n.parameter),
+                    num(n.parameter_se),
+                    num(n.delta_bic)
+                );
+            }
+            if let Some(sig) = &d.signature {
+                let _ = writeln!(out, "\n### Residual signature ({})\n", sig.model);
+                for line in &sig.summary {
+                    let _ = writeln!(out, "- {line}");
+                }
+                out.push_str("\n| rows | n | tip position RMS (mm) | tip angle RMS (°) |\n|---|---|---|---|\n");
+                for (name, n, pos, ang) in &sig.by_tension {
+                    let _ = writeln!(out, "| {name} | {n} | {} | {} |", num(*pos), num(*ang));
+                }
+                out.push_str("\n| routing | tip position RMS (mm) | tip angle RMS (°) |\n|---|---|---|\n");
+                for (r, pos, ang) in &sig.by_routing {
+                    let _ = writeln!(out, "| {r} | {} | {} |", num(*pos), num(*ang));
+                }
+            }
+            out.push('\n');
+        }
         "ambiguous" => {
             let _ = writeln!(
                 out,
-                "**ambiguous**: the data cannot tell **{}** and **{}** apart. To separate them: {}.\n",
+                "**ambiguous**: the data cannot tell **{}** and **{}** apart ({}). To separate them: {}.\n",
                 d.ambiguous_between[0],
                 d.ambiguous_between[1],
+                d.reason,
                 d.separating_measurement.as_deref().unwrap_or("")
             );
         }
@@ -143,18 +220,28 @@ fn markdown(data_path: &Path, data: &Dataset, d: &Diagnosis, after_label: &str) 
             for n in &d.named {
                 let _ = writeln!(out, "- **{}**: `{}` = {} ± {} (ΔBIC {})", n.effect, n.parameter_name, num(n.parameter), num(n.parameter_se), num(n.delta_bic));
             }
-            out.push('\n');
+            let _ = writeln!(out, "\nWhy: {}.\n", d.reason);
         }
     }
     if let (Some(h), Some(b), Some(a)) = (&d.holdout, d.holdout_rms_before, d.holdout_rms_after) {
-        let _ = writeln!(out, "Held-out routing `{h}`: RMS {} mm with the thesis model, {} mm {} ({}× smaller).\n", num(b), num(a), after_label, num(b / a));
+        match after_label {
+            None => {
+                let _ = writeln!(out, "Held-out routing `{h}`: RMS {} mm with the thesis model (no effect added).\n", num(b));
+            }
+            Some(label) => {
+                let ratio = if a <= b { format!("{}× smaller", num(b / a)) } else { format!("{}× larger", num(a / b)) };
+                let _ = writeln!(out, "Held-out routing `{h}`: RMS {} mm with the thesis model, {} mm {label} ({ratio}).\n", num(b), num(a));
+            }
+        }
     }
+    let _ = writeln!(out, "Thesis model against the noise: {}.\n", adequacy_line(&d.baseline));
     let _ = writeln!(out, "Criterion: {}.\n", d.criterion);
     out.push_str("Cable stretch is not a candidate: under tension control the cable's stretch does not change the forces on the rod, so no tip reading can identify it.\n\n");
     out.push_str("## Candidates (each refitted with EA, GA, EI)\n\n");
     candidate_table(&mut out, &d.candidates);
     if !d.second_round.is_empty() {
-        let _ = writeln!(out, "\nSecond round (given {}):\n", d.named.first().map_or("", |n| n.effect));
+        let first = d.named.first().or(d.partial_effects.first()).map_or_else(|| d.candidates.first().map_or("", |c| c.effect), |n| n.effect);
+        let _ = writeln!(out, "\nSecond round (given {first}):\n");
         candidate_table(&mut out, &d.second_round);
     }
     out.push_str("\n## Residual diagnostics of the thesis model\n\nResiduals are simulated − measured; θ is weighted so that the angle weight (mm per degree) converts it to mm.\n\n| rows | n | RMS (mm) | mean Δx (mm) | mean Δy (mm) | mean Δθ (°) |\n|---|---|---|---|---|---|\n");
@@ -167,13 +254,97 @@ fn markdown(data_path: &Path, data: &Dataset, d: &Diagnosis, after_label: &str) 
         num(d.diagnostics.loop_gap_deg),
         num(d.diagnostics.rest_shift_deg)
     );
+    if let Some(c) = centrelines {
+        coefficient_section(&mut out, data, d, c, after_label, noise_mm);
+    }
     out.push_str("## Fits\n\n");
     fit_section(&mut out, "Thesis model (EA, GA, EI)", &d.baseline);
-    if !d.extended.effects.is_empty() {
-        fit_section(&mut out, &format!("Model {after_label}"), &d.extended);
+    if let Some(label) = after_label {
+        fit_section(&mut out, &format!("Model {label}"), &d.extended);
     }
     out.push_str("## Plots\n\n![residuals before and after](residuals.png)\n\n![load/unload loops](loops.png)\n\n![measured vs simulated shapes](shapes.png)\n");
     out
+}
+
+/// Highest Legendre order shown for measured vs simulated shapes.
+const SHAPE_ORDER: usize = 3;
+
+/// Legendre curvature coefficients a_0 … a_`order` of a centreline given
+/// by points (clamp first), in the thesis's basis: per unit REST length L,
+/// a_i = a_i^deformed · ℓ / L (model-notes §4). Measured and simulated
+/// shapes both go through this one function so that they are compared in
+/// the same basis; it is the place to switch to `shape::LengthBasis` when
+/// that lands.
+pub fn shape_coefficients_rest_basis(points: &[[f64; 2]], rest_length_mm: f64, order: usize) -> Result<Vec<f64>, crate::shape::ShapeError> {
+    let c = crate::shape::coefficients_from_points(points, order)?;
+    let factor = c.length_mm / rest_length_mm;
+    Ok(c.a.iter().map(|a| a * factor).collect())
+}
+
+/// Measured vs simulated a_0 … a_n at the top tension of each routing with
+/// a measured centreline.
+/// Standard deviation of [`shape_coefficients_rest_basis`] over noisy
+/// copies of the predicted centreline sampled at `count` points (the noise
+/// `noise_mm` on x and y): how much of a measured a_i noise alone explains.
+fn coefficient_noise(prediction: &Option<Prediction>, count: usize, noise_mm: f64, length_mm: f64) -> Option<Vec<f64>> {
+    let line: Vec<[f64; 2]> = prediction.as_ref()?.centreline.as_ref()?.iter().map(|c| [c.x_mm, c.y_mm]).collect();
+    let base = super::synth::resample(&line, count);
+    let mut rng = super::rng::Rng::new(0x5eed);
+    const DRAWS: usize = 40;
+    let mut sum = [0.0; SHAPE_ORDER + 1];
+    let mut sum2 = [0.0; SHAPE_ORDER + 1];
+    for _ in 0..DRAWS {
+        let noisy: Vec<[f64; 2]> = base.iter().map(|p| [p[0] + noise_mm * rng.normal(), p[1] + noise_mm * rng.normal()]).collect();
+        let a = shape_coefficients_rest_basis(&noisy, length_mm, SHAPE_ORDER).ok()?;
+        for (k, v) in a.iter().enumerate() {
+            sum[k] += v;
+            sum2[k] += v * v;
+        }
+    }
+    let n = DRAWS as f64;
+    Some(sum.iter().zip(&sum2).map(|(s, s2)| ((s2 - s * s / n) / (n - 1.0)).max(0.0).sqrt()).collect())
+}
+
+fn coefficient_section(out: &mut String, data: &Dataset, d: &Diagnosis, centrelines: &CentrelinePoints, after_label: Option<&str>, noise_mm: f64) {
+    let length = d.baseline.actuator.length_mm;
+    let mut rows = Vec::new();
+    for g in data.groups() {
+        let Some(i) = g.rows.iter().copied().filter(|i| centrelines.get(&data.rows[*i].measurement).is_some_and(|p| p.len() >= 5)).max_by(|&a, &b| data.rows[a].tension_n.total_cmp(&data.rows[b].tension_n)) else {
+            continue;
+        };
+        let m = &data.rows[i];
+        let simulated = |preds: &[Option<Prediction>]| -> Option<Vec<f64>> {
+            let line: Vec<[f64; 2]> = preds[i].as_ref()?.centreline.as_ref()?.iter().map(|c| [c.x_mm, c.y_mm]).collect();
+            shape_coefficients_rest_basis(&line, length, SHAPE_ORDER).ok()
+        };
+        let points = &centrelines[&m.measurement];
+        let measured = shape_coefficients_rest_basis(points, length, SHAPE_ORDER).ok();
+        let spread = coefficient_noise(&d.baseline_predictions[i], points.len(), m.noise_mm.unwrap_or(noise_mm), length);
+        rows.push((g.routing.clone(), m.measurement, m.tension_n, measured, spread, simulated(&d.baseline_predictions), simulated(&d.extended_predictions)));
+    }
+    if rows.is_empty() {
+        return;
+    }
+    let _ = writeln!(
+        out,
+        "## Shapes: curvature coefficients, measured vs simulated\n\nLegendre coefficients a_0 … a_{SHAPE_ORDER} (1/mm) in the thesis's basis, per unit rest length L = {} mm (a_i = a_i^deformed · ℓ/L), computed the same way from the measured points and from the simulated centreline, at the top tension of each routing. The row ± noise is the standard deviation that the stated noise alone gives the measured coefficients (the simulated centreline sampled like the measurement, noised, 40 draws): higher orders from noisy points are mostly noise, which is why the fit uses point distances, not coefficients.\n",
+        num(length)
+    );
+    let heads: Vec<String> = (0..=SHAPE_ORDER).map(|k| format!("a_{k}")).collect();
+    let _ = writeln!(out, "| routing | reading | tension (N) | shape | {} |\n|---|---|---|---|{}", heads.join(" | "), "---|".repeat(SHAPE_ORDER + 1));
+    let cells = |a: &Option<Vec<f64>>| match a {
+        Some(a) => a.iter().map(|v| format!("{v:+.5}")).collect::<Vec<_>>().join(" | "),
+        None => ["—"; SHAPE_ORDER + 1].join(" | "),
+    };
+    for (routing, id, t, measured, spread, base, ext) in &rows {
+        let _ = writeln!(out, "| {routing} | {id} | {} | measured | {} |", num(*t), cells(measured));
+        let _ = writeln!(out, "| | | | ± noise | {} |", cells(spread).replace('+', ""));
+        let _ = writeln!(out, "| | | | thesis model | {} |", cells(base));
+        if let Some(label) = after_label {
+            let _ = writeln!(out, "| | | | {label} | {} |", cells(ext));
+        }
+    }
+    out.push('\n');
 }
 
 type Chart<'a, 'b> = ChartContext<'a, BitMapBackend<'b>, Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>>;
@@ -190,11 +361,12 @@ fn draw_legend<'a, 'b: 'a>(chart: &mut Chart<'a, 'b>, path: &Path, position: Ser
         .map_err(|e| PlotError::new(path, e))
 }
 
-fn residual_plot(path: &Path, data: &Dataset, groups: &[RoutingGroup], d: &Diagnosis, after: &str, w: f64) -> Result<(), PlotError> {
+fn residual_plot(path: &Path, data: &Dataset, groups: &[RoutingGroup], d: &Diagnosis, after: Option<&str>, w: f64) -> Result<(), PlotError> {
     register_fonts();
-    let root = BitMapBackend::new(path, (1100, 800)).into_drawing_area();
+    let height = if after.is_some() { 800 } else { 420 };
+    let root = BitMapBackend::new(path, (1100, height)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| PlotError::new(path, e))?;
-    let panels = root.split_evenly((2, 1));
+    let panels = root.split_evenly((if after.is_some() { 2 } else { 1 }, 1));
     let order: Vec<usize> = groups.iter().flat_map(|g| g.rows.iter().copied()).collect();
     let series = |preds: &[Option<Prediction>]| -> Vec<[f64; 3]> {
         order.iter().map(|&i| row_residual(&data.rows[i], &preds[i].as_ref().expect("predicted").pose, w)).collect()
@@ -202,7 +374,11 @@ fn residual_plot(path: &Path, data: &Dataset, groups: &[RoutingGroup], d: &Diagn
     let before = series(&d.baseline_predictions);
     let after_r = series(&d.extended_predictions);
     let lim = before.iter().chain(&after_r).flat_map(|r| r.iter().map(|v| v.abs())).fold(1.0, f64::max) * 1.1;
-    for (panel, (res, title)) in panels.iter().zip([(&before, "thesis model".to_string()), (&after_r, after.to_string())]) {
+    let mut shown = vec![(&before, "thesis model".to_string())];
+    if let Some(label) = after {
+        shown.push((&after_r, label.to_string()));
+    }
+    for (panel, (res, title)) in panels.iter().zip(shown) {
         let mut chart = ChartBuilder::on(panel)
             .caption(format!("residuals (simulated − measured), {title}"), (FONT, 20))
             .margin(10)
@@ -237,7 +413,7 @@ fn residual_plot(path: &Path, data: &Dataset, groups: &[RoutingGroup], d: &Diagn
     root.present().map_err(|e| PlotError::new(path, e))
 }
 
-fn loop_plot(path: &Path, data: &Dataset, groups: &[RoutingGroup], d: &Diagnosis, after: &str) -> Result<(), PlotError> {
+fn loop_plot(path: &Path, data: &Dataset, groups: &[RoutingGroup], d: &Diagnosis, after: Option<&str>) -> Result<(), PlotError> {
     register_fonts();
     let cols = groups.len().clamp(1, 3);
     let rows = groups.len().div_ceil(cols).max(1);
@@ -276,12 +452,23 @@ fn loop_plot(path: &Path, data: &Dataset, groups: &[RoutingGroup], d: &Diagnosis
             .map_err(|e| PlotError::new(path, e))?
             .label("thesis model")
             .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], BLUE.stroke_width(2)));
-        chart
-            .draw_series(LineSeries::new(ext, orange.stroke_width(2)))
-            .map_err(|e| PlotError::new(path, e))?
-            .label(after.to_string())
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], orange.stroke_width(2)));
-        for (dir, colour, label) in [(Direction::Load, BLACK, "measured, load"), (Direction::Unload, RED, "measured, unload"), (Direction::Rest, RGBColor(120, 120, 120), "measured, rest")] {
+        if let Some(label) = after {
+            chart
+                .draw_series(LineSeries::new(ext, orange.stroke_width(2)))
+                .map_err(|e| PlotError::new(path, e))?
+                .label(label.to_string())
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], orange.stroke_width(2)));
+        }
+        for (dir, colour, label) in [
+            (Direction::Load, BLACK, "measured, load"),
+            (Direction::Unload, RED, "measured, unload"),
+            (Direction::Rest, RGBColor(120, 120, 120), "measured, rest"),
+            (Direction::Static, RGBColor(60, 60, 200), "measured, static"),
+        ] {
+            // A legend entry only for kinds of reading this routing has.
+            if !measured.iter().any(|m| m.2 == dir) {
+                continue;
+            }
             chart
                 .draw_series(measured.iter().filter(|m| m.2 == dir).map(|m| Circle::new((m.0, m.1), 4, colour.filled())))
                 .map_err(|e| PlotError::new(path, e))?
@@ -299,7 +486,8 @@ fn shape_plot(
     groups: &[RoutingGroup],
     d: &Diagnosis,
     centrelines: Option<&CentrelinePoints>,
-    after: &str,
+    markers: Option<&MarkerPoints>,
+    after: Option<&str>,
 ) -> Result<(), PlotError> {
     register_fonts();
     // The reading at the top tension of each routing.
@@ -331,9 +519,11 @@ fn shape_plot(
         if first {
             s.label("thesis model").legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], BLUE.stroke_width(2)));
         }
-        let s = chart.draw_series(LineSeries::new(line(&d.extended_predictions, i), orange.stroke_width(2))).map_err(|e| PlotError::new(path, e))?;
-        if first {
-            s.label(after.to_string()).legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], orange.stroke_width(2)));
+        if let Some(label) = after {
+            let s = chart.draw_series(LineSeries::new(line(&d.extended_predictions, i), orange.stroke_width(2))).map_err(|e| PlotError::new(path, e))?;
+            if first {
+                s.label(label.to_string()).legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], orange.stroke_width(2)));
+            }
         }
         let m = &data.rows[i];
         let s = chart
@@ -346,6 +536,14 @@ fn shape_plot(
             chart
                 .draw_series(points.iter().map(|p| Circle::new((p[1], -p[0]), 2, BLACK.mix(0.6).filled())))
                 .map_err(|e| PlotError::new(path, e))?;
+        }
+        if let Some(ms) = markers.and_then(|c| c.get(&m.measurement)) {
+            let s = chart
+                .draw_series(ms.iter().map(|p| TriangleMarker::new((p.y_mm, -p.x_mm), 5, RED.filled())))
+                .map_err(|e| PlotError::new(path, e))?;
+            if first {
+                s.label("measured markers").legend(|(x, y)| TriangleMarker::new((x + 8, y), 4, RED.filled()));
+            }
         }
         chart
             .draw_series(std::iter::once(Text::new(g.routing.clone(), (m.tip_y_mm + 2.0, -m.tip_x_mm + 2.0), (FONT, 13))))

@@ -5,7 +5,7 @@
 //! top tension; unload in the same steps; rest again. Each step is held for
 //! the step dwell, the two rest states for the rest dwell.
 
-use super::data::{CentrelinePoints, Dataset, Direction, Measurement, RoutingGroup};
+use super::data::{CentrelinePoints, Dataset, Direction, Marker, MarkerPoints, Measurement, RoutingGroup};
 use super::predict::predict_group;
 use super::rng::Rng;
 use super::CalibrateError;
@@ -40,6 +40,10 @@ pub struct SynthSpec {
     pub noise_deg: f64,
     /// Noise seed.
     pub seed: u64,
+    /// Markers on every reading: (rest arc length s, lateral body-frame
+    /// offset), mm. Their noise is `noise_mm` per axis, from a stream of
+    /// its own so that adding markers leaves the other data unchanged.
+    pub markers: Vec<(f64, f64)>,
 }
 
 /// Default routings: one with y_c(0) ≠ 0, an S-curve, a straight one, one
@@ -69,6 +73,7 @@ impl Default for SynthSpec {
             noise_mm: 0.4,
             noise_deg: 1.0,
             seed: 1,
+            markers: Vec::new(),
         }
     }
 }
@@ -92,6 +97,19 @@ pub const MAX_CENTRELINE_POINTS: usize = 10_000;
 /// Generates the measurements (and noisy centreline points of every
 /// reading, `points` per reading, when `points > 0`).
 pub fn synthesize(spec: &SynthSpec, points: usize) -> Result<(Dataset, CentrelinePoints), CalibrateError> {
+    synthesize_with_markers(spec, points).map(|(d, c, _)| (d, c))
+}
+
+/// [`synthesize`], and the markers of `spec.markers` on every reading.
+pub fn synthesize_with_markers(spec: &SynthSpec, points: usize) -> Result<(Dataset, CentrelinePoints, MarkerPoints), CalibrateError> {
+    for &(s_mm, offset_mm) in &spec.markers {
+        if !(s_mm.is_finite() && offset_mm.is_finite() && (0.0..=spec.actuator.length_mm).contains(&s_mm)) {
+            return Err(CalibrateError::Invalid(format!(
+                "marker at s = {s_mm} mm, offset {offset_mm} mm: s must lie on the rod (0 … {} mm) and both must be finite",
+                spec.actuator.length_mm
+            )));
+        }
+    }
     if !(spec.max_tension_n.is_finite() && spec.max_tension_n > 0.0) || spec.load_steps == 0 {
         return Err(CalibrateError::Invalid(format!(
             "the protocol needs a top tension > 0 N and at least one load step (got {} N, {} steps)",
@@ -142,32 +160,50 @@ pub fn synthesize(spec: &SynthSpec, points: usize) -> Result<(Dataset, Centrelin
                 tip_y_mm: 0.0,
                 tip_angle_rad: 0.0,
                 clamp_tilt_rad,
+                noise_mm: None,
+                noise_deg: None,
                 row: measurement as usize,
             });
         }
     }
     let mut rng = Rng::new(spec.seed);
+    let mut marker_rng = Rng::new(spec.seed ^ 0x6d61_726b_6572);
     let mut centrelines = CentrelinePoints::new();
+    let mut markers = MarkerPoints::new();
     let groups: Vec<RoutingGroup> = data.groups();
     for g in &groups {
-        let preds = predict_group(&spec.actuator, &spec.options, &data, g, points > 0)?;
+        let preds = predict_group(&spec.actuator, &spec.options, &data, g, points > 0 || !spec.markers.is_empty())?;
         for (&i, p) in g.rows.iter().zip(preds) {
             let m = &mut data.rows[i];
             m.tip_x_mm = p.pose.tip_x_mm + spec.noise_mm * rng.normal();
             m.tip_y_mm = p.pose.tip_y_mm + spec.noise_mm * rng.normal();
             m.tip_angle_rad = p.pose.tip_angle_rad + spec.noise_deg.to_radians() * rng.normal();
             if let Some(line) = p.centreline {
-                let pts = resample(&line.iter().map(|c| [c.x_mm, c.y_mm]).collect::<Vec<_>>(), points);
-                let noisy = pts.into_iter().map(|[x, y]| [x + spec.noise_mm * rng.normal(), y + spec.noise_mm * rng.normal()]);
-                centrelines.insert(m.measurement, noisy.collect());
+                if points > 0 {
+                    let pts = resample(&line.iter().map(|c| [c.x_mm, c.y_mm]).collect::<Vec<_>>(), points);
+                    let noisy = pts.into_iter().map(|[x, y]| [x + spec.noise_mm * rng.normal(), y + spec.noise_mm * rng.normal()]);
+                    centrelines.insert(m.measurement, noisy.collect());
+                }
+                if !spec.markers.is_empty() {
+                    let on_body = spec.markers.iter().map(|&(s_mm, offset_mm)| {
+                        let exact = super::fit::simulated_marker(&Marker { s_mm, offset_mm, x_mm: 0.0, y_mm: 0.0 }, &line);
+                        Marker {
+                            s_mm,
+                            offset_mm,
+                            x_mm: exact[0] + spec.noise_mm * marker_rng.normal(),
+                            y_mm: exact[1] + spec.noise_mm * marker_rng.normal(),
+                        }
+                    });
+                    markers.insert(m.measurement, on_body.collect());
+                }
             }
         }
     }
-    Ok((data, centrelines))
+    Ok((data, centrelines, markers))
 }
 
 /// `count` points at equal index spacing along a polyline (clamp and tip included).
-fn resample(line: &[[f64; 2]], count: usize) -> Vec<[f64; 2]> {
+pub fn resample(line: &[[f64; 2]], count: usize) -> Vec<[f64; 2]> {
     if count < 2 || line.len() < 2 {
         return line.iter().take(count).copied().collect();
     }

@@ -3,8 +3,9 @@
 //! RMS error per routing.
 
 use super::ActuatorArgs;
+use crate::calibrate::data::{read_centrelines, read_markers, Dataset};
 use crate::calibrate::diagnose::{fit_json, split_holdout};
-use crate::calibrate::fit::rms_per_routing;
+use crate::calibrate::fit::{apply_held, parse_held, rms_per_routing, Held, Loss, Noise, ShapeData};
 use crate::calibrate::predict::predict;
 use crate::calibrate::{fit, read_measurements, Effect, FitSpec};
 use crate::model::{Actuator, SolverOptions};
@@ -12,6 +13,93 @@ use anyhow::bail;
 use clap::Args;
 use std::io::Write;
 use std::path::PathBuf;
+use std::sync::Arc;
+
+/// Settings every fit shares (calibrate and diagnose).
+#[derive(Debug, Clone, Args)]
+pub struct FitArgs {
+    /// Noise (standard deviation) of tip x, y, centreline points and markers, mm; a `noise_mm` column overrides it per row.
+    #[arg(long, default_value_t = 0.4, value_name = "MM")]
+    pub noise_mm: f64,
+    /// Noise of the tip angle, degrees; a `noise_deg` column overrides it per row.
+    #[arg(long, default_value_t = 1.0, value_name = "DEG")]
+    pub noise_deg: f64,
+    /// Hold a parameter at a value instead of fitting it (repeatable): EA, GA, EI or an effect parameter, e.g. GA=1.70866 or friction_mu=0.05.
+    #[arg(long = "fix", value_name = "NAME=VALUE")]
+    pub fix: Vec<String>,
+    /// Loss on the noise-whitened residuals: huber (robust to a few bad readings) or squares.
+    #[arg(long, default_value = "huber", value_name = "LOSS")]
+    pub loss: String,
+    /// Where the Huber loss turns linear, in noise σ.
+    #[arg(long, default_value_t = 3.0, value_name = "SIGMA")]
+    pub huber_k: f64,
+    /// Most Levenberg–Marquardt iterations per fit.
+    #[arg(long, default_value_t = 200)]
+    pub max_iterations: usize,
+    /// Measured centreline points (measurement,x_mm,y_mm), fitted as distances to the simulated centreline.
+    #[arg(long, value_name = "FILE")]
+    pub centrelines: Option<PathBuf>,
+    /// Markers off the centreline (measurement,s_mm,offset_mm,x_mm,y_mm), fitted by position.
+    #[arg(long, value_name = "FILE")]
+    pub markers: Option<PathBuf>,
+    /// Weight of the tip angle in the reported mm-equivalent RMS, mm per degree (the fit weights by the noise).
+    #[arg(long, default_value_t = 1.0, value_name = "MM_PER_DEG")]
+    pub angle_weight: f64,
+}
+
+impl FitArgs {
+    /// The fit settings and the starting actuator with held values set;
+    /// also returns the held effects.
+    pub fn spec(&self, base: &Actuator, data: &Dataset) -> anyhow::Result<(FitSpec, Actuator, Vec<Effect>)> {
+        let mut held: Vec<(Held, f64)> = Vec::new();
+        for item in &self.fix {
+            let Some((name, value)) = item.split_once('=') else {
+                bail!("--fix {item}: expected NAME=VALUE, e.g. GA=1.70866");
+            };
+            let Some(h) = parse_held(name) else {
+                let effects: Vec<&str> = Effect::ALL.iter().map(|e| e.parameter_name()).collect();
+                bail!("--fix {item}: unknown parameter '{name}'; use EA, GA, EI or one of {}", effects.join(", "));
+            };
+            let Ok(v) = value.trim().parse::<f64>() else {
+                bail!("--fix {item}: '{value}' is not a number");
+            };
+            held.push((h, v));
+        }
+        let (start, fixed_rigidities, held_effects) = apply_held(base, &held)?;
+        let loss = match self.loss.as_str() {
+            "huber" => {
+                if !(self.huber_k.is_finite() && self.huber_k > 0.0) {
+                    bail!("--huber-k {}: must be a number of σ > 0", self.huber_k);
+                }
+                Loss::Huber { k: self.huber_k }
+            }
+            "squares" => Loss::Squared,
+            other => bail!("--loss {other}: use huber or squares"),
+        };
+        if self.max_iterations == 0 {
+            bail!("--max-iterations must be at least 1");
+        }
+        let mut shapes = ShapeData::default();
+        if let Some(p) = &self.centrelines {
+            shapes.centrelines = read_centrelines(p, data)?;
+        }
+        if let Some(p) = &self.markers {
+            shapes.markers = read_markers(p, data, start.length_mm)?;
+        }
+        let noise = Noise { mm: self.noise_mm, deg: self.noise_deg };
+        noise.validate()?;
+        let spec = FitSpec {
+            effects: Vec::new(),
+            angle_weight_mm_per_deg: self.angle_weight,
+            noise,
+            loss,
+            fixed_rigidities,
+            max_iterations: self.max_iterations,
+            shapes: Arc::new(shapes),
+        };
+        Ok((spec, start, held_effects))
+    }
+}
 
 /// Arguments of `cablemap calibrate`.
 #[derive(Debug, Clone, Args)]
@@ -21,9 +109,9 @@ pub struct CalibrateArgs {
     /// Leave this routing out of the fit and report the error on it.
     #[arg(long, value_name = "ROUTING")]
     pub holdout: Option<String>,
-    /// Weight of the tip angle in mm per degree (1: 1° counts like 1 mm).
-    #[arg(long, default_value_t = 1.0, value_name = "MM_PER_DEG")]
-    pub angle_weight: f64,
+    /// Noise, held parameters, loss, shapes.
+    #[command(flatten)]
+    pub fit: FitArgs,
     /// Also fit this effect's parameter (repeatable): friction, gravity, stiffening, clamp_compliance, channel_offset, creep.
     #[arg(long = "effect", value_name = "EFFECT")]
     pub effects: Vec<String>,
@@ -60,13 +148,17 @@ pub fn run(args: &CalibrateArgs) -> anyhow::Result<()> {
     let options = args.actuator.solver_options(&SolverOptions::default());
     let data = read_measurements(&args.data)?;
     let (train, held) = split_holdout(&data, args.holdout.as_deref())?;
-    let spec = FitSpec { effects: parse_effects(&args.effects)?, angle_weight_mm_per_deg: args.angle_weight };
+    let (mut spec, start, held_effects) = args.fit.spec(&base, &data)?;
+    spec.effects = parse_effects(&args.effects)?;
+    if let Some(e) = spec.effects.iter().find(|e| held_effects.contains(e)) {
+        bail!("--effect {0} and --fix {1}=…: an effect is either fitted or held, not both", e.name(), e.parameter_name());
+    }
     if data.rows.len() >= LARGE_DATA_ROWS {
         // A fit re-simulates every reading (1 + parameters) times per
         // iteration: state the cost of one pass up front for large files,
         // so a long silent run is expected rather than mistaken for a hang.
         let started = std::time::Instant::now();
-        predict(&base, &options, &data, &train, false)?;
+        predict(&start, &options, &data, &train, false)?;
         let pass_s = started.elapsed().as_secs_f64();
         let per_iteration_s = pass_s * (4 + spec.effects.len()) as f64;
         eprintln!(
@@ -75,12 +167,12 @@ pub fn run(args: &CalibrateArgs) -> anyhow::Result<()> {
             data.rows.len()
         );
     }
-    let result = fit(&base, &options, &data, &train, &spec)?;
+    let result = fit(&start, &options, &data, &train, &spec)?;
     let holdout_rms = match &held {
         Some(g) => {
             let g = std::slice::from_ref(g);
             let preds = predict(&result.actuator, &options, &data, g, false)?;
-            Some(rms_per_routing(&data, g, &preds, args.angle_weight)[0].clone())
+            Some(rms_per_routing(&data, g, &preds, spec.angle_weight_mm_per_deg)[0].clone())
         }
         None => None,
     };
@@ -89,12 +181,32 @@ pub fn run(args: &CalibrateArgs) -> anyhow::Result<()> {
     if args.json {
         let mut v = fit_json(&result);
         v["holdout"] = serde_json::to_value(&holdout_rms)?;
+        let held: serde_json::Map<String, serde_json::Value> =
+            held_effects.iter().map(|e| (e.parameter_name().to_string(), serde_json::json!(e.current(&start).unwrap_or(0.0)))).collect();
+        v["held_effects"] = serde_json::Value::Object(held);
         writeln!(out, "{v}")?;
         return Ok(());
     }
-    writeln!(out, "fit of {} readings on {} routings (eq. 2.14, θ weight {} mm/°)", result.n_residuals / 3, train.len(), args.angle_weight)?;
+    let readings: usize = train.iter().map(|g| g.rows.len()).sum();
+    writeln!(
+        out,
+        "fit of {readings} readings on {} routings ({} residuals weighted by noise {} mm, {}°; {})",
+        train.len(),
+        result.n_residuals,
+        spec.noise.mm,
+        spec.noise.deg,
+        spec.loss.describe()
+    )?;
     for p in &result.parameters {
-        writeln!(out, "  {:<30} {:>14.6} ± {:<12.4e}", p.name, p.value, p.se)?;
+        if p.fixed {
+            writeln!(out, "  {:<30} {:>14.6}   (held)", p.name, p.value)?;
+        } else {
+            writeln!(out, "  {:<30} {:>14.6} ± {:<12.4e}", p.name, p.value, p.se)?;
+        }
+    }
+    for e in &held_effects {
+        let v = e.current(&start).unwrap_or(0.0);
+        writeln!(out, "  {:<30} {:>14.6}   (held)", e.parameter_name(), v)?;
     }
     writeln!(out, "correlations:")?;
     write!(out, "  {:<30}", "")?;
@@ -105,7 +217,11 @@ pub fn run(args: &CalibrateArgs) -> anyhow::Result<()> {
     for (p, row) in result.parameters.iter().zip(&result.correlation) {
         write!(out, "  {:<30}", p.name)?;
         for c in row {
-            write!(out, " {c:>+9.3}")?;
+            if c.is_finite() {
+                write!(out, " {c:>+9.3}")?;
+            } else {
+                write!(out, " {:>9}", "—")?;
+            }
         }
         writeln!(out)?;
     }
@@ -116,7 +232,23 @@ pub fn run(args: &CalibrateArgs) -> anyhow::Result<()> {
     if let Some(r) = holdout_rms {
         writeln!(out, "  {:<20} {:>3} rows  {:>8.4} mm   {:>8.4} mm  {:>8.4}°  (held out)", r.routing, r.rows, r.rms_mm, r.rms_position_mm, r.rms_angle_deg)?;
     }
-    writeln!(out, "overall RMS {:.4} mm, {} iterations{}", result.rms_mm, result.iterations, if result.converged { "" } else { " (iteration cap reached)" })?;
+    writeln!(
+        out,
+        "overall tip RMS {:.4} mm; χ² = {:.1} on {} dof (χ²/dof = {:.3}, p = {:.2e}){}",
+        result.rms_mm,
+        result.chi2,
+        result.dof,
+        result.reduced_chi2,
+        result.p_value,
+        if result.p_value < 1e-3 { ": well above the stated noise (p < 1e-3)" } else { ": consistent with the stated noise" }
+    )?;
+    if !result.outliers.is_empty() {
+        writeln!(out, "outliers set aside in the χ² test (measurement ids): {:?}", result.outliers)?;
+    }
+    writeln!(out, "{} iterations{}", result.iterations, if result.converged { ", converged" } else { ": NOT converged (iteration cap or an unsolvable model near the optimum); do not trust these values" })?;
+    for f in &result.flags {
+        writeln!(out, "warning: {f}")?;
+    }
     writeln!(out, "cable stretch is not fitted: under tension control it is not identifiable")?;
     Ok(())
 }

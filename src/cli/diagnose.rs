@@ -1,8 +1,8 @@
 //! `cablemap diagnose DATA`: finds, names and adds the missing effect, with
 //! a Markdown report and plots.
 
+use super::calibrate::FitArgs;
 use super::ActuatorArgs;
-use crate::calibrate::data::read_centrelines;
 use crate::calibrate::diagnose::{diagnose, DiagnoseSpec};
 use crate::calibrate::read_measurements;
 use crate::calibrate::report::write_report;
@@ -19,18 +19,18 @@ pub struct DiagnoseArgs {
     /// Routing left out of every fit; the gap on it is shown before and after.
     #[arg(long, value_name = "ROUTING")]
     pub holdout: Option<String>,
-    /// Measured centreline points (measurement,x_mm,y_mm), drawn in the shape plot.
-    #[arg(long, value_name = "FILE")]
-    pub centrelines: Option<PathBuf>,
     /// Report directory (report.md and PNG plots).
     #[arg(long, default_value = "diagnose-report", value_name = "DIR")]
     pub out: PathBuf,
     /// Skip the report and plots.
     #[arg(long)]
     pub no_report: bool,
-    /// Weight of the tip angle in mm per degree (1: 1° counts like 1 mm).
-    #[arg(long, default_value_t = 1.0, value_name = "MM_PER_DEG")]
-    pub angle_weight: f64,
+    /// Noise, held parameters, loss, shapes.
+    #[command(flatten)]
+    pub fit: FitArgs,
+    /// A model is consistent with the noise when the chi-square test's p ≥ this.
+    #[arg(long, default_value_t = 1e-3, value_name = "P")]
+    pub alpha: f64,
     /// BIC decrease an effect needs against the model without it.
     #[arg(long, default_value_t = 10.0)]
     pub threshold: f64,
@@ -58,20 +58,18 @@ pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
     base.validate()?;
     let options = args.actuator.solver_options(&SolverOptions::default());
     let data = read_measurements(&args.data)?;
-    let centrelines = args.centrelines.as_ref().map(|p| read_centrelines(p, &data)).transpose()?;
+    let (fit, start, held_effects) = args.fit.spec(&base, &data)?;
     let spec = DiagnoseSpec {
         holdout: args.holdout.clone(),
-        angle_weight_mm_per_deg: args.angle_weight,
+        fit,
         threshold: args.threshold,
         margin: args.margin,
         max_effects: args.max_effects.max(1),
+        alpha: args.alpha,
+        held_effects,
     };
-    let d = diagnose(&base, &options, &data, &spec)?;
-    let report = if args.no_report {
-        None
-    } else {
-        Some(write_report(&args.out, &args.data, &data, &d, centrelines.as_ref(), args.angle_weight)?)
-    };
+    let d = diagnose(&start, &options, &data, &spec)?;
+    let report = if args.no_report { None } else { Some(write_report(&args.out, &args.data, &data, &d, &spec)?) };
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
     if args.json {
@@ -81,28 +79,59 @@ pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
         return Ok(());
     }
     writeln!(out, "verdict: {}", d.verdict)?;
+    writeln!(out, "  {}", d.reason)?;
+    for n in &d.partial_effects {
+        writeln!(out, "  helps but does not explain: {} {} = {} (ΔBIC {:.1})", n.effect, n.parameter_name, value(n.parameter), n.delta_bic)?;
+    }
+    if let Some(sig) = &d.signature {
+        writeln!(out, "  residual signature ({}):", sig.model)?;
+        for line in &sig.summary {
+            writeln!(out, "    {line}")?;
+        }
+    }
     for n in &d.named {
         writeln!(out, "  {} {} = {} ± {:.3e} (ΔBIC {:.1})", n.effect, n.parameter_name, value(n.parameter), n.parameter_se, n.delta_bic)?;
     }
     if let Some(m) = &d.separating_measurement {
         writeln!(out, "  cannot tell {} from {}: {m}", d.ambiguous_between[0], d.ambiguous_between[1])?;
     }
+    let b = &d.baseline;
+    writeln!(
+        out,
+        "thesis model: χ²/dof = {:.3} ({:.1} on {} dof, p = {:.2e}){}",
+        b.reduced_chi2,
+        b.chi2,
+        b.dof,
+        b.p_value,
+        if b.converged { "" } else { ", NOT converged" }
+    )?;
+    if !b.outliers.is_empty() {
+        writeln!(out, "  outliers set aside (measurement ids): {:?}", b.outliers)?;
+    }
+    for f in &b.flags {
+        writeln!(out, "  warning: {f}")?;
+    }
     writeln!(out, "candidates (ΔBIC against the thesis model):")?;
     for c in &d.candidates {
         writeln!(
             out,
-            "  {}. {:<17} {:<30} {:>12} ± {:<10.3e} ΔBIC {:>9.2}{}",
+            "  {}. {:<17} {:<30} {:>12} ± {:<10.3e} ΔBIC {:>9.2}  χ²/dof {:>8.3}{}",
             c.rank,
             c.effect,
             c.parameter_name,
             value(c.parameter),
             c.parameter_se,
             c.delta_bic,
-            if c.plausible { "" } else { "  (implausible or failed)" }
+            c.reduced_chi2,
+            c.failure().map(|f| format!("  (not counted: {f})")).unwrap_or_default()
         )?;
     }
     if let (Some(h), Some(b), Some(a)) = (&d.holdout, d.holdout_rms_before, d.holdout_rms_after) {
-        writeln!(out, "held-out routing {h}: RMS {b:.4} mm before, {a:.4} mm after")?;
+        if d.extended.effects.is_empty() {
+            writeln!(out, "held-out routing {h}: RMS {b:.4} mm with the thesis model (no effect added)")?;
+        } else {
+            writeln!(out, "held-out routing {h}: RMS {b:.4} mm with the thesis model, {a:.4} mm {}", crate::calibrate::diagnose::model_name(&d.extended))?;
+        }
     }
     writeln!(out, "criterion: {}", d.criterion)?;
     if let Some(p) = report {

@@ -2,8 +2,8 @@
 //! hidden effect and noise.
 
 use super::{parse_list, ActuatorArgs};
-use crate::calibrate::data::{centrelines_csv, measurements_csv};
-use crate::calibrate::synth::{default_routings, synthesize, SynthSpec};
+use crate::calibrate::data::{centrelines_csv, markers_csv, measurements_csv};
+use crate::calibrate::synth::{default_routings, synthesize_with_markers, SynthSpec};
 use crate::calibrate::Effect;
 use crate::model::routing::CONTROL_POINTS;
 use crate::model::{Actuator, SolverOptions};
@@ -21,12 +21,17 @@ pub struct SynthArgs {
     /// Overwrite existing output files.
     #[arg(long)]
     pub force: bool,
-    /// Hidden effect: none, friction, gravity, stiffening, clamp_compliance, channel_offset or creep.
+    /// Hidden effect: none, friction, gravity, stiffening, clamp_compliance, channel_offset or creep; or, for testing the
+    /// diagnosis, an effect outside its candidate list: rest_curvature (a rod cured bent) or glue_joint (a stiff segment at the clamp).
     #[arg(long, default_value = "none")]
     pub effect: String,
-    /// The hidden effect's parameter: μ, gravity scale k, α, k_θ (N·mm/rad), δ (mm) or creep fraction f.
+    /// The hidden effect's parameter: μ, gravity scale k, α, k_θ (N·mm/rad), δ (mm), creep fraction f; rest curvature
+    /// (1/mm) or the glue joint's EI factor.
     #[arg(long, allow_hyphen_values = true)]
     pub magnitude: Option<f64>,
+    /// Length of the glue joint from the clamp, mm (with --effect glue_joint).
+    #[arg(long, default_value_t = 5.0, value_name = "MM")]
+    pub glue_length_mm: f64,
     /// Seed of the noise.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -62,9 +67,20 @@ pub struct SynthArgs {
     /// Centreline points per reading.
     #[arg(long, default_value_t = 21)]
     pub centreline_points: usize,
+    /// Also write markers (measurement,s_mm,offset_mm,x_mm,y_mm) here.
+    #[arg(long, value_name = "FILE")]
+    pub markers_out: Option<PathBuf>,
+    /// Markers as "s:offset;s:offset" in mm (rest arc length, lateral body-frame offset) [default: L/4, L/2, 3L/4 and L on
+    /// alternate sides at the surface].
+    #[arg(long, allow_hyphen_values = true, value_name = "S:OFFSET;…")]
+    pub markers: Option<String>,
     #[command(flatten)]
     pub actuator: ActuatorArgs,
 }
+
+/// Effects `synth` can hide that are deliberately not diagnosis candidates,
+/// so that tests can check the diagnosis answers `unexplained` for them.
+pub const OUT_OF_LIBRARY: [&str; 2] = ["rest_curvature", "glue_joint"];
 
 /// Routings parsed from `--routings`, with the per-routing clamp tilts.
 type ParsedRoutings = (Vec<(String, [f64; CONTROL_POINTS])>, BTreeMap<String, f64>);
@@ -98,12 +114,39 @@ pub fn parse_routings(text: &str) -> anyhow::Result<ParsedRoutings> {
     Ok((out, tilts))
 }
 
+/// Parses "s:offset;s:offset" (mm).
+fn parse_markers(text: &str) -> anyhow::Result<Vec<(f64, f64)>> {
+    let mut out = Vec::new();
+    for item in text.split(';').filter(|s| !s.trim().is_empty()) {
+        let parsed = item.split_once(':').and_then(|(s, o)| Some((s.trim().parse::<f64>().ok()?, o.trim().parse::<f64>().ok()?)));
+        let Some(m) = parsed else {
+            bail!("--markers: '{item}' should look like s_mm:offset_mm, e.g. 32.5:5");
+        };
+        out.push(m);
+    }
+    if out.is_empty() {
+        bail!("--markers: no marker given");
+    }
+    Ok(out)
+}
+
 /// Runs `cablemap synth`.
 pub fn run(args: &SynthArgs) -> anyhow::Result<()> {
     let mut actuator = args.actuator.apply(&Actuator::default());
-    if args.effect != "none" {
+    if let Some(hidden) = OUT_OF_LIBRARY.iter().find(|h| **h == args.effect) {
+        let Some(m) = args.magnitude else {
+            bail!("--effect {hidden} needs --magnitude ({})", if *hidden == "rest_curvature" { "the rest curvature in 1/mm, e.g. 0.004" } else { "the joint's EI factor, e.g. 5" });
+        };
+        let h = &mut actuator.effects.hidden;
+        if *hidden == "rest_curvature" {
+            h.rest_curvature_per_mm = m;
+        } else {
+            h.base_segment_ei_factor = m;
+            h.base_segment_mm = args.glue_length_mm;
+        }
+    } else if args.effect != "none" {
         let Some(effect) = Effect::parse(&args.effect) else {
-            let names: Vec<&str> = Effect::ALL.iter().map(|e| e.name()).collect();
+            let names: Vec<&str> = Effect::ALL.iter().map(|e| e.name()).chain(OUT_OF_LIBRARY).collect();
             bail!("--effect {}: unknown effect; use none or one of {}", args.effect, names.join(", "));
         };
         let Some(m) = args.magnitude else {
@@ -118,7 +161,17 @@ pub fn run(args: &SynthArgs) -> anyhow::Result<()> {
         Some(t) => parse_routings(t)?,
         None => (default_routings(), BTreeMap::new()),
     };
+    let markers = match (&args.markers_out, &args.markers) {
+        (None, Some(_)) => bail!("--markers needs --markers-out FILE"),
+        (None, None) => Vec::new(),
+        (Some(_), Some(text)) => parse_markers(text)?,
+        (Some(_), None) => {
+            let (l, r) = (actuator.length_mm, actuator.radius_mm);
+            vec![(0.25 * l, r), (0.5 * l, -r), (0.75 * l, r), (l, -r)]
+        }
+    };
     let spec = SynthSpec {
+        markers,
         actuator,
         options: args.actuator.solver_options(&SolverOptions::default()),
         routings,
@@ -132,7 +185,7 @@ pub fn run(args: &SynthArgs) -> anyhow::Result<()> {
         noise_deg: args.noise_deg,
         seed: args.seed,
     };
-    for path in std::iter::once(&args.out).chain(&args.centreline_out) {
+    for path in std::iter::once(&args.out).chain(&args.centreline_out).chain(&args.markers_out) {
         anyhow::ensure!(
             args.force || !path.exists(),
             "{} exists: synth does not overwrite measurement files; give another --out, or --force to replace it",
@@ -140,11 +193,14 @@ pub fn run(args: &SynthArgs) -> anyhow::Result<()> {
         );
     }
     let points = if args.centreline_out.is_some() { args.centreline_points.max(2) } else { 0 };
-    let (data, centrelines) = synthesize(&spec, points)?;
+    let (data, centrelines, markers) = synthesize_with_markers(&spec, points)?;
     crate::io::write_atomic(&args.out, measurements_csv(&data).as_bytes())
         .with_context(|| format!("writing {}", args.out.display()))?;
     if let Some(path) = &args.centreline_out {
         crate::io::write_atomic(path, centrelines_csv(&centrelines).as_bytes()).with_context(|| format!("writing {}", path.display()))?;
+    }
+    if let Some(path) = &args.markers_out {
+        crate::io::write_atomic(path, markers_csv(&markers).as_bytes()).with_context(|| format!("writing {}", path.display()))?;
     }
     eprintln!(
         "wrote {} readings of {} routings to {} (hidden effect: {}{})",

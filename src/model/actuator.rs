@@ -94,6 +94,40 @@ pub struct Effects {
     /// how long each tension is held on a rod with no load history before
     /// the shape is taken, s. 0 gives the instantaneous (elastic) shape.
     pub creep_hold_s: f64,
+    /// Out-of-library effects, for synthetic test data only (they are not
+    /// diagnosis candidates): see [`Hidden`]. Not written when off, so
+    /// existing specs and metadata are unchanged.
+    #[serde(skip_serializing_if = "Hidden::is_off")]
+    pub hidden: Hidden,
+}
+
+/// Effects deliberately outside the diagnosis's candidate list, so that
+/// tests can check that the diagnosis says "unexplained" instead of naming
+/// a wrong effect (`cablemap synth --effect rest_curvature|glue_joint`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Hidden {
+    /// Rest (cured-in) curvature along the whole rod, 1/mm: the bending law
+    /// becomes m = EI (u − u₀).
+    pub rest_curvature_per_mm: f64,
+    /// Bending rigidity factor over `[0, base_segment_mm]` (a stiff glue
+    /// joint at the clamp); 1 is none.
+    pub base_segment_ei_factor: f64,
+    /// Length of the stiff base segment, mm.
+    pub base_segment_mm: f64,
+}
+
+impl Default for Hidden {
+    fn default() -> Self {
+        Self { rest_curvature_per_mm: 0.0, base_segment_ei_factor: 1.0, base_segment_mm: 0.0 }
+    }
+}
+
+impl Hidden {
+    /// Whether every hidden effect is off.
+    pub fn is_off(&self) -> bool {
+        *self == Hidden::default()
+    }
 }
 
 impl Default for Effects {
@@ -107,6 +141,7 @@ impl Default for Effects {
             creep_fraction: 0.0,
             creep_time_s: DEFAULT_CREEP_TIME_S,
             creep_hold_s: 0.0,
+            hidden: Hidden::default(),
         }
     }
 }
@@ -214,6 +249,24 @@ impl Actuator {
         let hold = self.effects.creep_hold_s;
         if !(hold.is_finite() && hold >= 0.0) {
             return Err(ParameterError::OutOfRange { name: "effects.creep_hold_s", value: hold, expected: "a finite time ≥ 0 s" });
+        }
+        let h = &self.effects.hidden;
+        if !h.rest_curvature_per_mm.is_finite() {
+            return Err(ParameterError::OutOfRange {
+                name: "effects.hidden.rest_curvature_per_mm",
+                value: h.rest_curvature_per_mm,
+                expected: "a finite curvature in 1/mm",
+            });
+        }
+        if !(h.base_segment_ei_factor.is_finite() && h.base_segment_ei_factor > 0.0) {
+            return Err(ParameterError::NotPositive { name: "effects.hidden.base_segment_ei_factor", value: h.base_segment_ei_factor });
+        }
+        if !(h.base_segment_mm.is_finite() && h.base_segment_mm >= 0.0) {
+            return Err(ParameterError::OutOfRange {
+                name: "effects.hidden.base_segment_mm",
+                value: h.base_segment_mm,
+                expected: "a finite length ≥ 0 mm",
+            });
         }
         let delta = self.effects.channel_offset_mm;
         if !(delta.is_finite() && delta.abs() < self.radius_mm) {

@@ -410,11 +410,24 @@ impl Simulator {
         Ok(())
     }
 
-    /// Curvature u from the bending moment `m` (N·mm) and du/dm. Linear
-    /// (m = EI u) unless material stiffening makes it m = EI u (1 + α (r u)²).
+    /// Curvature u from the bending moment `m` (N·mm) at `s` and du/dm.
+    /// Linear (m = EI u) unless material stiffening makes it
+    /// m = EI u (1 + α (r u)²); the test-only hidden effects add a rest
+    /// curvature u₀ (m = EI (u − u₀)) and a stiffer base segment.
     #[inline]
-    fn bending_curvature(&self, m: f64) -> (f64, f64) {
-        let ei = self.actuator.ei_n_mm2;
+    fn bending_curvature(&self, m: f64, s: f64) -> (f64, f64) {
+        let hidden = &self.actuator.effects.hidden;
+        let mut ei = self.actuator.ei_n_mm2;
+        if s < hidden.base_segment_mm {
+            ei *= hidden.base_segment_ei_factor;
+        }
+        let (u, du_dm) = self.elastic_curvature(m, ei);
+        (u + hidden.rest_curvature_per_mm, du_dm)
+    }
+
+    /// The elastic part of [`Simulator::bending_curvature`] with rigidity `ei`.
+    #[inline]
+    fn elastic_curvature(&self, m: f64, ei: f64) -> (f64, f64) {
         let alpha = self.actuator.effects.stiffening_alpha;
         if alpha == 0.0 {
             return (m / ei, 1.0 / ei);
@@ -467,7 +480,7 @@ impl Simulator {
             let v1 = 1.0 + (w1 - tension * ca) / ea;
             let v2 = (w2 - tension * sa) / ga;
             let m = tension * ch.y * ca + moment;
-            let (u_el, du_dm_el) = self.bending_curvature(m);
+            let (u_el, du_dm_el) = self.bending_curvature(m, s);
             let u = u_el + self.creep_gain * m + creep_offset;
             let du_dm = du_dm_el + self.creep_gain;
             let p = v1 - u * ch.y;
@@ -1084,5 +1097,31 @@ mod tests {
         let shifted = ladder(&mut straight(|a| a.effects.channel_offset_mm = 0.5, d), tau);
         let direct = ladder(&mut straight(|_| {}, d + 0.5), tau);
         assert!((shifted.tip_y_mm - direct.tip_y_mm).abs() < 1e-12);
+    }
+
+    #[test]
+    fn hidden_rest_curvature_and_stiff_base_segment_follow_their_laws() {
+        // Straight routing: u = τ d / EI_local + u₀, so φ(L) = ∫ u ds.
+        let (tau, d, u0) = (1.5, 3.0, 0.004);
+        let a = Actuator::default();
+        let curved = ladder(&mut straight(|a| a.effects.hidden.rest_curvature_per_mm = u0, d), tau);
+        let want = tau * d * a.length_mm / a.ei_n_mm2 + u0 * a.length_mm;
+        assert!((curved.tip_angle_rad - want).abs() < 1e-6, "{} vs {want}", curved.tip_angle_rad);
+        // At rest the rod keeps its cured-in bend.
+        let mut rest = straight(|a| a.effects.hidden.rest_curvature_per_mm = u0, d);
+        assert!((rest.solve(0.0).unwrap().tip_angle_rad - u0 * a.length_mm).abs() < 1e-9);
+        let glued = ladder(
+            &mut straight(
+                |a| {
+                    a.effects.hidden.base_segment_ei_factor = 5.0;
+                    a.effects.hidden.base_segment_mm = 5.0;
+                },
+                d,
+            ),
+            tau,
+        );
+        let want = tau * d / a.ei_n_mm2 * (a.length_mm - 5.0 + 5.0 / 5.0);
+        // The rigidity jumps inside an RK4 step: first-order accurate there.
+        assert!((glued.tip_angle_rad - want).abs() < 0.01 * want, "{} vs {want}", glued.tip_angle_rad);
     }
 }
