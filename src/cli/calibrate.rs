@@ -6,7 +6,8 @@ use super::ActuatorArgs;
 use crate::calibrate::diagnose::{fit_json, split_holdout};
 use crate::calibrate::fit::rms_per_routing;
 use crate::calibrate::predict::predict;
-use crate::calibrate::{fit, read_measurements, Effect, FitSpec};
+use crate::calibrate::fit::fit_observed;
+use crate::calibrate::{read_measurements, Effect, FitSpec};
 use crate::model::{Actuator, SolverOptions};
 use anyhow::bail;
 use clap::Args;
@@ -61,21 +62,29 @@ pub fn run(args: &CalibrateArgs) -> anyhow::Result<()> {
     let data = read_measurements(&args.data)?;
     let (train, held) = split_holdout(&data, args.holdout.as_deref())?;
     let spec = FitSpec { effects: parse_effects(&args.effects)?, angle_weight_mm_per_deg: args.angle_weight };
-    if data.rows.len() >= LARGE_DATA_ROWS {
+    let large = data.rows.len() >= LARGE_DATA_ROWS;
+    if large {
         // A fit re-simulates every reading (1 + parameters) times per
         // iteration: state the cost of one pass up front for large files,
         // so a long silent run is expected rather than mistaken for a hang.
         let started = std::time::Instant::now();
         predict(&base, &options, &data, &train, false)?;
         let pass_s = started.elapsed().as_secs_f64();
-        let per_iteration_s = pass_s * (4 + spec.effects.len()) as f64;
+        // Central differences: two passes per parameter for the Jacobian,
+        // plus the trial steps (at least two).
+        let passes = 2 * (3 + spec.effects.len()) + 2;
+        let per_iteration_s = pass_s * passes as f64;
         eprintln!(
-            "calibrate: {} readings; one pass over them takes {pass_s:.1} s, so each fit iteration takes about \
-             {per_iteration_s:.0} s (typically 5-30 iterations, at most 200)",
+            "calibrate: {} readings; one pass over them takes {pass_s:.2} s, an iteration about {passes} passes \
+             (≈ {per_iteration_s:.1} s); typically 5-30 iterations, at most 200",
             data.rows.len()
         );
     }
-    let result = fit(&base, &options, &data, &train, &spec)?;
+    let result = fit_observed(&base, &options, &data, &train, &spec, &mut |p| {
+        if large {
+            eprintln!("calibrate: iteration {} (of at most 200): RMS {:.4} mm", p.iteration, p.rms_mm);
+        }
+    })?;
     let holdout_rms = match &held {
         Some(g) => {
             let g = std::slice::from_ref(g);
