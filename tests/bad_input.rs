@@ -262,3 +262,17 @@ fn parquet_measurement_files_in_every_standard_codec_are_read() {
         assert_eq!(format!("{:?}", read.rows), format!("{:?}", reference.rows), "{name}");
     }
 }
+
+#[test]
+fn calibrate_on_a_large_file_states_its_cost_and_shows_progress() {
+    let tmp = tempfile::tempdir().unwrap();
+    let data = tmp.path().join("big.csv");
+    assert!(run(&["synth", "--out", s(&data), "--load-steps", "200"]).0);
+    let (ok, stdout, stderr) = run(&["calibrate", s(&data), "--json"]);
+    assert!(ok, "{stderr}");
+    assert!(stderr.contains("2005 readings; one pass over them takes") && stderr.contains("passes"), "{stderr}");
+    let iterations: Vec<&str> = stderr.lines().filter(|l| l.starts_with("calibrate: iteration ")).collect();
+    let v: serde_json::Value = serde_json::from_str(stdout.trim()).unwrap();
+    assert!(!iterations.is_empty(), "{stderr}");
+    assert!(iterations.len() as u64 <= v["iterations"].as_u64().unwrap(), "{stderr}\n{v}");
+}

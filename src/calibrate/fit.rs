@@ -590,6 +590,28 @@ pub fn fit(
     groups: &[RoutingGroup],
     spec: &FitSpec,
 ) -> Result<FitResult, CalibrateError> {
+    fit_observed(base, options, data, groups, spec, &mut |_| {})
+}
+
+/// Where a running fit is: reported after every accepted step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FitProgress {
+    /// Iterations done (of at most 200).
+    pub iteration: usize,
+    /// Weighted RMS residual after this iteration, mm.
+    pub rms_mm: f64,
+}
+
+/// [`fit`], calling `observe` after every accepted step, so that a long fit
+/// (10⁵ readings) can show progress.
+pub fn fit_observed(
+    base: &Actuator,
+    options: &SolverOptions,
+    data: &Dataset,
+    groups: &[RoutingGroup],
+    spec: &FitSpec,
+    observe: &mut dyn FnMut(FitProgress),
+) -> Result<FitResult, CalibrateError> {
     if !(spec.angle_weight_mm_per_deg.is_finite() && spec.angle_weight_mm_per_deg >= 0.0) {
         return Err(CalibrateError::Invalid(format!(
             "the angle weight must be a finite number ≥ 0 mm per degree, got {}",
@@ -695,6 +717,7 @@ pub fn fit(
         x = trial;
         r = rt;
         cost = ct;
+        observe(FitProgress { iteration: iterations, rms_mm: (cost / n as f64).sqrt() });
         if cost < 1e-24 * n as f64 || reduction < 1e-12 || step_size < 1e-11 {
             converged = true;
             break;
@@ -944,9 +967,16 @@ mod tests {
         };
         let (data, _) = synthesize(&spec, 0).unwrap();
         let t0 = std::time::Instant::now();
-        let result = fit(&Actuator::default(), &SolverOptions::default(), &data, &data.groups(), &FitSpec::default()).unwrap();
+        let mut seen = Vec::new();
+        let result = fit_observed(&Actuator::default(), &SolverOptions::default(), &data, &data.groups(), &FitSpec::default(), &mut |p| {
+            seen.push(p)
+        })
+        .unwrap();
         eprintln!("noise-free fit: {:?}, {} iterations", t0.elapsed(), result.iterations);
         assert!(result.converged);
+        // Progress: one report per accepted step, iterations rising, RMS falling.
+        assert!(!seen.is_empty() && seen.len() <= result.iterations);
+        assert!(seen.windows(2).all(|w| w[0].iteration < w[1].iteration && w[0].rms_mm >= w[1].rms_mm));
         let t = truth();
         for (p, want) in result.parameters.iter().zip([t.ea_n, t.ga_n, t.ei_n_mm2]) {
             assert!(((p.value - want) / want).abs() < 1e-6, "{}: {} vs {want}", p.name, p.value);

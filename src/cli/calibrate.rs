@@ -7,7 +7,8 @@ use crate::calibrate::data::{read_centrelines, read_markers, Dataset};
 use crate::calibrate::diagnose::{fit_json, split_holdout};
 use crate::calibrate::fit::{apply_held, parse_held, rms_per_routing, Held, Loss, Noise, ShapeData};
 use crate::calibrate::predict::predict;
-use crate::calibrate::{fit, read_measurements, Effect, FitSpec};
+use crate::calibrate::fit::fit_observed;
+use crate::calibrate::{read_measurements, Effect, FitSpec};
 use crate::model::{Actuator, SolverOptions};
 use anyhow::bail;
 use clap::Args;
@@ -153,21 +154,29 @@ pub fn run(args: &CalibrateArgs) -> anyhow::Result<()> {
     if let Some(e) = spec.effects.iter().find(|e| held_effects.contains(e)) {
         bail!("--effect {0} and --fix {1}=…: an effect is either fitted or held, not both", e.name(), e.parameter_name());
     }
-    if data.rows.len() >= LARGE_DATA_ROWS {
+    let large = data.rows.len() >= LARGE_DATA_ROWS;
+    if large {
         // A fit re-simulates every reading (1 + parameters) times per
         // iteration: state the cost of one pass up front for large files,
         // so a long silent run is expected rather than mistaken for a hang.
         let started = std::time::Instant::now();
         predict(&start, &options, &data, &train, false)?;
         let pass_s = started.elapsed().as_secs_f64();
-        let per_iteration_s = pass_s * (4 + spec.effects.len()) as f64;
+        // Central differences: two passes per parameter for the Jacobian,
+        // plus the trial steps (at least two).
+        let passes = 2 * (3 + spec.effects.len()) + 2;
+        let per_iteration_s = pass_s * passes as f64;
         eprintln!(
-            "calibrate: {} readings; one pass over them takes {pass_s:.1} s, so each fit iteration takes about \
-             {per_iteration_s:.0} s (typically 5-30 iterations, at most 200)",
+            "calibrate: {} readings; one pass over them takes {pass_s:.2} s, an iteration about {passes} passes \
+             (≈ {per_iteration_s:.1} s); typically 5-30 iterations, at most 200",
             data.rows.len()
         );
     }
-    let result = fit(&start, &options, &data, &train, &spec)?;
+    let result = fit_observed(&start, &options, &data, &train, &spec, &mut |p| {
+        if large {
+            eprintln!("calibrate: iteration {} (of at most 200): RMS {:.4} mm", p.iteration, p.rms_mm);
+        }
+    })?;
     let holdout_rms = match &held {
         Some(g) => {
             let g = std::slice::from_ref(g);
