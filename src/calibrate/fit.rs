@@ -640,14 +640,18 @@ pub fn fit_observed(
         )));
     }
     let mut cost: f64 = r.iter().map(|v| v * v).sum();
-    if !cost.is_finite() {
-        // Residuals so large their squares overflow: no step can lower an
-        // infinite cost, and "no step lowers the cost" must not read as a
-        // converged fit.
-        let worst = r.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    // Residuals are in units of the noise (and the robust loss compresses
+    // large ones): a trillion noise widths, or squares that overflow, is no
+    // measurement of this actuator. No step can lower such a cost, and "no
+    // step lowers the cost" must not read as a converged fit.
+    const ABSURD_RESIDUAL: f64 = 1e12;
+    let worst = r.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    if !cost.is_finite() || !(worst < ABSURD_RESIDUAL) {
+        let farthest = data.rows.iter().map(|m| m.tip_x_mm.abs().max(m.tip_y_mm.abs())).fold(0.0, f64::max);
         return Err(CalibrateError::Invalid(format!(
-            "the measurements are absurdly far from any shape the actuator can take (a weighted residual of {} mm): \
-             check the units (mm and degrees) and the column order of the data",
+            "the measurements are absurdly far from any shape the actuator can take (a tip coordinate of {} mm, a \
+             residual of {} noise widths): check the units (mm and degrees) and the column order of the data",
+            crate::io::fmt_num(farthest),
             crate::io::fmt_num(worst)
         )));
     }
