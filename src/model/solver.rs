@@ -44,6 +44,8 @@ use super::routing::Routing;
 use crate::shape::{self, LengthBasis};
 use serde::{Deserialize, Serialize};
 
+mod collocation;
+
 /// Why a solve produced no result. The sweep stores [`SolveFailure::status`].
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SolveFailure {
@@ -71,6 +73,10 @@ pub enum SolveFailure {
     /// The friction tension profile did not settle.
     #[error("the cable tension profile with friction did not converge")]
     FrictionNotConverged,
+    /// The equilibrium under the rod's own weight was not found, even by
+    /// Newton's method with continuation in the weight.
+    #[error("the equilibrium under the rod's weight did not converge (reached {reached_percent:.0} % of the weight); try smaller tension steps from a lower tension, more nodes per span, or a smaller gravity scale")]
+    WeightNotConverged { reached_percent: f64 },
 }
 
 impl SolveFailure {
@@ -85,6 +91,7 @@ impl SolveFailure {
             SolveFailure::ClampNotConverged => "clamp_not_converged",
             SolveFailure::NonFinite { .. } => "non_finite",
             SolveFailure::FrictionNotConverged => "friction_not_converged",
+            SolveFailure::WeightNotConverged { .. } => "weight_not_converged",
         }
     }
 }
@@ -97,11 +104,35 @@ const FRICTION_TOLERANCE: f64 = 1e-10;
 /// Status string of a successful solve.
 pub const STATUS_OK: &str = "ok";
 
+/// How the centreline is integrated along each knot span of the routing.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum SolverMethod {
+    /// Spectral collocation on Chebyshev–Lobatto nodes per span (the
+    /// default): strains at `nodes_per_span + 1` points per span, integrals
+    /// by the exact integral of the interpolating polynomial; gravity's
+    /// distal moment by fixed-point sweeps (no shooting), with Newton's
+    /// method and continuation in the weight as the fallback for heavy rods.
+    #[default]
+    Collocation,
+    /// The previous method, kept as the reference: classical RK4 with
+    /// `steps_per_span` steps per span and secant shooting on gravity's
+    /// base moment.
+    Rk4,
+}
+
 /// Numerical settings of the solver.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct SolverOptions {
-    /// RK4 steps on each of the routing's two knot spans (even, ≥ 2).
+    /// Integration method.
+    pub method: SolverMethod,
+    /// Collocation: Chebyshev–Lobatto intervals per knot span (4–64); the
+    /// span's integrands are smooth, so the error falls geometrically with it.
+    pub nodes_per_span: usize,
+    /// RK4 steps on each of the routing's two knot spans (even, ≥ 2). With
+    /// collocation it sets the centreline's resolution: 2·steps_per_span + 1
+    /// evenly spaced points.
     pub steps_per_span: usize,
     /// Last Newton step accepted for the cable angle α, rad (the error left
     /// is of the order of its square).
@@ -116,7 +147,14 @@ pub struct SolverOptions {
 
 impl Default for SolverOptions {
     fn default() -> Self {
-        Self { steps_per_span: 24, angle_tolerance_rad: 1e-7, moment_tolerance_n_mm: 1e-8, max_shooting_passes: 30 }
+        Self {
+            method: SolverMethod::Collocation,
+            nodes_per_span: 10,
+            steps_per_span: 24,
+            angle_tolerance_rad: 1e-7,
+            moment_tolerance_n_mm: 1e-8,
+            max_shooting_passes: 30,
+        }
     }
 }
 
@@ -272,6 +310,8 @@ pub struct Simulator {
     virgin_holds: bool,
     /// Whether passes record cable angles and moments (friction or creep on).
     records_profile: bool,
+    /// Collocation state (`None` with the RK4 method).
+    col: Option<Box<collocation::Colloc>>,
 }
 
 /// How a solve is held: the direction of the last tension change (friction)
@@ -295,8 +335,22 @@ impl Simulator {
                 expected: "an even number ≥ 2",
             });
         }
+        if options.method == SolverMethod::Collocation && !(4..=64).contains(&options.nodes_per_span) {
+            return Err(ParameterError::OutOfRange {
+                name: "nodes_per_span",
+                value: options.nodes_per_span as f64,
+                expected: "between 4 and 64",
+            });
+        }
         let n = options.steps_per_span;
         let nodes = 2 * n + 1;
+        // Per-point buffers: RK4 stage points, or collocation nodes.
+        let points = match options.method {
+            SolverMethod::Rk4 => 2 * (2 * n + 1),
+            SolverMethod::Collocation => 2 * (options.nodes_per_span + 1),
+        };
+        let col = (options.method == SolverMethod::Collocation)
+            .then(|| Box::new(collocation::Colloc::new(options.nodes_per_span)));
         let beta = actuator.gravity.direction_rad;
         Ok(Self {
             actuator: actuator.clone(),
@@ -305,8 +359,8 @@ impl Simulator {
             gravity_cos: beta.cos(),
             gravity_sin: beta.sin(),
             routing: None,
-            channel: vec![ChannelSample::default(); 2 * (2 * n + 1)],
-            cable_dir: vec![(1.0, 0.0); 2 * (2 * n + 1)],
+            channel: vec![ChannelSample::default(); points],
+            cable_dir: vec![(1.0, 0.0); points],
             step_mm: [0.0; 2],
             span_start_mm: [0.0; 2],
             nodes_state: vec![State::default(); nodes],
@@ -317,15 +371,16 @@ impl Simulator {
             continuation: Continuation::default(),
             last: None,
             friction_sign: actuator.effects.load_direction.sign(),
-            tension_ratio: vec![1.0; 2 * (2 * n + 1)],
-            cable_global: vec![(1.0, 0.0); 2 * (2 * n + 1)],
-            bending_moment: vec![0.0; 2 * (2 * n + 1)],
-            creep_q: vec![0.0; 2 * (2 * n + 1)],
+            tension_ratio: vec![1.0; points],
+            cable_global: vec![(1.0, 0.0); points],
+            bending_moment: vec![0.0; points],
+            creep_q: vec![0.0; points],
             dwell_s: 0.0,
             creep_decay: 1.0,
             creep_gain: 0.0,
             virgin_holds: true,
             records_profile: actuator.effects.friction_mu > 0.0 || actuator.effects.creep_fraction > 0.0,
+            col,
         })
         .and_then(|mut sim: Simulator| {
             let hold = Hold { direction: actuator.effects.load_direction, dwell_s: actuator.effects.creep_hold_s };
@@ -352,6 +407,14 @@ impl Simulator {
     pub fn set_routing(&mut self, routing: &Routing) {
         let delta = self.actuator.effects.channel_offset_mm;
         let built = if delta != 0.0 { routing.shifted(delta) } else { routing.clone() };
+        if self.col.is_some() {
+            self.colloc_set_routing(&built);
+            self.routing = Some(built);
+            self.reset_warm_start();
+            self.reset_history();
+            self.last = None;
+            return;
+        }
         let n = self.options.steps_per_span;
         let knot = built.knot_mm();
         let length = self.actuator.length_mm;
@@ -374,6 +437,9 @@ impl Simulator {
     /// history is physical state and is kept.
     pub fn reset_warm_start(&mut self) {
         self.continuation = Continuation::default();
+        if let Some(col) = self.col.as_mut() {
+            col.forget();
+        }
         self.cable_dir.iter_mut().for_each(|d| *d = (1.0, 0.0));
         self.tension_ratio.iter_mut().for_each(|r| *r = 1.0);
     }
@@ -729,6 +795,13 @@ impl Simulator {
     }
 
     fn solve_inner(&mut self, tension: f64) -> Result<TipPose, SolveFailure> {
+        if self.col.is_some() {
+            let passes = self.colloc_solve(tension)?;
+            if self.actuator.effects.creep_fraction > 0.0 && self.dwell_s > 0.0 && !self.virgin_holds {
+                self.advance_creep();
+            }
+            return Ok(self.colloc_pose(tension, passes));
+        }
         let has_moment = self.weight_n_per_mm != 0.0;
         let has_friction = self.actuator.effects.friction_mu > 0.0 && tension > 0.0;
         let mut passes;
@@ -807,6 +880,10 @@ impl Simulator {
     /// If the last solve failed or none was made.
     pub fn coefficients_into(&mut self, basis: LengthBasis, out: &mut [f64]) {
         assert!(self.last.is_some(), "coefficients_into needs a successful solve");
+        if self.col.is_some() {
+            self.colloc_coefficients(basis, out);
+            return;
+        }
         for (i, (st, e)) in self.nodes_state.iter().zip(&self.nodes_strain).enumerate() {
             self.theta[i] = st.phi + e.v2.atan2(e.v1);
             self.speed[i] = e.v1.hypot(e.v2);
@@ -824,6 +901,9 @@ impl Simulator {
     /// The centreline of the last successful solve, clamp to tip.
     pub fn centreline(&self) -> Vec<CentrelinePoint> {
         assert!(self.last.is_some(), "centreline needs a successful solve");
+        if self.col.is_some() {
+            return self.colloc_centreline();
+        }
         let n = self.options.steps_per_span;
         let tension = self.last.map_or(0.0, |p| p.tension_n);
         (0..self.nodes_state.len())
