@@ -53,25 +53,25 @@ pub enum SolveFailure {
     #[error("tension {0} N is invalid: a cable pulls with a finite tension ≥ 0 N")]
     InvalidTension(f64),
     /// The per-point cable-direction equation did not converge.
-    #[error("the cable-direction equation did not converge at s = {s_mm:.3} mm")]
+    #[error("the cable-direction equation did not converge at s = {s_mm:.3} mm; try smaller tension steps from a lower tension")]
     CableDirectionNotConverged { s_mm: f64 },
     /// The cable tangent vanished (v + u × r_c + r_c' = 0 or points backwards).
-    #[error("the cable tangent is degenerate at s = {s_mm:.3} mm")]
+    #[error("the cable tangent is degenerate at s = {s_mm:.3} mm (the cable would leave the channel backwards); try smaller tension steps from a lower tension, or a lower tension")]
     CableTangentDegenerate { s_mm: f64 },
     /// Axial stretch fell to zero or below: the rod would collapse.
-    #[error("the rod collapses axially (v1 ≤ 0) at s = {s_mm:.3} mm")]
+    #[error("the rod collapses axially (v1 ≤ 0) at s = {s_mm:.3} mm: the load exceeds the axial rigidity EA; lower the tension")]
     RodCollapsed { s_mm: f64 },
     /// The shooting on gravity's base moment did not converge.
-    #[error("the shooting on the base moment did not converge after {iterations} passes (residual {residual_n_mm:.3e} N·mm)")]
+    #[error("the shooting on the base moment did not converge after {iterations} passes (residual {residual_n_mm:.3e} N·mm); try smaller tension steps, or the default collocation method")]
     ShootingNotConverged { iterations: u32, residual_n_mm: f64 },
     /// The clamp-compliance fixed point did not converge.
-    #[error("the clamp rotation did not converge")]
+    #[error("the clamp rotation did not converge; try a stiffer clamp (clamp stiffness) or smaller tension steps")]
     ClampNotConverged,
     /// A non-finite number appeared in the state.
-    #[error("a non-finite value appeared at s = {s_mm:.3} mm")]
+    #[error("a non-finite value appeared at s = {s_mm:.3} mm; check the actuator parameters, or try smaller tension steps")]
     NonFinite { s_mm: f64 },
     /// The friction tension profile did not settle.
-    #[error("the cable tension profile with friction did not converge")]
+    #[error("the cable tension profile with friction did not converge; try smaller tension steps or a smaller friction coefficient")]
     FrictionNotConverged,
     /// The equilibrium under the rod's own weight was not found, even by
     /// Newton's method with continuation in the weight.

@@ -491,7 +491,9 @@ impl Simulator {
             let dratio = if has_friction { self.colloc_update_tension_ratio(tension) } else { 0.0 };
             // The moment's change in angle units: δM·L/EI turns the tip by about that.
             let change = dphi.max(dmom * self.actuator.length_mm / self.actuator.ei_n_mm2);
-            if dphi <= SWEEP_ANGLE_TOLERANCE_RAD && dmom <= self.options.moment_tolerance_n_mm && dratio < FRICTION_TOLERANCE {
+            // Settled, and still contracting (a stalled iteration goes to Newton).
+            let settled = dphi <= SWEEP_ANGLE_TOLERANCE_RAD && dmom <= self.options.moment_tolerance_n_mm && dratio < FRICTION_TOLERANCE;
+            if settled && (passes == 1 || change <= 0.5 * previous || !has_weight) {
                 break Ok(());
             }
             if passes >= max_sweeps {
