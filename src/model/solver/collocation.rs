@@ -488,7 +488,7 @@ impl Simulator {
                 Err(e) => break Err(e),
             };
             passes += 1;
-            let dratio = if has_friction { self.colloc_update_tension_ratio(tension) } else { 0.0 };
+            let dratio = if has_friction { self.colloc_update_tension_ratio(c) } else { 0.0 };
             // The moment's change in angle units: δM·L/EI turns the tip by about that.
             let change = dphi.max(dmom * self.actuator.length_mm / self.actuator.ei_n_mm2);
             // Settled, and still contracting (a stalled iteration goes to Newton).
@@ -649,29 +649,41 @@ impl Simulator {
     }
 
     /// Friction: the tension profile τ(s)/τ(0) at the nodes from the cable
-    /// angles of the last sweep (capstan law between neighbouring nodes,
-    /// exact where the cable's turning is monotone between them); returns
-    /// the largest change.
-    fn colloc_update_tension_ratio(&mut self, _tension: f64) -> f64 {
-        let nn = self.tension_ratio.len();
-        let np = nn / 2;
+    /// angles of the last sweep, by the capstan law ln τ(s)/τ(0) =
+    /// −σ μ ∫_0^s |ψ'| ds. The cable's global angle ψ = φ + α is smooth on a
+    /// span, but |ψ'| has kinks where the cable turns back, so the turning
+    /// is summed over a fine grid of the interpolated ψ (exact wherever ψ is
+    /// monotone between grid points). Returns the largest change.
+    fn colloc_update_tension_ratio(&mut self, c: &mut Colloc) -> f64 {
+        const SUBSTEPS: usize = 8;
+        let np = c.np();
         let mu = self.actuator.effects.friction_mu * self.friction_sign;
-        let mut change: f64 = 0.0;
-        let mut ratio = 1.0;
-        let mut prev = self.cable_global[0];
-        change = change.max((self.tension_ratio[0] - 1.0).abs());
-        self.tension_ratio[0] = 1.0;
-        for i in 1..nn {
-            if i != np {
-                let dir = self.cable_global[i];
-                let turn = (prev.0 * dir.1 - prev.1 * dir.0).atan2(prev.0 * dir.0 + prev.1 * dir.1);
-                ratio *= (-mu * turn.abs()).exp();
-                prev = dir;
-            }
-            // Node np is the knot again (span 1's first node).
-            change = change.max((self.tension_ratio[i] - ratio).abs());
-            self.tension_ratio[i] = ratio;
+        let mut psi = std::mem::take(&mut c.scratch);
+        for (i, p) in psi.iter_mut().enumerate() {
+            let (ca, sa) = self.cable_dir[i];
+            *p = c.phi[i] + sa.atan2(ca);
         }
+        let mut change: f64 = 0.0;
+        let mut turning = 0.0;
+        for span in 0..2 {
+            let base = span * np;
+            let values = &psi[base..base + np];
+            for j in 0..np {
+                if j > 0 {
+                    let mut prev = values[j - 1];
+                    for k in 1..=SUBSTEPS {
+                        let x = c.x[j - 1] + (c.x[j] - c.x[j - 1]) * k as f64 / SUBSTEPS as f64;
+                        let v = if k == SUBSTEPS { values[j] } else { c.interpolate(values, x) };
+                        turning += (v - prev).abs();
+                        prev = v;
+                    }
+                }
+                let ratio = (-mu * turning).exp();
+                change = change.max((self.tension_ratio[base + j] - ratio).abs());
+                self.tension_ratio[base + j] = ratio;
+            }
+        }
+        c.scratch = psi;
         change
     }
 
@@ -740,7 +752,7 @@ impl Simulator {
         let mut iterations = 0;
         for _ in 0..FRICTION_MAX_PASSES {
             iterations += self.colloc_newton_inner(c, tension)?;
-            if !has_friction || self.colloc_update_tension_ratio(tension) < FRICTION_TOLERANCE {
+            if !has_friction || self.colloc_update_tension_ratio(c) < FRICTION_TOLERANCE {
                 self.colloc_strains(c, tension)?;
                 self.colloc_positions(c);
                 return Ok(iterations);
