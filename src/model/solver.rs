@@ -141,11 +141,13 @@ pub struct SolverOptions {
     /// Last Newton step accepted for the cable angle α, rad (the error left
     /// is of the order of its square).
     pub angle_tolerance_rad: f64,
-    /// Convergence of gravity's moment at the tip, N·mm. 1e-8 N·mm leaves a
-    /// curvature error of about 1e-10 /mm (δm/EI): far below the solver's
-    /// discretisation error.
+    /// Convergence of gravity's moment, N·mm: RK4, the residual at the tip;
+    /// collocation, the largest change at a node between the last sweeps.
+    /// 1e-8 N·mm leaves a curvature error of about 1e-10 /mm (δm/EI): far
+    /// below the solver's discretisation error.
     pub moment_tolerance_n_mm: f64,
-    /// Most shooting passes before giving up.
+    /// RK4: most shooting passes before giving up. (Collocation has no
+    /// shooting: its sweeps hand over to Newton's method when they stall.)
     pub max_shooting_passes: u32,
 }
 
