@@ -6,8 +6,12 @@
 //! frame, and the loads of distributed external forces beyond the cut. Writing
 //! the cable direction as t_c = (cos α, sin α) leaves one scalar equation per
 //! point (t_c ∥ v + u × r_c + r_c'), solved by Newton. The centreline then
-//! follows by integrating forward from the clamp (classical RK4 on each knot
-//! span of the routing, where the routing is a polynomial).
+//! follows by integrating from the clamp on each knot span of the routing,
+//! where the routing is a polynomial: by default with spectral collocation
+//! on Chebyshev–Lobatto nodes ([`SolverMethod::Collocation`], in the
+//! `collocation` submodule, which also replaces the shooting below by
+//! fixed-point sweeps and Newton's method), or with the previous classical
+//! RK4 ([`SolverMethod::Rk4`], kept as the reference).
 //!
 //! Gravity's moment beyond the cut, M_W(s), depends on the distal shape; it
 //! obeys M_W' = w (L − s)(y' cos β − x' sin β) with M_W(L) = 0, so its value at
@@ -36,8 +40,9 @@
 //!   and q is advanced in closed form after the solve. The history q(s) lives
 //!   in the simulator; `set_routing` and `reset_history` clear it.
 //!
-//! The hot path (`integrate`) works in buffers allocated once per
-//! [`Simulator`]; solving allocates nothing.
+//! The hot paths (RK4's `integrate`, collocation's sweeps) work in buffers
+//! allocated once per [`Simulator`]; solving allocates nothing, except in
+//! collocation's Newton fallback for heavy rods (a dense Jacobian).
 
 use super::actuator::{Actuator, LoadDirection, ParameterError};
 use super::routing::Routing;
