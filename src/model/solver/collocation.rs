@@ -130,7 +130,7 @@ impl Colloc {
                 }
                 qb
             },
-            anderson: Anderson::new(2 * nn),
+            anderson: Anderson::new(3 * nn),
             hist_t: [0.0; 3],
             hist_phi: std::array::from_fn(|_| vec![0.0; nn]),
             hist_mom: std::array::from_fn(|_| vec![0.0; nn]),
@@ -232,15 +232,17 @@ impl Colloc {
 
     /// Replaces the state G(z) left by the last sweep with the Anderson
     /// (depth 2) combination of the last sweeps, and keeps sin/cos φ in step.
-    fn accelerate(&mut self, scale: f64) {
+    fn accelerate(&mut self, scale: f64, ratio: &mut [f64]) {
         let nn = self.phi.len();
         let a = &mut self.anderson;
         for i in 0..nn {
             a.g[i] = self.phi[i];
             a.g[nn + i] = self.mom[i] * scale;
+            a.g[2 * nn + i] = ratio[i];
         }
         let Some(next) = a.step() else { return };
         for i in 0..nn {
+            ratio[i] = next[2 * nn + i];
             let delta = next[i] - self.phi[i];
             self.phi[i] = next[i];
             self.mom[i] = next[nn + i] / scale;
@@ -330,11 +332,12 @@ impl Anderson {
     }
 
     /// Records the input of the next sweep.
-    fn begin(&mut self, phi: &[f64], mom: &[f64], scale: f64) {
+    fn begin(&mut self, phi: &[f64], mom: &[f64], ratio: &[f64], scale: f64) {
         let nn = phi.len();
         for i in 0..nn {
             self.z[i] = phi[i];
             self.z[nn + i] = mom[i] * scale;
+            self.z[2 * nn + i] = ratio[i];
         }
     }
 
@@ -474,15 +477,11 @@ impl Simulator {
         let max_sweeps = if has_weight { MAX_SWEEPS } else { FRICTION_MAX_PASSES as u32 };
         let mut passes = 0u32;
         let mut previous = f64::INFINITY;
-        // Anderson acceleration of the sweeps (gravity without friction,
-        // where the sweep is a fixed map of (φ, M)).
-        let accelerate = has_weight && !has_friction;
+        // Anderson acceleration of the sweeps, a fixed map of (φ, M, τ(s)/τ(0)).
         let scale = self.actuator.length_mm / self.actuator.ei_n_mm2;
         c.anderson.restart();
         let outcome = loop {
-            if accelerate {
-                c.anderson.begin(&c.phi, &c.mom, scale);
-            }
+            c.anderson.begin(&c.phi, &c.mom, &self.tension_ratio, scale);
             let (dphi, dmom) = match self.colloc_sweep(c, tension) {
                 Ok(change) => change,
                 Err(e) => break Err(e),
@@ -508,9 +507,7 @@ impl Simulator {
                 break Err(SolveFailure::WeightNotConverged { reached_percent: 100.0 });
             }
             previous = change;
-            if accelerate {
-                c.accelerate(scale);
-            }
+            c.accelerate(scale, &mut self.tension_ratio);
         };
         match outcome {
             Ok(()) => {
