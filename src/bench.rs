@@ -5,8 +5,12 @@
 //! and the median time per solve over routings is reported for gravity on
 //! and off. Timing is by wall clock on a shared machine: the median over
 //! many routings keeps one noisy neighbour from moving the figure.
+//!
+//! [`bench_with_reference`] also times the previous method (RK4 with 24
+//! steps per span and secant shooting, [`SolverMethod::Rk4`]) in the same
+//! run, so the speed-up is measured under the same load.
 
-use crate::model::{Actuator, Routing, Simulator, SolverOptions};
+use crate::model::{Actuator, Routing, Simulator, SolverMethod, SolverOptions};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -29,6 +33,50 @@ pub struct BenchFigures {
     pub mean_passes: f64,
     /// Solves that failed.
     pub failures: usize,
+    /// The method measured: "collocation-N" (N intervals per span) or "rk4-N" (N steps per span).
+    pub method: String,
+    /// The previous method measured in the same run, if asked for.
+    pub reference: Option<Box<BenchFigures>>,
+    /// Reference median over this median.
+    pub speedup: Option<f64>,
+}
+
+/// Short name of a method and its resolution, e.g. "collocation-10", "rk4-24".
+pub fn method_label(options: &SolverOptions) -> String {
+    match options.method {
+        SolverMethod::Collocation => format!("collocation-{}", options.nodes_per_span),
+        SolverMethod::Rk4 => format!("rk4-{}", options.steps_per_span),
+    }
+}
+
+/// The previous method as the reference: RK4, 24 steps per span, secant shooting.
+pub fn reference_options() -> SolverOptions {
+    SolverOptions { method: SolverMethod::Rk4, steps_per_span: 24, ..SolverOptions::default() }
+}
+
+/// The sweep's ladder (21 tensions 1.0 → 2.0 N) timed with gravity on and
+/// off, each with `options` and, if `with_reference`, with
+/// [`reference_options`] right after on the same routings.
+pub fn bench_with_reference(
+    actuator: &Actuator,
+    options: &SolverOptions,
+    routings: &[[f64; 5]],
+    with_reference: bool,
+) -> Result<Vec<BenchFigures>, crate::Error> {
+    let mut rows = Vec::new();
+    for gravity in [true, false] {
+        let mut a = actuator.clone();
+        a.gravity.enabled = gravity;
+        let label = if gravity { "gravity on" } else { "gravity off" };
+        let mut row = bench_solver(&a, options, routings, 1.0, 2.0, 21, label)?;
+        if with_reference {
+            let reference = bench_solver(&a, &reference_options(), routings, 1.0, 2.0, 21, label)?;
+            row.speedup = Some(reference.median_us_per_solve / row.median_us_per_solve);
+            row.reference = Some(Box::new(reference));
+        }
+        rows.push(row);
+    }
+    Ok(rows)
 }
 
 /// A deterministic sample of `count` routings from the thesis grid
@@ -93,5 +141,8 @@ pub fn bench_solver(
         p90_us_per_solve: q(0.9),
         mean_passes: passes as f64 / solves.max(1) as f64,
         failures,
+        method: method_label(options),
+        reference: None,
+        speedup: None,
     })
 }

@@ -42,8 +42,10 @@ pub enum CalibrateError {
     #[error("routing '{routing}' (first on row {row}): {source}")]
     Routing { routing: String, row: usize, source: crate::model::RoutingError },
     /// The model could not be solved for a measurement.
-    #[error("routing '{routing}', row {row} ({tension_n} N): {source}")]
-    Solve { routing: String, row: usize, tension_n: f64, source: crate::model::SolveFailure },
+    // The failure is part of the message, not the error's source, so that
+    // `{:#}` (cause chains) does not print it twice on one line.
+    #[error("routing '{routing}', row {row} ({tension_n} N): {failure}")]
+    Solve { routing: String, row: usize, tension_n: f64, failure: crate::model::SolveFailure },
     /// Invalid actuator or fit settings.
     #[error(transparent)]
     Parameter(#[from] crate::model::ParameterError),

@@ -51,7 +51,7 @@ pub fn predict_group(
         // static capture is taken as reached by loading.
         let direction = if matches!(m.direction, Direction::Load | Direction::Static) { LoadDirection::Load } else { LoadDirection::Unload };
         let hold = Hold { direction, dwell_s: m.dwell_s };
-        let fail = |source| CalibrateError::Solve { routing: group.routing.clone(), row: m.row, tension_n: m.tension_n, source };
+        let fail = |failure| CalibrateError::Solve { routing: group.routing.clone(), row: m.row, tension_n: m.tension_n, failure };
         sim.set_hold(hold)?;
         let pose = match sim.solve(m.tension_n) {
             Ok(p) => p,

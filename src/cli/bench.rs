@@ -1,9 +1,18 @@
 //! `cablemap bench`: prints solver timings (see [`crate::bench`]).
 
 use super::ActuatorArgs;
-use crate::bench::{bench_solver, sample_thesis_routings};
-use crate::model::{Actuator, SolverOptions};
-use clap::Args;
+use crate::bench::{bench_with_reference, sample_thesis_routings};
+use crate::model::{Actuator, SolverMethod, SolverOptions};
+use clap::{Args, ValueEnum};
+
+/// Solver method to time.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub enum MethodArg {
+    /// Spectral collocation per knot span (the default solver).
+    Collocation,
+    /// The previous method: RK4 per span with secant shooting.
+    Rk4,
+}
 
 /// Arguments of `cablemap bench`.
 #[derive(Debug, Clone, Args)]
@@ -14,6 +23,15 @@ pub struct BenchArgs {
     /// Print one JSON object instead of a table.
     #[arg(long)]
     pub json: bool,
+    /// Method to time [default: collocation].
+    #[arg(long, value_enum, default_value = "collocation")]
+    pub method: MethodArg,
+    /// Collocation intervals per knot span [default: 10].
+    #[arg(long, value_name = "M")]
+    pub nodes_per_span: Option<usize>,
+    /// Skip the previous method (RK4, 24 steps per span), which is otherwise timed in the same run for the speed-up.
+    #[arg(long)]
+    pub no_reference: bool,
     #[command(flatten)]
     pub actuator: ActuatorArgs,
 }
@@ -22,29 +40,40 @@ pub struct BenchArgs {
 pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     anyhow::ensure!(args.routings > 0, "--routings must be at least 1");
     let base = args.actuator.apply(&Actuator::default());
-    let options = args.actuator.solver_options(&SolverOptions::default());
-    let routings = sample_thesis_routings(args.routings, base.radius_mm);
-    let mut rows = Vec::new();
-    for gravity in [true, false] {
-        let mut a = base.clone();
-        a.gravity.enabled = gravity;
-        let label = if gravity { "gravity on" } else { "gravity off" };
-        rows.push(bench_solver(&a, &options, &routings, 1.0, 2.0, 21, label)?);
+    let mut options = args.actuator.solver_options(&SolverOptions::default());
+    options.method = match args.method {
+        MethodArg::Collocation => SolverMethod::Collocation,
+        MethodArg::Rk4 => SolverMethod::Rk4,
+    };
+    if let Some(m) = args.nodes_per_span {
+        options.nodes_per_span = m;
     }
+    let routings = sample_thesis_routings(args.routings, base.radius_mm);
+    let rows = bench_with_reference(&base, &options, &routings, !args.no_reference)?;
     if args.json {
         println!("{}", serde_json::to_string_pretty(&rows)?);
         return Ok(());
     }
     println!(
-        "single thread, {} thesis-grid routings x 21 tensions (1.0..2.0 N, continuation), {} RK4 steps per span",
-        args.routings, options.steps_per_span
+        "single thread, {} thesis-grid routings x 21 tensions (1.0..2.0 N, continuation), a_0..a_3 included",
+        args.routings
     );
-    println!("{:<12} {:>12} {:>10} {:>10} {:>8} {:>9}", "case", "median µs", "p10 µs", "p90 µs", "passes", "failures");
+    println!(
+        "{:<12} {:<16} {:>10} {:>8} {:>8} {:>8} {:>9}",
+        "case", "method", "median µs", "p10 µs", "p90 µs", "passes", "failures"
+    );
     for r in &rows {
-        println!(
-            "{:<12} {:>12.2} {:>10.2} {:>10.2} {:>8.2} {:>9}",
-            r.label, r.median_us_per_solve, r.p10_us_per_solve, r.p90_us_per_solve, r.mean_passes, r.failures
-        );
+        for f in std::iter::once(r).chain(r.reference.as_deref()) {
+            println!(
+                "{:<12} {:<16} {:>10.2} {:>8.2} {:>8.2} {:>8.2} {:>9}",
+                f.label, f.method, f.median_us_per_solve, f.p10_us_per_solve, f.p90_us_per_solve, f.mean_passes, f.failures
+            );
+        }
+    }
+    for r in &rows {
+        if let (Some(s), Some(reference)) = (r.speedup, r.reference.as_deref()) {
+            println!("{}: {} is {:.1}x faster than {} (medians, same run)", r.label, r.method, s, reference.method);
+        }
     }
     Ok(())
 }
