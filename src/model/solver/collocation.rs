@@ -809,7 +809,7 @@ impl Simulator {
         let w2 = wl * (cp * gs - sp * gc);
         let (ca, sa) = dir;
         let bend = t * ch.y * ca + moment;
-        let (_, du_dm_el) = self.bending_curvature(bend);
+        let (_, du_dm_el) = self.bending_curvature(bend, s);
         let dudm = du_dm_el + self.creep_gain;
         let p = e.v1 - e.u * ch.y;
         let q = e.v2 + ch.dy;
