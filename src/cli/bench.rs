@@ -2,17 +2,8 @@
 
 use super::ActuatorArgs;
 use crate::bench::{bench_with_reference, sample_thesis_routings};
-use crate::model::{Actuator, SolverMethod, SolverOptions};
-use clap::{Args, ValueEnum};
-
-/// Solver method to time.
-#[derive(Debug, Clone, Copy, ValueEnum)]
-pub enum MethodArg {
-    /// Spectral collocation per knot span (the default solver).
-    Collocation,
-    /// The previous method: RK4 per span with secant shooting.
-    Rk4,
-}
+use crate::model::{Actuator, SolverOptions};
+use clap::Args;
 
 /// Arguments of `cablemap bench`.
 #[derive(Debug, Clone, Args)]
@@ -23,12 +14,6 @@ pub struct BenchArgs {
     /// Print one JSON object instead of a table.
     #[arg(long)]
     pub json: bool,
-    /// Method to time [default: collocation].
-    #[arg(long, value_enum, default_value = "collocation")]
-    pub method: MethodArg,
-    /// Collocation intervals per knot span [default: 10].
-    #[arg(long, value_name = "M")]
-    pub nodes_per_span: Option<usize>,
     /// Skip the previous method (RK4, 24 steps per span), which is otherwise timed in the same run for the speed-up.
     #[arg(long)]
     pub no_reference: bool,
@@ -40,14 +25,7 @@ pub struct BenchArgs {
 pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     anyhow::ensure!(args.routings > 0, "--routings must be at least 1");
     let base = args.actuator.apply(&Actuator::default());
-    let mut options = args.actuator.solver_options(&SolverOptions::default());
-    options.method = match args.method {
-        MethodArg::Collocation => SolverMethod::Collocation,
-        MethodArg::Rk4 => SolverMethod::Rk4,
-    };
-    if let Some(m) = args.nodes_per_span {
-        options.nodes_per_span = m;
-    }
+    let options = args.actuator.solver_options(&SolverOptions::default());
     let routings = sample_thesis_routings(args.routings, base.radius_mm);
     let rows = bench_with_reference(&base, &options, &routings, !args.no_reference)?;
     if args.json {

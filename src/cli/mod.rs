@@ -68,9 +68,25 @@ pub struct ActuatorArgs {
     /// Creep: seconds each tension is held on a fresh rod in sweeps and design [default 0].
     #[arg(long, value_name = "S")]
     pub creep_hold_s: Option<f64>,
-    /// RK4 steps per knot span of the routing (even) [default 24].
+    /// Solver method: `collocation` (spectral, the default) or `rk4` (the previous method).
+    #[arg(long, value_enum, value_name = "METHOD")]
+    pub method: Option<MethodArg>,
+    /// Collocation: Chebyshev–Lobatto intervals per knot span (4–64; more resolve higher orders) [default: 10].
+    #[arg(long, value_name = "M")]
+    pub nodes_per_span: Option<usize>,
+    /// RK4 steps per knot span (even); with collocation, the centreline's resolution
+    /// (2·N + 1 points) [default: 24].
     #[arg(long, value_name = "N")]
     pub steps_per_span: Option<usize>,
+}
+
+/// Solver method on the command line.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum MethodArg {
+    /// Spectral collocation per knot span (the default solver).
+    Collocation,
+    /// The previous method: RK4 per span with secant shooting on gravity's moment.
+    Rk4,
 }
 
 impl ActuatorArgs {
@@ -110,6 +126,15 @@ impl ActuatorArgs {
         let mut o = base.clone();
         if let Some(n) = self.steps_per_span {
             o.steps_per_span = n;
+        }
+        if let Some(m) = self.nodes_per_span {
+            o.nodes_per_span = m;
+        }
+        if let Some(m) = self.method {
+            o.method = match m {
+                MethodArg::Collocation => crate::model::SolverMethod::Collocation,
+                MethodArg::Rk4 => crate::model::SolverMethod::Rk4,
+            };
         }
         o
     }

@@ -129,7 +129,7 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     // ones are only needed up to what the steps resolve.
     let exact_order = match args.coefficients {
         CoefficientRoute::Exact => args.order,
-        CoefficientRoute::Thesis => args.order.min(crate::model::resolution::max_order(options.steps_per_span)),
+        CoefficientRoute::Thesis => args.order.min(crate::model::resolution::max_order(&options)),
     };
     let basis = args.basis.length_basis;
     let mut sim = simulate_held(&actuator, &options, &routing, args.tension, exact_order, basis, hold)

@@ -1,49 +1,71 @@
 //! How many shape coefficients the discretisation resolves.
 //!
-//! The curvature coefficients a_k come from the solver's nodes (2 spans of
-//! `steps_per_span` RK4 steps). High-order Legendre polynomials oscillate
-//! faster than the nodes sample them, so a_k's error grows quickly with k:
-//! at the default 24 steps, a_5 is within 1e-5 mm⁻¹ of the converged value
-//! but a_9 is off by ~3e-3 and a_12 by ~5e-2 (issue 10). cablemap does not
-//! refine silently; it refuses an order the chosen steps do not resolve and
-//! names the steps that would.
+//! The curvature coefficients a_k come from the solver's nodes. High-order
+//! Legendre polynomials oscillate faster than the nodes sample them, so
+//! a_k's error grows quickly with k. cablemap does not refine silently; it
+//! refuses an order the chosen discretisation does not resolve and names the
+//! setting that would.
 //!
-//! [`REQUIRED_STEPS_PER_SPAN`] was measured with `cablemap simulate --json`:
-//! seven routings (straight to fully alternating, ±4 mm) at 0.5–2 N, each
-//! a_k compared with a 2048-step solve; an entry is the fewest steps (on a
-//! grid of 4, then 16) at which a_0 … a_k all lie within
-//! [`ORDER_TOLERANCE_PER_MM`] of it. Orders above the table are refused.
+//! Two tables, one per solver method, each the fewest nodes at which
+//! a_0 … a_k all lie within [`ORDER_TOLERANCE_PER_MM`] of a converged solve:
+//! - RK4 ([`REQUIRED_STEPS_PER_SPAN`]), measured with `cablemap simulate
+//!   --json`: seven routings (straight to fully alternating, ±4 mm) at
+//!   0.5–2 N against a 2048-step solve (on a grid of 4, then 16 steps). At
+//!   the old default of 24 steps a_5 is resolved, a_9 is off by ~3e-3.
+//! - Collocation, the default ([`REQUIRED_NODES_PER_SPAN`]): five routings
+//!   (±4 mm, straight to alternating) at 0.5 and 2 N against 64 intervals
+//!   per span, on the grid 4, 6, 8, 10, 12, 16; an entry within a factor 1.5
+//!   of the tolerance was moved to the next grid point. At the default 10
+//!   intervals a_11 is within 2e-5 mm⁻¹ and a_12 is off by 2e-4.
+//!
+//! Orders above the tables are refused.
+
+use super::{SolverMethod, SolverOptions};
 
 /// Accuracy the order check guarantees for every a_k, mm⁻¹.
 pub const ORDER_TOLERANCE_PER_MM: f64 = 5e-5;
 
-/// Fewest steps per span resolving a_0 … a_k, indexed by k.
+/// RK4: fewest steps per span resolving a_0 … a_k, indexed by k.
 pub const REQUIRED_STEPS_PER_SPAN: [usize; 17] = [4, 4, 8, 8, 16, 20, 32, 40, 60, 80, 96, 112, 144, 160, 192, 224, 256];
 
-/// Highest order supported at all (with enough steps).
+/// Collocation: fewest Chebyshev–Lobatto intervals per span resolving
+/// a_0 … a_k, indexed by k.
+pub const REQUIRED_NODES_PER_SPAN: [usize; 17] = [4, 4, 6, 6, 6, 6, 8, 8, 8, 10, 10, 10, 12, 12, 16, 16, 16];
+
+/// Highest order supported at all (with enough nodes).
 pub const MAX_RESOLVED_ORDER: usize = REQUIRED_STEPS_PER_SPAN.len() - 1;
 
-/// Highest order resolved at `steps_per_span`.
-pub fn max_order(steps_per_span: usize) -> usize {
-    REQUIRED_STEPS_PER_SPAN.iter().rposition(|&s| s <= steps_per_span).unwrap_or(0)
+/// The table, the setting's value, its spec name and its flag for a method.
+fn discretisation(options: &SolverOptions) -> (&'static [usize; 17], usize, &'static str, &'static str) {
+    match options.method {
+        SolverMethod::Rk4 => (&REQUIRED_STEPS_PER_SPAN, options.steps_per_span, "steps_per_span", "--steps-per-span"),
+        SolverMethod::Collocation => (&REQUIRED_NODES_PER_SPAN, options.nodes_per_span, "nodes_per_span", "--nodes-per-span"),
+    }
 }
 
-/// Checks that `order` is resolved at `steps_per_span`; the message names
-/// the fix.
-pub fn check_order(order: usize, steps_per_span: usize) -> Result<(), String> {
+/// Highest order resolved with `options`.
+pub fn max_order(options: &SolverOptions) -> usize {
+    let (table, have, _, _) = discretisation(options);
+    table.iter().rposition(|&s| s <= have).unwrap_or(0)
+}
+
+/// Checks that `order` is resolved with `options`; the message names the
+/// fix (the flag; a spec says `[solver] NAME = N`).
+pub fn check_order(order: usize, options: &SolverOptions) -> Result<(), String> {
     if order > MAX_RESOLVED_ORDER {
         return Err(format!(
             "order {order} is above the highest supported order {MAX_RESOLVED_ORDER} (higher coefficients are not resolved \
              by the solver's discretisation; see docs/reliability.md)"
         ));
     }
-    let needed = REQUIRED_STEPS_PER_SPAN[order];
-    if steps_per_span < needed {
+    let (table, have, name, flag) = discretisation(options);
+    let needed = table[order];
+    if have < needed {
         return Err(format!(
-            "order {order} is not resolved at {steps_per_span} steps per span (a_k would be off by more than \
-             {ORDER_TOLERANCE_PER_MM:e} mm⁻¹; at most order {} here): use steps_per_span ≥ {needed} \
-             (--steps-per-span {needed}), or a lower order",
-            max_order(steps_per_span)
+            "order {order} is not resolved at {name} = {have} (a_k would be off by more than \
+             {ORDER_TOLERANCE_PER_MM:e} mm⁻¹; at most order {} here): use {name} ≥ {needed} \
+             ({flag} {needed}), or a lower order",
+            max_order(options)
         ));
     }
     Ok(())
@@ -52,47 +74,63 @@ pub fn check_order(order: usize, steps_per_span: usize) -> Result<(), String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::{Actuator, Routing, Simulator};
 
-    #[test]
-    fn table_is_monotone_and_the_defaults_resolve_order_3() {
-        assert!(REQUIRED_STEPS_PER_SPAN.windows(2).all(|w| w[0] <= w[1]));
-        assert!(REQUIRED_STEPS_PER_SPAN.iter().all(|s| s % 2 == 0));
-        assert_eq!(max_order(24), 5);
-        assert!(check_order(3, 24).is_ok());
-        let e = check_order(12, 24).unwrap_err();
-        assert!(e.contains("--steps-per-span 144"), "{e}");
-        assert!(check_order(12, 144).is_ok());
-        assert!(check_order(100, 100_000).unwrap_err().contains("highest supported order 16"));
+    fn rk4(steps: usize) -> SolverOptions {
+        SolverOptions { method: SolverMethod::Rk4, steps_per_span: steps, ..SolverOptions::default() }
     }
 
-    /// The claim behind the table, re-measured at two entries: a_k at the
-    /// tabulated steps is within the tolerance of a much finer solve.
+    fn collocation(nodes: usize) -> SolverOptions {
+        SolverOptions { method: SolverMethod::Collocation, nodes_per_span: nodes, ..SolverOptions::default() }
+    }
+
     #[test]
-    fn tabulated_steps_meet_the_tolerance() {
-        use crate::model::{Actuator, Routing, Simulator, SolverOptions};
+    fn tables_are_monotone_and_the_defaults_resolve_order_3() {
+        for table in [&REQUIRED_STEPS_PER_SPAN, &REQUIRED_NODES_PER_SPAN] {
+            assert!(table.windows(2).all(|w| w[0] <= w[1]));
+            assert!(table.iter().all(|s| s % 2 == 0));
+        }
+        assert!(check_order(3, &SolverOptions::default()).is_ok());
+        assert_eq!(max_order(&SolverOptions::default()), 11, "collocation at 10 intervals");
+        assert_eq!(max_order(&rk4(24)), 5);
+        let e = check_order(12, &rk4(24)).unwrap_err();
+        assert!(e.contains("--steps-per-span 144"), "{e}");
+        assert!(check_order(12, &rk4(144)).is_ok());
+        let e = check_order(12, &SolverOptions::default()).unwrap_err();
+        assert!(e.contains("--nodes-per-span 12") && e.contains("nodes_per_span = 10"), "{e}");
+        assert!(check_order(16, &collocation(16)).is_ok());
+        assert!(check_order(100, &collocation(64)).unwrap_err().contains("highest supported order 16"));
+    }
+
+    /// The solver itself (not `simulate`, which would refuse coarse cases).
+    fn coefficients(options: &SolverOptions, order: usize) -> Vec<f64> {
         let actuator = Actuator::default();
         let routing = Routing::new(&[-4.0, 4.0, -4.0, 4.0, -4.0], actuator.length_mm, actuator.radius_mm).unwrap();
-        // The solver itself (not `simulate`, which would refuse the coarse case).
-        let at = |steps: usize, order: usize| {
-            let options = SolverOptions { steps_per_span: steps, ..SolverOptions::default() };
-            let mut sim = Simulator::new(&actuator, &options).unwrap();
-            sim.set_routing(&routing);
-            for t in [0.5, 1.0, 1.5, 2.0] {
-                sim.solve(t).unwrap();
-            }
-            let mut a = vec![0.0; order + 1];
-            sim.coefficients_into(crate::shape::LengthBasis::Rest, &mut a);
-            a
-        };
-        for order in [5, 9] {
-            let coarse = at(REQUIRED_STEPS_PER_SPAN[order], order);
-            let fine = at(1024, order);
+        let mut sim = Simulator::new(&actuator, options).unwrap();
+        sim.set_routing(&routing);
+        for t in [0.5, 1.0, 1.5, 2.0] {
+            sim.solve(t).unwrap();
+        }
+        let mut a = vec![0.0; order + 1];
+        sim.coefficients_into(crate::shape::LengthBasis::Rest, &mut a);
+        a
+    }
+
+    /// The claim behind the tables, re-measured at a few entries: a_k at
+    /// the tabulated discretisation is within the tolerance of a much finer
+    /// solve, and a coarser one is not (the tables are not slack).
+    #[test]
+    fn tabulated_discretisations_meet_the_tolerance() {
+        let cases: [(fn(usize) -> SolverOptions, &[usize; 17], usize, usize); 4] =
+            [(rk4, &REQUIRED_STEPS_PER_SPAN, 5, 1024), (rk4, &REQUIRED_STEPS_PER_SPAN, 9, 1024), (collocation, &REQUIRED_NODES_PER_SPAN, 9, 64), (collocation, &REQUIRED_NODES_PER_SPAN, 12, 64)];
+        for (make, table, order, fine_n) in cases {
+            let fine = coefficients(&make(fine_n), order);
+            let coarse = coefficients(&make(table[order]), order);
             for k in 0..=order {
                 assert!((coarse[k] - fine[k]).abs() <= ORDER_TOLERANCE_PER_MM, "a_{k} at order {order}: {} vs {}", coarse[k], fine[k]);
             }
-            // And one step below the table is not (the table is not slack).
-            let below = at(REQUIRED_STEPS_PER_SPAN[order] / 2, order);
-            assert!((below[order] - fine[order]).abs() > ORDER_TOLERANCE_PER_MM / 10.0);
+            let below = coefficients(&make(table[order] / 2), order);
+            assert!((below[order] - fine[order]).abs() > ORDER_TOLERANCE_PER_MM / 10.0, "order {order} at half the table");
         }
     }
 }

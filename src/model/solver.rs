@@ -1027,7 +1027,7 @@ pub fn simulate_held(
     basis: LengthBasis,
     hold: Hold,
 ) -> Result<Simulation, crate::Error> {
-    super::resolution::check_order(order, options.steps_per_span).map_err(ParameterError::Unresolved)?;
+    super::resolution::check_order(order, options).map_err(ParameterError::Unresolved)?;
     let mut sim = Simulator::new(actuator, options)?;
     sim.set_routing(routing);
     // A ladder of tensions: cheap, and it keeps Newton and the shooting in
