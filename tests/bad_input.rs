@@ -44,30 +44,34 @@ fn orders_the_steps_do_not_resolve_are_refused_with_the_steps_that_would() {
     fn sim<'a>(extra: &[&'a str]) -> Vec<&'a str> {
         [&["simulate"][..], &R, extra].concat()
     }
-    refused(&sim(&["--order", "12"]), &["order 12 is not resolved at 24 steps", "--steps-per-span 144"]);
+    // The default solver (collocation, 10 intervals per span) resolves a_0…a_11.
+    refused(&sim(&["--order", "12"]), &["order 12 is not resolved at nodes_per_span = 10", "--nodes-per-span 12"]);
     refused(&sim(&["--order", "100"]), &["highest supported order 16"]);
     refused(&sim(&["--order", "100000000000"]), &["highest supported order 16"]);
-    // With the steps the message asks for, the coefficients are the converged ones.
+    // The previous method (RK4) has its own table, in steps per span.
+    refused(&sim(&["--method", "rk4", "--order", "12"]), &["order 12 is not resolved at steps_per_span = 24", "--steps-per-span 144"]);
+    // With the discretisation the message asks for, the coefficients are the converged ones.
     let a = |extra: &[&str]| -> Vec<f64> {
         let (ok, out, err) = run(&sim(&[extra, &["--json"][..]].concat()));
         assert!(ok, "{err}");
         let v: serde_json::Value = serde_json::from_str(out.trim()).unwrap();
         v["a"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect()
     };
-    let at_144 = a(&["--order", "12", "--steps-per-span", "144"]);
-    let at_1024 = a(&["--order", "12", "--steps-per-span", "1024"]);
-    for k in 0..=12 {
-        assert!((at_144[k] - at_1024[k]).abs() <= 5e-5, "a_{k}: {} vs {}", at_144[k], at_1024[k]);
+    let fine = a(&["--order", "12", "--nodes-per-span", "48"]);
+    for coarse in [a(&["--order", "12", "--nodes-per-span", "12"]), a(&["--order", "12", "--method", "rk4", "--steps-per-span", "144"])] {
+        for k in 0..=12 {
+            assert!((coarse[k] - fine[k]).abs() <= 5e-5, "a_{k}: {} vs {}", coarse[k], fine[k]);
+        }
     }
-    // The default order is resolved at the default steps.
+    // The default order is resolved at the default settings.
     assert_eq!(a(&[]).len(), 4);
     // So is a design target, before the search.
-    refused(&["design", "--target", "x=50,y=5,a9=0.001"], &["order 9", "--steps-per-span 80"]);
+    refused(&["design", "--target", "x=50,y=5,a12=0.001"], &["order 12", "--nodes-per-span 12"]);
     // A sweep spec is checked the same way, before any file is written.
     let tmp = tempfile::tempdir().unwrap();
     let spec = tmp.path().join("o.toml");
-    std::fs::write(&spec, "[output]\norder = 9\n").unwrap();
-    refused(&["sweep", s(&spec), "--out", s(&tmp.path().join("run"))], &["order 9", "steps_per_span = 80"]);
+    std::fs::write(&spec, "[output]\norder = 12\n").unwrap();
+    refused(&["sweep", s(&spec), "--out", s(&tmp.path().join("run"))], &["order 12", "nodes_per_span = 12"]);
     assert!(!tmp.path().join("run").exists());
 }
 

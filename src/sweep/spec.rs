@@ -325,7 +325,9 @@ mod tests {
     fn absurd_sizes_are_refused_before_allocation() {
         assert!(err("[tension]\ncount = 4000000000\n").contains("count = 4000000000"));
         assert!(err("[solver]\nsteps_per_span = 4000000000\n").contains("steps_per_span"));
-        assert!(err("[output]\norder = 9\n").contains("steps_per_span = 80"));
+        // Orders beyond what the solver resolves: collocation at 10 intervals stops at 11.
+        assert!(err("[output]\norder = 12\n").contains("[solver] nodes_per_span = 12"));
+        assert!(err("[solver]\nmethod = \"rk4\"\n[output]\norder = 9\n").contains("[solver] steps_per_span = 80"));
         assert!(err("[tension]\ncount = 100000\n").contains("chunk_routings"));
         let huge = SweepSpec::from_toml("[grid]\nlevels = 99\n", "t").unwrap();
         assert!(huge.check_size(false).unwrap_err().contains("--allow-large"));
