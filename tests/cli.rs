@@ -145,3 +145,24 @@ fn simulate_json_coefficients_match_the_reference_in_both_bases() {
     }
     assert!(checked >= 32, "only {checked} reference checks");
 }
+
+/// `diagnose` ends with the lines to paste: flags with the fitted rigidities
+/// and effect, which `simulate` accepts as they are.
+#[test]
+fn diagnose_prints_pasteable_next_steps() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = dir.path().join("friction.csv");
+    let (ok, _, err) = run(&["synth", "--effect", "friction", "--magnitude", "0.1", "--out", data.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    let (ok, out, err) = run(&["diagnose", data.to_str().unwrap(), "--no-report"]);
+    assert!(ok, "{err}");
+    assert!(out.starts_with("verdict: friction"), "{out}");
+    let flags = out.lines().find_map(|l| l.trim().strip_prefix("simulate / design / calibrate flags: ")).unwrap_or_else(|| panic!("{out}"));
+    assert!(flags.contains("--ei-n-mm2 ") && flags.contains("--friction-mu 0.0"), "{flags}");
+    assert!(out.contains("[actuator.effects]") && out.contains("friction_mu = "), "{out}");
+    let mut args = vec!["simulate", "--routing", "1,-2,3,0.5,-3", "--tension", "1.5", "--json"];
+    args.extend(flags.split_whitespace());
+    let (ok, out, err) = run(&args);
+    assert!(ok, "{flags}: {err}");
+    assert!(out.contains("\"tip_x_mm\""));
+}

@@ -104,6 +104,12 @@ fn quick_sweep_has_every_row_once_with_the_documented_columns() {
     let (ok, stdout, stderr) = run(&["sweep", QUICK, "--out", dir.to_str().unwrap(), "--log-interval-s", "0"]);
     assert!(ok, "{stderr}");
     assert!(stdout.contains("610 rows solved and written"), "{stdout}");
+    // Lines fit an 80-column terminal (the temporary path is short), and the
+    // summary names the next command.
+    for line in stdout.lines().chain(stderr.lines()) {
+        assert!(line.chars().count() <= 80, "over 80 columns: {line}");
+    }
+    assert!(stdout.contains(&format!("next: cablemap reduce {} --out MAP_DIR", dir.display())), "{stdout}");
     // stderr is not a terminal here: plain progress lines, no bar.
     assert!(stderr.contains("rows (") && stderr.contains("solves/s") && stderr.contains("ETA"), "{stderr}");
     assert!(stdout.contains("610/610 rows, complete"), "{stdout}");
@@ -274,7 +280,7 @@ fn shards_from_flags_and_cluster_variables_make_up_the_single_run() {
     let out = cablemap().args(args(&[])).env("SLURM_ARRAY_TASK_ID", "1").env("SLURM_CPUS_PER_TASK", "1").output().unwrap();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(stdout.contains("shard 1/3") && stdout.contains("1 threads"), "{stdout}");
+    assert!(stdout.contains("shard 1/3") && stdout.contains("1 thread\n") && !stdout.contains("1 threads"), "{stdout}");
     assert!(stdout.contains("partial"), "{stdout}");
     let (ok, status, _) = run(&["status", sharded.to_str().unwrap()]);
     assert!(ok);
@@ -533,4 +539,35 @@ fn the_reducer_reads_a_sweep_through_open_run() {
     assert_eq!(spec, *open_run(&dir, Completeness::Complete).unwrap().spec());
     assert_eq!(map.summary.rows_total, (2 * 122 - 1) * 5);
     assert_eq!(map.summary.rows_converged, map.summary.rows_total);
+}
+
+/// Ctrl-C (SIGINT) says what is kept and how to resume, ends like the
+/// signal (exit 130), and the resume completes the run.
+#[cfg(unix)]
+#[test]
+fn an_interrupted_sweep_says_how_to_resume() {
+    let tmp = tempfile::tempdir().unwrap();
+    let spec = write_spec(tmp.path(), "kill.toml", KILL_SPEC);
+    let dir = tmp.path().join("run");
+    let mut child = cablemap()
+        .args(["sweep", spec.to_str().unwrap(), "--out", dir.to_str().unwrap(), "--threads", "1"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // After the first committed chunk (not after a time).
+    let deadline = Instant::now() + Duration::from_secs(300);
+    let has_chunk = || std::fs::read_dir(dir.join("shards")).map(|r| r.filter_map(Result::ok).any(|e| e.file_name().to_string_lossy().starts_with("chunk-"))).unwrap_or(false);
+    while !has_chunk() && Instant::now() < deadline && child.try_wait().unwrap().is_none() {
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    assert!(Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap().success());
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(130), "{stderr}");
+    assert!(stderr.contains("interrupted: every chunk already written is kept; resume with the same command:"), "{stderr}");
+    assert!(stderr.contains(&format!("sweep {} --out {}", spec.display(), dir.display())), "{stderr}");
+    let (ok, stdout, stderr) = sweep(&spec, &dir, &[]);
+    assert!(ok, "{stderr}");
+    assert!(stdout.contains("complete") && !stdout.contains(" 0 already done"), "{stdout}");
 }

@@ -134,6 +134,9 @@ pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
         }
     }
     writeln!(out, "criterion: {}", d.criterion)?;
+    if d.verdict == "none" || !d.named.is_empty() && d.verdict != "unexplained" && d.verdict != "inconclusive" {
+        write!(out, "{}", next_step(&d.extended))?;
+    }
     if let Some(p) = report {
         writeln!(out, "report: {}", p.display())?;
     }
@@ -146,5 +149,80 @@ fn value(v: f64) -> String {
         format!("{v:.5e}")
     } else {
         format!("{v:.5}")
+    }
+}
+
+/// Five significant digits: what a fitted value with a standard error of a
+/// few per cent supports, and short enough to paste.
+fn sig5(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return format!("{v}");
+    }
+    let digits = (4 - v.abs().log10().floor() as i32).max(0) as usize;
+    let text = format!("{v:.digits$}");
+    if text.contains('.') { text.trim_end_matches('0').trim_end_matches('.').to_string() } else { text }
+}
+
+/// The lines to paste to use the fitted model: flags for `simulate`,
+/// `design` and `sweep`-free commands, and the TOML block for a spec.
+fn next_step(fit: &crate::calibrate::FitResult) -> String {
+    let a = &fit.actuator;
+    let mut flags = vec![format!("--ea-n {}", sig5(a.ea_n)), format!("--ga-n {}", sig5(a.ga_n)), format!("--ei-n-mm2 {}", sig5(a.ei_n_mm2))];
+    let mut toml = format!("[actuator]\nea_n = {}\nga_n = {}\nei_n_mm2 = {}\n", sig5(a.ea_n), sig5(a.ga_n), sig5(a.ei_n_mm2));
+    let mut effects = String::new();
+    for e in &fit.effects {
+        use crate::calibrate::Effect;
+        match e {
+            Effect::Friction => {
+                flags.push(format!("--friction-mu {}", sig5(a.effects.friction_mu)));
+                effects.push_str(&format!("friction_mu = {}\n", sig5(a.effects.friction_mu)));
+            }
+            Effect::Gravity => {
+                flags.push(format!("--gravity-scale {}", sig5(a.gravity.scale)));
+                toml.push_str(&format!("[actuator.gravity]\nscale = {}\n", sig5(a.gravity.scale)));
+            }
+            Effect::Stiffening => {
+                flags.push(format!("--stiffening-alpha {}", sig5(a.effects.stiffening_alpha)));
+                effects.push_str(&format!("stiffening_alpha = {}\n", sig5(a.effects.stiffening_alpha)));
+            }
+            Effect::ClampCompliance => {
+                let k = a.effects.clamp_stiffness_n_mm_per_rad.unwrap_or(f64::INFINITY);
+                flags.push(format!("--clamp-stiffness {}", sig5(k)));
+                effects.push_str(&format!("clamp_stiffness_n_mm_per_rad = {}\n", sig5(k)));
+            }
+            Effect::ChannelOffset => {
+                flags.push(format!("--channel-offset-mm {}", sig5(a.effects.channel_offset_mm)));
+                effects.push_str(&format!("channel_offset_mm = {}\n", sig5(a.effects.channel_offset_mm)));
+            }
+            Effect::Creep => {
+                flags.push(format!("--creep-fraction {}", sig5(a.effects.creep_fraction)));
+                effects.push_str(&format!("creep_fraction = {}\n", sig5(a.effects.creep_fraction)));
+            }
+        }
+    }
+    if !effects.is_empty() {
+        toml.push_str("[actuator.effects]\n");
+        toml.push_str(&effects);
+    }
+    let mut s = String::from("next step: use the fitted model\n");
+    s.push_str(&format!("  simulate / design / calibrate flags: {}\n", flags.join(" ")));
+    s.push_str("  in a sweep spec:\n");
+    for line in toml.lines() {
+        s.push_str(&format!("    {line}\n"));
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::sig5;
+
+    #[test]
+    fn five_significant_digits() {
+        assert_eq!(sig5(0.0961123), "0.096112");
+        assert_eq!(sig5(115.1172), "115.12");
+        assert_eq!(sig5(26.69641), "26.696");
+        assert_eq!(sig5(12345.67), "12346");
+        assert_eq!(sig5(-0.5), "-0.5");
     }
 }

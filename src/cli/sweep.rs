@@ -113,6 +113,11 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
         args.shards
     );
     let options = SweepOptions { shard, shards: args.shards, threads, progress, allow_large: args.allow_large };
+    let again: Vec<String> = std::env::args().collect();
+    say_how_to_resume_on_interrupt(format!(
+        "\ninterrupted: every chunk already written is kept; resume with the same command:\n  {}\n",
+        again.join(" ")
+    ));
     let summary = run_sweep(&spec, &args.out, &options)?;
     let status = run_status(&args.out).with_context(|| format!("checking {} after the sweep", args.out.display()))?;
     if args.json {
@@ -123,11 +128,14 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// The closing lines, each short enough for an 80-column terminal, and the
+/// next command.
 fn print_summary(s: &SweepSummary, status: &RunStatus) {
-    println!(
-        "shard {}/{}: {} rows solved and written, {} already done ({} abandoned partial chunks removed, {} damaged chunks redone), {:.2} s wall, {:.0} solves/s, {} threads",
-        s.shard, s.shards, s.rows_written, s.rows_skipped, s.partial_chunks_removed, s.damaged_chunks_redone, s.wall_s, s.solves_per_s, s.threads
-    );
+    println!("shard {}/{}: {} rows solved and written, {} already done", s.shard, s.shards, s.rows_written, s.rows_skipped);
+    if s.partial_chunks_removed + s.damaged_chunks_redone > 0 {
+        println!("  {} abandoned partial chunks removed, {} damaged chunks redone", s.partial_chunks_removed, s.damaged_chunks_redone);
+    }
+    println!("  {:.2} s wall, {:.0} solves/s, {} thread{}", s.wall_s, s.solves_per_s, s.threads, if s.threads == 1 { "" } else { "s" });
     println!("shard {}/{} statuses: {}", s.shard, s.shards, fmt_counts(&s.status_counts));
     println!(
         "run {}: {}/{} rows, {}",
@@ -136,7 +144,37 @@ fn print_summary(s: &SweepSummary, status: &RunStatus) {
         status.rows_total,
         if status.complete { "complete" } else { "partial (other shards not done yet)" }
     );
+    if status.complete {
+        println!("next: cablemap reduce {} --out MAP_DIR", status.dir.display());
+    }
 }
+
+/// On Ctrl-C (SIGINT) or SIGTERM: say what is kept and how to resume, then
+/// end as the signal would. Written chunks are complete files (renamed into
+/// place), so stopping loses only the chunks in flight, which a resume redoes.
+#[cfg(unix)]
+fn say_how_to_resume_on_interrupt(resume: String) {
+    use std::sync::OnceLock;
+    static MESSAGE: OnceLock<Vec<u8>> = OnceLock::new();
+    extern "C" fn on_signal(signal: libc::c_int) {
+        // Only async-signal-safe calls here: write(2) and _exit(2).
+        if let Some(m) = MESSAGE.get() {
+            // SAFETY: writing an immutable, initialised buffer to stderr.
+            unsafe { libc::write(2, m.as_ptr().cast(), m.len()) };
+        }
+        // SAFETY: ends the process without running anything else.
+        unsafe { libc::_exit(128 + signal) };
+    }
+    if MESSAGE.set(resume.into_bytes()).is_ok() {
+        for signal in [libc::SIGINT, libc::SIGTERM] {
+            // SAFETY: installs a handler that only calls async-signal-safe functions.
+            unsafe { libc::signal(signal, on_signal as extern "C" fn(libc::c_int) as libc::sighandler_t) };
+        }
+    }
+}
+
+#[cfg(not(unix))]
+fn say_how_to_resume_on_interrupt(_resume: String) {}
 
 fn fmt_counts(counts: &std::collections::BTreeMap<String, u64>) -> String {
     if counts.is_empty() {

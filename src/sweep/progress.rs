@@ -41,7 +41,7 @@ impl Progress {
             ProgressMode::Auto if std::io::stderr().is_terminal() => {
                 let bar = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
                 bar.set_style(
-                    ProgressStyle::with_template("{prefix} [{wide_bar}] {human_pos}/{human_len} rows, {rate}, ETA {eta}")
+                    ProgressStyle::with_template("{prefix} [{wide_bar}] {human_pos}/{human_len} rows, {rate}, {elapsed} elapsed, ETA {eta}")
                         .expect("valid template")
                         .with_key("rate", |state: &ProgressState, w: &mut dyn std::fmt::Write| {
                             let _ = write!(w, "{:.0} solves/s", state.per_sec());

@@ -180,12 +180,11 @@ pub fn run_sweep(spec: &SweepSpec, dir: &Path, options: &SweepOptions) -> Result
 
     let label = format!("sweep shard {shard}/{shards}");
     if options.progress != ProgressMode::Quiet {
+        // Short lines: a terminal of 80 columns must not wrap them.
+        eprintln!("{label}: {} of {} chunks to do, {} rows", pending.len(), own.len(), shard_rows - rows_skipped);
         eprintln!(
-            "{label}: {} of {} chunks to do ({} rows of {shard_rows}; {} already written), {threads} threads, output {}",
-            pending.len(),
-            own.len(),
-            shard_rows - rows_skipped,
-            rows_skipped,
+            "  ({rows_skipped} of {shard_rows} already written; {threads} thread{}; output {})",
+            if threads == 1 { "" } else { "s" },
             dir.display()
         );
     }
