@@ -23,13 +23,13 @@ pub struct DesignArgs {
     /// its nearest designs and supplies the tension bounds.
     #[arg(long, value_name = "MAP_DIR")]
     pub map: Option<PathBuf>,
-    /// Lower tension bound τ_l, N [default 1.0, or the map's].
+    /// Lower tension bound τ_l, N [default: 1.0, or the map's].
     #[arg(long, value_name = "N")]
     pub tension_min_n: Option<f64>,
-    /// Upper tension bound τ_u, N [default 2.0, or the map's].
+    /// Upper tension bound τ_u, N [default: 2.0, or the map's].
     #[arg(long, value_name = "N")]
     pub tension_max_n: Option<f64>,
-    /// Largest |y_i| of a control point, mm [default 0.999 r: the thesis's −r < y_i < r].
+    /// Largest |y_i| of a control point, mm [default: 0.999 r: the thesis's −r < y_i < r].
     /// A channel of diameter d breaks the surface beyond r − d/2.
     #[arg(long, value_name = "MM")]
     pub max_offset_mm: Option<f64>,

@@ -187,7 +187,7 @@ fn next_step(fit: &crate::calibrate::FitResult) -> String {
             }
             Effect::ClampCompliance => {
                 let k = a.effects.clamp_stiffness_n_mm_per_rad.unwrap_or(f64::INFINITY);
-                flags.push(format!("--clamp-stiffness {}", sig5(k)));
+                flags.push(format!("--clamp-stiffness-n-mm-per-rad {}", sig5(k)));
                 effects.push_str(&format!("clamp_stiffness_n_mm_per_rad = {}\n", sig5(k)));
             }
             Effect::ChannelOffset => {

@@ -20,52 +20,53 @@ use clap::Args;
 /// Defaults are the thesis's (model-notes §1).
 #[derive(Debug, Clone, Args, Default)]
 pub struct ActuatorArgs {
-    /// Rod length L, mm [default 65].
+    /// Rod length L, mm [default: 65].
     #[arg(long, value_name = "MM")]
     pub length_mm: Option<f64>,
-    /// Rod radius r, mm [default 5].
+    /// Rod radius r, mm [default: 5].
     #[arg(long, value_name = "MM")]
     pub radius_mm: Option<f64>,
-    /// Axial rigidity EA, N [default 26.6964].
+    /// Axial rigidity EA, N [default: 26.6964].
     #[arg(long, value_name = "N")]
     pub ea_n: Option<f64>,
-    /// Shear rigidity GA, N [default 1.70866].
+    /// Shear rigidity GA, N [default: 1.70866].
     #[arg(long, value_name = "N")]
     pub ga_n: Option<f64>,
-    /// Bending rigidity EI, N·mm² [default 115.117].
+    /// Bending rigidity EI, N·mm² [default: 115.117].
     #[arg(long, value_name = "N_MM2")]
     pub ei_n_mm2: Option<f64>,
-    /// Material density, g/cm³ [default 1.07].
+    /// Material density, g/cm³ [default: 1.07].
     #[arg(long, value_name = "G_CM3")]
     pub density_g_cm3: Option<f64>,
     /// Turn self-weight off (the thesis's rod hangs: gravity is on by default).
     #[arg(long)]
     pub no_gravity: bool,
-    /// Gravity direction from the clamp axis, rad (clamp tilt) [default 0].
+    /// Gravity direction from the clamp axis, rad (clamp tilt) [default: 0].
     #[arg(long, value_name = "RAD", allow_hyphen_values = true)]
     pub gravity_direction_rad: Option<f64>,
-    /// Scale on the nominal self-weight [default 1].
+    /// Scale on the nominal self-weight [default: 1].
     #[arg(long, value_name = "K")]
     pub gravity_scale: Option<f64>,
-    /// Material stiffening α: moment EI·u·(1 + α (r u)²) [default 0].
+    /// Material stiffening α: moment EI·u·(1 + α (r u)²) [default: 0].
     #[arg(long, value_name = "ALPHA")]
     pub stiffening_alpha: Option<f64>,
-    /// Clamp rotational stiffness k_θ, N·mm/rad [default: rigid clamp].
-    #[arg(long, value_name = "N_MM_PER_RAD")]
+    /// Clamp rotational stiffness k_θ, N·mm/rad: the effect `clamp_compliance`
+    /// (`--clamp-stiffness` is the old name) [default: rigid clamp].
+    #[arg(long = "clamp-stiffness-n-mm-per-rad", alias = "clamp-stiffness", value_name = "N_MM_PER_RAD")]
     pub clamp_stiffness: Option<f64>,
-    /// Channel offset δ added to every y_i, mm [default 0].
+    /// Channel offset δ added to every y_i, mm [default: 0].
     #[arg(long, value_name = "MM", allow_hyphen_values = true)]
     pub channel_offset_mm: Option<f64>,
-    /// Cable–channel friction coefficient μ (capstan law) [default 0].
+    /// Cable–channel friction coefficient μ (capstan law) [default: 0].
     #[arg(long, value_name = "MU")]
     pub friction_mu: Option<f64>,
-    /// Creep: fraction f of the bending rigidity that relaxes (0 ≤ f < 1) [default 0].
+    /// Creep: fraction f of the bending rigidity that relaxes (0 ≤ f < 1) [default: 0].
     #[arg(long, value_name = "F")]
     pub creep_fraction: Option<f64>,
-    /// Creep time constant T, s [default 10].
+    /// Creep time constant T, s [default: 10].
     #[arg(long, value_name = "S")]
     pub creep_time_s: Option<f64>,
-    /// Creep: seconds each tension is held on a fresh rod in sweeps and design [default 0].
+    /// Creep: seconds each tension is held on a fresh rod in sweeps and design [default: 0].
     #[arg(long, value_name = "S")]
     pub creep_hold_s: Option<f64>,
     /// Solver method: `collocation` (spectral, the default) or `rk4` (the previous method).

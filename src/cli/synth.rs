@@ -46,8 +46,8 @@ pub struct SynthArgs {
     /// straight, tip_bend, arc].
     #[arg(long, allow_hyphen_values = true)]
     pub routings: Option<String>,
-    /// Top tension τ_u, N.
-    #[arg(long, default_value_t = 2.0, allow_hyphen_values = true)]
+    /// Top tension τ_u, N (`--max-tension` is the old name).
+    #[arg(long = "tension-max-n", alias = "max-tension", value_name = "N", default_value_t = 2.0, allow_hyphen_values = true)]
     pub max_tension: f64,
     /// Loading steps from rest to τ_u (unloading uses the same levels).
     #[arg(long, default_value_t = 5)]

@@ -100,7 +100,31 @@ pub fn mould_svg(routing: &Routing, radius_mm: f64, channel_diameter_mm: f64, te
             px(s),
             py(*y)
         );
+        // Labelled on the side away from the channel, so a mirrored print reads wrong.
+        let above = *y < 0.0;
+        let _ = writeln!(
+            svg,
+            r#"<text class="control-point-label" x="{:.4}" y="{:.4}" font-size="1.6" fill="blue" text-anchor="middle">y{i}</text>"#,
+            px(s),
+            if above { py(*y) - 0.9 } else { py(*y) + 2.2 }
+        );
     }
+    // Orientation: +y points up the page; the drawing is the cutting plane
+    // seen from the mould's open face; the clamp end is on the left.
+    let (ax, ay) = (px(length) + 3.0, py(0.0));
+    let _ = writeln!(
+        svg,
+        r#"<g id="orientation"><line x1="{ax}" y1="{ay}" x2="{ax}" y2="{}" stroke="black" stroke-width="0.3"/><path d="M {} {} L {ax} {} L {} {} Z" fill="black"/><text x="{}" y="{}" font-size="2">+y</text></g>"#,
+        ay - radius_mm,
+        ax - 0.8,
+        ay - radius_mm + 1.6,
+        ay - radius_mm - 0.2,
+        ax + 0.8,
+        ay - radius_mm + 1.6,
+        ax - 1.4,
+        ay + 2.8
+    );
+    let _ = writeln!(svg, r#"<text id="clamp-label" x="{}" y="{}" font-size="2">CLAMP</text>"#, px(0.0) + 0.5, py(radius_mm) - 1.0);
     // 10 mm scale bar to check the print scale.
     let bar_y = py(-radius_mm) + 6.0;
     let _ = writeln!(
@@ -114,6 +138,7 @@ pub fn mould_svg(routing: &Routing, radius_mm: f64, channel_diameter_mm: f64, te
     let notes = [
         "10 mm".to_string(),
         format!("L = {length} mm, r = {radius_mm} mm, channel Ø {channel_diameter_mm} mm; clamp on the left"),
+        "seen from mould 1's open face, +y up: mirrored, it bends the other way".to_string(),
         format!("y0..y4 = [{ys}] mm"),
         format!("tension {tension_n:.3} N"),
     ];
@@ -216,5 +241,10 @@ mod tests {
         assert!(svg.contains(r#"width="85mm""#) && svg.contains(r#"viewBox="0 0 85 46""#), "{svg}");
         assert!(svg.contains(r#"<rect id="body" x="10" y="10" width="65" height="10""#));
         assert_eq!(svg.matches("class=\"control-point\"").count(), 5);
+        // Orientation marks: labelled control points, a +y arrow, the clamp end.
+        for i in 0..5 {
+            assert!(svg.contains(&format!(">y{i}</text>")), "y{i}");
+        }
+        assert!(svg.contains(r#"<g id="orientation">"#) && svg.contains(">+y</text>") && svg.contains(">CLAMP</text>"));
     }
 }
