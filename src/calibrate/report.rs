@@ -388,27 +388,54 @@ fn residual_plot(path: &Path, data: &Dataset, groups: &[RoutingGroup], d: &Diagn
             .map_err(|e| PlotError::new(path, e))?;
         chart
             .configure_mesh()
-            .x_desc("reading (routings in protocol order)")
+            .x_desc("reading (routings in protocol order; loading ●, unloading ○, rest or static ×)")
             .y_desc("mm  (θ: mm-equivalent)")
             .label_style((FONT, 13))
             .axis_desc_style((FONT, 14))
             .draw()
             .map_err(|e| PlotError::new(path, e))?;
+        // The held-out routing's readings on a grey band, so they stand apart.
+        let mut start = 0;
+        for g in groups {
+            let end = start + g.rows.len();
+            if d.holdout.as_deref() == Some(g.routing.as_str()) {
+                let band = Rectangle::new([(start as f64 - 0.5, -lim), (end as f64 - 0.5, lim)], BLACK.mix(0.07).filled());
+                chart.draw_series(std::iter::once(band)).map_err(|e| PlotError::new(path, e))?;
+            }
+            start = end;
+        }
+        // Loading filled, unloading open, rest and static captures as crosses:
+        // a friction or creep loop shows as two marker kinds apart.
+        let direction = |k: usize| data.rows[order[k]].direction;
+        let is_rest = |k: usize| matches!(direction(k), Direction::Rest | Direction::Static);
         for (c, (name, colour)) in [("Δx", BLUE), ("Δy", GREEN), ("Δθ·w", RGBColor(230, 120, 0))].into_iter().enumerate() {
+            let at = |k: usize| (k as f64, res[k][c]);
             chart
-                .draw_series(res.iter().enumerate().map(|(k, r)| Circle::new((k as f64, r[c]), 3, colour.filled())))
+                .draw_series((0..res.len()).filter(|&k| direction(k) == Direction::Load).map(|k| Circle::new(at(k), 3, colour.filled())))
                 .map_err(|e| PlotError::new(path, e))?
                 .label(name)
                 .legend(move |(x, y)| Circle::new((x + 8, y), 4, colour.filled()));
+            chart
+                .draw_series((0..res.len()).filter(|&k| direction(k) == Direction::Unload).map(|k| Circle::new(at(k), 3, colour.stroke_width(2))))
+                .map_err(|e| PlotError::new(path, e))?;
+            chart
+                .draw_series((0..res.len()).filter(|&k| is_rest(k)).map(|k| Cross::new(at(k), 3, colour.stroke_width(2))))
+                .map_err(|e| PlotError::new(path, e))?;
         }
-        // Routing boundaries.
+        // Routing boundaries and names (the held-out one marked).
         let mut k = 0;
         for g in groups {
+            let first = k;
             k += g.rows.len();
             let x = k as f64 - 0.5;
             chart.draw_series(LineSeries::new(vec![(x, -lim), (x, lim)], BLACK.mix(0.3))).map_err(|e| PlotError::new(path, e))?;
+            let held = d.holdout.as_deref() == Some(g.routing.as_str());
+            let name = format!("{}{}", g.routing, if held { " (held out)" } else { "" });
+            chart
+                .draw_series(std::iter::once(Text::new(name, (first as f64, lim * 0.97), (FONT, 12))))
+                .map_err(|e| PlotError::new(path, e))?;
         }
-        draw_legend(&mut chart, path, SeriesLabelPosition::UpperRight, 13)?;
+        draw_legend(&mut chart, path, SeriesLabelPosition::LowerRight, 13)?;
     }
     root.present().map_err(|e| PlotError::new(path, e))
 }
