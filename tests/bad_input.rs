@@ -4,17 +4,13 @@
 
 use std::io::{BufRead, Read};
 use std::path::Path;
-use std::process::{Command, Stdio};
+use std::process::Stdio;
+
+mod process;
+use process::cablemap;
 
 const QUICK: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/jobs/quick.toml");
 
-fn cablemap() -> Command {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_cablemap"));
-    for v in ["SLURM_ARRAY_TASK_ID", "JOB_COMPLETION_INDEX", "SLURM_CPUS_PER_TASK"] {
-        c.env_remove(v);
-    }
-    c
-}
 
 fn run(args: &[&str]) -> (bool, String, String) {
     let out = cablemap().args(args).output().expect("runs");

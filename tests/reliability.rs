@@ -11,17 +11,13 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
+mod process;
+use process::{cablemap, snapshot};
+
 const QUICK: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/jobs/quick.toml");
 /// Many small chunks, a few seconds of work: long enough for two copies to overlap.
 const OVERLAP_SPEC: &str = "[grid]\nlevels = 5\n[tension]\ncount = 4\n[output]\nchunk_routings = 10\n";
 
-fn cablemap() -> Command {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_cablemap"));
-    for v in ["SLURM_ARRAY_TASK_ID", "JOB_COMPLETION_INDEX", "SLURM_CPUS_PER_TASK"] {
-        c.env_remove(v);
-    }
-    c
-}
 
 fn run(args: &[&str]) -> (bool, String, String) {
     let out = cablemap().args(args).output().expect("runs");
@@ -36,22 +32,6 @@ fn sweep(spec: &Path, dir: &Path) -> (bool, String, String) {
     run(&["sweep", s(spec), "--out", s(dir), "--quiet"])
 }
 
-/// Every file under `dir` with its bytes.
-fn snapshot(dir: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
-    let mut out = BTreeMap::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        for e in std::fs::read_dir(&d).unwrap() {
-            let p = e.unwrap().path();
-            if p.is_dir() {
-                stack.push(p);
-            } else {
-                out.insert(p.clone(), std::fs::read(&p).unwrap());
-            }
-        }
-    }
-    out
-}
 
 /// The chunk files of a run, by name, with their bytes.
 fn chunks(dir: &Path) -> BTreeMap<String, Vec<u8>> {

@@ -10,16 +10,11 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
+mod process;
+use process::{cablemap, snapshot};
+
 const QUICK: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/jobs/quick.toml");
 
-fn cablemap() -> Command {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_cablemap"));
-    // Cluster variables of the environment the tests run in must not pick a shard.
-    for v in ["SLURM_ARRAY_TASK_ID", "JOB_COMPLETION_INDEX", "SLURM_CPUS_PER_TASK"] {
-        c.env_remove(v);
-    }
-    c
-}
 
 fn run(args: &[&str]) -> (bool, String, String) {
     let out = cablemap().args(args).output().expect("runs");
@@ -80,22 +75,6 @@ fn cell(column: &dyn Array, r: usize) -> String {
     }
 }
 
-/// Every file in DIR with its bytes.
-fn snapshot(dir: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
-    let mut out = BTreeMap::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        for e in std::fs::read_dir(&d).unwrap() {
-            let p = e.unwrap().path();
-            if p.is_dir() {
-                stack.push(p);
-            } else {
-                out.insert(p.clone(), std::fs::read(&p).unwrap());
-            }
-        }
-    }
-    out
-}
 
 #[test]
 fn quick_sweep_has_every_row_once_with_the_documented_columns() {

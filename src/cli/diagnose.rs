@@ -172,32 +172,23 @@ fn next_step(fit: &crate::calibrate::FitResult) -> String {
     let mut effects = String::new();
     for e in &fit.effects {
         use crate::calibrate::Effect;
-        match e {
-            Effect::Friction => {
-                flags.push(format!("--friction-mu {}", sig5(a.effects.friction_mu)));
-                effects.push_str(&format!("friction_mu = {}\n", sig5(a.effects.friction_mu)));
-            }
-            Effect::Gravity => {
-                flags.push(format!("--gravity-scale {}", sig5(a.gravity.scale)));
-                toml.push_str(&format!("[actuator.gravity]\nscale = {}\n", sig5(a.gravity.scale)));
-            }
-            Effect::Stiffening => {
-                flags.push(format!("--stiffening-alpha {}", sig5(a.effects.stiffening_alpha)));
-                effects.push_str(&format!("stiffening_alpha = {}\n", sig5(a.effects.stiffening_alpha)));
-            }
+        let fx = &a.effects;
+        // (flag, spec key, value); gravity's scale lives in [actuator.gravity].
+        let (flag, key, value) = match e {
+            Effect::Friction => ("--friction-mu", "friction_mu", fx.friction_mu),
+            Effect::Gravity => ("--gravity-scale", "scale", a.gravity.scale),
+            Effect::Stiffening => ("--stiffening-alpha", "stiffening_alpha", fx.stiffening_alpha),
             Effect::ClampCompliance => {
-                let k = a.effects.clamp_stiffness_n_mm_per_rad.unwrap_or(f64::INFINITY);
-                flags.push(format!("--clamp-stiffness-n-mm-per-rad {}", sig5(k)));
-                effects.push_str(&format!("clamp_stiffness_n_mm_per_rad = {}\n", sig5(k)));
+                ("--clamp-stiffness-n-mm-per-rad", "clamp_stiffness_n_mm_per_rad", fx.clamp_stiffness_n_mm_per_rad.unwrap_or(f64::INFINITY))
             }
-            Effect::ChannelOffset => {
-                flags.push(format!("--channel-offset-mm {}", sig5(a.effects.channel_offset_mm)));
-                effects.push_str(&format!("channel_offset_mm = {}\n", sig5(a.effects.channel_offset_mm)));
-            }
-            Effect::Creep => {
-                flags.push(format!("--creep-fraction {}", sig5(a.effects.creep_fraction)));
-                effects.push_str(&format!("creep_fraction = {}\n", sig5(a.effects.creep_fraction)));
-            }
+            Effect::ChannelOffset => ("--channel-offset-mm", "channel_offset_mm", fx.channel_offset_mm),
+            Effect::Creep => ("--creep-fraction", "creep_fraction", fx.creep_fraction),
+        };
+        flags.push(format!("{flag} {}", sig5(value)));
+        if *e == Effect::Gravity {
+            toml.push_str(&format!("[actuator.gravity]\n{key} = {}\n", sig5(value)));
+        } else {
+            effects.push_str(&format!("{key} = {}\n", sig5(value)));
         }
     }
     if !effects.is_empty() {
