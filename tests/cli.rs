@@ -166,3 +166,18 @@ fn diagnose_prints_pasteable_next_steps() {
     assert!(ok, "{flags}: {err}");
     assert!(out.contains("\"tip_x_mm\""));
 }
+
+/// Without `--out`, the diagnosis report lands beside the data file, not in
+/// the current directory.
+#[test]
+fn diagnose_report_goes_beside_the_data_by_default() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = dir.path().join("lab.csv");
+    let (ok, _, err) = run(&["synth", "--out", data.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    let cwd = tempfile::tempdir().unwrap();
+    let out = cablemap().current_dir(cwd.path()).args(["diagnose", data.to_str().unwrap()]).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(dir.path().join("lab-diagnosis").join("report.md").exists());
+    assert_eq!(std::fs::read_dir(cwd.path()).unwrap().count(), 0, "the current directory was written to");
+}

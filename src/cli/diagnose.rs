@@ -19,9 +19,10 @@ pub struct DiagnoseArgs {
     /// Routing left out of every fit; the gap on it is shown before and after.
     #[arg(long, value_name = "ROUTING")]
     pub holdout: Option<String>,
-    /// Report directory (report.md and PNG plots).
-    #[arg(long, default_value = "diagnose-report", value_name = "DIR")]
-    pub out: PathBuf,
+    /// Report directory (report.md and PNG plots) [default: DATA's name with
+    /// `-diagnosis`, beside the data file: measurements.csv → measurements-diagnosis/].
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
     /// Skip the report and plots.
     #[arg(long)]
     pub no_report: bool,
@@ -49,10 +50,20 @@ pub struct DiagnoseArgs {
 }
 
 /// Runs `cablemap diagnose`.
+/// The report directory: `--out`, else beside the data file, so that a run
+/// never litters the current directory.
+fn report_dir(args: &DiagnoseArgs) -> PathBuf {
+    args.out.clone().unwrap_or_else(|| {
+        let stem = args.data.file_stem().map_or_else(|| "measurements".into(), |s| s.to_string_lossy().into_owned());
+        args.data.with_file_name(format!("{stem}-diagnosis"))
+    })
+}
+
 pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
+    let out_dir = report_dir(args);
     if !args.no_report {
         // Before the fits, not after them.
-        crate::io::check_not_in_run_dir(&args.out, "--out").map_err(anyhow::Error::msg)?;
+        crate::io::check_not_in_run_dir(&out_dir, "--out").map_err(anyhow::Error::msg)?;
     }
     let base = args.actuator.apply(&Actuator::default());
     base.validate()?;
@@ -69,7 +80,7 @@ pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
         held_effects,
     };
     let d = diagnose(&start, &options, &data, &spec)?;
-    let report = if args.no_report { None } else { Some(write_report(&args.out, &args.data, &data, &d, &spec)?) };
+    let report = if args.no_report { None } else { Some(write_report(&out_dir, &args.data, &data, &d, &spec)?) };
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
     if args.json {
