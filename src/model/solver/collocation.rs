@@ -73,6 +73,11 @@ pub(super) struct Colloc {
     scratch: Vec<f64>,
     /// qb[j][k] = q[m][k] − q[j][k]: integrals from node j to the span end.
     qb: Vec<f64>,
+    /// Interpolation weights onto the friction grid, row-major: row
+    /// (j − 1)·(FRICTION_SUBSTEPS − 1) + (k − 1) gives the value at
+    /// x_{j−1} + k/FRICTION_SUBSTEPS·(x_j − x_{j−1}) from the np node values
+    /// (fixed nodes: computed once instead of a barycentric sum per point).
+    fine: Vec<f64>,
     /// Anderson acceleration memory.
     anderson: Anderson,
     /// Converged solves of this routing, newest first: tension, φ, M.
@@ -130,6 +135,7 @@ impl Colloc {
                 }
                 qb
             },
+            fine: friction_grid_weights(m),
             anderson: Anderson::new(3 * nn),
             hist_t: [0.0; 3],
             hist_phi: std::array::from_fn(|_| vec![0.0; nn]),
@@ -252,6 +258,7 @@ impl Colloc {
 
     /// Barycentric interpolation of node values `f` (one span) at unit
     /// coordinate `x` ∈ [−1, 1].
+    #[allow(dead_code)]
     fn interpolate(&self, f: &[f64], x: f64) -> f64 {
         let np = self.np();
         let (mut num, mut den) = (0.0, 0.0);
@@ -652,7 +659,7 @@ impl Simulator {
     /// is summed over a fine grid of the interpolated ψ (exact wherever ψ is
     /// monotone between grid points). Returns the largest change.
     fn colloc_update_tension_ratio(&mut self, c: &mut Colloc) -> f64 {
-        const SUBSTEPS: usize = 8;
+        const SUBSTEPS: usize = FRICTION_SUBSTEPS;
         let np = c.np();
         let mu = self.actuator.effects.friction_mu * self.friction_sign;
         let mut psi = std::mem::take(&mut c.scratch);
@@ -670,7 +677,13 @@ impl Simulator {
                     let mut prev = values[j - 1];
                     for k in 1..=SUBSTEPS {
                         let x = c.x[j - 1] + (c.x[j] - c.x[j - 1]) * k as f64 / SUBSTEPS as f64;
-                        let v = if k == SUBSTEPS { values[j] } else { c.interpolate(values, x) };
+                        let v = if k == SUBSTEPS {
+                            values[j]
+                        } else {
+                            let row = &c.fine[((j - 1) * (SUBSTEPS - 1) + (k - 1)) * np..][..np];
+                            debug_assert!((row.iter().zip(values).map(|(w, v)| w * v).sum::<f64>() - c.interpolate(values, x)).abs() < 1e-9);
+                            row.iter().zip(values).map(|(w, v)| w * v).sum()
+                        };
                         turning += (v - prev).abs();
                         prev = v;
                     }
@@ -1023,6 +1036,23 @@ mod tests {
     use super::*;
 
     #[test]
+    fn friction_grid_weights_are_the_barycentric_interpolant() {
+        for m in [4, 10, 16] {
+            let c = Colloc::new(m);
+            let np = m + 1;
+            let f: Vec<f64> = c.x.iter().map(|&x| (3.0 * x).sin() + x * x).collect();
+            for j in 1..np {
+                for k in 1..FRICTION_SUBSTEPS {
+                    let at = c.x[j - 1] + (c.x[j] - c.x[j - 1]) * k as f64 / FRICTION_SUBSTEPS as f64;
+                    let row = &c.fine[((j - 1) * (FRICTION_SUBSTEPS - 1) + (k - 1)) * np..][..np];
+                    let via_weights: f64 = row.iter().zip(&f).map(|(w, v)| w * v).sum();
+                    assert!((via_weights - c.interpolate(&f, at)).abs() < 1e-12, "m {m}, j {j}, k {k}");
+                }
+            }
+        }
+    }
+
+    #[test]
     fn integration_matrix_is_exact_for_polynomials() {
         for m in [4, 7, 12, 20] {
             let c = Colloc::new(m);
@@ -1040,4 +1070,33 @@ mod tests {
             assert!((c.interpolate(&f, 0.3) - (1.0 + 0.3 - 0.18)).abs() < 1e-13);
         }
     }
+}
+
+/// Points between consecutive nodes at which friction's turning angle is
+/// summed (the cable angle is interpolated there).
+const FRICTION_SUBSTEPS: usize = 8;
+
+/// Barycentric interpolation weights (Chebyshev–Lobatto nodes of `m`
+/// intervals) onto the friction grid; see [`Colloc::fine`].
+fn friction_grid_weights(m: usize) -> Vec<f64> {
+    let np = m + 1;
+    let x: Vec<f64> = (0..np).map(|j| -(std::f64::consts::PI * j as f64 / m as f64).cos()).collect();
+    let mut out = Vec::with_capacity((np - 1) * (FRICTION_SUBSTEPS - 1) * np);
+    for j in 1..np {
+        for k in 1..FRICTION_SUBSTEPS {
+            let at = x[j - 1] + (x[j] - x[j - 1]) * k as f64 / FRICTION_SUBSTEPS as f64;
+            let w: Vec<f64> = (0..np)
+                .map(|i| {
+                    let mut w = if i % 2 == 0 { 1.0 } else { -1.0 };
+                    if i == 0 || i == np - 1 {
+                        w *= 0.5;
+                    }
+                    w / (at - x[i])
+                })
+                .collect();
+            let sum: f64 = w.iter().sum();
+            out.extend(w.iter().map(|v| v / sum));
+        }
+    }
+    out
 }
