@@ -27,6 +27,13 @@ fn sweep(spec: &Path, dir: &Path, extra: &[&str]) -> (bool, String, String) {
     run(&args)
 }
 
+/// Chunk files committed (renamed into place) in a run directory.
+fn committed_chunks(dir: &Path) -> u64 {
+    std::fs::read_dir(dir.join("shards"))
+        .map(|r| r.filter_map(Result::ok).filter(|e| e.file_name().to_string_lossy().starts_with("chunk-")).count() as u64)
+        .unwrap_or(0)
+}
+
 fn write_spec(dir: &Path, name: &str, text: &str) -> PathBuf {
     let path = dir.join(name);
     std::fs::write(&path, text).unwrap();
@@ -194,11 +201,7 @@ fn sigkill_after_written_chunks_then_resume_gives_the_uninterrupted_rows() {
         seed ^= seed << 17;
         seed % n
     };
-    let chunk_files = |d: &Path| {
-        std::fs::read_dir(d.join("shards"))
-            .map(|r| r.filter_map(Result::ok).filter(|e| e.file_name().to_string_lossy().starts_with("chunk-")).count() as u64)
-            .unwrap_or(0)
-    };
+    let chunk_files = committed_chunks;
     let mut interrupted = 0;
     let rounds = 6;
     for round in 0..rounds {
@@ -536,8 +539,7 @@ fn an_interrupted_sweep_says_how_to_resume() {
         .unwrap();
     // After the first committed chunk (not after a time).
     let deadline = Instant::now() + Duration::from_secs(300);
-    let has_chunk = || std::fs::read_dir(dir.join("shards")).map(|r| r.filter_map(Result::ok).any(|e| e.file_name().to_string_lossy().starts_with("chunk-"))).unwrap_or(false);
-    while !has_chunk() && Instant::now() < deadline && child.try_wait().unwrap().is_none() {
+    while committed_chunks(&dir) == 0 && Instant::now() < deadline && child.try_wait().unwrap().is_none() {
         std::thread::sleep(Duration::from_millis(1));
     }
     assert!(Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap().success());

@@ -47,7 +47,6 @@ def close(a, b, rel=2e-4):
 
 
 def hover(map_name, ix, iy, click=False):
-    pos = driver.execute_script("return window.cablemapCellCentre(arguments[0], arguments[1], arguments[2]);", map_name, int(ix), int(iy))
     canvas = driver.find_element(By.ID, "map-main" if map_name == "main" else f"map-{map_name}")
     driver.execute_script("arguments[0].scrollIntoView({block: 'center'});", canvas)
     pos = driver.execute_script("return window.cablemapCellCentre(arguments[0], arguments[1], arguments[2]);", map_name, int(ix), int(iy))
