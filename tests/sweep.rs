@@ -201,7 +201,6 @@ fn sigkill_after_written_chunks_then_resume_gives_the_uninterrupted_rows() {
         seed ^= seed << 17;
         seed % n
     };
-    let chunk_files = committed_chunks;
     let mut interrupted = 0;
     let rounds = 6;
     for round in 0..rounds {
@@ -213,9 +212,9 @@ fn sigkill_after_written_chunks_then_resume_gives_the_uninterrupted_rows() {
             .unwrap();
         // Round 0: as soon as the manifest exists (no chunk yet, or the first
         // ones in flight); later rounds: after 1–6 more committed chunks.
-        let before = chunk_files(&dir);
+        let before = committed_chunks(&dir);
         let wait_chunks = if round == 0 { 0 } else { 1 + next(6) };
-        let ready = |d: &Path| d.join("manifest.json").exists() && chunk_files(d) >= before + wait_chunks;
+        let ready = |d: &Path| d.join("manifest.json").exists() && committed_chunks(d) >= before + wait_chunks;
         // A generous safety net only (a hung child), never the kill point.
         let deadline = Instant::now() + Duration::from_secs(300);
         while !ready(&dir) && Instant::now() < deadline && child.try_wait().unwrap().is_none() {
@@ -235,7 +234,7 @@ fn sigkill_after_written_chunks_then_resume_gives_the_uninterrupted_rows() {
         }
     }
     eprintln!("kills that left the run partial: {interrupted} of {rounds}");
-    assert!(chunk_files(&dir) < total_chunks);
+    assert!(committed_chunks(&dir) < total_chunks);
     assert_eq!(interrupted, rounds, "every kill must land mid-run");
     let (ok, stdout, stderr) = sweep(&spec, &dir, &[]);
     assert!(ok, "{stderr}");
