@@ -50,7 +50,7 @@ pub fn max_order(options: &SolverOptions) -> usize {
 }
 
 /// Checks that `order` is resolved with `options`; the message names the
-/// fix (the flag; a spec says `[solver] NAME = N`).
+/// fix both ways it is given (flag and spec field).
 pub fn check_order(order: usize, options: &SolverOptions) -> Result<(), String> {
     if order > MAX_RESOLVED_ORDER {
         return Err(format!(
@@ -64,7 +64,7 @@ pub fn check_order(order: usize, options: &SolverOptions) -> Result<(), String> 
         return Err(format!(
             "order {order} is not resolved at {name} = {have} (a_k would be off by more than \
              {ORDER_TOLERANCE_PER_MM:e} mm⁻¹; at most order {} here): use {name} ≥ {needed} \
-             ({flag} {needed}), or a lower order",
+             (command line: {flag} {needed}; sweep spec: [solver] {name} = {needed}), or a lower order",
             max_order(options)
         ));
     }

@@ -206,9 +206,7 @@ impl SweepSpec {
         if o.order > MAX_ORDER {
             return Err(format!("[output] order = {} is above the supported {MAX_ORDER}", o.order));
         }
-        crate::model::resolution::check_order(o.order, &self.solver).map_err(|e| {
-            format!("[output] {}", e.replace("(--steps-per-span", "([solver] steps_per_span =").replace("(--nodes-per-span", "([solver] nodes_per_span ="))
-        })?;
+        crate::model::resolution::check_order(o.order, &self.solver).map_err(|e| format!("[output] {e}"))?;
         if o.chunk_routings == 0 {
             return Err("[output] chunk_routings = 0: a chunk needs at least one routing".into());
         }
