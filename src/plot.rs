@@ -60,6 +60,19 @@ pub struct BodyDrawing {
 }
 
 impl BodyDrawing {
+    /// The drawing of a simulated body: its centreline, outline at ±`radius_mm`
+    /// about it and the cable path.
+    pub fn of_simulation(sim: &crate::model::Simulation, radius_mm: f64, label: String, colour: RGBColor) -> Self {
+        BodyDrawing {
+            centreline: sim.centreline.iter().map(|c| (c.x_mm, c.y_mm)).collect(),
+            frame_angle_rad: sim.centreline.iter().map(|c| c.frame_angle_rad).collect(),
+            cable: sim.centreline.iter().map(|c| (c.cable_x_mm, c.cable_y_mm)).collect(),
+            radius_mm,
+            label,
+            colour,
+        }
+    }
+
     /// The body outline at ±r about the centreline, as two polylines.
     pub fn outline(&self) -> (Vec<(f64, f64)>, Vec<(f64, f64)>) {
         let side = |sign: f64| -> Vec<(f64, f64)> {

@@ -98,18 +98,6 @@ pub fn write_centreline_csv(path: &std::path::Path, sim: &Simulation) -> anyhow:
     crate::io::write_atomic(path, out.as_bytes()).with_context(|| format!("writing centreline CSV {}", path.display()))
 }
 
-/// A drawing of a simulated body.
-pub fn body_drawing(sim: &Simulation, radius_mm: f64, label: String, colour: plotters::style::RGBColor) -> BodyDrawing {
-    BodyDrawing {
-        centreline: sim.centreline.iter().map(|c| (c.x_mm, c.y_mm)).collect(),
-        frame_angle_rad: sim.centreline.iter().map(|c| c.frame_angle_rad).collect(),
-        cable: sim.centreline.iter().map(|c| (c.cable_x_mm, c.cable_y_mm)).collect(),
-        radius_mm,
-        label,
-        colour,
-    }
-}
-
 /// Runs `cablemap simulate`.
 pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     let actuator = args.actuator.apply(&Actuator::default());
@@ -146,7 +134,7 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     }
     if let Some(path) = &args.png {
         let title = format!("routing [{}] mm, tension {:.3} N", fmt_list(&y), args.tension);
-        let drawing = body_drawing(&sim, actuator.radius_mm, "body (outline at ±r), cable in red".into(), BLUE_800);
+        let drawing = BodyDrawing::of_simulation(&sim, actuator.radius_mm, "body (outline at ±r), cable in red".into(), BLUE_800);
         draw_bodies(path, &title, &[drawing], &[])?;
     }
     let stdout = std::io::stdout();

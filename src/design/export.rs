@@ -183,7 +183,7 @@ pub fn shape_png(path: &Path, objective: &Objective, eval: &Evaluation) -> Resul
         DesignError::Io { context: format!("re-simulating the design for {}", path.display()), source: std::io::Error::other(e.to_string()) }
     })?;
     let mut bodies =
-        vec![crate::cli::simulate::body_drawing(&sim, act.radius_mm, "achieved body (outline at ±r), cable in red".into(), BLUE_800)];
+        vec![crate::plot::BodyDrawing::of_simulation(&sim, act.radius_mm, "achieved body (outline at ±r), cable in red".into(), BLUE_800)];
     let target = &objective.target;
     if target.highest_order().is_some() {
         let pose = &eval.pose;

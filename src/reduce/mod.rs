@@ -743,7 +743,7 @@ pub fn write_map(
             let d = m.representative.as_ref()?;
             let routing = crate::model::Routing::new(&d.y_mm, actuator.length_mm, actuator.radius_mm).ok()?;
             let sim = crate::model::simulate(actuator, solver, &routing, d.tension_n, 1, crate::shape::LengthBasis::default()).ok()?;
-            Some(crate::cli::simulate::body_drawing(&sim, actuator.radius_mm, format!("mode {}", m.mode), plotters::style::full_palette::BLUE_800))
+            Some(crate::plot::BodyDrawing::of_simulation(&sim, actuator.radius_mm, format!("mode {}", m.mode), plotters::style::full_palette::BLUE_800))
         })
         .collect();
     plots::draw_modes(&dir.join("modes.png"), map, &shapes)?;
