@@ -6,7 +6,6 @@
 
 pub mod bench;
 pub mod calibrate;
-pub mod cli;
 pub mod design;
 pub mod io;
 pub mod model;

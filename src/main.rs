@@ -1,6 +1,6 @@
 //! The `cablemap` command: parses arguments and calls the library.
 
-use cablemap::cli;
+mod cli;
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 

@@ -1,8 +1,8 @@
-//! `cablemap bench`: prints solver timings (see [`crate::bench`]).
+//! `cablemap bench`: prints solver timings (see [`cablemap::bench`]).
 
 use super::ActuatorArgs;
-use crate::bench::{bench_with_reference, sample_thesis_routings};
-use crate::model::{Actuator, SolverOptions};
+use cablemap::bench::{bench_with_reference, sample_thesis_routings};
+use cablemap::model::{Actuator, SolverOptions};
 use clap::Args;
 
 /// Arguments of `cablemap bench`.

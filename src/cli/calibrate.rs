@@ -3,13 +3,13 @@
 //! RMS error per routing.
 
 use super::ActuatorArgs;
-use crate::calibrate::data::{read_centrelines, read_markers, Dataset};
-use crate::calibrate::diagnose::{fit_json, split_holdout};
-use crate::calibrate::fit::{apply_held, parse_held, rms_per_routing, Held, Loss, Noise, ShapeData};
-use crate::calibrate::predict::predict;
-use crate::calibrate::fit::fit_observed;
-use crate::calibrate::{read_measurements, Effect, FitSpec};
-use crate::model::{Actuator, SolverOptions};
+use cablemap::calibrate::data::{read_centrelines, read_markers, Dataset};
+use cablemap::calibrate::diagnose::{fit_json, split_holdout};
+use cablemap::calibrate::fit::{apply_held, parse_held, rms_per_routing, Held, Loss, Noise, ShapeData};
+use cablemap::calibrate::predict::predict;
+use cablemap::calibrate::fit::fit_observed;
+use cablemap::calibrate::{read_measurements, Effect, FitSpec};
+use cablemap::model::{Actuator, SolverOptions};
 use anyhow::bail;
 use clap::Args;
 use std::io::Write;

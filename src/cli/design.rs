@@ -1,8 +1,8 @@
 //! `cablemap design`: routing and tension for a target shape (eq. 3.17).
 
 use super::{ActuatorArgs, LengthBasisArgs};
-use crate::design::{self, compare, map::MapDir, optimise, Bounds, ComponentResult, DesignOutcome, Objective, SearchOptions, Target, Weights};
-use crate::model::{Actuator, SolverOptions};
+use cablemap::design::{self, compare, map::MapDir, optimise, Bounds, ComponentResult, DesignOutcome, Objective, SearchOptions, Target, Weights};
+use cablemap::model::{Actuator, SolverOptions};
 use clap::Args;
 use serde_json::json;
 use std::io::Write;
@@ -122,7 +122,7 @@ pub fn design_json(objective: &Objective, outcome: &DesignOutcome, results: &[Co
 pub fn run(args: &DesignArgs) -> anyhow::Result<()> {
     if let Some(dir) = &args.out {
         // Before the search, not after it.
-        crate::io::check_not_in_run_dir(dir, "--out").map_err(anyhow::Error::msg)?;
+        cablemap::io::check_not_in_run_dir(dir, "--out").map_err(anyhow::Error::msg)?;
     }
     let map = args.map.as_deref().map(MapDir::open).transpose()?;
     let objective = objective(args, map.as_ref())?;
@@ -149,7 +149,7 @@ pub fn run(args: &DesignArgs) -> anyhow::Result<()> {
         design::export::write_all(dir, &objective, &outcome.best, &value)?;
         if args.moulds {
             let act = &objective.actuator;
-            let routing = crate::model::Routing::new(&outcome.best.routing_mm, act.length_mm, act.radius_mm)?;
+            let routing = cablemap::model::Routing::new(&outcome.best.routing_mm, act.length_mm, act.radius_mm)?;
             moulds = Some(super::mould::write_moulds(dir, &routing, act.radius_mm, &args.mould)?);
         }
     }

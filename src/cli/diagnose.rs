@@ -3,10 +3,10 @@
 
 use super::calibrate::FitArgs;
 use super::ActuatorArgs;
-use crate::calibrate::diagnose::{diagnose, DiagnoseSpec};
-use crate::calibrate::read_measurements;
-use crate::calibrate::report::write_report;
-use crate::model::{Actuator, SolverOptions};
+use cablemap::calibrate::diagnose::{diagnose, DiagnoseSpec};
+use cablemap::calibrate::read_measurements;
+use cablemap::calibrate::report::write_report;
+use cablemap::model::{Actuator, SolverOptions};
 use clap::Args;
 use std::io::Write;
 use std::path::PathBuf;
@@ -63,7 +63,7 @@ pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
     let out_dir = report_dir(args);
     if !args.no_report {
         // Before the fits, not after them.
-        crate::io::check_not_in_run_dir(&out_dir, "--out").map_err(anyhow::Error::msg)?;
+        cablemap::io::check_not_in_run_dir(&out_dir, "--out").map_err(anyhow::Error::msg)?;
     }
     let base = args.actuator.apply(&Actuator::default());
     base.validate()?;
@@ -141,7 +141,7 @@ pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
         if d.extended.effects.is_empty() {
             writeln!(out, "held-out routing {h}: RMS {b:.4} mm with the thesis model (no effect added)")?;
         } else {
-            writeln!(out, "held-out routing {h}: RMS {b:.4} mm with the thesis model, {a:.4} mm {}", crate::calibrate::diagnose::model_name(&d.extended))?;
+            writeln!(out, "held-out routing {h}: RMS {b:.4} mm with the thesis model, {a:.4} mm {}", cablemap::calibrate::diagnose::model_name(&d.extended))?;
         }
     }
     writeln!(out, "criterion: {}", d.criterion)?;
@@ -176,13 +176,13 @@ fn sig5(v: f64) -> String {
 
 /// The lines to paste to use the fitted model: flags for `simulate`,
 /// `design` and `sweep`-free commands, and the TOML block for a spec.
-fn next_step(fit: &crate::calibrate::FitResult) -> String {
+fn next_step(fit: &cablemap::calibrate::FitResult) -> String {
     let a = &fit.actuator;
     let mut flags = vec![format!("--ea-n {}", sig5(a.ea_n)), format!("--ga-n {}", sig5(a.ga_n)), format!("--ei-n-mm2 {}", sig5(a.ei_n_mm2))];
     let mut toml = format!("[actuator]\nea_n = {}\nga_n = {}\nei_n_mm2 = {}\n", sig5(a.ea_n), sig5(a.ga_n), sig5(a.ei_n_mm2));
     let mut effects = String::new();
     for e in &fit.effects {
-        use crate::calibrate::Effect;
+        use cablemap::calibrate::Effect;
         let fx = &a.effects;
         // (flag, spec key, value); gravity's scale lives in [actuator.gravity].
         let (flag, key, value) = match e {

@@ -1,8 +1,8 @@
 //! `cablemap feasible`: the map's verdict on a target (thesis §4.2).
 
-use crate::design::feasible::{check, FeasibilityReport};
-use crate::design::map::MapDir;
-use crate::design::{Target, Weights};
+use cablemap::design::feasible::{check, FeasibilityReport};
+use cablemap::design::map::MapDir;
+use cablemap::design::{Target, Weights};
 use clap::Args;
 use std::io::Write;
 use std::path::PathBuf;

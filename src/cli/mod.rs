@@ -12,8 +12,8 @@ pub mod simulate;
 pub mod sweep;
 pub mod synth;
 
-use crate::model::{Actuator, SolverOptions};
-use crate::shape::LengthBasis;
+use cablemap::model::{Actuator, SolverOptions};
+use cablemap::shape::LengthBasis;
 use clap::Args;
 
 /// Actuator parameter overrides shared by every command that simulates.
@@ -133,8 +133,8 @@ impl ActuatorArgs {
         }
         if let Some(m) = self.method {
             o.method = match m {
-                MethodArg::Collocation => crate::model::SolverMethod::Collocation,
-                MethodArg::Rk4 => crate::model::SolverMethod::Rk4,
+                MethodArg::Collocation => cablemap::model::SolverMethod::Collocation,
+                MethodArg::Rk4 => cablemap::model::SolverMethod::Rk4,
             };
         }
         o

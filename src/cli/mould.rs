@@ -1,8 +1,8 @@
 //! `cablemap mould`: printable moulds (binary STL) for a routing.
 
 use super::{parse_list, ActuatorArgs};
-use crate::model::{Actuator, Routing};
-use crate::mould::{MouldParams, MouldSet};
+use cablemap::model::{Actuator, Routing};
+use cablemap::mould::{MouldParams, MouldSet};
 use clap::Args;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -79,13 +79,13 @@ fn read_design(path: &Path) -> anyhow::Result<(Vec<f64>, Actuator)> {
 }
 
 /// Builds and writes the moulds; returns the report text.
-pub fn write_moulds(dir: &Path, routing: &Routing, radius_mm: f64, args: &MouldParamArgs) -> anyhow::Result<crate::mould::MouldSummary> {
+pub fn write_moulds(dir: &Path, routing: &Routing, radius_mm: f64, args: &MouldParamArgs) -> anyhow::Result<cablemap::mould::MouldSummary> {
     let set = MouldSet::new(routing, radius_mm, &args.params())?;
     Ok(set.write_all(dir)?)
 }
 
 /// A short text report of written moulds.
-pub fn report(dir: &Path, s: &crate::mould::MouldSummary) -> String {
+pub fn report(dir: &Path, s: &cablemap::mould::MouldSummary) -> String {
     let mut out = String::new();
     out.push_str(&format!(
         "moulds for y0..y4 = [{}] mm, L = {} mm, r = {} mm, clamp block {} mm, tube Ø {} mm\n",

@@ -1,6 +1,6 @@
 //! `cablemap reduce` and `cablemap map` (sweep then reduce: the main job).
 
-use crate::reduce::{reduce_run, write_map_replacing, MapData, ModeBoundaries, ReduceOptions};
+use cablemap::reduce::{reduce_run, write_map_replacing, MapData, ModeBoundaries, ReduceOptions};
 use anyhow::Context;
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -64,7 +64,7 @@ pub struct ReduceArgs {
 /// Reduces `run` into `out` and prints a summary.
 pub fn reduce_into(run: &Path, out: &Path, partial: bool, args: &MapOptionArgs) -> anyhow::Result<MapData> {
     let options = args.options()?;
-    crate::reduce::check_map_out(out)?;
+    cablemap::reduce::check_map_out(out)?;
     let start = Instant::now();
     let (map, spec) = reduce_run(run, partial, &options).with_context(|| format!("reducing {}", run.display()))?;
     let reduced_s = start.elapsed().as_secs_f64();

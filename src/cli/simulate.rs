@@ -1,8 +1,8 @@
 //! `cablemap simulate`: one actuator, one tension.
 
 use super::{parse_list, ActuatorArgs, LengthBasisArgs};
-use crate::model::{simulate_held, Actuator, Hold, LoadDirection, Routing, Simulation, SolverOptions, STATUS_OK};
-use crate::plot::{draw_bodies, BodyDrawing};
+use cablemap::model::{simulate_held, Actuator, Hold, LoadDirection, Routing, Simulation, SolverOptions, STATUS_OK};
+use cablemap::plot::{draw_bodies, BodyDrawing};
 use anyhow::Context;
 use clap::Args;
 use plotters::style::full_palette::BLUE_800;
@@ -95,7 +95,7 @@ pub fn write_centreline_csv(path: &std::path::Path, sim: &Simulation) -> anyhow:
             c.channel_y_mm, c.cable_x_mm, c.cable_y_mm
         ));
     }
-    crate::io::write_atomic(path, out.as_bytes()).with_context(|| format!("writing centreline CSV {}", path.display()))
+    cablemap::io::write_atomic(path, out.as_bytes()).with_context(|| format!("writing centreline CSV {}", path.display()))
 }
 
 /// Runs `cablemap simulate`.
@@ -117,14 +117,14 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     // ones are only needed up to what the steps resolve.
     let exact_order = match args.coefficients {
         CoefficientRoute::Exact => args.order,
-        CoefficientRoute::Thesis => args.order.min(crate::model::resolution::max_order(&options)),
+        CoefficientRoute::Thesis => args.order.min(cablemap::model::resolution::max_order(&options)),
     };
     let basis = args.basis.length_basis;
     let mut sim = simulate_held(&actuator, &options, &routing, args.tension, exact_order, basis, hold)
         .with_context(|| format!("simulating routing {y:?} at {} N", args.tension))?;
     if args.coefficients == CoefficientRoute::Thesis {
         let points: Vec<[f64; 2]> = sim.centreline.iter().map(|c| [c.x_mm, c.y_mm]).collect();
-        sim.a = crate::shape::thesis_coefficients(&points, args.order, args.n_d)
+        sim.a = cablemap::shape::thesis_coefficients(&points, args.order, args.n_d)
             .context("thesis coefficient route")?
             .in_basis(basis, actuator.length_mm)
             .a;

@@ -1,7 +1,7 @@
-//! `cablemap sweep` and `cablemap status`: front ends of [`crate::sweep`].
+//! `cablemap sweep` and `cablemap status`: front ends of [`cablemap::sweep`].
 
-use crate::sweep::progress::ProgressMode;
-use crate::sweep::{run_status, run_sweep, RunStatus, SweepOptions, SweepSpec, SweepSummary};
+use cablemap::sweep::progress::ProgressMode;
+use cablemap::sweep::{run_status, run_sweep, RunStatus, SweepOptions, SweepSpec, SweepSummary};
 use anyhow::Context;
 use clap::Args;
 use std::path::PathBuf;

@@ -2,11 +2,11 @@
 //! hidden effect and noise.
 
 use super::{parse_list, ActuatorArgs};
-use crate::calibrate::data::{centrelines_csv, markers_csv, measurements_csv};
-use crate::calibrate::synth::{default_routings, synthesize_with_markers, SynthSpec};
-use crate::calibrate::Effect;
-use crate::model::routing::CONTROL_POINTS;
-use crate::model::{Actuator, SolverOptions};
+use cablemap::calibrate::data::{centrelines_csv, markers_csv, measurements_csv};
+use cablemap::calibrate::synth::{default_routings, synthesize_with_markers, SynthSpec};
+use cablemap::calibrate::Effect;
+use cablemap::model::routing::CONTROL_POINTS;
+use cablemap::model::{Actuator, SolverOptions};
 use anyhow::{bail, Context};
 use clap::Args;
 use std::collections::BTreeMap;
@@ -194,13 +194,13 @@ pub fn run(args: &SynthArgs) -> anyhow::Result<()> {
     }
     let points = if args.centreline_out.is_some() { args.centreline_points.max(2) } else { 0 };
     let (data, centrelines, markers) = synthesize_with_markers(&spec, points)?;
-    crate::io::write_atomic(&args.out, measurements_csv(&data).as_bytes())
+    cablemap::io::write_atomic(&args.out, measurements_csv(&data).as_bytes())
         .with_context(|| format!("writing {}", args.out.display()))?;
     if let Some(path) = &args.centreline_out {
-        crate::io::write_atomic(path, centrelines_csv(&centrelines).as_bytes()).with_context(|| format!("writing {}", path.display()))?;
+        cablemap::io::write_atomic(path, centrelines_csv(&centrelines).as_bytes()).with_context(|| format!("writing {}", path.display()))?;
     }
     if let Some(path) = &args.markers_out {
-        crate::io::write_atomic(path, markers_csv(&markers).as_bytes()).with_context(|| format!("writing {}", path.display()))?;
+        cablemap::io::write_atomic(path, markers_csv(&markers).as_bytes()).with_context(|| format!("writing {}", path.display()))?;
     }
     eprintln!(
         "wrote {} readings of {} routings to {} (hidden effect: {}{})",
