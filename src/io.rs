@@ -132,8 +132,9 @@ pub fn is_run_dir(dir: &Path) -> bool {
 
 /// Refuses an output directory that is a sweep run directory or lies
 /// directly inside one: the run would then hold files cablemap's checks
-/// reject, and be unusable until cleaned by hand. `flag` names the option.
-pub fn check_not_in_run_dir(out: &Path, flag: &str) -> Result<(), String> {
+/// reject, and be unusable until cleaned by hand. `what` names the
+/// directory in the message (the command line adds its flag).
+pub fn check_not_in_run_dir(out: &Path, what: &str) -> Result<(), String> {
     let parent = match out.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
@@ -141,7 +142,7 @@ pub fn check_not_in_run_dir(out: &Path, flag: &str) -> Result<(), String> {
     for (candidate, inside) in [(out, false), (parent, true)] {
         if is_run_dir(candidate) {
             return Err(format!(
-                "{flag} {} {} the sweep run directory {}; writing there would make the run unusable: \
+                "{what} {} {} the sweep run directory {}; writing there would make the run unusable: \
                  give a directory outside the run",
                 out.display(),
                 if inside { "is inside" } else { "is" },

@@ -21,7 +21,7 @@ pub fn write_report(
     d: &Diagnosis,
     spec: &DiagnoseSpec,
 ) -> Result<PathBuf, CalibrateError> {
-    crate::io::check_not_in_run_dir(dir, "--out").map_err(CalibrateError::Invalid)?;
+    crate::io::check_not_in_run_dir(dir, "the report directory").map_err(CalibrateError::Invalid)?;
     std::fs::create_dir_all(dir)
         .map_err(|source| CalibrateError::Io { context: format!("creating report directory {}", dir.display()), source })?;
     let groups = data.groups();

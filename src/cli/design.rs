@@ -1,10 +1,11 @@
 //! `cablemap design`: routing and tension for a target shape (eq. 3.17).
 
 use super::{ActuatorArgs, LengthBasisArgs};
-use cablemap::design::{self, compare, map::MapDir, optimise, Bounds, ComponentResult, DesignOutcome, Objective, SearchOptions, Target, Weights};
+use anyhow::Context;
+use cablemap::design::run::DesignRequest;
+use cablemap::design::{self, ComponentResult, DesignError, DesignOutcome, Objective, SearchOptions, Target, Weights};
 use cablemap::model::{Actuator, SolverOptions};
 use clap::Args;
-use serde_json::json;
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -60,113 +61,52 @@ pub struct DesignArgs {
     pub actuator: ActuatorArgs,
 }
 
-/// Builds the objective from the arguments (and the map's tension range when given).
-fn objective(args: &DesignArgs, map: Option<&MapDir>) -> anyhow::Result<Objective> {
-    let actuator = args.actuator.apply(&Actuator::default());
-    actuator.validate()?;
-    let options = args.actuator.solver_options(&SolverOptions::default());
-    let target = Target::parse(&args.target)?;
+/// The design request the arguments describe.
+fn request(args: &DesignArgs) -> anyhow::Result<DesignRequest> {
     let weights = match &args.weights {
-        Some(w) => Weights::parse(w)?,
+        Some(w) => Weights::parse(w).context("--weights")?,
         None => Weights::default(),
     };
-    let (map_lo, map_hi) = map.map_or((1.0, 2.0), |m| (m.summary.tension_range_n[0], m.summary.tension_range_n[1]));
-    let mut bounds = Bounds::thesis(
-        actuator.radius_mm,
-        args.tension_min_n.unwrap_or(map_lo),
-        args.tension_max_n.unwrap_or(map_hi),
-    );
-    if let Some(y) = args.max_offset_mm {
-        bounds.max_offset_mm = y;
-    }
-    if !(args.tolerance_pct.is_finite() && args.tolerance_pct >= 0.0) {
-        anyhow::bail!("--tolerance-pct must be a finite number ≥ 0, got {}", args.tolerance_pct);
-    }
-    if args.starts == 0 {
-        anyhow::bail!("--starts must be at least 1");
-    }
-    Ok(Objective::new(actuator, options, target, weights, bounds)?.with_length_basis(args.basis.length_basis))
-}
-
-/// The JSON object of a design (also written as design.json).
-pub fn design_json(objective: &Objective, outcome: &DesignOutcome, results: &[ComponentResult]) -> serde_json::Value {
-    let e = &outcome.best;
-    let unmet: Vec<String> = results.iter().filter(|r| !r.met).map(|r| r.component.key()).collect();
-    json!({
-        "routing_mm": e.routing_mm,
-        "tension_n": e.tension_n,
-        "tip_x_mm": e.pose.tip_x_mm,
-        "tip_y_mm": e.pose.tip_y_mm,
-        "tip_angle_rad": e.pose.tip_angle_rad,
-        "base_angle_rad": e.pose.base_angle_rad,
-        "length_mm": e.pose.length_mm,
-        "a": e.a,
-        "target": objective.target.to_json(),
-        "weights": serde_json::Value::Object(objective.target.components.iter()
-            .map(|(c, _)| (c.key(), json!(objective.weights.get(*c)))).collect()),
-        "achieved": serde_json::Value::Object(results.iter().map(|r| (r.component.key(), json!(r.achieved))).collect()),
-        "error_pct": serde_json::Value::Object(results.iter().map(|r| (r.component.key(), json!(r.error_pct))).collect()),
-        "met": unmet.is_empty(),
-        "unmet": unmet,
-        "cost": outcome.cost,
-        "bounds": objective.bounds,
-        "length_basis": objective.length_basis,
-        "actuator": objective.actuator,
-        "seeds_simulated": outcome.seeds_simulated,
-        "starts": outcome.starts,
-        "seconds": outcome.seconds,
+    Ok(DesignRequest {
+        actuator: args.actuator.apply(&Actuator::default()),
+        options: args.actuator.solver_options(&SolverOptions::default()),
+        target: Target::parse(&args.target).context("--target")?,
+        weights,
+        tension_min_n: args.tension_min_n,
+        tension_max_n: args.tension_max_n,
+        max_offset_mm: args.max_offset_mm,
+        length_basis: args.basis.length_basis,
+        map: args.map.clone(),
+        search: SearchOptions { starts: args.starts, max_evaluations: args.max_evaluations, ..SearchOptions::default() },
+        tolerance_pct: args.tolerance_pct,
+        out: args.out.clone(),
+        moulds: args.moulds.then(|| args.mould.params()),
     })
 }
 
 /// Runs `cablemap design`.
 pub fn run(args: &DesignArgs) -> anyhow::Result<()> {
     if let Some(dir) = &args.out {
-        // Before the search, not after it.
-        cablemap::io::check_not_in_run_dir(dir, "--out").map_err(anyhow::Error::msg)?;
+        design::run::check_export_dir(dir).context("--out")?;
     }
-    let map = args.map.as_deref().map(MapDir::open).transpose()?;
-    let objective = objective(args, map.as_ref())?;
-    if let Some(m) = &map {
-        m.check_actuator(&objective.actuator)?;
-    }
-    // With a map: its verdict first (reported, not enforced: the optimiser
-    // still returns the closest design), and its nearest designs as seeds.
-    let feasibility = match &map {
-        Some(m) => Some(design::feasible::check(m, &objective.target, objective.length_basis, &objective.weights, 2 * args.starts)?),
-        None => None,
-    };
-    let seeds: Vec<design::Seed> =
-        feasibility.iter().flat_map(|f| f.nearest.iter().map(|d| d.seed())).collect();
-    let search = SearchOptions { starts: args.starts, max_evaluations: args.max_evaluations, ..SearchOptions::default() };
-    let outcome = optimise::design(&objective, &search, &seeds)?;
-    let results = compare(&objective, &outcome.best, args.tolerance_pct);
-    let mut value = design_json(&objective, &outcome, &results);
-    if let Some(f) = &feasibility {
-        value["feasibility"] = serde_json::json!({ "verdict": f.verdict, "reasons": f.reasons, "map": args.map });
-    }
-    let mut moulds = None;
-    if let Some(dir) = &args.out {
-        design::export::write_all(dir, &objective, &outcome.best, &value)?;
-        if args.moulds {
-            let act = &objective.actuator;
-            let routing = cablemap::model::Routing::new(&outcome.best.routing_mm, act.length_mm, act.radius_mm)?;
-            moulds = Some(super::mould::write_moulds(dir, &routing, act.radius_mm, &args.mould)?);
-        }
-    }
+    let done = design::run::run(&request(args)?).map_err(|e| match e {
+        DesignError::BadSearch(_) => anyhow::Error::new(e).context("--starts / --tolerance-pct"),
+        e => anyhow::Error::new(e),
+    })?;
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
     if args.json {
-        writeln!(out, "{value}")?;
+        writeln!(out, "{}", done.record.to_json_line())?;
         return Ok(());
     }
-    if let Some(f) = &feasibility {
+    if let Some(f) = &done.feasibility {
         writeln!(out, "map verdict  {}: {}\n", f.verdict.as_str(), f.reasons.join("; "))?;
     }
-    write!(out, "{}", report(&objective, &outcome, &results, args.tolerance_pct))?;
+    write!(out, "{}", report(&done.objective, &done.outcome, &done.results, args.tolerance_pct))?;
     if let Some(dir) = &args.out {
         writeln!(out, "exported design.json, channel.csv, mould.svg, shape.png to {}", dir.display())?;
     }
-    if let (Some(dir), Some(summary)) = (&args.out, &moulds) {
+    if let (Some(dir), Some(summary)) = (&args.out, &done.moulds) {
         write!(out, "{}", super::mould::report(dir, summary))?;
     }
     Ok(())

@@ -3,6 +3,7 @@
 use super::{parse_list, ActuatorArgs};
 use cablemap::model::{Actuator, Routing};
 use cablemap::mould::{MouldParams, MouldSet};
+use anyhow::Context;
 use clap::Args;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -62,28 +63,6 @@ pub struct MouldArgs {
     pub actuator: ActuatorArgs,
 }
 
-/// Reads the routing and actuator of a design.json.
-fn read_design(path: &Path) -> anyhow::Result<(Vec<f64>, Actuator)> {
-    let text = std::fs::read_to_string(path).map_err(|e| anyhow::anyhow!("reading {}: {e}", path.display()))?;
-    let v: serde_json::Value = serde_json::from_str(&text)
-        .map_err(|e| anyhow::anyhow!("{} is not JSON ({e}); give a design.json written by `cablemap design --out`", path.display()))?;
-    let routing: Vec<f64> = v
-        .get("routing_mm")
-        .and_then(|r| serde_json::from_value(r.clone()).ok())
-        .ok_or_else(|| anyhow::anyhow!("{} has no numeric routing_mm list; give a design.json written by `cablemap design --out`", path.display()))?;
-    let actuator: Actuator = match v.get("actuator") {
-        Some(a) => serde_json::from_value(a.clone()).map_err(|e| anyhow::anyhow!("{}: bad actuator object: {e}", path.display()))?,
-        None => Actuator::default(),
-    };
-    Ok((routing, actuator))
-}
-
-/// Builds and writes the moulds; returns the report text.
-pub fn write_moulds(dir: &Path, routing: &Routing, radius_mm: f64, args: &MouldParamArgs) -> anyhow::Result<cablemap::mould::MouldSummary> {
-    let set = MouldSet::new(routing, radius_mm, &args.params())?;
-    Ok(set.write_all(dir)?)
-}
-
 /// A short text report of written moulds.
 pub fn report(dir: &Path, s: &cablemap::mould::MouldSummary) -> String {
     let mut out = String::new();
@@ -123,13 +102,16 @@ pub fn report(dir: &Path, s: &cablemap::mould::MouldSummary) -> String {
 pub fn run(args: &MouldArgs) -> anyhow::Result<()> {
     let (ys, base) = match (&args.routing, &args.design) {
         (Some(r), _) => (parse_list(r, "--routing")?, Actuator::default()),
-        (None, Some(d)) => read_design(d)?,
+        (None, Some(d)) => {
+            let file = cablemap::design::record::read_design_file(d).context("--design")?;
+            (file.routing_mm, file.actuator)
+        }
         (None, None) => anyhow::bail!("give --routing y0,..,y4 or --design design.json"),
     };
     let actuator = args.actuator.apply(&base);
     actuator.validate()?;
     let routing = Routing::new(&ys, actuator.length_mm, actuator.radius_mm)?;
-    let summary = write_moulds(&args.out, &routing, actuator.radius_mm, &args.mould)?;
+    let summary = MouldSet::new(&routing, actuator.radius_mm, &args.mould.params())?.write_all(&args.out)?;
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
     if args.json {

@@ -1,12 +1,12 @@
 //! `cablemap simulate`: one actuator, one tension.
 
 use super::{parse_list, ActuatorArgs, LengthBasisArgs};
-use cablemap::model::{simulate_held, Actuator, Hold, LoadDirection, Routing, Simulation, SolverOptions, STATUS_OK};
+use cablemap::model::record::{self, SimulationRecord};
+use cablemap::model::{simulate_held, Actuator, Hold, LoadDirection, Routing, SolverOptions};
 use cablemap::plot::{draw_bodies, BodyDrawing};
 use anyhow::Context;
 use clap::Args;
 use plotters::style::full_palette::BLUE_800;
-use serde_json::json;
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -64,40 +64,6 @@ pub enum CoefficientRoute {
     Thesis,
 }
 
-/// The JSON object other tools rely on (names shared with sweep columns).
-pub fn simulation_json(sim: &Simulation) -> serde_json::Value {
-    let p = &sim.pose;
-    json!({
-        "status": STATUS_OK,
-        "routing_mm": sim.routing_mm,
-        "tension_n": p.tension_n,
-        "tip_x_mm": p.tip_x_mm,
-        "tip_y_mm": p.tip_y_mm,
-        "tip_angle_rad": p.tip_angle_rad,
-        "tip_frame_angle_rad": p.tip_frame_angle_rad,
-        "base_angle_rad": p.base_angle_rad,
-        "length_mm": p.length_mm,
-        "a": sim.a,
-        "length_basis": sim.length_basis,
-        "iterations": p.iterations,
-    })
-}
-
-/// Writes the centreline CSV (one row per solver node).
-pub fn write_centreline_csv(path: &std::path::Path, sim: &Simulation) -> anyhow::Result<()> {
-    let mut out = String::from(
-        "s_mm,x_mm,y_mm,frame_angle_rad,tangent_angle_rad,arc_length_mm,v1,v2,u_per_mm,channel_y_mm,cable_x_mm,cable_y_mm\n",
-    );
-    for c in &sim.centreline {
-        out.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{},{},{},{}\n",
-            c.s_mm, c.x_mm, c.y_mm, c.frame_angle_rad, c.tangent_angle_rad, c.arc_length_mm, c.v1, c.v2, c.u_per_mm,
-            c.channel_y_mm, c.cable_x_mm, c.cable_y_mm
-        ));
-    }
-    cablemap::io::write_atomic(path, out.as_bytes()).with_context(|| format!("writing centreline CSV {}", path.display()))
-}
-
 /// Runs `cablemap simulate`.
 pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     let actuator = args.actuator.apply(&Actuator::default());
@@ -130,7 +96,7 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
             .a;
     }
     if let Some(path) = &args.csv {
-        write_centreline_csv(path, &sim)?;
+        record::write_centreline_csv(path, &sim).with_context(|| format!("writing centreline CSV {}", path.display()))?;
     }
     if let Some(path) = &args.png {
         let title = format!("routing [{}] mm, tension {:.3} N", fmt_list(&y), args.tension);
@@ -140,7 +106,7 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
     if args.json {
-        writeln!(out, "{}", simulation_json(&sim))?;
+        writeln!(out, "{}", SimulationRecord::from(&sim).to_json_line())?;
         return Ok(());
     }
     let p = &sim.pose;

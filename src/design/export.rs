@@ -4,6 +4,7 @@
 
 use super::objective::{Evaluation, Objective};
 use super::target::Component;
+use super::record::DesignRecord;
 use super::DesignError;
 use crate::model::{simulate, Routing};
 use crate::plot::{draw_bodies, BodyDrawing};
@@ -12,34 +13,8 @@ use plotters::style::full_palette::{BLUE_800, GREEN_700};
 use std::fmt::Write as _;
 use std::path::Path;
 
-/// Spacing of the channel CSV and SVG samples along the rod, mm.
-pub const CHANNEL_STEP_MM: f64 = 0.25;
-
 fn io_error(context: String) -> impl FnOnce(std::io::Error) -> DesignError {
     move |source| DesignError::Io { context, source }
-}
-
-/// Channel centreline samples (s, y_c(s), dy_c/ds) from clamp to tip.
-pub fn channel_samples(routing: &Routing) -> Vec<(f64, f64, f64)> {
-    let length = routing.length_mm();
-    let n = (length / CHANNEL_STEP_MM).ceil() as usize;
-    (0..=n)
-        .map(|i| {
-            let s = length * i as f64 / n as f64;
-            let c = routing.channel_at(s);
-            (s, c.y_mm, c.dy_ds)
-        })
-        .collect()
-}
-
-/// The channel centreline as CSV: `s_mm,y_mm,dy_ds` (s along the straight
-/// body from the clamp, y lateral from the body axis).
-pub fn channel_csv(routing: &Routing) -> String {
-    let mut out = String::from("s_mm,y_mm,dy_ds\n");
-    for (s, y, d) in channel_samples(routing) {
-        let _ = writeln!(out, "{s:.4},{y:.6},{d:.6}");
-    }
-    out
 }
 
 /// A 1:1 drawing of the straight body (L × 2r) with its channel, in mm
@@ -85,7 +60,7 @@ pub fn mould_svg(routing: &Routing, radius_mm: f64, channel_diameter_mm: f64, te
         py(-radius_mm - 2.0)
     );
     let points: String =
-        channel_samples(routing).iter().map(|(s, y, _)| format!("{:.4},{:.4}", px(*s), py(*y))).collect::<Vec<_>>().join(" ");
+        routing.channel_samples().iter().map(|(s, y, _)| format!("{:.4},{:.4}", px(*s), py(*y))).collect::<Vec<_>>().join(" ");
     // The channel at its real width, then its centreline.
     let _ = writeln!(
         svg,
@@ -152,21 +127,17 @@ pub fn mould_svg(routing: &Routing, radius_mm: f64, channel_diameter_mm: f64, te
 
 /// Writes design.json, channel.csv, mould.svg and shape.png into `dir`
 /// (created if missing).
-pub fn write_all(dir: &Path, objective: &Objective, eval: &Evaluation, json: &serde_json::Value) -> Result<(), DesignError> {
-    crate::io::check_not_in_run_dir(dir, "--out").map_err(|m| DesignError::Io {
-        context: "choosing the export directory".into(),
-        source: std::io::Error::new(std::io::ErrorKind::InvalidInput, m),
-    })?;
+pub fn write_all(dir: &Path, objective: &Objective, eval: &Evaluation, record: &DesignRecord) -> Result<(), DesignError> {
+    super::run::check_export_dir(dir)?;
     std::fs::create_dir_all(dir).map_err(io_error(format!("creating {}", dir.display())))?;
     let write = |name: &str, bytes: &[u8]| {
         let p = dir.join(name);
         crate::io::write_atomic(&p, bytes).map_err(io_error(format!("writing {}", p.display())))
     };
-    let pretty = serde_json::to_string_pretty(json).expect("JSON values serialise");
-    write("design.json", (pretty + "\n").as_bytes())?;
+    write("design.json", record.to_file_text().as_bytes())?;
     let act = &objective.actuator;
-    let routing = Routing::new(&eval.routing_mm, act.length_mm, act.radius_mm).expect("designs lie inside the body");
-    write("channel.csv", channel_csv(&routing).as_bytes())?;
+    let routing = Routing::new(&eval.routing_mm, act.length_mm, act.radius_mm)?;
+    write("channel.csv", routing.channel_csv().as_bytes())?;
     // The thesis's channel: a PTFE tube of 1 mm outer diameter (§5.2).
     write("mould.svg", mould_svg(&routing, act.radius_mm, 1.0, eval.tension_n).as_bytes())?;
     shape_png(&dir.join("shape.png"), objective, eval)
@@ -223,7 +194,7 @@ mod tests {
     #[test]
     fn channel_csv_follows_the_spline_from_clamp_to_tip() {
         let r = Routing::new(&[1.0, -2.0, 3.0, 0.5, -4.0], 65.0, 5.0).unwrap();
-        let csv = channel_csv(&r);
+        let csv = r.channel_csv();
         let rows: Vec<Vec<f64>> =
             csv.lines().skip(1).map(|l| l.split(',').map(|v| v.parse().unwrap()).collect()).collect();
         assert_eq!(rows.first().unwrap()[0], 0.0);

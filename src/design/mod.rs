@@ -5,13 +5,17 @@
 //! - [`optimise`]: multi-start bounded Levenberg–Marquardt.
 //! - [`map`]: reading a feasibility map directory (`docs/maps.md`).
 //! - [`feasible`]: the map's verdict on a target before any optimisation.
-//! - [`export`]: design JSON, channel CSV, 1:1 mould SVG, achieved-vs-target PNG.
+//! - [`record`]: design.json, its fields, writer and reader.
+//! - [`export`]: the design's files: design.json, channel CSV, 1:1 mould SVG, achieved-vs-target PNG.
+//! - [`run`]: the whole workflow of `cablemap design`.
 
 pub mod export;
 pub mod feasible;
 pub mod map;
 pub mod objective;
 pub mod optimise;
+pub mod record;
+pub mod run;
 pub mod target;
 
 pub use objective::{Bounds, Evaluation, Objective};
@@ -21,12 +25,35 @@ pub use target::{Component, Target, Weights};
 /// Why a feasibility check or a design could not be made.
 #[derive(Debug, thiserror::Error)]
 pub enum DesignError {
-    /// The `--target` text is malformed.
-    #[error("bad --target: {0}")]
+    /// The target is malformed or asks for what the solver cannot resolve.
+    #[error("bad target: {0}")]
     BadTarget(String),
-    /// The `--weights` text is malformed or inconsistent with the target.
-    #[error("bad --weights: {0}")]
+    /// The weights are malformed or inconsistent with the target.
+    #[error("bad weights: {0}")]
     BadWeights(String),
+    /// A search setting is unusable (tolerance, number of starts).
+    #[error("bad search setting: {0}")]
+    BadSearch(String),
+    /// The export directory is unusable.
+    #[error("{message}")]
+    ExportDir {
+        /// Why.
+        message: String,
+    },
+    /// A design.json that cannot be read back.
+    #[error("{path} {message}; give a design.json written by `cablemap design --out`")]
+    DesignFile {
+        /// The file.
+        path: String,
+        /// What is wrong with it.
+        message: String,
+    },
+    /// The designed routing is not a valid channel.
+    #[error(transparent)]
+    Routing(#[from] crate::model::RoutingError),
+    /// Building or writing the moulds.
+    #[error(transparent)]
+    Mould(#[from] crate::mould::MouldError),
     /// Tension or offset bounds are unusable.
     #[error("bad bounds: {0}")]
     BadBounds(String),

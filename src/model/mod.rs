@@ -2,6 +2,7 @@
 //! static rod–cable solver.
 
 pub mod actuator;
+pub mod record;
 pub mod routing;
 pub mod resolution;
 pub mod solver;

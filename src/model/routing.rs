@@ -78,7 +78,36 @@ pub struct ChannelPoint {
     pub d2y_ds2: f64,
 }
 
+/// Spacing of the channel CSV and drawing samples along the rod, mm.
+pub const CHANNEL_STEP_MM: f64 = 0.25;
+
 impl Routing {
+    /// Channel centreline samples (s, y_c(s), dy_c/ds) from clamp to tip,
+    /// every [`CHANNEL_STEP_MM`] or closer.
+    pub fn channel_samples(&self) -> Vec<(f64, f64, f64)> {
+        let length = self.length_mm();
+        let n = (length / CHANNEL_STEP_MM).ceil() as usize;
+        (0..=n)
+            .map(|i| {
+                let s = length * i as f64 / n as f64;
+                let c = self.channel_at(s);
+                (s, c.y_mm, c.dy_ds)
+            })
+            .collect()
+    }
+
+    /// The channel centreline as `channel.csv` (written by `design --out` and
+    /// `mould`): columns `s_mm,y_mm,dy_ds`, s along the straight body from
+    /// the clamp, y lateral from the body axis. This is the file's one writer.
+    pub fn channel_csv(&self) -> String {
+        use std::fmt::Write as _;
+        let mut out = String::from("s_mm,y_mm,dy_ds\n");
+        for (s, y, d) in self.channel_samples() {
+            let _ = writeln!(out, "{s:.4},{y:.6},{d:.6}");
+        }
+        out
+    }
+
     /// Builds a routing from control-point offsets `y_mm` (mm) for a rod of
     /// length `length_mm` and radius `radius_mm`. Every |y_i| must be below
     /// the radius so the channel (inside the control polygon's convex hull)

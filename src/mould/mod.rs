@@ -736,7 +736,7 @@ impl MouldSet {
             files.push(MouldFile { file: name, parts: placed });
         }
         let path = dir.join("channel.csv");
-        crate::io::write_atomic(&path, crate::design::export::channel_csv(routing).as_bytes())
+        crate::io::write_atomic(&path, routing.channel_csv().as_bytes())
             .map_err(io(format!("writing {}", path.display())))?;
         let summary = MouldSummary {
             routing_mm: routing.control_points_mm(),

@@ -1,0 +1,157 @@
+//! design.json: the record of a design that `cablemap design --json` prints,
+//! `design --out` writes and `cablemap mould --design` reads. This module owns
+//! the format: its fields (the struct below), writer and reader.
+
+use super::feasible::{FeasibilityReport, Verdict};
+use super::objective::{Bounds, Objective};
+use super::optimise::{ComponentResult, DesignOutcome, StartReport};
+use super::DesignError;
+use crate::model::Actuator;
+use crate::shape::LengthBasis;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// One design, as design.json holds it. Keys print in alphabetical order.
+#[derive(Debug, Clone, Serialize)]
+pub struct DesignRecord {
+    /// Curvature coefficients a_0..a_n achieved, mm⁻¹, in `length_basis`.
+    pub a: Vec<f64>,
+    /// Achieved value of each target component (x, y in mm; a_i in mm⁻¹).
+    pub achieved: BTreeMap<String, f64>,
+    /// The actuator designed for.
+    pub actuator: Actuator,
+    /// Tangent angle at the clamp, rad.
+    pub base_angle_rad: f64,
+    /// Search bounds (tension range, largest control-point offset).
+    pub bounds: Bounds,
+    /// Objective value (eq. 3.17) of the design.
+    pub cost: f64,
+    /// Relative error of each component, % (none where the target is 0).
+    pub error_pct: BTreeMap<String, Option<f64>>,
+    /// The map's verdict on the target, when a map was given.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub feasibility: Option<FeasibilityRecord>,
+    /// The length the coefficients are per unit of.
+    pub length_basis: LengthBasis,
+    /// Deformed length ℓ, mm.
+    pub length_mm: f64,
+    /// Every component met within the tolerance.
+    pub met: bool,
+    /// Routing control points y_0..y_4, mm.
+    pub routing_mm: [f64; 5],
+    /// Wall time of the search, s.
+    pub seconds: f64,
+    /// Seed designs simulated before refining.
+    pub seeds_simulated: usize,
+    /// Each refined start.
+    pub starts: Vec<StartReport>,
+    /// The target as given.
+    pub target: serde_json::Value,
+    /// Cable tension, N.
+    pub tension_n: f64,
+    /// Tangent angle at the tip, rad.
+    pub tip_angle_rad: f64,
+    /// Tip position, mm.
+    pub tip_x_mm: f64,
+    /// Tip position, mm.
+    pub tip_y_mm: f64,
+    /// Components not met.
+    pub unmet: Vec<String>,
+    /// Weight λ of each target component.
+    pub weights: BTreeMap<String, f64>,
+}
+
+/// A feasibility map's verdict on the target, inside a [`DesignRecord`].
+#[derive(Debug, Clone, Serialize)]
+pub struct FeasibilityRecord {
+    /// The map directory.
+    pub map: Option<PathBuf>,
+    /// Why, one sentence per finding.
+    pub reasons: Vec<String>,
+    /// The verdict.
+    pub verdict: Verdict,
+}
+
+impl DesignRecord {
+    /// The record of `outcome` for `objective`, with each component's result.
+    pub fn new(objective: &Objective, outcome: &DesignOutcome, results: &[ComponentResult]) -> Self {
+        let e = &outcome.best;
+        let key_values = |f: &dyn Fn(&ComponentResult) -> f64| results.iter().map(|r| (r.component.key(), f(r))).collect();
+        DesignRecord {
+            a: e.a.clone(),
+            achieved: key_values(&|r| r.achieved),
+            actuator: objective.actuator.clone(),
+            base_angle_rad: e.pose.base_angle_rad,
+            bounds: objective.bounds.clone(),
+            cost: outcome.cost,
+            error_pct: results.iter().map(|r| (r.component.key(), r.error_pct)).collect(),
+            feasibility: None,
+            length_basis: objective.length_basis,
+            length_mm: e.pose.length_mm,
+            met: results.iter().all(|r| r.met),
+            routing_mm: e.routing_mm,
+            seconds: outcome.seconds,
+            seeds_simulated: outcome.seeds_simulated,
+            starts: outcome.starts.clone(),
+            target: objective.target.to_json(),
+            tension_n: e.tension_n,
+            tip_angle_rad: e.pose.tip_angle_rad,
+            tip_x_mm: e.pose.tip_x_mm,
+            tip_y_mm: e.pose.tip_y_mm,
+            unmet: results.iter().filter(|r| !r.met).map(|r| r.component.key()).collect(),
+            weights: objective.target.components.iter().map(|(c, _)| (c.key(), objective.weights.get(*c))).collect(),
+        }
+    }
+
+    /// Adds a map's verdict.
+    pub fn with_feasibility(mut self, report: &FeasibilityReport, map: Option<&Path>) -> Self {
+        self.feasibility =
+            Some(FeasibilityRecord { map: map.map(Path::to_path_buf), reasons: report.reasons.clone(), verdict: report.verdict });
+        self
+    }
+
+    /// The record as a JSON value; every object's keys sorted (nested
+    /// records included), the order design.json has always had.
+    pub fn to_json_value(&self) -> serde_json::Value {
+        serde_json::to_value(self).expect("design records serialise")
+    }
+
+    /// The record as one line of JSON.
+    pub fn to_json_line(&self) -> String {
+        self.to_json_value().to_string()
+    }
+
+    /// The record as design.json's text: indented, ending in a newline.
+    pub fn to_file_text(&self) -> String {
+        serde_json::to_string_pretty(&self.to_json_value()).expect("JSON values serialise") + "\n"
+    }
+}
+
+/// What a reader of design.json needs to rebuild the actuator: the routing
+/// and the actuator it was designed for.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+pub struct DesignFile {
+    /// Routing control points y_0..y_4, mm.
+    pub routing_mm: Vec<f64>,
+    /// The actuator (the thesis's when the file has none).
+    #[serde(default)]
+    pub actuator: Actuator,
+}
+
+/// Reads the routing and actuator of a design.json written by `design --out`.
+pub fn read_design_file(path: &Path) -> Result<DesignFile, DesignError> {
+    let bad = |message: String| DesignError::DesignFile { path: path.display().to_string(), message };
+    let text = std::fs::read_to_string(path)
+        .map_err(|source| DesignError::Io { context: format!("reading {}", path.display()), source })?;
+    let v: serde_json::Value = serde_json::from_str(&text).map_err(|e| bad(format!("is not JSON ({e})")))?;
+    let routing_mm: Vec<f64> = v
+        .get("routing_mm")
+        .and_then(|r| serde_json::from_value(r.clone()).ok())
+        .ok_or_else(|| bad("has no numeric routing_mm list".into()))?;
+    let actuator = match v.get("actuator") {
+        Some(a) => serde_json::from_value(a.clone()).map_err(|e| bad(format!("bad actuator object: {e}")))?,
+        None => Actuator::default(),
+    };
+    Ok(DesignFile { routing_mm, actuator })
+}

@@ -1,0 +1,209 @@
+//! The files and records `cablemap simulate` writes for other tools: the
+//! one-line JSON record of a solve (its field names are shared with the sweep's
+//! columns) and the centreline CSV. This module owns both formats: their field
+//! and column names, writers and readers.
+
+use super::{CentrelinePoint, Simulation, STATUS_OK};
+use crate::shape::LengthBasis;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// One solve as other tools read it (`cablemap simulate --json`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SimulationRecord {
+    /// Always [`STATUS_OK`]: failed solves are errors, not records.
+    pub status: String,
+    /// Routing control points y_0..y_4, mm.
+    pub routing_mm: [f64; 5],
+    /// Cable tension, N.
+    pub tension_n: f64,
+    /// Tip position along the clamp axis, mm.
+    pub tip_x_mm: f64,
+    /// Tip position across the clamp axis, mm.
+    pub tip_y_mm: f64,
+    /// Tangent angle of the centreline at the tip, rad.
+    pub tip_angle_rad: f64,
+    /// Frame angle of the tip cross-section, rad.
+    pub tip_frame_angle_rad: f64,
+    /// Tangent angle at the clamp, rad.
+    pub base_angle_rad: f64,
+    /// Deformed length ℓ, mm.
+    pub length_mm: f64,
+    /// Curvature coefficients a_0..a_n, mm⁻¹, in `length_basis`.
+    pub a: Vec<f64>,
+    /// The length the coefficients are per unit of.
+    pub length_basis: LengthBasis,
+    /// Integration passes the solve used.
+    pub iterations: u32,
+}
+
+impl From<&Simulation> for SimulationRecord {
+    fn from(sim: &Simulation) -> Self {
+        let p = &sim.pose;
+        SimulationRecord {
+            status: STATUS_OK.to_string(),
+            routing_mm: sim.routing_mm,
+            tension_n: p.tension_n,
+            tip_x_mm: p.tip_x_mm,
+            tip_y_mm: p.tip_y_mm,
+            tip_angle_rad: p.tip_angle_rad,
+            tip_frame_angle_rad: p.tip_frame_angle_rad,
+            base_angle_rad: p.base_angle_rad,
+            length_mm: p.length_mm,
+            a: sim.a.clone(),
+            length_basis: sim.length_basis,
+            iterations: p.iterations,
+        }
+    }
+}
+
+impl SimulationRecord {
+    /// The record as one line of JSON, keys in alphabetical order.
+    pub fn to_json_line(&self) -> String {
+        // Through a Value: its map keeps keys sorted, the order this record
+        // has always been printed in.
+        serde_json::to_value(self).expect("records serialise").to_string()
+    }
+}
+
+/// Columns of the centreline CSV, in order.
+pub const CENTRELINE_COLUMNS: [&str; 12] = [
+    "s_mm",
+    "x_mm",
+    "y_mm",
+    "frame_angle_rad",
+    "tangent_angle_rad",
+    "arc_length_mm",
+    "v1",
+    "v2",
+    "u_per_mm",
+    "channel_y_mm",
+    "cable_x_mm",
+    "cable_y_mm",
+];
+
+/// The centreline CSV text: a header of [`CENTRELINE_COLUMNS`], one row per
+/// solver node (numbers printed so they read back exactly).
+pub fn centreline_csv(centreline: &[CentrelinePoint]) -> String {
+    let mut out = CENTRELINE_COLUMNS.join(",");
+    out.push('\n');
+    for c in centreline {
+        out.push_str(&format!(
+            "{},{},{},{},{},{},{},{},{},{},{},{}\n",
+            c.s_mm, c.x_mm, c.y_mm, c.frame_angle_rad, c.tangent_angle_rad, c.arc_length_mm, c.v1, c.v2, c.u_per_mm,
+            c.channel_y_mm, c.cable_x_mm, c.cable_y_mm
+        ));
+    }
+    out
+}
+
+/// Writes the centreline CSV of `sim` to `path` atomically.
+pub fn write_centreline_csv(path: &Path, sim: &Simulation) -> std::io::Result<()> {
+    crate::io::write_atomic(path, centreline_csv(&sim.centreline).as_bytes())
+}
+
+/// Why a centreline CSV could not be read.
+#[derive(Debug, thiserror::Error)]
+pub enum CentrelineCsvError {
+    /// The file could not be read.
+    #[error("reading centreline CSV {path}: {source}")]
+    Io {
+        /// The file.
+        path: String,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// The header is not [`CENTRELINE_COLUMNS`].
+    #[error("centreline CSV {path}: header is not {expected}; write it with `cablemap simulate --csv`")]
+    Header {
+        /// The file.
+        path: String,
+        /// The expected header.
+        expected: String,
+    },
+    /// A row has the wrong number of fields or a non-number.
+    #[error("centreline CSV {path}, line {line}: {problem}")]
+    Row {
+        /// The file.
+        path: String,
+        /// 1-based line number.
+        line: usize,
+        /// What is wrong.
+        problem: String,
+    },
+}
+
+/// Reads a centreline CSV written by [`write_centreline_csv`]: one row of the
+/// 12 columns per node, in order (the cable tension is not in the file and
+/// reads as NaN).
+pub fn read_centreline_csv(path: &Path) -> Result<Vec<CentrelinePoint>, CentrelineCsvError> {
+    let name = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|source| CentrelineCsvError::Io { path: name.clone(), source })?;
+    let mut lines = text.lines();
+    let expected = CENTRELINE_COLUMNS.join(",");
+    if lines.next().map(str::trim) != Some(expected.as_str()) {
+        return Err(CentrelineCsvError::Header { path: name, expected });
+    }
+    let mut points = Vec::new();
+    for (i, line) in lines.enumerate().filter(|(_, l)| !l.trim().is_empty()) {
+        let row = |problem: String| CentrelineCsvError::Row { path: name.clone(), line: i + 2, problem };
+        let v: Vec<f64> = line
+            .split(',')
+            .map(|f| f.trim().parse::<f64>().map_err(|_| row(format!("'{}' is not a number", f.trim()))))
+            .collect::<Result<_, _>>()?;
+        if v.len() != CENTRELINE_COLUMNS.len() {
+            return Err(row(format!("{} fields, expected {}", v.len(), CENTRELINE_COLUMNS.len())));
+        }
+        points.push(CentrelinePoint {
+            s_mm: v[0],
+            x_mm: v[1],
+            y_mm: v[2],
+            frame_angle_rad: v[3],
+            tangent_angle_rad: v[4],
+            arc_length_mm: v[5],
+            v1: v[6],
+            v2: v[7],
+            u_per_mm: v[8],
+            channel_y_mm: v[9],
+            cable_x_mm: v[10],
+            cable_y_mm: v[11],
+            cable_tension_n: f64::NAN,
+        });
+    }
+    Ok(points)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::{simulate, Actuator, Routing, SolverOptions};
+
+    fn solve() -> Simulation {
+        let a = Actuator::default();
+        let routing = Routing::new(&[0.0, 1.0, -2.0, 3.0, 0.5], a.length_mm, a.radius_mm).unwrap();
+        simulate(&a, &SolverOptions::default(), &routing, 1.5, 3, LengthBasis::Rest).unwrap()
+    }
+
+    #[test]
+    fn centreline_csv_reads_back_exactly() {
+        let sim = solve();
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("c.csv");
+        write_centreline_csv(&path, &sim).unwrap();
+        let back = read_centreline_csv(&path).unwrap();
+        assert_eq!(back.len(), sim.centreline.len());
+        for (b, c) in back.iter().zip(&sim.centreline) {
+            assert_eq!((b.s_mm, b.x_mm, b.y_mm, b.u_per_mm, b.cable_y_mm), (c.s_mm, c.x_mm, c.y_mm, c.u_per_mm, c.cable_y_mm));
+        }
+        std::fs::write(&path, "s,x\n1,2\n").unwrap();
+        assert!(matches!(read_centreline_csv(&path), Err(CentrelineCsvError::Header { .. })));
+    }
+
+    #[test]
+    fn record_round_trips_through_json() {
+        let record = SimulationRecord::from(&solve());
+        let back: SimulationRecord = serde_json::from_str(&record.to_json_line()).unwrap();
+        assert_eq!(back, record);
+        assert!(record.to_json_line().starts_with("{\"a\":["), "keys are sorted");
+    }
+}
