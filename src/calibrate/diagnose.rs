@@ -286,12 +286,12 @@ pub fn split_holdout(data: &Dataset, holdout: Option<&str>) -> Result<(Vec<Routi
     };
     let ids: Vec<&str> = groups.iter().map(|g| g.routing.as_str()).collect();
     let Some(pos) = groups.iter().position(|g| g.routing == id) else {
-        return Err(CalibrateError::Invalid(format!("--holdout: no routing '{id}' in the data (routings: {})", ids.join(", "))));
+        return Err(CalibrateError::Invalid(format!("no routing '{id}' in the data to hold out (routings: {})", ids.join(", "))));
     };
     let mut train = groups;
     let held = train.remove(pos);
     if train.is_empty() {
-        return Err(CalibrateError::Invalid(format!("--holdout {id}: it is the only routing; nothing would be left to fit")));
+        return Err(CalibrateError::Invalid(format!("routing {id} is the only routing; holding it out would leave nothing to fit")));
     }
     Ok((train, Some(held)))
 }

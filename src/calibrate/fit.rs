@@ -69,9 +69,9 @@ impl Default for Noise {
 impl Noise {
     /// Checks that both levels are positive and finite.
     pub fn validate(&self) -> Result<(), CalibrateError> {
-        for (name, v) in [("--noise-mm", self.mm), ("--noise-deg", self.deg)] {
+        for (name, v) in [("noise_mm", self.mm), ("noise_deg", self.deg)] {
             if !(v.is_finite() && v > 0.0) {
-                return Err(CalibrateError::Invalid(format!("{name} {v}: the measurement noise must be a standard deviation > 0")));
+                return Err(CalibrateError::Invalid(format!("{name} = {v}: the measurement noise must be a standard deviation > 0")));
             }
         }
         Ok(())
@@ -884,7 +884,7 @@ pub fn apply_held(base: &Actuator, held: &[(Held, f64)]) -> Result<(Actuator, [b
     let mut effects = Vec::new();
     for &(h, v) in held {
         if !v.is_finite() {
-            return Err(CalibrateError::Invalid(format!("--fix: value {v} is not a finite number")));
+            return Err(CalibrateError::Invalid(format!("held value {v} is not a finite number")));
         }
         match h {
             Held::Rigidity(k) => {

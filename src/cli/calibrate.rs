@@ -2,6 +2,7 @@
 //! measurements and reports them with standard errors, correlations and the
 //! RMS error per routing.
 
+use anyhow::Context;
 use super::ActuatorArgs;
 use cablemap::calibrate::data::{read_centrelines, read_markers, Dataset};
 use cablemap::calibrate::diagnose::{fit_json, split_holdout};
@@ -66,7 +67,7 @@ impl FitArgs {
             };
             held.push((h, v));
         }
-        let (start, fixed_rigidities, held_effects) = apply_held(base, &held)?;
+        let (start, fixed_rigidities, held_effects) = apply_held(base, &held).context("--fix")?;
         let loss = match self.loss.as_str() {
             "huber" => {
                 if !(self.huber_k.is_finite() && self.huber_k > 0.0) {
@@ -88,7 +89,7 @@ impl FitArgs {
             shapes.markers = read_markers(p, data, start.length_mm)?;
         }
         let noise = Noise { mm: self.noise_mm, deg: self.noise_deg };
-        noise.validate()?;
+        noise.validate().context("--noise-mm / --noise-deg")?;
         let spec = FitSpec {
             effects: Vec::new(),
             angle_weight_mm_per_deg: self.angle_weight,
@@ -148,7 +149,7 @@ pub fn run(args: &CalibrateArgs) -> anyhow::Result<()> {
     base.validate()?;
     let options = args.actuator.solver_options(&SolverOptions::default());
     let data = read_measurements(&args.data)?;
-    let (train, held) = split_holdout(&data, args.holdout.as_deref())?;
+    let (train, held) = split_holdout(&data, args.holdout.as_deref()).context("--holdout")?;
     let (mut spec, start, held_effects) = args.fit.spec(&base, &data)?;
     spec.effects = parse_effects(&args.effects)?;
     if let Some(e) = spec.effects.iter().find(|e| held_effects.contains(e)) {

@@ -91,6 +91,7 @@ pub fn run(args: &DesignArgs) -> anyhow::Result<()> {
     }
     let done = design::run::run(&request(args)?).map_err(|e| match e {
         DesignError::BadSearch(_) => anyhow::Error::new(e).context("--starts / --tolerance-pct"),
+        DesignError::Mould(m) => super::mould::with_flag(m),
         e => anyhow::Error::new(e),
     })?;
     let stdout = std::io::stdout();

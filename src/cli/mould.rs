@@ -2,7 +2,7 @@
 
 use super::{parse_list, ActuatorArgs};
 use cablemap::model::{Actuator, Routing};
-use cablemap::mould::{MouldParams, MouldSet};
+use cablemap::mould::{MouldError, MouldParams, MouldSet};
 use anyhow::Context;
 use clap::Args;
 use std::io::Write;
@@ -63,6 +63,17 @@ pub struct MouldArgs {
     pub actuator: ActuatorArgs,
 }
 
+/// A mould error, with the flag of the parameter it names.
+pub fn with_flag(e: MouldError) -> anyhow::Error {
+    match &e {
+        MouldError::BadParameter { name, .. } if *name != "sizes" => {
+            let flag = format!("--{}", name.replace('_', "-"));
+            anyhow::Error::new(e).context(flag)
+        }
+        _ => anyhow::Error::new(e),
+    }
+}
+
 /// A short text report of written moulds.
 pub fn report(dir: &Path, s: &cablemap::mould::MouldSummary) -> String {
     let mut out = String::new();
@@ -111,7 +122,9 @@ pub fn run(args: &MouldArgs) -> anyhow::Result<()> {
     let actuator = args.actuator.apply(&base);
     actuator.validate()?;
     let routing = Routing::new(&ys, actuator.length_mm, actuator.radius_mm)?;
-    let summary = MouldSet::new(&routing, actuator.radius_mm, &args.mould.params())?.write_all(&args.out)?;
+    let summary = MouldSet::new(&routing, actuator.radius_mm, &args.mould.params())
+        .and_then(|set| set.write_all(&args.out))
+        .map_err(with_flag)?;
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
     if args.json {

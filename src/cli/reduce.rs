@@ -2,6 +2,8 @@
 
 use cablemap::reduce::{reduce_run, write_map_replacing, MapData, ModeBoundaries, ReduceOptions};
 use anyhow::Context;
+use cablemap::sweep::progress::ProgressMode;
+use cablemap::sweep::SweepOptions;
 use clap::Args;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -123,17 +125,9 @@ pub struct MapArgs {
 
 /// Runs `cablemap map`: the sweep (resumable) then the reduction.
 pub fn run_map(args: &MapArgs) -> anyhow::Result<()> {
-    let sweep_args = super::sweep::SweepArgs {
-        spec: args.spec.clone(),
-        out: args.out.join("run"),
-        shard: Some(0),
-        shards: 1,
-        threads: args.threads,
-        log_interval_s: None,
-        quiet: false,
-        allow_large: args.allow_large,
-        json: false,
-    };
-    super::sweep::run(&sweep_args)?;
+    let spec = super::sweep::load_spec(args.spec.as_deref())?;
+    let threads = super::sweep::thread_count(args.threads)?;
+    let options = SweepOptions { shard: 0, shards: 1, threads, progress: ProgressMode::Auto, allow_large: args.allow_large };
+    super::sweep::sweep_and_report(&spec, &args.out.join("run"), &options, false)?;
     reduce_into(&args.out.join("run"), &args.out.join("map"), false, &args.map).map(|_| ())
 }

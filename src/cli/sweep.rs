@@ -4,7 +4,7 @@ use cablemap::sweep::progress::ProgressMode;
 use cablemap::sweep::{run_status, run_sweep, RunStatus, SweepOptions, SweepSpec, SweepSummary};
 use anyhow::Context;
 use clap::Args;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 /// Arguments of `cablemap sweep`.
@@ -76,9 +76,9 @@ fn shard_index(args: &SweepArgs) -> anyhow::Result<(u64, &'static str)> {
     Ok((0, "default"))
 }
 
-/// Runs `cablemap sweep`.
-pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
-    let spec = match &args.spec {
+/// The sweep spec at `path`, or the built-in thesis spec.
+pub fn load_spec(path: Option<&Path>) -> anyhow::Result<SweepSpec> {
+    Ok(match path {
         Some(path) => {
             let spec = SweepSpec::load(path)?;
             if std::fs::read_to_string(path).is_ok_and(|t| SweepSpec::is_blank_toml(&t)) {
@@ -90,12 +90,41 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
             spec
         }
         None => SweepSpec::thesis(),
-    };
-    let threads = match args.threads {
+    })
+}
+
+/// Worker threads: `threads`, else $SLURM_CPUS_PER_TASK, else one per core (None).
+pub fn thread_count(threads: Option<usize>) -> anyhow::Result<Option<usize>> {
+    let threads = match threads {
         Some(t) => Some(t),
         None => env_number::<usize>("SLURM_CPUS_PER_TASK")?,
     };
     anyhow::ensure!(threads != Some(0), "--threads must be at least 1");
+    Ok(threads)
+}
+
+/// Runs one shard of `spec` into `out`, saying how to resume when
+/// interrupted, and prints the summary and the run's state.
+pub fn sweep_and_report(spec: &SweepSpec, out: &Path, options: &SweepOptions, json: bool) -> anyhow::Result<()> {
+    let again: Vec<String> = std::env::args().collect();
+    say_how_to_resume_on_interrupt(format!(
+        "\ninterrupted: every chunk already written is kept; resume with the same command:\n  {}\n",
+        again.join(" ")
+    ));
+    let summary = run_sweep(spec, out, options)?;
+    let status = run_status(out).with_context(|| format!("checking {} after the sweep", out.display()))?;
+    if json {
+        println!("{}", serde_json::json!({ "summary": summary, "run": status.to_json_value() }));
+    } else {
+        print_summary(&summary, &status);
+    }
+    Ok(())
+}
+
+/// Runs `cablemap sweep`.
+pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
+    let spec = load_spec(args.spec.as_deref())?;
+    let threads = thread_count(args.threads)?;
     let progress = if args.quiet {
         ProgressMode::Quiet
     } else if let Some(s) = args.log_interval_s {
@@ -113,19 +142,7 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
         args.shards
     );
     let options = SweepOptions { shard, shards: args.shards, threads, progress, allow_large: args.allow_large };
-    let again: Vec<String> = std::env::args().collect();
-    say_how_to_resume_on_interrupt(format!(
-        "\ninterrupted: every chunk already written is kept; resume with the same command:\n  {}\n",
-        again.join(" ")
-    ));
-    let summary = run_sweep(&spec, &args.out, &options)?;
-    let status = run_status(&args.out).with_context(|| format!("checking {} after the sweep", args.out.display()))?;
-    if args.json {
-        println!("{}", serde_json::json!({ "summary": summary, "run": status_json(&status) }));
-    } else {
-        print_summary(&summary, &status);
-    }
-    Ok(())
+    sweep_and_report(&spec, &args.out, &options, args.json)
 }
 
 /// The closing lines, each short enough for an 80-column terminal, and the
@@ -183,28 +200,11 @@ fn fmt_counts(counts: &std::collections::BTreeMap<String, u64>) -> String {
     counts.iter().map(|(s, n)| format!("{s} {n}")).collect::<Vec<_>>().join(", ")
 }
 
-fn status_json(s: &RunStatus) -> serde_json::Value {
-    serde_json::json!({
-        "dir": s.dir,
-        "spec_sha256": s.manifest.spec_sha256,
-        "tool_version": s.manifest.tool_version,
-        "length_basis": s.manifest.length_basis,
-        "rows_done": s.rows_done,
-        "rows_total": s.rows_total,
-        "failures": s.failures(),
-        "status_counts": s.status_counts,
-        "chunks_in_progress": s.chunks_in_progress,
-        "damaged": s.damaged,
-        "complete": s.complete,
-        "shards": s.shards,
-    })
-}
-
 /// Runs `cablemap status`.
 pub fn run_status_command(args: &StatusArgs) -> anyhow::Result<()> {
     let s = run_status(&args.dir)?;
     if args.json {
-        println!("{}", status_json(&s));
+        println!("{}", s.to_json_value());
         return Ok(());
     }
     let m = &s.manifest;

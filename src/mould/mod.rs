@@ -68,8 +68,13 @@ impl Default for MouldParams {
 #[derive(Debug, thiserror::Error)]
 pub enum MouldError {
     /// A parameter is out of range.
-    #[error("bad mould parameter: {0}")]
-    BadParameter(String),
+    #[error("bad mould parameter {name}: {message}")]
+    BadParameter {
+        /// The parameter's name in [`MouldParams`].
+        name: &'static str,
+        /// Its value and what it must be.
+        message: String,
+    },
     /// The channel comes too close to the body surface to be cast.
     #[error(
         "the channel (tube Ø {tube_mm} mm) comes within {skin_mm:.3} mm of the body surface at s = {s_mm:.2} mm \
@@ -182,41 +187,41 @@ impl Moulds {
     /// Checks the parameters and the routing's channel against the body.
     pub fn new(routing: &Routing, radius_mm: f64, params: &MouldParams) -> Result<Self, MouldError> {
         let p = params;
-        let bad = |m: String| Err(MouldError::BadParameter(m));
+        let bad = |name: &'static str, message: String| Err(MouldError::BadParameter { name, message });
         let finite = [p.wall_mm, p.tube_diameter_mm, p.clearance_mm, p.clamp_mm, p.min_skin_mm, p.station_step_mm, radius_mm];
         if finite.iter().any(|v| !v.is_finite()) {
-            return bad(format!("every size must be a finite number of mm ({p:?}, r = {radius_mm})"));
+            return bad("sizes", format!("every size must be a finite number of mm ({p:?}, r = {radius_mm})"));
         }
         if p.tube_diameter_mm <= 0.0 || p.tube_diameter_mm > radius_mm {
-            return bad(format!(
-                "--tube-diameter-mm {} must be positive and at most the radius {radius_mm} mm (the pour opening is r/2 deep)",
+            return bad("tube_diameter_mm", format!(
+                "{} mm must be positive and at most the radius {radius_mm} mm (the pour opening is r/2 deep)",
                 p.tube_diameter_mm
             ));
         }
         if !(0.0..=0.5).contains(&p.clearance_mm) {
-            return bad(format!("--clearance-mm {} must be between 0 and 0.5", p.clearance_mm));
+            return bad("clearance_mm", format!("{} mm must be between 0 and 0.5", p.clearance_mm));
         }
         if p.wall_mm < PIN_HEIGHT_MM + p.clearance_mm + 0.8 {
-            return bad(format!(
-                "--wall-mm {} is too thin: the lid's pin holes are {} mm deep; use at least {} mm",
+            return bad("wall_mm", format!(
+                "{} mm is too thin: the lid's pin holes are {} mm deep; use at least {} mm",
                 p.wall_mm,
                 PIN_HEIGHT_MM + p.clearance_mm,
                 PIN_HEIGHT_MM + p.clearance_mm + 0.8
             ));
         }
         if p.clamp_mm < 0.0 {
-            return bad(format!("--clamp-mm {} must be ≥ 0", p.clamp_mm));
+            return bad("clamp_mm", format!("{} mm must be ≥ 0", p.clamp_mm));
         }
         if p.min_skin_mm < 0.0 {
-            return bad(format!("--min-skin-mm {} must be ≥ 0", p.min_skin_mm));
+            return bad("min_skin_mm", format!("{} mm must be ≥ 0", p.min_skin_mm));
         }
         if !(0.01..=2.0).contains(&p.station_step_mm) {
-            return bad(format!("station step {} mm must be between 0.01 and 2", p.station_step_mm));
+            return bad("station_step_mm", format!("{} mm must be between 0.01 and 2", p.station_step_mm));
         }
         let length = routing.length_mm();
         let text_mm = text_width_mm("CL ^+Y");
         if length + p.clamp_mm < text_mm + 12.0 {
-            return bad(format!(
+            return bad("clamp_mm", format!(
                 "body of {length} mm plus clamp block {} mm is too short for the marks and pins (needs {} mm)",
                 p.clamp_mm,
                 text_mm + 12.0
@@ -258,7 +263,7 @@ impl Moulds {
         for i in 0..=n {
             let y = routing.channel_at(length * i as f64 / n as f64).y_mm.abs();
             if y + w >= radius_mm {
-                return bad(format!(
+                return bad("tube_diameter_mm", format!(
                     "the protrusion (half-width {w:.3} mm in x-sections) at |y_c| = {y:.3} mm reaches the body surface r = {radius_mm} mm; \
                      use a routing further from the surface or a thinner tube"
                 ));
@@ -978,7 +983,7 @@ mod tests {
             MouldParams { clamp_mm: f64::NAN, ..p.clone() },
         ] {
             let e = Moulds::new(&ok, 5.0, &bad).unwrap_err();
-            assert!(matches!(e, MouldError::BadParameter(_)), "{bad:?}: {e}");
+            assert!(matches!(e, MouldError::BadParameter { .. }), "{bad:?}: {e}");
         }
         let short = Routing::new(&[0.0; 5], 10.0, 5.0).unwrap();
         assert!(Moulds::new(&short, 5.0, &MouldParams { clamp_mm: 0.0, ..p }).is_err());

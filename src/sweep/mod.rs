@@ -32,8 +32,13 @@ use std::path::PathBuf;
 #[derive(Debug, thiserror::Error)]
 pub enum SweepError {
     /// The job spec is malformed or invalid.
-    #[error("bad sweep spec {origin}: {message}")]
-    BadSpec { origin: String, message: String },
+    #[error("bad sweep spec {origin}: {source}")]
+    BadSpec {
+        /// The spec file, or where an in-memory spec came from.
+        origin: String,
+        /// What is wrong.
+        source: spec::SpecError,
+    },
     /// Shard index or count out of range.
     #[error("shard {shard} of {shards} is out of range: use 0 ≤ shard < shards (shards ≥ 1)")]
     BadShard { shard: u64, shards: u64 },

@@ -106,7 +106,7 @@ impl SweepSummary {
 /// Runs (or resumes) shard `options.shard` of `spec` into `dir`.
 pub fn run_sweep(spec: &SweepSpec, dir: &Path, options: &SweepOptions) -> Result<SweepSummary, SweepError> {
     let started = Instant::now();
-    spec.validate().map_err(|message| SweepError::BadSpec { origin: "(in memory)".into(), message })?;
+    spec.validate().map_err(|source| SweepError::BadSpec { origin: "(in memory)".into(), source })?;
     let (shard, shards) = (options.shard, options.shards);
     if shards == 0 || shard >= shards {
         return Err(SweepError::BadShard { shard, shards });
@@ -114,7 +114,7 @@ pub fn run_sweep(spec: &SweepSpec, dir: &Path, options: &SweepOptions) -> Result
     if options.threads == Some(0) {
         return Err(SweepError::BadThreads("0: use at least 1 thread".into()));
     }
-    spec.check_size(options.allow_large).map_err(|message| SweepError::BadSpec { origin: "(size)".into(), message })?;
+    spec.check_size(options.allow_large).map_err(|source| SweepError::BadSpec { origin: "(size)".into(), source })?;
     let (threads_wanted, capped) = capped_threads(options.threads);
     if capped && options.progress != ProgressMode::Quiet {
         eprintln!(

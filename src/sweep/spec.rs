@@ -126,6 +126,34 @@ impl Default for OutputSpec {
     }
 }
 
+/// What is wrong with a sweep spec: the section and setting, and what to do.
+#[derive(Debug, thiserror::Error)]
+pub enum SpecError {
+    /// The actuator's parameters.
+    #[error("[actuator] {0}")]
+    Actuator(#[source] crate::model::ParameterError),
+    /// Another setting, in its section.
+    #[error("[{section}] {message}")]
+    Setting {
+        /// TOML section, e.g. `grid`.
+        section: &'static str,
+        /// The setting, its value and what to do.
+        message: String,
+    },
+    /// The TOML text does not parse or has unknown keys.
+    #[error("{0}")]
+    Toml(#[from] toml::de::Error),
+    /// The whole sweep is larger than a sweep is allowed to be by default.
+    #[error("{0}")]
+    TooLarge(String),
+}
+
+impl SpecError {
+    fn setting(section: &'static str, message: impl Into<String>) -> Self {
+        SpecError::Setting { section, message: message.into() }
+    }
+}
+
 impl SweepSpec {
     /// The thesis sweep (the built-in default).
     pub fn thesis() -> Self {
@@ -135,8 +163,8 @@ impl SweepSpec {
     /// Parses and validates a spec; `origin` names it in errors.
     pub fn from_toml(text: &str, origin: &str) -> Result<Self, SweepError> {
         let spec: SweepSpec =
-            toml::from_str(text).map_err(|e| SweepError::BadSpec { origin: origin.to_string(), message: e.to_string() })?;
-        spec.validate().map_err(|message| SweepError::BadSpec { origin: origin.to_string(), message })?;
+            toml::from_str(text).map_err(|e| SweepError::BadSpec { origin: origin.to_string(), source: SpecError::Toml(e) })?;
+        spec.validate().map_err(|source| SweepError::BadSpec { origin: origin.to_string(), source })?;
         Ok(spec)
     }
 
@@ -148,77 +176,72 @@ impl SweepSpec {
     }
 
     /// Checks every setting; the message names the field and what to do.
-    pub fn validate(&self) -> Result<(), String> {
-        self.actuator.validate().map_err(|e| format!("[actuator] {e}"))?;
+    pub fn validate(&self) -> Result<(), SpecError> {
+        self.actuator.validate().map_err(SpecError::Actuator)?;
         // Sizes before anything is allocated for them.
         if self.solver.steps_per_span > MAX_STEPS_PER_SPAN {
-            return Err(format!(
-                "[solver] steps_per_span = {} is more than {MAX_STEPS_PER_SPAN}: the solver would need more memory than a \
+            return Err(SpecError::setting("solver", format!("steps_per_span = {} is more than {MAX_STEPS_PER_SPAN}: the solver would need more memory than a \
                  machine has, and {} steps already resolve every supported order",
                 self.solver.steps_per_span,
                 crate::model::resolution::REQUIRED_STEPS_PER_SPAN[crate::model::resolution::MAX_RESOLVED_ORDER]
-            ));
+            )));
         }
         if self.tension.count > MAX_TENSIONS {
-            return Err(format!("[tension] count = {} is more than {MAX_TENSIONS} tensions per routing", self.tension.count));
+            return Err(SpecError::setting("tension", format!("count = {} is more than {MAX_TENSIONS} tensions per routing", self.tension.count)));
         }
-        crate::model::Simulator::new(&self.actuator, &self.solver).map_err(|e| format!("[solver] {e}"))?;
+        crate::model::Simulator::new(&self.actuator, &self.solver).map_err(|e| SpecError::setting("solver", e.to_string()))?;
         let g = &self.grid;
         if g.levels == 0 || g.levels > MAX_LEVELS {
-            return Err(format!("[grid] levels = {} must be between 1 and {MAX_LEVELS}", g.levels));
+            return Err(SpecError::setting("grid", format!("levels = {} must be between 1 and {MAX_LEVELS}", g.levels)));
         }
         if !(g.extent_r.is_finite() && g.extent_r >= 0.0 && g.extent_r < 1.0) {
-            return Err(format!(
-                "[grid] extent_r = {} puts levels beyond ±r (outside the body): use a fraction 0 ≤ extent_r < 1",
+            return Err(SpecError::setting("grid", format!("extent_r = {} puts levels beyond ±r (outside the body): use a fraction 0 ≤ extent_r < 1",
                 g.extent_r
-            ));
+            )));
         }
         let delta = self.actuator.effects.channel_offset_mm;
         if (g.extent_r * self.actuator.radius_mm).abs() + delta.abs() >= self.actuator.radius_mm {
-            return Err(format!(
-                "[grid] extent_r = {} with channel_offset_mm = {delta} puts the channel beyond ±r: reduce one of them",
+            return Err(SpecError::setting("grid", format!("extent_r = {} with channel_offset_mm = {delta} puts the channel beyond ±r: reduce one of them",
                 g.extent_r
-            ));
+            )));
         }
         if g.mirror_dedup {
             let gravity = &self.actuator.gravity;
             let tilted = gravity.enabled && gravity.scale != 0.0 && gravity.direction_rad.sin().abs() > 1e-12;
             if delta != 0.0 || tilted {
-                return Err("[grid] mirror_dedup = true needs a mirror-symmetric actuator (channel_offset_mm = 0 and \
-                            gravity along the clamp axis): set mirror_dedup = false"
-                    .into());
+                return Err(SpecError::setting("grid", "mirror_dedup = true needs a mirror-symmetric actuator (channel_offset_mm = 0 and \
+                            gravity along the clamp axis): set mirror_dedup = false"));
             }
         }
         let t = &self.tension;
         if !(t.min_n.is_finite() && t.min_n >= 0.0) {
-            return Err(format!("[tension] min_n = {} must be a finite tension ≥ 0 N", t.min_n));
+            return Err(SpecError::setting("tension", format!("min_n = {} must be a finite tension ≥ 0 N", t.min_n)));
         }
         if !(t.max_n.is_finite() && t.max_n >= t.min_n) {
-            return Err(format!("[tension] max_n = {} must be finite and ≥ min_n = {}", t.max_n, t.min_n));
+            return Err(SpecError::setting("tension", format!("max_n = {} must be finite and ≥ min_n = {}", t.max_n, t.min_n)));
         }
         if t.count == 0 {
-            return Err("[tension] count = 0: at least one tension is needed".into());
+            return Err(SpecError::setting("tension", "count = 0: at least one tension is needed"));
         }
         if t.count == 1 && t.max_n != t.min_n {
-            return Err("[tension] count = 1 needs min_n = max_n (or give count ≥ 2)".into());
+            return Err(SpecError::setting("tension", "count = 1 needs min_n = max_n (or give count ≥ 2)"));
         }
         let o = &self.output;
         if o.order > MAX_ORDER {
-            return Err(format!("[output] order = {} is above the supported {MAX_ORDER}", o.order));
+            return Err(SpecError::setting("output", format!("order = {} is above the supported {MAX_ORDER}", o.order)));
         }
-        crate::model::resolution::check_order(o.order, &self.solver).map_err(|e| format!("[output] {e}"))?;
+        crate::model::resolution::check_order(o.order, &self.solver).map_err(|e| SpecError::setting("output", e))?;
         if o.chunk_routings == 0 {
-            return Err("[output] chunk_routings = 0: a chunk needs at least one routing".into());
+            return Err(SpecError::setting("output", "chunk_routings = 0: a chunk needs at least one routing"));
         }
         let chunk_rows = u64::from(o.chunk_routings) * u64::from(t.count);
         if chunk_rows > MAX_CHUNK_ROWS {
-            return Err(format!(
-                "[output] chunk_routings = {} × [tension] count = {} gives {chunk_rows} rows per chunk, more than \
+            return Err(SpecError::setting("output", format!("chunk_routings = {} × [tension] count = {} gives {chunk_rows} rows per chunk, more than \
                  {MAX_CHUNK_ROWS} (each chunk is built in memory): lower chunk_routings to ≤ {}",
                 o.chunk_routings,
                 t.count,
                 (MAX_CHUNK_ROWS / u64::from(t.count)).max(1)
-            ));
+            )));
         }
         Ok(())
     }
@@ -226,15 +249,15 @@ impl SweepSpec {
     /// Checks the size of the whole sweep: more than [`MAX_ROWS`] rows is
     /// refused (a typo like `levels = 99` means 10¹¹ rows) unless
     /// `allow_large`, for a deliberate huge job.
-    pub fn check_size(&self, allow_large: bool) -> Result<(), String> {
+    pub fn check_size(&self, allow_large: bool) -> Result<(), SpecError> {
         let plan = super::SweepPlan::new(self);
         let rows = plan.total_rows();
         if rows > MAX_ROWS && !allow_large {
-            return Err(format!(
+            return Err(SpecError::TooLarge(format!(
                 "the sweep has {rows} rows ({} routings × {} tensions), more than {MAX_ROWS}: check [grid] levels and \
                  [tension] count, or pass --allow-large if the job is meant to be this big",
                 plan.routings, plan.tensions
-            ));
+            )));
         }
         Ok(())
     }
@@ -328,7 +351,7 @@ mod tests {
         assert!(err("[solver]\nmethod = \"rk4\"\n[output]\norder = 9\n").contains("[solver] steps_per_span = 80"));
         assert!(err("[tension]\ncount = 100000\n").contains("chunk_routings"));
         let huge = SweepSpec::from_toml("[grid]\nlevels = 99\n", "t").unwrap();
-        assert!(huge.check_size(false).unwrap_err().contains("--allow-large"));
+        assert!(huge.check_size(false).unwrap_err().to_string().contains("--allow-large"));
         assert!(huge.check_size(true).is_ok());
         assert!(SweepSpec::thesis().check_size(false).is_ok());
         assert!(SweepSpec::is_blank_toml("\n# nothing\n  \n"));

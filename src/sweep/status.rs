@@ -54,6 +54,25 @@ impl RunStatus {
     pub fn failures(&self) -> u64 {
         failures(&self.status_counts)
     }
+
+    /// The record `cablemap status --json` prints (and `sweep --json` under
+    /// "run"): the manifest's identity, not the whole spec.
+    pub fn to_json_value(&self) -> serde_json::Value {
+        serde_json::json!({
+            "dir": self.dir,
+            "spec_sha256": self.manifest.spec_sha256,
+            "tool_version": self.manifest.tool_version,
+            "length_basis": self.manifest.length_basis,
+            "rows_done": self.rows_done,
+            "rows_total": self.rows_total,
+            "failures": self.failures(),
+            "status_counts": self.status_counts,
+            "chunks_in_progress": self.chunks_in_progress,
+            "damaged": self.damaged,
+            "complete": self.complete,
+            "shards": self.shards,
+        })
+    }
 }
 
 /// Reads and checks a run directory (manifest and every chunk footer).
