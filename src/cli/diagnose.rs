@@ -1,6 +1,7 @@
 //! `cablemap diagnose DATA`: finds, names and adds the missing effect, with
 //! a Markdown report and plots.
 
+use anyhow::Context;
 use super::calibrate::FitArgs;
 use super::ActuatorArgs;
 use cablemap::calibrate::diagnose::{diagnose, DiagnoseSpec};
@@ -63,7 +64,7 @@ pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
     let out_dir = report_dir(args);
     if !args.no_report {
         // Before the fits, not after them.
-        cablemap::io::check_not_in_run_dir(&out_dir, "--out").map_err(anyhow::Error::msg)?;
+        cablemap::io::check_not_in_run_dir(&out_dir, "the report directory").map_err(anyhow::Error::msg).context("--out")?;
     }
     let base = args.actuator.apply(&Actuator::default());
     base.validate()?;
