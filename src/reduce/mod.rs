@@ -532,7 +532,7 @@ pub fn reduce_run(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use arrow::array::{ArrayRef, Float64Array, Int64Array, StringArray};
+    use arrow::array::{Array, ArrayRef, Float64Array, Int64Array, StringArray};
     use arrow::datatypes::{DataType, Field, Schema};
     use std::sync::Arc;
 
@@ -661,6 +661,72 @@ mod tests {
         })
         .unwrap_err();
         assert!(e.to_string().contains("ascending"), "{e}");
+    }
+    #[test]
+    fn the_tables_read_back_as_written() {
+        let map = run(&pseudo_rows(300), true, &ReduceOptions::default());
+        let tmp = tempfile::tempdir().unwrap();
+        tables::write_tables(tmp.path(), &map).unwrap();
+        let summary = tables::read_summary(tmp.path()).unwrap();
+        assert_eq!(serde_json::to_value(&summary).unwrap(), serde_json::to_value(&map.summary).unwrap());
+        let cells = tables::read_cells(tmp.path(), summary.order).unwrap();
+        assert_eq!(format!("{cells:?}"), format!("{:?}", map.cells));
+        assert_eq!(tables::read_designs(tmp.path(), summary.order).unwrap(), map.designs);
+        // A table without one of its columns is refused, naming the column.
+        let e = tables::read_designs(tmp.path(), 3).unwrap_err();
+        assert!(e.to_string().contains("`a3` is missing"), "{e}");
+    }
+
+    #[test]
+    fn errors_name_the_problem_and_keep_their_source() {
+        use std::error::Error as _;
+        let tmp = tempfile::tempdir().unwrap();
+        let e = reduce_run(tmp.path(), false, &ReduceOptions::default()).unwrap_err();
+        assert!(matches!(e, ReduceError::Sweep(crate::sweep::SweepError::NoRun { .. })), "{e:?}");
+        assert!(e.source().is_some());
+        // A cell too small for the grid: the smallest that works, no flag names.
+        let e = reduce_batches(&info(false), &ReduceOptions { cell_mm: 1e-300, ..Default::default() }, || {
+            Ok(vec![Ok(batch(&pseudo_rows(40)))].into_iter())
+        })
+        .unwrap_err();
+        match &e {
+            ReduceError::CellTooSmall { smallest_cell_mm, .. } => assert!(*smallest_cell_mm > 1e-6 && *smallest_cell_mm < 1e-3),
+            other => panic!("{other:?}"),
+        }
+        // One routing cannot be split into modes by quantiles.
+        let one: Vec<Row> = (0..5).map(|i| ([0.0, 1.0, 0.0, -1.0, 0.5], 1.0 + 0.1 * i as f64, "ok", 50.0, 2.0, [0.1, 0.2, 0.0])).collect();
+        let e = reduce_batches(&info(false), &ReduceOptions::default(), || Ok(vec![Ok(batch(&one))].into_iter())).unwrap_err();
+        assert!(matches!(e, ReduceError::ModesNotSplit { .. }), "{e:?}");
+        for e in [e.to_string(), ReduceError::CellSize { cell_mm: 0.0 }.to_string()] {
+            assert!(!e.contains("--"), "a library message names no flag: {e}");
+        }
+        // A sweep column of the wrong type keeps Arrow's error as its source.
+        let b = batch(&pseudo_rows(3));
+        let i = b.schema().index_of("tip_x_mm").unwrap();
+        let mut cols = b.columns().to_vec();
+        let lists = arrow::array::ListArray::from_iter_primitive::<arrow::datatypes::Float64Type, _, _>((0..3).map(|_| Some(vec![Some(1.0)])));
+        let list_type = lists.data_type().clone();
+        cols[i] = Arc::new(lists);
+        let mut fields: Vec<Field> = b.schema().fields().iter().map(|f| f.as_ref().clone()).collect();
+        fields[i] = Field::new("tip_x_mm", list_type, true);
+        let bad = RecordBatch::try_new(Arc::new(Schema::new(fields)), cols).unwrap();
+        let e = reduce_batches(&info(false), &ReduceOptions::default(), || Ok(vec![Ok(bad.clone())].into_iter())).unwrap_err();
+        assert!(matches!(e, ReduceError::ColumnType { .. }) && e.source().is_some(), "{e:?}");
+    }
+
+    #[test]
+    fn a_representative_that_cannot_be_drawn_is_reported() {
+        let mut map = run(&pseudo_rows(200), false, &ReduceOptions::default());
+        let actuator = crate::model::Actuator::default();
+        let m = map.modes.iter().position(|m| m.representative.is_some()).unwrap();
+        // Outside the body: the routing is refused, and the drawing says so.
+        map.modes[m].representative.as_mut().unwrap().y_mm[2] = 2.0 * actuator.radius_mm;
+        let drawings = drawings::ModeDrawings::of_map(&map, &actuator, &crate::model::SolverOptions::default());
+        assert_eq!(drawings.shapes.len(), MODES);
+        assert!(drawings.shapes[m].is_none());
+        assert_eq!(drawings.failures.len(), 1);
+        let note = drawings.failure_note();
+        assert!(note.contains(&format!("mode {m}")) && note.contains("routing"), "{note}");
     }
 }
 
