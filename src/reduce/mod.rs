@@ -422,6 +422,14 @@ pub struct MapData {
 
 /// Reduces a run. `batches` is called once per pass and must yield the same
 /// rows in the same order each time.
+///
+/// What each stage needs of the run, so that it can be computed without
+/// holding every row: the mode split, the run's a_0/a_1 quantiles; the
+/// grid, the tips' extent; a cell, its own samples only (cells can be done
+/// range by range and concatenated in (ix, iy) order); a mode's
+/// representative, the mode's medians and its nearest member (ties to the
+/// lowest simulation, so any partition gives the same pick); pass 2, the
+/// row numbers wanted.
 pub fn reduce_batches<F, I>(info: &RunInfo, options: &ReduceOptions, mut batches: F) -> Result<MapData, ReduceError>
 where
     F: FnMut() -> Result<I, ReduceError>,

@@ -27,12 +27,16 @@ pub fn write_map_replacing(
     remove_abandoned_staging(&parent, &name);
     let staging = parent.join(format!(".{name}.tmp-{}", crate::io::unique_token()));
     std::fs::create_dir(&staging).map_err(|source| ReduceError::CreateDir { path: staging.clone(), source })?;
-    // Held while writing so that another reduce does not clear it away
-    // (best effort: without the lock, staging is only judged by its age).
-    let lock = std::fs::File::open(&staging).ok();
-    if let Some(l) = &lock {
-        let _ = l.try_lock();
-    }
+    // Held while writing so that another reduce does not clear it away.
+    let lock = match std::fs::File::open(&staging) {
+        Ok(lock) => lock,
+        Err(source) => {
+            let _ = std::fs::remove_dir_all(&staging);
+            return Err(ReduceError::CreateDir { path: staging, source });
+        }
+    };
+    // Best effort: where locks are unsupported, staging is judged by its age.
+    let _ = lock.try_lock();
     let written = write_map(&staging, map, actuator, solver).and_then(|pictures| {
         crate::io::sync_dir(&staging);
         replace_dir(&staging, dir, &parent, &name).map_err(|source| ReduceError::Replace { path: dir.to_path_buf(), source })?;

@@ -246,7 +246,7 @@ fn read_error(path: &Path, message: impl Into<String>) -> ReadError {
 pub fn read_summary(dir: &Path) -> Result<MapSummary, ReadError> {
     let path = dir.join(SUMMARY_FILE);
     let text = crate::io::read_utf8(&path).map_err(|e| {
-        read_error(&path, format!("cannot read ({e}); give the directory written by `cablemap reduce RUN_DIR --out MAP_DIR`"))
+        read_error(&path, format!("cannot read ({e}); give a map directory written by `cablemap reduce`"))
     })?;
     let summary: MapSummary =
         serde_json::from_str(&text).map_err(|e| read_error(&path, format!("does not match the map contract: {e}")))?;
