@@ -1,7 +1,7 @@
 //! The map format (docs/maps.md), one owner: the file and column names of a
 //! map directory's tables, their writer and their reader. `summary.json` is
 //! [`MapSummary`] serialised; `cells.parquet`, `modes.parquet` and
-//! `designs.parquet` hold [`CellStats`], [`ModeStats`] and [`Design`] rows.
+//! `designs.parquet` hold [`CellStats`], [`ModeStats`](super::ModeStats) and [`Design`] rows.
 //! The design columns are the sweep's own (`sweep::schema`).
 
 use super::{CellStats, CoefficientStats, Design, MapData, MapSummary, ReduceError, CELL_STATS_ORDER, MAX_CELLS_PER_AXIS, MODES};
