@@ -1,6 +1,6 @@
 //! `cablemap reduce` and `cablemap map` (sweep then reduce: the main job).
 
-use cablemap::reduce::{reduce_run, write_map_replacing, MapData, ModeBoundaries, ReduceOptions};
+use cablemap::reduce::{reduce_run, write_map_replacing, MapData, ModeBoundaries, ReduceError, ReduceOptions};
 use anyhow::Context;
 use cablemap::sweep::progress::ProgressMode;
 use cablemap::sweep::SweepOptions;
@@ -68,7 +68,7 @@ pub fn reduce_into(run: &Path, out: &Path, partial: bool, args: &MapOptionArgs) 
     let options = args.options()?;
     cablemap::reduce::check_map_out(out)?;
     let start = Instant::now();
-    let (map, spec) = reduce_run(run, partial, &options).with_context(|| format!("reducing {}", run.display()))?;
+    let (map, spec) = reduce_run(run, partial, &options).map_err(with_flags).with_context(|| format!("reducing {}", run.display()))?;
     let reduced_s = start.elapsed().as_secs_f64();
     let pictures = write_map_replacing(out, &map, &spec.actuator, &spec.solver)?;
     let total_s = start.elapsed().as_secs_f64();
@@ -97,6 +97,15 @@ pub fn reduce_into(run: &Path, out: &Path, partial: bool, args: &MapOptionArgs) 
         println!("reduced in {reduced_s:.2} s, tables and {} pictures written in {total_s:.2} s; open {}", pictures.len(), out.join("index.html").display());
     }
     Ok(map)
+}
+
+/// The library's error, with the flag that fixes it where there is one.
+fn with_flags(e: ReduceError) -> anyhow::Error {
+    match &e {
+        ReduceError::CellTooSmall { smallest_cell_mm, .. } => anyhow::anyhow!("{e} (use --cell-mm ≥ {smallest_cell_mm:.3e})"),
+        ReduceError::ModesNotSplit { .. } => anyhow::anyhow!("{e}: --a0-bounds B1,B2,B3 and --a1-bounds C1,C2"),
+        _ => e.into(),
+    }
 }
 
 /// Runs `cablemap reduce`.

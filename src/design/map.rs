@@ -1,14 +1,13 @@
-//! Reading a feasibility map directory (the contract of `docs/maps.md`):
-//! `summary.json`, `cells.parquet` and `designs.parquet`.
+//! A feasibility map directory opened for design: its summary and cells
+//! indexed by position, its designs on demand. The files are read by the
+//! map format's owner, [`crate::reduce::tables`].
 
 use super::optimise::{Seed, SeedSource};
 use super::target::{Component, Target, Weights};
 use super::DesignError;
 use crate::model::Actuator;
+use crate::reduce::tables;
 use crate::shape::LengthBasis;
-use arrow::array::{Array, AsArray, RecordBatch};
-use arrow::datatypes::{Float64Type, Int32Type, Int64Type};
-use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
 use serde::Serialize;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -17,7 +16,7 @@ use std::path::{Path, PathBuf};
 pub use crate::reduce::MODES;
 
 /// Highest coefficient order with per-cell statistics in `cells.parquet`.
-pub const CELL_STATS_ORDER: usize = 2;
+pub use crate::reduce::CELL_STATS_ORDER;
 
 /// `summary.json`, read with the reducer's own type so that the contract
 /// has one definition.
@@ -88,67 +87,16 @@ pub struct MapDir {
     /// Non-empty cells.
     pub cells: Vec<Cell>,
     index: HashMap<(i32, i32), usize>,
-    designs_path: PathBuf,
 }
 
 fn map_error(path: &Path, message: impl Into<String>) -> DesignError {
     DesignError::Map { path: path.display().to_string(), message: message.into() }
 }
 
-/// Reads every record batch of a parquet file.
-fn read_batches(path: &Path) -> Result<Vec<RecordBatch>, DesignError> {
-    let file = std::fs::File::open(path)
-        .map_err(|e| map_error(path, format!("cannot open ({e}); is this a `cablemap reduce` output directory?")))?;
-    let reader = ParquetRecordBatchReaderBuilder::try_new(file)
-        .and_then(|b| b.build())
-        .map_err(|e| map_error(path, format!("not a readable parquet file: {e}")))?;
-    reader.collect::<Result<Vec<_>, _>>().map_err(|e| map_error(path, format!("reading: {e}")))
-}
-
-/// Typed column access with errors that name the column.
-struct Columns<'a> {
-    path: &'a Path,
-    batch: &'a RecordBatch,
-}
-
-impl<'a> Columns<'a> {
-    fn column(&self, name: &str) -> Result<&'a dyn Array, DesignError> {
-        let c = self
-            .batch
-            .column_by_name(name)
-            .ok_or_else(|| map_error(self.path, format!("column `{name}` is missing (see docs/maps.md)")))?;
-        if c.null_count() > 0 {
-            return Err(map_error(self.path, format!("column `{name}` has nulls")));
-        }
-        Ok(c.as_ref())
-    }
-
-    fn f64(&self, name: &str) -> Result<&'a [f64], DesignError> {
-        let c = self.column(name)?;
-        c.as_primitive_opt::<Float64Type>()
-            .map(|a| a.values().as_ref())
-            .ok_or_else(|| map_error(self.path, format!("column `{name}` should be f64, is {}", c.data_type())))
-    }
-
-    fn i32(&self, name: &str) -> Result<&'a [i32], DesignError> {
-        let c = self.column(name)?;
-        c.as_primitive_opt::<Int32Type>()
-            .map(|a| a.values().as_ref())
-            .ok_or_else(|| map_error(self.path, format!("column `{name}` should be i32, is {}", c.data_type())))
-    }
-
-    fn i64(&self, name: &str) -> Result<&'a [i64], DesignError> {
-        let c = self.column(name)?;
-        c.as_primitive_opt::<Int64Type>()
-            .map(|a| a.values().as_ref())
-            .ok_or_else(|| map_error(self.path, format!("column `{name}` should be i64, is {}", c.data_type())))
-    }
-
-    fn bool(&self, name: &str) -> Result<Vec<bool>, DesignError> {
-        let c = self.column(name)?;
-        c.as_boolean_opt()
-            .map(|a| a.iter().map(|v| v.unwrap_or(false)).collect())
-            .ok_or_else(|| map_error(self.path, format!("column `{name}` should be bool, is {}", c.data_type())))
+/// A map file that breaks the map format is a design input error.
+impl From<tables::ReadError> for DesignError {
+    fn from(e: tables::ReadError) -> Self {
+        DesignError::Map { path: e.path.display().to_string(), message: e.message }
     }
 }
 
@@ -164,56 +112,10 @@ impl MapDir {
     /// Opens a map directory: reads `summary.json` and `cells.parquet`
     /// (`designs.parquet` is read on demand).
     pub fn open(dir: &Path) -> Result<Self, DesignError> {
-        let summary_path = dir.join("summary.json");
-        let text = crate::io::read_utf8(&summary_path).map_err(|e| {
-            map_error(&summary_path, format!("cannot read ({e}); give the directory written by `cablemap reduce RUN_DIR --out MAP_DIR`"))
-        })?;
-        let summary: Summary =
-            serde_json::from_str(&text).map_err(|e| map_error(&summary_path, format!("does not match the map contract: {e}")))?;
-        summary
-            .mode_boundaries
-            .validate()
-            .map_err(|e| map_error(&summary_path, format!("mode_boundaries: {e}")))?;
-        if !(summary.cell_mm > 0.0 && summary.cell_mm.is_finite()) {
-            return Err(map_error(&summary_path, format!("cell_mm must be positive, got {}", summary.cell_mm)));
-        }
-        let [lo, hi] = summary.tension_range_n;
-        if !(lo.is_finite() && hi.is_finite() && lo <= hi) {
-            return Err(map_error(&summary_path, format!("tension_range_n [{lo}, {hi}] is not a range")));
-        }
-        let cells_path = dir.join("cells.parquet");
-        let stats_order = summary.order.min(CELL_STATS_ORDER);
-        let mut cells = Vec::new();
-        for batch in read_batches(&cells_path)? {
-            let c = Columns { path: &cells_path, batch: &batch };
-            let (ix, iy, x, y, count) = (c.i32("ix")?, c.i32("iy")?, c.f64("x_mm")?, c.f64("y_mm")?, c.i64("count")?);
-            let stats: Vec<[&[f64]; 4]> = (0..=stats_order)
-                .map(|k| {
-                    Ok([c.f64(&format!("a{k}_p10"))?, c.f64(&format!("a{k}_p90"))?, c.f64(&format!("a{k}_min"))?, c.f64(&format!("a{k}_max"))?])
-                })
-                .collect::<Result<_, DesignError>>()?;
-            let modes: Vec<&[i64]> = (0..MODES).map(|m| c.i64(&format!("mode_{m}"))).collect::<Result<_, _>>()?;
-            for r in 0..batch.num_rows() {
-                cells.push(Cell {
-                    ix: ix[r],
-                    iy: iy[r],
-                    x_mm: x[r],
-                    y_mm: y[r],
-                    count: count[r],
-                    coefficients: stats.iter().map(|s| CoefficientStats { p10: s[0][r], p90: s[1][r], min: s[2][r], max: s[3][r] }).collect(),
-                    modes: std::array::from_fn(|m| modes[m][r]),
-                });
-            }
-        }
-        let grid = 0..crate::reduce::MAX_CELLS_PER_AXIS as i32;
-        if let Some(c) = cells.iter().find(|c| !grid.contains(&c.ix) || !grid.contains(&c.iy)) {
-            return Err(map_error(
-                &cells_path,
-                format!("cell ({}, {}) lies off the grid 0..{}: the file is damaged; reduce the run again", c.ix, c.iy, grid.end),
-            ));
-        }
+        let summary = tables::read_summary(dir)?;
+        let cells = tables::read_cells(dir, summary.order)?;
         let index = cells.iter().enumerate().map(|(i, c)| ((c.ix, c.iy), i)).collect();
-        Ok(Self { path: dir.to_path_buf(), summary, cells, index, designs_path: dir.join("designs.parquet") })
+        Ok(Self { path: dir.to_path_buf(), summary, cells, index })
     }
 
     /// Refuses to use a map made for a different rod.
@@ -276,32 +178,7 @@ impl MapDir {
 
     /// Reads every design of `designs.parquet`.
     pub fn designs(&self) -> Result<Vec<MapDesign>, DesignError> {
-        let path = &self.designs_path;
-        let order = self.summary.order;
-        let mut out = Vec::new();
-        for batch in read_batches(path)? {
-            let c = Columns { path, batch: &batch };
-            let (ix, iy, id) = (c.i32("ix")?, c.i32("iy")?, c.i64("routing_id")?);
-            let mirrored = c.bool("mirrored")?;
-            let ys: Vec<&[f64]> = (0..5).map(|i| c.f64(&format!("y{i}_mm"))).collect::<Result<_, _>>()?;
-            let (t, x, y, ang) = (c.f64("tension_n")?, c.f64("tip_x_mm")?, c.f64("tip_y_mm")?, c.f64("tip_angle_rad")?);
-            let a: Vec<&[f64]> = (0..=order).map(|k| c.f64(&format!("a{k}"))).collect::<Result<_, _>>()?;
-            for r in 0..batch.num_rows() {
-                out.push(MapDesign {
-                    ix: ix[r],
-                    iy: iy[r],
-                    routing_id: id[r],
-                    mirrored: mirrored[r],
-                    y_mm: std::array::from_fn(|i| ys[i][r]),
-                    tension_n: t[r],
-                    tip_x_mm: x[r],
-                    tip_y_mm: y[r],
-                    tip_angle_rad: ang[r],
-                    a: a.iter().map(|col| col[r]).collect(),
-                });
-            }
-        }
-        Ok(out)
+        Ok(tables::read_designs(&self.path, self.summary.order)?)
     }
 
     /// The `count` designs of `designs.parquet` nearest to `target` by the

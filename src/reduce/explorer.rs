@@ -145,10 +145,7 @@ pub fn write_explorer(
     shapes: &[Option<BodyDrawing>],
     pictures: &[Picture],
 ) -> Result<(), ReduceError> {
-    let write = |name: &str, bytes: &[u8]| {
-        let path = dir.join(name);
-        crate::io::write_atomic(&path, bytes).map_err(|e| ReduceError::Write { path: path.display().to_string(), message: e.to_string() })
-    };
+    let write = |name: &str, bytes: &[u8]| super::tables::write_file(&dir.join(name), bytes);
     let value = data(map, actuator, shapes, pictures, &utc_now());
     let script = format!("// Written by `cablemap reduce`: the map explorer's data (index.html).\nwindow.CABLEMAP_MAP = {value};\n");
     write(DATA_FILE, script.as_bytes())?;

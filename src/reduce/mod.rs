@@ -1,45 +1,198 @@
 //! Reduce: bin a sweep's tip positions into feasibility maps (thesis Ch. 4,
 //! model-notes §5; the output contract is docs/maps.md).
 //!
-//! Two passes over the run's batches: the first keeps, per converged row, its
-//! tip and a_0…a_2 (and restores the mirrored half when the run dropped
-//! mirror images); cells, percentiles, modes and the picks are computed from
-//! that; the second pass fetches the full rows of the picked designs.
+//! [`reduce_batches`] runs the stages in order, each in its own module:
+//! - `samples` (pass 1): tip and a_0…a_2 of every converged row, the
+//!   mirrored half restored (the mirror rule lives in `mirror`);
+//! - `modes::split`: mode boundaries, given or by quantiles;
+//! - `grid`: the cells over the reach;
+//! - `cells`: per cell its count, percentiles, mode counts and the designs kept;
+//! - `modes::representatives`: the simulation nearest each mode's median;
+//! - `fetch` (pass 2): the full rows of the kept designs and representatives;
+//! - assembly into [`MapData`].
+//!
+//! The map format (file and column names, writer, reader) is [`tables`];
+//! [`output`] writes a whole map directory, [`drawings`] the modes' bodies.
 
+mod cells;
 mod columns;
+pub mod drawings;
 pub mod explorer;
+mod fetch;
+mod grid;
+mod mirror;
+mod modes;
+pub mod output;
 pub mod plots;
+mod samples;
 pub mod stats;
-pub mod write;
+pub mod tables;
 
-use arrow::record_batch::RecordBatch;
-use columns::RowColumns;
-use serde::{Deserialize, Serialize};
 use crate::shape::LengthBasis;
-use stats::{quantile_sorted, quantiles};
-use std::collections::{BTreeMap, HashMap};
+use arrow::record_batch::RecordBatch;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+pub use output::{check_map_out, write_map, write_map_replacing};
 
 /// Number of characteristic modes: a_0 in 4 ranges × a_1 in 3.
 pub const MODES: usize = 12;
 
+/// Highest coefficient order with per-cell statistics (a_0 … a_2).
+pub const CELL_STATS_ORDER: usize = 2;
+
 /// Why a reduction failed.
 #[derive(Debug, thiserror::Error)]
 pub enum ReduceError {
-    /// The shards lack a column or hold it with an unusable type.
-    #[error("sweep data: {0}")]
-    Schema(String),
-    /// Reading the run failed.
+    /// The shards lack a column the reducer reads.
+    #[error("sweep data: column '{name}' is missing from the sweep shards")]
+    MissingColumn {
+        /// The column.
+        name: String,
+    },
+    /// A column holds a type that cannot be read as the reducer's.
+    #[error("sweep data: column '{name}' cannot be read as {to}: {source}")]
+    ColumnType {
+        /// The column.
+        name: String,
+        /// The type the reducer reads.
+        to: arrow::datatypes::DataType,
+        /// Arrow's cast error.
+        source: arrow::error::ArrowError,
+    },
+    /// Opening or reading the run failed.
     #[error("reading the run: {0}")]
-    Read(String),
+    Sweep(#[from] crate::sweep::SweepError),
+    /// The second pass did not find a row the first pass saw.
+    #[error("reading the run: the run changed between the two passes: reduce again")]
+    RunChanged,
     /// No converged row to map.
     #[error("the run has no converged solves to map ({failed} failed): check the spec and `cablemap status`")]
-    Empty { failed: u64 },
-    /// An option is out of range.
+    Empty {
+        /// Failed rows (after mirroring).
+        failed: u64,
+    },
+    /// The cell size is not a positive number.
+    #[error("cell size {} mm must be positive", crate::io::fmt_num(*cell_mm))]
+    CellSize {
+        /// The cell size given, mm.
+        cell_mm: f64,
+    },
+    /// The run has no a_1 column.
+    #[error("the run stores only a_0; modes need a_1: sweep with order ≥ 1")]
+    OrderTooLow,
+    /// Mode boundaries are not finite and ascending.
+    #[error("mode boundaries must be finite and strictly ascending: a0 {a0:?}, a1 {a1:?}")]
+    Boundaries {
+        /// a_0 boundaries.
+        a0: [f64; 3],
+        /// a_1 boundaries.
+        a1: [f64; 2],
+    },
+    /// The quantiles of the run's a_0 and a_1 do not split it into modes.
+    #[error(
+        "mode boundaries must be finite and strictly ascending: a0 {a0:?}, a1 {a1:?}: the run's a0/a1 values are too few \
+         or too alike to split into modes by quantiles (one routing, or a grid whose routings all bend alike); give explicit \
+         mode boundaries (three for a0, two for a1)"
+    )]
+    ModesNotSplit {
+        /// The a_0 quantiles.
+        a0: [f64; 3],
+        /// The a_1 quantiles.
+        a1: [f64; 2],
+    },
+    /// The cell is so small that the grid would exceed [`MAX_CELLS_PER_AXIS`].
+    #[error(
+        "cell size {} mm is too small: the reach ({reach_x_mm:.3} × {reach_y_mm:.3} mm) would span more than \
+         {MAX_CELLS_PER_AXIS} cells per axis; use a cell size ≥ {smallest_cell_mm:.3e} mm",
+        crate::io::fmt_num(*cell_mm)
+    )]
+    CellTooSmall {
+        /// The cell size given, mm.
+        cell_mm: f64,
+        /// Extent of the tips along x, mm.
+        reach_x_mm: f64,
+        /// Extent of the tips along y, mm.
+        reach_y_mm: f64,
+        /// The smallest cell that works, mm.
+        smallest_cell_mm: f64,
+    },
+    /// The map directory is, or lies inside, a sweep run directory.
     #[error("{0}")]
-    BadOption(String),
-    /// Writing an output.
-    #[error("writing {path}: {message}")]
-    Write { path: String, message: String },
+    MapInRun(String),
+    /// The map directory is given as `.` or `..`.
+    #[error("map directory {}: give a map directory by name (not '.' or '..'): it is replaced as a whole", path.display())]
+    MapDirUnnamed {
+        /// The directory.
+        path: PathBuf,
+    },
+    /// The map directory holds something other than a map.
+    #[error(
+        "map directory {}: exists and is not a cablemap map (no summary.json), and a map directory is replaced as a whole: \
+         give a new directory, or an earlier map to replace",
+        path.display()
+    )]
+    NotAMap {
+        /// The directory.
+        path: PathBuf,
+    },
+    /// The map directory cannot be listed.
+    #[error("map directory {}: cannot be read as a directory ({source})", path.display())]
+    MapDirUnreadable {
+        /// The directory.
+        path: PathBuf,
+        /// The error listing it.
+        source: std::io::Error,
+    },
+    /// Creating a directory failed.
+    #[error("writing {}: cannot create ({source})", path.display())]
+    CreateDir {
+        /// The directory.
+        path: PathBuf,
+        /// The error.
+        source: std::io::Error,
+    },
+    /// Writing a file failed.
+    #[error("writing {}: {source}", path.display())]
+    Write {
+        /// The file.
+        path: PathBuf,
+        /// The error.
+        source: std::io::Error,
+    },
+    /// Encoding a table as Parquet failed.
+    #[error("writing {}: {source}", path.display())]
+    WriteParquet {
+        /// The file.
+        path: PathBuf,
+        /// The error.
+        source: parquet::errors::ParquetError,
+    },
+    /// Assembling a table failed.
+    #[error("writing {}: {source}", path.display())]
+    WriteArrow {
+        /// The file.
+        path: PathBuf,
+        /// The error.
+        source: arrow::error::ArrowError,
+    },
+    /// Encoding JSON failed.
+    #[error("writing {}: {source}", path.display())]
+    WriteJson {
+        /// The file.
+        path: PathBuf,
+        /// The error.
+        source: serde_json::Error,
+    },
+    /// Putting the new map in place of the old failed.
+    #[error("writing {}: cannot put the new map in place ({source})", path.display())]
+    Replace {
+        /// The map directory.
+        path: PathBuf,
+        /// The error.
+        source: std::io::Error,
+    },
     /// Drawing a picture.
     #[error(transparent)]
     Plot(#[from] crate::plot::PlotError),
@@ -83,10 +236,7 @@ impl ModeBoundaries {
         if ok(&self.a0) && ok(&self.a1) {
             Ok(())
         } else {
-            Err(ReduceError::BadOption(format!(
-                "mode boundaries must be finite and strictly ascending: a0 {:?}, a1 {:?}",
-                self.a0, self.a1
-            )))
+            Err(ReduceError::Boundaries { a0: self.a0, a1: self.a1 })
         }
     }
 
@@ -270,294 +420,64 @@ pub struct MapData {
     pub designs: Vec<Design>,
 }
 
-/// One converged simulation as pass 1 keeps it.
-#[derive(Debug, Clone, Copy)]
-struct Sample {
-    x: f64,
-    y: f64,
-    a: [f64; 3],
-    /// Row number in pass order.
-    row: u32,
-    mirrored: bool,
-}
-
 /// Reduces a run. `batches` is called once per pass and must yield the same
 /// rows in the same order each time.
+///
+/// What each stage needs of the run, so that it can be computed without
+/// holding every row: the mode split, the run's a_0/a_1 quantiles; the
+/// grid, the tips' extent; a cell, its own samples only (cells can be done
+/// range by range and concatenated in (ix, iy) order); a mode's
+/// representative, the mode's medians and its nearest member (ties to the
+/// lowest simulation, so any partition gives the same pick); pass 2, the
+/// row numbers wanted.
 pub fn reduce_batches<F, I>(info: &RunInfo, options: &ReduceOptions, mut batches: F) -> Result<MapData, ReduceError>
 where
     F: FnMut() -> Result<I, ReduceError>,
     I: Iterator<Item = Result<RecordBatch, ReduceError>>,
 {
-    if !(options.cell_mm.is_finite() && options.cell_mm > 0.0) {
-        return Err(ReduceError::BadOption(format!("cell size {} mm must be positive", crate::io::fmt_num(options.cell_mm))));
-    }
-    if info.order < 1 {
-        return Err(ReduceError::BadOption("the run stores only a_0; modes need a_1: sweep with order ≥ 1".into()));
-    }
-    if let Some(b) = &options.mode_boundaries {
-        b.validate()?;
-    }
-    let nk = info.order.min(2) + 1;
-    // Pass 1: tips and coefficients of every converged row (and its mirror).
-    let mut samples: Vec<Sample> = Vec::new();
-    let mut failed_by_status: BTreeMap<String, u64> = BTreeMap::new();
-    let mut rows_total = 0u64;
-    let mut row = 0u32;
-    for batch in batches()? {
-        let cols = RowColumns::from_batch(&batch?, info.order)?;
-        for i in 0..cols.len() {
-            let self_mirror = cols.y_mm.iter().all(|y| y.value(i) == 0.0);
-            let copies = if info.mirrored && !self_mirror { 2 } else { 1 };
-            rows_total += copies;
-            if !cols.converged(i) {
-                *failed_by_status.entry(cols.status_of(i).to_string()).or_default() += copies;
-            } else {
-                let mut a = [0.0; 3];
-                for (k, slot) in a.iter_mut().enumerate().take(nk) {
-                    *slot = cols.a[k].value(i);
-                }
-                let s = Sample { x: cols.tip_x_mm.value(i), y: cols.tip_y_mm.value(i), a, row, mirrored: false };
-                samples.push(s);
-                if copies == 2 {
-                    samples.push(Sample { y: -s.y, a: a.map(|v| -v), mirrored: true, ..s });
-                }
-            }
-            row += 1;
-        }
-    }
-    let rows_failed: u64 = failed_by_status.values().sum();
+    check_options(info, options)?;
+    let (mut samples, tally) = samples::read_samples(info, batches()?)?;
     if samples.is_empty() {
-        return Err(ReduceError::Empty { failed: rows_failed });
+        return Err(ReduceError::Empty { failed: tally.rows_failed() });
     }
-    // Quantiles of a_0 and a_1 over the converged rows, sorted once: they
-    // give the default mode boundaries and the spreads (interquartile
-    // ranges) that scale the distance to a mode's median.
-    let sorted = |k: usize| -> Vec<f64> {
-        let mut v: Vec<f64> = samples.iter().map(|s| s.a[k]).collect();
-        v.sort_unstable_by(f64::total_cmp);
-        v
-    };
-    let (a0, a1) = (sorted(0), sorted(1));
-    let q0 = [0.25, 0.5, 0.75].map(|p| quantile_sorted(&a0, p));
-    let q1 = [0.25, 1.0 / 3.0, 2.0 / 3.0, 0.75].map(|p| quantile_sorted(&a1, p));
-    drop((a0, a1));
-    let (s0, s1) = ((q0[2] - q0[0]).max(1e-12), (q1[3] - q1[0]).max(1e-12));
-    let (boundaries, source) = match options.mode_boundaries {
-        Some(b) => (b, "explicit"),
-        None => (ModeBoundaries { a0: [q0[0], q0[1], q0[2]], a1: [q1[1], q1[2]] }, "quantiles"),
-    };
-    // Quantiles of too few distinct coefficients (a one-routing run) do not
-    // split the modes; a map with such boundaries would be refused by
-    // `feasible` and `design`, so it is refused here, with the fix.
-    boundaries.validate().map_err(|e| {
-        ReduceError::BadOption(format!(
-            "{e}: the run's a0/a1 values are too few or too alike to split into modes by quantiles \
-             (one routing, or a grid whose routings all bend alike); give explicit --a0-bounds B1,B2,B3 and \
-             --a1-bounds C1,C2"
-        ))
-    })?;
-    // The grid.
-    let cell = options.cell_mm;
-    let (mut xmin, mut xmax, mut ymin, mut ymax) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-    for s in &samples {
-        xmin = xmin.min(s.x);
-        xmax = xmax.max(s.x);
-        ymin = ymin.min(s.y);
-        ymax = ymax.max(s.y);
-    }
-    let x0 = (xmin / cell).floor() * cell;
-    let y0 = (ymin / cell).floor() * cell;
-    // Cell indices are i32 in the tables: a cell so small that the reach
-    // spans more than MAX_CELLS_PER_AXIS cells would overflow them (and no
-    // picture of it could be drawn), so it is refused with the smallest
-    // cell that works.
-    let (span_x, span_y) = ((xmax - x0) / cell, (ymax - y0) / cell);
-    let limit = MAX_CELLS_PER_AXIS as f64;
-    if !(x0.is_finite() && y0.is_finite() && span_x < limit && span_y < limit) {
-        let reach = (xmax - xmin).max(ymax - ymin);
-        return Err(ReduceError::BadOption(format!(
-            "--cell-mm {} is too small: the reach ({:.3} × {:.3} mm) would span more than {MAX_CELLS_PER_AXIS} cells per axis; \
-             use --cell-mm ≥ {:.3e}",
-            crate::io::fmt_num(cell),
-            xmax - xmin,
-            ymax - ymin,
-            (reach / (limit - 2.0)).max(f64::MIN_POSITIVE)
-        )));
-    }
-    let nx = (span_x.floor() as usize) + 1;
-    let ny = (span_y.floor() as usize) + 1;
-    let cell_of = |s: &Sample| -> (i32, i32) {
-        (((s.x - x0) / cell).floor() as i32, ((s.y - y0) / cell).floor() as i32)
-    };
-    samples.sort_unstable_by_key(|s| {
-        let (ix, iy) = cell_of(s);
-        (ix, iy, s.row, s.mirrored)
-    });
-    // Per cell: counts, percentiles, modes, design picks.
-    let mut cells = Vec::new();
-    let mut picks: Vec<(u32, bool, i32, i32)> = Vec::new();
-    let mut mode_cells = [0i64; MODES];
-    let mut values = Vec::new();
-    let mut start = 0;
-    while start < samples.len() {
-        let key = cell_of(&samples[start]);
-        let mut end = start;
-        while end < samples.len() && cell_of(&samples[end]) == key {
-            end += 1;
-        }
-        let group = &mut samples[start..end];
-        let mut coefficients = Vec::with_capacity(nk);
-        for k in 0..nk {
-            values.clear();
-            values.extend(group.iter().map(|s| s.a[k]));
-            values.sort_unstable_by(f64::total_cmp);
-            coefficients.push(CoefficientStats {
-                p10: quantile_sorted(&values, 0.1),
-                p90: quantile_sorted(&values, 0.9),
-                min: values[0],
-                max: values[values.len() - 1],
-            });
-        }
-        let mut modes = [0i64; MODES];
-        for s in group.iter() {
-            modes[boundaries.mode(s.a[0], s.a[1])] += 1;
-        }
-        for (m, &c) in modes.iter().enumerate() {
-            if c > 0 {
-                mode_cells[m] += 1;
-            }
-        }
-        // Designs spanning the cell's a_0 range.
-        group.sort_unstable_by(|p, q| p.a[0].total_cmp(&q.a[0]).then(p.row.cmp(&q.row)));
-        let n = group.len();
-        let keep = options.designs_per_cell.min(n);
-        for j in 0..keep {
-            let idx = if keep == 1 { n / 2 } else { j * (n - 1) / (keep - 1) };
-            picks.push((group[idx].row, group[idx].mirrored, key.0, key.1));
-        }
-        cells.push(CellStats {
-            ix: key.0,
-            iy: key.1,
-            x_mm: x0 + (key.0 as f64 + 0.5) * cell,
-            y_mm: y0 + (key.1 as f64 + 0.5) * cell,
-            count: (end - start) as i64,
-            coefficients,
-            modes,
-        });
-        start = end;
-    }
-    // Modes: counts and the sample nearest each mode's median (a_0, a_1),
-    // distances scaled by the spread of each coefficient over the run.
-    let mut by_mode: Vec<Vec<&Sample>> = vec![Vec::new(); MODES];
-    for s in &samples {
-        by_mode[boundaries.mode(s.a[0], s.a[1])].push(s);
-    }
-    let mut rep_rows: Vec<Option<(u32, bool)>> = vec![None; MODES];
-    for (m, members) in by_mode.iter().enumerate() {
-        if members.is_empty() {
-            continue;
-        }
-        let med = |k: usize| quantiles(&members.iter().map(|s| s.a[k]).collect::<Vec<_>>(), &[0.5])[0];
-        let (m0, m1) = (med(0), med(1));
-        let best = members
-            .iter()
-            .min_by(|p, q| {
-                let d = |s: &Sample| ((s.a[0] - m0) / s0).powi(2) + ((s.a[1] - m1) / s1).powi(2);
-                d(p).total_cmp(&d(q)).then(p.row.cmp(&q.row))
-            })
-            .expect("non-empty");
-        rep_rows[m] = Some((best.row, best.mirrored));
-    }
+    let split = modes::split(&samples, options.mode_boundaries)?;
+    let grid = grid::Grid::spanning(&samples, options.cell_mm)?;
+    let nk = info.order.min(CELL_STATS_ORDER) + 1;
+    let cells = cells::tabulate(&mut samples, &grid, &split.boundaries, nk, options.designs_per_cell);
+    let representatives = modes::representatives(&samples, &split);
     let rows_converged = samples.len() as u64;
-    drop(by_mode);
     drop(samples);
-    // Pass 2: the full rows of every pick.
-    let mut wanted: HashMap<u32, Option<Design>> = picks.iter().map(|p| (p.0, None)).collect();
-    for r in rep_rows.iter().flatten() {
-        wanted.insert(r.0, None);
-    }
-    let mut row = 0u32;
-    for batch in batches()? {
-        let cols = RowColumns::from_batch(&batch?, info.order)?;
-        for i in 0..cols.len() {
-            if let Some(slot) = wanted.get_mut(&row) {
-                *slot = Some(Design {
-                    ix: 0,
-                    iy: 0,
-                    routing_id: cols.routing_id.value(i),
-                    mirrored: false,
-                    y_mm: std::array::from_fn(|k| cols.y_mm[k].value(i)),
-                    tension_n: cols.tension_n.value(i),
-                    tip_x_mm: cols.tip_x_mm.value(i),
-                    tip_y_mm: cols.tip_y_mm.value(i),
-                    tip_angle_rad: cols.tip_angle_rad.value(i),
-                    a: cols.a.iter().map(|a| a.value(i)).collect(),
-                });
-            }
-            row += 1;
+    let wanted = cells.picks.iter().map(|p| p.at).chain(representatives.iter().flatten().copied());
+    let rows = fetch::Fetched::read(info.order, wanted, batches()?)?;
+    let designs = cells
+        .picks
+        .iter()
+        .map(|p| Ok(Design { ix: p.ix, iy: p.iy, ..rows.design(p.at)? }))
+        .collect::<Result<Vec<_>, ReduceError>>()?;
+    let mut fetched: [Option<Design>; MODES] = Default::default();
+    for (slot, at) in fetched.iter_mut().zip(representatives) {
+        if let Some(at) = at {
+            let d = rows.design(at)?;
+            let (ix, iy) = grid.cell_of(d.tip_x_mm, d.tip_y_mm);
+            *slot = Some(Design { ix, iy, ..d });
         }
     }
-    let fetch = |r: u32, mirrored: bool| -> Result<Design, ReduceError> {
-        let d = wanted
-            .get(&r)
-            .and_then(|d| d.clone())
-            .ok_or_else(|| ReduceError::Read("the run changed between the two passes: reduce again".into()))?;
-        Ok(if mirrored {
-            Design {
-                mirrored: true,
-                y_mm: d.y_mm.map(|v| -v),
-                tip_y_mm: -d.tip_y_mm,
-                tip_angle_rad: -d.tip_angle_rad,
-                a: d.a.iter().map(|v| -v).collect(),
-                ..d
-            }
-        } else {
-            d
-        })
-    };
-    let mut designs = Vec::with_capacity(picks.len());
-    for &(r, mirrored, ix, iy) in &picks {
-        designs.push(Design { ix, iy, ..fetch(r, mirrored)? });
-    }
-    let mut modes = Vec::with_capacity(MODES);
-    for m in 0..MODES {
-        let (i, j) = (m / 3, m % 3);
-        let count = cells.iter().map(|c| c.modes[m]).sum();
-        let representative = match rep_rows[m] {
-            Some((r, mirrored)) => {
-                let d = fetch(r, mirrored)?;
-                let ix = ((d.tip_x_mm - x0) / cell).floor() as i32;
-                let iy = ((d.tip_y_mm - y0) / cell).floor() as i32;
-                Some(Design { ix, iy, ..d })
-            }
-            None => None,
-        };
-        modes.push(ModeStats {
-            mode: m,
-            a0_range: i,
-            a1_range: j,
-            a0_bounds: ModeBoundaries::bounds(&boundaries.a0, i),
-            a1_bounds: ModeBoundaries::bounds(&boundaries.a1, j),
-            count,
-            cells: mode_cells[m],
-            representative,
-        });
-    }
+    let modes = modes::table(&cells, &split.boundaries, fetched);
     let summary = MapSummary {
-        cell_mm: cell,
-        x_min_mm: x0,
-        y_min_mm: y0,
-        nx,
-        ny,
+        cell_mm: grid.cell_mm,
+        x_min_mm: grid.x_min_mm,
+        y_min_mm: grid.y_min_mm,
+        nx: grid.nx,
+        ny: grid.ny,
         order: info.order,
         mirrored: info.mirrored,
-        rows_total,
+        rows_total: tally.rows_total,
         rows_converged,
-        rows_failed,
-        failed_by_status,
-        mode_boundaries: boundaries,
-        mode_boundaries_source: source.into(),
-        cells: cells.len(),
+        rows_failed: tally.rows_failed(),
+        failed_by_status: tally.failed_by_status,
+        mode_boundaries: split.boundaries,
+        mode_boundaries_source: split.source.into(),
+        cells: cells.cells.len(),
         tension_range_n: info.tension_range_n,
         radius_mm: info.radius_mm,
         length_mm: info.length_mm,
@@ -565,7 +485,21 @@ where
         spec_hash: info.spec_hash.clone(),
         length_basis: info.length_basis,
     };
-    Ok(MapData { summary, cells, modes, designs })
+    Ok(MapData { summary, cells: cells.cells, modes, designs })
+}
+
+/// Refuses options the reduction cannot use, before reading the run.
+fn check_options(info: &RunInfo, options: &ReduceOptions) -> Result<(), ReduceError> {
+    if !(options.cell_mm.is_finite() && options.cell_mm > 0.0) {
+        return Err(ReduceError::CellSize { cell_mm: options.cell_mm });
+    }
+    if info.order < 1 {
+        return Err(ReduceError::OrderTooLow);
+    }
+    if let Some(b) = &options.mode_boundaries {
+        b.validate()?;
+    }
+    Ok(())
 }
 
 /// Most cells along either axis of a map (cell indices are stored as i32;
@@ -576,193 +510,37 @@ pub const MAX_CELLS_PER_AXIS: usize = 100_000;
 /// coefficient is a curvature.
 pub const COEFFICIENT_UNIT: &str = "mm⁻¹";
 
-/// Writes the map directory `dir` as a whole: everything is written into a
-/// staging directory beside it (`.NAME.tmp-TOKEN`), which then replaces
-/// `dir` by rename, so a reader sees the old map or the new one, never a
-/// mix (an interrupted reduce leaves the old map untouched). `dir` must be
-/// new, empty, or an earlier map (it has summary.json); it must not be, or
-/// lie directly inside, a sweep run directory.
-pub fn write_map_replacing(
-    dir: &std::path::Path,
-    map: &MapData,
-    actuator: &crate::model::Actuator,
-    solver: &crate::model::SolverOptions,
-) -> Result<Vec<plots::Picture>, ReduceError> {
-    use std::path::Path;
-    let werr = |path: &Path, message: String| ReduceError::Write { path: path.display().to_string(), message };
-    let name = check_map_out(dir)?;
-    let parent = match dir.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-        _ => std::path::PathBuf::from("."),
+/// Reduces the sweep run in `run_dir` (refusing an unfinished run unless
+/// `partial`). Returns the map and the run's spec (for drawing).
+pub fn reduce_run(
+    run_dir: &std::path::Path,
+    partial: bool,
+    options: &ReduceOptions,
+) -> Result<(MapData, crate::sweep::SweepSpec), ReduceError> {
+    use crate::sweep::{open_run, Completeness};
+    let completeness = if partial { Completeness::AllowPartial } else { Completeness::Complete };
+    let run = open_run(run_dir, completeness)?;
+    let spec = run.spec().clone();
+    let info = RunInfo {
+        mirrored: spec.grid.mirror_dedup,
+        order: spec.output.order,
+        tension_range_n: [spec.tension.min_n, spec.tension.max_n],
+        radius_mm: spec.actuator.radius_mm,
+        length_mm: spec.actuator.length_mm,
+        run_dir: run_dir.display().to_string(),
+        spec_hash: run.manifest().spec_sha256.clone(),
+        length_basis: spec.output.length_basis,
     };
-    std::fs::create_dir_all(&parent).map_err(|e| werr(&parent, format!("cannot create ({e})")))?;
-    remove_abandoned_staging(&parent, &name);
-    let staging = parent.join(format!(".{name}.tmp-{}", crate::io::unique_token()));
-    std::fs::create_dir(&staging).map_err(|e| werr(&staging, format!("cannot create ({e})")))?;
-    // Held while writing so that another reduce does not clear it away.
-    let lock = std::fs::File::open(&staging).ok();
-    if let Some(l) = &lock {
-        let _ = l.try_lock();
-    }
-    let written = write_map(&staging, map, actuator, solver).and_then(|pictures| {
-        crate::io::sync_dir(&staging);
-        replace_dir(&staging, dir, &parent, &name).map_err(|e| werr(dir, format!("cannot put the new map in place ({e})")))?;
-        Ok(pictures)
-    });
-    if written.is_err() {
-        let _ = std::fs::remove_dir_all(&staging);
-    }
-    drop(lock);
-    written
-}
-
-/// Checks that `dir` can take a map (see [`write_map_replacing`]) before
-/// any work is done; returns its file name.
-pub fn check_map_out(dir: &std::path::Path) -> Result<String, ReduceError> {
-    use std::path::Path;
-    let werr = |path: &Path, message: String| ReduceError::BadOption(format!("map directory {}: {message}", path.display()));
-    crate::io::check_not_in_run_dir(dir, "--out").map_err(ReduceError::BadOption)?;
-    let name = dir.file_name().map(|n| n.to_string_lossy().into_owned()).filter(|n| n != "." && n != "..");
-    let Some(name) = name else {
-        return Err(werr(dir, "give a map directory by name (not '.' or '..'): it is replaced as a whole".into()));
-    };
-    match std::fs::read_dir(dir) {
-        Ok(mut entries) => {
-            if entries.next().is_some() && !dir.join("summary.json").is_file() {
-                return Err(werr(
-                    dir,
-                    "exists and is not a cablemap map (no summary.json), and a map directory is replaced as a whole: \
-                     give a new directory, or an earlier map to replace"
-                        .into(),
-                ));
-            }
-        }
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
-        Err(e) => return Err(werr(dir, format!("cannot be read as a directory ({e})"))),
-    }
-    Ok(name)
-}
-
-/// Moves `staging` to `dir`: directly when `dir` is absent or empty, else
-/// by an atomic exchange (Linux), else by moving the old map aside first
-/// and deleting it after (a moment without `dir`, never a mixed one).
-fn replace_dir(staging: &std::path::Path, dir: &std::path::Path, parent: &std::path::Path, name: &str) -> std::io::Result<()> {
-    match std::fs::rename(staging, dir) {
-        Ok(()) => {}
-        Err(_) if dir.is_dir() && crate::io::exchange(staging, dir)? => {
-            // `staging` now holds the old map.
-            let _ = std::fs::remove_dir_all(staging);
-        }
-        Err(_) if dir.is_dir() => {
-            let old = parent.join(format!(".{name}.old-{}", crate::io::unique_token()));
-            std::fs::rename(dir, &old)?;
-            if let Err(e) = std::fs::rename(staging, dir) {
-                let _ = std::fs::rename(&old, dir);
-                return Err(e);
-            }
-            let _ = std::fs::remove_dir_all(&old);
-        }
-        Err(e) => return Err(e),
-    }
-    crate::io::sync_dir(parent);
-    Ok(())
-}
-
-/// Removes staging and old-map directories of `name` left by killed
-/// reduces (no writer holds their lock, or they are stale).
-fn remove_abandoned_staging(parent: &std::path::Path, name: &str) {
-    let Ok(entries) = std::fs::read_dir(parent) else { return };
-    for entry in entries.flatten() {
-        let file_name = entry.file_name().to_string_lossy().into_owned();
-        let left = crate::io::is_temp_of(&file_name, name)
-            || file_name.strip_prefix(&format!(".{name}.old-")).is_some_and(|t| !t.is_empty());
-        if left && entry.path().is_dir() && crate::io::is_abandoned(&entry.path()) {
-            let _ = std::fs::remove_dir_all(entry.path());
-        }
-    }
-}
-
-/// Writes the whole map directory: tables, pictures and index.html.
-/// `actuator` and `solver` re-simulate the mode representatives for drawing.
-/// Writes in place; [`write_map_replacing`] is what the commands use.
-pub fn write_map(
-    dir: &std::path::Path,
-    map: &MapData,
-    actuator: &crate::model::Actuator,
-    solver: &crate::model::SolverOptions,
-) -> Result<Vec<plots::Picture>, ReduceError> {
-    use plots::{draw_heatmap, Picture, Scale};
-    std::fs::create_dir_all(dir)
-        .map_err(|e| ReduceError::Write { path: dir.display().to_string(), message: e.to_string() })?;
-    write::write_tables(dir, map)?;
-    let s = &map.summary;
-    let mut pictures = Vec::new();
-    let reach: Vec<(i32, i32, f64)> = map.cells.iter().map(|c| (c.ix, c.iy, c.count as f64)).collect();
-    draw_heatmap(&dir.join("reach.png"), s, "Reachable tip positions: simulations per cell", "simulations per cell (log scale)", &reach, Scale::Log)?;
-    pictures.push(Picture {
-        file: "reach.png".into(),
-        title: "Reach (thesis Fig. 4.1)".into(),
-        explanation: format!(
-            "Every {} mm cell that some routing and tension puts the tip in; the colour counts the simulations, so dark cells are reached by few configurations.",
-            s.cell_mm
-        ),
-    });
-    let nk = map.cells.first().map_or(0, |c| c.coefficients.len());
-    for k in 0..nk {
-        let stats = |f: &dyn Fn(&CoefficientStats) -> f64| -> Vec<(i32, i32, f64)> {
-            map.cells.iter().map(|c| (c.ix, c.iy, f(&c.coefficients[k]))).collect()
-        };
-        let unit = format!("a{k} ({COEFFICIENT_UNIT}, {} basis)", s.length_basis);
-        for (name, what, values, scale) in [
-            ("p10", "10th percentile", stats(&|c| c.p10), Scale::Symmetric),
-            ("p90", "90th percentile", stats(&|c| c.p90), Scale::Symmetric),
-            ("gap", "90th − 10th percentile", stats(&|c| c.p90 - c.p10), Scale::Linear),
-        ] {
-            let file = format!("a{k}_{name}.png");
-            let title = format!("a{k}: {what} per cell");
-            draw_heatmap(&dir.join(&file), s, &title, &unit, &values, scale)?;
-            // Thesis Fig. 4.2 shows a0, Fig. 4.3 a1; the thesis has no a2 map.
-            let figure = match k {
-                0 => " (as thesis Fig. 4.2)",
-                1 => " (as thesis Fig. 4.3)",
-                _ => "",
-            };
-            let basis = s.length_basis.describe();
-            let explanation = match name {
-                "gap" => format!("Spread of a{k} ({COEFFICIENT_UNIT}, {basis}) among the configurations reaching each cell: a large gap means more than one mode of deformation reaches it{figure}."),
-                _ => format!("The {what} of a{k} ({COEFFICIENT_UNIT}, {basis}) over the simulations whose tip falls in each cell{figure}."),
-            };
-            pictures.push(Picture { file, title, explanation });
-        }
-    }
-    // Representative shapes, re-simulated from their routing and tension.
-    let shapes: Vec<Option<crate::plot::BodyDrawing>> = map
-        .modes
-        .iter()
-        .map(|m| {
-            let d = m.representative.as_ref()?;
-            let routing = crate::model::Routing::new(&d.y_mm, actuator.length_mm, actuator.radius_mm).ok()?;
-            let sim = crate::model::simulate(actuator, solver, &routing, d.tension_n, 1, crate::shape::LengthBasis::default()).ok()?;
-            Some(crate::plot::BodyDrawing::of_simulation(&sim, actuator.radius_mm, format!("mode {}", m.mode), plotters::style::full_palette::BLUE_800))
-        })
-        .collect();
-    plots::draw_modes(&dir.join("modes.png"), map, &shapes)?;
-    pictures.push(Picture {
-        file: "modes.png".into(),
-        title: "Characteristic modes (thesis Fig. 4.4)".into(),
-        explanation: format!(
-            "a0 split into 4 ranges (rows) and a1 into 3 (columns), a_i {}; each panel maps where that combination occurs and draws the simulation nearest the mode's median coefficients.",
-            s.length_basis.describe()
-        ),
-    });
-    explorer::write_explorer(dir, map, actuator, &shapes, &pictures)?;
-    Ok(pictures)
+    let columns = columns::RowColumns::names(info.order);
+    let names: Vec<&str> = columns.iter().map(String::as_str).collect();
+    let map = reduce_batches(&info, options, || Ok(run.batches_projected(&names)?.map(|b| b.map_err(ReduceError::from))))?;
+    Ok((map, spec))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use arrow::array::{ArrayRef, Float64Array, Int64Array, StringArray};
+    use arrow::array::{Array, ArrayRef, Float64Array, Int64Array, StringArray};
     use arrow::datatypes::{DataType, Field, Schema};
     use std::sync::Arc;
 
@@ -892,6 +670,72 @@ mod tests {
         .unwrap_err();
         assert!(e.to_string().contains("ascending"), "{e}");
     }
+    #[test]
+    fn the_tables_read_back_as_written() {
+        let map = run(&pseudo_rows(300), true, &ReduceOptions::default());
+        let tmp = tempfile::tempdir().unwrap();
+        tables::write_tables(tmp.path(), &map).unwrap();
+        let summary = tables::read_summary(tmp.path()).unwrap();
+        assert_eq!(serde_json::to_value(&summary).unwrap(), serde_json::to_value(&map.summary).unwrap());
+        let cells = tables::read_cells(tmp.path(), summary.order).unwrap();
+        assert_eq!(format!("{cells:?}"), format!("{:?}", map.cells));
+        assert_eq!(tables::read_designs(tmp.path(), summary.order).unwrap(), map.designs);
+        // A table without one of its columns is refused, naming the column.
+        let e = tables::read_designs(tmp.path(), 3).unwrap_err();
+        assert!(e.to_string().contains("`a3` is missing"), "{e}");
+    }
+
+    #[test]
+    fn errors_name_the_problem_and_keep_their_source() {
+        use std::error::Error as _;
+        let tmp = tempfile::tempdir().unwrap();
+        let e = reduce_run(tmp.path(), false, &ReduceOptions::default()).unwrap_err();
+        assert!(matches!(e, ReduceError::Sweep(crate::sweep::SweepError::NoRun { .. })), "{e:?}");
+        assert!(e.source().is_some());
+        // A cell too small for the grid: the smallest that works, no flag names.
+        let e = reduce_batches(&info(false), &ReduceOptions { cell_mm: 1e-300, ..Default::default() }, || {
+            Ok(vec![Ok(batch(&pseudo_rows(40)))].into_iter())
+        })
+        .unwrap_err();
+        match &e {
+            ReduceError::CellTooSmall { smallest_cell_mm, .. } => assert!(*smallest_cell_mm > 1e-6 && *smallest_cell_mm < 1e-3),
+            other => panic!("{other:?}"),
+        }
+        // One routing cannot be split into modes by quantiles.
+        let one: Vec<Row> = (0..5).map(|i| ([0.0, 1.0, 0.0, -1.0, 0.5], 1.0 + 0.1 * i as f64, "ok", 50.0, 2.0, [0.1, 0.2, 0.0])).collect();
+        let e = reduce_batches(&info(false), &ReduceOptions::default(), || Ok(vec![Ok(batch(&one))].into_iter())).unwrap_err();
+        assert!(matches!(e, ReduceError::ModesNotSplit { .. }), "{e:?}");
+        for e in [e.to_string(), ReduceError::CellSize { cell_mm: 0.0 }.to_string()] {
+            assert!(!e.contains("--"), "a library message names no flag: {e}");
+        }
+        // A sweep column of the wrong type keeps Arrow's error as its source.
+        let b = batch(&pseudo_rows(3));
+        let i = b.schema().index_of("tip_x_mm").unwrap();
+        let mut cols = b.columns().to_vec();
+        let lists = arrow::array::ListArray::from_iter_primitive::<arrow::datatypes::Float64Type, _, _>((0..3).map(|_| Some(vec![Some(1.0)])));
+        let list_type = lists.data_type().clone();
+        cols[i] = Arc::new(lists);
+        let mut fields: Vec<Field> = b.schema().fields().iter().map(|f| f.as_ref().clone()).collect();
+        fields[i] = Field::new("tip_x_mm", list_type, true);
+        let bad = RecordBatch::try_new(Arc::new(Schema::new(fields)), cols).unwrap();
+        let e = reduce_batches(&info(false), &ReduceOptions::default(), || Ok(vec![Ok(bad.clone())].into_iter())).unwrap_err();
+        assert!(matches!(e, ReduceError::ColumnType { .. }) && e.source().is_some(), "{e:?}");
+    }
+
+    #[test]
+    fn a_representative_that_cannot_be_drawn_is_reported() {
+        let mut map = run(&pseudo_rows(200), false, &ReduceOptions::default());
+        let actuator = crate::model::Actuator::default();
+        let m = map.modes.iter().position(|m| m.representative.is_some()).unwrap();
+        // Outside the body: the routing is refused, and the drawing says so.
+        map.modes[m].representative.as_mut().unwrap().y_mm[2] = 2.0 * actuator.radius_mm;
+        let drawings = drawings::ModeDrawings::of_map(&map, &actuator, &crate::model::SolverOptions::default());
+        assert_eq!(drawings.shapes.len(), MODES);
+        assert!(drawings.shapes[m].is_none());
+        assert_eq!(drawings.failures.len(), 1);
+        let note = drawings.failure_note();
+        assert!(note.contains(&format!("mode {m}")) && note.contains("routing"), "{note}");
+    }
 }
 
 #[cfg(test)]
@@ -993,42 +837,3 @@ mod picture_tests {
     }
 }
 
-/// Columns the reducer reads from a sweep (docs/schema.md).
-fn needed_columns(order: usize) -> Vec<String> {
-    let mut cols: Vec<String> = ["routing_id", "status", "y0_mm", "y1_mm", "y2_mm", "y3_mm", "y4_mm", "tension_n", "tip_x_mm", "tip_y_mm", "tip_angle_rad"]
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
-    cols.extend((0..=order).map(|k| format!("a{k}")));
-    cols
-}
-
-/// Reduces the sweep run in `run_dir` (refusing an unfinished run unless
-/// `partial`). Returns the map and the run's spec (for drawing).
-pub fn reduce_run(
-    run_dir: &std::path::Path,
-    partial: bool,
-    options: &ReduceOptions,
-) -> Result<(MapData, crate::sweep::SweepSpec), crate::Error> {
-    use crate::sweep::{open_run, Completeness};
-    let completeness = if partial { Completeness::AllowPartial } else { Completeness::Complete };
-    let run = open_run(run_dir, completeness)?;
-    let spec = run.spec().clone();
-    let info = RunInfo {
-        mirrored: spec.grid.mirror_dedup,
-        order: spec.output.order,
-        tension_range_n: [spec.tension.min_n, spec.tension.max_n],
-        radius_mm: spec.actuator.radius_mm,
-        length_mm: spec.actuator.length_mm,
-        run_dir: run_dir.display().to_string(),
-        spec_hash: run.manifest().spec_sha256.clone(),
-        length_basis: spec.output.length_basis,
-    };
-    let columns = needed_columns(info.order);
-    let names: Vec<&str> = columns.iter().map(String::as_str).collect();
-    let map = reduce_batches(&info, options, || {
-        let batches = run.batches_projected(&names).map_err(|e| ReduceError::Read(e.to_string()))?;
-        Ok(batches.map(|b| b.map_err(|e| ReduceError::Read(e.to_string()))))
-    })?;
-    Ok((map, spec))
-}

@@ -22,8 +22,14 @@ pub const TENSION_N: &str = "tension_n";
 pub const STATUS: &str = "status";
 /// Integration passes of the solve (i32, non-null; 0 for failed solves).
 pub const ITERATIONS: &str = "iterations";
+/// Tip position x (nullable f64, mm).
+pub const TIP_X_MM: &str = "tip_x_mm";
+/// Tip position y (nullable f64, mm).
+pub const TIP_Y_MM: &str = "tip_y_mm";
+/// Tip tangent angle (nullable f64, rad).
+pub const TIP_ANGLE_RAD: &str = "tip_angle_rad";
 /// Pose columns (nullable f64), named as in `cablemap simulate --json`.
-pub const POSE_COLUMNS: [&str; 5] = ["tip_x_mm", "tip_y_mm", "tip_angle_rad", "base_angle_rad", "length_mm"];
+pub const POSE_COLUMNS: [&str; 5] = [TIP_X_MM, TIP_Y_MM, TIP_ANGLE_RAD, "base_angle_rad", "length_mm"];
 /// Optional centreline x positions (list of f64, mm; clamp to tip).
 pub const CENTRELINE_X_MM: &str = "centreline_x_mm";
 /// Optional centreline y positions (list of f64, mm; clamp to tip).

@@ -5,7 +5,7 @@
 
 use arrow::array::{ArrayRef, Float64Array, Int64Array, RecordBatch, StringArray};
 use cablemap::model::{Actuator, Routing, Simulator, SolverOptions, STATUS_OK};
-use cablemap::reduce::{reduce_batches, write::write_tables, ReduceOptions, RunInfo};
+use cablemap::reduce::{reduce_batches, tables::write_tables, ReduceOptions, RunInfo};
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, OnceLock};
 

@@ -1,0 +1,182 @@
+//! Writing a map directory: its tables (`tables`), pictures and explorer
+//! page, put in place as a whole.
+
+use super::drawings::ModeDrawings;
+use super::plots::{self, draw_heatmap, Picture, Scale};
+use super::{explorer, tables, CoefficientStats, MapData, ReduceError, COEFFICIENT_UNIT};
+use std::path::{Path, PathBuf};
+
+/// Writes the map directory `dir` as a whole: everything is written into a
+/// staging directory beside it (`.NAME.tmp-TOKEN`), which then replaces
+/// `dir` by rename, so a reader sees the old map or the new one, never a
+/// mix (an interrupted reduce leaves the old map untouched). `dir` must be
+/// new, empty, or an earlier map (it has summary.json); it must not be, or
+/// lie directly inside, a sweep run directory.
+pub fn write_map_replacing(
+    dir: &Path,
+    map: &MapData,
+    actuator: &crate::model::Actuator,
+    solver: &crate::model::SolverOptions,
+) -> Result<Vec<Picture>, ReduceError> {
+    let name = check_map_out(dir)?;
+    let parent = match dir.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    std::fs::create_dir_all(&parent).map_err(|source| ReduceError::CreateDir { path: parent.clone(), source })?;
+    remove_abandoned_staging(&parent, &name);
+    let staging = parent.join(format!(".{name}.tmp-{}", crate::io::unique_token()));
+    std::fs::create_dir(&staging).map_err(|source| ReduceError::CreateDir { path: staging.clone(), source })?;
+    // Held while writing so that another reduce does not clear it away.
+    let lock = match std::fs::File::open(&staging) {
+        Ok(lock) => lock,
+        Err(source) => {
+            let _ = std::fs::remove_dir_all(&staging);
+            return Err(ReduceError::CreateDir { path: staging, source });
+        }
+    };
+    // Best effort: where locks are unsupported, staging is judged by its age.
+    let _ = lock.try_lock();
+    let written = write_map(&staging, map, actuator, solver).and_then(|pictures| {
+        crate::io::sync_dir(&staging);
+        replace_dir(&staging, dir, &parent, &name).map_err(|source| ReduceError::Replace { path: dir.to_path_buf(), source })?;
+        Ok(pictures)
+    });
+    if written.is_err() {
+        let _ = std::fs::remove_dir_all(&staging);
+    }
+    drop(lock);
+    written
+}
+
+/// Checks that `dir` can take a map (see [`write_map_replacing`]) before
+/// any work is done; returns its file name.
+pub fn check_map_out(dir: &Path) -> Result<String, ReduceError> {
+    crate::io::check_not_in_run_dir(dir, "the map directory").map_err(ReduceError::MapInRun)?;
+    let name = dir.file_name().map(|n| n.to_string_lossy().into_owned()).filter(|n| n != "." && n != "..");
+    let Some(name) = name else {
+        return Err(ReduceError::MapDirUnnamed { path: dir.to_path_buf() });
+    };
+    match std::fs::read_dir(dir) {
+        Ok(mut entries) => {
+            if entries.next().is_some() && !dir.join(tables::SUMMARY_FILE).is_file() {
+                return Err(ReduceError::NotAMap { path: dir.to_path_buf() });
+            }
+        }
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+        Err(source) => return Err(ReduceError::MapDirUnreadable { path: dir.to_path_buf(), source }),
+    }
+    Ok(name)
+}
+
+/// Moves `staging` to `dir`: directly when `dir` is absent or empty, else
+/// by an atomic exchange (Linux), else by moving the old map aside first
+/// and deleting it after (a moment without `dir`, never a mixed one).
+fn replace_dir(staging: &Path, dir: &Path, parent: &Path, name: &str) -> std::io::Result<()> {
+    match std::fs::rename(staging, dir) {
+        Ok(()) => {}
+        Err(_) if dir.is_dir() && crate::io::exchange(staging, dir)? => {
+            // `staging` now holds the old map.
+            let _ = std::fs::remove_dir_all(staging);
+        }
+        Err(_) if dir.is_dir() => {
+            let old = parent.join(format!(".{name}.old-{}", crate::io::unique_token()));
+            std::fs::rename(dir, &old)?;
+            if let Err(e) = std::fs::rename(staging, dir) {
+                let _ = std::fs::rename(&old, dir);
+                return Err(e);
+            }
+            let _ = std::fs::remove_dir_all(&old);
+        }
+        Err(e) => return Err(e),
+    }
+    crate::io::sync_dir(parent);
+    Ok(())
+}
+
+/// Removes staging and old-map directories of `name` left by killed
+/// reduces (no writer holds their lock, or they are stale).
+fn remove_abandoned_staging(parent: &Path, name: &str) {
+    let Ok(entries) = std::fs::read_dir(parent) else { return };
+    for entry in entries.flatten() {
+        let file_name = entry.file_name().to_string_lossy().into_owned();
+        let left = crate::io::is_temp_of(&file_name, name)
+            || file_name.strip_prefix(&format!(".{name}.old-")).is_some_and(|t| !t.is_empty());
+        if left && entry.path().is_dir() && crate::io::is_abandoned(&entry.path()) {
+            let _ = std::fs::remove_dir_all(entry.path());
+        }
+    }
+}
+
+/// Writes the whole map directory: tables, pictures and index.html.
+/// `actuator` and `solver` re-simulate the mode representatives for drawing
+/// ([`ModeDrawings`]). Writes in place; [`write_map_replacing`] is what the
+/// commands use.
+pub fn write_map(
+    dir: &Path,
+    map: &MapData,
+    actuator: &crate::model::Actuator,
+    solver: &crate::model::SolverOptions,
+) -> Result<Vec<Picture>, ReduceError> {
+    std::fs::create_dir_all(dir).map_err(|source| ReduceError::CreateDir { path: dir.to_path_buf(), source })?;
+    tables::write_tables(dir, map)?;
+    let mut pictures = coefficient_pictures(dir, map)?;
+    let drawings = ModeDrawings::of_map(map, actuator, solver);
+    plots::draw_modes(&dir.join("modes.png"), map, &drawings.shapes)?;
+    pictures.push(Picture {
+        file: "modes.png".into(),
+        title: "Characteristic modes (thesis Fig. 4.4)".into(),
+        explanation: format!(
+            "a0 split into 4 ranges (rows) and a1 into 3 (columns), a_i {}; each panel maps where that combination occurs and draws the simulation nearest the mode's median coefficients.{}",
+            map.summary.length_basis.describe(),
+            drawings.failure_note()
+        ),
+    });
+    explorer::write_explorer(dir, map, actuator, &drawings.shapes, &pictures)?;
+    Ok(pictures)
+}
+
+/// Draws reach.png and the per-cell pictures of each coefficient.
+fn coefficient_pictures(dir: &Path, map: &MapData) -> Result<Vec<Picture>, ReduceError> {
+    let s = &map.summary;
+    let mut pictures = Vec::new();
+    let reach: Vec<(i32, i32, f64)> = map.cells.iter().map(|c| (c.ix, c.iy, c.count as f64)).collect();
+    draw_heatmap(&dir.join("reach.png"), s, "Reachable tip positions: simulations per cell", "simulations per cell (log scale)", &reach, Scale::Log)?;
+    pictures.push(Picture {
+        file: "reach.png".into(),
+        title: "Reach (thesis Fig. 4.1)".into(),
+        explanation: format!(
+            "Every {} mm cell that some routing and tension puts the tip in; the colour counts the simulations, so dark cells are reached by few configurations.",
+            s.cell_mm
+        ),
+    });
+    let nk = map.cells.first().map_or(0, |c| c.coefficients.len());
+    for k in 0..nk {
+        let stats = |f: &dyn Fn(&CoefficientStats) -> f64| -> Vec<(i32, i32, f64)> {
+            map.cells.iter().map(|c| (c.ix, c.iy, f(&c.coefficients[k]))).collect()
+        };
+        let unit = format!("a{k} ({COEFFICIENT_UNIT}, {} basis)", s.length_basis);
+        for (name, what, values, scale) in [
+            ("p10", "10th percentile", stats(&|c| c.p10), Scale::Symmetric),
+            ("p90", "90th percentile", stats(&|c| c.p90), Scale::Symmetric),
+            ("gap", "90th − 10th percentile", stats(&|c| c.p90 - c.p10), Scale::Linear),
+        ] {
+            let file = format!("a{k}_{name}.png");
+            let title = format!("a{k}: {what} per cell");
+            draw_heatmap(&dir.join(&file), s, &title, &unit, &values, scale)?;
+            // Thesis Fig. 4.2 shows a0, Fig. 4.3 a1; the thesis has no a2 map.
+            let figure = match k {
+                0 => " (as thesis Fig. 4.2)",
+                1 => " (as thesis Fig. 4.3)",
+                _ => "",
+            };
+            let basis = s.length_basis.describe();
+            let explanation = match name {
+                "gap" => format!("Spread of a{k} ({COEFFICIENT_UNIT}, {basis}) among the configurations reaching each cell: a large gap means more than one mode of deformation reaches it{figure}."),
+                _ => format!("The {what} of a{k} ({COEFFICIENT_UNIT}, {basis}) over the simulations whose tip falls in each cell{figure}."),
+            };
+            pictures.push(Picture { file, title, explanation });
+        }
+    }
+    Ok(pictures)
+}

@@ -1,0 +1,388 @@
+//! The map format (docs/maps.md), one owner: the file and column names of a
+//! map directory's tables, their writer and their reader. `summary.json` is
+//! [`MapSummary`] serialised; `cells.parquet`, `modes.parquet` and
+//! `designs.parquet` hold [`CellStats`], [`ModeStats`](super::ModeStats) and [`Design`] rows.
+//! The design columns are the sweep's own (`sweep::schema`).
+
+use super::{CellStats, CoefficientStats, Design, MapData, MapSummary, ReduceError, CELL_STATS_ORDER, MAX_CELLS_PER_AXIS, MODES};
+use crate::sweep::schema::{coefficient_column, ROUTING_ID, TENSION_N, TIP_ANGLE_RAD, TIP_X_MM, TIP_Y_MM, Y_MM};
+use arrow::array::{Array, ArrayRef, AsArray, BooleanArray, Float64Array, Int32Array, Int64Array};
+use arrow::datatypes::{DataType, Field, Float64Type, Int32Type, Int64Type, Schema};
+use arrow::record_batch::RecordBatch;
+use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
+use parquet::arrow::ArrowWriter;
+use parquet::basic::{Compression, ZstdLevel};
+use parquet::file::properties::WriterProperties;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// The map's summary (JSON).
+pub const SUMMARY_FILE: &str = "summary.json";
+/// One row per non-empty cell.
+pub const CELLS_FILE: &str = "cells.parquet";
+/// One row per characteristic mode.
+pub const MODES_FILE: &str = "modes.parquet";
+/// The simulated designs kept per cell.
+pub const DESIGNS_FILE: &str = "designs.parquet";
+
+/// Columns of `cells.parquet`.
+pub mod cell_columns {
+    /// Cell column (i32).
+    pub const IX: &str = "ix";
+    /// Cell row (i32).
+    pub const IY: &str = "iy";
+    /// Cell centre (f64, mm).
+    pub const X_MM: &str = "x_mm";
+    /// Cell centre (f64, mm).
+    pub const Y_MM: &str = "y_mm";
+    /// Simulations in the cell (i64).
+    pub const COUNT: &str = "count";
+
+    /// A statistic of a coefficient over a cell's simulations.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+    pub enum Stat {
+        /// 10th percentile.
+        P10,
+        /// 90th percentile.
+        P90,
+        /// p90 − p10.
+        Gap,
+        /// Smallest value.
+        Min,
+        /// Largest value.
+        Max,
+    }
+
+    /// Column of statistic `stat` of a_k (f64, mm⁻¹): `a{k}_p10`, …
+    pub fn stat(k: usize, stat: Stat) -> String {
+        let suffix = match stat {
+            Stat::P10 => "p10",
+            Stat::P90 => "p90",
+            Stat::Gap => "gap",
+            Stat::Min => "min",
+            Stat::Max => "max",
+        };
+        format!("a{k}_{suffix}")
+    }
+
+    /// Simulations of mode `m` in the cell (i64): `mode_{m}`.
+    pub fn mode(m: usize) -> String {
+        format!("mode_{m}")
+    }
+}
+
+/// Columns of `modes.parquet`.
+pub mod mode_columns {
+    /// Mode index 3·i + j (i32).
+    pub const MODE: &str = "mode";
+    /// a_0 range i (i32).
+    pub const A0_RANGE: &str = "a0_range";
+    /// a_1 range j (i32).
+    pub const A1_RANGE: &str = "a1_range";
+    /// Bounds of the a_0 range (f64, mm⁻¹; open ends ±inf).
+    pub const A0_LO: &str = "a0_lo";
+    /// See `A0_LO`.
+    pub const A0_HI: &str = "a0_hi";
+    /// Bounds of the a_1 range.
+    pub const A1_LO: &str = "a1_lo";
+    /// See `A1_LO`.
+    pub const A1_HI: &str = "a1_hi";
+    /// Simulations in the mode (i64).
+    pub const COUNT: &str = "count";
+    /// Cells where the mode occurs (i64).
+    pub const CELLS: &str = "cells";
+
+    /// A representative's column: `rep_` and the design column (f64, null
+    /// for a mode without simulations).
+    pub fn representative(design_column: &str) -> String {
+        format!("rep_{design_column}")
+    }
+}
+
+/// Columns of `designs.parquet`: the cell, then the sweep row's own columns.
+pub mod design_columns {
+    /// Cell column (i32).
+    pub const IX: &str = "ix";
+    /// Cell row (i32).
+    pub const IY: &str = "iy";
+    /// Whether the design is the mirror image of the stored row (bool).
+    pub const MIRRORED: &str = "mirrored";
+    pub use crate::sweep::schema::{coefficient_column, ROUTING_ID, TENSION_N, TIP_ANGLE_RAD, TIP_X_MM, TIP_Y_MM, Y_MM};
+}
+
+/// Columns built up by name, then turned into one record batch.
+#[derive(Default)]
+struct Table {
+    fields: Vec<Field>,
+    columns: Vec<ArrayRef>,
+}
+
+impl Table {
+    fn f64(&mut self, name: &str, values: Vec<Option<f64>>) {
+        self.fields.push(Field::new(name, DataType::Float64, values.iter().any(Option::is_none)));
+        self.columns.push(Arc::new(Float64Array::from(values)));
+    }
+    fn f64_all(&mut self, name: &str, values: Vec<f64>) {
+        self.f64(name, values.into_iter().map(Some).collect());
+    }
+    fn i32(&mut self, name: &str, values: Vec<i32>) {
+        self.fields.push(Field::new(name, DataType::Int32, false));
+        self.columns.push(Arc::new(Int32Array::from(values)));
+    }
+    fn i64(&mut self, name: &str, values: Vec<i64>) {
+        self.fields.push(Field::new(name, DataType::Int64, false));
+        self.columns.push(Arc::new(Int64Array::from(values)));
+    }
+    fn bool(&mut self, name: &str, values: Vec<bool>) {
+        self.fields.push(Field::new(name, DataType::Boolean, false));
+        self.columns.push(Arc::new(BooleanArray::from(values)));
+    }
+    fn write(self, path: &Path) -> Result<(), ReduceError> {
+        let schema = Arc::new(Schema::new(self.fields));
+        let arrow = |source| ReduceError::WriteArrow { path: path.to_path_buf(), source };
+        let parquet = |source| ReduceError::WriteParquet { path: path.to_path_buf(), source };
+        let batch = RecordBatch::try_new(schema.clone(), self.columns).map_err(arrow)?;
+        let props = WriterProperties::builder().set_compression(Compression::ZSTD(ZstdLevel::default())).build();
+        let mut buf = Vec::new();
+        let mut writer = ArrowWriter::try_new(&mut buf, schema, Some(props)).map_err(parquet)?;
+        writer.write(&batch).map_err(parquet)?;
+        writer.close().map_err(parquet)?;
+        write_file(path, &buf)
+    }
+}
+
+/// Writes `bytes` to `path` atomically.
+pub(crate) fn write_file(path: &Path, bytes: &[u8]) -> Result<(), ReduceError> {
+    crate::io::write_atomic(path, bytes).map_err(|source| ReduceError::Write { path: path.to_path_buf(), source })
+}
+
+/// Writes cells.parquet, modes.parquet, designs.parquet and summary.json.
+pub fn write_tables(dir: &Path, map: &MapData) -> Result<(), ReduceError> {
+    use cell_columns::Stat;
+    let mut cells = Table::default();
+    let c = &map.cells;
+    cells.i32(cell_columns::IX, c.iter().map(|c| c.ix).collect());
+    cells.i32(cell_columns::IY, c.iter().map(|c| c.iy).collect());
+    cells.f64_all(cell_columns::X_MM, c.iter().map(|c| c.x_mm).collect());
+    cells.f64_all(cell_columns::Y_MM, c.iter().map(|c| c.y_mm).collect());
+    cells.i64(cell_columns::COUNT, c.iter().map(|c| c.count).collect());
+    let nk = c.first().map_or(0, |c| c.coefficients.len());
+    for k in 0..nk {
+        let stats = |f: &dyn Fn(&CoefficientStats) -> f64| c.iter().map(|c| f(&c.coefficients[k])).collect();
+        cells.f64_all(&cell_columns::stat(k, Stat::P10), stats(&|s| s.p10));
+        cells.f64_all(&cell_columns::stat(k, Stat::P90), stats(&|s| s.p90));
+        cells.f64_all(&cell_columns::stat(k, Stat::Gap), stats(&|s| s.p90 - s.p10));
+        cells.f64_all(&cell_columns::stat(k, Stat::Min), stats(&|s| s.min));
+        cells.f64_all(&cell_columns::stat(k, Stat::Max), stats(&|s| s.max));
+    }
+    for m in 0..MODES {
+        cells.i64(&cell_columns::mode(m), c.iter().map(|c| c.modes[m]).collect());
+    }
+    cells.write(&dir.join(CELLS_FILE))?;
+
+    use mode_columns as mc;
+    let mut modes = Table::default();
+    let m = &map.modes;
+    modes.i32(mc::MODE, m.iter().map(|m| m.mode as i32).collect());
+    modes.i32(mc::A0_RANGE, m.iter().map(|m| m.a0_range as i32).collect());
+    modes.i32(mc::A1_RANGE, m.iter().map(|m| m.a1_range as i32).collect());
+    modes.f64_all(mc::A0_LO, m.iter().map(|m| m.a0_bounds.0).collect());
+    modes.f64_all(mc::A0_HI, m.iter().map(|m| m.a0_bounds.1).collect());
+    modes.f64_all(mc::A1_LO, m.iter().map(|m| m.a1_bounds.0).collect());
+    modes.f64_all(mc::A1_HI, m.iter().map(|m| m.a1_bounds.1).collect());
+    modes.i64(mc::COUNT, m.iter().map(|m| m.count).collect());
+    modes.i64(mc::CELLS, m.iter().map(|m| m.cells).collect());
+    let rep = |f: &dyn Fn(&Design) -> f64| -> Vec<Option<f64>> { m.iter().map(|m| m.representative.as_ref().map(f)).collect() };
+    for (k, name) in Y_MM.iter().enumerate() {
+        modes.f64(&mc::representative(name), rep(&|d| d.y_mm[k]));
+    }
+    modes.f64(&mc::representative(TENSION_N), rep(&|d| d.tension_n));
+    modes.f64(&mc::representative(TIP_X_MM), rep(&|d| d.tip_x_mm));
+    modes.f64(&mc::representative(TIP_Y_MM), rep(&|d| d.tip_y_mm));
+    for k in 0..2 {
+        modes.f64(&mc::representative(&coefficient_column(k)), rep(&|d| d.a[k]));
+    }
+    modes.write(&dir.join(MODES_FILE))?;
+
+    use design_columns as dc;
+    let mut designs = Table::default();
+    let d = &map.designs;
+    designs.i32(dc::IX, d.iter().map(|d| d.ix).collect());
+    designs.i32(dc::IY, d.iter().map(|d| d.iy).collect());
+    designs.i64(ROUTING_ID, d.iter().map(|d| d.routing_id).collect());
+    designs.bool(dc::MIRRORED, d.iter().map(|d| d.mirrored).collect());
+    for (k, name) in Y_MM.iter().enumerate() {
+        designs.f64_all(name, d.iter().map(|d| d.y_mm[k]).collect());
+    }
+    designs.f64_all(TENSION_N, d.iter().map(|d| d.tension_n).collect());
+    designs.f64_all(TIP_X_MM, d.iter().map(|d| d.tip_x_mm).collect());
+    designs.f64_all(TIP_Y_MM, d.iter().map(|d| d.tip_y_mm).collect());
+    designs.f64_all(TIP_ANGLE_RAD, d.iter().map(|d| d.tip_angle_rad).collect());
+    for k in 0..=map.summary.order {
+        designs.f64_all(&coefficient_column(k), d.iter().map(|d| d.a[k]).collect());
+    }
+    designs.write(&dir.join(DESIGNS_FILE))?;
+
+    let path = dir.join(SUMMARY_FILE);
+    let json = serde_json::to_vec_pretty(&map.summary).map_err(|source| ReduceError::WriteJson { path: path.clone(), source })?;
+    write_file(&path, &json)
+}
+
+/// A map table that cannot be read, or breaks the map format.
+#[derive(Debug, Clone, thiserror::Error)]
+#[error("map {}: {message}", path.display())]
+pub struct ReadError {
+    /// The file.
+    pub path: PathBuf,
+    /// What is wrong, and what to do.
+    pub message: String,
+}
+
+fn read_error(path: &Path, message: impl Into<String>) -> ReadError {
+    ReadError { path: path.to_path_buf(), message: message.into() }
+}
+
+/// Reads and checks `summary.json` of map directory `dir`.
+pub fn read_summary(dir: &Path) -> Result<MapSummary, ReadError> {
+    let path = dir.join(SUMMARY_FILE);
+    let text = crate::io::read_utf8(&path).map_err(|e| {
+        read_error(&path, format!("cannot read ({e}); give a map directory written by `cablemap reduce`"))
+    })?;
+    let summary: MapSummary =
+        serde_json::from_str(&text).map_err(|e| read_error(&path, format!("does not match the map contract: {e}")))?;
+    summary.mode_boundaries.validate().map_err(|e| read_error(&path, format!("mode_boundaries: {e}")))?;
+    if !(summary.cell_mm > 0.0 && summary.cell_mm.is_finite()) {
+        return Err(read_error(&path, format!("cell_mm must be positive, got {}", summary.cell_mm)));
+    }
+    let [lo, hi] = summary.tension_range_n;
+    if !(lo.is_finite() && hi.is_finite() && lo <= hi) {
+        return Err(read_error(&path, format!("tension_range_n [{lo}, {hi}] is not a range")));
+    }
+    Ok(summary)
+}
+
+/// Reads every record batch of a parquet file.
+fn read_batches(path: &Path) -> Result<Vec<RecordBatch>, ReadError> {
+    let file = std::fs::File::open(path)
+        .map_err(|e| read_error(path, format!("cannot open ({e}); is this a `cablemap reduce` output directory?")))?;
+    let reader = ParquetRecordBatchReaderBuilder::try_new(file)
+        .and_then(|b| b.build())
+        .map_err(|e| read_error(path, format!("not a readable parquet file: {e}")))?;
+    reader.collect::<Result<Vec<_>, _>>().map_err(|e| read_error(path, format!("reading: {e}")))
+}
+
+/// Typed column access with errors that name the column.
+struct Columns<'a> {
+    path: &'a Path,
+    batch: &'a RecordBatch,
+}
+
+impl<'a> Columns<'a> {
+    fn column(&self, name: &str) -> Result<&'a dyn Array, ReadError> {
+        let c = self
+            .batch
+            .column_by_name(name)
+            .ok_or_else(|| read_error(self.path, format!("column `{name}` is missing (see docs/maps.md)")))?;
+        if c.null_count() > 0 {
+            return Err(read_error(self.path, format!("column `{name}` has nulls")));
+        }
+        Ok(c.as_ref())
+    }
+
+    fn f64(&self, name: &str) -> Result<&'a [f64], ReadError> {
+        let c = self.column(name)?;
+        c.as_primitive_opt::<Float64Type>()
+            .map(|a| a.values().as_ref())
+            .ok_or_else(|| read_error(self.path, format!("column `{name}` should be f64, is {}", c.data_type())))
+    }
+
+    fn i32(&self, name: &str) -> Result<&'a [i32], ReadError> {
+        let c = self.column(name)?;
+        c.as_primitive_opt::<Int32Type>()
+            .map(|a| a.values().as_ref())
+            .ok_or_else(|| read_error(self.path, format!("column `{name}` should be i32, is {}", c.data_type())))
+    }
+
+    fn i64(&self, name: &str) -> Result<&'a [i64], ReadError> {
+        let c = self.column(name)?;
+        c.as_primitive_opt::<Int64Type>()
+            .map(|a| a.values().as_ref())
+            .ok_or_else(|| read_error(self.path, format!("column `{name}` should be i64, is {}", c.data_type())))
+    }
+
+    fn bool(&self, name: &str) -> Result<Vec<bool>, ReadError> {
+        let c = self.column(name)?;
+        c.as_boolean_opt()
+            .map(|a| a.iter().map(|v| v.unwrap_or(false)).collect())
+            .ok_or_else(|| read_error(self.path, format!("column `{name}` should be bool, is {}", c.data_type())))
+    }
+}
+
+/// Reads `cells.parquet` of map directory `dir` for a map of coefficient
+/// order `order` (statistics up to a_min(order, 2)); refuses cells off the grid.
+pub fn read_cells(dir: &Path, order: usize) -> Result<Vec<CellStats>, ReadError> {
+    use cell_columns::{self as cc, Stat};
+    let path = dir.join(CELLS_FILE);
+    let stats_order = order.min(CELL_STATS_ORDER);
+    let mut cells = Vec::new();
+    for batch in read_batches(&path)? {
+        let c = Columns { path: &path, batch: &batch };
+        let (ix, iy, x, y, count) = (c.i32(cc::IX)?, c.i32(cc::IY)?, c.f64(cc::X_MM)?, c.f64(cc::Y_MM)?, c.i64(cc::COUNT)?);
+        let stats: Vec<[&[f64]; 4]> = (0..=stats_order)
+            .map(|k| {
+                Ok([c.f64(&cc::stat(k, Stat::P10))?, c.f64(&cc::stat(k, Stat::P90))?, c.f64(&cc::stat(k, Stat::Min))?, c.f64(&cc::stat(k, Stat::Max))?])
+            })
+            .collect::<Result<_, ReadError>>()?;
+        let modes: Vec<&[i64]> = (0..MODES).map(|m| c.i64(&cc::mode(m))).collect::<Result<_, _>>()?;
+        for r in 0..batch.num_rows() {
+            cells.push(CellStats {
+                ix: ix[r],
+                iy: iy[r],
+                x_mm: x[r],
+                y_mm: y[r],
+                count: count[r],
+                coefficients: stats.iter().map(|s| CoefficientStats { p10: s[0][r], p90: s[1][r], min: s[2][r], max: s[3][r] }).collect(),
+                modes: std::array::from_fn(|m| modes[m][r]),
+            });
+        }
+    }
+    let grid = 0..MAX_CELLS_PER_AXIS as i32;
+    if let Some(c) = cells.iter().find(|c| !grid.contains(&c.ix) || !grid.contains(&c.iy)) {
+        return Err(read_error(
+            &path,
+            format!("cell ({}, {}) lies off the grid 0..{}: the file is damaged; reduce the run again", c.ix, c.iy, grid.end),
+        ));
+    }
+    Ok(cells)
+}
+
+/// Reads every design of `designs.parquet` of map directory `dir` (a map of
+/// coefficient order `order`).
+pub fn read_designs(dir: &Path, order: usize) -> Result<Vec<Design>, ReadError> {
+    use design_columns as dc;
+    let path = dir.join(DESIGNS_FILE);
+    let mut out = Vec::new();
+    for batch in read_batches(&path)? {
+        let c = Columns { path: &path, batch: &batch };
+        let (ix, iy, id) = (c.i32(dc::IX)?, c.i32(dc::IY)?, c.i64(ROUTING_ID)?);
+        let mirrored = c.bool(dc::MIRRORED)?;
+        let ys: Vec<&[f64]> = Y_MM.iter().map(|name| c.f64(name)).collect::<Result<_, _>>()?;
+        let (t, x, y, ang) = (c.f64(TENSION_N)?, c.f64(TIP_X_MM)?, c.f64(TIP_Y_MM)?, c.f64(TIP_ANGLE_RAD)?);
+        let a: Vec<&[f64]> = (0..=order).map(|k| c.f64(&coefficient_column(k))).collect::<Result<_, _>>()?;
+        for r in 0..batch.num_rows() {
+            out.push(Design {
+                ix: ix[r],
+                iy: iy[r],
+                routing_id: id[r],
+                mirrored: mirrored[r],
+                y_mm: std::array::from_fn(|i| ys[i][r]),
+                tension_n: t[r],
+                tip_x_mm: x[r],
+                tip_y_mm: y[r],
+                tip_angle_rad: ang[r],
+                a: a.iter().map(|col| col[r]).collect(),
+            });
+        }
+    }
+    Ok(out)
+}
