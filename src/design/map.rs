@@ -93,13 +93,6 @@ fn map_error(path: &Path, message: impl Into<String>) -> DesignError {
     DesignError::Map { path: path.display().to_string(), message: message.into() }
 }
 
-/// A map file that breaks the map format is a design input error.
-impl From<tables::ReadError> for DesignError {
-    fn from(e: tables::ReadError) -> Self {
-        DesignError::Map { path: e.path.display().to_string(), message: e.message }
-    }
-}
-
 /// Off-grid indices are clamped to ±2³⁰: far outside every map (cells lie in
 /// 0..[`crate::reduce::MAX_CELLS_PER_AXIS`]) and small enough that index
 /// differences cannot overflow.

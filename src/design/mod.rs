@@ -65,7 +65,15 @@ pub enum DesignError {
     NoSeed,
     /// A map directory is missing a file or breaks the map contract.
     #[error("map {path}: {message}")]
-    Map { path: String, message: String },
+    Map {
+        /// The map directory or file.
+        path: String,
+        /// What is wrong, and what to do.
+        message: String,
+    },
+    /// A map table cannot be read.
+    #[error(transparent)]
+    MapTable(#[from] crate::reduce::tables::ReadError),
     /// Writing an export.
     #[error("{context}: {source}")]
     Io { context: String, source: std::io::Error },
