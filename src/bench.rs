@@ -10,7 +10,7 @@
 //! steps per span and secant shooting, [`SolverMethod::Rk4`]) in the same
 //! run, so the speed-up is measured under the same load.
 
-use crate::model::{Actuator, Routing, Simulator, SolverMethod, SolverOptions};
+use crate::model::{Actuator, ControlPoints, Routing, Simulator, SolverMethod, SolverOptions};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -60,7 +60,7 @@ pub fn reference_options() -> SolverOptions {
 pub fn bench_with_reference(
     actuator: &Actuator,
     options: &SolverOptions,
-    routings: &[[f64; 5]],
+    routings: &[ControlPoints],
     with_reference: bool,
 ) -> Result<Vec<BenchFigures>, crate::Error> {
     let mut rows = Vec::new();
@@ -81,16 +81,16 @@ pub fn bench_with_reference(
 
 /// A deterministic sample of `count` routings from the thesis grid
 /// (9 levels ±0.8 r), spread over the grid by a multiplicative walk.
-pub fn sample_thesis_routings(count: usize, radius_mm: f64) -> Vec<[f64; 5]> {
+pub fn sample_thesis_routings(count: usize, radius_mm: f64) -> Vec<ControlPoints> {
     let total = 9usize.pow(5);
     (0..count)
         .map(|k| {
             let mut idx = (k * 7919 + 13) % total;
-            std::array::from_fn(|_| {
+            ControlPoints(std::array::from_fn(|_| {
                 let level = idx % 9;
                 idx /= 9;
                 (level as f64 - 4.0) * 0.2 * radius_mm
-            })
+            }))
         })
         .collect()
 }
@@ -100,7 +100,7 @@ pub fn sample_thesis_routings(count: usize, radius_mm: f64) -> Vec<[f64; 5]> {
 pub fn bench_solver(
     actuator: &Actuator,
     options: &SolverOptions,
-    routings: &[[f64; 5]],
+    routings: &[ControlPoints],
     tension_min_n: f64,
     tension_max_n: f64,
     tensions: usize,

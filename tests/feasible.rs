@@ -38,7 +38,7 @@ fn a_simulated_design_inside_its_cells_percentiles_is_feasible_and_nearest() {
     let nearest = &v["nearest"][0];
     assert!(nearest["distance"].as_f64().unwrap() < 1e-9, "{v}");
     let routing: Vec<f64> = nearest["routing_mm"].as_array().unwrap().iter().map(|y| y.as_f64().unwrap()).collect();
-    assert_eq!(routing, d.y_mm.to_vec());
+    assert_eq!(routing, d.routing_mm.to_vec());
     assert!(v["mode"]["mode"].as_u64().unwrap() < 12);
     assert!(v["mode"]["count_in_cell"].as_i64().unwrap() >= 1);
 }

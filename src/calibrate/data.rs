@@ -6,7 +6,7 @@
 //! same and every error names the file, the row and the column.
 
 use super::CalibrateError;
-use crate::model::routing::CONTROL_POINTS;
+use crate::model::routing::{ControlPoints, CONTROL_POINTS};
 use std::collections::{BTreeMap, HashMap};
 use std::path::Path;
 
@@ -66,7 +66,7 @@ pub struct Measurement {
     /// Routing id.
     pub routing: String,
     /// Routing control points y0..y4, mm.
-    pub y_mm: [f64; CONTROL_POINTS],
+    pub routing_mm: ControlPoints,
     /// Cable tension at the base, N.
     pub tension_n: f64,
     /// Direction of the step.
@@ -97,8 +97,8 @@ pub struct Measurement {
 pub struct RoutingGroup {
     /// Routing id.
     pub routing: String,
-    /// Control points, mm.
-    pub y_mm: [f64; CONTROL_POINTS],
+    /// Routing control points, mm.
+    pub routing_mm: ControlPoints,
     /// Clamp tilt, rad.
     pub clamp_tilt_rad: f64,
     /// Indices into [`Dataset::rows`], sorted by step.
@@ -130,7 +130,7 @@ impl Dataset {
                 let mut rows = by_id.remove(id.as_str()).expect("known id");
                 rows.sort_by_key(|&i| self.rows[i].step);
                 let first = &self.rows[rows[0]];
-                RoutingGroup { routing: id, y_mm: first.y_mm, clamp_tilt_rad: first.clamp_tilt_rad, rows }
+                RoutingGroup { routing: id, routing_mm: first.routing_mm, clamp_tilt_rad: first.clamp_tilt_rad, rows }
             })
             .collect()
     }
@@ -422,7 +422,7 @@ fn parse_measurements(path: &Path, table: &Table) -> Result<Dataset, CalibrateEr
         rows.push(Measurement {
             measurement,
             routing,
-            y_mm,
+            routing_mm: ControlPoints(y_mm),
             tension_n,
             direction,
             step,
@@ -448,7 +448,7 @@ pub fn measurements_csv(data: &Dataset) -> String {
     }
     out.push('\n');
     for m in &data.rows {
-        let y: Vec<String> = m.y_mm.iter().map(|v| v.to_string()).collect();
+        let y: Vec<String> = m.routing_mm.iter().map(|v| v.to_string()).collect();
         out.push_str(&format!(
             "{},{},{},{},{},{},{},{},{},{},{}\n",
             m.measurement,

@@ -35,7 +35,7 @@ pub fn predict_group(
 ) -> Result<Vec<Prediction>, CalibrateError> {
     let a = group_actuator(actuator, group);
     let first_row = data.rows[group.rows[0]].row;
-    let routing = Routing::new(&group.y_mm, a.length_mm, a.radius_mm)
+    let routing = Routing::new(group.routing_mm, a.length_mm, a.radius_mm)
         .map_err(|source| CalibrateError::Routing { routing: group.routing.clone(), row: first_row, source })?;
     let mut sim = Simulator::new(&a, options)?;
     sim.set_routing(&routing);
@@ -103,7 +103,7 @@ mod tests {
         Measurement {
             measurement: 1,
             routing: routing.into(),
-            y_mm: [0.0; 5],
+            routing_mm: Default::default(),
             tension_n: 0.0,
             direction: Direction::Rest,
             step: 0,
@@ -144,7 +144,7 @@ mod tests {
             tension_n,
             direction,
             dwell_s,
-            y_mm: [2.0; 5],
+            routing_mm: [2.0; 5].into(),
             ..rest_row("r", 0.0)
         };
         let angle = |rows: Vec<Measurement>| {

@@ -5,6 +5,7 @@
 //! top tension; unload in the same steps; rest again. Each step is held for
 //! the step dwell, the two rest states for the rest dwell.
 
+use crate::model::ControlPoints;
 use super::data::{CentrelinePoints, Dataset, Direction, Marker, MarkerPoints, Measurement, RoutingGroup};
 use super::predict::predict_group;
 use super::rng::Rng;
@@ -151,7 +152,7 @@ pub fn synthesize_with_markers(spec: &SynthSpec, points: usize) -> Result<(Datas
             data.rows.push(Measurement {
                 measurement,
                 routing: id.clone(),
-                y_mm: *y,
+                routing_mm: ControlPoints(*y),
                 tension_n,
                 direction,
                 step: k as i64,

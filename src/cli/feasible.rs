@@ -92,7 +92,7 @@ pub fn text(r: &FeasibilityReport) -> String {
         let d = &near.design;
         s.push_str(&format!(
             "  y = [{}] mm, τ = {:.3} N → tip ({:.2}, {:.2}) mm, a = [{}]  (distance {:.4})\n",
-            d.y_mm.iter().map(|v| format!("{v:.2}")).collect::<Vec<_>>().join(", "),
+            d.routing_mm.iter().map(|v| format!("{v:.2}")).collect::<Vec<_>>().join(", "),
             d.tension_n,
             d.tip_x_mm,
             d.tip_y_mm,

@@ -52,7 +52,7 @@ pub struct NearDesign {
 impl NearDesign {
     /// As a starting design for the optimiser.
     pub fn seed(&self) -> Seed {
-        Seed { routing_mm: self.design.y_mm, tension_n: self.design.tension_n, source: SeedSource::Map }
+        Seed { routing_mm: self.design.routing_mm, tension_n: self.design.tension_n, source: SeedSource::Map }
     }
 }
 
@@ -61,7 +61,7 @@ impl Serialize for NearDesign {
     fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
         let d = &self.design;
         serde_json::json!({
-            "routing_mm": d.y_mm,
+            "routing_mm": d.routing_mm,
             "tension_n": d.tension_n,
             "tip_x_mm": d.tip_x_mm,
             "tip_y_mm": d.tip_y_mm,

@@ -3,7 +3,7 @@
 
 use super::target::{Component, Target, Weights};
 use super::DesignError;
-use crate::model::{Actuator, Routing, Simulator, SolveFailure, SolverOptions, TipPose};
+use crate::model::{Actuator, ControlPoints, Routing, Simulator, SolveFailure, SolverOptions, TipPose};
 use crate::shape::LengthBasis;
 use serde::Serialize;
 
@@ -45,7 +45,7 @@ impl Bounds {
     }
 
     /// Clamps a design into the bounds.
-    pub fn clamp(&self, y_mm: &mut [f64; 5], tension_n: &mut f64) {
+    pub fn clamp(&self, y_mm: &mut ControlPoints, tension_n: &mut f64) {
         for y in y_mm.iter_mut() {
             *y = y.clamp(-self.max_offset_mm, self.max_offset_mm);
         }
@@ -57,7 +57,7 @@ impl Bounds {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Evaluation {
     /// Control points y_0…y_4, mm.
-    pub routing_mm: [f64; 5],
+    pub routing_mm: ControlPoints,
     /// Cable tension, N.
     pub tension_n: f64,
     /// Tip pose and deformed length.
@@ -139,7 +139,7 @@ impl Objective {
     /// ladder to 3e-7 mm) and is 4× cheaper, so it is tried first; if it
     /// fails, a continuation ladder from low tension (as `model::simulate`)
     /// takes over.
-    pub fn evaluate(&self, sim: &mut Simulator, routing_mm: &[f64; 5], tension_n: f64) -> Result<Evaluation, SolveFailure> {
+    pub fn evaluate(&self, sim: &mut Simulator, routing_mm: &ControlPoints, tension_n: f64) -> Result<Evaluation, SolveFailure> {
         let routing = Routing::new(routing_mm, self.actuator.length_mm, self.actuator.radius_mm)
             .expect("design variables are kept inside the body by the bounds");
         sim.set_routing(&routing);
@@ -188,10 +188,10 @@ mod tests {
         let probe = Objective::new(actuator.clone(), SolverOptions::default(), Target::parse("x=1").unwrap(), Weights::default(), bounds).unwrap();
         let mut sim = probe.simulator();
         let y = [1.0, -2.0, 3.0, 2.5, -1.0];
-        let e = probe.evaluate(&mut sim, &y, 1.5).unwrap();
+        let e = probe.evaluate(&mut sim, &y.into(), 1.5).unwrap();
         let text = format!("x={},y={},a0={},a1={},a2={}", e.pose.tip_x_mm, e.pose.tip_y_mm, e.a[0], e.a[1], e.a[2]);
         let exact = Objective::new(actuator.clone(), SolverOptions::default(), Target::parse(&text).unwrap(), Weights::default(), bounds).unwrap();
-        let e2 = exact.evaluate(&mut sim, &y, 1.5).unwrap();
+        let e2 = exact.evaluate(&mut sim, &y.into(), 1.5).unwrap();
         assert!(exact.cost(&e2) < 1e-20, "{}", exact.cost(&e2));
         // Off by 0.01 in a0 costs λ_0 · 1e-4 = 0.01.
         let text = format!("x={},a0={}", e.pose.tip_x_mm, e.a[0] + 0.01);

@@ -17,7 +17,7 @@
 use super::objective::{Evaluation, Objective};
 use super::target::Component;
 use super::DesignError;
-use crate::model::{Routing, Simulator, SolveFailure};
+use crate::model::{ControlPoints, Routing, Simulator, SolveFailure};
 use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
 use nalgebra::{DMatrix, DVector, Dyn, Owned};
 use rayon::prelude::*;
@@ -55,7 +55,7 @@ impl Default for SearchOptions {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Seed {
     /// Control points, mm.
-    pub routing_mm: [f64; 5],
+    pub routing_mm: ControlPoints,
     /// Tension, N.
     pub tension_n: f64,
     /// Where it came from.
@@ -105,7 +105,7 @@ pub struct DesignOutcome {
 /// Mirrors an evaluation (negated routing): model-notes §3, mirror symmetry.
 fn mirrored(e: &Evaluation) -> Evaluation {
     let mut m = e.clone();
-    m.routing_mm = e.routing_mm.map(|y| -y);
+    m.routing_mm = e.routing_mm.mirrored();
     m.pose.tip_y_mm = -e.pose.tip_y_mm;
     m.pose.tip_angle_rad = -e.pose.tip_angle_rad;
     m.pose.tip_frame_angle_rad = -e.pose.tip_frame_angle_rad;
@@ -126,7 +126,7 @@ pub fn grid_seeds(objective: &Objective, search: &SearchOptions) -> Vec<(f64, Se
     let total = nl.pow(5);
     // Keep one routing of each mirror pair: the one whose first non-zero
     // control point is positive (the all-zero routing is its own mirror).
-    let canonical = |idx: usize| -> Option<[f64; 5]> {
+    let canonical = |idx: usize| -> Option<ControlPoints> {
         let mut y = [0.0; 5];
         let mut k = idx;
         for v in y.iter_mut() {
@@ -135,7 +135,7 @@ pub fn grid_seeds(objective: &Objective, search: &SearchOptions) -> Vec<(f64, Se
         }
         match y.iter().find(|v| **v != 0.0) {
             Some(v) if *v < 0.0 => None,
-            _ => Some(y),
+            _ => Some(y.into()),
         }
     };
     let order = objective.target.order();
@@ -227,14 +227,14 @@ pub const COST_FLOOR: f64 = 1e-20;
 const FD_STEP: f64 = 2e-6;
 
 impl Problem<'_> {
-    fn design_of(&self, z: &DVector<f64>) -> ([f64; 5], f64) {
+    fn design_of(&self, z: &DVector<f64>) -> (ControlPoints, f64) {
         let b = self.objective.bounds;
         let y = std::array::from_fn(|i| b.max_offset_mm * z[i].sin());
         let tension = b.tension_min_n + (b.tension_max_n - b.tension_min_n) * 0.5 * (1.0 + z[5].sin());
-        (y, tension)
+        (y.into(), tension)
     }
 
-    fn z_of(&self, y: &[f64; 5], tension: f64) -> DVector<f64> {
+    fn z_of(&self, y: &ControlPoints, tension: f64) -> DVector<f64> {
         let b = self.objective.bounds;
         let mut z = DVector::zeros(6);
         for i in 0..5 {
@@ -511,7 +511,7 @@ mod tests {
             stop: &AtomicBool::new(false),
         };
         let y = [4.99, -4.99, 0.0, 1.234, -3.0];
-        let (y2, t2) = p.design_of(&p.z_of(&y, 1.7));
+        let (y2, t2) = p.design_of(&p.z_of(&y.into(), 1.7));
         for (a, b) in y.iter().zip(&y2) {
             assert!((a - b).abs() < 1e-12);
         }
@@ -524,7 +524,7 @@ mod tests {
 
     #[test]
     fn diverse_skips_grid_neighbours_but_not_distinct_designs() {
-        let seed = |y: [f64; 5], t: f64| (0.0, Seed { routing_mm: y, tension_n: t, source: SeedSource::Grid });
+        let seed = |y: [f64; 5], t: f64| (0.0, Seed { routing_mm: y.into(), tension_n: t, source: SeedSource::Grid });
         let ranked = [
             seed([0.0, 0.0, 0.0, 0.0, 0.0], 1.0),
             seed([0.0, 0.0, 0.0, 0.0, 0.0], 2.0),
@@ -543,8 +543,8 @@ mod tests {
     fn mirrored_negates_lateral_quantities() {
         let obj = objective();
         let mut sim = obj.simulator();
-        let e = obj.evaluate(&mut sim, &[1.0, -2.0, 3.0, 0.5, -1.5], 1.4).unwrap();
-        let m = obj.evaluate(&mut sim, &[-1.0, 2.0, -3.0, -0.5, 1.5], 1.4).unwrap();
+        let e = obj.evaluate(&mut sim, &[1.0, -2.0, 3.0, 0.5, -1.5].into(), 1.4).unwrap();
+        let m = obj.evaluate(&mut sim, &[-1.0, 2.0, -3.0, -0.5, 1.5].into(), 1.4).unwrap();
         let mm = mirrored(&e);
         assert!((mm.pose.tip_y_mm - m.pose.tip_y_mm).abs() < 1e-9 && (mm.pose.tip_x_mm - m.pose.tip_x_mm).abs() < 1e-9);
         for (a, b) in mm.a.iter().zip(&m.a) {

@@ -6,6 +6,7 @@ use super::feasible::{FeasibilityReport, Verdict};
 use super::objective::{Bounds, Objective};
 use super::optimise::{ComponentResult, DesignOutcome, StartReport};
 use super::DesignError;
+use crate::model::routing::ControlPoints;
 use crate::model::Actuator;
 use crate::shape::LengthBasis;
 use serde::{Deserialize, Serialize};
@@ -39,7 +40,7 @@ pub struct DesignRecord {
     /// Every component met within the tolerance.
     pub met: bool,
     /// Routing control points y_0..y_4, mm.
-    pub routing_mm: [f64; 5],
+    pub routing_mm: ControlPoints,
     /// Wall time of the search, s.
     pub seconds: f64,
     /// Seed designs simulated before refining.

@@ -8,5 +8,5 @@ pub mod resolution;
 pub mod solver;
 
 pub use actuator::{Actuator, Effects, Gravity, LoadDirection, ParameterError};
-pub use routing::{Routing, RoutingError};
+pub use routing::{ControlPoints, Routing, RoutingError};
 pub use solver::{simulate, simulate_held, CentrelinePoint, Hold, Simulation, Simulator, SolveFailure, SolverMethod, SolverOptions, TipPose, STATUS_OK};

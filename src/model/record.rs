@@ -3,6 +3,7 @@
 //! columns) and the centreline CSV. This module owns both formats: their field
 //! and column names, writers and readers.
 
+use super::routing::ControlPoints;
 use super::{CentrelinePoint, Simulation, STATUS_OK};
 use crate::shape::LengthBasis;
 use serde::{Deserialize, Serialize};
@@ -14,7 +15,7 @@ pub struct SimulationRecord {
     /// Always [`STATUS_OK`]: failed solves are errors, not records.
     pub status: String,
     /// Routing control points y_0..y_4, mm.
-    pub routing_mm: [f64; 5],
+    pub routing_mm: ControlPoints,
     /// Cable tension, N.
     pub tension_n: f64,
     /// Tip position along the clamp axis, mm.

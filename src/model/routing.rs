@@ -12,6 +12,80 @@ use serde::{Deserialize, Serialize};
 /// Number of control points of a routing (thesis: five).
 pub const CONTROL_POINTS: usize = 5;
 
+/// A routing's control-point offsets y_0..y_4 (mm) at s_i = i·L/4 (thesis
+/// §2.2): what the sweep enumerates, the design varies and every record
+/// stores as `routing_mm`. Serialised as a plain list of five numbers.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(transparent)]
+pub struct ControlPoints(pub [f64; CONTROL_POINTS]);
+
+impl ControlPoints {
+    /// The offsets as an array, mm.
+    pub fn as_array(&self) -> &[f64; CONTROL_POINTS] {
+        &self.0
+    }
+
+    /// The offsets as a slice, mm.
+    pub fn as_slice(&self) -> &[f64] {
+        &self.0
+    }
+
+    /// The mirror image y_i → −y_i.
+    pub fn mirrored(&self) -> Self {
+        ControlPoints(self.0.map(|y| -y))
+    }
+}
+
+impl From<[f64; CONTROL_POINTS]> for ControlPoints {
+    fn from(y_mm: [f64; CONTROL_POINTS]) -> Self {
+        ControlPoints(y_mm)
+    }
+}
+
+impl TryFrom<&[f64]> for ControlPoints {
+    type Error = RoutingError;
+
+    /// Exactly [`CONTROL_POINTS`] values, else [`RoutingError::WrongCount`].
+    fn try_from(y_mm: &[f64]) -> Result<Self, RoutingError> {
+        <[f64; CONTROL_POINTS]>::try_from(y_mm).map(ControlPoints).map_err(|_| RoutingError::WrongCount(y_mm.len()))
+    }
+}
+
+impl<'a> IntoIterator for &'a ControlPoints {
+    type Item = &'a f64;
+    type IntoIter = std::slice::Iter<'a, f64>;
+
+    fn into_iter(self) -> Self::IntoIter {
+        self.0.iter()
+    }
+}
+
+impl PartialEq<[f64; CONTROL_POINTS]> for ControlPoints {
+    fn eq(&self, other: &[f64; CONTROL_POINTS]) -> bool {
+        self.0 == *other
+    }
+}
+
+impl AsRef<[f64]> for ControlPoints {
+    fn as_ref(&self) -> &[f64] {
+        &self.0
+    }
+}
+
+impl std::ops::Deref for ControlPoints {
+    type Target = [f64; CONTROL_POINTS];
+
+    fn deref(&self) -> &Self::Target {
+        &self.0
+    }
+}
+
+impl std::ops::DerefMut for ControlPoints {
+    fn deref_mut(&mut self) -> &mut Self::Target {
+        &mut self.0
+    }
+}
+
 /// Why a routing was rejected.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum RoutingError {
@@ -112,7 +186,10 @@ impl Routing {
     /// length `length_mm` and radius `radius_mm`. Every |y_i| must be below
     /// the radius so the channel (inside the control polygon's convex hull)
     /// stays inside the body.
-    pub fn new(y_mm: &[f64], length_mm: f64, radius_mm: f64) -> Result<Self, RoutingError> {
+    /// Takes a [`ControlPoints`], an array or a slice (a slice of the wrong
+    /// length is [`RoutingError::WrongCount`]).
+    pub fn new(y_mm: impl AsRef<[f64]>, length_mm: f64, radius_mm: f64) -> Result<Self, RoutingError> {
+        let y_mm = y_mm.as_ref();
         if !(length_mm.is_finite() && radius_mm.is_finite() && length_mm > 0.0 && radius_mm > 0.0) {
             return Err(RoutingError::BadGeometry { length_mm, radius_mm });
         }
@@ -155,8 +232,8 @@ impl Routing {
     }
 
     /// The control-point offsets y0..y4, mm.
-    pub fn control_points_mm(&self) -> [f64; CONTROL_POINTS] {
-        self.y_mm
+    pub fn control_points_mm(&self) -> ControlPoints {
+        ControlPoints(self.y_mm)
     }
 
     /// Rod length the routing was built for, mm.

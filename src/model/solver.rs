@@ -989,7 +989,7 @@ fn rotate((c, s): (f64, f64), delta: f64) -> (f64, f64) {
 #[derive(Debug, Clone, Serialize)]
 pub struct Simulation {
     /// Routing control points, mm.
-    pub routing_mm: [f64; 5],
+    pub routing_mm: super::routing::ControlPoints,
     /// Tip pose and length.
     pub pose: TipPose,
     /// a_0 … a_n, mm⁻¹ (κ = Σ a_i P_i(t) with dimensionless t, so every a_i

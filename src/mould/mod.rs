@@ -629,7 +629,7 @@ pub struct MouldFile {
 #[derive(Debug, Clone, Serialize)]
 pub struct MouldSummary {
     /// Control points y0..y4, mm.
-    pub routing_mm: [f64; 5],
+    pub routing_mm: crate::model::routing::ControlPoints,
     /// Body length L and radius r, mm.
     pub length_mm: f64,
     /// Body radius r, mm.

@@ -1,5 +1,6 @@
 //! Typed access to the sweep's row columns (docs/schema.md) in Arrow batches.
 
+use crate::model::routing::{ControlPoints, CONTROL_POINTS};
 use super::{Design, ReduceError};
 use crate::sweep::schema::{coefficient_column, ROUTING_ID, STATUS, TENSION_N, TIP_ANGLE_RAD, TIP_X_MM, TIP_Y_MM, Y_MM};
 use arrow::array::{Array, AsArray, Float64Array, Int64Array, StringArray};
@@ -14,7 +15,7 @@ pub struct RowColumns {
     /// `routing_id`.
     pub routing_id: Int64Array,
     /// `y0_mm` … `y4_mm`.
-    pub y_mm: [Float64Array; 5],
+    pub routing_mm: [Float64Array; CONTROL_POINTS],
     /// `tension_n`.
     pub tension_n: Float64Array,
     /// `tip_x_mm`, `tip_y_mm`, `tip_angle_rad`.
@@ -45,12 +46,12 @@ impl RowColumns {
         let status = column(batch, STATUS, &DataType::Utf8)?.as_string::<i32>().clone();
         let routing_id = column(batch, ROUTING_ID, &DataType::Int64)?.as_primitive::<arrow::datatypes::Int64Type>().clone();
         let [y0, y1, y2, y3, y4] = Y_MM.map(|name| f64_column(batch, name));
-        let y_mm = [y0?, y1?, y2?, y3?, y4?];
+        let routing_mm = [y0?, y1?, y2?, y3?, y4?];
         let a = (0..=order).map(|k| f64_column(batch, &coefficient_column(k))).collect::<Result<Vec<_>, _>>()?;
         Ok(Self {
             status,
             routing_id,
-            y_mm,
+            routing_mm,
             tension_n: f64_column(batch, TENSION_N)?,
             tip_x_mm: f64_column(batch, TIP_X_MM)?,
             tip_y_mm: f64_column(batch, TIP_Y_MM)?,
@@ -80,7 +81,7 @@ impl RowColumns {
             iy: 0,
             routing_id: self.routing_id.value(i),
             mirrored: false,
-            y_mm: std::array::from_fn(|k| self.y_mm[k].value(i)),
+            routing_mm: ControlPoints(std::array::from_fn(|k| self.routing_mm[k].value(i))),
             tension_n: self.tension_n.value(i),
             tip_x_mm: self.tip_x_mm.value(i),
             tip_y_mm: self.tip_y_mm.value(i),

@@ -62,7 +62,7 @@ fn data(map: &MapData, actuator: &Actuator, shapes: &[Option<BodyDrawing>], pict
             let rep = m.representative.as_ref().zip(shapes.get(m.mode).and_then(Option::as_ref)).map(|(r, shape)| {
                 let (left, right) = shape.outline();
                 json!({
-                    "routing_mm": nums(r.y_mm),
+                    "routing_mm": nums(r.routing_mm.0),
                     "tension_n": num(r.tension_n),
                     "tip_x_mm": num(r.tip_x_mm),
                     "tip_y_mm": num(r.tip_y_mm),
@@ -99,7 +99,7 @@ fn data(map: &MapData, actuator: &Actuator, shapes: &[Option<BodyDrawing>], pict
         "designs": {
             "ix": d.iter().map(|d| d.ix).collect::<Vec<_>>(),
             "iy": d.iter().map(|d| d.iy).collect::<Vec<_>>(),
-            "y": d.iter().map(|d| nums(d.y_mm)).collect::<Vec<_>>(),
+            "y": d.iter().map(|d| nums(d.routing_mm.0)).collect::<Vec<_>>(),
             "tension_n": nums(d.iter().map(|d| d.tension_n)),
             "tip_x_mm": nums(d.iter().map(|d| d.tip_x_mm)),
             "tip_y_mm": nums(d.iter().map(|d| d.tip_y_mm)),

@@ -41,7 +41,7 @@ impl Mirror for Design {
     fn mirror(&self) -> Self {
         Design {
             mirrored: true,
-            y_mm: self.y_mm.map(|v| -v),
+            routing_mm: self.routing_mm.mirrored(),
             tip_y_mm: -self.tip_y_mm,
             tip_angle_rad: -self.tip_angle_rad,
             a: self.a.iter().map(|v| -v).collect(),
@@ -68,7 +68,7 @@ mod tests {
             iy: 2,
             routing_id: 7,
             mirrored: false,
-            y_mm: [0.0, 1.0, -2.0, 3.0, 0.5],
+            routing_mm: [0.0, 1.0, -2.0, 3.0, 0.5].into(),
             tension_n: 1.5,
             tip_x_mm: 50.0,
             tip_y_mm: 5.0,
@@ -78,7 +78,7 @@ mod tests {
         let m = d.mirror();
         assert!(m.mirrored);
         assert_eq!((m.tip_x_mm, m.tip_y_mm, m.tip_angle_rad, m.tension_n), (50.0, -5.0, -0.3, 1.5));
-        assert_eq!(m.y_mm, [0.0, -1.0, 2.0, -3.0, -0.5]);
+        assert_eq!(m.routing_mm, [0.0, -1.0, 2.0, -3.0, -0.5]);
         assert_eq!(m.a, vec![0.02, -0.01, -0.003]);
         assert_eq!(Design { mirrored: false, ..m.mirror() }, d);
     }

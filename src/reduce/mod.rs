@@ -28,6 +28,7 @@ mod samples;
 pub mod stats;
 pub mod tables;
 
+use crate::model::ControlPoints;
 use crate::shape::LengthBasis;
 use arrow::record_batch::RecordBatch;
 use serde::{Deserialize, Serialize};
@@ -372,8 +373,8 @@ pub struct Design {
     pub routing_id: i64,
     /// Whether this is the mirror image of the stored row.
     pub mirrored: bool,
-    /// Control points, mm.
-    pub y_mm: [f64; 5],
+    /// Routing control points, mm.
+    pub routing_mm: ControlPoints,
     /// Tension, N.
     pub tension_n: f64,
     /// Tip, mm.
@@ -647,7 +648,7 @@ mod tests {
         assert_eq!(map.cells.iter().map(|c| c.count).sum::<i64>(), 2 * converged - 1);
         assert!(map.designs.iter().any(|d| d.mirrored && d.tip_y_mm < 0.0));
         for d in map.designs.iter().filter(|d| d.mirrored) {
-            let original = rows.iter().find(|r| r.0 == d.y_mm.map(|v| -v) && r.1 == d.tension_n).unwrap();
+            let original = rows.iter().find(|r| r.0 == *d.routing_mm.mirrored() && r.1 == d.tension_n).unwrap();
             assert_eq!(d.tip_y_mm, -original.4);
             assert_eq!(d.a[0], -original.5[0]);
         }
@@ -728,7 +729,7 @@ mod tests {
         let actuator = crate::model::Actuator::default();
         let m = map.modes.iter().position(|m| m.representative.is_some()).unwrap();
         // Outside the body: the routing is refused, and the drawing says so.
-        map.modes[m].representative.as_mut().unwrap().y_mm[2] = 2.0 * actuator.radius_mm;
+        map.modes[m].representative.as_mut().unwrap().routing_mm[2] = 2.0 * actuator.radius_mm;
         let drawings = drawings::ModeDrawings::of_map(&map, &actuator, &crate::model::SolverOptions::default());
         assert_eq!(drawings.shapes.len(), MODES);
         assert!(drawings.shapes[m].is_none());

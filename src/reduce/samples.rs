@@ -59,7 +59,7 @@ pub(crate) fn read_samples(
     for batch in batches {
         let cols = RowColumns::from_batch(&batch?, info.order)?;
         for i in 0..cols.len() {
-            let copies = copies(info.mirrored, cols.y_mm.iter().map(|y| y.value(i)));
+            let copies = copies(info.mirrored, cols.routing_mm.iter().map(|y| y.value(i)));
             tally.rows_total += copies;
             if !cols.converged(i) {
                 *tally.failed_by_status.entry(cols.status_of(i).to_string()).or_default() += copies;

@@ -4,6 +4,7 @@
 //! `designs.parquet` hold [`CellStats`], [`ModeStats`](super::ModeStats) and [`Design`] rows.
 //! The design columns are the sweep's own (`sweep::schema`).
 
+use crate::model::ControlPoints;
 use super::{CellStats, CoefficientStats, Design, MapData, MapSummary, ReduceError, CELL_STATS_ORDER, MAX_CELLS_PER_AXIS, MODES};
 use crate::sweep::schema::{coefficient_column, ROUTING_ID, TENSION_N, TIP_ANGLE_RAD, TIP_X_MM, TIP_Y_MM, Y_MM};
 use arrow::array::{Array, ArrayRef, AsArray, BooleanArray, Float64Array, Int32Array, Int64Array};
@@ -194,7 +195,7 @@ pub fn write_tables(dir: &Path, map: &MapData) -> Result<(), ReduceError> {
     modes.i64(mc::CELLS, m.iter().map(|m| m.cells).collect());
     let rep = |f: &dyn Fn(&Design) -> f64| -> Vec<Option<f64>> { m.iter().map(|m| m.representative.as_ref().map(f)).collect() };
     for (k, name) in Y_MM.iter().enumerate() {
-        modes.f64(&mc::representative(name), rep(&|d| d.y_mm[k]));
+        modes.f64(&mc::representative(name), rep(&|d| d.routing_mm[k]));
     }
     modes.f64(&mc::representative(TENSION_N), rep(&|d| d.tension_n));
     modes.f64(&mc::representative(TIP_X_MM), rep(&|d| d.tip_x_mm));
@@ -212,7 +213,7 @@ pub fn write_tables(dir: &Path, map: &MapData) -> Result<(), ReduceError> {
     designs.i64(ROUTING_ID, d.iter().map(|d| d.routing_id).collect());
     designs.bool(dc::MIRRORED, d.iter().map(|d| d.mirrored).collect());
     for (k, name) in Y_MM.iter().enumerate() {
-        designs.f64_all(name, d.iter().map(|d| d.y_mm[k]).collect());
+        designs.f64_all(name, d.iter().map(|d| d.routing_mm[k]).collect());
     }
     designs.f64_all(TENSION_N, d.iter().map(|d| d.tension_n).collect());
     designs.f64_all(TIP_X_MM, d.iter().map(|d| d.tip_x_mm).collect());
@@ -375,7 +376,7 @@ pub fn read_designs(dir: &Path, order: usize) -> Result<Vec<Design>, ReadError> 
                 iy: iy[r],
                 routing_id: id[r],
                 mirrored: mirrored[r],
-                y_mm: std::array::from_fn(|i| ys[i][r]),
+                routing_mm: ControlPoints(std::array::from_fn(|i| ys[i][r])),
                 tension_n: t[r],
                 tip_x_mm: x[r],
                 tip_y_mm: y[r],

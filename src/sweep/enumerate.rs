@@ -26,10 +26,8 @@
 //! its neighbours and on the sharding).
 
 use super::spec::SweepSpec;
+use crate::model::routing::{ControlPoints, CONTROL_POINTS};
 use std::ops::Range;
-
-/// Number of control points of a routing.
-pub const CONTROL_POINTS: usize = 5;
 
 /// The sweep's index arithmetic, derived from a spec.
 #[derive(Debug, Clone, PartialEq)]
@@ -79,8 +77,8 @@ impl SweepPlan {
     }
 
     /// Control points y0…y4 of routing `id`, mm.
-    pub fn routing_mm(&self, id: u64) -> [f64; CONTROL_POINTS] {
-        self.digits(id).map(|d| self.levels_mm[d])
+    pub fn routing_mm(&self, id: u64) -> ControlPoints {
+        ControlPoints(self.digits(id).map(|d| self.levels_mm[d]))
     }
 
     /// Routing ids of chunk `chunk`.
@@ -146,10 +144,10 @@ mod tests {
             let full = SweepPlan::new(&spec);
             spec.grid.mirror_dedup = true;
             let kept = SweepPlan::new(&spec);
-            let pairs: HashSet<[u64; 5]> = (0..full.routings).map(|id| canonical(full.routing_mm(id))).collect();
+            let pairs: HashSet<[u64; 5]> = (0..full.routings).map(|id| canonical(full.routing_mm(id).0)).collect();
             let ours: HashSet<[u64; 5]> = (0..kept.routings)
                 .map(|id| {
-                    let y = kept.routing_mm(id);
+                    let y = kept.routing_mm(id).0;
                     assert_eq!(canonical(y), y.map(|v| (v + 0.0).to_bits()), "levels {levels}: kept {y:?} is not the smaller of its pair");
                     canonical(y)
                 })

@@ -249,7 +249,7 @@ fn solve_routing(
     let routing = Routing::new(&y_mm, spec.actuator.length_mm, spec.actuator.radius_mm)?;
     sim.set_routing(&routing);
     let rows = tensions_n.iter().map(|&t| solve_row(sim, t, &spec.output)).collect();
-    Ok(SolvedRouting { id, y_mm, rows })
+    Ok(SolvedRouting { id, routing_mm: y_mm, rows })
 }
 
 /// One solve as a row: outputs only for a successful, finite solve.

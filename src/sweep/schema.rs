@@ -4,7 +4,7 @@
 //! One row per (routing, tension). Inputs are never null; outputs are null
 //! when the solve failed (never NaN), and `status` says why.
 
-use super::enumerate::CONTROL_POINTS;
+use crate::model::routing::{ControlPoints, CONTROL_POINTS};
 use super::spec::SweepSpec;
 use crate::model::TipPose;
 use arrow::array::{ArrayRef, Float64Builder, Int32Builder, Int64Builder, ListBuilder, StringBuilder};
@@ -79,8 +79,8 @@ pub struct SolvedRow {
 pub struct SolvedRouting {
     /// Routing id.
     pub id: u64,
-    /// Control points, mm.
-    pub y_mm: [f64; CONTROL_POINTS],
+    /// Routing control points, mm.
+    pub routing_mm: ControlPoints,
     /// One entry per tension.
     pub rows: Vec<SolvedRow>,
 }
@@ -100,7 +100,7 @@ pub fn build_batch(schema: &SchemaRef, order: usize, centreline: bool, routings:
     for r in routings {
         for row in &r.rows {
             id.append_value(r.id as i64);
-            for (b, v) in y.iter_mut().zip(r.y_mm) {
+            for (b, v) in y.iter_mut().zip(r.routing_mm.0) {
                 b.append_value(v);
             }
             tension.append_value(row.tension_n);
