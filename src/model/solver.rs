@@ -22,23 +22,21 @@
 //! Effects (model-notes §6) enter as local terms: the bending law
 //! ([`Simulator::bending_curvature`]), the clamp boundary
 //! ([`Simulator::clamp_angle`]), the routing (channel offset) and the weight.
+//! The section's rigidities and the weight beyond a cut are looked up in one
+//! place each ([`Simulator::section_at`], [`Simulator::distal_weight_n`]),
+//! and the bending moment at a cut is one function ([`bending_moment`]).
 //!
-//! Two effects carry state beyond one point:
-//! - **Cable–channel friction** (capstan law dτ/ds = −σ μ τ |ψ'|, ψ the
-//!   cable's global angle φ + α, σ = +1 loading and −1 unloading): the tension
-//!   profile τ(s)/τ(0) is held at every stage point and updated from the
-//!   cable angles of the last pass until it stops changing (a fixed point that
-//!   contracts like μ·|Δψ|; warm-started from the previous solve). The cut
-//!   equations hold unchanged with τ(s) at the cut, because friction acts
-//!   inside the distal free body.
-//! - **Viscoelastic creep in bending** (standard linear solid): the moment is
-//!   m = EI (u − f q) with an internal curvature q obeying T q̇ = u − q. Each
-//!   solve is one step of a protocol: the tension jumps, then is held for the
-//!   dwell time d with m(s) taken as constant over the hold. That makes the
-//!   law at the end of the hold local and linear,
-//!   u = m/EI · (1 + f (1 − E)/(1 − f)) + f E q₀,  E = exp(−(1 − f) d / T),
-//!   and q is advanced in closed form after the solve. The history q(s) lives
-//!   in the simulator; `set_routing` and `reset_history` clear it.
+//! Two effects carry state beyond one point, each a small state type with
+//! the few hooks the integrators call:
+//! - **Cable–channel friction** (`friction`: capstan law
+//!   dτ/ds = −η μ τ |ψ'| with the slip sign η): a tension profile τ(s)/τ(0)
+//!   updated from the cable angles of the last pass until it settles.
+//! - **Viscoelastic creep in bending** (`creep`: standard linear solid): a
+//!   local, linear law at the end of each held step, and the internal
+//!   curvature q(s) advanced after the solve. `set_routing` and
+//!   `reset_history` clear that history.
+//!
+//! (σ is the deformed arc length throughout.)
 //!
 //! The hot paths (RK4's `integrate`, collocation's sweeps) work in buffers
 //! allocated once per [`Simulator`]; solving allocates nothing, except in
@@ -50,6 +48,13 @@ use crate::shape::{self, LengthBasis};
 use serde::{Deserialize, Serialize};
 
 mod collocation;
+mod continuation;
+mod creep;
+mod friction;
+
+use continuation::Continuation;
+use creep::Creep;
+use friction::Friction;
 
 /// Why a solve produced no result. The sweep stores [`SolveFailure::status`].
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -101,10 +106,16 @@ impl SolveFailure {
     }
 }
 
-/// Most re-integrations while the friction tension profile settles.
-const FRICTION_MAX_PASSES: usize = 60;
-/// Largest change of τ(s)/τ(0) accepted as settled.
-const FRICTION_TOLERANCE: f64 = 1e-10;
+/// Most Newton iterations of material stiffening's cubic curvature law.
+const STIFFENING_MAX_ITERATIONS: usize = 60;
+/// Relative Newton step accepted as converged in the stiffening law.
+const STIFFENING_TOLERANCE: f64 = 1e-15;
+/// Most Newton iterations of the cable-direction equation at one point.
+const CABLE_ANGLE_MAX_ITERATIONS: usize = 50;
+/// Most fixed-point iterations of the compliant clamp's rotation (RK4).
+const CLAMP_MAX_ITERATIONS: usize = 100;
+/// Change of the clamp rotation accepted as converged, rad.
+const CLAMP_TOLERANCE_RAD: f64 = 1e-14;
 
 /// Collocation intervals per span used at least when material stiffening is on.
 pub const MIN_NODES_WITH_STIFFENING: usize = 16;
@@ -262,14 +273,23 @@ struct ChannelSample {
     dy: f64,
 }
 
-/// Warm-start memory of a continuation in tension.
-#[derive(Debug, Clone, Copy, Default)]
-struct Continuation {
-    /// Previous converged (tension, base moment) pairs, newest first.
-    history: [(f64, f64); 3],
-    solved: usize,
-    /// Secant slopes dM(L)/dM(0) of the last two solves, newest first.
-    slopes: [f64; 2],
+/// Rigidities of the cross-section at one point.
+#[derive(Debug, Clone, Copy)]
+struct Section {
+    /// Axial rigidity EA, N.
+    ea_n: f64,
+    /// Shear rigidity GA, N.
+    ga_n: f64,
+    /// Bending rigidity EI, N·mm².
+    ei_n_mm2: f64,
+}
+
+/// Bending moment at a cut, N·mm: the cable's moment τ y_c cos α about the
+/// centreline (`tension` at the cut, channel offset `channel_y_mm`, cable
+/// direction cos α) plus gravity's distal moment M.
+#[inline]
+fn bending_moment(tension: f64, channel_y_mm: f64, cos_alpha: f64, distal_moment: f64) -> f64 {
+    tension * channel_y_mm * cos_alpha + distal_moment
 }
 
 /// A reusable solver for one actuator: set a routing, then solve tensions
@@ -299,28 +319,10 @@ pub struct Simulator {
     sigma: Vec<f64>,
     continuation: Continuation,
     last: Option<TipPose>,
-    /// Friction sign σ of the next solves: +1 loading, −1 unloading.
-    friction_sign: f64,
-    /// Cable tension at each stage point relative to the base tension.
-    tension_ratio: Vec<f64>,
-    /// Cable's global direction (cos ψ, sin ψ) at each stage point, last pass.
-    cable_global: Vec<(f64, f64)>,
-    /// Bending moment at each stage point in the last pass, N·mm.
-    bending_moment: Vec<f64>,
-    /// Creep's internal curvature q at each stage point, 1/mm.
-    creep_q: Vec<f64>,
-    /// Dwell before the reading of the next solves, s.
-    dwell_s: f64,
-    /// E = exp(−(1 − f) d / T) for the current dwell.
-    creep_decay: f64,
-    /// Extra compliance of the held step, f (1 − E)/((1 − f) EI), 1/(N·mm²).
-    creep_gain: f64,
-    /// Whether every solve starts from a rod with no load history (the
-    /// default, held `effects.creep_hold_s`), or follows a protocol set by
-    /// [`Simulator::set_hold`].
-    virgin_holds: bool,
-    /// Whether passes record cable angles and moments (friction or creep on).
-    records_profile: bool,
+    /// Cable–channel friction: slip sign and tension profile per point.
+    friction: Friction,
+    /// Creep: the hold and the load history per point.
+    creep: Creep,
     /// Collocation state (`None` with the RK4 method).
     col: Option<Box<collocation::Colloc>>,
 }
@@ -389,22 +391,14 @@ impl Simulator {
             sigma: vec![0.0; nodes],
             continuation: Continuation::default(),
             last: None,
-            friction_sign: actuator.effects.load_direction.sign(),
-            tension_ratio: vec![1.0; points],
-            cable_global: vec![(1.0, 0.0); points],
-            bending_moment: vec![0.0; points],
-            creep_q: vec![0.0; points],
-            dwell_s: 0.0,
-            creep_decay: 1.0,
-            creep_gain: 0.0,
-            virgin_holds: true,
-            records_profile: actuator.effects.friction_mu > 0.0 || actuator.effects.creep_fraction > 0.0,
+            friction: Friction::new(actuator.effects.friction_mu, actuator.effects.load_direction.sign(), points),
+            creep: Creep::new(&actuator.effects, actuator.ei_n_mm2, points),
             col,
         })
         .and_then(|mut sim: Simulator| {
+            // Outside a protocol every solve is held like this from a virgin rod.
             let hold = Hold { direction: actuator.effects.load_direction, dwell_s: actuator.effects.creep_hold_s };
-            sim.set_hold(hold)?;
-            sim.virgin_holds = true;
+            sim.apply_hold(hold)?;
             Ok(sim)
         })
     }
@@ -460,12 +454,12 @@ impl Simulator {
             col.forget();
         }
         self.cable_dir.iter_mut().for_each(|d| *d = (1.0, 0.0));
-        self.tension_ratio.iter_mut().for_each(|r| *r = 1.0);
+        self.friction.forget();
     }
 
     /// Forgets the load history (creep): the material is as new, unloaded.
     pub fn reset_history(&mut self) {
-        self.creep_q.iter_mut().for_each(|q| *q = 0.0);
+        self.creep.forget();
     }
 
     /// Sets how the next solves are held: the load direction (sign of
@@ -476,37 +470,49 @@ impl Simulator {
     /// Without this call every solve is held `effects.creep_hold_s` on a
     /// rod with no load history, in `effects.load_direction`.
     pub fn set_hold(&mut self, hold: Hold) -> Result<(), ParameterError> {
-        self.virgin_holds = false;
+        self.creep.follow_protocol();
+        self.apply_hold(hold)
+    }
+
+    /// Checks `hold` and hands it to friction (slip sign) and creep (dwell).
+    fn apply_hold(&mut self, hold: Hold) -> Result<(), ParameterError> {
         if !(hold.dwell_s.is_finite() && hold.dwell_s >= 0.0) {
             return Err(ParameterError::OutOfRange { name: "dwell_s", value: hold.dwell_s, expected: "a finite time ≥ 0 s" });
         }
-        self.friction_sign = hold.direction.sign();
-        self.dwell_s = hold.dwell_s;
-        let e = &self.actuator.effects;
-        let f = e.creep_fraction;
-        if f > 0.0 {
-            self.creep_decay = (-(1.0 - f) * hold.dwell_s / e.creep_time_s).exp();
-            self.creep_gain = f * (1.0 - self.creep_decay) / ((1.0 - f) * self.actuator.ei_n_mm2);
-        } else {
-            self.creep_decay = 1.0;
-            self.creep_gain = 0.0;
-        }
+        self.friction.set_slip_sign(hold.direction.sign());
+        self.creep.set_dwell(hold.dwell_s);
         Ok(())
     }
 
-    /// Curvature u from the bending moment `m` (N·mm) at `s` and du/dm.
-    /// Linear (m = EI u) unless material stiffening makes it
-    /// m = EI u (1 + α (r u)²); the test-only hidden effects add a rest
-    /// curvature u₀ (m = EI (u − u₀)) and a stiffer base segment.
+    /// The section's rigidities at reference arc length `s` (mm): the
+    /// actuator's, with the test-only hidden stiffer base segment. The one
+    /// place a profile along s would enter.
     #[inline]
-    fn bending_curvature(&self, m: f64, s: f64) -> (f64, f64) {
-        let hidden = &self.actuator.effects.hidden;
-        let mut ei = self.actuator.ei_n_mm2;
+    fn section_at(&self, s: f64) -> Section {
+        let a = &self.actuator;
+        let hidden = &a.effects.hidden;
+        let mut ei = a.ei_n_mm2;
         if s < hidden.base_segment_mm {
             ei *= hidden.base_segment_ei_factor;
         }
-        let (u, du_dm) = self.elastic_curvature(m, ei);
-        (u + hidden.rest_curvature_per_mm, du_dm)
+        Section { ea_n: a.ea_n, ga_n: a.ga_n, ei_n_mm2: ei }
+    }
+
+    /// The rod's weight beyond the cut at `s` (mm), N.
+    #[inline]
+    fn distal_weight_n(&self, s: f64) -> f64 {
+        self.weight_n_per_mm * (self.actuator.length_mm - s)
+    }
+
+    /// Curvature u from the bending moment `m` (N·mm) on `section` and du/dm.
+    /// Linear (m = EI u) unless material stiffening makes it
+    /// m = EI u (1 + α (r u)²); the test-only hidden effects add a rest
+    /// curvature u₀ (m = EI (u − u₀)) and a stiffer base segment
+    /// ([`Simulator::section_at`]).
+    #[inline]
+    fn bending_curvature(&self, m: f64, section: &Section) -> (f64, f64) {
+        let (u, du_dm) = self.elastic_curvature(m, section.ei_n_mm2);
+        (u + self.actuator.effects.hidden.rest_curvature_per_mm, du_dm)
     }
 
     /// The elastic part of [`Simulator::bending_curvature`] with rigidity `ei`.
@@ -519,12 +525,12 @@ impl Simulator {
         // Monotone cubic EI (u + c u³) = m, c = α r²: Newton from the linear guess.
         let c = alpha * self.actuator.radius_mm.powi(2);
         let mut u = m / ei;
-        for _ in 0..60 {
+        for _ in 0..STIFFENING_MAX_ITERATIONS {
             let f = ei * (u + c * u * u * u) - m;
             let df = ei * (1.0 + 3.0 * c * u * u);
             let du = f / df;
             u -= du;
-            if du.abs() <= 1e-15 * (1.0 + u.abs()) {
+            if du.abs() <= STIFFENING_TOLERANCE * (1.0 + u.abs()) {
                 break;
             }
         }
@@ -553,20 +559,21 @@ impl Simulator {
         dir0: (f64, f64),
         creep_offset: f64,
     ) -> Result<(Strains, (f64, f64)), SolveFailure> {
-        let a = &self.actuator;
-        let (ea, ga) = (a.ea_n, a.ga_n);
+        let section = self.section_at(s);
+        let (ea, ga) = (section.ea_n, section.ga_n);
+        let creep_gain = self.creep.gain();
         // Weight beyond the cut, in the body frame: Rᵀ W.
-        let wl = self.weight_n_per_mm * (a.length_mm - s);
+        let wl = self.distal_weight_n(s);
         let w1 = wl * (cp * self.gravity_cos + sp * self.gravity_sin);
         let w2 = wl * (cp * self.gravity_sin - sp * self.gravity_cos);
         let (mut ca, mut sa) = dir0;
-        for _ in 0..50 {
+        for _ in 0..CABLE_ANGLE_MAX_ITERATIONS {
             let v1 = 1.0 + (w1 - tension * ca) / ea;
             let v2 = (w2 - tension * sa) / ga;
-            let m = tension * ch.y * ca + moment;
-            let (u_el, du_dm_el) = self.bending_curvature(m, s);
-            let u = u_el + self.creep_gain * m + creep_offset;
-            let du_dm = du_dm_el + self.creep_gain;
+            let m = bending_moment(tension, ch.y, ca, moment);
+            let (u_el, du_dm_el) = self.bending_curvature(m, &section);
+            let u = u_el + creep_gain * m + creep_offset;
+            let du_dm = du_dm_el + creep_gain;
             let p = v1 - u * ch.y;
             let q = v2 + ch.dy;
             let g = p * sa - q * ca;
@@ -598,30 +605,31 @@ impl Simulator {
     }
 
     /// Right-hand side of the forward ODE at stage point `k` (index into the
-    /// channel samples).
+    /// channel samples); `(sp, cp)` = sin, cos of the state's φ.
     #[inline]
-    /// `(cp, sp)` are cos φ, sin φ of the state.
     fn derivative(
         &mut self,
         s: f64,
         k: usize,
         st: &State,
-        (cp, sp): (f64, f64),
+        (sp, cp): (f64, f64),
         tension: f64,
     ) -> Result<(State, Strains), SolveFailure> {
         let ch = self.channel[k];
-        let local_tension = tension * self.tension_ratio[k];
-        let creep_offset = self.creep_offset(k);
+        let local_tension = tension * self.friction.ratio(k);
+        let creep_offset = self.creep.offset(k);
         let (e, dir) = self.strains_at(s, ch, (sp, cp), st.moment, local_tension, self.cable_dir[k], creep_offset)?;
         self.cable_dir[k] = dir;
         // Only friction (cable angles) and creep (moments) need these.
-        if self.records_profile {
-            self.cable_global[k] = (cp * dir.0 - sp * dir.1, sp * dir.0 + cp * dir.1);
-            self.bending_moment[k] = local_tension * ch.y * dir.0 + st.moment;
+        if self.friction.is_on() {
+            self.friction.record_cable_direction(k, (sp, cp), dir);
+        }
+        if self.creep.is_on() {
+            self.creep.record_moment(k, bending_moment(local_tension, ch.y, dir.0, st.moment));
         }
         let dx = e.v1 * cp - e.v2 * sp;
         let dy = e.v1 * sp + e.v2 * cp;
-        let wl = self.weight_n_per_mm * (self.actuator.length_mm - s);
+        let wl = self.distal_weight_n(s);
         let d = State {
             x: dx,
             y: dy,
@@ -630,17 +638,6 @@ impl Simulator {
             sigma: (e.v1 * e.v1 + e.v2 * e.v2).sqrt(),
         };
         Ok((d, e))
-    }
-
-    /// The creep's held curvature f E q₀ at stage point `k`, 1/mm.
-    #[inline]
-    fn creep_offset(&self, k: usize) -> f64 {
-        let f = self.actuator.effects.creep_fraction;
-        if f == 0.0 {
-            0.0
-        } else {
-            f * self.creep_decay * self.creep_q[k]
-        }
     }
 
     /// Frame angle at the clamp: 0 for a rigid clamp; with clamp compliance
@@ -652,12 +649,12 @@ impl Simulator {
         };
         let ch = self.channel[0];
         let mut phi: f64 = 0.0;
-        for _ in 0..100 {
+        for _ in 0..CLAMP_MAX_ITERATIONS {
             let (_, (ca, _)) =
-                self.strains_at(0.0, ch, phi.sin_cos(), moment0, tension, self.cable_dir[0], self.creep_offset(0))?;
-            let m = tension * ch.y * ca + moment0;
+                self.strains_at(0.0, ch, phi.sin_cos(), moment0, tension, self.cable_dir[0], self.creep.offset(0))?;
+            let m = bending_moment(tension, ch.y, ca, moment0);
             let next = m / k_theta;
-            if (next - phi).abs() < 1e-14 {
+            if (next - phi).abs() < CLAMP_TOLERANCE_RAD {
                 return Ok(next);
             }
             phi = next;
@@ -677,17 +674,17 @@ impl Simulator {
                 let s = self.span_start_mm[span] + step as f64 * h;
                 let k = base + 2 * step;
                 // One sin/cos per step; the stages rotate it by small angles.
-                let (sp, cp) = st.phi.sin_cos();
-                let (d1, e1) = self.derivative(s, k, &st, (cp, sp), tension)?;
+                let trig = st.phi.sin_cos();
+                let (d1, e1) = self.derivative(s, k, &st, trig, tension)?;
                 let node = span * n + step;
                 self.nodes_state[node] = st;
                 self.nodes_strain[node] = e1;
                 let s2 = st.axpy(0.5 * h, &d1);
-                let (d2, _) = self.derivative(s + 0.5 * h, k + 1, &s2, rotate((cp, sp), 0.5 * h * d1.phi), tension)?;
+                let (d2, _) = self.derivative(s + 0.5 * h, k + 1, &s2, rotate_sin_cos(trig, 0.5 * h * d1.phi), tension)?;
                 let s3 = st.axpy(0.5 * h, &d2);
-                let (d3, _) = self.derivative(s + 0.5 * h, k + 1, &s3, rotate((cp, sp), 0.5 * h * d2.phi), tension)?;
+                let (d3, _) = self.derivative(s + 0.5 * h, k + 1, &s3, rotate_sin_cos(trig, 0.5 * h * d2.phi), tension)?;
                 let s4 = st.axpy(h, &d3);
-                let (d4, _) = self.derivative(s + h, k + 2, &s4, rotate((cp, sp), h * d3.phi), tension)?;
+                let (d4, _) = self.derivative(s + h, k + 2, &s4, rotate_sin_cos(trig, h * d3.phi), tension)?;
                 st = State {
                     x: st.x + h / 6.0 * (d1.x + 2.0 * d2.x + 2.0 * d3.x + d4.x),
                     y: st.y + h / 6.0 * (d1.y + 2.0 * d2.y + 2.0 * d3.y + d4.y),
@@ -702,8 +699,7 @@ impl Simulator {
         }
         // Tip node.
         let k_tip = 2 * (2 * n + 1) - 1;
-        let (sp, cp) = st.phi.sin_cos();
-        let (_, e) = self.derivative(self.actuator.length_mm, k_tip, &st, (cp, sp), tension)?;
+        let (_, e) = self.derivative(self.actuator.length_mm, k_tip, &st, st.phi.sin_cos(), tension)?;
         let tip = 2 * n;
         self.nodes_state[tip] = st;
         self.nodes_strain[tip] = e;
@@ -734,74 +730,6 @@ impl Simulator {
         Ok(passes)
     }
 
-    /// Friction: updates the tension profile from the last pass and re-solves
-    /// with `repass` (returning its passes) until the profile settles.
-    fn settle_friction(&mut self, mut repass: impl FnMut(&mut Self) -> Result<u32, SolveFailure>) -> Result<u32, SolveFailure> {
-        let mut passes = 0;
-        for _ in 0..FRICTION_MAX_PASSES {
-            if self.update_tension_ratio() < FRICTION_TOLERANCE {
-                return Ok(passes);
-            }
-            passes += repass(self)?;
-        }
-        Err(SolveFailure::FrictionNotConverged)
-    }
-
-    /// Recomputes the friction tension profile τ(s)/τ(0) from the cable
-    /// angles of the last pass (capstan law between neighbouring nodes,
-    /// exact for a constant |ψ'| between them); returns the largest change.
-    ///
-    /// Only the nodes (accepted RK4 states) are used, not the predictor
-    /// stages; the stage point between two nodes gets their geometric mean.
-    fn update_tension_ratio(&mut self) -> f64 {
-        let n = self.options.steps_per_span;
-        let span_len = 2 * n + 1;
-        let k_node = |node: usize| -> usize {
-            // Span 0's last node is the same point as span 1's first.
-            if node < n {
-                2 * node
-            } else {
-                span_len + 2 * (node - n)
-            }
-        };
-        let mu = self.actuator.effects.friction_mu * self.friction_sign;
-        let mut change: f64 = 0.0;
-        let mut ratio = 1.0;
-        let mut prev_dir = self.cable_global[k_node(0)];
-        let mut set = |ratio_vec: &mut Vec<f64>, k: usize, value: f64| {
-            change = change.max((ratio_vec[k] - value).abs());
-            ratio_vec[k] = value;
-        };
-        set(&mut self.tension_ratio, 0, 1.0);
-        for node in 1..=2 * n {
-            let dir = self.cable_global[k_node(node)];
-            let turn = (prev_dir.0 * dir.1 - prev_dir.1 * dir.0).atan2(prev_dir.0 * dir.0 + prev_dir.1 * dir.1);
-            let next = ratio * (-mu * turn.abs()).exp();
-            let k = k_node(node);
-            let mid = (ratio * next).sqrt();
-            set(&mut self.tension_ratio, k_node(node - 1) + 1, mid);
-            set(&mut self.tension_ratio, k, next);
-            if node == n {
-                set(&mut self.tension_ratio, 2 * n, next);
-            }
-            ratio = next;
-            prev_dir = dir;
-        }
-        change
-    }
-
-    /// Advances the creep's internal curvature over the hold just solved:
-    /// q ← q∞ + (q − q∞) E with q∞ = m/(EI (1 − f)).
-    fn advance_creep(&mut self) {
-        let f = self.actuator.effects.creep_fraction;
-        let scale = 1.0 / (self.actuator.ei_n_mm2 * (1.0 - f));
-        let e = self.creep_decay;
-        for (q, &m) in self.creep_q.iter_mut().zip(&self.bending_moment) {
-            let q_inf = m * scale;
-            *q = q_inf + (*q - q_inf) * e;
-        }
-    }
-
     /// Solves the statics for `tension_n` (N) on the current routing,
     /// warm-started from the previous solves of this routing.
     ///
@@ -812,9 +740,7 @@ impl Simulator {
         if !(tension_n.is_finite() && tension_n >= 0.0) {
             return Err(SolveFailure::InvalidTension(tension_n));
         }
-        if self.virgin_holds && self.actuator.effects.creep_fraction > 0.0 {
-            self.reset_history();
-        }
+        self.creep.begin_solve();
         let result = self.solve_inner(tension_n);
         match &result {
             Ok(pose) => self.last = Some(*pose),
@@ -829,69 +755,40 @@ impl Simulator {
     fn solve_inner(&mut self, tension: f64) -> Result<TipPose, SolveFailure> {
         if self.col.is_some() {
             let passes = self.colloc_solve(tension)?;
-            if self.actuator.effects.creep_fraction > 0.0 && self.dwell_s > 0.0 && !self.virgin_holds {
-                self.advance_creep();
-            }
+            self.creep.end_solve();
             return Ok(self.colloc_pose(tension, passes));
         }
         let has_moment = self.weight_n_per_mm != 0.0;
-        let has_friction = self.actuator.effects.friction_mu > 0.0 && tension > 0.0;
+        let has_friction = self.friction.acts_at(tension);
+        let n = self.options.steps_per_span;
         let mut passes;
         if has_moment {
-            let c = self.continuation;
-            // Predict the base moment from the last solves: the Lagrange
-            // polynomial through up to three previous (tension, moment) pairs.
-            let known = &c.history[..c.solved.min(3)];
-            let mut m0 = 0.0;
-            for (i, &(ti, mi)) in known.iter().enumerate() {
-                let mut weight = 1.0;
-                for (j, &(tj, _)) in known.iter().enumerate() {
-                    if i != j {
-                        weight *= (tension - tj) / (ti - tj);
-                    }
-                }
-                m0 += weight * mi;
-            }
-            if !m0.is_finite() {
-                // Repeated tensions: fall back to the newest solution.
-                m0 = known.first().map_or(0.0, |h| h.1);
-            }
-            // dM(L)/dM(0) is near 1 (the weight's moment hardly depends on
-            // it) and drifts slowly with tension: extrapolate it linearly.
-            let mut slope = match c.solved {
-                0 => 1.0,
-                1 => c.slopes[0],
-                _ => {
-                    let (t1, t2) = (c.history[0].0, c.history[1].0);
-                    c.slopes[0] + (c.slopes[0] - c.slopes[1]) / (t1 - t2) * (tension - t1)
-                }
-            };
-            if !(slope.is_finite() && slope.abs() > 1e-3) {
-                slope = 1.0;
-            }
+            let (mut m0, mut slope) = self.continuation.predict(tension);
             passes = self.shoot(tension, &mut m0, &mut slope)?;
             if has_friction {
-                passes += self.settle_friction(|sim| sim.shoot(tension, &mut m0, &mut slope))?;
+                passes += friction::settle(
+                    self,
+                    |sim| sim.friction.update_from_rk4_nodes(n),
+                    |sim| sim.shoot(tension, &mut m0, &mut slope),
+                )?;
             }
-            let cont = &mut self.continuation;
-            cont.history.rotate_right(1);
-            cont.history[0] = (tension, m0);
-            cont.solved += 1;
-            cont.slopes = [slope, cont.slopes[0]];
+            self.continuation.record(tension, m0, slope);
         } else {
             self.integrate(tension, 0.0)?;
             passes = 1;
             if has_friction {
-                passes += self.settle_friction(|sim| sim.integrate(tension, 0.0).map(|_| 1))?;
+                passes += friction::settle(
+                    self,
+                    |sim| sim.friction.update_from_rk4_nodes(n),
+                    |sim| sim.integrate(tension, 0.0).map(|_| 1),
+                )?;
             }
         }
         let n_nodes = self.nodes_state.len();
         let base = self.nodes_state[0];
         let tip = self.nodes_state[n_nodes - 1];
         let (e0, et) = (self.nodes_strain[0], self.nodes_strain[n_nodes - 1]);
-        if self.actuator.effects.creep_fraction > 0.0 && self.dwell_s > 0.0 && !self.virgin_holds {
-            self.advance_creep();
-        }
+        self.creep.end_solve();
         Ok(TipPose {
             tension_n: tension,
             tip_x_mm: tip.x,
@@ -960,7 +857,7 @@ impl Simulator {
                     channel_y_mm: yc,
                     cable_x_mm: st.x - sp * yc,
                     cable_y_mm: st.y + cp * yc,
-                    cable_tension_n: tension * self.tension_ratio[k],
+                    cable_tension_n: tension * self.friction.ratio(k),
                 }
             })
             .collect()
@@ -984,6 +881,13 @@ fn rotate((c, s): (f64, f64), delta: f64) -> (f64, f64) {
     (c * cd - s * sd, s * cd + c * sd)
 }
 
+/// [`rotate`] for the pair in `sin_cos` order, (sin a, cos a).
+#[inline]
+fn rotate_sin_cos((s, c): (f64, f64), delta: f64) -> (f64, f64) {
+    let (c, s) = rotate((c, s), delta);
+    (s, c)
+}
+
 /// Everything about one solved actuator: the pose, the coefficients and the
 /// centreline. Convenience for single solves (allocates).
 #[derive(Debug, Clone, Serialize)]
@@ -1001,6 +905,17 @@ pub struct Simulation {
     pub centreline: Vec<CentrelinePoint>,
 }
 
+/// Why [`simulate`] or [`simulate_held`] produced no result.
+#[derive(Debug, thiserror::Error)]
+pub enum SimulateError {
+    /// The actuator, solver options, hold or coefficient order are invalid.
+    #[error(transparent)]
+    Parameter(#[from] ParameterError),
+    /// A solve of the tension ladder failed.
+    #[error(transparent)]
+    Solve(#[from] SolveFailure),
+}
+
 /// Solves one actuator at `tension_n`, stepping up from a low tension by
 /// continuation so that large deformations start from a nearby solution.
 pub fn simulate(
@@ -1010,7 +925,7 @@ pub fn simulate(
     tension_n: f64,
     order: usize,
     basis: LengthBasis,
-) -> Result<Simulation, crate::Error> {
+) -> Result<Simulation, SimulateError> {
     let hold = Hold { direction: actuator.effects.load_direction, dwell_s: actuator.effects.creep_hold_s };
     simulate_held(actuator, options, routing, tension_n, order, basis, hold)
 }
@@ -1026,7 +941,7 @@ pub fn simulate_held(
     order: usize,
     basis: LengthBasis,
     hold: Hold,
-) -> Result<Simulation, crate::Error> {
+) -> Result<Simulation, SimulateError> {
     super::resolution::check_order(order, options).map_err(ParameterError::Unresolved)?;
     let mut sim = Simulator::new(actuator, options)?;
     sim.set_routing(routing);
@@ -1125,20 +1040,20 @@ mod tests {
 
     #[test]
     fn friction_matches_the_capstan_closed_form() {
-        // ψ' = u = τ(s) d / EI and dτ/ds = −σ μ τ ψ' give
-        // τ(s) = τ0 / (1 + σ μ τ0 d s / EI), φ(L) = σ ln(1 + σ μ τ0 d L / EI) / μ.
+        // ψ' = u = τ(s) d / EI and dτ/ds = −η μ τ ψ' (slip sign η) give
+        // τ(s) = τ0 / (1 + η μ τ0 d s / EI), φ(L) = η ln(1 + η μ τ0 d L / EI) / μ.
         let (mu, tau, d) = (0.1, 2.0, 4.0);
         let a = Actuator::default();
         for direction in [LoadDirection::Load, LoadDirection::Unload] {
-            let sigma = direction.sign();
+            let slip = direction.sign();
             let mut sim = straight(|a| a.effects.friction_mu = mu, d);
             sim.set_hold(Hold { direction, dwell_s: 0.0 }).unwrap();
             let pose = ladder(&mut sim, tau);
-            let expected = sigma * (1.0 + sigma * mu * tau * d * a.length_mm / a.ei_n_mm2).ln() / mu;
+            let expected = slip * (1.0 + slip * mu * tau * d * a.length_mm / a.ei_n_mm2).ln() / mu;
             assert!((pose.tip_angle_rad - expected).abs() < 2e-4, "{direction:?}: {} vs {expected}", pose.tip_angle_rad);
             let line = sim.centreline();
             let tip = line.last().unwrap();
-            let tip_tension = tau / (1.0 + sigma * mu * tau * d * a.length_mm / a.ei_n_mm2);
+            let tip_tension = tau / (1.0 + slip * mu * tau * d * a.length_mm / a.ei_n_mm2);
             assert!((tip.cable_tension_n - tip_tension).abs() < 1e-4, "{} vs {tip_tension}", tip.cable_tension_n);
         }
         // Without friction the profile is flat and load = unload.

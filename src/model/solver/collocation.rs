@@ -20,9 +20,8 @@
 //! over, damped by backtracking, and if it fails from the warm start it is
 //! continued in the weight from a weightless rod.
 
-use super::{
-    CentrelinePoint, ChannelSample, Simulator, SolveFailure, Strains, TipPose, FRICTION_MAX_PASSES, FRICTION_TOLERANCE,
-};
+use super::friction::{MAX_PASSES as FRICTION_MAX_PASSES, TOLERANCE as FRICTION_TOLERANCE};
+use super::{bending_moment, CentrelinePoint, ChannelSample, Simulator, SolveFailure, Strains, TipPose};
 use crate::shape::LengthBasis;
 use nalgebra::{DMatrix, DVector};
 
@@ -493,7 +492,7 @@ impl Simulator {
     fn colloc_solve_with(&mut self, c: &mut Colloc, tension: f64) -> Result<u32, SolveFailure> {
         c.predict(tension);
         let has_weight = self.weight_n_per_mm != 0.0;
-        let has_friction = self.actuator.effects.friction_mu > 0.0 && tension > 0.0;
+        let has_friction = self.friction.acts_at(tension);
         if !has_weight && !has_friction {
             // The strains do not depend on φ or M: one sweep is the solution.
             self.colloc_sweep(c, tension)?;
@@ -508,7 +507,7 @@ impl Simulator {
         let scale = self.actuator.length_mm / self.actuator.ei_n_mm2;
         c.anderson.restart();
         let outcome = loop {
-            c.anderson.begin(&c.phi, &c.mom, &self.tension_ratio, scale);
+            c.anderson.begin(&c.phi, &c.mom, self.friction.ratios(), scale);
             let (dphi, dmom) = match self.colloc_sweep(c, tension) {
                 Ok(change) => change,
                 Err(e) => break Err(e),
@@ -534,7 +533,7 @@ impl Simulator {
                 break Err(SolveFailure::WeightNotConverged { reached_percent: 100.0 });
             }
             previous = change;
-            c.accelerate(scale, &mut self.tension_ratio);
+            c.accelerate(scale, self.friction.ratios_mut());
         };
         match outcome {
             Ok(()) => {
@@ -552,17 +551,15 @@ impl Simulator {
     }
 
     /// Strains at every node from the current φ, M; records the cable
-    /// direction and bending moment for friction and creep.
+    /// direction (friction reads it with φ) and the bending moment (creep).
     fn colloc_strains(&mut self, c: &mut Colloc, tension: f64) -> Result<(), SolveFailure> {
         for i in 0..c.s.len() {
             let ch = self.channel[i];
-            let t = tension * self.tension_ratio[i];
-            let (e, dir) = self.strains_at(c.s[i], ch, c.trig[i], c.mom[i], t, self.cable_dir[i], self.creep_offset(i))?;
+            let t = tension * self.friction.ratio(i);
+            let (e, dir) = self.strains_at(c.s[i], ch, c.trig[i], c.mom[i], t, self.cable_dir[i], self.creep.offset(i))?;
             self.cable_dir[i] = dir;
-            if self.records_profile {
-                let (sp, cp) = c.trig[i];
-                self.cable_global[i] = (cp * dir.0 - sp * dir.1, sp * dir.0 + cp * dir.1);
-                self.bending_moment[i] = t * ch.y * dir.0 + c.mom[i];
+            if self.creep.is_on() {
+                self.creep.record_moment(i, bending_moment(t, ch.y, dir.0, c.mom[i]));
             }
             c.strain[i] = e;
             c.du[i] = e.u;
@@ -573,7 +570,7 @@ impl Simulator {
     /// Frame angle at the clamp from node 0's bending moment.
     fn colloc_clamp_angle(&self, c: &Colloc, tension: f64) -> f64 {
         match self.actuator.effects.clamp_stiffness_n_mm_per_rad {
-            Some(k) => (tension * self.tension_ratio[0] * self.channel[0].y * self.cable_dir[0].0 + c.mom[0]) / k,
+            Some(k) => bending_moment(tension * self.friction.ratio(0), self.channel[0].y, self.cable_dir[0].0, c.mom[0]) / k,
             None => 0.0,
         }
     }
@@ -581,9 +578,7 @@ impl Simulator {
     /// Gravity's distal moment from the strains and φ at the nodes,
     /// integrated backward from M(L) = 0. Returns its largest change.
     fn colloc_moment(&mut self, c: &mut Colloc) -> f64 {
-        let length = self.actuator.length_mm;
-        let w = self.weight_n_per_mm;
-        if w == 0.0 {
+        if self.weight_n_per_mm == 0.0 {
             return 0.0;
         }
         let (gc, gs) = (self.gravity_cos, self.gravity_sin);
@@ -593,7 +588,7 @@ impl Simulator {
             // M' = w (L − s)(y' cos β − x' sin β).
             let dx = e.v1 * cp - e.v2 * sp;
             let dy = e.v1 * sp + e.v2 * cp;
-            c.dmom[i] = w * (length - c.s[i]) * (dy * gc - dx * gs);
+            c.dmom[i] = self.distal_weight_n(c.s[i]) * (dy * gc - dx * gs);
         }
         let np = c.np();
         let mut change: f64 = 0.0;
@@ -681,7 +676,6 @@ impl Simulator {
     fn colloc_update_tension_ratio(&mut self, c: &mut Colloc) -> f64 {
         const SUBSTEPS: usize = FRICTION_SUBSTEPS;
         let np = c.np();
-        let mu = self.actuator.effects.friction_mu * self.friction_sign;
         let mut psi = std::mem::take(&mut c.scratch);
         for (i, p) in psi.iter_mut().enumerate() {
             let (ca, sa) = self.cable_dir[i];
@@ -706,9 +700,7 @@ impl Simulator {
                         prev = v;
                     }
                 }
-                let ratio = (-mu * turning).exp();
-                change = change.max((self.tension_ratio[base + j] - ratio).abs());
-                self.tension_ratio[base + j] = ratio;
+                change = change.max(self.friction.set_from_turning(base + j, turning));
             }
         }
         c.scratch = psi;
@@ -776,7 +768,7 @@ impl Simulator {
     /// Newton's method on the collocation equations in (φ, M) at the nodes,
     /// damped by backtracking; the friction profile is settled around it.
     fn colloc_newton(&mut self, c: &mut Colloc, tension: f64) -> Result<u32, SolveFailure> {
-        let has_friction = self.actuator.effects.friction_mu > 0.0 && tension > 0.0;
+        let has_friction = self.friction.acts_at(tension);
         let mut iterations = 0;
         for _ in 0..FRICTION_MAX_PASSES {
             iterations += self.colloc_newton_inner(c, tension)?;
@@ -832,16 +824,16 @@ impl Simulator {
     /// (implicit function theorem on the cable-direction equation).
     #[allow(clippy::too_many_arguments)]
     fn colloc_node_partials(&self, s: f64, ch: ChannelSample, (sp, cp): (f64, f64), moment: f64, t: f64, dir: (f64, f64), e: Strains) -> Partials {
-        let a = &self.actuator;
-        let (ea, ga) = (a.ea_n, a.ga_n);
-        let wl = self.weight_n_per_mm * (a.length_mm - s);
+        let section = self.section_at(s);
+        let (ea, ga) = (section.ea_n, section.ga_n);
+        let wl = self.distal_weight_n(s);
         let (gc, gs) = (self.gravity_cos, self.gravity_sin);
         let w1 = wl * (cp * gc + sp * gs);
         let w2 = wl * (cp * gs - sp * gc);
         let (ca, sa) = dir;
-        let bend = t * ch.y * ca + moment;
-        let (_, du_dm_el) = self.bending_curvature(bend, s);
-        let dudm = du_dm_el + self.creep_gain;
+        let bend = bending_moment(t, ch.y, ca, moment);
+        let (_, du_dm_el) = self.bending_curvature(bend, &section);
+        let dudm = du_dm_el + self.creep.gain();
         let p = e.v1 - e.u * ch.y;
         let q = e.v2 + ch.dy;
         let (dv1a, dv2a, dua) = (t * sa / ea, -t * ca / ga, -t * ch.y * sa * dudm);
@@ -874,19 +866,17 @@ impl Simulator {
         self.colloc_strains(c, tension)?;
         let nn = c.s.len();
         let np = c.np();
-        let length = self.actuator.length_mm;
-        let scale = length / self.actuator.ei_n_mm2;
-        let w = self.weight_n_per_mm;
+        let scale = self.actuator.length_mm / self.actuator.ei_n_mm2;
         let (gc, gs) = (self.gravity_cos, self.gravity_sin);
         let mut parts = vec![Partials::default(); nn];
         for i in 0..nn {
-            let t = tension * self.tension_ratio[i];
+            let t = tension * self.friction.ratio(i);
             let e = c.strain[i];
             parts[i] = self.colloc_node_partials(c.s[i], self.channel[i], c.trig[i], c.mom[i], t, self.cable_dir[i], e);
             let (sp, cp) = c.trig[i];
             let dx = e.v1 * cp - e.v2 * sp;
             let dy = e.v1 * sp + e.v2 * cp;
-            c.dmom[i] = w * (length - c.s[i]) * (dy * gc - dx * gs);
+            c.dmom[i] = self.distal_weight_n(c.s[i]) * (dy * gc - dx * gs);
         }
         let k_theta = self.actuator.effects.clamp_stiffness_n_mm_per_rad;
         let mut jac = jac;
@@ -1042,7 +1032,7 @@ impl Simulator {
                     channel_y_mm: yc,
                     cable_x_mm: px - sp * yc,
                     cable_y_mm: py + cp * yc,
-                    cable_tension_n: tension * at(&self.tension_ratio),
+                    cable_tension_n: tension * at(self.friction.ratios()),
                 }
             })
             .collect()
