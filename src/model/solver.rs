@@ -801,6 +801,26 @@ mod tests {
     }
 
     #[test]
+    fn simulate_reports_its_own_errors_with_the_lower_layers_as_sources() {
+        let (a, options) = (Actuator::default(), SolverOptions::default());
+        let routing = Routing::new(&[1.0, -2.0, 4.0, 4.0, -4.0], a.length_mm, a.radius_mm).unwrap();
+        let err = simulate(&a, &options, &routing, -1.0, 3, LengthBasis::Rest).unwrap_err();
+        assert!(matches!(err, SimulateError::Solve(SolveFailure::InvalidTension(t)) if t == -1.0), "{err:?}");
+        assert_eq!(err.to_string(), SolveFailure::InvalidTension(-1.0).to_string());
+        let hold = Hold { direction: LoadDirection::Load, dwell_s: f64::NAN };
+        let err = simulate_held(&a, &options, &routing, 1.0, 3, LengthBasis::Rest, hold).unwrap_err();
+        assert!(matches!(err, SimulateError::Parameter(ParameterError::OutOfRange { name: "dwell_s", .. })), "{err:?}");
+        // The library's top-level error carries it unchanged.
+        let top: crate::Error = err.into();
+        assert!(matches!(top, crate::Error::Simulate(SimulateError::Parameter(_))));
+    }
+
+    #[test]
+    fn bending_moment_adds_the_cable_moment_to_the_distal_moment() {
+        assert_eq!(bending_moment(2.0, 3.0, 0.5, 0.25), 2.0 * 3.0 * 0.5 + 0.25);
+    }
+
+    #[test]
     fn friction_matches_the_capstan_closed_form() {
         // ψ' = u = τ(s) d / EI and dτ/ds = −η μ τ ψ' (slip sign η) give
         // τ(s) = τ0 / (1 + η μ τ0 d s / EI), φ(L) = η ln(1 + η μ τ0 d L / EI) / μ.

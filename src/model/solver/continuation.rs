@@ -56,3 +56,29 @@ impl Continuation {
         self.slopes = [slope, self.slopes[0]];
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_predictor_extrapolates_over_three_solves() {
+        let mut c = Continuation::default();
+        assert_eq!(c.predict(1.0), (0.0, 1.0));
+        let moment = |t: f64| 0.5 + 2.0 * t - 0.3 * t * t;
+        c.record(1.0, moment(1.0), 0.9);
+        assert_eq!(c.predict(1.5), (moment(1.0), 0.9));
+        c.record(1.25, moment(1.25), 0.8);
+        c.record(1.5, moment(1.5), 0.7);
+        let (m0, slope) = c.predict(1.75);
+        // Exact for a quadratic moment; the slope linear in the last two.
+        assert!((m0 - moment(1.75)).abs() < 1e-12, "{m0}");
+        assert!((slope - 0.6).abs() < 1e-12, "{slope}");
+        // A repeated tension falls back to the newest solve; a vanishing
+        // slope to 1.
+        c.record(1.5, moment(1.5), 0.0);
+        let (m0, slope) = c.predict(1.5);
+        assert_eq!(m0, moment(1.5));
+        assert_eq!(slope, 1.0);
+    }
+}

@@ -129,3 +129,53 @@ impl Creep {
         self.moment[k] = m;
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn creep(f: f64, t_s: f64) -> Creep {
+        let effects = Effects { creep_fraction: f, creep_time_s: t_s, ..Effects::default() };
+        Creep::new(&effects, 100.0, 2)
+    }
+
+    #[test]
+    fn a_held_step_follows_the_standard_linear_solid() {
+        let (f, t_s, d, ei, m) = (0.3, 10.0, 7.0, 100.0, 2.0);
+        let mut c = creep(f, t_s);
+        c.follow_protocol();
+        c.set_dwell(d);
+        let e = (-(1.0 - f) * d / t_s).exp();
+        assert!((c.gain() - f * (1.0 - e) / ((1.0 - f) * ei)).abs() < 1e-18);
+        assert_eq!(c.offset(0), 0.0);
+        c.begin_solve();
+        c.record_moment(0, m);
+        c.end_solve();
+        // q after the hold, and the held curvature it leaves for the next step.
+        let q1 = m / (ei * (1.0 - f)) * (1.0 - e);
+        assert!((c.offset(0) - f * e * q1).abs() < 1e-15);
+        assert_eq!(c.offset(1), 0.0);
+        // No dwell: the history stays as it is.
+        c.set_dwell(0.0);
+        assert_eq!(c.gain(), 0.0);
+        c.record_moment(0, 5.0);
+        c.end_solve();
+        assert!((c.offset(0) - f * q1).abs() < 1e-15);
+    }
+
+    #[test]
+    fn outside_a_protocol_every_solve_starts_from_a_virgin_rod() {
+        let mut c = creep(0.3, 10.0);
+        c.set_dwell(5.0);
+        c.record_moment(0, 2.0);
+        c.end_solve();
+        assert_eq!(c.offset(0), 0.0, "a virgin hold keeps no history");
+        c.q[0] = 1.0;
+        c.begin_solve();
+        assert_eq!(c.offset(0), 0.0);
+        // Without creep nothing happens at all.
+        let mut off = creep(0.0, 10.0);
+        off.set_dwell(5.0);
+        assert!(!off.is_on() && off.gain() == 0.0 && off.offset(0) == 0.0);
+    }
+}

@@ -161,3 +161,61 @@ pub(super) fn settle<S>(
     }
     Err(SolveFailure::FrictionNotConverged)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_profile_follows_the_capstan_law_with_the_slip_sign() {
+        for slip_sign in [1.0, -1.0] {
+            let mut f = Friction::new(0.2, slip_sign, 3);
+            let change = f.set_from_turning(1, 0.5);
+            let want = (-0.2 * slip_sign * 0.5f64).exp();
+            assert_eq!(f.ratio(1), want);
+            assert_eq!(change, (1.0 - want).abs());
+            // Settled: setting it again changes nothing.
+            assert_eq!(f.set_from_turning(1, 0.5), 0.0);
+            f.forget();
+            assert!(f.ratios().iter().all(|&r| r == 1.0));
+        }
+        assert!(!Friction::new(0.0, 1.0, 1).acts_at(1.0) && !Friction::new(0.1, 1.0, 1).acts_at(0.0));
+    }
+
+    #[test]
+    fn rk4_nodes_turning_evenly_lose_tension_geometrically() {
+        // n = 2 steps per span: nodes at stage points 0, 2 | 5, 7, 9 (4 shares node 2's point).
+        let n = 2;
+        let (mu, turn) = (0.3, 0.1);
+        let mut f = Friction::new(mu, 1.0, 2 * (2 * n + 1));
+        let node_points = [0, 2, 5, 7, 9];
+        for (node, &k) in node_points.iter().enumerate() {
+            let psi = turn * node as f64;
+            f.record_cable_direction(k, (0.0, 1.0), (psi.cos(), psi.sin()));
+        }
+        assert!(f.update_from_rk4_nodes(n) > 0.0);
+        for (node, &k) in node_points.iter().enumerate() {
+            let want = (-mu * turn * node as f64).exp();
+            assert!((f.ratio(k) - want).abs() < 1e-14, "node {node}: {} vs {want}", f.ratio(k));
+        }
+        // The knot's copy in span 0, and the stages between nodes (geometric mean).
+        assert_eq!(f.ratio(4), f.ratio(5));
+        assert!((f.ratio(1) - (f.ratio(0) * f.ratio(2)).sqrt()).abs() < 1e-15);
+        assert!((f.ratio(8) - (f.ratio(7) * f.ratio(9)).sqrt()).abs() < 1e-15);
+        assert!(f.update_from_rk4_nodes(n) < 1e-15);
+    }
+
+    #[test]
+    fn settle_counts_passes_and_gives_up() {
+        let mut changes = vec![1.0, 0.1, 0.0];
+        let passes = settle(&mut changes, |c| c.remove(0), |_| Ok(2)).unwrap();
+        assert_eq!(passes, 4);
+        let mut never = 0u32;
+        let err = settle(&mut never, |_| 1.0, |n| {
+            *n += 1;
+            Ok(1)
+        });
+        assert_eq!(err, Err(SolveFailure::FrictionNotConverged));
+        assert_eq!(never as usize, MAX_PASSES);
+    }
+}
