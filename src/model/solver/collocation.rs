@@ -669,7 +669,7 @@ impl Simulator {
 
     /// Friction: the tension profile τ(s)/τ(0) at the nodes from the cable
     /// angles of the last sweep, by the capstan law ln τ(s)/τ(0) =
-    /// −σ μ ∫_0^s |ψ'| ds. The cable's global angle ψ = φ + α is smooth on a
+    /// −η μ ∫_0^s |ψ'| ds (slip sign η). The cable's global angle ψ = φ + α is smooth on a
     /// span, but |ψ'| has kinks where the cable turns back, so the turning
     /// is summed over a fine grid of the interpolated ψ (exact wherever ψ is
     /// monotone between grid points). Returns the largest change.
