@@ -58,10 +58,8 @@ mod creep;
 mod friction;
 mod rk4;
 
-use continuation::Continuation;
 use creep::Creep;
 use friction::Friction;
-use rk4::State;
 
 /// Why a solve produced no result. The sweep stores [`SolveFailure::status`].
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -288,18 +286,6 @@ pub struct Simulator {
     channel: Vec<ChannelSample>,
     /// Cable direction (cos α, sin α) at each stage point, kept as the Newton start.
     cable_dir: Vec<(f64, f64)>,
-    /// Step length on each span, mm.
-    step_mm: [f64; 2],
-    /// Span starts, mm.
-    span_start_mm: [f64; 2],
-    /// Per-node results of the last pass (2N+1 nodes per span, the knot shared).
-    nodes_state: Vec<State>,
-    nodes_strain: Vec<Strains>,
-    /// Scratch for shape coefficients.
-    theta: Vec<f64>,
-    speed: Vec<f64>,
-    sigma: Vec<f64>,
-    continuation: Continuation,
     last: Option<TipPose>,
     /// Cable–channel friction: slip sign and tension profile per point.
     friction: Friction,
@@ -307,6 +293,8 @@ pub struct Simulator {
     creep: Creep,
     /// Collocation state (`None` with the RK4 method).
     col: Option<Box<collocation::Colloc>>,
+    /// RK4 state (also sized with collocation: it is small).
+    rk4: rk4::Rk4,
 }
 
 /// How a solve is held: the direction of the last tension change (friction)
@@ -339,7 +327,6 @@ impl Simulator {
             });
         }
         let n = options.steps_per_span;
-        let nodes = 2 * n + 1;
         // Material stiffening's curvature law u(m) has complex branch points
         // near the real axis (1 + 3 α r² u² = 0), which slows the spectral
         // convergence: 10 intervals leave 2e-6 rad there, 16 leave 1e-8.
@@ -364,18 +351,11 @@ impl Simulator {
             routing: None,
             channel: vec![ChannelSample::default(); points],
             cable_dir: vec![(1.0, 0.0); points],
-            step_mm: [0.0; 2],
-            span_start_mm: [0.0; 2],
-            nodes_state: vec![State::default(); nodes],
-            nodes_strain: vec![Strains::default(); nodes],
-            theta: vec![0.0; nodes],
-            speed: vec![0.0; nodes],
-            sigma: vec![0.0; nodes],
-            continuation: Continuation::default(),
             last: None,
             friction: Friction::new(actuator.effects.friction_mu, actuator.effects.load_direction.slip_sign(), points),
             creep: Creep::new(&actuator.effects, actuator.ei_n_mm2, points),
             col,
+            rk4: rk4::Rk4::new(n),
         })
         .and_then(|mut sim: Simulator| {
             // Outside a protocol every solve is held like this from a virgin rod.
@@ -404,13 +384,9 @@ impl Simulator {
         let built = if delta != 0.0 { routing.shifted(delta) } else { routing.clone() };
         if self.col.is_some() {
             self.colloc_set_routing(&built);
-            self.routing = Some(built);
-            self.reset_warm_start();
-            self.reset_history();
-            self.last = None;
-            return;
+        } else {
+            self.rk4_set_routing(&built);
         }
-        self.rk4_set_routing(&built);
         self.routing = Some(built);
         self.reset_warm_start();
         self.reset_history();
@@ -420,7 +396,7 @@ impl Simulator {
     /// Forgets the warm start (the next solve starts cold). The creep
     /// history is physical state and is kept.
     pub fn reset_warm_start(&mut self) {
-        self.continuation = Continuation::default();
+        self.rk4.forget();
         if let Some(col) = self.col.as_mut() {
             col.forget();
         }

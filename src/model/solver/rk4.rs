@@ -5,6 +5,7 @@
 //! tension (`continuation`). Per-point buffers are indexed by stage point,
 //! 2n + 1 per span of n steps (the knot appears in both spans).
 
+use super::continuation::Continuation;
 use super::{
     bending_moment, friction, rotate, CentrelinePoint, ChannelSample, Routing, Simulator, SolveFailure, Strains, TipPose,
     CLAMP_MAX_ITERATIONS, CLAMP_TOLERANCE_RAD,
@@ -13,7 +14,7 @@ use crate::shape::{self, LengthBasis};
 
 /// Integration state: position, frame angle, gravity's distal moment, arc length.
 #[derive(Debug, Clone, Copy, Default)]
-pub(super) struct State {
+struct State {
     x: f64,
     y: f64,
     phi: f64,
@@ -43,6 +44,47 @@ fn rotate_sin_cos((s, c): (f64, f64), delta: f64) -> (f64, f64) {
     (s, c)
 }
 
+/// RK4's state: the step grid, the nodes of the last pass and the warm
+/// start of the shooting.
+#[derive(Debug, Clone)]
+pub(super) struct Rk4 {
+    /// Step length on each span, mm.
+    step_mm: [f64; 2],
+    /// Span starts, mm.
+    span_start_mm: [f64; 2],
+    /// Per-node results of the last pass (n + 1 nodes per span, the knot shared).
+    nodes_state: Vec<State>,
+    nodes_strain: Vec<Strains>,
+    /// Scratch for shape coefficients.
+    theta: Vec<f64>,
+    speed: Vec<f64>,
+    sigma: Vec<f64>,
+    /// Warm start of the shooting across the continuation in tension.
+    continuation: Continuation,
+}
+
+impl Rk4 {
+    /// Buffers for `n` steps per span.
+    pub(super) fn new(n: usize) -> Self {
+        let nodes = 2 * n + 1;
+        Self {
+            step_mm: [0.0; 2],
+            span_start_mm: [0.0; 2],
+            nodes_state: vec![State::default(); nodes],
+            nodes_strain: vec![Strains::default(); nodes],
+            theta: vec![0.0; nodes],
+            speed: vec![0.0; nodes],
+            sigma: vec![0.0; nodes],
+            continuation: Continuation::default(),
+        }
+    }
+
+    /// Forgets the warm start of the shooting.
+    pub(super) fn forget(&mut self) {
+        self.continuation = Continuation::default();
+    }
+}
+
 impl Simulator {
     /// Places the stage points on the knot spans of `built` and samples the
     /// channel there.
@@ -50,11 +92,11 @@ impl Simulator {
         let n = self.options.steps_per_span;
         let knot = built.knot_mm();
         let length = self.actuator.length_mm;
-        self.span_start_mm = [0.0, knot];
-        self.step_mm = [knot / n as f64, (length - knot) / n as f64];
+        self.rk4.span_start_mm = [0.0, knot];
+        self.rk4.step_mm = [knot / n as f64, (length - knot) / n as f64];
         for span in 0..2 {
             for j in 0..=2 * n {
-                let s = self.span_start_mm[span] + 0.5 * j as f64 * self.step_mm[span];
+                let s = self.rk4.span_start_mm[span] + 0.5 * j as f64 * self.rk4.step_mm[span];
                 let c = built.channel_at(s);
                 self.channel[span * (2 * n + 1) + j] = ChannelSample { y: c.y_mm, dy: c.dy_ds };
             }
@@ -125,17 +167,17 @@ impl Simulator {
         let n = self.options.steps_per_span;
         let mut st = State { phi: self.clamp_angle(moment0, tension)?, moment: moment0, ..State::default() };
         for span in 0..2 {
-            let h = self.step_mm[span];
+            let h = self.rk4.step_mm[span];
             let base = span * (2 * n + 1);
             for step in 0..n {
-                let s = self.span_start_mm[span] + step as f64 * h;
+                let s = self.rk4.span_start_mm[span] + step as f64 * h;
                 let k = base + 2 * step;
                 // One sin/cos per step; the stages rotate it by small angles.
                 let trig = st.phi.sin_cos();
                 let (d1, e1) = self.derivative(s, k, &st, trig, tension)?;
                 let node = span * n + step;
-                self.nodes_state[node] = st;
-                self.nodes_strain[node] = e1;
+                self.rk4.nodes_state[node] = st;
+                self.rk4.nodes_strain[node] = e1;
                 let s2 = st.axpy(0.5 * h, &d1);
                 let (d2, _) = self.derivative(s + 0.5 * h, k + 1, &s2, rotate_sin_cos(trig, 0.5 * h * d1.phi), tension)?;
                 let s3 = st.axpy(0.5 * h, &d2);
@@ -158,8 +200,8 @@ impl Simulator {
         let k_tip = 2 * (2 * n + 1) - 1;
         let (_, e) = self.derivative(self.actuator.length_mm, k_tip, &st, st.phi.sin_cos(), tension)?;
         let tip = 2 * n;
-        self.nodes_state[tip] = st;
-        self.nodes_strain[tip] = e;
+        self.rk4.nodes_state[tip] = st;
+        self.rk4.nodes_strain[tip] = e;
         Ok(st.moment)
     }
 
@@ -194,7 +236,7 @@ impl Simulator {
         let n = self.options.steps_per_span;
         let mut passes;
         if has_moment {
-            let (mut m0, mut slope) = self.continuation.predict(tension);
+            let (mut m0, mut slope) = self.rk4.continuation.predict(tension);
             passes = self.shoot(tension, &mut m0, &mut slope)?;
             if has_friction {
                 passes += friction::settle(
@@ -203,7 +245,7 @@ impl Simulator {
                     |sim| sim.shoot(tension, &mut m0, &mut slope),
                 )?;
             }
-            self.continuation.record(tension, m0, slope);
+            self.rk4.continuation.record(tension, m0, slope);
         } else {
             self.integrate(tension, 0.0)?;
             passes = 1;
@@ -220,10 +262,10 @@ impl Simulator {
 
     /// The pose of the last pass.
     pub(super) fn rk4_pose(&self, tension: f64, passes: u32) -> TipPose {
-        let n_nodes = self.nodes_state.len();
-        let base = self.nodes_state[0];
-        let tip = self.nodes_state[n_nodes - 1];
-        let (e0, et) = (self.nodes_strain[0], self.nodes_strain[n_nodes - 1]);
+        let n_nodes = self.rk4.nodes_state.len();
+        let base = self.rk4.nodes_state[0];
+        let tip = self.rk4.nodes_state[n_nodes - 1];
+        let (e0, et) = (self.rk4.nodes_strain[0], self.rk4.nodes_strain[n_nodes - 1]);
         TipPose {
             tension_n: tension,
             tip_x_mm: tip.x,
@@ -238,17 +280,17 @@ impl Simulator {
 
     /// Legendre coefficients of the last solve from the tangent at the nodes.
     pub(super) fn rk4_coefficients(&mut self, basis: LengthBasis, out: &mut [f64]) {
-        for (i, (st, e)) in self.nodes_state.iter().zip(&self.nodes_strain).enumerate() {
-            self.theta[i] = st.phi + e.v2.atan2(e.v1);
-            self.speed[i] = e.v1.hypot(e.v2);
-            self.sigma[i] = st.sigma;
+        for (i, (st, e)) in self.rk4.nodes_state.iter().zip(&self.rk4.nodes_strain).enumerate() {
+            self.rk4.theta[i] = st.phi + e.v2.atan2(e.v1);
+            self.rk4.speed[i] = e.v1.hypot(e.v2);
+            self.rk4.sigma[i] = st.sigma;
         }
         // Nodes are evenly spaced in s: the knot is at L/2 for the clamped
         // spline with evenly spaced control points.
-        let h = self.step_mm[0];
-        debug_assert!((self.step_mm[0] - self.step_mm[1]).abs() < 1e-12);
-        shape::legendre_from_tangent(&self.theta, &self.sigma, &self.speed, h, out);
-        let deformed_length_mm = self.sigma[self.sigma.len() - 1] - self.sigma[0];
+        let h = self.rk4.step_mm[0];
+        debug_assert!((self.rk4.step_mm[0] - self.rk4.step_mm[1]).abs() < 1e-12);
+        shape::legendre_from_tangent(&self.rk4.theta, &self.rk4.sigma, &self.rk4.speed, h, out);
+        let deformed_length_mm = self.rk4.sigma[self.rk4.sigma.len() - 1] - self.rk4.sigma[0];
         basis.convert_from_deformed(out, deformed_length_mm, self.actuator.length_mm);
     }
 
@@ -256,13 +298,13 @@ impl Simulator {
     pub(super) fn rk4_centreline(&self) -> Vec<CentrelinePoint> {
         let n = self.options.steps_per_span;
         let tension = self.last.map_or(0.0, |p| p.tension_n);
-        (0..self.nodes_state.len())
+        (0..self.rk4.nodes_state.len())
             .map(|i| {
                 let (span, j) = if i < n { (0, i) } else { (1, i - n) };
-                let s = self.span_start_mm[span] + j as f64 * self.step_mm[span];
+                let s = self.rk4.span_start_mm[span] + j as f64 * self.rk4.step_mm[span];
                 let k = span * (2 * n + 1) + 2 * j;
-                let st = self.nodes_state[i];
-                let e = self.nodes_strain[i];
+                let st = self.rk4.nodes_state[i];
+                let e = self.rk4.nodes_strain[i];
                 let yc = self.channel[k].y;
                 let (sp, cp) = st.phi.sin_cos();
                 CentrelinePoint {
