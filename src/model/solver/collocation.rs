@@ -35,6 +35,15 @@ const SWEEP_ANGLE_TOLERANCE_RAD: f64 = 1e-9;
 const NEWTON_TOLERANCE: f64 = 1e-12;
 /// Newton iterations per solve before giving up.
 const NEWTON_MAX_ITERATIONS: u32 = 40;
+/// Newton: residual accepted after the last iteration (stalled at rounding).
+const NEWTON_STALL_TOLERANCE: f64 = 1e3 * NEWTON_TOLERANCE;
+/// Newton: the backtracking's sufficient decrease (Armijo) factor.
+const NEWTON_SUFFICIENT_DECREASE: f64 = 1e-4;
+/// Newton: smallest damping factor λ tried before giving up.
+const NEWTON_MIN_DAMPING: f64 = 1e-4;
+/// First and largest weight steps of the continuation, as fractions of the weight.
+const FIRST_WEIGHT_STEP: f64 = 0.25;
+const MAX_WEIGHT_STEP: f64 = 0.5;
 /// Smallest weight step of the continuation, as a fraction of the weight.
 const MIN_WEIGHT_STEP: f64 = 1.0 / 1024.0;
 
@@ -728,7 +737,7 @@ impl Simulator {
         let result = (|| -> Result<(), SolveFailure> {
             self.colloc_sweep(c, tension)?;
             iterations += self.colloc_newton(c, tension)?;
-            let (mut reached, mut step) = (0.0f64, 0.25f64);
+            let (mut reached, mut step) = (0.0f64, FIRST_WEIGHT_STEP);
             while reached < 1.0 {
                 let next = (reached + step).min(1.0);
                 let (phi, mom, dir) = (c.phi.clone(), c.mom.clone(), self.cable_dir.clone());
@@ -737,7 +746,7 @@ impl Simulator {
                     Ok(n) => {
                         iterations += n;
                         reached = next;
-                        step = (step * 2.0).min(0.5);
+                        step = (step * 2.0).min(MAX_WEIGHT_STEP);
                     }
                     Err(_) => {
                         (c.phi, c.mom) = (phi, mom);
@@ -800,21 +809,21 @@ impl Simulator {
                     c.trig[i] = c.phi[i].sin_cos();
                 }
                 match self.colloc_residual(c, tension, &mut res, Some(&mut jac)) {
-                    Ok(n) if n.is_finite() && n < (1.0 - 1e-4 * lambda) * norm => {
+                    Ok(n) if n.is_finite() && n < (1.0 - NEWTON_SUFFICIENT_DECREASE * lambda) * norm => {
                         norm = n;
                         break;
                     }
                     _ => {
                         self.cable_dir.copy_from_slice(&dir0);
                         lambda /= 2.0;
-                        if lambda < 1e-4 {
+                        if lambda < NEWTON_MIN_DAMPING {
                             return Err(SolveFailure::WeightNotConverged { reached_percent: 0.0 });
                         }
                     }
                 }
             }
         }
-        if norm <= 1e3 * NEWTON_TOLERANCE {
+        if norm <= NEWTON_STALL_TOLERANCE {
             return Ok(NEWTON_MAX_ITERATIONS);
         }
         Err(SolveFailure::WeightNotConverged { reached_percent: 0.0 })
