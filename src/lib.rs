@@ -27,6 +27,9 @@ pub enum Error {
     /// A solve failed.
     #[error(transparent)]
     Solve(#[from] model::SolveFailure),
+    /// A single simulation (parameters or a solve) failed.
+    #[error(transparent)]
+    Simulate(#[from] model::SimulateError),
     /// Shape coefficients could not be computed.
     #[error(transparent)]
     Shape(#[from] shape::ShapeError),

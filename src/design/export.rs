@@ -149,10 +149,8 @@ pub fn write_all(dir: &Path, objective: &Objective, eval: &Evaluation, record: &
 /// design's ℓ and θ_0 (coefficients the target omits are the achieved ones).
 pub fn shape_png(path: &Path, objective: &Objective, eval: &Evaluation) -> Result<(), DesignError> {
     let act = &objective.actuator;
-    let routing = Routing::new(&eval.routing_mm, act.length_mm, act.radius_mm).expect("designs lie inside the body");
-    let sim = simulate(act, &objective.options, &routing, eval.tension_n, objective.target.order(), objective.length_basis).map_err(|e| {
-        DesignError::Io { context: format!("re-simulating the design for {}", path.display()), source: std::io::Error::other(e.to_string()) }
-    })?;
+    let routing = Routing::new(&eval.routing_mm, act.length_mm, act.radius_mm)?;
+    let sim = simulate(act, &objective.options, &routing, eval.tension_n, objective.target.order(), objective.length_basis)?;
     let mut bodies =
         vec![crate::plot::BodyDrawing::of_simulation(&sim, act.radius_mm, "achieved body (outline at ±r), cable in red".into(), BLUE_800)];
     let target = &objective.target;

@@ -48,6 +48,9 @@ pub enum DesignError {
         /// What is wrong with it.
         message: String,
     },
+    /// Re-simulating a design (for its drawing) failed.
+    #[error("re-simulating the design: {0}")]
+    Simulate(#[from] crate::model::SimulateError),
     /// The designed routing is not a valid channel.
     #[error(transparent)]
     Routing(#[from] crate::model::RoutingError),

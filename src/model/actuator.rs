@@ -58,8 +58,9 @@ pub enum LoadDirection {
 }
 
 impl LoadDirection {
-    /// σ in dτ/ds = −σ μ τ |ψ'|: +1 loading, −1 unloading.
-    pub fn sign(self) -> f64 {
+    /// The slip sign η in friction's capstan law dτ/ds = −η μ τ |ψ'|:
+    /// +1 loading, −1 unloading.
+    pub fn slip_sign(self) -> f64 {
         match self {
             LoadDirection::Load => 1.0,
             LoadDirection::Unload => -1.0,

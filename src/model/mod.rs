@@ -9,4 +9,4 @@ pub mod solver;
 
 pub use actuator::{Actuator, Effects, Gravity, LoadDirection, ParameterError};
 pub use routing::{ControlPoints, Routing, RoutingError};
-pub use solver::{simulate, simulate_held, CentrelinePoint, Hold, Simulation, Simulator, SolveFailure, SolverMethod, SolverOptions, TipPose, STATUS_OK};
+pub use solver::{simulate, simulate_held, CentrelinePoint, Hold, SimulateError, Simulation, Simulator, SolveFailure, SolverMethod, SolverOptions, TipPose, STATUS_OK};

@@ -11,7 +11,12 @@
 //! on Chebyshev–Lobatto nodes ([`SolverMethod::Collocation`], in the
 //! `collocation` submodule, which also replaces the shooting below by
 //! fixed-point sweeps and Newton's method), or with the previous classical
-//! RK4 ([`SolverMethod::Rk4`], kept as the reference).
+//! RK4 ([`SolverMethod::Rk4`], kept as the reference, in `rk4`).
+//!
+//! One file per piece: this file holds the cut equations shared by both
+//! integrators ([`Simulator::strains_at`]) and the public API; `collocation`
+//! and `rk4` are the two integrators; `continuation` is RK4's warm-start
+//! predictor; `friction` and `creep` are the two effects with state.
 //!
 //! Gravity's moment beyond the cut, M_W(s), depends on the distal shape; it
 //! obeys M_W' = w (L − s)(y' cos β − x' sin β) with M_W(L) = 0, so its value at
@@ -20,25 +25,23 @@
 //! shooting at all.
 //!
 //! Effects (model-notes §6) enter as local terms: the bending law
-//! ([`Simulator::bending_curvature`]), the clamp boundary
-//! ([`Simulator::clamp_angle`]), the routing (channel offset) and the weight.
+//! ([`Simulator::bending_curvature`]), the clamp boundary (`clamp_angle` in
+//! each integrator), the routing (channel offset) and the weight.
+//! The section's rigidities and the weight beyond a cut are looked up in one
+//! place each ([`Simulator::section_at`], [`Simulator::distal_weight_n`]),
+//! and the bending moment at a cut is one function ([`bending_moment`]).
 //!
-//! Two effects carry state beyond one point:
-//! - **Cable–channel friction** (capstan law dτ/ds = −σ μ τ |ψ'|, ψ the
-//!   cable's global angle φ + α, σ = +1 loading and −1 unloading): the tension
-//!   profile τ(s)/τ(0) is held at every stage point and updated from the
-//!   cable angles of the last pass until it stops changing (a fixed point that
-//!   contracts like μ·|Δψ|; warm-started from the previous solve). The cut
-//!   equations hold unchanged with τ(s) at the cut, because friction acts
-//!   inside the distal free body.
-//! - **Viscoelastic creep in bending** (standard linear solid): the moment is
-//!   m = EI (u − f q) with an internal curvature q obeying T q̇ = u − q. Each
-//!   solve is one step of a protocol: the tension jumps, then is held for the
-//!   dwell time d with m(s) taken as constant over the hold. That makes the
-//!   law at the end of the hold local and linear,
-//!   u = m/EI · (1 + f (1 − E)/(1 − f)) + f E q₀,  E = exp(−(1 − f) d / T),
-//!   and q is advanced in closed form after the solve. The history q(s) lives
-//!   in the simulator; `set_routing` and `reset_history` clear it.
+//! Two effects carry state beyond one point, each a small state type with
+//! the few hooks the integrators call:
+//! - **Cable–channel friction** (`friction`: capstan law
+//!   dτ/ds = −η μ τ |ψ'| with the slip sign η): a tension profile τ(s)/τ(0)
+//!   updated from the cable angles of the last pass until it settles.
+//! - **Viscoelastic creep in bending** (`creep`: standard linear solid): a
+//!   local, linear law at the end of each held step, and the internal
+//!   curvature q(s) advanced after the solve. `set_routing` and
+//!   `reset_history` clear that history.
+//!
+//! (σ is the deformed arc length throughout.)
 //!
 //! The hot paths (RK4's `integrate`, collocation's sweeps) work in buffers
 //! allocated once per [`Simulator`]; solving allocates nothing, except in
@@ -46,10 +49,17 @@
 
 use super::actuator::{Actuator, LoadDirection, ParameterError};
 use super::routing::Routing;
-use crate::shape::{self, LengthBasis};
+use crate::shape::LengthBasis;
 use serde::{Deserialize, Serialize};
 
 mod collocation;
+mod continuation;
+mod creep;
+mod friction;
+mod rk4;
+
+use creep::Creep;
+use friction::Friction;
 
 /// Why a solve produced no result. The sweep stores [`SolveFailure::status`].
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -101,10 +111,16 @@ impl SolveFailure {
     }
 }
 
-/// Most re-integrations while the friction tension profile settles.
-const FRICTION_MAX_PASSES: usize = 60;
-/// Largest change of τ(s)/τ(0) accepted as settled.
-const FRICTION_TOLERANCE: f64 = 1e-10;
+/// Most Newton iterations of material stiffening's cubic curvature law.
+const STIFFENING_MAX_ITERATIONS: usize = 60;
+/// Relative Newton step accepted as converged in the stiffening law.
+const STIFFENING_TOLERANCE: f64 = 1e-15;
+/// Most Newton iterations of the cable-direction equation at one point.
+const CABLE_ANGLE_MAX_ITERATIONS: usize = 50;
+/// Most fixed-point iterations of the compliant clamp's rotation (RK4).
+const CLAMP_MAX_ITERATIONS: usize = 100;
+/// Change of the clamp rotation accepted as converged, rad.
+const CLAMP_TOLERANCE_RAD: f64 = 1e-14;
 
 /// Collocation intervals per span used at least when material stiffening is on.
 pub const MIN_NODES_WITH_STIFFENING: usize = 16;
@@ -222,31 +238,6 @@ pub struct CentrelinePoint {
     pub cable_tension_n: f64,
 }
 
-/// Integration state: position, frame angle, gravity's distal moment, arc length.
-#[derive(Debug, Clone, Copy, Default)]
-struct State {
-    x: f64,
-    y: f64,
-    phi: f64,
-    moment: f64,
-    sigma: f64,
-}
-
-impl State {
-    fn axpy(self, h: f64, d: &State) -> State {
-        State {
-            x: self.x + h * d.x,
-            y: self.y + h * d.y,
-            phi: self.phi + h * d.phi,
-            moment: self.moment + h * d.moment,
-            sigma: self.sigma + h * d.sigma,
-        }
-    }
-    fn is_finite(&self) -> bool {
-        self.x.is_finite() && self.y.is_finite() && self.phi.is_finite() && self.moment.is_finite() && self.sigma.is_finite()
-    }
-}
-
 /// Strains at one point.
 #[derive(Debug, Clone, Copy, Default)]
 struct Strains {
@@ -262,14 +253,23 @@ struct ChannelSample {
     dy: f64,
 }
 
-/// Warm-start memory of a continuation in tension.
-#[derive(Debug, Clone, Copy, Default)]
-struct Continuation {
-    /// Previous converged (tension, base moment) pairs, newest first.
-    history: [(f64, f64); 3],
-    solved: usize,
-    /// Secant slopes dM(L)/dM(0) of the last two solves, newest first.
-    slopes: [f64; 2],
+/// Rigidities of the cross-section at one point.
+#[derive(Debug, Clone, Copy)]
+struct Section {
+    /// Axial rigidity EA, N.
+    ea_n: f64,
+    /// Shear rigidity GA, N.
+    ga_n: f64,
+    /// Bending rigidity EI, N·mm².
+    ei_n_mm2: f64,
+}
+
+/// Bending moment at a cut, N·mm: the cable's moment τ y_c cos α about the
+/// centreline (`tension` at the cut, channel offset `channel_y_mm`, cable
+/// direction cos α) plus gravity's distal moment M.
+#[inline]
+fn bending_moment(tension: f64, channel_y_mm: f64, cos_alpha: f64, distal_moment: f64) -> f64 {
+    tension * channel_y_mm * cos_alpha + distal_moment
 }
 
 /// A reusable solver for one actuator: set a routing, then solve tensions
@@ -286,43 +286,15 @@ pub struct Simulator {
     channel: Vec<ChannelSample>,
     /// Cable direction (cos α, sin α) at each stage point, kept as the Newton start.
     cable_dir: Vec<(f64, f64)>,
-    /// Step length on each span, mm.
-    step_mm: [f64; 2],
-    /// Span starts, mm.
-    span_start_mm: [f64; 2],
-    /// Per-node results of the last pass (2N+1 nodes per span, the knot shared).
-    nodes_state: Vec<State>,
-    nodes_strain: Vec<Strains>,
-    /// Scratch for shape coefficients.
-    theta: Vec<f64>,
-    speed: Vec<f64>,
-    sigma: Vec<f64>,
-    continuation: Continuation,
     last: Option<TipPose>,
-    /// Friction sign σ of the next solves: +1 loading, −1 unloading.
-    friction_sign: f64,
-    /// Cable tension at each stage point relative to the base tension.
-    tension_ratio: Vec<f64>,
-    /// Cable's global direction (cos ψ, sin ψ) at each stage point, last pass.
-    cable_global: Vec<(f64, f64)>,
-    /// Bending moment at each stage point in the last pass, N·mm.
-    bending_moment: Vec<f64>,
-    /// Creep's internal curvature q at each stage point, 1/mm.
-    creep_q: Vec<f64>,
-    /// Dwell before the reading of the next solves, s.
-    dwell_s: f64,
-    /// E = exp(−(1 − f) d / T) for the current dwell.
-    creep_decay: f64,
-    /// Extra compliance of the held step, f (1 − E)/((1 − f) EI), 1/(N·mm²).
-    creep_gain: f64,
-    /// Whether every solve starts from a rod with no load history (the
-    /// default, held `effects.creep_hold_s`), or follows a protocol set by
-    /// [`Simulator::set_hold`].
-    virgin_holds: bool,
-    /// Whether passes record cable angles and moments (friction or creep on).
-    records_profile: bool,
+    /// Cable–channel friction: slip sign and tension profile per point.
+    friction: Friction,
+    /// Creep: the hold and the load history per point.
+    creep: Creep,
     /// Collocation state (`None` with the RK4 method).
     col: Option<Box<collocation::Colloc>>,
+    /// RK4 state (also sized with collocation: it is small).
+    rk4: rk4::Rk4,
 }
 
 /// How a solve is held: the direction of the last tension change (friction)
@@ -355,7 +327,6 @@ impl Simulator {
             });
         }
         let n = options.steps_per_span;
-        let nodes = 2 * n + 1;
         // Material stiffening's curvature law u(m) has complex branch points
         // near the real axis (1 + 3 α r² u² = 0), which slows the spectral
         // convergence: 10 intervals leave 2e-6 rad there, 16 leave 1e-8.
@@ -380,31 +351,16 @@ impl Simulator {
             routing: None,
             channel: vec![ChannelSample::default(); points],
             cable_dir: vec![(1.0, 0.0); points],
-            step_mm: [0.0; 2],
-            span_start_mm: [0.0; 2],
-            nodes_state: vec![State::default(); nodes],
-            nodes_strain: vec![Strains::default(); nodes],
-            theta: vec![0.0; nodes],
-            speed: vec![0.0; nodes],
-            sigma: vec![0.0; nodes],
-            continuation: Continuation::default(),
             last: None,
-            friction_sign: actuator.effects.load_direction.sign(),
-            tension_ratio: vec![1.0; points],
-            cable_global: vec![(1.0, 0.0); points],
-            bending_moment: vec![0.0; points],
-            creep_q: vec![0.0; points],
-            dwell_s: 0.0,
-            creep_decay: 1.0,
-            creep_gain: 0.0,
-            virgin_holds: true,
-            records_profile: actuator.effects.friction_mu > 0.0 || actuator.effects.creep_fraction > 0.0,
+            friction: Friction::new(actuator.effects.friction_mu, actuator.effects.load_direction.slip_sign(), points),
+            creep: Creep::new(&actuator.effects, actuator.ei_n_mm2, points),
             col,
+            rk4: rk4::Rk4::new(n),
         })
         .and_then(|mut sim: Simulator| {
+            // Outside a protocol every solve is held like this from a virgin rod.
             let hold = Hold { direction: actuator.effects.load_direction, dwell_s: actuator.effects.creep_hold_s };
-            sim.set_hold(hold)?;
-            sim.virgin_holds = true;
+            sim.apply_hold(hold)?;
             Ok(sim)
         })
     }
@@ -428,23 +384,8 @@ impl Simulator {
         let built = if delta != 0.0 { routing.shifted(delta) } else { routing.clone() };
         if self.col.is_some() {
             self.colloc_set_routing(&built);
-            self.routing = Some(built);
-            self.reset_warm_start();
-            self.reset_history();
-            self.last = None;
-            return;
-        }
-        let n = self.options.steps_per_span;
-        let knot = built.knot_mm();
-        let length = self.actuator.length_mm;
-        self.span_start_mm = [0.0, knot];
-        self.step_mm = [knot / n as f64, (length - knot) / n as f64];
-        for span in 0..2 {
-            for j in 0..=2 * n {
-                let s = self.span_start_mm[span] + 0.5 * j as f64 * self.step_mm[span];
-                let c = built.channel_at(s);
-                self.channel[span * (2 * n + 1) + j] = ChannelSample { y: c.y_mm, dy: c.dy_ds };
-            }
+        } else {
+            self.rk4_set_routing(&built);
         }
         self.routing = Some(built);
         self.reset_warm_start();
@@ -455,17 +396,17 @@ impl Simulator {
     /// Forgets the warm start (the next solve starts cold). The creep
     /// history is physical state and is kept.
     pub fn reset_warm_start(&mut self) {
-        self.continuation = Continuation::default();
+        self.rk4.forget();
         if let Some(col) = self.col.as_mut() {
             col.forget();
         }
         self.cable_dir.iter_mut().for_each(|d| *d = (1.0, 0.0));
-        self.tension_ratio.iter_mut().for_each(|r| *r = 1.0);
+        self.friction.forget();
     }
 
     /// Forgets the load history (creep): the material is as new, unloaded.
     pub fn reset_history(&mut self) {
-        self.creep_q.iter_mut().for_each(|q| *q = 0.0);
+        self.creep.forget();
     }
 
     /// Sets how the next solves are held: the load direction (sign of
@@ -476,37 +417,49 @@ impl Simulator {
     /// Without this call every solve is held `effects.creep_hold_s` on a
     /// rod with no load history, in `effects.load_direction`.
     pub fn set_hold(&mut self, hold: Hold) -> Result<(), ParameterError> {
-        self.virgin_holds = false;
+        self.creep.follow_protocol();
+        self.apply_hold(hold)
+    }
+
+    /// Checks `hold` and hands it to friction (slip sign) and creep (dwell).
+    fn apply_hold(&mut self, hold: Hold) -> Result<(), ParameterError> {
         if !(hold.dwell_s.is_finite() && hold.dwell_s >= 0.0) {
             return Err(ParameterError::OutOfRange { name: "dwell_s", value: hold.dwell_s, expected: "a finite time ≥ 0 s" });
         }
-        self.friction_sign = hold.direction.sign();
-        self.dwell_s = hold.dwell_s;
-        let e = &self.actuator.effects;
-        let f = e.creep_fraction;
-        if f > 0.0 {
-            self.creep_decay = (-(1.0 - f) * hold.dwell_s / e.creep_time_s).exp();
-            self.creep_gain = f * (1.0 - self.creep_decay) / ((1.0 - f) * self.actuator.ei_n_mm2);
-        } else {
-            self.creep_decay = 1.0;
-            self.creep_gain = 0.0;
-        }
+        self.friction.set_slip_sign(hold.direction.slip_sign());
+        self.creep.set_dwell(hold.dwell_s);
         Ok(())
     }
 
-    /// Curvature u from the bending moment `m` (N·mm) at `s` and du/dm.
-    /// Linear (m = EI u) unless material stiffening makes it
-    /// m = EI u (1 + α (r u)²); the test-only hidden effects add a rest
-    /// curvature u₀ (m = EI (u − u₀)) and a stiffer base segment.
+    /// The section's rigidities at reference arc length `s` (mm): the
+    /// actuator's, with the test-only hidden stiffer base segment. The one
+    /// place a profile along s would enter.
     #[inline]
-    fn bending_curvature(&self, m: f64, s: f64) -> (f64, f64) {
-        let hidden = &self.actuator.effects.hidden;
-        let mut ei = self.actuator.ei_n_mm2;
+    fn section_at(&self, s: f64) -> Section {
+        let a = &self.actuator;
+        let hidden = &a.effects.hidden;
+        let mut ei = a.ei_n_mm2;
         if s < hidden.base_segment_mm {
             ei *= hidden.base_segment_ei_factor;
         }
-        let (u, du_dm) = self.elastic_curvature(m, ei);
-        (u + hidden.rest_curvature_per_mm, du_dm)
+        Section { ea_n: a.ea_n, ga_n: a.ga_n, ei_n_mm2: ei }
+    }
+
+    /// The rod's weight beyond the cut at `s` (mm), N.
+    #[inline]
+    fn distal_weight_n(&self, s: f64) -> f64 {
+        self.weight_n_per_mm * (self.actuator.length_mm - s)
+    }
+
+    /// Curvature u from the bending moment `m` (N·mm) on `section` and du/dm.
+    /// Linear (m = EI u) unless material stiffening makes it
+    /// m = EI u (1 + α (r u)²); the test-only hidden effects add a rest
+    /// curvature u₀ (m = EI (u − u₀)) and a stiffer base segment
+    /// ([`Simulator::section_at`]).
+    #[inline]
+    fn bending_curvature(&self, m: f64, section: &Section) -> (f64, f64) {
+        let (u, du_dm) = self.elastic_curvature(m, section.ei_n_mm2);
+        (u + self.actuator.effects.hidden.rest_curvature_per_mm, du_dm)
     }
 
     /// The elastic part of [`Simulator::bending_curvature`] with rigidity `ei`.
@@ -519,12 +472,12 @@ impl Simulator {
         // Monotone cubic EI (u + c u³) = m, c = α r²: Newton from the linear guess.
         let c = alpha * self.actuator.radius_mm.powi(2);
         let mut u = m / ei;
-        for _ in 0..60 {
+        for _ in 0..STIFFENING_MAX_ITERATIONS {
             let f = ei * (u + c * u * u * u) - m;
             let df = ei * (1.0 + 3.0 * c * u * u);
             let du = f / df;
             u -= du;
-            if du.abs() <= 1e-15 * (1.0 + u.abs()) {
+            if du.abs() <= STIFFENING_TOLERANCE * (1.0 + u.abs()) {
                 break;
             }
         }
@@ -553,20 +506,21 @@ impl Simulator {
         dir0: (f64, f64),
         creep_offset: f64,
     ) -> Result<(Strains, (f64, f64)), SolveFailure> {
-        let a = &self.actuator;
-        let (ea, ga) = (a.ea_n, a.ga_n);
+        let section = self.section_at(s);
+        let (ea, ga) = (section.ea_n, section.ga_n);
+        let creep_gain = self.creep.gain();
         // Weight beyond the cut, in the body frame: Rᵀ W.
-        let wl = self.weight_n_per_mm * (a.length_mm - s);
+        let wl = self.distal_weight_n(s);
         let w1 = wl * (cp * self.gravity_cos + sp * self.gravity_sin);
         let w2 = wl * (cp * self.gravity_sin - sp * self.gravity_cos);
         let (mut ca, mut sa) = dir0;
-        for _ in 0..50 {
+        for _ in 0..CABLE_ANGLE_MAX_ITERATIONS {
             let v1 = 1.0 + (w1 - tension * ca) / ea;
             let v2 = (w2 - tension * sa) / ga;
-            let m = tension * ch.y * ca + moment;
-            let (u_el, du_dm_el) = self.bending_curvature(m, s);
-            let u = u_el + self.creep_gain * m + creep_offset;
-            let du_dm = du_dm_el + self.creep_gain;
+            let m = bending_moment(tension, ch.y, ca, moment);
+            let (u_el, du_dm_el) = self.bending_curvature(m, &section);
+            let u = u_el + creep_gain * m + creep_offset;
+            let du_dm = du_dm_el + creep_gain;
             let p = v1 - u * ch.y;
             let q = v2 + ch.dy;
             let g = p * sa - q * ca;
@@ -597,211 +551,6 @@ impl Simulator {
         Err(SolveFailure::CableDirectionNotConverged { s_mm: s })
     }
 
-    /// Right-hand side of the forward ODE at stage point `k` (index into the
-    /// channel samples).
-    #[inline]
-    /// `(cp, sp)` are cos φ, sin φ of the state.
-    fn derivative(
-        &mut self,
-        s: f64,
-        k: usize,
-        st: &State,
-        (cp, sp): (f64, f64),
-        tension: f64,
-    ) -> Result<(State, Strains), SolveFailure> {
-        let ch = self.channel[k];
-        let local_tension = tension * self.tension_ratio[k];
-        let creep_offset = self.creep_offset(k);
-        let (e, dir) = self.strains_at(s, ch, (sp, cp), st.moment, local_tension, self.cable_dir[k], creep_offset)?;
-        self.cable_dir[k] = dir;
-        // Only friction (cable angles) and creep (moments) need these.
-        if self.records_profile {
-            self.cable_global[k] = (cp * dir.0 - sp * dir.1, sp * dir.0 + cp * dir.1);
-            self.bending_moment[k] = local_tension * ch.y * dir.0 + st.moment;
-        }
-        let dx = e.v1 * cp - e.v2 * sp;
-        let dy = e.v1 * sp + e.v2 * cp;
-        let wl = self.weight_n_per_mm * (self.actuator.length_mm - s);
-        let d = State {
-            x: dx,
-            y: dy,
-            phi: e.u,
-            moment: wl * (dy * self.gravity_cos - dx * self.gravity_sin),
-            sigma: (e.v1 * e.v1 + e.v2 * e.v2).sqrt(),
-        };
-        Ok((d, e))
-    }
-
-    /// The creep's held curvature f E q₀ at stage point `k`, 1/mm.
-    #[inline]
-    fn creep_offset(&self, k: usize) -> f64 {
-        let f = self.actuator.effects.creep_fraction;
-        if f == 0.0 {
-            0.0
-        } else {
-            f * self.creep_decay * self.creep_q[k]
-        }
-    }
-
-    /// Frame angle at the clamp: 0 for a rigid clamp; with clamp compliance
-    /// φ(0) = m(0)/k_θ with m(0) the bending moment there (fixed point, as
-    /// m(0) depends on φ(0) only through the weight's direction).
-    fn clamp_angle(&mut self, moment0: f64, tension: f64) -> Result<f64, SolveFailure> {
-        let Some(k_theta) = self.actuator.effects.clamp_stiffness_n_mm_per_rad else {
-            return Ok(0.0);
-        };
-        let ch = self.channel[0];
-        let mut phi: f64 = 0.0;
-        for _ in 0..100 {
-            let (_, (ca, _)) =
-                self.strains_at(0.0, ch, phi.sin_cos(), moment0, tension, self.cable_dir[0], self.creep_offset(0))?;
-            let m = tension * ch.y * ca + moment0;
-            let next = m / k_theta;
-            if (next - phi).abs() < 1e-14 {
-                return Ok(next);
-            }
-            phi = next;
-        }
-        Err(SolveFailure::ClampNotConverged)
-    }
-
-    /// One forward pass from the clamp with base moment `moment0`; records
-    /// the nodes and returns gravity's moment left at the tip (0 at the solution).
-    fn integrate(&mut self, tension: f64, moment0: f64) -> Result<f64, SolveFailure> {
-        let n = self.options.steps_per_span;
-        let mut st = State { phi: self.clamp_angle(moment0, tension)?, moment: moment0, ..State::default() };
-        for span in 0..2 {
-            let h = self.step_mm[span];
-            let base = span * (2 * n + 1);
-            for step in 0..n {
-                let s = self.span_start_mm[span] + step as f64 * h;
-                let k = base + 2 * step;
-                // One sin/cos per step; the stages rotate it by small angles.
-                let (sp, cp) = st.phi.sin_cos();
-                let (d1, e1) = self.derivative(s, k, &st, (cp, sp), tension)?;
-                let node = span * n + step;
-                self.nodes_state[node] = st;
-                self.nodes_strain[node] = e1;
-                let s2 = st.axpy(0.5 * h, &d1);
-                let (d2, _) = self.derivative(s + 0.5 * h, k + 1, &s2, rotate((cp, sp), 0.5 * h * d1.phi), tension)?;
-                let s3 = st.axpy(0.5 * h, &d2);
-                let (d3, _) = self.derivative(s + 0.5 * h, k + 1, &s3, rotate((cp, sp), 0.5 * h * d2.phi), tension)?;
-                let s4 = st.axpy(h, &d3);
-                let (d4, _) = self.derivative(s + h, k + 2, &s4, rotate((cp, sp), h * d3.phi), tension)?;
-                st = State {
-                    x: st.x + h / 6.0 * (d1.x + 2.0 * d2.x + 2.0 * d3.x + d4.x),
-                    y: st.y + h / 6.0 * (d1.y + 2.0 * d2.y + 2.0 * d3.y + d4.y),
-                    phi: st.phi + h / 6.0 * (d1.phi + 2.0 * d2.phi + 2.0 * d3.phi + d4.phi),
-                    moment: st.moment + h / 6.0 * (d1.moment + 2.0 * d2.moment + 2.0 * d3.moment + d4.moment),
-                    sigma: st.sigma + h / 6.0 * (d1.sigma + 2.0 * d2.sigma + 2.0 * d3.sigma + d4.sigma),
-                };
-                if !st.is_finite() {
-                    return Err(SolveFailure::NonFinite { s_mm: s + h });
-                }
-            }
-        }
-        // Tip node.
-        let k_tip = 2 * (2 * n + 1) - 1;
-        let (sp, cp) = st.phi.sin_cos();
-        let (_, e) = self.derivative(self.actuator.length_mm, k_tip, &st, (cp, sp), tension)?;
-        let tip = 2 * n;
-        self.nodes_state[tip] = st;
-        self.nodes_strain[tip] = e;
-        Ok(st.moment)
-    }
-
-    /// Secant shooting on gravity's base moment `m0` from the given guess
-    /// and slope dM(L)/dM(0) (both updated in place). Returns the passes used.
-    fn shoot(&mut self, tension: f64, m0: &mut f64, slope: &mut f64) -> Result<u32, SolveFailure> {
-        let mut passes = 1u32;
-        let mut f0 = self.integrate(tension, *m0)?;
-        let mut prev: Option<(f64, f64)> = None;
-        while f0.abs() > self.options.moment_tolerance_n_mm {
-            if passes >= self.options.max_shooting_passes {
-                return Err(SolveFailure::ShootingNotConverged { iterations: passes, residual_n_mm: f0 });
-            }
-            if let Some((mp, fp)) = prev {
-                let secant = (f0 - fp) / (*m0 - mp);
-                if secant.is_finite() && secant != 0.0 {
-                    *slope = secant;
-                }
-            }
-            prev = Some((*m0, f0));
-            *m0 -= f0 / *slope;
-            f0 = self.integrate(tension, *m0)?;
-            passes += 1;
-        }
-        Ok(passes)
-    }
-
-    /// Friction: updates the tension profile from the last pass and re-solves
-    /// with `repass` (returning its passes) until the profile settles.
-    fn settle_friction(&mut self, mut repass: impl FnMut(&mut Self) -> Result<u32, SolveFailure>) -> Result<u32, SolveFailure> {
-        let mut passes = 0;
-        for _ in 0..FRICTION_MAX_PASSES {
-            if self.update_tension_ratio() < FRICTION_TOLERANCE {
-                return Ok(passes);
-            }
-            passes += repass(self)?;
-        }
-        Err(SolveFailure::FrictionNotConverged)
-    }
-
-    /// Recomputes the friction tension profile τ(s)/τ(0) from the cable
-    /// angles of the last pass (capstan law between neighbouring nodes,
-    /// exact for a constant |ψ'| between them); returns the largest change.
-    ///
-    /// Only the nodes (accepted RK4 states) are used, not the predictor
-    /// stages; the stage point between two nodes gets their geometric mean.
-    fn update_tension_ratio(&mut self) -> f64 {
-        let n = self.options.steps_per_span;
-        let span_len = 2 * n + 1;
-        let k_node = |node: usize| -> usize {
-            // Span 0's last node is the same point as span 1's first.
-            if node < n {
-                2 * node
-            } else {
-                span_len + 2 * (node - n)
-            }
-        };
-        let mu = self.actuator.effects.friction_mu * self.friction_sign;
-        let mut change: f64 = 0.0;
-        let mut ratio = 1.0;
-        let mut prev_dir = self.cable_global[k_node(0)];
-        let mut set = |ratio_vec: &mut Vec<f64>, k: usize, value: f64| {
-            change = change.max((ratio_vec[k] - value).abs());
-            ratio_vec[k] = value;
-        };
-        set(&mut self.tension_ratio, 0, 1.0);
-        for node in 1..=2 * n {
-            let dir = self.cable_global[k_node(node)];
-            let turn = (prev_dir.0 * dir.1 - prev_dir.1 * dir.0).atan2(prev_dir.0 * dir.0 + prev_dir.1 * dir.1);
-            let next = ratio * (-mu * turn.abs()).exp();
-            let k = k_node(node);
-            let mid = (ratio * next).sqrt();
-            set(&mut self.tension_ratio, k_node(node - 1) + 1, mid);
-            set(&mut self.tension_ratio, k, next);
-            if node == n {
-                set(&mut self.tension_ratio, 2 * n, next);
-            }
-            ratio = next;
-            prev_dir = dir;
-        }
-        change
-    }
-
-    /// Advances the creep's internal curvature over the hold just solved:
-    /// q ← q∞ + (q − q∞) E with q∞ = m/(EI (1 − f)).
-    fn advance_creep(&mut self) {
-        let f = self.actuator.effects.creep_fraction;
-        let scale = 1.0 / (self.actuator.ei_n_mm2 * (1.0 - f));
-        let e = self.creep_decay;
-        for (q, &m) in self.creep_q.iter_mut().zip(&self.bending_moment) {
-            let q_inf = m * scale;
-            *q = q_inf + (*q - q_inf) * e;
-        }
-    }
-
     /// Solves the statics for `tension_n` (N) on the current routing,
     /// warm-started from the previous solves of this routing.
     ///
@@ -812,9 +561,7 @@ impl Simulator {
         if !(tension_n.is_finite() && tension_n >= 0.0) {
             return Err(SolveFailure::InvalidTension(tension_n));
         }
-        if self.virgin_holds && self.actuator.effects.creep_fraction > 0.0 {
-            self.reset_history();
-        }
+        self.creep.begin_solve();
         let result = self.solve_inner(tension_n);
         match &result {
             Ok(pose) => self.last = Some(*pose),
@@ -829,79 +576,12 @@ impl Simulator {
     fn solve_inner(&mut self, tension: f64) -> Result<TipPose, SolveFailure> {
         if self.col.is_some() {
             let passes = self.colloc_solve(tension)?;
-            if self.actuator.effects.creep_fraction > 0.0 && self.dwell_s > 0.0 && !self.virgin_holds {
-                self.advance_creep();
-            }
+            self.creep.end_solve();
             return Ok(self.colloc_pose(tension, passes));
         }
-        let has_moment = self.weight_n_per_mm != 0.0;
-        let has_friction = self.actuator.effects.friction_mu > 0.0 && tension > 0.0;
-        let mut passes;
-        if has_moment {
-            let c = self.continuation;
-            // Predict the base moment from the last solves: the Lagrange
-            // polynomial through up to three previous (tension, moment) pairs.
-            let known = &c.history[..c.solved.min(3)];
-            let mut m0 = 0.0;
-            for (i, &(ti, mi)) in known.iter().enumerate() {
-                let mut weight = 1.0;
-                for (j, &(tj, _)) in known.iter().enumerate() {
-                    if i != j {
-                        weight *= (tension - tj) / (ti - tj);
-                    }
-                }
-                m0 += weight * mi;
-            }
-            if !m0.is_finite() {
-                // Repeated tensions: fall back to the newest solution.
-                m0 = known.first().map_or(0.0, |h| h.1);
-            }
-            // dM(L)/dM(0) is near 1 (the weight's moment hardly depends on
-            // it) and drifts slowly with tension: extrapolate it linearly.
-            let mut slope = match c.solved {
-                0 => 1.0,
-                1 => c.slopes[0],
-                _ => {
-                    let (t1, t2) = (c.history[0].0, c.history[1].0);
-                    c.slopes[0] + (c.slopes[0] - c.slopes[1]) / (t1 - t2) * (tension - t1)
-                }
-            };
-            if !(slope.is_finite() && slope.abs() > 1e-3) {
-                slope = 1.0;
-            }
-            passes = self.shoot(tension, &mut m0, &mut slope)?;
-            if has_friction {
-                passes += self.settle_friction(|sim| sim.shoot(tension, &mut m0, &mut slope))?;
-            }
-            let cont = &mut self.continuation;
-            cont.history.rotate_right(1);
-            cont.history[0] = (tension, m0);
-            cont.solved += 1;
-            cont.slopes = [slope, cont.slopes[0]];
-        } else {
-            self.integrate(tension, 0.0)?;
-            passes = 1;
-            if has_friction {
-                passes += self.settle_friction(|sim| sim.integrate(tension, 0.0).map(|_| 1))?;
-            }
-        }
-        let n_nodes = self.nodes_state.len();
-        let base = self.nodes_state[0];
-        let tip = self.nodes_state[n_nodes - 1];
-        let (e0, et) = (self.nodes_strain[0], self.nodes_strain[n_nodes - 1]);
-        if self.actuator.effects.creep_fraction > 0.0 && self.dwell_s > 0.0 && !self.virgin_holds {
-            self.advance_creep();
-        }
-        Ok(TipPose {
-            tension_n: tension,
-            tip_x_mm: tip.x,
-            tip_y_mm: tip.y,
-            tip_angle_rad: tip.phi + et.v2.atan2(et.v1),
-            tip_frame_angle_rad: tip.phi,
-            base_angle_rad: base.phi + e0.v2.atan2(e0.v1),
-            length_mm: tip.sigma,
-            iterations: passes,
-        })
+        let passes = self.rk4_solve(tension)?;
+        self.creep.end_solve();
+        Ok(self.rk4_pose(tension, passes))
     }
 
     /// Legendre curvature coefficients a_0 … a_{n−1} (n = `out.len()`) of the
@@ -916,18 +596,7 @@ impl Simulator {
             self.colloc_coefficients(basis, out);
             return;
         }
-        for (i, (st, e)) in self.nodes_state.iter().zip(&self.nodes_strain).enumerate() {
-            self.theta[i] = st.phi + e.v2.atan2(e.v1);
-            self.speed[i] = e.v1.hypot(e.v2);
-            self.sigma[i] = st.sigma;
-        }
-        // Nodes are evenly spaced in s: the knot is at L/2 for the clamped
-        // spline with evenly spaced control points.
-        let h = self.step_mm[0];
-        debug_assert!((self.step_mm[0] - self.step_mm[1]).abs() < 1e-12);
-        shape::legendre_from_tangent(&self.theta, &self.sigma, &self.speed, h, out);
-        let deformed_length_mm = self.sigma[self.sigma.len() - 1] - self.sigma[0];
-        basis.convert_from_deformed(out, deformed_length_mm, self.actuator.length_mm);
+        self.rk4_coefficients(basis, out);
     }
 
     /// The centreline of the last successful solve, clamp to tip.
@@ -936,34 +605,7 @@ impl Simulator {
         if self.col.is_some() {
             return self.colloc_centreline();
         }
-        let n = self.options.steps_per_span;
-        let tension = self.last.map_or(0.0, |p| p.tension_n);
-        (0..self.nodes_state.len())
-            .map(|i| {
-                let (span, j) = if i < n { (0, i) } else { (1, i - n) };
-                let s = self.span_start_mm[span] + j as f64 * self.step_mm[span];
-                let k = span * (2 * n + 1) + 2 * j;
-                let st = self.nodes_state[i];
-                let e = self.nodes_strain[i];
-                let yc = self.channel[k].y;
-                let (sp, cp) = st.phi.sin_cos();
-                CentrelinePoint {
-                    s_mm: s,
-                    x_mm: st.x,
-                    y_mm: st.y,
-                    frame_angle_rad: st.phi,
-                    tangent_angle_rad: st.phi + e.v2.atan2(e.v1),
-                    arc_length_mm: st.sigma,
-                    v1: e.v1,
-                    v2: e.v2,
-                    u_per_mm: e.u,
-                    channel_y_mm: yc,
-                    cable_x_mm: st.x - sp * yc,
-                    cable_y_mm: st.y + cp * yc,
-                    cable_tension_n: tension * self.tension_ratio[k],
-                }
-            })
-            .collect()
+        self.rk4_centreline()
     }
 }
 
@@ -1001,6 +643,17 @@ pub struct Simulation {
     pub centreline: Vec<CentrelinePoint>,
 }
 
+/// Why [`simulate`] or [`simulate_held`] produced no result.
+#[derive(Debug, thiserror::Error)]
+pub enum SimulateError {
+    /// The actuator, solver options, hold or coefficient order are invalid.
+    #[error(transparent)]
+    Parameter(#[from] ParameterError),
+    /// A solve of the tension ladder failed.
+    #[error(transparent)]
+    Solve(#[from] SolveFailure),
+}
+
 /// Solves one actuator at `tension_n`, stepping up from a low tension by
 /// continuation so that large deformations start from a nearby solution.
 pub fn simulate(
@@ -1010,7 +663,7 @@ pub fn simulate(
     tension_n: f64,
     order: usize,
     basis: LengthBasis,
-) -> Result<Simulation, crate::Error> {
+) -> Result<Simulation, SimulateError> {
     let hold = Hold { direction: actuator.effects.load_direction, dwell_s: actuator.effects.creep_hold_s };
     simulate_held(actuator, options, routing, tension_n, order, basis, hold)
 }
@@ -1026,7 +679,7 @@ pub fn simulate_held(
     order: usize,
     basis: LengthBasis,
     hold: Hold,
-) -> Result<Simulation, crate::Error> {
+) -> Result<Simulation, SimulateError> {
     super::resolution::check_order(order, options).map_err(ParameterError::Unresolved)?;
     let mut sim = Simulator::new(actuator, options)?;
     sim.set_routing(routing);
@@ -1124,21 +777,38 @@ mod tests {
     }
 
     #[test]
+    fn simulate_reports_its_own_errors_with_the_lower_layers_as_sources() {
+        let (a, options) = (Actuator::default(), SolverOptions::default());
+        let routing = Routing::new(&[1.0, -2.0, 4.0, 4.0, -4.0], a.length_mm, a.radius_mm).unwrap();
+        let err = simulate(&a, &options, &routing, -1.0, 3, LengthBasis::Rest).unwrap_err();
+        assert!(matches!(err, SimulateError::Solve(SolveFailure::InvalidTension(t)) if t == -1.0), "{err:?}");
+        assert_eq!(err.to_string(), SolveFailure::InvalidTension(-1.0).to_string());
+        let hold = Hold { direction: LoadDirection::Load, dwell_s: f64::NAN };
+        let err = simulate_held(&a, &options, &routing, 1.0, 3, LengthBasis::Rest, hold).unwrap_err();
+        assert!(matches!(err, SimulateError::Parameter(ParameterError::OutOfRange { name: "dwell_s", .. })), "{err:?}");
+    }
+
+    #[test]
+    fn bending_moment_adds_the_cable_moment_to_the_distal_moment() {
+        assert_eq!(bending_moment(2.0, 3.0, 0.5, 0.25), 2.0 * 3.0 * 0.5 + 0.25);
+    }
+
+    #[test]
     fn friction_matches_the_capstan_closed_form() {
-        // ψ' = u = τ(s) d / EI and dτ/ds = −σ μ τ ψ' give
-        // τ(s) = τ0 / (1 + σ μ τ0 d s / EI), φ(L) = σ ln(1 + σ μ τ0 d L / EI) / μ.
+        // ψ' = u = τ(s) d / EI and dτ/ds = −η μ τ ψ' (slip sign η) give
+        // τ(s) = τ0 / (1 + η μ τ0 d s / EI), φ(L) = η ln(1 + η μ τ0 d L / EI) / μ.
         let (mu, tau, d) = (0.1, 2.0, 4.0);
         let a = Actuator::default();
         for direction in [LoadDirection::Load, LoadDirection::Unload] {
-            let sigma = direction.sign();
+            let slip = direction.slip_sign();
             let mut sim = straight(|a| a.effects.friction_mu = mu, d);
             sim.set_hold(Hold { direction, dwell_s: 0.0 }).unwrap();
             let pose = ladder(&mut sim, tau);
-            let expected = sigma * (1.0 + sigma * mu * tau * d * a.length_mm / a.ei_n_mm2).ln() / mu;
+            let expected = slip * (1.0 + slip * mu * tau * d * a.length_mm / a.ei_n_mm2).ln() / mu;
             assert!((pose.tip_angle_rad - expected).abs() < 2e-4, "{direction:?}: {} vs {expected}", pose.tip_angle_rad);
             let line = sim.centreline();
             let tip = line.last().unwrap();
-            let tip_tension = tau / (1.0 + sigma * mu * tau * d * a.length_mm / a.ei_n_mm2);
+            let tip_tension = tau / (1.0 + slip * mu * tau * d * a.length_mm / a.ei_n_mm2);
             assert!((tip.cable_tension_n - tip_tension).abs() < 1e-4, "{} vs {tip_tension}", tip.cable_tension_n);
         }
         // Without friction the profile is flat and load = unload.

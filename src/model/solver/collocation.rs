@@ -20,9 +20,8 @@
 //! over, damped by backtracking, and if it fails from the warm start it is
 //! continued in the weight from a weightless rod.
 
-use super::{
-    CentrelinePoint, ChannelSample, Simulator, SolveFailure, Strains, TipPose, FRICTION_MAX_PASSES, FRICTION_TOLERANCE,
-};
+use super::friction::{MAX_PASSES as FRICTION_MAX_PASSES, TOLERANCE as FRICTION_TOLERANCE};
+use super::{bending_moment, CentrelinePoint, ChannelSample, Simulator, SolveFailure, Strains, TipPose};
 use crate::shape::LengthBasis;
 use nalgebra::{DMatrix, DVector};
 
@@ -36,6 +35,15 @@ const SWEEP_ANGLE_TOLERANCE_RAD: f64 = 1e-9;
 const NEWTON_TOLERANCE: f64 = 1e-12;
 /// Newton iterations per solve before giving up.
 const NEWTON_MAX_ITERATIONS: u32 = 40;
+/// Newton: residual accepted after the last iteration (stalled at rounding).
+const NEWTON_STALL_TOLERANCE: f64 = 1e3 * NEWTON_TOLERANCE;
+/// Newton: the backtracking's sufficient decrease (Armijo) factor.
+const NEWTON_SUFFICIENT_DECREASE: f64 = 1e-4;
+/// Newton: smallest damping factor λ tried before giving up.
+const NEWTON_MIN_DAMPING: f64 = 1e-4;
+/// First and largest weight steps of the continuation, as fractions of the weight.
+const FIRST_WEIGHT_STEP: f64 = 0.25;
+const MAX_WEIGHT_STEP: f64 = 0.5;
 /// Smallest weight step of the continuation, as a fraction of the weight.
 const MIN_WEIGHT_STEP: f64 = 1.0 / 1024.0;
 
@@ -493,7 +501,7 @@ impl Simulator {
     fn colloc_solve_with(&mut self, c: &mut Colloc, tension: f64) -> Result<u32, SolveFailure> {
         c.predict(tension);
         let has_weight = self.weight_n_per_mm != 0.0;
-        let has_friction = self.actuator.effects.friction_mu > 0.0 && tension > 0.0;
+        let has_friction = self.friction.acts_at(tension);
         if !has_weight && !has_friction {
             // The strains do not depend on φ or M: one sweep is the solution.
             self.colloc_sweep(c, tension)?;
@@ -508,7 +516,7 @@ impl Simulator {
         let scale = self.actuator.length_mm / self.actuator.ei_n_mm2;
         c.anderson.restart();
         let outcome = loop {
-            c.anderson.begin(&c.phi, &c.mom, &self.tension_ratio, scale);
+            c.anderson.begin(&c.phi, &c.mom, self.friction.ratios(), scale);
             let (dphi, dmom) = match self.colloc_sweep(c, tension) {
                 Ok(change) => change,
                 Err(e) => break Err(e),
@@ -534,7 +542,7 @@ impl Simulator {
                 break Err(SolveFailure::WeightNotConverged { reached_percent: 100.0 });
             }
             previous = change;
-            c.accelerate(scale, &mut self.tension_ratio);
+            c.accelerate(scale, self.friction.ratios_mut());
         };
         match outcome {
             Ok(()) => {
@@ -552,17 +560,15 @@ impl Simulator {
     }
 
     /// Strains at every node from the current φ, M; records the cable
-    /// direction and bending moment for friction and creep.
+    /// direction (friction reads it with φ) and the bending moment (creep).
     fn colloc_strains(&mut self, c: &mut Colloc, tension: f64) -> Result<(), SolveFailure> {
         for i in 0..c.s.len() {
             let ch = self.channel[i];
-            let t = tension * self.tension_ratio[i];
-            let (e, dir) = self.strains_at(c.s[i], ch, c.trig[i], c.mom[i], t, self.cable_dir[i], self.creep_offset(i))?;
+            let t = tension * self.friction.ratio(i);
+            let (e, dir) = self.strains_at(c.s[i], ch, c.trig[i], c.mom[i], t, self.cable_dir[i], self.creep.offset(i))?;
             self.cable_dir[i] = dir;
-            if self.records_profile {
-                let (sp, cp) = c.trig[i];
-                self.cable_global[i] = (cp * dir.0 - sp * dir.1, sp * dir.0 + cp * dir.1);
-                self.bending_moment[i] = t * ch.y * dir.0 + c.mom[i];
+            if self.creep.is_on() {
+                self.creep.record_moment(i, bending_moment(t, ch.y, dir.0, c.mom[i]));
             }
             c.strain[i] = e;
             c.du[i] = e.u;
@@ -573,7 +579,7 @@ impl Simulator {
     /// Frame angle at the clamp from node 0's bending moment.
     fn colloc_clamp_angle(&self, c: &Colloc, tension: f64) -> f64 {
         match self.actuator.effects.clamp_stiffness_n_mm_per_rad {
-            Some(k) => (tension * self.tension_ratio[0] * self.channel[0].y * self.cable_dir[0].0 + c.mom[0]) / k,
+            Some(k) => bending_moment(tension * self.friction.ratio(0), self.channel[0].y, self.cable_dir[0].0, c.mom[0]) / k,
             None => 0.0,
         }
     }
@@ -581,9 +587,7 @@ impl Simulator {
     /// Gravity's distal moment from the strains and φ at the nodes,
     /// integrated backward from M(L) = 0. Returns its largest change.
     fn colloc_moment(&mut self, c: &mut Colloc) -> f64 {
-        let length = self.actuator.length_mm;
-        let w = self.weight_n_per_mm;
-        if w == 0.0 {
+        if self.weight_n_per_mm == 0.0 {
             return 0.0;
         }
         let (gc, gs) = (self.gravity_cos, self.gravity_sin);
@@ -593,7 +597,7 @@ impl Simulator {
             // M' = w (L − s)(y' cos β − x' sin β).
             let dx = e.v1 * cp - e.v2 * sp;
             let dy = e.v1 * sp + e.v2 * cp;
-            c.dmom[i] = w * (length - c.s[i]) * (dy * gc - dx * gs);
+            c.dmom[i] = self.distal_weight_n(c.s[i]) * (dy * gc - dx * gs);
         }
         let np = c.np();
         let mut change: f64 = 0.0;
@@ -674,14 +678,13 @@ impl Simulator {
 
     /// Friction: the tension profile τ(s)/τ(0) at the nodes from the cable
     /// angles of the last sweep, by the capstan law ln τ(s)/τ(0) =
-    /// −σ μ ∫_0^s |ψ'| ds. The cable's global angle ψ = φ + α is smooth on a
+    /// −η μ ∫_0^s |ψ'| ds (slip sign η). The cable's global angle ψ = φ + α is smooth on a
     /// span, but |ψ'| has kinks where the cable turns back, so the turning
     /// is summed over a fine grid of the interpolated ψ (exact wherever ψ is
     /// monotone between grid points). Returns the largest change.
     fn colloc_update_tension_ratio(&mut self, c: &mut Colloc) -> f64 {
         const SUBSTEPS: usize = FRICTION_SUBSTEPS;
         let np = c.np();
-        let mu = self.actuator.effects.friction_mu * self.friction_sign;
         let mut psi = std::mem::take(&mut c.scratch);
         for (i, p) in psi.iter_mut().enumerate() {
             let (ca, sa) = self.cable_dir[i];
@@ -706,9 +709,7 @@ impl Simulator {
                         prev = v;
                     }
                 }
-                let ratio = (-mu * turning).exp();
-                change = change.max((self.tension_ratio[base + j] - ratio).abs());
-                self.tension_ratio[base + j] = ratio;
+                change = change.max(self.friction.set_from_turning(base + j, turning));
             }
         }
         c.scratch = psi;
@@ -736,7 +737,7 @@ impl Simulator {
         let result = (|| -> Result<(), SolveFailure> {
             self.colloc_sweep(c, tension)?;
             iterations += self.colloc_newton(c, tension)?;
-            let (mut reached, mut step) = (0.0f64, 0.25f64);
+            let (mut reached, mut step) = (0.0f64, FIRST_WEIGHT_STEP);
             while reached < 1.0 {
                 let next = (reached + step).min(1.0);
                 let (phi, mom, dir) = (c.phi.clone(), c.mom.clone(), self.cable_dir.clone());
@@ -745,7 +746,7 @@ impl Simulator {
                     Ok(n) => {
                         iterations += n;
                         reached = next;
-                        step = (step * 2.0).min(0.5);
+                        step = (step * 2.0).min(MAX_WEIGHT_STEP);
                     }
                     Err(_) => {
                         (c.phi, c.mom) = (phi, mom);
@@ -776,7 +777,7 @@ impl Simulator {
     /// Newton's method on the collocation equations in (φ, M) at the nodes,
     /// damped by backtracking; the friction profile is settled around it.
     fn colloc_newton(&mut self, c: &mut Colloc, tension: f64) -> Result<u32, SolveFailure> {
-        let has_friction = self.actuator.effects.friction_mu > 0.0 && tension > 0.0;
+        let has_friction = self.friction.acts_at(tension);
         let mut iterations = 0;
         for _ in 0..FRICTION_MAX_PASSES {
             iterations += self.colloc_newton_inner(c, tension)?;
@@ -808,21 +809,21 @@ impl Simulator {
                     c.trig[i] = c.phi[i].sin_cos();
                 }
                 match self.colloc_residual(c, tension, &mut res, Some(&mut jac)) {
-                    Ok(n) if n.is_finite() && n < (1.0 - 1e-4 * lambda) * norm => {
+                    Ok(n) if n.is_finite() && n < (1.0 - NEWTON_SUFFICIENT_DECREASE * lambda) * norm => {
                         norm = n;
                         break;
                     }
                     _ => {
                         self.cable_dir.copy_from_slice(&dir0);
                         lambda /= 2.0;
-                        if lambda < 1e-4 {
+                        if lambda < NEWTON_MIN_DAMPING {
                             return Err(SolveFailure::WeightNotConverged { reached_percent: 0.0 });
                         }
                     }
                 }
             }
         }
-        if norm <= 1e3 * NEWTON_TOLERANCE {
+        if norm <= NEWTON_STALL_TOLERANCE {
             return Ok(NEWTON_MAX_ITERATIONS);
         }
         Err(SolveFailure::WeightNotConverged { reached_percent: 0.0 })
@@ -832,16 +833,16 @@ impl Simulator {
     /// (implicit function theorem on the cable-direction equation).
     #[allow(clippy::too_many_arguments)]
     fn colloc_node_partials(&self, s: f64, ch: ChannelSample, (sp, cp): (f64, f64), moment: f64, t: f64, dir: (f64, f64), e: Strains) -> Partials {
-        let a = &self.actuator;
-        let (ea, ga) = (a.ea_n, a.ga_n);
-        let wl = self.weight_n_per_mm * (a.length_mm - s);
+        let section = self.section_at(s);
+        let (ea, ga) = (section.ea_n, section.ga_n);
+        let wl = self.distal_weight_n(s);
         let (gc, gs) = (self.gravity_cos, self.gravity_sin);
         let w1 = wl * (cp * gc + sp * gs);
         let w2 = wl * (cp * gs - sp * gc);
         let (ca, sa) = dir;
-        let bend = t * ch.y * ca + moment;
-        let (_, du_dm_el) = self.bending_curvature(bend, s);
-        let dudm = du_dm_el + self.creep_gain;
+        let bend = bending_moment(t, ch.y, ca, moment);
+        let (_, du_dm_el) = self.bending_curvature(bend, &section);
+        let dudm = du_dm_el + self.creep.gain();
         let p = e.v1 - e.u * ch.y;
         let q = e.v2 + ch.dy;
         let (dv1a, dv2a, dua) = (t * sa / ea, -t * ca / ga, -t * ch.y * sa * dudm);
@@ -874,19 +875,17 @@ impl Simulator {
         self.colloc_strains(c, tension)?;
         let nn = c.s.len();
         let np = c.np();
-        let length = self.actuator.length_mm;
-        let scale = length / self.actuator.ei_n_mm2;
-        let w = self.weight_n_per_mm;
+        let scale = self.actuator.length_mm / self.actuator.ei_n_mm2;
         let (gc, gs) = (self.gravity_cos, self.gravity_sin);
         let mut parts = vec![Partials::default(); nn];
         for i in 0..nn {
-            let t = tension * self.tension_ratio[i];
+            let t = tension * self.friction.ratio(i);
             let e = c.strain[i];
             parts[i] = self.colloc_node_partials(c.s[i], self.channel[i], c.trig[i], c.mom[i], t, self.cable_dir[i], e);
             let (sp, cp) = c.trig[i];
             let dx = e.v1 * cp - e.v2 * sp;
             let dy = e.v1 * sp + e.v2 * cp;
-            c.dmom[i] = w * (length - c.s[i]) * (dy * gc - dx * gs);
+            c.dmom[i] = self.distal_weight_n(c.s[i]) * (dy * gc - dx * gs);
         }
         let k_theta = self.actuator.effects.clamp_stiffness_n_mm_per_rad;
         let mut jac = jac;
@@ -1042,7 +1041,7 @@ impl Simulator {
                     channel_y_mm: yc,
                     cable_x_mm: px - sp * yc,
                     cable_y_mm: py + cp * yc,
-                    cable_tension_n: tension * at(&self.tension_ratio),
+                    cable_tension_n: tension * at(self.friction.ratios()),
                 }
             })
             .collect()

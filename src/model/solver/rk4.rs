@@ -1,0 +1,328 @@
+//! The previous integration method, kept as the reference
+//! ([`super::SolverMethod::Rk4`]): classical RK4 forward from the clamp with
+//! `steps_per_span` steps on each knot span, and secant shooting on
+//! gravity's base moment M(0), warm-started across the continuation in
+//! tension (`continuation`). Per-point buffers are indexed by stage point,
+//! 2n + 1 per span of n steps (the knot appears in both spans).
+
+use super::continuation::Continuation;
+use super::{
+    bending_moment, friction, rotate, CentrelinePoint, ChannelSample, Routing, Simulator, SolveFailure, Strains, TipPose,
+    CLAMP_MAX_ITERATIONS, CLAMP_TOLERANCE_RAD,
+};
+use crate::shape::{self, LengthBasis};
+
+/// Integration state: position, frame angle, gravity's distal moment, arc length.
+#[derive(Debug, Clone, Copy, Default)]
+struct State {
+    x: f64,
+    y: f64,
+    phi: f64,
+    moment: f64,
+    sigma: f64,
+}
+
+impl State {
+    fn axpy(self, h: f64, d: &State) -> State {
+        State {
+            x: self.x + h * d.x,
+            y: self.y + h * d.y,
+            phi: self.phi + h * d.phi,
+            moment: self.moment + h * d.moment,
+            sigma: self.sigma + h * d.sigma,
+        }
+    }
+    fn is_finite(&self) -> bool {
+        self.x.is_finite() && self.y.is_finite() && self.phi.is_finite() && self.moment.is_finite() && self.sigma.is_finite()
+    }
+}
+
+/// [`rotate`] for the pair in `sin_cos` order, (sin a, cos a).
+#[inline]
+fn rotate_sin_cos((s, c): (f64, f64), delta: f64) -> (f64, f64) {
+    let (c, s) = rotate((c, s), delta);
+    (s, c)
+}
+
+/// RK4's state: the step grid, the nodes of the last pass and the warm
+/// start of the shooting.
+#[derive(Debug, Clone)]
+pub(super) struct Rk4 {
+    /// Step length on each span, mm.
+    step_mm: [f64; 2],
+    /// Span starts, mm.
+    span_start_mm: [f64; 2],
+    /// Per-node results of the last pass (n + 1 nodes per span, the knot shared).
+    nodes_state: Vec<State>,
+    nodes_strain: Vec<Strains>,
+    /// Scratch for shape coefficients.
+    theta: Vec<f64>,
+    speed: Vec<f64>,
+    sigma: Vec<f64>,
+    /// Warm start of the shooting across the continuation in tension.
+    continuation: Continuation,
+}
+
+impl Rk4 {
+    /// Buffers for `n` steps per span.
+    pub(super) fn new(n: usize) -> Self {
+        let nodes = 2 * n + 1;
+        Self {
+            step_mm: [0.0; 2],
+            span_start_mm: [0.0; 2],
+            nodes_state: vec![State::default(); nodes],
+            nodes_strain: vec![Strains::default(); nodes],
+            theta: vec![0.0; nodes],
+            speed: vec![0.0; nodes],
+            sigma: vec![0.0; nodes],
+            continuation: Continuation::default(),
+        }
+    }
+
+    /// Forgets the warm start of the shooting.
+    pub(super) fn forget(&mut self) {
+        self.continuation = Continuation::default();
+    }
+}
+
+impl Simulator {
+    /// Places the stage points on the knot spans of `built` and samples the
+    /// channel there.
+    pub(super) fn rk4_set_routing(&mut self, built: &Routing) {
+        let n = self.options.steps_per_span;
+        let knot = built.knot_mm();
+        let length = self.actuator.length_mm;
+        self.rk4.span_start_mm = [0.0, knot];
+        self.rk4.step_mm = [knot / n as f64, (length - knot) / n as f64];
+        for span in 0..2 {
+            for j in 0..=2 * n {
+                let s = self.rk4.span_start_mm[span] + 0.5 * j as f64 * self.rk4.step_mm[span];
+                let c = built.channel_at(s);
+                self.channel[span * (2 * n + 1) + j] = ChannelSample { y: c.y_mm, dy: c.dy_ds };
+            }
+        }
+    }
+
+    /// Right-hand side of the forward ODE at stage point `k` (index into the
+    /// channel samples); `(sp, cp)` = sin, cos of the state's φ.
+    #[inline]
+    fn derivative(
+        &mut self,
+        s: f64,
+        k: usize,
+        st: &State,
+        (sp, cp): (f64, f64),
+        tension: f64,
+    ) -> Result<(State, Strains), SolveFailure> {
+        let ch = self.channel[k];
+        let local_tension = tension * self.friction.ratio(k);
+        let creep_offset = self.creep.offset(k);
+        let (e, dir) = self.strains_at(s, ch, (sp, cp), st.moment, local_tension, self.cable_dir[k], creep_offset)?;
+        self.cable_dir[k] = dir;
+        // Only friction (cable angles) and creep (moments) need these.
+        if self.friction.is_on() {
+            self.friction.record_cable_direction(k, (sp, cp), dir);
+        }
+        if self.creep.is_on() {
+            self.creep.record_moment(k, bending_moment(local_tension, ch.y, dir.0, st.moment));
+        }
+        let dx = e.v1 * cp - e.v2 * sp;
+        let dy = e.v1 * sp + e.v2 * cp;
+        let wl = self.distal_weight_n(s);
+        let d = State {
+            x: dx,
+            y: dy,
+            phi: e.u,
+            moment: wl * (dy * self.gravity_cos - dx * self.gravity_sin),
+            sigma: (e.v1 * e.v1 + e.v2 * e.v2).sqrt(),
+        };
+        Ok((d, e))
+    }
+
+    /// Frame angle at the clamp: 0 for a rigid clamp; with clamp compliance
+    /// φ(0) = m(0)/k_θ with m(0) the bending moment there (fixed point, as
+    /// m(0) depends on φ(0) only through the weight's direction).
+    fn clamp_angle(&mut self, moment0: f64, tension: f64) -> Result<f64, SolveFailure> {
+        let Some(k_theta) = self.actuator.effects.clamp_stiffness_n_mm_per_rad else {
+            return Ok(0.0);
+        };
+        let ch = self.channel[0];
+        let mut phi: f64 = 0.0;
+        for _ in 0..CLAMP_MAX_ITERATIONS {
+            let (_, (ca, _)) =
+                self.strains_at(0.0, ch, phi.sin_cos(), moment0, tension, self.cable_dir[0], self.creep.offset(0))?;
+            let m = bending_moment(tension, ch.y, ca, moment0);
+            let next = m / k_theta;
+            if (next - phi).abs() < CLAMP_TOLERANCE_RAD {
+                return Ok(next);
+            }
+            phi = next;
+        }
+        Err(SolveFailure::ClampNotConverged)
+    }
+
+    /// One forward pass from the clamp with base moment `moment0`; records
+    /// the nodes and returns gravity's moment left at the tip (0 at the solution).
+    fn integrate(&mut self, tension: f64, moment0: f64) -> Result<f64, SolveFailure> {
+        let n = self.options.steps_per_span;
+        let mut st = State { phi: self.clamp_angle(moment0, tension)?, moment: moment0, ..State::default() };
+        for span in 0..2 {
+            let h = self.rk4.step_mm[span];
+            let base = span * (2 * n + 1);
+            for step in 0..n {
+                let s = self.rk4.span_start_mm[span] + step as f64 * h;
+                let k = base + 2 * step;
+                // One sin/cos per step; the stages rotate it by small angles.
+                let trig = st.phi.sin_cos();
+                let (d1, e1) = self.derivative(s, k, &st, trig, tension)?;
+                let node = span * n + step;
+                self.rk4.nodes_state[node] = st;
+                self.rk4.nodes_strain[node] = e1;
+                let s2 = st.axpy(0.5 * h, &d1);
+                let (d2, _) = self.derivative(s + 0.5 * h, k + 1, &s2, rotate_sin_cos(trig, 0.5 * h * d1.phi), tension)?;
+                let s3 = st.axpy(0.5 * h, &d2);
+                let (d3, _) = self.derivative(s + 0.5 * h, k + 1, &s3, rotate_sin_cos(trig, 0.5 * h * d2.phi), tension)?;
+                let s4 = st.axpy(h, &d3);
+                let (d4, _) = self.derivative(s + h, k + 2, &s4, rotate_sin_cos(trig, h * d3.phi), tension)?;
+                st = State {
+                    x: st.x + h / 6.0 * (d1.x + 2.0 * d2.x + 2.0 * d3.x + d4.x),
+                    y: st.y + h / 6.0 * (d1.y + 2.0 * d2.y + 2.0 * d3.y + d4.y),
+                    phi: st.phi + h / 6.0 * (d1.phi + 2.0 * d2.phi + 2.0 * d3.phi + d4.phi),
+                    moment: st.moment + h / 6.0 * (d1.moment + 2.0 * d2.moment + 2.0 * d3.moment + d4.moment),
+                    sigma: st.sigma + h / 6.0 * (d1.sigma + 2.0 * d2.sigma + 2.0 * d3.sigma + d4.sigma),
+                };
+                if !st.is_finite() {
+                    return Err(SolveFailure::NonFinite { s_mm: s + h });
+                }
+            }
+        }
+        // Tip node.
+        let k_tip = 2 * (2 * n + 1) - 1;
+        let (_, e) = self.derivative(self.actuator.length_mm, k_tip, &st, st.phi.sin_cos(), tension)?;
+        let tip = 2 * n;
+        self.rk4.nodes_state[tip] = st;
+        self.rk4.nodes_strain[tip] = e;
+        Ok(st.moment)
+    }
+
+    /// Secant shooting on gravity's base moment `m0` from the given guess
+    /// and slope dM(L)/dM(0) (both updated in place). Returns the passes used.
+    fn shoot(&mut self, tension: f64, m0: &mut f64, slope: &mut f64) -> Result<u32, SolveFailure> {
+        let mut passes = 1u32;
+        let mut f0 = self.integrate(tension, *m0)?;
+        let mut prev: Option<(f64, f64)> = None;
+        while f0.abs() > self.options.moment_tolerance_n_mm {
+            if passes >= self.options.max_shooting_passes {
+                return Err(SolveFailure::ShootingNotConverged { iterations: passes, residual_n_mm: f0 });
+            }
+            if let Some((mp, fp)) = prev {
+                let secant = (f0 - fp) / (*m0 - mp);
+                if secant.is_finite() && secant != 0.0 {
+                    *slope = secant;
+                }
+            }
+            prev = Some((*m0, f0));
+            *m0 -= f0 / *slope;
+            f0 = self.integrate(tension, *m0)?;
+            passes += 1;
+        }
+        Ok(passes)
+    }
+
+    /// Solves for `tension` from the warm start; returns the passes used.
+    pub(super) fn rk4_solve(&mut self, tension: f64) -> Result<u32, SolveFailure> {
+        let has_moment = self.weight_n_per_mm != 0.0;
+        let has_friction = self.friction.acts_at(tension);
+        let n = self.options.steps_per_span;
+        let mut passes;
+        if has_moment {
+            let (mut m0, mut slope) = self.rk4.continuation.predict(tension);
+            passes = self.shoot(tension, &mut m0, &mut slope)?;
+            if has_friction {
+                passes += friction::settle(
+                    self,
+                    |sim| sim.friction.update_from_rk4_nodes(n),
+                    |sim| sim.shoot(tension, &mut m0, &mut slope),
+                )?;
+            }
+            self.rk4.continuation.record(tension, m0, slope);
+        } else {
+            self.integrate(tension, 0.0)?;
+            passes = 1;
+            if has_friction {
+                passes += friction::settle(
+                    self,
+                    |sim| sim.friction.update_from_rk4_nodes(n),
+                    |sim| sim.integrate(tension, 0.0).map(|_| 1),
+                )?;
+            }
+        }
+        Ok(passes)
+    }
+
+    /// The pose of the last pass.
+    pub(super) fn rk4_pose(&self, tension: f64, passes: u32) -> TipPose {
+        let n_nodes = self.rk4.nodes_state.len();
+        let base = self.rk4.nodes_state[0];
+        let tip = self.rk4.nodes_state[n_nodes - 1];
+        let (e0, et) = (self.rk4.nodes_strain[0], self.rk4.nodes_strain[n_nodes - 1]);
+        TipPose {
+            tension_n: tension,
+            tip_x_mm: tip.x,
+            tip_y_mm: tip.y,
+            tip_angle_rad: tip.phi + et.v2.atan2(et.v1),
+            tip_frame_angle_rad: tip.phi,
+            base_angle_rad: base.phi + e0.v2.atan2(e0.v1),
+            length_mm: tip.sigma,
+            iterations: passes,
+        }
+    }
+
+    /// Legendre coefficients of the last solve from the tangent at the nodes.
+    pub(super) fn rk4_coefficients(&mut self, basis: LengthBasis, out: &mut [f64]) {
+        for (i, (st, e)) in self.rk4.nodes_state.iter().zip(&self.rk4.nodes_strain).enumerate() {
+            self.rk4.theta[i] = st.phi + e.v2.atan2(e.v1);
+            self.rk4.speed[i] = e.v1.hypot(e.v2);
+            self.rk4.sigma[i] = st.sigma;
+        }
+        // Nodes are evenly spaced in s: the knot is at L/2 for the clamped
+        // spline with evenly spaced control points.
+        let h = self.rk4.step_mm[0];
+        debug_assert!((self.rk4.step_mm[0] - self.rk4.step_mm[1]).abs() < 1e-12);
+        shape::legendre_from_tangent(&self.rk4.theta, &self.rk4.sigma, &self.rk4.speed, h, out);
+        let deformed_length_mm = self.rk4.sigma[self.rk4.sigma.len() - 1] - self.rk4.sigma[0];
+        basis.convert_from_deformed(out, deformed_length_mm, self.actuator.length_mm);
+    }
+
+    /// The centreline of the last solve at the nodes.
+    pub(super) fn rk4_centreline(&self) -> Vec<CentrelinePoint> {
+        let n = self.options.steps_per_span;
+        let tension = self.last.map_or(0.0, |p| p.tension_n);
+        (0..self.rk4.nodes_state.len())
+            .map(|i| {
+                let (span, j) = if i < n { (0, i) } else { (1, i - n) };
+                let s = self.rk4.span_start_mm[span] + j as f64 * self.rk4.step_mm[span];
+                let k = span * (2 * n + 1) + 2 * j;
+                let st = self.rk4.nodes_state[i];
+                let e = self.rk4.nodes_strain[i];
+                let yc = self.channel[k].y;
+                let (sp, cp) = st.phi.sin_cos();
+                CentrelinePoint {
+                    s_mm: s,
+                    x_mm: st.x,
+                    y_mm: st.y,
+                    frame_angle_rad: st.phi,
+                    tangent_angle_rad: st.phi + e.v2.atan2(e.v1),
+                    arc_length_mm: st.sigma,
+                    v1: e.v1,
+                    v2: e.v2,
+                    u_per_mm: e.u,
+                    channel_y_mm: yc,
+                    cable_x_mm: st.x - sp * yc,
+                    cable_y_mm: st.y + cp * yc,
+                    cable_tension_n: tension * self.friction.ratio(k),
+                }
+            })
+            .collect()
+    }
+}
