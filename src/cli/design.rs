@@ -144,7 +144,7 @@ pub fn report(objective: &Objective, outcome: &DesignOutcome, results: &[Compone
     s.push('\n');
     // Pasteable into `simulate` and `design`: --routing takes a plain comma list.
     s.push_str(&format!(
-        "routing      y0..y4 (mm): --routing {} --tension {:.4}\n",
+        "routing      y0..y4 (mm): --routing {} --tension-n {:.4}\n",
         e.routing_mm.iter().map(|y| format!("{y:.4}")).collect::<Vec<_>>().join(","),
         e.tension_n
     ));

@@ -16,9 +16,9 @@ pub struct SimulateArgs {
     /// Routing control points y0,y1,y2,y3,y4 in mm (each |y_i| < r).
     #[arg(long, value_name = "Y0,Y1,Y2,Y3,Y4", allow_hyphen_values = true)]
     pub routing: String,
-    /// Cable tension, N (≥ 0).
-    #[arg(long, value_name = "N", allow_hyphen_values = true)]
-    pub tension: f64,
+    /// Cable tension τ, N (≥ 0) (`--tension` is the old name).
+    #[arg(long = "tension-n", alias = "tension", value_name = "N", allow_hyphen_values = true)]
+    pub tension_n: f64,
     /// Highest Legendre order n of the curvature coefficients a_0..a_n.
     #[arg(long, default_value_t = 3)]
     pub order: usize,
@@ -86,8 +86,8 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         CoefficientRoute::Thesis => args.order.min(cablemap::model::resolution::max_order(&options)),
     };
     let basis = args.basis.length_basis;
-    let mut sim = simulate_held(&actuator, &options, &routing, args.tension, exact_order, basis, hold)
-        .with_context(|| format!("simulating routing {y:?} at {} N", args.tension))?;
+    let mut sim = simulate_held(&actuator, &options, &routing, args.tension_n, exact_order, basis, hold)
+        .with_context(|| format!("simulating routing {y:?} at {} N", args.tension_n))?;
     if args.coefficients == CoefficientRoute::Thesis {
         let points: Vec<[f64; 2]> = sim.centreline.iter().map(|c| [c.x_mm, c.y_mm]).collect();
         sim.a = cablemap::shape::thesis_coefficients(&points, args.order, args.n_d)
@@ -99,7 +99,7 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         record::write_centreline_csv(path, &sim).with_context(|| format!("writing centreline CSV {}", path.display()))?;
     }
     if let Some(path) = &args.png {
-        let title = format!("routing [{}] mm, tension {:.3} N", fmt_list(&y), args.tension);
+        let title = format!("routing [{}] mm, tension {:.3} N", fmt_list(&y), args.tension_n);
         let drawing = BodyDrawing::of_simulation(&sim, actuator.radius_mm, "body (outline at ±r), cable in red".into(), BLUE_800);
         draw_bodies(path, &title, &[drawing], &[])?;
     }

@@ -4,7 +4,7 @@
 //! and column names, writers and readers.
 
 use super::routing::ControlPoints;
-use super::{CentrelinePoint, Simulation, STATUS_OK};
+use super::{CentrelinePoint, Simulation, TipPose, STATUS_OK};
 use crate::shape::LengthBasis;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -16,44 +16,24 @@ pub struct SimulationRecord {
     pub status: String,
     /// Routing control points y_0..y_4, mm.
     pub routing_mm: ControlPoints,
-    /// Cable tension, N.
-    pub tension_n: f64,
-    /// Tip position along the clamp axis, mm.
-    pub tip_x_mm: f64,
-    /// Tip position across the clamp axis, mm.
-    pub tip_y_mm: f64,
-    /// Tangent angle of the centreline at the tip, rad.
-    pub tip_angle_rad: f64,
-    /// Frame angle of the tip cross-section, rad.
-    pub tip_frame_angle_rad: f64,
-    /// Tangent angle at the clamp, rad.
-    pub base_angle_rad: f64,
-    /// Deformed length ℓ, mm.
-    pub length_mm: f64,
+    /// Tension, tip pose, deformed length and integration passes (their
+    /// fields appear at the top level of the record).
+    #[serde(flatten)]
+    pub pose: TipPose,
     /// Curvature coefficients a_0..a_n, mm⁻¹, in `length_basis`.
     pub a: Vec<f64>,
     /// The length the coefficients are per unit of.
     pub length_basis: LengthBasis,
-    /// Integration passes the solve used.
-    pub iterations: u32,
 }
 
 impl From<&Simulation> for SimulationRecord {
     fn from(sim: &Simulation) -> Self {
-        let p = &sim.pose;
         SimulationRecord {
             status: STATUS_OK.to_string(),
             routing_mm: sim.routing_mm,
-            tension_n: p.tension_n,
-            tip_x_mm: p.tip_x_mm,
-            tip_y_mm: p.tip_y_mm,
-            tip_angle_rad: p.tip_angle_rad,
-            tip_frame_angle_rad: p.tip_frame_angle_rad,
-            base_angle_rad: p.base_angle_rad,
-            length_mm: p.length_mm,
+            pose: sim.pose,
             a: sim.a.clone(),
             length_basis: sim.length_basis,
-            iterations: p.iterations,
         }
     }
 }

@@ -186,7 +186,7 @@ impl Default for SolverOptions {
 }
 
 /// The scalar results of one solve.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct TipPose {
     /// Tension the solve was for, N.
     pub tension_n: f64,
