@@ -23,7 +23,7 @@ use nalgebra::{DMatrix, DVector, Dyn, Owned};
 use rayon::prelude::*;
 use serde::Serialize;
 use std::cell::{Cell, RefCell};
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
 /// Settings of the multi-start search.
@@ -213,8 +213,45 @@ struct Problem<'a> {
     best: RefCell<Option<(f64, Evaluation)>>,
     evaluations: Cell<usize>,
     max_evaluations: usize,
-    /// Raised by whichever start first reaches [`COST_FLOOR`]: the others stop.
-    stop: &'a AtomicBool,
+    /// This start's place in its pass (the seeds' order).
+    index: usize,
+    /// Shared by a pass's starts: the lowest index that fitted exactly.
+    exact_fit: &'a ExactFit,
+}
+
+/// The lowest start index of a pass that reached [`COST_FLOOR`]. A start
+/// stops once a start *before* it has fitted exactly, never for one after it:
+/// so the first start that fits exactly always runs as if alone, and the
+/// design chosen (the first exact fit, else the least cost) does not depend
+/// on which thread finished first.
+#[derive(Debug)]
+pub struct ExactFit(AtomicUsize);
+
+impl ExactFit {
+    /// No start has fitted exactly yet.
+    pub fn new() -> Self {
+        ExactFit(AtomicUsize::new(usize::MAX))
+    }
+
+    fn record(&self, index: usize) {
+        self.0.fetch_min(index, Ordering::Relaxed);
+    }
+
+    /// Whether a start before `index` fitted exactly.
+    fn before(&self, index: usize) -> bool {
+        self.0.load(Ordering::Relaxed) < index
+    }
+
+    /// Whether any start fitted exactly.
+    pub fn any(&self) -> bool {
+        self.0.load(Ordering::Relaxed) != usize::MAX
+    }
+}
+
+impl Default for ExactFit {
+    fn default() -> Self {
+        Self::new()
+    }
 }
 
 /// An objective this small is an exact fit: errors near 1e-10 mm and
@@ -277,10 +314,10 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
     fn residuals(&self) -> Option<DVector<f64>> {
         let exact = self.best.borrow().as_ref().is_some_and(|(c, _)| *c <= COST_FLOOR);
         if exact {
-            self.stop.store(true, Ordering::Relaxed);
+            self.exact_fit.record(self.index);
         }
-        if exact || self.stop.load(Ordering::Relaxed) || self.evaluations.get() >= self.max_evaluations {
-            // Exact fit here or elsewhere, or out of budget: returning no
+        if exact || self.exact_fit.before(self.index) || self.evaluations.get() >= self.max_evaluations {
+            // Exact fit here or in an earlier start, or out of budget: returning no
             // residuals stops the solver (the best design is kept).
             return None;
         }
@@ -321,8 +358,15 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
 /// Refines one seed with bounded Levenberg–Marquardt; returns the best design
 /// it saw (None if not even the seed could be simulated).
 ///
-/// `stop` is shared between parallel starts: set once any start fits exactly.
-pub fn refine(objective: &Objective, seed: &Seed, max_evaluations: usize, stop: &AtomicBool) -> (Option<(f64, Evaluation)>, StartReport) {
+/// `index` is the start's place in its pass and `exact_fit` is shared by the
+/// pass's parallel starts (see [`ExactFit`]).
+pub fn refine(
+    objective: &Objective,
+    seed: &Seed,
+    max_evaluations: usize,
+    index: usize,
+    exact_fit: &ExactFit,
+) -> (Option<(f64, Evaluation)>, StartReport) {
     let mut problem = Problem {
         objective,
         sim: RefCell::new(objective.simulator()),
@@ -331,7 +375,8 @@ pub fn refine(objective: &Objective, seed: &Seed, max_evaluations: usize, stop: 
         best: RefCell::new(None),
         evaluations: Cell::new(0),
         max_evaluations,
-        stop,
+        index,
+        exact_fit,
     };
     let mut s = *seed;
     objective.bounds.clamp(&mut s.routing_mm, &mut s.tension_n);
@@ -352,8 +397,8 @@ pub fn refine(objective: &Objective, seed: &Seed, max_evaluations: usize, stop: 
         // Our own stops surface from the solver as residual failures.
         termination: if best.as_ref().is_some_and(|(c, _)| *c <= COST_FLOOR) {
             "exact fit (objective at the noise floor)".to_string()
-        } else if stop.load(Ordering::Relaxed) {
-            "stopped: another start fitted exactly".to_string()
+        } else if exact_fit.before(index) {
+            "stopped: an earlier start fitted exactly".to_string()
         } else if problem.evaluations.get() >= max_evaluations {
             "evaluation budget reached".to_string()
         } else {
@@ -380,6 +425,22 @@ fn diverse(ranked: &[(f64, Seed)], count: usize, step_mm: f64) -> Vec<Seed> {
         }
     }
     picked
+}
+
+/// The design a pass yields, from its results in start order: the first
+/// start that fitted exactly, else the least cost (ties to the earlier
+/// start). Starts after the first exact fit may have been stopped at any
+/// point, so they never decide.
+fn choice(results: &[(Option<(f64, Evaluation)>, StartReport)]) -> Option<(f64, Evaluation)> {
+    let found = results.iter().filter_map(|r| r.0.as_ref());
+    match found.clone().find(|(c, _)| *c <= COST_FLOOR) {
+        Some(exact) => Some(exact.clone()),
+        None => found.fold(None, |best: Option<&(f64, Evaluation)>, r| match best {
+            Some(b) if b.0 <= r.0 => Some(b),
+            _ => Some(r),
+        })
+        .cloned(),
+    }
 }
 
 /// Evaluation budget of the first, exploratory pass of each start.
@@ -410,10 +471,14 @@ pub fn design(objective: &Objective, search: &SearchOptions, extra_seeds: &[Seed
     if seeds.is_empty() {
         return Err(DesignError::NoSeed);
     }
-    let stop = AtomicBool::new(false);
     // Pass 1: a short look from every seed.
-    let mut first: Vec<(Option<(f64, Evaluation)>, StartReport)> =
-        seeds.par_iter().map(|seed| refine(objective, seed, EXPLORE_EVALUATIONS, &stop)).collect();
+    let exact_first = ExactFit::new();
+    let mut first: Vec<(Option<(f64, Evaluation)>, StartReport)> = seeds
+        .par_iter()
+        .enumerate()
+        .map(|(i, seed)| refine(objective, seed, EXPLORE_EVALUATIONS, i, &exact_first))
+        .collect();
+    let first_choice = choice(&first);
     first.sort_by(|p, q| p.1.cost.total_cmp(&q.1.cost));
     // Pass 2: converge the most promising, continuing from where pass 1 stopped.
     let continued: Vec<(f64, Seed)> = first
@@ -422,12 +487,19 @@ pub fn design(objective: &Objective, search: &SearchOptions, extra_seeds: &[Seed
             best.as_ref().map(|(c, e)| (*c, Seed { routing_mm: e.routing_mm, tension_n: e.tension_n, source: report.seed.source }))
         })
         .collect();
-    let finalists = if stop.load(Ordering::Relaxed) { Vec::new() } else { diverse(&continued, search.starts, 0.0) };
-    let mut results: Vec<(Option<(f64, Evaluation)>, StartReport)> = if finalists.is_empty() {
+    let finalists = if exact_first.any() { Vec::new() } else { diverse(&continued, search.starts, 0.0) };
+    let exact_final = ExactFit::new();
+    let (mut results, chosen): (Vec<(Option<(f64, Evaluation)>, StartReport)>, _) = if finalists.is_empty() {
         // An exact fit already (or nothing to continue): pass 1 is the answer.
-        first.clone()
+        (first.clone(), first_choice)
     } else {
-        finalists.par_iter().map(|seed| refine(objective, seed, search.max_evaluations, &stop)).collect()
+        let results: Vec<_> = finalists
+            .par_iter()
+            .enumerate()
+            .map(|(i, seed)| refine(objective, seed, search.max_evaluations, i, &exact_final))
+            .collect();
+        let chosen = choice(&results);
+        (results, chosen)
     };
     // Report each finalist against the seed it came from.
     for (result, finalist) in results.iter_mut().zip(&finalists) {
@@ -439,9 +511,9 @@ pub fn design(objective: &Objective, search: &SearchOptions, extra_seeds: &[Seed
             result.1.seed = origin.seed;
         }
     }
+    let (cost, best) = chosen.ok_or(DesignError::NoSeed)?;
     results.sort_by(|p, q| p.1.cost.total_cmp(&q.1.cost));
     let starts: Vec<StartReport> = results.iter().map(|r| r.1.clone()).collect();
-    let (cost, best) = results.into_iter().find_map(|r| r.0).ok_or(DesignError::NoSeed)?;
     Ok(DesignOutcome { best, cost, starts, seeds_simulated, seconds: started.elapsed().as_secs_f64() })
 }
 
@@ -498,6 +570,35 @@ mod tests {
     }
 
     #[test]
+    fn the_choice_is_the_first_exact_fit_else_the_least_cost() {
+        let obj = objective();
+        let mut sim = obj.simulator();
+        let e = obj.evaluate(&mut sim, &[1.0, -2.0, 3.0, 0.5, -1.5].into(), 1.4).unwrap();
+        let seed = Seed { routing_mm: e.routing_mm, tension_n: 1.4, source: SeedSource::Grid };
+        let result = |cost: f64| {
+            let report = StartReport { seed, seed_cost: 1.0, cost, evaluations: 1, termination: String::new() };
+            (Some((cost, e.clone())), report)
+        };
+        let none = (None, StartReport { seed, seed_cost: 1.0, cost: f64::INFINITY, evaluations: 1, termination: String::new() });
+        // A later, smaller exact fit does not win: the later start may have been stopped anywhere.
+        let exact = [none.clone(), result(0.5), result(COST_FLOOR / 2.0), result(COST_FLOOR / 100.0)];
+        assert_eq!(choice(&exact).unwrap().0, COST_FLOOR / 2.0);
+        let inexact = [result(0.5), none.clone(), result(0.25), result(0.25)];
+        assert_eq!(choice(&inexact).unwrap().0, 0.25);
+        assert!(choice(&[none]).is_none());
+    }
+
+    #[test]
+    fn a_design_does_not_depend_on_thread_timing() {
+        let obj = objective();
+        let search = SearchOptions { starts: 4, ..SearchOptions::default() };
+        let runs: Vec<DesignOutcome> = (0..3).map(|_| design(&obj, &search, &[]).unwrap()).collect();
+        for r in &runs[1..] {
+            assert_eq!((r.best.routing_mm, r.best.tension_n, r.cost), (runs[0].best.routing_mm, runs[0].best.tension_n, runs[0].cost));
+        }
+    }
+
+    #[test]
     fn the_bounds_transformation_round_trips_and_stays_inside() {
         let obj = objective();
         let p = Problem {
@@ -508,7 +609,8 @@ mod tests {
             best: RefCell::new(None),
             evaluations: Cell::new(0),
             max_evaluations: 10,
-            stop: &AtomicBool::new(false),
+            index: 0,
+            exact_fit: &ExactFit::new(),
         };
         let y = [4.99, -4.99, 0.0, 1.234, -3.0];
         let (y2, t2) = p.design_of(&p.z_of(&y.into(), 1.7));
