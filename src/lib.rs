@@ -28,6 +28,9 @@ pub enum Error {
     /// A solve failed.
     #[error(transparent)]
     Solve(#[from] model::SolveFailure),
+    /// Spatial (several-cable) actuator or solve.
+    #[error(transparent)]
+    Spatial(#[from] model::spatial::SpatialError),
     /// Shape coefficients could not be computed.
     #[error(transparent)]
     Shape(#[from] shape::ShapeError),

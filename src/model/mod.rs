@@ -5,6 +5,7 @@ pub mod actuator;
 pub mod routing;
 pub mod resolution;
 pub mod solver;
+pub mod spatial;
 
 pub use actuator::{Actuator, Effects, Gravity, LoadDirection, ParameterError};
 pub use routing::{Routing, RoutingError};
