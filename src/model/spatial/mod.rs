@@ -10,10 +10,11 @@
 //! planar single-cable work, and the two agree on planar cases.
 
 pub mod cable;
+pub mod record;
 pub mod solver;
 
 pub use cable::{Cable, MAX_CABLES};
-pub use solver::{SpatialFailure, SpatialNode, SpatialOptions, SpatialPose, SpatialSolver, MAX_SPATIAL_ORDER};
+pub use solver::{check_order, SpatialFailure, SpatialNode, SpatialOptions, SpatialPose, SpatialSolver, MAX_SPATIAL_ORDER};
 
 use crate::model::routing::RoutingError;
 use crate::model::{Actuator, ParameterError};
@@ -54,6 +55,12 @@ pub enum SpatialError {
     /// The spatial solver models the thesis's rod only.
     #[error("effects.{0} is not modelled by the spatial solver (it models the thesis's rod: no friction, stiffening, clamp compliance, channel offset or creep); leave it at its default")]
     UnsupportedEffect(&'static str),
+    /// The `--cable` text could not be read.
+    #[error("--cable \"{text}\": {why} (expected \"y=Y0,Y1,Y2,Y3,Y4 z=Z0,Z1,Z2,Z3,Z4 tension=T\", z= optional, anchor=S optional)")]
+    CableSpec { text: String, why: String },
+    /// An actuator file is not valid TOML or has unknown fields.
+    #[error("actuator file {source_name}: {message}(see docs/schema.md, \"Spatial actuator file\")")]
+    Toml { source_name: String, message: String },
     /// A numerical setting is bad.
     #[error("spatial solver: {0}")]
     Option(String),
@@ -135,9 +142,17 @@ impl SpatialActuator {
         cable::validate(&self.rod, &self.cables)
     }
 
-    /// Reads the TOML format; errors name the file's problem.
-    pub fn from_toml(text: &str) -> Result<Self, String> {
-        let a: Self = toml::from_str(text).map_err(|e| e.to_string())?;
+    /// Reads the TOML format (docs/schema.md); `source` names the file in errors.
+    pub fn from_toml(text: &str, source: &str) -> Result<Self, SpatialError> {
+        toml::from_str(text).map_err(|e| SpatialError::Toml { source_name: source.to_string(), message: e.to_string() })
+    }
+
+    /// Reads and validates an actuator file.
+    pub fn read(path: &std::path::Path) -> Result<Self, crate::Error> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|source| crate::Error::Io { context: format!("reading actuator file {}", path.display()), source })?;
+        let a = Self::from_toml(&text, &path.display().to_string())?;
+        a.validate()?;
         Ok(a)
     }
 }
@@ -191,6 +206,7 @@ pub fn simulate_spatial(
     order: usize,
     basis: LengthBasis,
 ) -> Result<SpatialSimulation, SpatialError> {
+    solver::check_order(order, options)?;
     let mut solver = SpatialSolver::new(actuator, options)?;
     let top = actuator.cables.iter().map(|c| c.tension_n).fold(0.0, f64::max);
     let rungs = ((top / 0.25).ceil() as usize).max(1);
