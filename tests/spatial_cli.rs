@@ -172,3 +172,13 @@ fn bad_input_is_refused_with_a_clear_message() {
         assert!(err.contains(needle), "{args:?}: stderr {err:?} lacks {needle:?}");
     }
 }
+
+#[test]
+fn the_documented_actuator_file_runs() {
+    let file = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/spatial/antagonistic.toml");
+    let v = json(&["simulate", "--actuator", file.to_str().unwrap(), "--json"]);
+    assert_eq!(v["cables"].as_array().unwrap().len(), 2);
+    assert!((v["gj_n_mm2"].as_f64().unwrap() - 76.74).abs() < 1e-12);
+    assert_eq!(f3(&v["gravity_direction"]), [0.0, -1.0, 0.0]);
+    assert!(v["tip_y_mm"].as_f64().unwrap() > 5.0, "the stronger cable at +y wins: {v}");
+}
