@@ -76,6 +76,8 @@ fn a_spatial_pair_sweep_writes_rows_and_reach_maps() {
         let counts = m.column_by_name("count").unwrap().as_any().downcast_ref::<Int64Array>().unwrap();
         assert_eq!(counts.iter().map(|c| c.unwrap()).sum::<i64>(), 36, "{file}");
     }
+    let png = image::open(out.join("maps/reach.png")).unwrap();
+    assert!(png.width() > 1000 && png.height() > 500);
     let m = read(&out.join("maps/reach_3d.parquet"));
     for name in ["ix", "iy", "iz", "x_mm", "y_mm", "z_mm", "count"] {
         assert!(m.column_by_name(name).is_some(), "{name}");

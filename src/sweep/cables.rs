@@ -57,6 +57,8 @@ pub const STATUS_INVALID_ROUTING: &str = "invalid_routing";
 pub const STATUS_FAILED: &str = "failed";
 /// Rows file of a run directory.
 pub const ROWS_FILE: &str = "rows.parquet";
+/// The three reach maps drawn side by side, in `maps/`.
+pub const REACH_PICTURE: &str = "reach.png";
 /// Map tables written into `maps/` of a run directory.
 pub const MAP_FILES: [&str; 4] = ["reach_xy.parquet", "reach_xz.parquet", "reach_yz.parquet", "reach_3d.parquet"];
 
@@ -535,6 +537,7 @@ fn write_maps(dir: &Path, rows: &[Row], cell_mm: f64) -> Result<[u64; 4], String
     let planes: [(&str, [usize; 2], [&str; 2]); 3] =
         [(MAP_FILES[0], [0, 1], ["x", "y"]), (MAP_FILES[1], [0, 2], ["x", "z"]), (MAP_FILES[2], [1, 2], ["y", "z"])];
     let mut cells = [0u64; 4];
+    let mut pictures = Vec::new();
     for (k, (file, axes, names)) in planes.iter().enumerate() {
         let mut counts: BTreeMap<[i32; 2], i64> = BTreeMap::new();
         for t in &tips {
@@ -542,7 +545,16 @@ fn write_maps(dir: &Path, rows: &[Row], cell_mm: f64) -> Result<[u64; 4], String
         }
         cells[k] = counts.len() as u64;
         write_batch(&dir.join(file), counts_batch(&counts, names, cell_mm))?;
+        // Page: x down, the other coordinate across; y–z: y across, z down.
+        let plane = if names[0] == "x" {
+            crate::plot::spatial::ReachPlane { axes: (names[1], "x"), cells: counts.iter().map(|(c, &n)| (c[1], c[0], n)).collect() }
+        } else {
+            crate::plot::spatial::ReachPlane { axes: (names[0], names[1]), cells: counts.iter().map(|(c, &n)| (c[0], c[1], n)).collect() }
+        };
+        pictures.push(plane);
     }
+    let title = format!("reach: {} solutions, cells of {cell_mm} mm", tips.len());
+    crate::plot::spatial::draw_reach_maps(&dir.join(REACH_PICTURE), &title, &pictures, cell_mm).map_err(|e| e.to_string())?;
     let mut counts: BTreeMap<[i32; 3], i64> = BTreeMap::new();
     for t in &tips {
         *counts.entry([index(t[0]), index(t[1]), index(t[2])]).or_default() += 1;
