@@ -572,7 +572,7 @@ impl SpatialSolver {
         }
         let mut converged = false;
         let mut lu = Lu6::default();
-        for _ in 0..50 {
+        for _ in 0..100 {
             let (f, j) = self.residual_jacobian(&x, chans, tensions, nw, mw);
             let mut dx = f.map(|v| -v);
             if !lu.factor(j) {
@@ -584,6 +584,21 @@ impl SpatialSolver {
             let mut lambda = 1.0;
             while x[0] + lambda * dx[0] < 0.05 && lambda > 1e-3 {
                 lambda *= 0.5;
+            }
+            // Far from the solution (a large step: a cold start or a big
+            // tension step), backtrack until the residual falls, so that
+            // Newton cannot jump into another branch of t_i = q_i/|q_i|.
+            if dx.iter().fold(0.0f64, |m, d| m.max(d.abs())) > 0.02 {
+                let norm = |r: [f64; 6]| r.iter().map(|v| v * v).sum::<f64>();
+                let f0 = norm(f);
+                while lambda > 1e-3 {
+                    let trial: [f64; 6] = std::array::from_fn(|i| x[i] + lambda * dx[i]);
+                    let ft = norm(self.residual_only(&trial, chans, tensions, nw, mw));
+                    if ft.is_finite() && ft < f0 {
+                        break;
+                    }
+                    lambda *= 0.5;
+                }
             }
             let mut big = 0.0f64;
             for i in 0..6 {
