@@ -101,11 +101,14 @@ pub fn draw_spatial(path: &Path, title: &str, sim: &SpatialSimulation) -> Result
     Ok(())
 }
 
+/// Page points of one side of a body outline.
+type Outline = Vec<(f64, f64)>;
+
 /// The body's outline in the view plane (x, lateral axis `a`), as page
 /// points: at each node the cross-section (a disc of radius r spanned by
 /// the body y and z axes) reaches r·|(b_y·N, b_z·N)| along the in-view
 /// normal N of the projected centreline.
-fn silhouette(sim: &SpatialSimulation, a: usize, radius: f64) -> (Vec<(f64, f64)>, Vec<(f64, f64)>) {
+fn silhouette(sim: &SpatialSimulation, a: usize, radius: f64) -> (Outline, Outline) {
     let nodes = &sim.nodes;
     let mut left = Vec::with_capacity(nodes.len());
     let mut right = Vec::with_capacity(nodes.len());

@@ -838,7 +838,7 @@ fn axpy(y: &State, h: f64, f: &State) -> State {
 /// (−1)^(i+j) C(i, j) C(i + j, j).
 fn shifted_legendre_coefficient(i: usize, j: usize) -> f64 {
     let binom = |n: usize, k: usize| (0..k).fold(1.0, |acc, m| acc * (n - m) as f64 / (m + 1) as f64);
-    let sign = if (i + j) % 2 == 0 { 1.0 } else { -1.0 };
+    let sign = if (i + j).is_multiple_of(2) { 1.0 } else { -1.0 };
     sign * binom(i, j) * binom(i + j, j)
 }
 
@@ -876,8 +876,9 @@ impl Lu6 {
                 let f = a[r][col] * d;
                 a[r][col] = f;
                 if f != 0.0 {
-                    for c in col + 1..6 {
-                        a[r][c] -= f * a[col][c];
+                    let pivot_row = a[col];
+                    for (x, p) in a[r][col + 1..].iter_mut().zip(&pivot_row[col + 1..]) {
+                        *x -= f * p;
                     }
                 }
             }
