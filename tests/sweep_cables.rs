@@ -99,6 +99,7 @@ fn a_spatial_pair_sweep_writes_rows_and_reach_maps() {
     let summary: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
     assert_eq!(summary["rows"], 36);
     assert_eq!(summary["planar"], false);
+    assert!(!out.join("maps/planar").exists(), "a spatial run has no planar maps");
     // Not resumable: the same directory again is refused.
     let (ok, _, stderr) = run(&["sweep-cables", spec.to_str().unwrap(), "--out", out.to_str().unwrap()]);
     assert!(!ok && stderr.contains("not empty"), "{stderr}");
@@ -133,8 +134,20 @@ levels_mm = [-2.0, 2.0]
     let statuses: Vec<&str> = (0..rows.num_rows()).map(|i| status.value(i)).collect();
     assert_eq!(statuses, ["ok", "ok", "invalid_routing", "invalid_routing"]);
     assert_eq!(f64s(&rows, "tip_x_mm")[2], None);
-    // A planar run: tips on the x–y plane.
+    // A planar run: tips on the x–y plane, and the planar sweep's map tables.
     assert!(f64s(&rows, "tip_z_mm")[0].unwrap().abs() < 1e-12);
+    let cells = read(&out.join("maps/planar/cells.parquet"));
+    let counts = cells.column_by_name("count").unwrap().as_any().downcast_ref::<Int64Array>().unwrap();
+    assert_eq!(counts.iter().map(|c| c.unwrap()).sum::<i64>(), 2, "the two solved rows");
+    let designs = read(&out.join("maps/planar/designs.parquet"));
+    let ids = designs.column_by_name("routing_id").unwrap().as_any().downcast_ref::<Int64Array>().unwrap();
+    let tips = f64s(&rows, "tip_x_mm");
+    for (k, id) in ids.iter().enumerate() {
+        // routing_id there is the row number in rows.parquet.
+        assert_eq!(f64s(&designs, "tip_x_mm")[k], tips[id.unwrap() as usize]);
+    }
+    let summary: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("maps/planar/summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["rows_converged"], 2);
 }
 
 #[test]

@@ -428,6 +428,9 @@ pub fn run_cable_sweep(spec: &CableSweepSpec, out: &Path, threads: Option<usize>
     let cells = write_maps(&out.join("maps"), &rows, spec.output.cell_mm).map_err(|e| write_err(format!("writing maps in {}", out.display()), &e))?;
     let planar = spec.cables.iter().all(|c| c.z_mm.iter().all(|&z| z == 0.0) && c.sweeps.iter().all(|s| s.axis == Axis::Y))
         && spec.gravity_direction.is_none_or(|g| g[2] == 0.0);
+    if planar && spec.output.order >= 1 {
+        write_planar_maps(spec, &rows, out)?;
+    }
     let ok = rows.iter().filter(|r| r.status == STATUS_OK).count() as u64;
     let invalid_rows = rows.iter().filter(|r| r.status == STATUS_INVALID_ROUTING).count() as u64;
     let summary = CableSweepSummary {
@@ -446,6 +449,74 @@ pub fn run_cable_sweep(spec: &CableSweepSpec, out: &Path, threads: Option<usize>
     let json = serde_json::to_string_pretty(&summary).map_err(|e| write_err("writing summary.json".into(), &e))?;
     crate::io::write_atomic(&out.join("summary.json"), json.as_bytes()).map_err(|e| write_err("writing summary.json".into(), &e))?;
     Ok(summary)
+}
+
+/// Directory (inside the run) of a planar run's feasibility-map tables.
+pub const PLANAR_MAP_DIR: &str = "maps/planar";
+
+/// A planar run (every cable and gravity in the x–y plane) also gets the
+/// planar sweep's map tables (cells, modes, designs, summary.json;
+/// docs/maps.md) by the same reducer, in `maps/planar/`. The reducer reads
+/// the planar row layout, so each row is handed over with `routing_id` =
+/// its row number in rows.parquet (where every cable's routing and tension
+/// are), `y0_mm`…`y4_mm` and `tension_n` = cable 1's, and `tip_angle_rad` =
+/// the signed in-plane tangent angle, continuous from the clamp. No mirror images are added (a pair's
+/// mirror is another routing of the spec, if swept). The reducer's pictures
+/// are not drawn: they re-simulate single-cable representatives.
+fn write_planar_maps(spec: &CableSweepSpec, rows: &[Row], out: &Path) -> Result<(), crate::Error> {
+    use crate::reduce::{reduce_batches, write::write_tables, ReduceError, ReduceOptions, RunInfo};
+    use sha2::{Digest, Sha256};
+    let order = spec.output.order;
+    let mut fields = vec![Field::new("routing_id", DataType::Int64, false), Field::new("status", DataType::Utf8, false)];
+    let mut columns: Vec<ArrayRef> = vec![
+        Arc::new(Int64Array::from_iter_values(0..rows.len() as i64)),
+        Arc::new(StringArray::from(rows.iter().map(|r| r.status).collect::<Vec<_>>())),
+    ];
+    let mut push = |name: String, values: Vec<Option<f64>>| {
+        fields.push(Field::new(name, DataType::Float64, true));
+        columns.push(Arc::new(Float64Array::from(values)));
+    };
+    for p in 0..CONTROL_POINTS {
+        push(format!("y{p}_mm"), rows.iter().map(|r| Some(r.cables[0].0[p])).collect());
+    }
+    push("tension_n".into(), rows.iter().map(|r| Some(r.tensions[0])).collect());
+    push("tip_x_mm".into(), rows.iter().map(|r| r.pose.map(|p| p.tip_mm[0])).collect());
+    push("tip_y_mm".into(), rows.iter().map(|r| r.pose.map(|p| p.tip_mm[1])).collect());
+    // The planar sweep's tip angle is continuous from the clamp, not wrapped:
+    // unwrap atan2 toward θ_e − θ_0 = a_0·L (rest basis; a_0·ℓ deformed),
+    // the clamp's shear angle θ_0 being far below π.
+    let length = spec.rod.length_mm;
+    let basis = spec.output.length_basis;
+    let unwrapped = |r: &Row| {
+        let (p, a) = (r.pose?, r.a.as_ref()?);
+        let wrapped = p.tip_tangent[1].atan2(p.tip_tangent[0]);
+        let turn = a[2][0] * if basis == LengthBasis::Rest { length } else { p.length_mm };
+        let tau = std::f64::consts::TAU;
+        Some(wrapped + tau * ((turn - wrapped) / tau).round())
+    };
+    push("tip_angle_rad".into(), rows.iter().map(unwrapped).collect());
+    for i in 0..=order {
+        push(format!("a{i}"), rows.iter().map(|r| r.a.as_ref().map(|a| a[2][i])).collect());
+    }
+    let batch = RecordBatch::try_new(Arc::new(Schema::new(fields)), columns)
+        .map_err(|e| CableSweepError::Write { context: "building the planar map rows".into(), message: e.to_string() })?;
+    let tensions: Vec<f64> = spec.cables.iter().flat_map(|c| [c.tension_n.min, c.tension_n.max]).collect();
+    let info = RunInfo {
+        mirrored: false,
+        order,
+        tension_range_n: [tensions.iter().copied().fold(f64::MAX, f64::min), tensions.iter().copied().fold(0.0, f64::max)],
+        radius_mm: spec.rod.radius_mm,
+        length_mm: spec.rod.length_mm,
+        run_dir: out.display().to_string(),
+        spec_hash: format!("{:x}", Sha256::digest(toml::to_string(spec).unwrap_or_default().as_bytes())),
+        length_basis: spec.output.length_basis,
+    };
+    let options = ReduceOptions { cell_mm: spec.output.cell_mm, ..ReduceOptions::default() };
+    let map = reduce_batches(&info, &options, || Ok(std::iter::once(Ok::<_, ReduceError>(batch.clone()))))?;
+    let dir = out.join(PLANAR_MAP_DIR);
+    std::fs::create_dir_all(&dir).map_err(|source| crate::Error::Io { context: format!("creating {}", dir.display()), source })?;
+    write_tables(&dir, &map)?;
+    Ok(())
 }
 
 /// Name of a control-point column, e.g. `cable2_z3_mm`.
