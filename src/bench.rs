@@ -130,21 +130,26 @@ pub fn bench_solver(
         per_solve.push(start.elapsed().as_secs_f64() * 1e6 / ladder.len() as f64);
     }
     std::hint::black_box(a);
+    Ok(figures(label, per_solve, tensions, passes as f64 / solves.max(1) as f64, failures, method_label(options)))
+}
+
+/// Figures from the mean µs per solve of each routing (any order).
+fn figures(label: &str, mut per_solve: Vec<f64>, tensions: usize, mean_passes: f64, failures: usize, method: String) -> BenchFigures {
     per_solve.sort_by(f64::total_cmp);
     let q = |p: f64| per_solve[((per_solve.len() - 1) as f64 * p).round() as usize];
-    Ok(BenchFigures {
+    BenchFigures {
         label: label.to_string(),
-        routings: routings.len(),
+        routings: per_solve.len(),
         tensions,
         median_us_per_solve: q(0.5),
         p10_us_per_solve: q(0.1),
         p90_us_per_solve: q(0.9),
-        mean_passes: passes as f64 / solves.max(1) as f64,
+        mean_passes,
         failures,
-        method: method_label(options),
+        method,
         reference: None,
         speedup: None,
-    })
+    }
 }
 
 /// Deterministic two-cable spatial actuators for [`bench_spatial`]: each
@@ -203,19 +208,6 @@ pub fn bench_spatial(
         per_solve.push(start.elapsed().as_secs_f64() * 1e6 / tensions as f64);
     }
     std::hint::black_box(sink);
-    per_solve.sort_by(f64::total_cmp);
-    let q = |p: f64| per_solve[((per_solve.len() - 1) as f64 * p).round() as usize];
-    Ok(BenchFigures {
-        label: label.to_string(),
-        routings: pairs.len(),
-        tensions,
-        median_us_per_solve: q(0.5),
-        p10_us_per_solve: q(0.1),
-        p90_us_per_solve: q(0.9),
-        mean_passes: passes as f64 / solves.max(1) as f64,
-        failures,
-        method: format!("spatial-rk4-{}", options.steps_per_span),
-        reference: None,
-        speedup: None,
-    })
+    let method = format!("spatial-rk4-{}", options.steps_per_span);
+    Ok(figures(label, per_solve, tensions, passes as f64 / solves.max(1) as f64, failures, method))
 }

@@ -162,6 +162,29 @@ impl From<ChannelPoint3> for Chan {
     }
 }
 
+impl Chan {
+    /// The cable's unit direction t = q/|q| in the body frame and |q|, with
+    /// q = v + u × r + r' (the channel's tangent on the deformed rod).
+    #[inline]
+    fn direction(&self, v: &V3, u: &V3) -> (V3, f64) {
+        let q = v + u.cross(&self.r) + self.dr;
+        let n = q.norm();
+        (q / n, n)
+    }
+}
+
+/// The cables that pull at a point: (channel, tension > 0).
+#[inline]
+fn pulling<'a>(chans: &'a [Chan], tensions: &'a [f64]) -> impl Iterator<Item = (&'a Chan, f64)> + 'a {
+    chans.iter().zip(tensions.iter().copied()).filter(|&(_, tau)| tau != 0.0)
+}
+
+/// (v, u) of a local solution.
+#[inline]
+fn strains(x: &[f64; 6]) -> (V3, V3) {
+    (V3::new(x[0], x[1], x[2]), V3::new(x[3], x[4], x[5]))
+}
+
 /// One RK4 segment: [start, start + steps·h].
 #[derive(Debug, Clone)]
 struct Segment {
@@ -630,19 +653,13 @@ impl SpatialSolver {
     /// with the exact product J·x' brings x' to ~1e-8 relative.
     #[allow(clippy::too_many_arguments)]
     fn curvature(&self, x: &[f64; 6], chans: &[Chan], tensions: &[f64], nw: V3, mw: V3, r: M3, lu: &Lu6, refine: bool) -> V3 {
-        let v = V3::new(x[0], x[1], x[2]);
-        let u = V3::new(x[3], x[4], x[5]);
+        let (v, u) = strains(x);
         // ∂G/∂s at fixed (v, u): the channel's motion, then the body-frame
         // change of the distal loads.
         let mut gs_f = V3::zeros();
         let mut gs_m = V3::zeros();
-        for (c, &tau) in chans.iter().zip(tensions) {
-            if tau == 0.0 {
-                continue;
-            }
-            let qc = v + u.cross(&c.r) + c.dr;
-            let n = qc.norm();
-            let t = qc / n;
+        for (c, tau) in pulling(chans, tensions) {
+            let (t, n) = c.direction(&v, &u);
             let b = u.cross(&c.dr) + c.d2r;
             let pb = (b - t * t.dot(&b)) / n;
             gs_f += tau * pb;
@@ -675,19 +692,12 @@ impl SpatialSolver {
     /// J(x)·w without forming J: δq_i = w_v + w_u × r_i, δt_i = P_i δq_i.
     fn jacobian_times(&self, x: &[f64; 6], chans: &[Chan], tensions: &[f64], w: &[f64; 6]) -> [f64; 6] {
         let k = &self.stiff;
-        let v = V3::new(x[0], x[1], x[2]);
-        let u = V3::new(x[3], x[4], x[5]);
-        let wv = V3::new(w[0], w[1], w[2]);
-        let wu = V3::new(w[3], w[4], w[5]);
+        let (v, u) = strains(x);
+        let (wv, wu) = strains(w);
         let mut jf = V3::new(k[0] * w[0], k[1] * w[1], k[2] * w[2]);
         let mut jm = V3::new(k[3] * w[3], k[4] * w[4], k[5] * w[5]);
-        for (c, &tau) in chans.iter().zip(tensions) {
-            if tau == 0.0 {
-                continue;
-            }
-            let qc = v + u.cross(&c.r) + c.dr;
-            let n = qc.norm();
-            let t = qc / n;
+        for (c, tau) in pulling(chans, tensions) {
+            let (t, n) = c.direction(&v, &u);
             let dq = wv + wu.cross(&c.r);
             let dt = (dq - t * t.dot(&dq)) * (tau / n);
             jf += dt;
@@ -696,18 +706,19 @@ impl SpatialSolver {
         [jf[0], jf[1], jf[2], jm[0], jm[1], jm[2]]
     }
 
+    /// The rod's part of the residual: K_se (v − v*) − Rᵀ W and K_bt u − Rᵀ M_W.
+    #[inline]
+    fn elastic_residual(&self, x: &[f64; 6], nw: V3, mw: V3) -> (V3, V3) {
+        let k = &self.stiff;
+        (V3::new(k[0] * (x[0] - 1.0), k[1] * x[1], k[2] * x[2]) - nw, V3::new(k[3] * x[3], k[4] * x[4], k[5] * x[5]) - mw)
+    }
+
     /// Residual G(x) of the cut equations (chord iterations).
     fn residual_only(&self, x: &[f64; 6], chans: &[Chan], tensions: &[f64], nw: V3, mw: V3) -> [f64; 6] {
-        let k = &self.stiff;
-        let v = V3::new(x[0], x[1], x[2]);
-        let u = V3::new(x[3], x[4], x[5]);
-        let mut ff = V3::new(k[0] * (x[0] - 1.0), k[1] * x[1], k[2] * x[2]) - nw;
-        let mut fm = V3::new(k[3] * x[3], k[4] * x[4], k[5] * x[5]) - mw;
-        for (c, &tau) in chans.iter().zip(tensions) {
-            if tau == 0.0 {
-                continue;
-            }
-            let t = (v + u.cross(&c.r) + c.dr).normalize();
+        let (v, u) = strains(x);
+        let (mut ff, mut fm) = self.elastic_residual(x, nw, mw);
+        for (c, tau) in pulling(chans, tensions) {
+            let (t, _) = c.direction(&v, &u);
             ff += tau * t;
             fm += tau * c.r.cross(&t);
         }
@@ -717,21 +728,14 @@ impl SpatialSolver {
     /// Residual G(x) of the cut equations and its Jacobian.
     fn residual_jacobian(&self, x: &[f64; 6], chans: &[Chan], tensions: &[f64], nw: V3, mw: V3) -> ([f64; 6], [[f64; 6]; 6]) {
         let k = &self.stiff;
-        let v = V3::new(x[0], x[1], x[2]);
-        let u = V3::new(x[3], x[4], x[5]);
-        let mut ff = V3::new(k[0] * (x[0] - 1.0), k[1] * x[1], k[2] * x[2]) - nw;
-        let mut fm = V3::new(k[3] * x[3], k[4] * x[4], k[5] * x[5]) - mw;
+        let (v, u) = strains(x);
+        let (mut ff, mut fm) = self.elastic_residual(x, nw, mw);
         let mut jvv = M3::from_diagonal(&V3::new(k[0], k[1], k[2]));
         let mut jvu = M3::zeros();
         let mut juv = M3::zeros();
         let mut juu = M3::from_diagonal(&V3::new(k[3], k[4], k[5]));
-        for (c, &tau) in chans.iter().zip(tensions) {
-            if tau == 0.0 {
-                continue;
-            }
-            let qc = v + u.cross(&c.r) + c.dr;
-            let n = qc.norm();
-            let t = qc / n;
+        for (c, tau) in pulling(chans, tensions) {
+            let (t, n) = c.direction(&v, &u);
             let a = (M3::identity() - t * t.transpose()) * (tau / n);
             let sk = c.r.cross_matrix();
             ff += tau * t;
