@@ -9,7 +9,7 @@ use std::path::PathBuf;
 /// Arguments of `cablemap sweep-cables`.
 #[derive(Debug, Clone, Args)]
 pub struct SweepCablesArgs {
-    /// The spec (TOML: [[cable]] tables with tension grids and [[cable.sweep]] control points; docs/schema.md).
+    /// The spec (TOML: `[[cable]]` tables with tension grids and `[[cable.sweep]]` control points; docs/schema.md).
     pub spec: PathBuf,
     /// New or empty output directory: rows.parquet, maps/reach_*.parquet, spec.toml, summary.json.
     #[arg(long, value_name = "DIR")]

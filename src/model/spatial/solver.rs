@@ -115,7 +115,7 @@ pub struct SpatialNode {
     pub s_mm: f64,
     /// Centreline position, mm.
     pub p_mm: [f64; 3],
-    /// Body frame: rows of R (R[i][j], columns are the body axes), global.
+    /// Body frame: rows of R (`R[i][j]`; its columns are the body axes, global).
     pub rotation: [[f64; 3]; 3],
     /// Strain v (body frame).
     pub v: [f64; 3],
