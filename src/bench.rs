@@ -130,19 +130,84 @@ pub fn bench_solver(
         per_solve.push(start.elapsed().as_secs_f64() * 1e6 / ladder.len() as f64);
     }
     std::hint::black_box(a);
+    Ok(figures(label, per_solve, tensions, passes as f64 / solves.max(1) as f64, failures, method_label(options)))
+}
+
+/// Figures from the mean µs per solve of each routing (any order).
+fn figures(label: &str, mut per_solve: Vec<f64>, tensions: usize, mean_passes: f64, failures: usize, method: String) -> BenchFigures {
     per_solve.sort_by(f64::total_cmp);
     let q = |p: f64| per_solve[((per_solve.len() - 1) as f64 * p).round() as usize];
-    Ok(BenchFigures {
+    BenchFigures {
         label: label.to_string(),
-        routings: routings.len(),
+        routings: per_solve.len(),
         tensions,
         median_us_per_solve: q(0.5),
         p10_us_per_solve: q(0.1),
         p90_us_per_solve: q(0.9),
-        mean_passes: passes as f64 / solves.max(1) as f64,
+        mean_passes,
         failures,
-        method: method_label(options),
+        method,
         reference: None,
         speedup: None,
-    })
+    }
+}
+
+/// Deterministic two-cable spatial actuators for [`bench_spatial`]: each
+/// cable's y and z control points from the thesis grid scaled by 0.7, so
+/// that every channel stays within 0.8 r of the axis.
+pub fn sample_spatial_pairs(count: usize, radius_mm: f64) -> Vec<[crate::model::spatial::Cable; 2]> {
+    use crate::model::spatial::Cable;
+    let grid = sample_thesis_routings(4 * count + 3, radius_mm);
+    let scaled = |k: usize| grid[k].map(|v| 0.7 * v);
+    (0..count)
+        .map(|k| {
+            let mut second = Cable::spatial(scaled(4 * k + 2), scaled(4 * k + 3), 0.5);
+            if second.y_mm == scaled(4 * k) && second.z_mm == scaled(4 * k + 1) {
+                second.y_mm = second.y_mm.map(|v| -v);
+            }
+            [Cable::spatial(scaled(4 * k), scaled(4 * k + 1), 1.0), second]
+        })
+        .collect()
+}
+
+/// Times the 3-D solver on two-cable spatial actuators: per actuator, a
+/// ladder of `tensions` steps with τ_1 = t and τ_2 = t/2, t from 1.0 to
+/// 2.0 N (continuation, as a sweep would step it), coefficients a_0 … a_3 of
+/// all three series included. `gravity` is the direction (None: off).
+pub fn bench_spatial(
+    rod: &Actuator,
+    options: &crate::model::spatial::SpatialOptions,
+    pairs: &[[crate::model::spatial::Cable; 2]],
+    tensions: usize,
+    gravity: Option<[f64; 3]>,
+    label: &str,
+) -> Result<BenchFigures, crate::Error> {
+    use crate::model::spatial::{SpatialActuator, SpatialSolver};
+    let mut rod = rod.clone();
+    rod.gravity.enabled = gravity.is_some();
+    let mut per_solve = Vec::with_capacity(pairs.len());
+    let (mut passes, mut solves, mut failures) = (0u64, 0u64, 0usize);
+    let mut sink = 0.0;
+    for pair in pairs {
+        let mut actuator = SpatialActuator::with_cables(rod.clone(), pair.to_vec());
+        actuator.gravity_direction = gravity;
+        let start = Instant::now();
+        let mut solver = SpatialSolver::new(&actuator, options)?;
+        for k in 0..tensions {
+            let t = 1.0 + k as f64 / (tensions.max(2) - 1) as f64;
+            match solver.solve(&[t, 0.5 * t]) {
+                Ok(pose) => {
+                    let a = solver.coefficients(3, crate::shape::LengthBasis::default())?;
+                    sink += a[2][0];
+                    passes += u64::from(pose.passes);
+                    solves += 1;
+                }
+                Err(_) => failures += 1,
+            }
+        }
+        per_solve.push(start.elapsed().as_secs_f64() * 1e6 / tensions as f64);
+    }
+    std::hint::black_box(sink);
+    let method = format!("spatial-rk4-{}", options.steps_per_span);
+    Ok(figures(label, per_solve, tensions, passes as f64 / solves.max(1) as f64, failures, method))
 }

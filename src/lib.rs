@@ -30,6 +30,9 @@ pub enum Error {
     /// A single simulation (parameters or a solve) failed.
     #[error(transparent)]
     Simulate(#[from] model::SimulateError),
+    /// Spatial (several-cable) actuator or solve.
+    #[error(transparent)]
+    Spatial(#[from] model::spatial::SpatialError),
     /// Shape coefficients could not be computed.
     #[error(transparent)]
     Shape(#[from] shape::ShapeError),
@@ -48,6 +51,9 @@ pub enum Error {
     /// Running, checking or reading a sweep.
     #[error(transparent)]
     Sweep(#[from] sweep::SweepError),
+    /// A sweep of several or spatial cables.
+    #[error(transparent)]
+    CableSweep(#[from] sweep::cables::CableSweepError),
     /// Building or writing moulds.
     #[error(transparent)]
     Mould(#[from] mould::MouldError),

@@ -193,3 +193,6 @@ pub fn draw_bodies(path: &Path, title: &str, bodies: &[BodyDrawing], targets: &[
     root.present().map_err(|e| PlotError::new(path, e))?;
     Ok(())
 }
+
+/// Two-view drawings of spatial (several-cable) actuators.
+pub mod spatial;

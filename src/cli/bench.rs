@@ -48,6 +48,23 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
             );
         }
     }
+    // The 3-D solver (issue 16): two spatial cables, in the table only (the
+    // JSON array keeps its two planar rows).
+    let spatial_options = cablemap::model::spatial::SpatialOptions::default();
+    let pairs = cablemap::bench::sample_spatial_pairs(args.routings.div_ceil(4), base.radius_mm);
+    println!(
+        "3-D solver, {} two-cable spatial actuators x 21 tensions (tau1 1.0..2.0 N, tau2 = tau1/2, continuation), twist and both bending series a_0..a_3 included",
+        pairs.len()
+    );
+    println!("{:<22} {:<16} {:>10} {:>8} {:>8} {:>8} {:>9}", "case", "method", "median µs", "p10 µs", "p90 µs", "passes", "failures");
+    let cases = [(Some([1.0, 0.0, 0.0]), "gravity +x (hanging)"), (Some([0.0, 0.6, 0.8]), "gravity (0, .6, .8)"), (None, "gravity off")];
+    for (gravity, label) in cases {
+        let f = cablemap::bench::bench_spatial(&base, &spatial_options, &pairs, 21, gravity, label)?;
+        println!(
+            "{:<22} {:<16} {:>10.2} {:>8.2} {:>8.2} {:>8.2} {:>9}",
+            f.label, f.method, f.median_us_per_solve, f.p10_us_per_solve, f.p90_us_per_solve, f.mean_passes, f.failures
+        );
+    }
     for r in &rows {
         if let (Some(s), Some(reference)) = (r.speedup, r.reference.as_deref()) {
             println!("{}: {} is {:.1}x faster than {} (medians, same run)", r.label, r.method, s, reference.method);

@@ -10,6 +10,7 @@ pub mod mould;
 pub mod reduce;
 pub mod simulate;
 pub mod sweep;
+pub mod sweep_cables;
 pub mod synth;
 
 use cablemap::model::{Actuator, SolverOptions};

@@ -13,12 +13,25 @@ use std::path::PathBuf;
 /// Arguments of `cablemap simulate`.
 #[derive(Debug, Clone, Args)]
 pub struct SimulateArgs {
-    /// Routing control points y0,y1,y2,y3,y4 in mm (each |y_i| < r).
-    #[arg(long, value_name = "Y0,Y1,Y2,Y3,Y4", allow_hyphen_values = true)]
-    pub routing: String,
-    /// Cable tension τ, N (≥ 0) (`--tension` is the old name).
-    #[arg(long = "tension-n", alias = "tension", value_name = "N", allow_hyphen_values = true)]
-    pub tension_n: f64,
+    /// Routing control points y0,y1,y2,y3,y4 in mm (each |y_i| < r): one planar cable.
+    #[arg(long, value_name = "Y0,Y1,Y2,Y3,Y4", allow_hyphen_values = true, requires = "tension_n", conflicts_with_all = ["cable"])]
+    pub routing: Option<String>,
+    /// Cable tension τ, N (≥ 0), with --routing (`--tension` is the old name).
+    #[arg(long = "tension-n", alias = "tension", value_name = "N", allow_hyphen_values = true, requires = "routing")]
+    pub tension_n: Option<f64>,
+    /// One cable of several or spatial cables, repeatable:
+    /// "y=Y0,..,Y4 z=Z0,..,Z4 tension=T" (mm, N; z= may be left out for a
+    /// planar cable; anchor=S knots it at s = S mm). Solved by the 3-D solver.
+    #[arg(long, value_name = "\"y=.. z=.. tension=T\"", allow_hyphen_values = true)]
+    pub cable: Vec<String>,
+    /// A whole actuator (rod, torsion, gravity direction, cables) as TOML
+    /// (docs/schema.md); --cable replaces its cables, rod flags override it.
+    #[arg(long = "actuator", value_name = "FILE.toml")]
+    pub actuator_file: Option<PathBuf>,
+    /// Gravity along a global direction X,Y,Z (normalised; the weight per
+    /// length still comes from the density). Uses the 3-D solver.
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
+    pub gravity_direction: Option<String>,
     /// Highest Legendre order n of the curvature coefficients a_0..a_n.
     #[arg(long, default_value_t = 3)]
     pub order: usize,
@@ -66,6 +79,14 @@ pub enum CoefficientRoute {
 
 /// Runs `cablemap simulate`.
 pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
+    if !args.cable.is_empty() || args.actuator_file.is_some() || args.gravity_direction.is_some() {
+        return run_spatial(args);
+    }
+    let (Some(routing_text), Some(tension)) = (&args.routing, args.tension_n) else {
+        anyhow::bail!(
+            "say what to simulate: --routing Y0,..,Y4 --tension-n T (one planar cable), --cable \"y=.. z=.. tension=T\" (repeatable), or --actuator FILE.toml"
+        );
+    };
     let actuator = args.actuator.apply(&Actuator::default());
     actuator.validate()?;
     let options = args.actuator.solver_options(&SolverOptions::default());
@@ -74,7 +95,7 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         "--n-d {} is more than {MAX_N_D} intervals (the thesis uses 40; the solver has only 2 × steps-per-span nodes to resample)",
         args.n_d
     );
-    let y = parse_list(&args.routing, "--routing")?;
+    let y = parse_list(routing_text, "--routing")?;
     let routing = Routing::new(&y, actuator.length_mm, actuator.radius_mm).context("--routing")?;
     let direction = if args.direction == "unload" { LoadDirection::Unload } else { LoadDirection::Load };
     let hold = Hold { direction, dwell_s: args.dwell_s.unwrap_or(actuator.effects.creep_hold_s) };
@@ -86,8 +107,8 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         CoefficientRoute::Thesis => args.order.min(cablemap::model::resolution::max_order(&options)),
     };
     let basis = args.basis.length_basis;
-    let mut sim = simulate_held(&actuator, &options, &routing, args.tension_n, exact_order, basis, hold)
-        .with_context(|| format!("simulating routing {y:?} at {} N", args.tension_n))?;
+    let mut sim = simulate_held(&actuator, &options, &routing, tension, exact_order, basis, hold)
+        .with_context(|| format!("simulating routing {y:?} at {} N", tension))?;
     if args.coefficients == CoefficientRoute::Thesis {
         let points: Vec<[f64; 2]> = sim.centreline.iter().map(|c| [c.x_mm, c.y_mm]).collect();
         sim.a = cablemap::shape::thesis_coefficients(&points, args.order, args.n_d)
@@ -99,7 +120,7 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         record::write_centreline_csv(path, &sim).with_context(|| format!("writing centreline CSV {}", path.display()))?;
     }
     if let Some(path) = &args.png {
-        let title = format!("routing [{}] mm, tension {:.3} N", fmt_list(&y), args.tension_n);
+        let title = format!("routing [{}] mm, tension {:.3} N", fmt_list(&y), tension);
         let drawing = BodyDrawing::of_simulation(&sim, actuator.radius_mm, "body (outline at ±r), cable in red".into(), BLUE_800);
         draw_bodies(path, &title, &[drawing], &[])?;
     }
@@ -121,6 +142,62 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         writeln!(out, "a_{i:<12} {a:.8e} mm^-1")?;
     }
     writeln!(out, "iterations     {} integration pass(es)", p.iterations)?;
+    Ok(())
+}
+
+/// Several or spatial cables: the 3-D solver (`model::spatial`).
+fn run_spatial(args: &SimulateArgs) -> anyhow::Result<()> {
+    use cablemap::model::spatial::{record, Cable, SpatialActuator, SpatialOptions};
+    let planar_only = [
+        (args.coefficients == CoefficientRoute::Thesis, "--coefficients thesis"),
+        (args.direction != "load", "--direction"),
+        (args.dwell_s.is_some(), "--dwell-s"),
+    ];
+    if let Some((_, flag)) = planar_only.iter().find(|(given, _)| *given) {
+        anyhow::bail!("{flag} applies to the planar single-cable solver (--routing/--tension) only; the 3-D solver models the thesis's rod");
+    }
+    let mut spatial = match &args.actuator_file {
+        Some(path) => SpatialActuator::read(path)?,
+        None => SpatialActuator::with_cables(Actuator::default(), Vec::new()),
+    };
+    spatial.rod = args.actuator.apply(&spatial.rod);
+    if !args.cable.is_empty() {
+        spatial.cables = args.cable.iter().map(|c| c.parse::<Cable>()).collect::<Result<_, _>>()?;
+    }
+    if let (Some(routing), Some(tension)) = (&args.routing, args.tension_n) {
+        let y = parse_list(routing, "--routing")?;
+        let y: [f64; 5] = y.try_into().map_err(|y: Vec<f64>| anyhow::anyhow!("--routing: a routing needs exactly 5 control points y0..y4 (mm), got {}", y.len()))?;
+        spatial.cables = vec![Cable::planar(y, tension)];
+    }
+    anyhow::ensure!(
+        !spatial.cables.is_empty(),
+        "no cables: give --cable \"y=.. z=.. tension=T\" (repeatable), --routing/--tension, or [[cable]] tables in --actuator"
+    );
+    if let Some(text) = &args.gravity_direction {
+        let g = parse_list(text, "--gravity-direction")?;
+        let g: [f64; 3] = g.try_into().map_err(|g: Vec<f64>| anyhow::anyhow!("--gravity-direction needs 3 numbers X,Y,Z, got {}", g.len()))?;
+        spatial.gravity_direction = Some(g);
+    }
+    let mut options = SpatialOptions::default();
+    if let Some(steps) = args.actuator.steps_per_span {
+        options.steps_per_span = steps;
+    }
+    let sim = cablemap::model::spatial::simulate_spatial(&spatial, &options, args.order, args.basis.length_basis)?;
+    if let Some(path) = &args.csv {
+        record::write_centreline_csv(path, &sim).with_context(|| format!("writing centreline CSV {}", path.display()))?;
+    }
+    if let Some(path) = &args.png {
+        let tensions: Vec<String> = spatial.cables.iter().map(|c| format!("{:.3}", c.tension_n)).collect();
+        let title = format!("{} cable(s), tensions [{}] N", spatial.cables.len(), tensions.join(", "));
+        cablemap::plot::spatial::draw_spatial(path, &title, &sim)?;
+    }
+    let stdout = std::io::stdout();
+    let mut out = stdout.lock();
+    if args.json {
+        writeln!(out, "{}", record::simulation_json(&sim))?;
+    } else {
+        write!(out, "{}", record::report(&sim))?;
+    }
     Ok(())
 }
 

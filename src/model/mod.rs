@@ -6,6 +6,7 @@ pub mod record;
 pub mod routing;
 pub mod resolution;
 pub mod solver;
+pub mod spatial;
 
 pub use actuator::{Actuator, Effects, Gravity, LoadDirection, ParameterError};
 pub use routing::{ControlPoints, Routing, RoutingError};

@@ -14,6 +14,7 @@
 //! The map format (file and column names, writer, reader) is [`tables`];
 //! [`output`] writes a whole map directory, [`drawings`] the modes' bodies.
 
+pub mod cables;
 mod cells;
 mod columns;
 pub mod drawings;
@@ -46,6 +47,9 @@ pub const CELL_STATS_ORDER: usize = 2;
 /// Why a reduction failed.
 #[derive(Debug, thiserror::Error)]
 pub enum ReduceError {
+    /// A cable sweep's spec, solve or rows (issue 16).
+    #[error(transparent)]
+    CableSweep(#[from] crate::sweep::cables::CableSweepError),
     /// The shards lack a column the reducer reads.
     #[error("sweep data: column '{name}' is missing from the sweep shards")]
     MissingColumn {

@@ -10,6 +10,7 @@
 //! - [`read`]: **the reader other stages use**: [`read::open_run`] checks a
 //!   run directory and streams its rows as Arrow record batches.
 
+pub mod cables;
 pub mod enumerate;
 pub mod progress;
 pub mod read;

@@ -1,0 +1,191 @@
+//! Cables of a spatial actuator: routing (y and z channels), tension and
+//! anchor, checked against the body.
+//!
+//! Each coordinate of the channel is the thesis's parametric cubic B-spline
+//! ([`Routing`], model-notes §2): y_c(s) and z_c(s) share s(ζ), so the pair
+//! is one parametric space curve r_c(s) = (0, y_c(s), z_c(s)) in the body
+//! frame. z ≡ 0 is today's planar routing.
+
+use super::SpatialError;
+use crate::model::routing::{ChannelPoint, Routing, CONTROL_POINTS};
+use crate::model::Actuator;
+use serde::{Deserialize, Serialize};
+
+/// Most cables an actuator may have.
+pub const MAX_CABLES: usize = 8;
+
+/// Points per knot span at which the channel is checked against the radius.
+const RADIUS_CHECK_POINTS_PER_SPAN: usize = 512;
+
+/// One cable: its channel's control points, its tension and where it is knotted.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Cable {
+    /// Lateral (body y) control points y_0 … y_4, mm.
+    pub y_mm: [f64; CONTROL_POINTS],
+    /// Out-of-plane (body z) control points z_0 … z_4, mm; all zero for a planar cable.
+    #[serde(default)]
+    pub z_mm: [f64; CONTROL_POINTS],
+    /// Tension pulled at the base, N (≥ 0).
+    pub tension_n: f64,
+    /// Arc length s_k of the knot, mm (0 < s_k ≤ L); `None` is the tip.
+    /// Beyond s_k the cable is slack and carries no load.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub anchor_mm: Option<f64>,
+}
+
+impl Cable {
+    /// A planar cable (z ≡ 0) knotted at the tip.
+    pub fn planar(y_mm: [f64; CONTROL_POINTS], tension_n: f64) -> Self {
+        Self { y_mm, z_mm: [0.0; CONTROL_POINTS], tension_n, anchor_mm: None }
+    }
+
+    /// A spatial cable knotted at the tip.
+    pub fn spatial(y_mm: [f64; CONTROL_POINTS], z_mm: [f64; CONTROL_POINTS], tension_n: f64) -> Self {
+        Self { y_mm, z_mm, tension_n, anchor_mm: None }
+    }
+
+    /// Whether the channel lies in the body's x–y plane (every z_i = 0).
+    pub fn is_planar(&self) -> bool {
+        self.z_mm.iter().all(|&z| z == 0.0)
+    }
+
+    /// The knot position s_k on a rod of length `length_mm`.
+    pub fn anchor_or_tip_mm(&self, length_mm: f64) -> f64 {
+        self.anchor_mm.unwrap_or(length_mm)
+    }
+}
+
+/// A validated cable's channel: the two coordinate splines.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Channel {
+    y: Routing,
+    z: Routing,
+}
+
+/// The channel's body-frame offset and its first two arc-length derivatives at one s.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ChannelPoint3 {
+    /// (y_c, z_c), mm.
+    pub r_mm: [f64; 2],
+    /// (dy_c/ds, dz_c/ds).
+    pub dr_ds: [f64; 2],
+    /// (d²y_c/ds², d²z_c/ds²), 1/mm.
+    pub d2r_ds2: [f64; 2],
+}
+
+impl Channel {
+    /// Channel offset and derivatives at `s_mm`.
+    pub fn at(&self, s_mm: f64) -> ChannelPoint3 {
+        let (a, b): (ChannelPoint, ChannelPoint) = (self.y.channel_at(s_mm), self.z.channel_at(s_mm));
+        ChannelPoint3 { r_mm: [a.y_mm, b.y_mm], dr_ds: [a.dy_ds, b.dy_ds], d2r_ds2: [a.d2y_ds2, b.d2y_ds2] }
+    }
+
+    /// Arc length of the routing's interior knot, mm.
+    pub fn knot_mm(&self) -> f64 {
+        self.y.knot_mm()
+    }
+
+    /// The channel's distance from the rod axis at parameter ζ, mm.
+    fn radius_at_parameter(&self, zeta: f64) -> (f64, f64) {
+        let (s, y) = self.y.at_parameter(zeta);
+        let (_, z) = self.z.at_parameter(zeta);
+        (s, y.hypot(z))
+    }
+}
+
+/// Checks every cable against the actuator and builds the channels.
+///
+/// Errors: no cables or more than [`MAX_CABLES`]; a tension that is negative
+/// or not finite; a control point that is not finite or not below the radius;
+/// a channel that reaches |r_c| ≥ r anywhere along s (checked at
+/// 2·512 + 1 points; the convex hull of the control points bounds each
+/// coordinate, not the distance); an anchor outside (0, L]; two cables on
+/// the same path (identical control points: the spline is linear in them, so
+/// this is exactly "the same curve").
+pub fn validate(actuator: &Actuator, cables: &[Cable]) -> Result<Vec<Channel>, SpatialError> {
+    if cables.is_empty() || cables.len() > MAX_CABLES {
+        return Err(SpatialError::CableCount(cables.len()));
+    }
+    let (length, radius) = (actuator.length_mm, actuator.radius_mm);
+    let mut channels = Vec::with_capacity(cables.len());
+    for (index, cable) in cables.iter().enumerate() {
+        let cable_no = index + 1;
+        if !(cable.tension_n.is_finite() && cable.tension_n >= 0.0) {
+            return Err(SpatialError::Tension { cable: cable_no, tension_n: cable.tension_n });
+        }
+        let y = Routing::new(&cable.y_mm, length, radius)
+            .map_err(|source| SpatialError::Routing { cable: cable_no, axis: 'y', source })?;
+        let z = Routing::new(&cable.z_mm, length, radius)
+            .map_err(|source| SpatialError::Routing { cable: cable_no, axis: 'z', source })?;
+        if let Some(anchor) = cable.anchor_mm {
+            if !(anchor.is_finite() && anchor > 0.0 && anchor <= length) {
+                return Err(SpatialError::Anchor { cable: cable_no, anchor_mm: anchor, length_mm: length });
+            }
+        }
+        let channel = Channel { y, z };
+        let n = 2 * RADIUS_CHECK_POINTS_PER_SPAN;
+        for k in 0..=n {
+            let (s, dist) = channel.radius_at_parameter(k as f64 / n as f64);
+            if dist >= radius {
+                return Err(SpatialError::OutsideBody { cable: cable_no, s_mm: s, distance_mm: dist, radius_mm: radius });
+            }
+        }
+        for (other, earlier) in cables[..index].iter().enumerate() {
+            if earlier.y_mm == cable.y_mm && earlier.z_mm == cable.z_mm {
+                return Err(SpatialError::SamePath { first: other + 1, second: cable_no });
+            }
+        }
+        channels.push(channel);
+    }
+    Ok(channels)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rod() -> Actuator {
+        Actuator::default()
+    }
+
+    #[test]
+    fn planar_channel_matches_the_planar_routing() {
+        let y = [1.0, -2.0, 3.0, 0.5, -4.0];
+        let ch = validate(&rod(), &[Cable::planar(y, 1.0)]).unwrap().remove(0);
+        let r = Routing::new(&y, 65.0, 5.0).unwrap();
+        for k in 0..=65 {
+            let s = k as f64;
+            let (a, b) = (ch.at(s), r.channel_at(s));
+            assert_eq!(a.r_mm, [b.y_mm, 0.0]);
+            assert_eq!(a.dr_ds, [b.dy_ds, 0.0]);
+        }
+    }
+
+    #[test]
+    fn bad_cables_get_named_errors() {
+        let ok = Cable::spatial([1.0; 5], [1.0; 5], 1.0);
+        let e = validate(&rod(), &[]).unwrap_err();
+        assert!(matches!(e, SpatialError::CableCount(0)), "{e}");
+        let e = validate(&rod(), &vec![ok.clone(); 9]).unwrap_err();
+        assert!(matches!(e, SpatialError::CableCount(9)), "{e}");
+        let mut neg = ok.clone();
+        neg.tension_n = -0.1;
+        let e = validate(&rod(), &[neg]).unwrap_err();
+        assert!(matches!(e, SpatialError::Tension { cable: 1, .. }), "{e}");
+        assert!(e.to_string().contains("cable 1"), "{e}");
+        // Each coordinate inside, the distance outside: (4, 4) is 5.66 mm from the axis.
+        let e = validate(&rod(), &[Cable::spatial([4.0; 5], [4.0; 5], 1.0)]).unwrap_err();
+        assert!(matches!(e, SpatialError::OutsideBody { cable: 1, .. }), "{e}");
+        assert!(e.to_string().contains("radius"), "{e}");
+        let e = validate(&rod(), &[Cable::spatial([1.0; 5], [0.0, 0.0, 5.5, 0.0, 0.0], 1.0)]).unwrap_err();
+        assert!(matches!(e, SpatialError::Routing { cable: 1, axis: 'z', .. }), "{e}");
+        assert!(e.to_string().contains("z"), "{e}");
+        let e = validate(&rod(), &[ok.clone(), Cable::planar([-1.0; 5], 1.0), ok.clone()]).unwrap_err();
+        assert!(matches!(e, SpatialError::SamePath { first: 1, second: 3 }), "{e}");
+        let mut anchored = ok.clone();
+        anchored.anchor_mm = Some(70.0);
+        let e = validate(&rod(), &[anchored]).unwrap_err();
+        assert!(matches!(e, SpatialError::Anchor { cable: 1, .. }), "{e}");
+    }
+}

@@ -1,0 +1,236 @@
+//! Several cables with spatial routings (issue 16, the thesis's future work).
+//!
+//! An actuator here is the thesis's rod ([`Actuator`]) with 1–8 cables, each
+//! routed along r_c,i(s) = (0, y_i(s), z_i(s)) in the body frame, y and z
+//! each the thesis's five-point parametric B-spline ([`cable`]); torsion
+//! enters with GJ (default EI/1.5: ν = 0.5, incompressible silicone) and
+//! gravity acts along any global direction. The 3-D solver ([`solver`]) is
+//! the equilibrium-at-a-cut form generalised to three dimensions; the planar
+//! single-cable solver ([`crate::model::simulate`]) stays the fast path for
+//! planar single-cable work, and the two agree on planar cases.
+
+pub mod cable;
+pub mod record;
+pub mod solver;
+
+pub use cable::{Cable, MAX_CABLES};
+pub use solver::{check_order, SpatialFailure, SpatialNode, SpatialOptions, SpatialPose, SpatialSolver, MAX_SPATIAL_ORDER};
+
+use crate::model::routing::RoutingError;
+use crate::model::{Actuator, ParameterError};
+use crate::shape::LengthBasis;
+use serde::{Deserialize, Serialize};
+
+/// GJ = EI / this factor when not given: for an isotropic material
+/// GJ/EI = G/E·(J/I) = 2/(2(1 + ν)) = 1/1.5 with ν = 0.5.
+pub const EI_OVER_GJ: f64 = 1.5;
+
+/// Why a spatial actuator or solve was rejected.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SpatialError {
+    /// Too few or too many cables.
+    #[error("an actuator needs 1 to {MAX_CABLES} cables, got {0}")]
+    CableCount(usize),
+    /// A tension is negative or not finite.
+    #[error("cable {cable}: tension {tension_n} N is invalid: a cable pulls with a finite tension ≥ 0 N")]
+    Tension { cable: usize, tension_n: f64 },
+    /// A control point is bad.
+    #[error("cable {cable}, {axis} control points: {source}")]
+    Routing { cable: usize, axis: char, source: RoutingError },
+    /// The channel leaves the body between control points.
+    #[error("cable {cable}: the channel reaches {distance_mm:.3} mm from the axis at s = {s_mm:.2} mm, on or outside the radius r = {radius_mm} mm; move its control points toward the axis (|r_c(s)| = √(y² + z²) must stay below r everywhere)")]
+    OutsideBody { cable: usize, s_mm: f64, distance_mm: f64, radius_mm: f64 },
+    /// Two cables share one channel.
+    #[error("cables {first} and {second} have the same path (identical y and z control points); two cables cannot share a channel: merge them into one cable with the summed tension, or move one")]
+    SamePath { first: usize, second: usize },
+    /// An anchor lies outside the rod.
+    #[error("cable {cable}: anchor s_k = {anchor_mm} mm must lie in (0, L = {length_mm} mm]")]
+    Anchor { cable: usize, anchor_mm: f64, length_mm: f64 },
+    /// Gravity direction is zero or not finite.
+    #[error("gravity direction {0:?} must be a finite, non-zero 3-vector (it is normalised; the weight per length comes from the density)")]
+    GravityDirection([f64; 3]),
+    /// A rod parameter is bad.
+    #[error(transparent)]
+    Parameter(#[from] ParameterError),
+    /// The spatial solver models the thesis's rod only.
+    #[error("effects.{0} is not modelled by the spatial solver (it models the thesis's rod: no friction, stiffening, clamp compliance, channel offset or creep); leave it at its default")]
+    UnsupportedEffect(&'static str),
+    /// The `--cable` text could not be read.
+    #[error("cable \"{text}\": {why} (expected \"y=Y0,Y1,Y2,Y3,Y4 z=Z0,Z1,Z2,Z3,Z4 tension=T\", z= optional, anchor=S optional)")]
+    CableSpec { text: String, why: String },
+    /// An actuator file is not valid TOML or has unknown fields.
+    #[error("actuator file {source_name}: {message}(see docs/schema.md, \"Spatial actuator file\")")]
+    Toml { source_name: String, message: String },
+    /// A numerical setting is bad.
+    #[error("spatial solver: {0}")]
+    Option(String),
+    /// The solve failed.
+    #[error(transparent)]
+    Solve(#[from] SpatialFailure),
+    /// An actuator file cannot be read.
+    #[error("reading actuator file {path}: {message}")]
+    Read {
+        /// The file.
+        path: String,
+        /// The cause (as text: this error is cloned and compared).
+        message: String,
+    },
+}
+
+/// A whole spatial actuator: rod, torsion, gravity direction and cables.
+/// This is the `--actuator FILE.toml` format (see docs/schema.md).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SpatialActuator {
+    /// Rod parameters (thesis defaults); `rod.gravity.direction_rad` is
+    /// ignored when `gravity_direction` is given.
+    #[serde(default)]
+    pub rod: Actuator,
+    /// Torsional rigidity GJ, N·mm²; `None` is EI/1.5.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gj_n_mm2: Option<f64>,
+    /// Gravity direction in the global frame (any length, normalised);
+    /// `None` takes the planar rod's in-plane direction (cos d, sin d, 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gravity_direction: Option<[f64; 3]>,
+    /// The cables (TOML: `[[cable]]` tables).
+    #[serde(rename = "cable")]
+    pub cables: Vec<Cable>,
+}
+
+impl SpatialActuator {
+    /// The thesis rod with `cables`.
+    pub fn with_cables(rod: Actuator, cables: Vec<Cable>) -> Self {
+        Self { rod, gj_n_mm2: None, gravity_direction: None, cables }
+    }
+
+    /// GJ in use, N·mm².
+    pub fn torsional_rigidity_n_mm2(&self) -> f64 {
+        self.gj_n_mm2.unwrap_or(self.rod.ei_n_mm2 / EI_OVER_GJ)
+    }
+
+    /// Unit gravity direction (global).
+    pub fn gravity_unit(&self) -> Result<[f64; 3], SpatialError> {
+        let g = match self.gravity_direction {
+            Some(g) => g,
+            None => {
+                let d = self.rod.gravity.direction_rad;
+                [d.cos(), d.sin(), 0.0]
+            }
+        };
+        let n = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
+        if !(n.is_finite() && n > 0.0) {
+            return Err(SpatialError::GravityDirection(g));
+        }
+        Ok(g.map(|c| c / n))
+    }
+
+    /// Checks everything and builds the cables' channels.
+    pub fn validate(&self) -> Result<Vec<cable::Channel>, SpatialError> {
+        self.rod.validate()?;
+        let e = &self.rod.effects;
+        let d = crate::model::Effects::default();
+        let unsupported = [
+            ("friction_mu", e.friction_mu != d.friction_mu),
+            ("stiffening_alpha", e.stiffening_alpha != d.stiffening_alpha),
+            ("clamp_stiffness_n_mm_per_rad", e.clamp_stiffness_n_mm_per_rad.is_some()),
+            ("channel_offset_mm", e.channel_offset_mm != d.channel_offset_mm),
+            ("creep_fraction", e.creep_fraction != d.creep_fraction),
+            ("hidden", e.hidden != d.hidden),
+        ];
+        if let Some((name, _)) = unsupported.iter().find(|(_, on)| *on) {
+            return Err(SpatialError::UnsupportedEffect(name));
+        }
+        if let Some(gj) = self.gj_n_mm2 {
+            if !(gj.is_finite() && gj > 0.0) {
+                return Err(ParameterError::NotPositive { name: "gj_n_mm2", value: gj }.into());
+            }
+        }
+        self.gravity_unit()?;
+        cable::validate(&self.rod, &self.cables)
+    }
+
+    /// Reads the TOML format (docs/schema.md); `source` names the file in errors.
+    pub fn from_toml(text: &str, source: &str) -> Result<Self, SpatialError> {
+        toml::from_str(text).map_err(|e| SpatialError::Toml { source_name: source.to_string(), message: e.to_string() })
+    }
+
+    /// Reads and validates an actuator file.
+    pub fn read(path: &std::path::Path) -> Result<Self, SpatialError> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| SpatialError::Read { path: path.display().to_string(), message: e.to_string() })?;
+        let a = Self::from_toml(&text, &path.display().to_string())?;
+        a.validate()?;
+        Ok(a)
+    }
+}
+
+/// Everything about one spatial solve (allocates; for single solves).
+#[derive(Debug, Clone, Serialize)]
+pub struct SpatialSimulation {
+    /// The actuator solved (its tensions are the final ones).
+    pub actuator: SpatialActuator,
+    /// Tip pose and length.
+    pub pose: SpatialPose,
+    /// Legendre coefficients of the twist u_1, a_0 … a_order, 1/mm.
+    pub a_twist: Vec<f64>,
+    /// Of the bending curvature about the body y-axis (out of the x–y plane).
+    pub a_bend_y: Vec<f64>,
+    /// Of the bending curvature about the body z-axis (in the x–y plane;
+    /// the planar solver's a_i for a planar rod).
+    pub a_bend_z: Vec<f64>,
+    /// The coefficients' length basis.
+    pub length_basis: LengthBasis,
+    /// Centreline nodes, clamp to tip.
+    pub nodes: Vec<SpatialNode>,
+}
+
+impl SpatialSimulation {
+    /// Each cable's path in the global frame at the nodes, mm.
+    pub fn cable_paths_mm(&self) -> Vec<Vec<[f64; 3]>> {
+        let channels = self.actuator.validate().expect("validated when solved");
+        channels
+            .iter()
+            .map(|c| {
+                self.nodes
+                    .iter()
+                    .map(|n| {
+                        let p = c.at(n.s_mm);
+                        n.body_point_mm(p.r_mm[0], p.r_mm[1])
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+}
+
+/// Solves `actuator` at its cables' tensions, stepping all tensions up
+/// together from zero (rungs of at most 0.25 N on the largest) so that large
+/// deformations start from a nearby solution, and computes the coefficients
+/// a_0 … a_order in `basis`.
+pub fn simulate_spatial(
+    actuator: &SpatialActuator,
+    options: &SpatialOptions,
+    order: usize,
+    basis: LengthBasis,
+) -> Result<SpatialSimulation, SpatialError> {
+    solver::check_order(order, options)?;
+    let mut solver = SpatialSolver::new(actuator, options)?;
+    let top = actuator.cables.iter().map(|c| c.tension_n).fold(0.0, f64::max);
+    let rungs = ((top / 0.25).ceil() as usize).max(1);
+    let mut pose = None;
+    for k in 1..=rungs {
+        pose = Some(solver.solve_scaled(k as f64 / rungs as f64)?);
+    }
+    let pose = pose.expect("at least one rung");
+    let [a_twist, a_bend_y, a_bend_z] = solver.coefficients(order, basis)?;
+    Ok(SpatialSimulation {
+        actuator: actuator.clone(),
+        pose,
+        a_twist,
+        a_bend_y,
+        a_bend_z,
+        length_basis: basis,
+        nodes: solver.nodes().to_vec(),
+    })
+}

@@ -1,0 +1,953 @@
+//! The 3-D solver: equilibrium at a cut with several cables (model-notes §3b
+//! generalised), RK4 along the rod, Broyden on gravity's distal moment.
+//!
+//! Cutting the rod at s and taking the distal part, rod and cables together,
+//! as a free body gives, in the body frame,
+//!
+//! ```text
+//! K_se (v − v*) = −Σ τ_i t_i + Rᵀ W(s)          K_se = diag(EA, GA, GA)
+//! K_bt u        = −Σ τ_i r_i × t_i + Rᵀ M_W(s)   K_bt = diag(GJ, EI, EI)
+//! t_i = q_i / |q_i|,  q_i = v + u × r_i + r_i'
+//! ```
+//!
+//! with W(s) = w (L − s) ĝ the distal weight and M_W(s) its moment about
+//! p(s). Cable i contributes only where s < s_k,i (its anchor); beyond it is
+//! slack. At each point this is a local 6×6 nonlinear system in (v, u),
+//! solved by Newton with the exact Jacobian (dt/dq = (I − t tᵀ)/|q|),
+//! warm-started from the same RK4 stage of the previous pass or solve.
+//!
+//! **Why this and not shooting on the Rucker–Webster ODE.** Shooting needs
+//! the six unknowns v(0), u(0) and a 6×6 Jacobian of the tip residual by
+//! finite differences (seven integrations per Newton step), and it loses its
+//! basin at high tension without continuation. Here the cable loads never
+//! need shooting: the tip condition holds by construction at every cut.
+//! Without gravity one integration gives the solution. With gravity the only
+//! unknown is the 3-vector M_W(0); M_W' = −p' × W, and the residual M_W(L)
+//! is nearly the identity in M_W(0) because the rod's weight (0.05 N) is
+//! small against the cable loads, so Broyden's method started from the
+//! identity (a plain fixed-point sweep on its first step) converges in a
+//! few passes with one integration each. Measured: see docs/performance.md.
+//!
+//! The centreline follows from p' = R v and the quaternion q' = ½ q ⊗ (0, u)
+//! (renormalised each step), with RK4 on segments split at the routing's knot
+//! (where the channel's second derivative jumps) and at every anchor (where a
+//! tension stops).
+//!
+//! **Coefficients.** The bending curvature of the centreline is the rotation
+//! rate of its unit tangent, κ = t̂ × dt̂/ds; in the body frame
+//! κ_b = u − (u·v̂) v̂ + v̂ × v̂' with v̂ = v/|v|, and v' comes from
+//! differentiating the cut equations along s (one more 6×6 solve with the
+//! Newton Jacobian). For a planar rod κ_b·e_z = dθ/ds with θ the tangent
+//! angle, so the in-plane series is the planar solver's a_i (model-notes §4).
+//! Each series is a_i = (2i + 1)/L ∫ P_i(2σ/ℓ − 1) κ ds over the rest length
+//! (σ the deformed arc length, ℓ its total), the thesis's basis; the twist
+//! series uses u_1, the torsion of the body frame.
+
+use super::cable::{Channel, ChannelPoint3};
+use super::{SpatialActuator, SpatialError};
+use crate::model::Actuator;
+use crate::shape::LengthBasis;
+use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
+use serde::{Deserialize, Serialize};
+
+type V3 = Vector3<f64>;
+type M3 = Matrix3<f64>;
+
+/// A gravity pass started from a moment residual below this (N·mm) is
+/// expected to be the last (Broyden cuts the residual by 100× or more per
+/// pass), so it also computes the coefficients; if it is not the last,
+/// [`SpatialSolver::coefficients`] runs one more pass.
+const LAST_PASS_RESIDUAL_N_MM: f64 = 1e-5;
+
+/// Highest coefficient order the spatial solver reports.
+pub const MAX_SPATIAL_ORDER: usize = 8;
+
+/// Fewest RK4 steps per span at which a_0 … a_k of every series lie within
+/// [`crate::model::resolution::ORDER_TOLERANCE_PER_MM`] of a 128-step solve,
+/// indexed by k. Measured on a two-cable spatial actuator at 2 N and 1 N
+/// (±4 mm S-shaped routings) on the grid 4, 6, 8, 10, 12, 16, 24; an entry
+/// within a factor 1.5 of the tolerance was moved to the next grid point,
+/// and the table made monotone. At the default 10 steps a_5 is resolved.
+pub const REQUIRED_SPATIAL_STEPS_PER_SPAN: [usize; MAX_SPATIAL_ORDER + 1] = [4, 4, 4, 4, 6, 6, 12, 12, 24];
+
+/// Numerical settings of the spatial solver.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SpatialOptions {
+    /// RK4 steps per knot span of the routing (≥ 2); anchors split a span
+    /// and share its steps in proportion to length.
+    pub steps_per_span: usize,
+    /// Convergence of gravity's distal moment at the tip, N·mm. 1e-7 N·mm
+    /// moves the tip by about δm L²/(2 EI) ≈ 2e-6 mm and turns it by
+    /// δm L/EI ≈ 6e-8 rad: well below RK4's error at the default steps.
+    pub moment_tolerance_n_mm: f64,
+    /// Most integration passes per solve (gravity's Broyden iteration).
+    pub max_passes: u32,
+}
+
+impl Default for SpatialOptions {
+    fn default() -> Self {
+        Self { steps_per_span: 10, moment_tolerance_n_mm: 1e-7, max_passes: 40 }
+    }
+}
+
+/// The tip of one solve.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct SpatialPose {
+    /// Tip position (x, y, z), mm.
+    pub tip_mm: [f64; 3],
+    /// Unit tangent of the centreline at the tip, R v/|v|.
+    pub tip_tangent: [f64; 3],
+    /// The tip cross-section's body y-axis in the global frame (column 2 of R).
+    pub tip_body_y_axis: [f64; 3],
+    /// Angle between the tip tangent and the clamp axis (+x), rad.
+    pub tip_angle_rad: f64,
+    /// Deformed centreline length ℓ, mm.
+    pub length_mm: f64,
+    /// Integration passes the solve took.
+    pub passes: u32,
+}
+
+/// One point of the solved rod.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct SpatialNode {
+    /// Rest arc length s, mm.
+    pub s_mm: f64,
+    /// Centreline position, mm.
+    pub p_mm: [f64; 3],
+    /// Body frame: rows of R (`R[i][j]`; its columns are the body axes, global).
+    pub rotation: [[f64; 3]; 3],
+    /// Strain v (body frame).
+    pub v: [f64; 3],
+    /// Curvature u (body frame), 1/mm.
+    pub u_per_mm: [f64; 3],
+    /// Deformed arc length σ, mm.
+    pub arc_length_mm: f64,
+}
+
+impl SpatialNode {
+    /// Global position of a point at body offset (0, y, z), mm.
+    pub fn body_point_mm(&self, y_mm: f64, z_mm: f64) -> [f64; 3] {
+        let r = &self.rotation;
+        std::array::from_fn(|i| self.p_mm[i] + r[i][1] * y_mm + r[i][2] * z_mm)
+    }
+}
+
+/// Why a spatial solve produced no result.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SpatialFailure {
+    /// The local equations at a point did not converge.
+    #[error("the cut equations did not converge at s = {s_mm:.3} mm (tension too high for this routing, or a cable pulls straight through the axis); lower the tension or raise --steps-per-span")]
+    Local { s_mm: f64 },
+    /// Gravity's moment iteration did not converge.
+    #[error("gravity's moment did not converge in {passes} passes (residual {residual_n_mm:.3e} N·mm); the rod may be too heavy for its stiffness")]
+    Gravity { passes: u32, residual_n_mm: f64 },
+}
+
+/// Per-point, per-cable channel data in body coordinates.
+#[derive(Debug, Clone, Copy)]
+struct Chan {
+    r: V3,
+    dr: V3,
+    d2r: V3,
+}
+
+impl From<ChannelPoint3> for Chan {
+    fn from(c: ChannelPoint3) -> Self {
+        Self {
+            r: V3::new(0.0, c.r_mm[0], c.r_mm[1]),
+            dr: V3::new(0.0, c.dr_ds[0], c.dr_ds[1]),
+            d2r: V3::new(0.0, c.d2r_ds2[0], c.d2r_ds2[1]),
+        }
+    }
+}
+
+impl Chan {
+    /// The cable's unit direction t = q/|q| in the body frame and |q|, with
+    /// q = v + u × r + r' (the channel's tangent on the deformed rod).
+    #[inline]
+    fn direction(&self, v: &V3, u: &V3) -> (V3, f64) {
+        let q = v + u.cross(&self.r) + self.dr;
+        let n = q.norm();
+        (q / n, n)
+    }
+}
+
+/// The cables that pull at a point: (channel, tension > 0).
+#[inline]
+fn pulling<'a>(chans: &'a [Chan], tensions: &'a [f64]) -> impl Iterator<Item = (&'a Chan, f64)> + 'a {
+    chans.iter().zip(tensions.iter().copied()).filter(|&(_, tau)| tau != 0.0)
+}
+
+/// (v, u) of a local solution.
+#[inline]
+fn strains(x: &[f64; 6]) -> (V3, V3) {
+    (V3::new(x[0], x[1], x[2]), V3::new(x[3], x[4], x[5]))
+}
+
+/// One RK4 segment: [start, start + steps·h].
+#[derive(Debug, Clone)]
+struct Segment {
+    start_mm: f64,
+    h_mm: f64,
+    steps: usize,
+    /// Index of the segment's first half-step point.
+    point0: usize,
+    /// Index of the segment's first step (warm-start slots).
+    step0: usize,
+    /// Whether each cable is loaded on this segment (false beyond its anchor).
+    active: Vec<bool>,
+}
+
+/// State integrated along s: p (0..3), q (3..7: w, i, j, k), M_W (7..10), σ (10).
+type State = [f64; 11];
+
+/// The local solution at one point and, when asked, the curvature vector.
+struct Local {
+    x: [f64; 6],
+    kappa: V3,
+}
+
+/// Reusable spatial solver for one actuator: set the cables, then solve.
+#[derive(Debug, Clone)]
+pub struct SpatialSolver {
+    rod: Actuator,
+    stiff: [f64; 6],
+    /// Weight per unit rest length along the gravity direction, N/mm (global vector).
+    weight: V3,
+    options: SpatialOptions,
+    cables: usize,
+    base_tension_n: Vec<f64>,
+    scale: f64,
+    segments: Vec<Segment>,
+    points_s: Vec<f64>,
+    chan: Vec<Chan>,
+    /// Warm start per step and RK4 stage (4 per step), plus one per segment end.
+    warm: Vec<[f64; 6]>,
+    m0: V3,
+    /// The solve before the last: its warm starts, gravity moment and
+    /// tensions; with the last solve's they extrapolate the next one.
+    warm_prev: Vec<[f64; 6]>,
+    m0_prev: V3,
+    /// Tensions of the last two successful solves (newest first), N.
+    history: Vec<Vec<f64>>,
+    binv: M3,
+    nodes: Vec<SpatialNode>,
+    /// ∫ (σ/L)^j κ_k ds of the last full pass, k = twist, about y, about z.
+    moments: [[f64; MAX_SPATIAL_ORDER + 1]; 3],
+    /// Whether `moments` belong to the last solve.
+    moments_valid: bool,
+    /// Newton's last factors per warm-start slot, for chord passes.
+    lus: Vec<Lu6>,
+    /// This pass reuses `lus` (simplified Newton).
+    chord: bool,
+    /// This pass computes the curvature vector and the coefficient moments.
+    with_kappa: bool,
+    last: Option<SpatialPose>,
+}
+
+impl SpatialSolver {
+    /// A solver for `actuator` (its cables, rod, torsion and gravity).
+    pub fn new(actuator: &SpatialActuator, options: &SpatialOptions) -> Result<Self, SpatialError> {
+        let channels = actuator.validate()?;
+        if options.steps_per_span < 2 {
+            return Err(SpatialError::Option(format!("steps_per_span = {} must be at least 2", options.steps_per_span)));
+        }
+        if !(options.moment_tolerance_n_mm.is_finite() && options.moment_tolerance_n_mm > 0.0) {
+            return Err(SpatialError::Option("moment_tolerance_n_mm must be a positive number".into()));
+        }
+        let rod = actuator.rod.clone();
+        let gj = actuator.torsional_rigidity_n_mm2();
+        let stiff = [rod.ea_n, rod.ga_n, rod.ga_n, gj, rod.ei_n_mm2, rod.ei_n_mm2];
+        let g = actuator.gravity_unit()?;
+        let weight = V3::from(g) * rod.weight_n_per_mm();
+        let length = rod.length_mm;
+        // Breakpoints: clamp, knot, anchors, tip.
+        let mut cuts = vec![0.0, channels[0].knot_mm(), length];
+        cuts.extend(actuator.cables.iter().filter_map(|c| c.anchor_mm).filter(|&a| a < length));
+        cuts.sort_by(f64::total_cmp);
+        cuts.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
+        let span = length / 2.0;
+        let mut segments = Vec::new();
+        let (mut point0, mut step0) = (0, 0);
+        let mut points_s = Vec::new();
+        for w in cuts.windows(2) {
+            let (a, b) = (w[0], w[1]);
+            let steps = ((options.steps_per_span as f64 * (b - a) / span).ceil() as usize).max(2);
+            let h = (b - a) / steps as f64;
+            let mid = 0.5 * (a + b);
+            let active = actuator.cables.iter().map(|c| mid < c.anchor_or_tip_mm(length)).collect();
+            for k in 0..=2 * steps {
+                points_s.push(if k == 2 * steps { b } else { a + 0.5 * h * k as f64 });
+            }
+            segments.push(Segment { start_mm: a, h_mm: h, steps, point0, step0, active });
+            point0 += 2 * steps + 1;
+            step0 += steps;
+        }
+        let n = channels.len();
+        let mut chan = Vec::with_capacity(points_s.len() * n);
+        for &s in &points_s {
+            chan.extend(channels.iter().map(|c: &Channel| Chan::from(c.at(s))));
+        }
+        let straight = [1.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+        Ok(Self {
+            rod,
+            stiff,
+            weight,
+            options: options.clone(),
+            cables: n,
+            base_tension_n: actuator.cables.iter().map(|c| c.tension_n).collect(),
+            scale: 1.0,
+            segments,
+            points_s,
+            chan,
+            warm: vec![straight; 4 * step0 + cuts.len()],
+            m0: V3::zeros(),
+            warm_prev: vec![straight; 4 * step0 + cuts.len()],
+            m0_prev: V3::zeros(),
+            history: Vec::new(),
+            binv: M3::identity(),
+            nodes: Vec::new(),
+            moments: [[0.0; MAX_SPATIAL_ORDER + 1]; 3],
+            moments_valid: false,
+            lus: vec![Lu6::default(); 4 * step0 + cuts.len()],
+            chord: false,
+            with_kappa: false,
+            last: None,
+        })
+    }
+
+    /// The rod parameters.
+    pub fn rod(&self) -> &Actuator {
+        &self.rod
+    }
+
+    /// Number of cables.
+    pub fn cable_count(&self) -> usize {
+        self.cables
+    }
+
+    /// Tension of every cable in the last solve, N.
+    pub fn tensions_n(&self) -> Vec<f64> {
+        self.base_tension_n.iter().map(|t| t * self.scale).collect()
+    }
+
+    /// Solves with every cable's tension scaled by `scale` (1 = the
+    /// actuator's tensions; continuation ladders step it from 0 to 1),
+    /// warm-started from the previous solve.
+    pub fn solve_scaled(&mut self, scale: f64) -> Result<SpatialPose, SpatialError> {
+        if !(scale.is_finite() && scale >= 0.0) {
+            return Err(SpatialError::Option(format!("tension scale {scale} must be finite and ≥ 0")));
+        }
+        self.scale = scale;
+        self.last = None;
+        let tensions = self.tensions_n();
+        self.predict(&tensions);
+        let result = self.solve_inner();
+        if result.is_ok() {
+            self.history.insert(0, tensions);
+            self.history.truncate(2);
+        } else {
+            self.history.clear();
+            // A failed solve leaves no sensible warm start.
+            self.warm.iter_mut().for_each(|w| *w = [1.0, 0.0, 0.0, 0.0, 0.0, 0.0]);
+            self.lus.iter_mut().for_each(|l| l.valid = false);
+            self.chord = false;
+            self.moments_valid = false;
+            self.m0 = V3::zeros();
+            self.binv = M3::identity();
+        }
+        result.map_err(SpatialError::from)
+    }
+
+    /// Sets every cable's tension (N, one per cable, each ≥ 0) and solves.
+    pub fn solve(&mut self, tensions_n: &[f64]) -> Result<SpatialPose, SpatialError> {
+        if tensions_n.len() != self.cables {
+            return Err(SpatialError::Option(format!("{} tensions given for {} cables", tensions_n.len(), self.cables)));
+        }
+        for (i, &t) in tensions_n.iter().enumerate() {
+            if !(t.is_finite() && t >= 0.0) {
+                return Err(SpatialError::Tension { cable: i + 1, tension_n: t });
+            }
+        }
+        self.base_tension_n.copy_from_slice(tensions_n);
+        self.solve_scaled(1.0)
+    }
+
+    /// Warm start for the next solve. When the tension step continues the
+    /// last one (the same direction, as in a sweep's ladder), every point's
+    /// strains and the gravity moment are extrapolated linearly from the last
+    /// two solves: this takes the first residual from ~3e-2 to ~1e-4 N·mm
+    /// and saves about one pass and a Newton step per point. Otherwise the
+    /// last solve is the warm start.
+    fn predict(&mut self, tensions: &[f64]) {
+        let lambda = match self.history.as_slice() {
+            [t1, t2] => {
+                let d1: Vec<f64> = tensions.iter().zip(t1).map(|(a, b)| a - b).collect();
+                let d0: Vec<f64> = t1.iter().zip(t2).map(|(a, b)| a - b).collect();
+                let dd: f64 = d0.iter().map(|d| d * d).sum();
+                let lambda = if dd > 0.0 { d1.iter().zip(&d0).map(|(a, b)| a * b).sum::<f64>() / dd } else { 0.0 };
+                let off: f64 = d1.iter().zip(&d0).map(|(a, b)| (a - lambda * b).powi(2)).sum::<f64>().sqrt();
+                let n1: f64 = d1.iter().map(|d| d * d).sum::<f64>().sqrt();
+                (dd > 0.0 && off <= 1e-9 * (1.0 + n1) && lambda.abs() <= 2.0).then_some(lambda)
+            }
+            _ => None,
+        };
+        match lambda {
+            Some(l) => {
+                for (p, w) in self.warm_prev.iter_mut().zip(&self.warm) {
+                    *p = std::array::from_fn(|i| w[i] + l * (w[i] - p[i]));
+                }
+                std::mem::swap(&mut self.warm, &mut self.warm_prev);
+                let m1 = self.m0;
+                self.m0 = m1 + l * (m1 - self.m0_prev);
+                self.m0_prev = m1;
+            }
+            None => {
+                self.warm_prev.copy_from_slice(&self.warm);
+                self.m0_prev = self.m0;
+            }
+        }
+    }
+
+    fn solve_inner(&mut self) -> Result<SpatialPose, SpatialFailure> {
+        let gravity = self.weight.norm() > 0.0;
+        let mut passes = 1;
+        // The first pass of a solve refactors everything (the tensions
+        // changed); later gravity passes move the strains by ~|δM_W|/EI and
+        // reuse the factors (chord iterations). The curvature vector (for
+        // the coefficients) is worked out only in a pass likely to be the
+        // last: without gravity the only one, with gravity once the moment
+        // residual is small enough for the next pass to meet the tolerance.
+        self.chord = false;
+        self.with_kappa = !gravity;
+        let (mut end, mut tip) = self.pass(if gravity { self.m0 } else { V3::zeros() })?;
+        if gravity {
+            let mut m = self.m0;
+            let mut f = residual(&end);
+            let mut b = self.binv;
+            while f.norm() > self.options.moment_tolerance_n_mm {
+                if passes >= self.options.max_passes {
+                    return Err(SpatialFailure::Gravity { passes, residual_n_mm: f.norm() });
+                }
+                let dm = -(b * f);
+                let m_new = m + dm;
+                self.chord = true;
+                self.with_kappa = f.norm() < LAST_PASS_RESIDUAL_N_MM;
+                let (e, t) = self.pass(m_new)?;
+                passes += 1;
+                let f_new = residual(&e);
+                let df = f_new - f;
+                let bdf = b * df;
+                let denom = dm.dot(&bdf);
+                if denom.abs() > 1e-300 {
+                    b += (dm - bdf) * (dm.transpose() * b) / denom;
+                }
+                m = m_new;
+                f = f_new;
+                end = e;
+                tip = t;
+            }
+            self.m0 = m;
+            self.binv = b;
+        }
+        self.moments_valid = self.with_kappa;
+        self.chord = false;
+        let q = quat(&end);
+        let r = q.to_rotation_matrix().into_inner();
+        let v = V3::new(tip[0], tip[1], tip[2]);
+        let t = (r * v).normalize();
+        let pose = SpatialPose {
+            tip_mm: [end[0], end[1], end[2]],
+            tip_tangent: [t[0], t[1], t[2]],
+            tip_body_y_axis: [r[(0, 1)], r[(1, 1)], r[(2, 1)]],
+            tip_angle_rad: t[0].clamp(-1.0, 1.0).acos(),
+            length_mm: end[10],
+            passes,
+        };
+        self.last = Some(pose);
+        Ok(pose)
+    }
+
+    /// One integration from the clamp with gravity's moment `m0` at the
+    /// clamp. Records the nodes and accumulates the coefficient moments
+    /// ∫ (σ/L)^j κ_k ds (RK4 quadrature with the stage values: a few
+    /// back-substitutions, much cheaper than another pass). Returns the tip
+    /// state and the local solution there.
+    fn pass(&mut self, m0: V3) -> Result<(State, [f64; 6]), SpatialFailure> {
+        let mut y: State = [0.0; 11];
+        y[3] = 1.0;
+        y[7..10].copy_from_slice(m0.as_slice());
+        let mut moments = [[0.0; MAX_SPATIAL_ORDER + 1]; 3];
+        let length = self.rod.length_mm;
+        self.nodes.clear();
+        let mut tip = [0.0; 6];
+        let segments = std::mem::take(&mut self.segments);
+        let result = (|| {
+            for (si, seg) in segments.iter().enumerate() {
+                let h = seg.h_mm;
+                for j in 0..seg.steps {
+                    let k0 = seg.point0 + 2 * j;
+                    let slot = 4 * (seg.step0 + j);
+                    let (f1, l1) = self.deriv(seg, k0, slot, &y)?;
+                    self.record(seg.start_mm + j as f64 * h, &y, &l1.x);
+                    let y2 = axpy(&y, 0.5 * h, &f1);
+                    let (f2, l2) = self.deriv(seg, k0 + 1, slot + 1, &y2)?;
+                    let y3 = axpy(&y, 0.5 * h, &f2);
+                    let (f3, l3) = self.deriv(seg, k0 + 1, slot + 2, &y3)?;
+                    let y4 = axpy(&y, h, &f3);
+                    let (f4, l4) = self.deriv(seg, k0 + 2, slot + 3, &y4)?;
+                    let stages = [(&y, &l1, 1.0), (&y2, &l2, 2.0), (&y3, &l3, 2.0), (&y4, &l4, 1.0)];
+                    for (ys, l, wgt) in stages.into_iter().filter(|_| self.with_kappa) {
+                        let x = ys[10] / length;
+                        for (series, kappa) in moments.iter_mut().zip([l.x[3], l.kappa[1], l.kappa[2]]) {
+                            let mut pw = wgt * h / 6.0 * kappa;
+                            for c in series.iter_mut() {
+                                *c += pw;
+                                pw *= x;
+                            }
+                        }
+                    }
+                    for i in 0..11 {
+                        y[i] += h / 6.0 * (f1[i] + 2.0 * f2[i] + 2.0 * f3[i] + f4[i]);
+                    }
+                    let norm = (y[3] * y[3] + y[4] * y[4] + y[5] * y[5] + y[6] * y[6]).sqrt();
+                    y[3..7].iter_mut().for_each(|c| *c /= norm);
+                }
+                if si + 1 == segments.len() {
+                    let k = seg.point0 + 2 * seg.steps;
+                    let slot = self.warm.len() - 1;
+                    let (_, l) = self.deriv(seg, k, slot, &y)?;
+                    tip = l.x;
+                    self.record(length, &y, &l.x);
+                }
+            }
+            Ok(())
+        })();
+        self.segments = segments;
+        if self.with_kappa {
+            self.moments = moments;
+        }
+        result.map(|()| (y, tip))
+    }
+
+    fn record(&mut self, s_mm: f64, y: &State, x: &[f64; 6]) {
+        let r = quat(y).to_rotation_matrix().into_inner();
+        self.nodes.push(SpatialNode {
+            s_mm,
+            p_mm: [y[0], y[1], y[2]],
+            rotation: std::array::from_fn(|i| std::array::from_fn(|j| r[(i, j)])),
+            v: [x[0], x[1], x[2]],
+            u_per_mm: [x[3], x[4], x[5]],
+            arc_length_mm: y[10],
+        });
+    }
+
+    /// Derivative of the state at point `k` (half-step index) and the local solution.
+    fn deriv(&mut self, seg: &Segment, k: usize, slot: usize, y: &State) -> Result<(State, Local), SpatialFailure> {
+        let q = quat(y);
+        let r = q.to_rotation_matrix().into_inner();
+        let s = self.points_s[k];
+        let w_dist = self.weight * (self.rod.length_mm - s);
+        let nw = r.transpose() * w_dist;
+        let mw = r.transpose() * V3::new(y[7], y[8], y[9]);
+        let local = self.local_solve(seg, k, slot, nw, mw, r)?;
+        let v = V3::new(local.x[0], local.x[1], local.x[2]);
+        let u = V3::new(local.x[3], local.x[4], local.x[5]);
+        let dp = r * v;
+        let qv = V3::new(y[4], y[5], y[6]);
+        let dqw = -0.5 * qv.dot(&u);
+        let dqv = 0.5 * (y[3] * u + qv.cross(&u));
+        let dmw = -dp.cross(&w_dist);
+        let d = [dp[0], dp[1], dp[2], dqw, dqv[0], dqv[1], dqv[2], dmw[0], dmw[1], dmw[2], v.norm()];
+        Ok((d, local))
+    }
+
+    /// Newton on the cut equations at point `k`, warm-started from `slot`,
+    /// then the curvature vector κ_b from x' (with the last Newton
+    /// Jacobian's factors: it is within one converged step of the solution's).
+    fn local_solve(&mut self, seg: &Segment, k: usize, slot: usize, nw: V3, mw: V3, r: M3) -> Result<Local, SpatialFailure> {
+        let chans = &self.chan[k * self.cables..(k + 1) * self.cables];
+        let mut taus = [0.0; super::cable::MAX_CABLES];
+        for (i, (&t, &on)) in self.base_tension_n.iter().zip(&seg.active).enumerate() {
+            taus[i] = if on { t * self.scale } else { 0.0 };
+        }
+        let tensions = &taus[..self.cables];
+        let mut x = self.warm[slot];
+        if self.chord && self.lus[slot].valid {
+            let lu = &self.lus[slot];
+            for _ in 0..4 {
+                let mut dx = self.residual_only(&x, chans, tensions, nw, mw).map(|v| -v);
+                lu.solve(&mut dx);
+                let mut big = 0.0f64;
+                for i in 0..6 {
+                    x[i] += dx[i];
+                    big = big.max(dx[i].abs());
+                }
+                // Contraction ~|ΔJ|/|J| ≈ 1e-4: a step of 1e-8 leaves ~1e-12.
+                if big < 1e-8 && x.iter().all(|v| v.is_finite()) {
+                    self.warm[slot] = x;
+                    let kappa = if self.with_kappa { self.curvature(&x, chans, tensions, nw, mw, r, lu, true) } else { V3::zeros() };
+                    return Ok(Local { x, kappa });
+                }
+            }
+            x = self.warm[slot];
+        }
+        let mut converged = false;
+        let mut lu = Lu6::default();
+        for _ in 0..100 {
+            let (f, j) = self.residual_jacobian(&x, chans, tensions, nw, mw);
+            let mut dx = f.map(|v| -v);
+            if !lu.factor(j) {
+                break;
+            }
+            lu.solve(&mut dx);
+            // Keep the axial stretch positive: a Newton step through v1 = 0
+            // would fold the rod onto itself.
+            let mut lambda = 1.0;
+            while x[0] + lambda * dx[0] < 0.05 && lambda > 1e-3 {
+                lambda *= 0.5;
+            }
+            // Far from the solution (a large step: a cold start or a big
+            // tension step), backtrack until the residual falls, so that
+            // Newton cannot jump into another branch of t_i = q_i/|q_i|.
+            if dx.iter().fold(0.0f64, |m, d| m.max(d.abs())) > 0.02 {
+                let norm = |r: [f64; 6]| r.iter().map(|v| v * v).sum::<f64>();
+                let f0 = norm(f);
+                while lambda > 1e-3 {
+                    let trial: [f64; 6] = std::array::from_fn(|i| x[i] + lambda * dx[i]);
+                    let ft = norm(self.residual_only(&trial, chans, tensions, nw, mw));
+                    if ft.is_finite() && ft < f0 {
+                        break;
+                    }
+                    lambda *= 0.5;
+                }
+            }
+            let mut big = 0.0f64;
+            for i in 0..6 {
+                x[i] += lambda * dx[i];
+                big = big.max(dx[i].abs());
+            }
+            if !x.iter().all(|v| v.is_finite()) {
+                break;
+            }
+            // Quadratic convergence: after a step of 1e-8 the error is ~1e-16.
+            if big < 1e-8 {
+                converged = true;
+                break;
+            }
+        }
+        if !converged {
+            return Err(SpatialFailure::Local { s_mm: self.points_s[k] });
+        }
+        self.warm[slot] = x;
+        self.lus[slot] = lu;
+        let kappa = if self.with_kappa { self.curvature(&x, chans, tensions, nw, mw, r, &lu, false) } else { V3::zeros() };
+        Ok(Local { x, kappa })
+    }
+
+    /// The curvature vector κ_b = u − (u·v̂) v̂ + v̂ × v̂' at the solution
+    /// `x`, with x' from differentiating the cut equations along s:
+    /// J x' = −∂G/∂s. `lu` factors J or, in a chord pass (`refine`), a
+    /// Jacobian within ~1e-4 of it; then one step of iterative refinement
+    /// with the exact product J·x' brings x' to ~1e-8 relative.
+    #[allow(clippy::too_many_arguments)]
+    fn curvature(&self, x: &[f64; 6], chans: &[Chan], tensions: &[f64], nw: V3, mw: V3, r: M3, lu: &Lu6, refine: bool) -> V3 {
+        let (v, u) = strains(x);
+        // ∂G/∂s at fixed (v, u): the channel's motion, then the body-frame
+        // change of the distal loads.
+        let mut gs_f = V3::zeros();
+        let mut gs_m = V3::zeros();
+        for (c, tau) in pulling(chans, tensions) {
+            let (t, n) = c.direction(&v, &u);
+            let b = u.cross(&c.dr) + c.d2r;
+            let pb = (b - t * t.dot(&b)) / n;
+            gs_f += tau * pb;
+            gs_m += tau * (c.dr.cross(&t) + c.r.cross(&pb));
+        }
+        let nw_s = -u.cross(&nw) - r.transpose() * self.weight;
+        let mw_s = -u.cross(&mw) - v.cross(&nw);
+        gs_f -= nw_s;
+        gs_m -= mw_s;
+        let rhs = [-gs_f[0], -gs_f[1], -gs_f[2], -gs_m[0], -gs_m[1], -gs_m[2]];
+        let mut xs = rhs;
+        lu.solve(&mut xs);
+        if refine {
+            for _ in 0..1 {
+                let jx = self.jacobian_times(x, chans, tensions, &xs);
+                let mut d: [f64; 6] = std::array::from_fn(|i| rhs[i] - jx[i]);
+                lu.solve(&mut d);
+                for i in 0..6 {
+                    xs[i] += d[i];
+                }
+            }
+        }
+        let vs = V3::new(xs[0], xs[1], xs[2]);
+        let speed = v.norm();
+        let vh = v / speed;
+        let vh_s = (vs - vh * vh.dot(&vs)) / speed;
+        u - vh * u.dot(&vh) + vh.cross(&vh_s)
+    }
+
+    /// J(x)·w without forming J: δq_i = w_v + w_u × r_i, δt_i = P_i δq_i.
+    fn jacobian_times(&self, x: &[f64; 6], chans: &[Chan], tensions: &[f64], w: &[f64; 6]) -> [f64; 6] {
+        let k = &self.stiff;
+        let (v, u) = strains(x);
+        let (wv, wu) = strains(w);
+        let mut jf = V3::new(k[0] * w[0], k[1] * w[1], k[2] * w[2]);
+        let mut jm = V3::new(k[3] * w[3], k[4] * w[4], k[5] * w[5]);
+        for (c, tau) in pulling(chans, tensions) {
+            let (t, n) = c.direction(&v, &u);
+            let dq = wv + wu.cross(&c.r);
+            let dt = (dq - t * t.dot(&dq)) * (tau / n);
+            jf += dt;
+            jm += c.r.cross(&dt);
+        }
+        [jf[0], jf[1], jf[2], jm[0], jm[1], jm[2]]
+    }
+
+    /// The rod's part of the residual: K_se (v − v*) − Rᵀ W and K_bt u − Rᵀ M_W.
+    #[inline]
+    fn elastic_residual(&self, x: &[f64; 6], nw: V3, mw: V3) -> (V3, V3) {
+        let k = &self.stiff;
+        (V3::new(k[0] * (x[0] - 1.0), k[1] * x[1], k[2] * x[2]) - nw, V3::new(k[3] * x[3], k[4] * x[4], k[5] * x[5]) - mw)
+    }
+
+    /// Residual G(x) of the cut equations (chord iterations).
+    fn residual_only(&self, x: &[f64; 6], chans: &[Chan], tensions: &[f64], nw: V3, mw: V3) -> [f64; 6] {
+        let (v, u) = strains(x);
+        let (mut ff, mut fm) = self.elastic_residual(x, nw, mw);
+        for (c, tau) in pulling(chans, tensions) {
+            let (t, _) = c.direction(&v, &u);
+            ff += tau * t;
+            fm += tau * c.r.cross(&t);
+        }
+        [ff[0], ff[1], ff[2], fm[0], fm[1], fm[2]]
+    }
+
+    /// Residual G(x) of the cut equations and its Jacobian.
+    fn residual_jacobian(&self, x: &[f64; 6], chans: &[Chan], tensions: &[f64], nw: V3, mw: V3) -> ([f64; 6], [[f64; 6]; 6]) {
+        let k = &self.stiff;
+        let (v, u) = strains(x);
+        let (mut ff, mut fm) = self.elastic_residual(x, nw, mw);
+        let mut jvv = M3::from_diagonal(&V3::new(k[0], k[1], k[2]));
+        let mut jvu = M3::zeros();
+        let mut juv = M3::zeros();
+        let mut juu = M3::from_diagonal(&V3::new(k[3], k[4], k[5]));
+        for (c, tau) in pulling(chans, tensions) {
+            let (t, n) = c.direction(&v, &u);
+            let a = (M3::identity() - t * t.transpose()) * (tau / n);
+            let sk = c.r.cross_matrix();
+            ff += tau * t;
+            fm += tau * c.r.cross(&t);
+            let sa = sk * a;
+            jvv += a;
+            jvu -= a * sk;
+            juv += sa;
+            juu -= sa * sk;
+        }
+        let mut j = [[0.0; 6]; 6];
+        for r in 0..3 {
+            for c in 0..3 {
+                j[r][c] = jvv[(r, c)];
+                j[r][c + 3] = jvu[(r, c)];
+                j[r + 3][c] = juv[(r, c)];
+                j[r + 3][c + 3] = juu[(r, c)];
+            }
+        }
+        ([ff[0], ff[1], ff[2], fm[0], fm[1], fm[2]], j)
+    }
+
+    /// The pose of the last successful solve.
+    pub fn pose(&self) -> Option<SpatialPose> {
+        self.last
+    }
+
+    /// The nodes (step points, clamp to tip) of the last successful solve.
+    pub fn nodes(&self) -> &[SpatialNode] {
+        assert!(self.last.is_some(), "nodes needs a successful solve");
+        &self.nodes
+    }
+
+    /// Legendre coefficients of the last solve, order `order`, in `basis`:
+    /// `[twist, bending about body y, bending about body z]`, each
+    /// a_0 … a_order in 1/mm (see the module comment), from the moments the
+    /// last (converged) pass accumulated.
+    pub fn coefficients(&mut self, order: usize, basis: LengthBasis) -> Result<[Vec<f64>; 3], SpatialError> {
+        assert!(self.last.is_some(), "coefficients needs a successful solve");
+        if !self.moments_valid {
+            // The converged pass was a chord pass: one full pass at the
+            // converged moment (warm: one Newton step per point).
+            let m0 = if self.weight.norm() > 0.0 { self.m0 } else { V3::zeros() };
+            self.with_kappa = true;
+            self.pass(m0)?;
+            self.moments_valid = true;
+        }
+        check_order(order, &self.options)?;
+        let moments = &self.moments;
+        let length = self.rod.length_mm;
+        let ell = self.last.expect("checked").length_mm;
+        let ratio = length / ell;
+        let factor = match basis {
+            LengthBasis::Rest => 1.0,
+            LengthBasis::Deformed => ratio,
+        };
+        let out = std::array::from_fn(|k| {
+            (0..=order)
+                .map(|i| {
+                    let mut sum = 0.0;
+                    let mut pw = 1.0;
+                    for (jj, c) in moments[k].iter().enumerate().take(i + 1) {
+                        sum += shifted_legendre_coefficient(i, jj) * pw * c;
+                        pw *= ratio;
+                    }
+                    factor * (2 * i + 1) as f64 / length * sum
+                })
+                .collect()
+        });
+        Ok(out)
+    }
+}
+
+/// Checks that `order` is resolved with `options` (the message names the fix).
+pub fn check_order(order: usize, options: &SpatialOptions) -> Result<(), SpatialError> {
+    if order > MAX_SPATIAL_ORDER {
+        return Err(SpatialError::Option(format!(
+            "order {order} is above the spatial solver's highest order {MAX_SPATIAL_ORDER}"
+        )));
+    }
+    let need = REQUIRED_SPATIAL_STEPS_PER_SPAN[order];
+    if options.steps_per_span < need {
+        return Err(SpatialError::Option(format!(
+            "order {order} needs at least {need} RK4 steps per span to be resolved (have {}); raise --steps-per-span (spec: steps_per_span) or lower the order",
+            options.steps_per_span
+        )));
+    }
+    Ok(())
+}
+
+fn residual(end: &State) -> V3 {
+    V3::new(end[7], end[8], end[9])
+}
+
+fn quat(y: &State) -> UnitQuaternion<f64> {
+    UnitQuaternion::new_unchecked(Quaternion::new(y[3], y[4], y[5], y[6]))
+}
+
+fn axpy(y: &State, h: f64, f: &State) -> State {
+    std::array::from_fn(|i| y[i] + h * f[i])
+}
+
+/// Coefficient of x^j in the shifted Legendre polynomial P_i(2x − 1):
+/// (−1)^(i+j) C(i, j) C(i + j, j).
+fn shifted_legendre_coefficient(i: usize, j: usize) -> f64 {
+    let binom = |n: usize, k: usize| (0..k).fold(1.0, |acc, m| acc * (n - m) as f64 / (m + 1) as f64);
+    let sign = if (i + j).is_multiple_of(2) { 1.0 } else { -1.0 };
+    sign * binom(i, j) * binom(i + j, j)
+}
+
+/// LU factors of a 6×6 matrix (Gaussian elimination with partial pivoting).
+#[derive(Debug, Clone, Copy, Default)]
+struct Lu6 {
+    a: [[f64; 6]; 6],
+    /// Row swapped with row `col` at step `col`.
+    piv: [usize; 6],
+    /// 1 / U's diagonal (a division per row is the slow part of a solve).
+    inv_diag: [f64; 6],
+    valid: bool,
+}
+
+impl Lu6 {
+    /// Factors `a`; false if it is singular.
+    fn factor(&mut self, mut a: [[f64; 6]; 6]) -> bool {
+        let mut pivots = [0; 6];
+        let mut inv_diag = [0.0; 6];
+        for col in 0..6 {
+            let mut piv = col;
+            for r in col + 1..6 {
+                if a[r][col].abs() > a[piv][col].abs() {
+                    piv = r;
+                }
+            }
+            if a[piv][col].abs() < 1e-300 || !a[piv][col].is_finite() {
+                return false;
+            }
+            a.swap(col, piv);
+            pivots[col] = piv;
+            let d = 1.0 / a[col][col];
+            inv_diag[col] = d;
+            for r in col + 1..6 {
+                let f = a[r][col] * d;
+                a[r][col] = f;
+                if f != 0.0 {
+                    let pivot_row = a[col];
+                    for (x, p) in a[r][col + 1..].iter_mut().zip(&pivot_row[col + 1..]) {
+                        *x -= f * p;
+                    }
+                }
+            }
+        }
+        self.a = a;
+        self.piv = pivots;
+        self.inv_diag = inv_diag;
+        self.valid = true;
+        true
+    }
+
+    /// Solves A x = b in place with the factors.
+    fn solve(&self, b: &mut [f64; 6]) {
+        let a = &self.a;
+        let mut y = *b;
+        for (col, &p) in self.piv.iter().enumerate() {
+            y.swap(col, p.min(5));
+        }
+        for r in 1..6 {
+            for c in 0..r {
+                y[r] -= a[r][c] * y[c];
+            }
+        }
+        for r in (0..6).rev() {
+            for c in r + 1..6 {
+                y[r] -= a[r][c] * y[c];
+            }
+            y[r] *= self.inv_diag[r];
+        }
+        *b = y;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shifted_legendre_matches_the_recurrence() {
+        for i in 0..=MAX_SPATIAL_ORDER {
+            for k in 0..=20 {
+                let x = k as f64 / 20.0;
+                let poly: f64 = (0..=i).map(|j| shifted_legendre_coefficient(i, j) * x.powi(j as i32)).sum();
+                assert!((poly - crate::shape::legendre(i, 2.0 * x - 1.0)).abs() < 1e-9, "P_{i}({x})");
+            }
+        }
+    }
+
+    #[test]
+    fn lu6_solves() {
+        let a = [
+            [4.0, 1.0, 0.0, 0.0, 0.0, 2.0],
+            [1.0, 5.0, 1.0, 0.0, 0.0, 0.0],
+            [0.0, 1.0, 6.0, 1.0, 0.0, 0.0],
+            [0.0, 0.0, 1.0, 7.0, 1.0, 0.0],
+            [3.0, 0.0, 0.0, 1.0, 8.0, 1.0],
+            [0.0, 0.0, 0.0, 0.0, 1.0, 0.0],
+        ];
+        let x = [1.0, -2.0, 3.0, -4.0, 5.0, -6.0];
+        let mut b: [f64; 6] = std::array::from_fn(|r| (0..6).map(|c| a[r][c] * x[c]).sum());
+        let mut lu = Lu6::default();
+        assert!(lu.factor(a));
+        lu.solve(&mut b);
+        for i in 0..6 {
+            assert!((b[i] - x[i]).abs() < 1e-12);
+        }
+    }
+}

@@ -1,0 +1,584 @@
+//! Sweeps of several and spatial cables (issue 16): a TOML spec says which
+//! control points of which cable (y or z) are swept over which levels, and
+//! a tension grid per cable; every routing is solved through the product of
+//! the tension grids by the 3-D solver ([`crate::model::spatial`]). The run
+//! writes one Parquet table of rows (one tension column per cable, the 3-D
+//! tip) and reach maps: counts of solutions per cell on the three coordinate
+//! planes and per voxel in 3-D (docs/schema.md, "Cable sweeps").
+//!
+//! ```toml
+//! gravity_direction = [1, 0, 0]   # optional, as in the actuator file
+//! [rod]                            # optional: model::Actuator
+//! [solver]                         # optional: SpatialOptions
+//! [output]
+//! order = 3                        # a0…a3, a_bend_y0…, a_twist0…
+//! cell_mm = 1.0                    # reach-map cell / voxel size
+//!
+//! [[cable]]                        # an antagonistic pair
+//! y_mm = [2, 2, 2, 2, 2]           # fixed values (swept points override them)
+//! tension_n = { min = 0.0, max = 2.0, count = 11 }
+//! [[cable.sweep]]
+//! axis = "y"
+//! points = [1, 2, 3]               # each swept independently over the levels
+//! levels_mm = [1.0, 2.5, 4.0]
+//!
+//! [[cable]]
+//! y_mm = [-2, -2, -2, -2, -2]
+//! tension_n = { min = 0.0, max = 2.0, count = 11 }
+//! ```
+//!
+//! Unlike the planar sweep this run is neither sharded nor resumable: it is
+//! solved in memory (at most [`MAX_CABLE_SWEEP_ROWS`] rows) and written at
+//! the end.
+
+use crate::model::routing::CONTROL_POINTS;
+use crate::model::spatial::{Cable, SpatialActuator, SpatialError, SpatialOptions, SpatialSolver};
+use crate::model::{Actuator, STATUS_OK};
+use crate::shape::LengthBasis;
+use arrow::array::{ArrayRef, Float64Array, Int32Array, Int64Array, StringArray};
+use arrow::datatypes::{DataType, Field, Schema};
+use arrow::record_batch::RecordBatch;
+use parquet::arrow::ArrowWriter;
+use parquet::basic::{Compression, ZstdLevel};
+use parquet::file::properties::WriterProperties;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// Most rows of one cable sweep (it is built in memory).
+pub const MAX_CABLE_SWEEP_ROWS: u64 = 2_000_000;
+/// Most values in one tension grid.
+pub const MAX_TENSION_COUNT: u32 = 10_000;
+/// Status of rows whose routing was rejected (e.g. two cables on one path).
+pub const STATUS_INVALID_ROUTING: &str = "invalid_routing";
+/// Status of rows whose solve failed.
+pub const STATUS_FAILED: &str = "failed";
+/// Rows file of a run directory.
+pub const ROWS_FILE: &str = "rows.parquet";
+/// Why a cable sweep could not run.
+#[derive(Debug, thiserror::Error)]
+pub enum CableSweepError {
+    /// The spec is malformed or invalid.
+    #[error("bad cable sweep spec {origin}: {message}")]
+    BadSpec { origin: String, message: String },
+    /// The output directory holds something.
+    #[error("{} is not empty: a cable sweep writes into a new or empty directory (it is not resumable)", .0.display())]
+    NotEmpty(PathBuf),
+    /// A file could not be written.
+    #[error("{context}: {message}")]
+    Write { context: String, message: String },
+}
+
+/// A cable sweep job.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CableSweepSpec {
+    /// Rod parameters (thesis defaults).
+    #[serde(default)]
+    pub rod: Actuator,
+    /// Torsional rigidity, N·mm² (default EI/1.5).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gj_n_mm2: Option<f64>,
+    /// Gravity direction, global (default: the rod's in-plane direction).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gravity_direction: Option<[f64; 3]>,
+    /// Numerical settings of the 3-D solver.
+    #[serde(default)]
+    pub solver: SpatialOptions,
+    /// What each row stores; the map resolution.
+    #[serde(default)]
+    pub output: CableOutputSpec,
+    /// The cables, each with its fixed control points, swept points and tension grid.
+    #[serde(rename = "cable")]
+    pub cables: Vec<CableSweep>,
+}
+
+/// One cable of a sweep.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CableSweep {
+    /// y control points, mm (those swept are overridden).
+    pub y_mm: [f64; CONTROL_POINTS],
+    /// z control points, mm (default 0).
+    #[serde(default)]
+    pub z_mm: [f64; CONTROL_POINTS],
+    /// Anchor s_k, mm (default: the tip).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub anchor_mm: Option<f64>,
+    /// The tension grid of this cable.
+    pub tension_n: TensionGrid,
+    /// Swept control points.
+    #[serde(default, rename = "sweep")]
+    pub sweeps: Vec<PointSweep>,
+}
+
+/// Control points of one axis of a cable, each swept over `levels_mm`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PointSweep {
+    /// `y` or `z`.
+    pub axis: Axis,
+    /// Control-point indices 0…4; each is swept independently (a product).
+    pub points: Vec<usize>,
+    /// The levels, mm.
+    pub levels_mm: Vec<f64>,
+}
+
+/// A body-frame lateral axis.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Axis {
+    /// Body y.
+    Y,
+    /// Body z.
+    Z,
+}
+
+/// `count` tensions evenly spaced from `min` to `max`, N.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TensionGrid {
+    /// First tension, N (≥ 0).
+    pub min: f64,
+    /// Last tension, N (≥ min).
+    pub max: f64,
+    /// Number of tensions (1: `min` only).
+    pub count: u32,
+}
+
+impl TensionGrid {
+    /// The tensions, N.
+    pub fn values(&self) -> Vec<f64> {
+        if self.count <= 1 {
+            return vec![self.min];
+        }
+        (0..self.count).map(|k| self.min + (self.max - self.min) * k as f64 / (self.count - 1) as f64).collect()
+    }
+}
+
+/// Output settings.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct CableOutputSpec {
+    /// Highest Legendre order stored (each of the three series).
+    pub order: usize,
+    /// Basis of the coefficients.
+    pub length_basis: LengthBasis,
+    /// Cell size of the reach maps, mm.
+    pub cell_mm: f64,
+}
+
+impl Default for CableOutputSpec {
+    fn default() -> Self {
+        Self { order: 3, length_basis: LengthBasis::Rest, cell_mm: 1.0 }
+    }
+}
+
+/// One swept dimension: cable, axis, control point, levels.
+#[derive(Debug, Clone)]
+struct Dimension {
+    cable: usize,
+    axis: Axis,
+    point: usize,
+    levels: Vec<f64>,
+}
+
+impl CableSweepSpec {
+    /// Reads a spec; `origin` names it in errors.
+    pub fn from_toml(text: &str, origin: &str) -> Result<Self, CableSweepError> {
+        let spec: Self = toml::from_str(text).map_err(|e| CableSweepError::BadSpec { origin: origin.into(), message: e.to_string() })?;
+        spec.validate(origin)?;
+        Ok(spec)
+    }
+
+    fn dimensions(&self) -> Vec<Dimension> {
+        let mut dims = Vec::new();
+        for (cable, c) in self.cables.iter().enumerate() {
+            for s in &c.sweeps {
+                for &point in &s.points {
+                    dims.push(Dimension { cable, axis: s.axis, point, levels: s.levels_mm.clone() });
+                }
+            }
+        }
+        dims
+    }
+
+    /// Number of routings (the product of the swept levels).
+    pub fn routings(&self) -> u64 {
+        self.dimensions().iter().map(|d| d.levels.len() as u64).product()
+    }
+
+    /// Number of tension combinations per routing.
+    pub fn tension_combinations(&self) -> u64 {
+        self.cables.iter().map(|c| u64::from(c.tension_n.count.max(1))).product()
+    }
+
+    /// Checks the spec; messages name the field.
+    pub fn validate(&self, origin: &str) -> Result<(), CableSweepError> {
+        let bad = |message: String| CableSweepError::BadSpec { origin: origin.into(), message };
+        if self.cables.is_empty() || self.cables.len() > crate::model::spatial::MAX_CABLES {
+            return Err(bad(format!("give 1 to {} [[cable]] tables, got {}", crate::model::spatial::MAX_CABLES, self.cables.len())));
+        }
+        for (i, c) in self.cables.iter().enumerate() {
+            let n = i + 1;
+            let t = &c.tension_n;
+            if !(t.min.is_finite() && t.max.is_finite() && t.min >= 0.0 && t.max >= t.min) {
+                return Err(bad(format!("cable {n}: tension_n needs 0 ≤ min ≤ max (finite), got min = {}, max = {}", t.min, t.max)));
+            }
+            if t.count == 0 || t.count > MAX_TENSION_COUNT {
+                return Err(bad(format!("cable {n}: tension_n.count = {} must be 1 … {MAX_TENSION_COUNT}", t.count)));
+            }
+            let mut seen = std::collections::BTreeSet::new();
+            for s in &c.sweeps {
+                if s.levels_mm.is_empty() || s.levels_mm.iter().any(|v| !v.is_finite()) {
+                    return Err(bad(format!("cable {n}: a sweep needs at least one finite level in levels_mm")));
+                }
+                if s.points.is_empty() {
+                    return Err(bad(format!("cable {n}: a sweep needs at least one control point in points (0 … 4)")));
+                }
+                for &p in &s.points {
+                    if p >= CONTROL_POINTS {
+                        return Err(bad(format!("cable {n}: control point {p} does not exist (points are 0 … 4)")));
+                    }
+                    if !seen.insert((s.axis, p)) {
+                        return Err(bad(format!("cable {n}: {:?} control point {p} is swept twice", s.axis).to_lowercase()));
+                    }
+                }
+            }
+        }
+        crate::model::spatial::check_order(self.output.order, &self.solver).map_err(|e| bad(e.to_string()))?;
+        if !(self.output.cell_mm.is_finite() && self.output.cell_mm > 0.0) {
+            return Err(bad(format!("output.cell_mm = {} must be a positive length", self.output.cell_mm)));
+        }
+        let rows = self.routings().saturating_mul(self.tension_combinations());
+        if rows > MAX_CABLE_SWEEP_ROWS {
+            return Err(bad(format!(
+                "{rows} rows ({} routings × {} tension combinations) is more than {MAX_CABLE_SWEEP_ROWS}: this sweep is built in memory; split the spec",
+                self.routings(),
+                self.tension_combinations()
+            )));
+        }
+        // The base actuator (swept points at their first level) must be a valid rod.
+        let base = self.actuator_for(0, &self.dimensions());
+        base.rod.validate().map_err(|e| bad(e.to_string()))?;
+        match base.validate() {
+            Err(SpatialError::Parameter(e)) => return Err(bad(e.to_string())),
+            Err(e @ (SpatialError::GravityDirection(_) | SpatialError::UnsupportedEffect(_))) => return Err(bad(e.to_string())),
+            _ => {}
+        }
+        Ok(())
+    }
+
+    /// The actuator of routing `id` (mixed radix over the dimensions, the
+    /// first fastest), tensions at zero.
+    fn actuator_for(&self, id: u64, dims: &[Dimension]) -> SpatialActuator {
+        let mut cables: Vec<Cable> = self
+            .cables
+            .iter()
+            .map(|c| Cable { y_mm: c.y_mm, z_mm: c.z_mm, tension_n: 0.0, anchor_mm: c.anchor_mm })
+            .collect();
+        let mut k = id;
+        for d in dims {
+            let n = d.levels.len() as u64;
+            let level = d.levels[(k % n) as usize];
+            k /= n;
+            let c = &mut cables[d.cable];
+            match d.axis {
+                Axis::Y => c.y_mm[d.point] = level,
+                Axis::Z => c.z_mm[d.point] = level,
+            }
+        }
+        SpatialActuator { rod: self.rod.clone(), gj_n_mm2: self.gj_n_mm2, gravity_direction: self.gravity_direction, cables }
+    }
+}
+
+/// One solved (or failed) row of a cable sweep.
+#[derive(Debug, Clone)]
+pub struct Row {
+    /// Routing number in the spec's enumeration.
+    pub routing_id: i64,
+    /// Each cable's (y, z) control points, mm.
+    pub cables: Vec<([f64; CONTROL_POINTS], [f64; CONTROL_POINTS])>,
+    /// Each cable's tension, N.
+    pub tensions: Vec<f64>,
+    /// `ok`, [`STATUS_FAILED`] or [`STATUS_INVALID_ROUTING`].
+    pub status: &'static str,
+    /// Solver passes (0 when not solved).
+    pub passes: i32,
+    /// The pose of a solved row.
+    pub pose: Option<crate::model::spatial::SpatialPose>,
+    /// Twist, out-of-plane and in-plane coefficient series of a solved row.
+    pub a: Option<[Vec<f64>; 3]>,
+}
+
+/// Tension combinations of one routing in snake order: each step changes
+/// one cable's tension by one grid step, so the solver's warm start (and
+/// its extrapolation along a straight run) stays close.
+fn snake(grids: &[Vec<f64>]) -> Vec<Vec<usize>> {
+    let mut out: Vec<Vec<usize>> = vec![vec![]];
+    for grid in grids {
+        let mut next = Vec::with_capacity(out.len() * grid.len());
+        for (k, prefix) in out.iter().enumerate() {
+            let order: Vec<usize> = if k % 2 == 0 { (0..grid.len()).collect() } else { (0..grid.len()).rev().collect() };
+            for j in order {
+                let mut p = prefix.clone();
+                p.push(j);
+                next.push(p);
+            }
+        }
+        out = next;
+    }
+    out
+}
+
+fn solve_routing(spec: &CableSweepSpec, id: u64, dims: &[Dimension], grids: &[Vec<f64>], combos: &[Vec<usize>]) -> Vec<Row> {
+    let mut actuator = spec.actuator_for(id, dims);
+    let geometry: Vec<_> = actuator.cables.iter().map(|c| (c.y_mm, c.z_mm)).collect();
+    let tensions_of = |combo: &[usize]| -> Vec<f64> { combo.iter().zip(grids).map(|(&j, g)| g[j]).collect() };
+    let row = |combo: &[usize], status, passes, pose, a| Row {
+        routing_id: id as i64,
+        cables: geometry.clone(),
+        tensions: tensions_of(combo),
+        status,
+        passes,
+        pose,
+        a,
+    };
+    // Build with the first combination's tensions so validation sees them.
+    for (c, t) in actuator.cables.iter_mut().zip(tensions_of(&combos[0])) {
+        c.tension_n = t;
+    }
+    let mut solver = match SpatialSolver::new(&actuator, &spec.solver) {
+        Ok(s) => s,
+        Err(_) => return combos.iter().map(|c| row(c, STATUS_INVALID_ROUTING, 0, None, None)).collect(),
+    };
+    let mut rows = Vec::with_capacity(combos.len());
+    // Continuation from zero to the first combination (rungs of ≤ 0.25 N).
+    let first = tensions_of(&combos[0]);
+    let top = first.iter().copied().fold(0.0, f64::max);
+    let rungs = ((top / 0.25).ceil() as usize).max(1);
+    for k in 1..rungs {
+        let t: Vec<f64> = first.iter().map(|t| t * k as f64 / rungs as f64).collect();
+        // A rung that fails only leaves a worse warm start; the rows report failures.
+        let _ = solver.solve(&t);
+    }
+    for combo in combos {
+        let t = tensions_of(combo);
+        match solver.solve(&t) {
+            Ok(pose) => match solver.coefficients(spec.output.order, spec.output.length_basis) {
+                Ok(a) => rows.push(row(combo, STATUS_OK, pose.passes as i32, Some(pose), Some(a))),
+                Err(_) => rows.push(row(combo, STATUS_FAILED, 0, None, None)),
+            },
+            Err(_) => rows.push(row(combo, STATUS_FAILED, 0, None, None)),
+        }
+    }
+    rows
+}
+
+/// The solved rows of a cable sweep.
+#[derive(Debug, Clone)]
+pub struct SolvedCableSweep {
+    /// Rows in (routing, tension grid) order, independent of threads.
+    pub rows: Vec<Row>,
+    /// Routings (swept combinations).
+    pub routings: u64,
+    /// Tension combinations per routing.
+    pub tension_combinations: usize,
+    /// Worker threads used.
+    pub threads: usize,
+}
+
+/// Refuses an output directory that holds anything (a cable sweep is not
+/// resumable) and creates it with its `maps/` directory.
+pub fn prepare_out_dir(out: &Path) -> Result<(), CableSweepError> {
+    if out.exists() && std::fs::read_dir(out).map(|mut d| d.next().is_some()).unwrap_or(true) {
+        return Err(CableSweepError::NotEmpty(out.to_path_buf()));
+    }
+    std::fs::create_dir_all(out.join("maps"))
+        .map_err(|e| CableSweepError::Write { context: format!("creating {}", out.display()), message: e.to_string() })
+}
+
+/// Solves every routing of `spec` through the product of its tension grids
+/// on `threads` workers (all cores when None).
+pub fn solve_cable_sweep(spec: &CableSweepSpec, threads: Option<usize>) -> Result<SolvedCableSweep, CableSweepError> {
+    spec.validate("(given)")?;
+    let dims = spec.dimensions();
+    let grids: Vec<Vec<f64>> = spec.cables.iter().map(|c| c.tension_n.values()).collect();
+    let combos = snake(&grids);
+    let routings = spec.routings();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.unwrap_or(0))
+        .build()
+        .map_err(|e| CableSweepError::Write { context: "starting worker threads".into(), message: e.to_string() })?;
+    let threads_used = pool.current_num_threads();
+    let mut rows: Vec<Row> =
+        pool.install(|| (0..routings).into_par_iter().flat_map_iter(|id| solve_routing(spec, id, &dims, &grids, &combos)).collect());
+    // Rows in (routing, tension grid) order, independent of the snake and the threads.
+    rows.sort_by(|a, b| a.routing_id.cmp(&b.routing_id).then_with(|| a.tensions.partial_cmp(&b.tensions).unwrap()));
+    Ok(SolvedCableSweep { rows, routings, tension_combinations: combos.len(), threads: threads_used })
+}
+
+/// Writes `rows.parquet` (docs/schema.md, "Cable sweeps") and the spec as
+/// `spec.toml` into the run directory `out`.
+pub fn write_rows(spec: &CableSweepSpec, rows: &[Row], out: &Path) -> Result<(), CableSweepError> {
+    let write_err = |context: String, e: &dyn std::fmt::Display| CableSweepError::Write { context, message: e.to_string() };
+    let path = out.join(ROWS_FILE);
+    write_parquet(&path, rows_batch(rows, spec.cables.len(), spec.output.order)).map_err(|e| write_err(format!("writing {}", path.display()), &e))?;
+    let spec_text = toml::to_string(spec).map_err(|e| write_err("writing spec.toml".into(), &e))?;
+    crate::io::write_atomic(&out.join("spec.toml"), spec_text.as_bytes()).map_err(|e| write_err("writing spec.toml".into(), &e))
+}
+
+/// Name of a control-point column, e.g. `cable2_z3_mm`.
+pub fn control_point_column(cable: usize, axis: Axis, point: usize) -> String {
+    format!("cable{cable}_{}{point}_mm", if axis == Axis::Y { "y" } else { "z" })
+}
+
+/// Name of a cable's tension column, e.g. `tension1_n`.
+pub fn tension_column(cable: usize) -> String {
+    format!("tension{cable}_n")
+}
+
+/// Pose columns of a cable sweep row (nullable f64).
+pub const POSE_COLUMNS: [&str; 11] = [
+    "tip_x_mm",
+    "tip_y_mm",
+    "tip_z_mm",
+    "tip_tangent_x",
+    "tip_tangent_y",
+    "tip_tangent_z",
+    "tip_body_y_x",
+    "tip_body_y_y",
+    "tip_body_y_z",
+    "tip_angle_rad",
+    "length_mm",
+];
+
+/// The rows as one record batch in the `rows.parquet` layout.
+pub fn rows_batch(rows: &[Row], n_cables: usize, order: usize) -> Result<RecordBatch, arrow::error::ArrowError> {
+    let mut fields = vec![Field::new("routing_id", DataType::Int64, false)];
+    let mut columns: Vec<ArrayRef> = vec![Arc::new(Int64Array::from_iter_values(rows.iter().map(|r| r.routing_id)))];
+    let mut f64_col = |name: String, values: Vec<Option<f64>>, fields: &mut Vec<Field>| {
+        fields.push(Field::new(name, DataType::Float64, values.iter().any(Option::is_none)));
+        columns.push(Arc::new(Float64Array::from(values)));
+    };
+    for c in 0..n_cables {
+        for axis in [Axis::Y, Axis::Z] {
+            for p in 0..CONTROL_POINTS {
+                let v = rows.iter().map(|r| Some(if axis == Axis::Y { r.cables[c].0[p] } else { r.cables[c].1[p] })).collect();
+                f64_col(control_point_column(c + 1, axis, p), v, &mut fields);
+            }
+        }
+    }
+    for c in 0..n_cables {
+        f64_col(tension_column(c + 1), rows.iter().map(|r| Some(r.tensions[c])).collect(), &mut fields);
+    }
+    let pose_value = |r: &Row, k: usize| {
+        r.pose.map(|p| match k {
+            0..=2 => p.tip_mm[k],
+            3..=5 => p.tip_tangent[k - 3],
+            6..=8 => p.tip_body_y_axis[k - 6],
+            9 => p.tip_angle_rad,
+            _ => p.length_mm,
+        })
+    };
+    for (k, name) in POSE_COLUMNS.iter().enumerate() {
+        f64_col(name.to_string(), rows.iter().map(|r| pose_value(r, k)).collect(), &mut fields);
+    }
+    // In-plane series as a0… (the planar sweep's names), then the other two.
+    for (series, prefix) in [(2, "a"), (1, "a_bend_y"), (0, "a_twist")] {
+        for i in 0..=order {
+            let v = rows.iter().map(|r| r.a.as_ref().map(|a| a[series][i])).collect();
+            f64_col(format!("{prefix}{i}"), v, &mut fields);
+        }
+    }
+    let status: Vec<&str> = rows.iter().map(|r| r.status).collect();
+    fields.insert(1 + 10 * n_cables + n_cables, Field::new("status", DataType::Utf8, false));
+    columns.insert(1 + 10 * n_cables + n_cables, Arc::new(StringArray::from(status)));
+    fields.insert(2 + 11 * n_cables, Field::new("iterations", DataType::Int32, false));
+    columns.insert(2 + 11 * n_cables, Arc::new(Int32Array::from_iter_values(rows.iter().map(|r| r.passes))));
+    RecordBatch::try_new(Arc::new(Schema::new(fields)), columns)
+}
+
+/// Writes one record batch as a zstd Parquet file, atomically.
+pub fn write_parquet(path: &Path, batch: Result<RecordBatch, arrow::error::ArrowError>) -> Result<(), String> {
+    let batch = batch.map_err(|e| e.to_string())?;
+    let props = WriterProperties::builder().set_compression(Compression::ZSTD(ZstdLevel::default())).build();
+    let mut buf = Vec::new();
+    let mut writer = ArrowWriter::try_new(&mut buf, batch.schema(), Some(props)).map_err(|e| e.to_string())?;
+    writer.write(&batch).map_err(|e| e.to_string())?;
+    writer.close().map_err(|e| e.to_string())?;
+    crate::io::write_atomic(path, &buf).map_err(|e| e.to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SPEC: &str = r#"
+[rod.gravity]
+enabled = false
+[[cable]]
+y_mm = [2, 2, 2, 2, 2]
+tension_n = { min = 0.0, max = 1.0, count = 3 }
+[[cable.sweep]]
+axis = "y"
+points = [1, 3]
+levels_mm = [1.0, 3.0]
+[[cable]]
+y_mm = [-2, -2, -2, -2, -2]
+tension_n = { min = 0.5, max = 1.0, count = 2 }
+[[cable.sweep]]
+axis = "z"
+points = [4]
+levels_mm = [0.0, 1.5, -1.5]
+"#;
+
+    #[test]
+    fn spec_counts_routings_and_tensions() {
+        let spec = CableSweepSpec::from_toml(SPEC, "test").unwrap();
+        assert_eq!(spec.routings(), 2 * 2 * 3);
+        assert_eq!(spec.tension_combinations(), 6);
+        let dims = spec.dimensions();
+        // Id 0: every swept point at its first level; id 1 moves the first dimension.
+        let a0 = spec.actuator_for(0, &dims);
+        assert_eq!(a0.cables[0].y_mm, [2.0, 1.0, 2.0, 1.0, 2.0]);
+        assert_eq!(a0.cables[1].z_mm, [0.0; 5]);
+        let a1 = spec.actuator_for(1, &dims);
+        assert_eq!(a1.cables[0].y_mm, [2.0, 3.0, 2.0, 1.0, 2.0]);
+        let last = spec.actuator_for(11, &dims);
+        assert_eq!(last.cables[0].y_mm, [2.0, 3.0, 2.0, 3.0, 2.0]);
+        assert_eq!(last.cables[1].z_mm, [0.0, 0.0, 0.0, 0.0, -1.5]);
+    }
+
+    #[test]
+    fn snake_order_visits_every_combination_one_step_at_a_time() {
+        let grids = vec![vec![0.0, 1.0, 2.0], vec![0.0, 1.0], vec![5.0, 6.0]];
+        let s = snake(&grids);
+        assert_eq!(s.len(), 12);
+        let unique: std::collections::BTreeSet<_> = s.iter().cloned().collect();
+        assert_eq!(unique.len(), 12);
+        for w in s.windows(2) {
+            let steps: usize = w[0].iter().zip(&w[1]).map(|(a, b)| a.abs_diff(*b)).sum();
+            assert_eq!(steps, 1, "{w:?}");
+        }
+    }
+
+    #[test]
+    fn bad_specs_name_the_problem() {
+        for (text, needle) in [
+            (SPEC.replace("points = [1, 3]", "points = [1, 5]"), "control point 5"),
+            (SPEC.replace("points = [1, 3]", "points = [1, 1]"), "swept twice"),
+            (SPEC.replace("count = 3", "count = 0"), "count = 0"),
+            (SPEC.replace("min = 0.5", "min = -0.5"), "0 ≤ min"),
+            (SPEC.replace("levels_mm = [1.0, 3.0]", "levels_mm = []"), "levels_mm"),
+            (SPEC.replace("[rod.gravity]", "[rod.effects]\nfriction_mu = 0.1\n[rod.gravity]"), "friction_mu"),
+            (format!("{SPEC}\n[output]\norder = 7\n"), "steps_per_span"),
+            (SPEC.replace("axis = \"z\"", "axis = \"x\""), "unknown variant"),
+            ("[rod]\n".to_string(), "cable"),
+        ] {
+            let e = CableSweepSpec::from_toml(&text, "spec.toml").unwrap_err().to_string();
+            assert!(e.contains(needle) && e.contains("spec.toml"), "{needle}: {e}");
+        }
+    }
+}
