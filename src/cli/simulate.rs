@@ -162,7 +162,7 @@ fn run_spatial(args: &SimulateArgs) -> anyhow::Result<()> {
     };
     spatial.rod = args.actuator.apply(&spatial.rod);
     if !args.cable.is_empty() {
-        spatial.cables = args.cable.iter().map(|c| c.parse::<Cable>()).collect::<Result<_, _>>()?;
+        spatial.cables = args.cable.iter().map(|c| c.parse::<Cable>()).collect::<Result<_, _>>().context("--cable")?;
     }
     if let (Some(routing), Some(tension)) = (&args.routing, args.tension_n) {
         let y = parse_list(routing, "--routing")?;
