@@ -35,7 +35,7 @@ pub fn predict_group(
 ) -> Result<Vec<Prediction>, CalibrateError> {
     let a = group_actuator(actuator, group);
     let first_row = data.rows[group.rows[0]].row;
-    let routing = Routing::new(group.routing_mm, a.length_mm, a.radius_mm)
+    let routing = Routing::for_actuator(group.routing_mm, &a)
         .map_err(|source| CalibrateError::Routing { routing: group.routing.clone(), row: first_row, source })?;
     let mut sim = Simulator::new(&a, options)?;
     sim.set_routing(&routing);

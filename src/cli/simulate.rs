@@ -75,7 +75,7 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         args.n_d
     );
     let y = parse_list(&args.routing, "--routing")?;
-    let routing = Routing::new(&y, actuator.length_mm, actuator.radius_mm).context("--routing")?;
+    let routing = Routing::for_actuator(&y, &actuator).context("--routing")?;
     let direction = if args.direction == "unload" { LoadDirection::Unload } else { LoadDirection::Load };
     let hold = Hold { direction, dwell_s: args.dwell_s.unwrap_or(actuator.effects.creep_hold_s) };
     // The thesis route computes its own coefficients from the centreline
@@ -100,7 +100,7 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     }
     if let Some(path) = &args.png {
         let title = format!("routing [{}] mm, tension {:.3} N", fmt_list(&y), args.tension);
-        let drawing = BodyDrawing::of_simulation(&sim, actuator.radius_mm, "body (outline at ±r), cable in red".into(), BLUE_800);
+        let drawing = BodyDrawing::of_body(&sim, &actuator, "body (outline at ±r), cable in red".into(), BLUE_800);
         draw_bodies(path, &title, &[drawing], &[])?;
     }
     let stdout = std::io::stdout();

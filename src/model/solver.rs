@@ -48,6 +48,7 @@
 //! collocation's Newton fallback for heavy rods (a dense Jacobian).
 
 use super::actuator::{Actuator, LoadDirection, ParameterError};
+use super::body::{merge_sorted, Body};
 use super::routing::Routing;
 use crate::shape::LengthBasis;
 use serde::{Deserialize, Serialize};
@@ -262,6 +263,8 @@ struct Section {
     ga_n: f64,
     /// Bending rigidity EI, N·mm².
     ei_n_mm2: f64,
+    /// Radius r, mm (material stiffening's α r²).
+    radius_mm: f64,
 }
 
 /// Bending moment at a cut, N·mm: the cable's moment τ y_c cos α about the
@@ -295,6 +298,13 @@ pub struct Simulator {
     col: Option<Box<collocation::Colloc>>,
     /// RK4 state (also sized with collocation: it is small).
     rk4: rk4::Rk4,
+    /// The non-uniform body (radius profile, segments); `None` for the
+    /// uniform cylinder, solved on the fast path.
+    body: Option<Body>,
+    /// Index of the first point beyond the cable's anchor (the number of
+    /// points when the cable is knotted at the tip): from there on the cut
+    /// carries no cable load.
+    cable_end: usize,
 }
 
 /// How a solve is held: the direction of the last tension change (friction)
@@ -335,17 +345,30 @@ impl Simulator {
         } else {
             options.nodes_per_span
         };
+        let body = Body::of(actuator)?;
+        if options.method == SolverMethod::Rk4 && !actuator.is_uniform_body() && actuator.cable_length_mm() < actuator.length_mm {
+            return Err(ParameterError::Body(
+                "the rk4 reference method knots the cable at the tip only: use the default collocation method for a cable anchored before the tip".into(),
+            ));
+        }
+        let spans = span_boundaries(actuator, body.as_ref(), 0.5 * actuator.cable_length_mm()).len() - 1;
         // Per-point buffers: RK4 stage points, or collocation nodes.
         let points = match options.method {
             SolverMethod::Rk4 => 2 * (2 * n + 1),
-            SolverMethod::Collocation => 2 * (m + 1),
+            SolverMethod::Collocation => spans * (m + 1),
         };
-        let col = (options.method == SolverMethod::Collocation).then(|| Box::new(collocation::Colloc::new(m)));
+        let col = (options.method == SolverMethod::Collocation).then(|| Box::new(collocation::Colloc::new(m, spans)));
         let beta = actuator.gravity.direction_rad;
+        // A non-uniform body's weight is this factor times ∫ ρ r² (Body).
+        let weight_n_per_mm = match &body {
+            None => actuator.weight_n_per_mm(),
+            Some(_) if !actuator.gravity.enabled => 0.0,
+            Some(_) => actuator.gravity.scale * 1e-6 * std::f64::consts::PI * actuator.gravity.g_m_s2,
+        };
         Ok(Self {
             actuator: actuator.clone(),
             options: options.clone(),
-            weight_n_per_mm: actuator.weight_n_per_mm(),
+            weight_n_per_mm,
             gravity_cos: beta.cos(),
             gravity_sin: beta.sin(),
             routing: None,
@@ -356,6 +379,8 @@ impl Simulator {
             creep: Creep::new(&actuator.effects, actuator.ei_n_mm2, points),
             col,
             rk4: rk4::Rk4::new(n),
+            body,
+            cable_end: points,
         })
         .and_then(|mut sim: Simulator| {
             // Outside a protocol every solve is held like this from a virgin rod.
@@ -372,14 +397,16 @@ impl Simulator {
 
     /// Validates `y_mm` against the actuator and sets it as the routing.
     pub fn set_routing_mm(&mut self, y_mm: &[f64]) -> Result<(), super::routing::RoutingError> {
-        let routing = Routing::new(y_mm, self.actuator.length_mm, self.actuator.radius_mm)?;
+        let routing = Routing::for_actuator(y_mm, &self.actuator)?;
         self.set_routing(&routing);
         Ok(())
     }
 
     /// Sets the routing (precomputing the channel at every stage point) and
-    /// forgets the warm start.
+    /// forgets the warm start. The routing must span the cable's length
+    /// (build it with [`Routing::for_actuator`]).
     pub fn set_routing(&mut self, routing: &Routing) {
+        debug_assert!((routing.length_mm() - self.actuator.cable_length_mm()).abs() <= 1e-9 * self.actuator.length_mm);
         let delta = self.actuator.effects.channel_offset_mm;
         let built = if delta != 0.0 { routing.shifted(delta) } else { routing.clone() };
         if self.col.is_some() {
@@ -432,23 +459,47 @@ impl Simulator {
     }
 
     /// The section's rigidities at reference arc length `s` (mm): the
-    /// actuator's, with the test-only hidden stiffer base segment. The one
-    /// place a profile along s would enter.
+    /// actuator's, or the non-uniform body's ([`Body::section_at`]), with
+    /// the stiffness gradient and the test-only hidden stiffer base segment.
     #[inline]
     fn section_at(&self, s: f64) -> Section {
         let a = &self.actuator;
         let hidden = &a.effects.hidden;
-        let mut ei = a.ei_n_mm2;
+        let mut section = match &self.body {
+            None => Section { ea_n: a.ea_n, ga_n: a.ga_n, ei_n_mm2: a.ei_n_mm2, radius_mm: a.radius_mm },
+            Some(b) => {
+                let x = b.section_at(s);
+                Section { ea_n: x.ea_n, ga_n: x.ga_n, ei_n_mm2: x.ei_n_mm2, radius_mm: x.radius_mm }
+            }
+        };
         if s < hidden.base_segment_mm {
-            ei *= hidden.base_segment_ei_factor;
+            section.ei_n_mm2 *= hidden.base_segment_ei_factor;
         }
-        Section { ea_n: a.ea_n, ga_n: a.ga_n, ei_n_mm2: ei }
+        let beta = a.effects.stiffness_gradient_beta;
+        if beta != 0.0 {
+            section.ei_n_mm2 *= (beta * (s / a.length_mm - 0.5)).exp();
+        }
+        section
     }
 
-    /// The rod's weight beyond the cut at `s` (mm), N.
+    /// The rod's weight beyond the cut at `s` (mm), N: w·(L − s) for the
+    /// uniform rod, the closed-form ∫_s^L w dσ for a non-uniform body.
     #[inline]
     fn distal_weight_n(&self, s: f64) -> f64 {
-        self.weight_n_per_mm * (self.actuator.length_mm - s)
+        match &self.body {
+            None => self.weight_n_per_mm * (self.actuator.length_mm - s),
+            Some(b) => self.weight_n_per_mm * b.distal_density_area(s),
+        }
+    }
+
+    /// The cable tension at point `i` for base tension `tension`: friction's
+    /// profile, and none beyond the cable's anchor.
+    #[inline]
+    fn tension_at(&self, i: usize, tension: f64) -> f64 {
+        if i >= self.cable_end {
+            return 0.0;
+        }
+        tension * self.friction.ratio(i)
     }
 
     /// Curvature u from the bending moment `m` (N·mm) on `section` and du/dm.
@@ -458,19 +509,20 @@ impl Simulator {
     /// ([`Simulator::section_at`]).
     #[inline]
     fn bending_curvature(&self, m: f64, section: &Section) -> (f64, f64) {
-        let (u, du_dm) = self.elastic_curvature(m, section.ei_n_mm2);
+        let (u, du_dm) = self.elastic_curvature(m, section.ei_n_mm2, section.radius_mm);
         (u + self.actuator.effects.hidden.rest_curvature_per_mm, du_dm)
     }
 
-    /// The elastic part of [`Simulator::bending_curvature`] with rigidity `ei`.
+    /// The elastic part of [`Simulator::bending_curvature`] with rigidity
+    /// `ei` and radius `radius_mm`.
     #[inline]
-    fn elastic_curvature(&self, m: f64, ei: f64) -> (f64, f64) {
+    fn elastic_curvature(&self, m: f64, ei: f64, radius_mm: f64) -> (f64, f64) {
         let alpha = self.actuator.effects.stiffening_alpha;
         if alpha == 0.0 {
             return (m / ei, 1.0 / ei);
         }
         // Monotone cubic EI (u + c u³) = m, c = α r²: Newton from the linear guess.
-        let c = alpha * self.actuator.radius_mm.powi(2);
+        let c = alpha * radius_mm.powi(2);
         let mut u = m / ei;
         for _ in 0..STIFFENING_MAX_ITERATIONS {
             let f = ei * (u + c * u * u * u) - m;
@@ -508,7 +560,7 @@ impl Simulator {
     ) -> Result<(Strains, (f64, f64)), SolveFailure> {
         let section = self.section_at(s);
         let (ea, ga) = (section.ea_n, section.ga_n);
-        let creep_gain = self.creep.gain();
+        let creep_gain = self.creep.gain(section.ei_n_mm2);
         // Weight beyond the cut, in the body frame: Rᵀ W.
         let wl = self.distal_weight_n(s);
         let w1 = wl * (cp * self.gravity_cos + sp * self.gravity_sin);
@@ -607,6 +659,19 @@ impl Simulator {
         }
         self.rk4_centreline()
     }
+}
+
+/// The collocation's span boundaries from the clamp to the tip: the
+/// routing's knot `knot_mm`, the cable's anchor and the body's breakpoints
+/// (so that every span's integrands are smooth); [0, knot, L] for the
+/// uniform rod.
+fn span_boundaries(a: &Actuator, body: Option<&Body>, knot_mm: f64) -> Vec<f64> {
+    let length = a.length_mm;
+    let mut cuts = vec![0.0, knot_mm, a.cable_length_mm(), length];
+    if let Some(b) = body {
+        cuts.extend(b.breakpoints_mm());
+    }
+    merge_sorted(cuts, length)
 }
 
 /// Rotates the unit vector (cos a, sin a) by `delta` rad. Small angles (the

@@ -70,5 +70,5 @@ fn draw(mode: usize, d: &Design, actuator: &Actuator, solver: &SolverOptions) ->
         .map_err(|source| DrawingError::Routing { mode, source })?;
     let sim = crate::model::simulate(actuator, solver, &routing, d.tension_n, 1, crate::shape::LengthBasis::default())
         .map_err(|e| DrawingError::Simulation { mode, source: Box::new(e) })?;
-    Ok(BodyDrawing::of_simulation(&sim, actuator.radius_mm, format!("mode {mode}"), plotters::style::full_palette::BLUE_800))
+    Ok(BodyDrawing::of_body(&sim, actuator, format!("mode {mode}"), plotters::style::full_palette::BLUE_800))
 }

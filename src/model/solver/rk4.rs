@@ -124,7 +124,8 @@ impl Simulator {
             self.friction.record_cable_direction(k, (sp, cp), dir);
         }
         if self.creep.is_on() {
-            self.creep.record_moment(k, bending_moment(local_tension, ch.y, dir.0, st.moment));
+            let ei = self.section_at(s).ei_n_mm2;
+            self.creep.record_moment(k, bending_moment(local_tension, ch.y, dir.0, st.moment), ei);
         }
         let dx = e.v1 * cp - e.v2 * sp;
         let dy = e.v1 * sp + e.v2 * cp;
