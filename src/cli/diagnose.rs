@@ -7,7 +7,7 @@ use super::ActuatorArgs;
 use cablemap::calibrate::diagnose::{diagnose, DiagnoseSpec};
 use cablemap::calibrate::read_measurements;
 use cablemap::calibrate::report::write_report;
-use cablemap::model::{Actuator, SolverOptions};
+use cablemap::model::SolverOptions;
 use clap::Args;
 use std::io::Write;
 use std::path::PathBuf;
@@ -66,10 +66,10 @@ pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
         // Before the fits, not after them.
         cablemap::io::check_not_in_run_dir(&out_dir, "the report directory").map_err(anyhow::Error::msg).context("--out")?;
     }
-    let base = args.actuator.apply(&Actuator::default());
+    let data = read_measurements(&args.data)?;
+    let base = args.actuator.resolve(data.actuator.as_ref())?;
     base.validate()?;
     let options = args.actuator.solver_options(&SolverOptions::default());
-    let data = read_measurements(&args.data)?;
     let (fit, start, held_effects) = args.fit.spec(&base, &data)?;
     let spec = DiagnoseSpec {
         holdout: args.holdout.clone(),
@@ -195,6 +195,7 @@ fn next_step(fit: &cablemap::calibrate::FitResult) -> String {
             }
             Effect::ChannelOffset => ("--channel-offset-mm", "channel_offset_mm", fx.channel_offset_mm),
             Effect::Creep => ("--creep-fraction", "creep_fraction", fx.creep_fraction),
+            Effect::StiffnessGradient => ("--stiffness-gradient-beta", "stiffness_gradient_beta", fx.stiffness_gradient_beta),
         };
         flags.push(format!("{flag} {}", sig5(value)));
         if *e == Effect::Gravity {

@@ -2,7 +2,7 @@
 
 use super::{parse_list, ActuatorArgs, LengthBasisArgs};
 use cablemap::model::record::{self, SimulationRecord};
-use cablemap::model::{simulate_held, Actuator, Hold, LoadDirection, Routing, SolverOptions};
+use cablemap::model::{simulate_held, Hold, LoadDirection, Routing, SolverOptions};
 use cablemap::plot::{draw_bodies, BodyDrawing};
 use anyhow::Context;
 use clap::Args;
@@ -66,7 +66,7 @@ pub enum CoefficientRoute {
 
 /// Runs `cablemap simulate`.
 pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
-    let actuator = args.actuator.apply(&Actuator::default());
+    let actuator = args.actuator.resolve(None)?;
     actuator.validate()?;
     let options = args.actuator.solver_options(&SolverOptions::default());
     anyhow::ensure!(

@@ -29,6 +29,16 @@ pub enum ParameterError {
     Body(String),
 }
 
+/// Why an actuator file could not be used.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("actuator file {path}: {message} (an actuator file holds the [actuator] fields of docs/model.md: length_mm, radius_mm, radius_profile_mm, segments, cable_anchor_mm, ...)")]
+pub struct ActuatorFileError {
+    /// The file.
+    pub path: String,
+    /// What is wrong.
+    pub message: String,
+}
+
 /// Self-weight of the rod.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -265,6 +275,21 @@ impl Actuator {
     /// The largest radius along the rod, mm.
     pub fn max_radius_mm(&self) -> f64 {
         self.radius_profile_mm.iter().map(|p| p.1).fold(if self.radius_profile_mm.is_empty() { self.radius_mm } else { 0.0 }, f64::max)
+    }
+
+    /// Reads an actuator TOML file (the fields of [`Actuator`], as in a sweep
+    /// spec's `[actuator]` section; missing fields are the thesis's), checked
+    /// with [`Actuator::validate`]. This module owns the actuator file format.
+    pub fn from_toml_file(path: &std::path::Path) -> Result<Actuator, ActuatorFileError> {
+        let text = std::fs::read_to_string(path).map_err(|e| ActuatorFileError { path: path.display().to_string(), message: e.to_string() })?;
+        Actuator::from_toml_str(&text).map_err(|message| ActuatorFileError { path: path.display().to_string(), message })
+    }
+
+    /// Parses actuator TOML text (see [`Actuator::from_toml_file`]).
+    pub fn from_toml_str(text: &str) -> Result<Actuator, String> {
+        let a: Actuator = toml::from_str(text).map_err(|e| e.to_string().trim_end().to_string())?;
+        a.validate().map_err(|e| e.to_string())?;
+        Ok(a)
     }
 
     /// Checks every parameter; the solver calls this before it starts.
