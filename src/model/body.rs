@@ -180,9 +180,15 @@ impl Body {
 
     #[inline]
     fn piece_index(&self, s: f64) -> usize {
+        self.piece_index_side(s, false)
+    }
+
+    /// The piece holding `s`; at a breakpoint the left one with `left`.
+    #[inline]
+    fn piece_index_side(&self, s: f64, left: bool) -> usize {
         // Few pieces: a linear scan beats a binary search.
         let mut k = 0;
-        while k + 1 < self.pieces.len() && s >= self.pieces[k].end_mm {
+        while k + 1 < self.pieces.len() && (s > self.pieces[k].end_mm || (!left && s == self.pieces[k].end_mm)) {
             k += 1;
         }
         k
@@ -196,7 +202,14 @@ impl Body {
     /// The section at `s`: rigidities scaled by (r/radius_mm)², ², ⁴.
     #[inline]
     pub fn section_at(&self, s: f64) -> BodySection {
-        let p = &self.pieces[self.piece_index(s)];
+        self.section_at_side(s, false)
+    }
+
+    /// [`Body::section_at`], taking a jump at a breakpoint from the left
+    /// with `left` (the right otherwise).
+    #[inline]
+    pub fn section_at_side(&self, s: f64, left: bool) -> BodySection {
+        let p = &self.pieces[self.piece_index_side(s, left)];
         let r = p.radius_at(s);
         let k2 = (r / self.radius_mm).powi(2);
         BodySection { ea_n: p.ea_n * k2, ga_n: p.ga_n * k2, ei_n_mm2: p.ei_n_mm2 * k2 * k2, radius_mm: r }

@@ -463,12 +463,20 @@ impl Simulator {
     /// the stiffness gradient and the test-only hidden stiffer base segment.
     #[inline]
     fn section_at(&self, s: f64) -> Section {
+        self.section_at_side(s, false)
+    }
+
+    /// [`Simulator::section_at`], where a section that jumps at `s` (a
+    /// segment's end) is taken from the left with `left` (the last node of
+    /// a span), from the right otherwise.
+    #[inline]
+    fn section_at_side(&self, s: f64, left: bool) -> Section {
         let a = &self.actuator;
         let hidden = &a.effects.hidden;
         let mut section = match &self.body {
             None => Section { ea_n: a.ea_n, ga_n: a.ga_n, ei_n_mm2: a.ei_n_mm2, radius_mm: a.radius_mm },
             Some(b) => {
-                let x = b.section_at(s);
+                let x = b.section_at_side(s, left);
                 Section { ea_n: x.ea_n, ga_n: x.ga_n, ei_n_mm2: x.ei_n_mm2, radius_mm: x.radius_mm }
             }
         };
@@ -536,7 +544,8 @@ impl Simulator {
         (u, 1.0 / (ei * (1.0 + 3.0 * c * u * u)))
     }
 
-    /// Solves the cut equations at one point for the cable angle α and the
+    /// Solves the cut equations at one point (arc length `s`, cross-section
+    /// `section`) for the cable angle α and the
     /// strains, starting Newton from the direction `dir0` = (cos α, sin α);
     /// `(sp, cp)` = sin, cos of φ; `tension` is the cable tension at the cut
     /// and `creep_offset` the creep's held curvature f E q₀ (1/mm). Returns
@@ -551,6 +560,7 @@ impl Simulator {
     fn strains_at(
         &self,
         s: f64,
+        section: &Section,
         ch: ChannelSample,
         (sp, cp): (f64, f64),
         moment: f64,
@@ -558,7 +568,6 @@ impl Simulator {
         dir0: (f64, f64),
         creep_offset: f64,
     ) -> Result<(Strains, (f64, f64)), SolveFailure> {
-        let section = self.section_at(s);
         let (ea, ga) = (section.ea_n, section.ga_n);
         let creep_gain = self.creep.gain(section.ei_n_mm2);
         // Weight beyond the cut, in the body frame: Rᵀ W.
@@ -570,7 +579,7 @@ impl Simulator {
             let v1 = 1.0 + (w1 - tension * ca) / ea;
             let v2 = (w2 - tension * sa) / ga;
             let m = bending_moment(tension, ch.y, ca, moment);
-            let (u_el, du_dm_el) = self.bending_curvature(m, &section);
+            let (u_el, du_dm_el) = self.bending_curvature(m, section);
             let u = u_el + creep_gain * m + creep_offset;
             let du_dm = du_dm_el + creep_gain;
             let p = v1 - u * ch.y;
@@ -1009,5 +1018,196 @@ mod tests {
         let want = tau * d / a.ei_n_mm2 * (a.length_mm - 5.0 + 5.0 / 5.0);
         // The rigidity jumps inside an RK4 step: first-order accurate there.
         assert!((glued.tip_angle_rad - want).abs() < 0.01 * want, "{} vs {want}", glued.tip_angle_rad);
+    }
+}
+
+#[cfg(test)]
+mod body_tests {
+    //! Non-uniform bodies (radius profile, segments, cable anchor) and the
+    //! stiffness gradient against closed forms and equilibrium.
+    use super::*;
+    use crate::model::body::Segment;
+
+    /// Gauss–Legendre 8-point nodes and weights on [−1, 1].
+    const GL8: [(f64, f64); 8] = [
+        (-0.960_289_856_497_536_3, 0.101_228_536_290_376_26),
+        (-0.796_666_477_413_626_7, 0.222_381_034_453_374_47),
+        (-0.525_532_409_916_329, 0.313_706_645_877_887_3),
+        (-0.183_434_642_495_649_8, 0.362_683_783_378_362),
+        (0.183_434_642_495_649_8, 0.362_683_783_378_362),
+        (0.525_532_409_916_329, 0.313_706_645_877_887_3),
+        (0.796_666_477_413_626_7, 0.222_381_034_453_374_47),
+        (0.960_289_856_497_536_3, 0.101_228_536_290_376_26),
+    ];
+
+    /// ∫_a^b f by composite 8-point Gauss–Legendre on `n` panels.
+    fn quad(f: impl Fn(f64) -> f64, a: f64, b: f64, n: usize) -> f64 {
+        let h = (b - a) / n as f64;
+        (0..n)
+            .map(|k| {
+                let c = a + (k as f64 + 0.5) * h;
+                GL8.iter().map(|&(x, w)| w * f(c + 0.5 * h * x)).sum::<f64>() * 0.5 * h
+            })
+            .sum()
+    }
+
+    /// The tip of a rod with curvature `kappa(s)` and stretch `v1(s)` (no
+    /// shear), integrated piecewise between `cuts` (where the integrands kink).
+    fn tip_by_quadrature(kappa: &dyn Fn(f64) -> f64, v1: &dyn Fn(f64) -> f64, cuts: &[f64]) -> (f64, f64, f64) {
+        let phi = |s: f64| -> f64 {
+            let mut total = 0.0;
+            for w in cuts.windows(2) {
+                if s <= w[0] {
+                    break;
+                }
+                total += quad(kappa, w[0], s.min(w[1]), 4);
+            }
+            total
+        };
+        let (mut x, mut y) = (0.0, 0.0);
+        for w in cuts.windows(2) {
+            x += quad(|s| v1(s) * phi(s).cos(), w[0], w[1], 40);
+            y += quad(|s| v1(s) * phi(s).sin(), w[0], w[1], 40);
+        }
+        (x, y, phi(cuts[cuts.len() - 1]))
+    }
+
+    fn tapered_thesis_rod() -> Actuator {
+        let mut a = Actuator::default();
+        a.radius_profile_mm = vec![(0.0, 6.0), (30.0, 5.0), (65.0, 4.0)];
+        a
+    }
+
+    #[test]
+    fn straight_routing_bends_as_tau_d_over_ei_of_s() {
+        let (tau, d) = (1.5, 3.0);
+        for beta in [0.0, -0.7] {
+            let mut a = tapered_thesis_rod();
+            a.gravity.enabled = false;
+            a.effects.stiffness_gradient_beta = beta;
+            a.segments = vec![
+                Segment { end_mm: 20.0, ea_n: Some(40.0), ga_n: None, ei_n_mm2: Some(150.0), density_g_cm3: None },
+                Segment { end_mm: 65.0, ea_n: None, ga_n: None, ei_n_mm2: None, density_g_cm3: None },
+            ];
+            let body = Body::of(&a).unwrap().unwrap();
+            let ei = |s: f64| body.section_at(s).ei_n_mm2 * (beta * (s / a.length_mm - 0.5)).exp();
+            let kappa = |s: f64| tau * d / ei(s);
+            let v1 = |s: f64| 1.0 - tau / body.section_at(s).ea_n;
+            let (x, y, phi) = tip_by_quadrature(&kappa, &v1, &[0.0, 20.0, 30.0, 65.0]);
+            let options = SolverOptions { nodes_per_span: 24, ..SolverOptions::default() };
+            let mut sim = Simulator::new(&a, &options).unwrap();
+            sim.set_routing_mm(&[d; 5]).unwrap();
+            let pose = sim.solve(tau).unwrap();
+            let err = (pose.tip_x_mm - x).hypot(pose.tip_y_mm - y);
+            eprintln!("angle {} vs {phi}; ell {}", pose.tip_angle_rad, pose.length_mm);
+            for p in sim.centreline().iter().step_by(6) { eprintln!("{} {} {} {}", p.s_mm, p.u_per_mm, kappa(p.s_mm), p.v1 - v1(p.s_mm)); }
+            assert!(err < 1e-8, "β {beta}: tip ({}, {}) vs ({x}, {y}): {err:e} mm", pose.tip_x_mm, pose.tip_y_mm);
+            assert!((pose.tip_angle_rad - phi).abs() < 1e-10);
+            // The curvature along the centreline is τ d / EI(s).
+            for p in sim.centreline().iter().step_by(7) {
+                assert!((p.u_per_mm - kappa(p.s_mm)).abs() < 1e-7 * kappa(p.s_mm), "s {}: {} vs {}", p.s_mm, p.u_per_mm, kappa(p.s_mm));
+            }
+        }
+    }
+
+    #[test]
+    fn beyond_the_anchor_the_rod_stays_straight_without_gravity() {
+        let (tau, d, anchor) = (1.2, 2.5, 45.0);
+        let mut a = tapered_thesis_rod();
+        a.gravity.enabled = false;
+        a.cable_anchor_mm = Some(anchor);
+        let mut sim = Simulator::new(&a, &SolverOptions::default()).unwrap();
+        sim.set_routing_mm(&[d; 5]).unwrap();
+        let pose = sim.solve(tau).unwrap();
+        let line = sim.centreline();
+        let at_anchor = line.iter().find(|p| p.s_mm > anchor).unwrap();
+        let body = Body::of(&a).unwrap().unwrap();
+        let phi_k = quad(|s| tau * d / body.section_at(s).ei_n_mm2, 0.0, 30.0, 8) + quad(|s| tau * d / body.section_at(s).ei_n_mm2, 30.0, anchor, 8);
+        assert!((pose.tip_angle_rad - phi_k).abs() < 1e-9, "{} vs {phi_k}", pose.tip_angle_rad);
+        for p in line.iter().filter(|p| p.s_mm > anchor) {
+            assert!(p.u_per_mm.abs() < 1e-12 && p.cable_tension_n == 0.0, "{p:?}");
+            assert!((p.tangent_angle_rad - pose.tip_angle_rad).abs() < 1e-12);
+            // On one straight line.
+            let (dx, dy) = (p.x_mm - at_anchor.x_mm, p.y_mm - at_anchor.y_mm);
+            assert!((dx * phi_k.sin() - dy * phi_k.cos()).abs() < 1e-9, "{p:?}");
+        }
+        // A routing spans the cable only: its control points sit on [0, s_k].
+        let r = Routing::for_actuator([d; 5], &a).unwrap();
+        assert_eq!(r.length_mm(), anchor);
+        assert!(Simulator::new(&a, &SolverOptions { method: SolverMethod::Rk4, ..SolverOptions::default() }).is_err());
+    }
+
+    #[test]
+    fn a_tapered_rod_under_its_weight_balances_the_base_moment() {
+        for (profile, direction) in [(vec![(0.0, 7.0), (65.0, 3.0)], 1.0), (vec![(0.0, 6.0), (30.0, 5.0), (65.0, 4.0)], 0.4)] {
+            let mut a = Actuator::default();
+            a.radius_profile_mm = profile;
+            a.gravity.direction_rad = direction;
+            a.gravity.scale = 20.0;
+            a.segments = vec![
+                Segment { end_mm: 40.0, ea_n: None, ga_n: None, ei_n_mm2: None, density_g_cm3: Some(1.5) },
+                Segment { end_mm: 65.0, ea_n: None, ga_n: None, ei_n_mm2: None, density_g_cm3: None },
+            ];
+            let options = SolverOptions { steps_per_span: 2000, ..SolverOptions::default() };
+            let mut sim = Simulator::new(&a, &options).unwrap();
+            sim.set_routing_mm(&[0.0; 5]).unwrap();
+            let pose = sim.solve(0.0).unwrap();
+            let line = sim.centreline();
+            let body = Body::of(&a).unwrap().unwrap();
+            let g = a.gravity.scale * a.gravity.g_m_s2 * 1e-6 * std::f64::consts::PI;
+            let w = |s: f64| g * body.density_at(s) * body.radius_at(s).powi(2);
+            let (c, sn) = (direction.cos(), direction.sin());
+            let (x0, y0) = (line[0].x_mm, line[0].y_mm);
+            // Trapezoid over the centreline (fine: 4001 points).
+            let mut moment = 0.0;
+            for pair in line.windows(2) {
+                let f = |p: &CentrelinePoint| w(p.s_mm) * ((p.y_mm - y0) * c - (p.x_mm - x0) * sn);
+                moment -= 0.5 * (f(&pair[0]) + f(&pair[1])) * (pair[1].s_mm - pair[0].s_mm);
+            }
+            let base = body.section_at(0.0).ei_n_mm2 * line[0].u_per_mm;
+            assert!(pose.tip_y_mm.abs() > 5.0, "the rod should bend: {pose:?}");
+            assert!((base - moment).abs() < 1e-5 * moment.abs(), "base moment {base} vs ∫ w lever {moment}");
+        }
+    }
+
+    #[test]
+    fn a_uniform_profile_and_one_material_match_the_uniform_rod() {
+        // The same spans: agreement to the fixed point's tolerance (the
+        // weight is summed differently, so rounding takes another path; the
+        // sweeps stop at 1e-9 rad, about 1e-7 mm at the tip); an extra
+        // breakpoint at 20 mm changes the discretisation, well below its error.
+        let mut flat = Actuator::default();
+        flat.radius_profile_mm = vec![(0.0, 5.0), (65.0, 5.0)];
+        flat.segments = vec![Segment { end_mm: 65.0, ea_n: None, ga_n: None, ei_n_mm2: None, density_g_cm3: None }];
+        flat.cable_anchor_mm = Some(65.0);
+        let mut split = flat.clone();
+        split.radius_profile_mm = vec![(0.0, 5.0), (20.0, 5.0), (65.0, 5.0)];
+        let route = [1.0, -2.0, 4.0, 4.0, -4.0];
+        let mut poses = Vec::new();
+        for a in [Actuator::default(), flat, split] {
+            let mut sim = Simulator::new(&a, &SolverOptions::default()).unwrap();
+            sim.set_routing_mm(&route).unwrap();
+            poses.push((1..=8).map(|k| sim.solve(0.25 * k as f64).unwrap()).collect::<Vec<_>>());
+        }
+        for (k, tol) in [(1, 1e-6), (2, 1e-6)] {
+            for (p, q) in poses[0].iter().zip(&poses[k]) {
+                assert!((p.tip_x_mm - q.tip_x_mm).abs() < tol && (p.tip_y_mm - q.tip_y_mm).abs() < tol, "{p:?} {q:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn the_real_tentacle_solves_up_to_7_7_n() {
+        // 360 mm, r 15.4 → 6.4 → 4.8 mm, tendon knotted at 305 mm, full gravity.
+        let mut a = Actuator { length_mm: 360.0, cable_anchor_mm: Some(305.0), ..Actuator::default() };
+        a.radius_profile_mm = vec![(0.0, 15.4), (305.0, 6.4), (360.0, 4.8)];
+        let mut sim = Simulator::new(&a, &SolverOptions::default()).unwrap();
+        sim.set_routing_mm(&[4.0; 5]).unwrap();
+        let mut last = None;
+        for k in 1..=31 {
+            last = Some(sim.solve(7.7 * k as f64 / 31.0).unwrap());
+        }
+        let pose = last.unwrap();
+        assert!(pose.tip_angle_rad > 3.0, "{pose:?}");
     }
 }

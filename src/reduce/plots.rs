@@ -341,7 +341,6 @@ mod tests {
             cells: 3,
             tension_range_n: [1.0, 2.0],
             radius_mm: 5.0,
-            radii_mm: Vec::new(),
             length_mm: 65.0,
             run_dir: "test".into(),
             spec_hash: "h".into(),

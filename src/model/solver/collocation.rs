@@ -64,6 +64,9 @@ pub(super) struct Colloc {
     /// and the cable's anchor.
     half: Vec<f64>,
     start: Vec<f64>,
+    /// The cross-section at each node (a span's last node takes a jump
+    /// at its end from the left).
+    section: Vec<super::Section>,
     /// Frame angle φ and gravity's distal moment M at the nodes.
     phi: Vec<f64>,
     mom: Vec<f64>,
@@ -123,6 +126,7 @@ impl Colloc {
             s: vec![0.0; nn],
             half: vec![0.0; spans],
             start: vec![0.0; spans],
+            section: Vec::with_capacity(nn),
             phi: vec![0.0; nn],
             mom: vec![0.0; nn],
             px: vec![0.0; nn],
@@ -485,6 +489,7 @@ impl Simulator {
         let np = c.np();
         let anchor = self.actuator.cable_length_mm();
         self.cable_end = c.s.len();
+        c.section.clear();
         for span in 0..c.spans() {
             // Spans from the anchor on carry no cable (and have no channel).
             let cable = c.start[span] < anchor;
@@ -500,6 +505,7 @@ impl Simulator {
                     _ => c.start[span] + c.half[span] * (1.0 + c.x[j]),
                 };
                 c.s[i] = s;
+                c.section.push(self.section_at_side(s, j == np - 1));
                 self.channel[i] = if cable {
                     let ch = built.channel_at(s.min(built.length_mm()));
                     ChannelSample { y: ch.y_mm, dy: ch.dy_ds }
@@ -587,10 +593,10 @@ impl Simulator {
         for i in 0..c.s.len() {
             let ch = self.channel[i];
             let t = self.tension_at(i, tension);
-            let (e, dir) = self.strains_at(c.s[i], ch, c.trig[i], c.mom[i], t, self.cable_dir[i], self.creep.offset(i))?;
+            let (e, dir) = self.strains_at(c.s[i], &c.section[i], ch, c.trig[i], c.mom[i], t, self.cable_dir[i], self.creep.offset(i))?;
             self.cable_dir[i] = dir;
             if self.creep.is_on() {
-                let ei = self.section_at(c.s[i]).ei_n_mm2;
+                let ei = c.section[i].ei_n_mm2;
                 self.creep.record_moment(i, bending_moment(t, ch.y, dir.0, c.mom[i]), ei);
             }
             c.strain[i] = e;
@@ -855,8 +861,7 @@ impl Simulator {
     /// Strains at a node with their derivatives with respect to φ and M
     /// (implicit function theorem on the cable-direction equation).
     #[allow(clippy::too_many_arguments)]
-    fn colloc_node_partials(&self, s: f64, ch: ChannelSample, (sp, cp): (f64, f64), moment: f64, t: f64, dir: (f64, f64), e: Strains) -> Partials {
-        let section = self.section_at(s);
+    fn colloc_node_partials(&self, s: f64, section: &super::Section, ch: ChannelSample, (sp, cp): (f64, f64), moment: f64, t: f64, dir: (f64, f64), e: Strains) -> Partials {
         let (ea, ga) = (section.ea_n, section.ga_n);
         let wl = self.distal_weight_n(s);
         let (gc, gs) = (self.gravity_cos, self.gravity_sin);
@@ -864,7 +869,7 @@ impl Simulator {
         let w2 = wl * (cp * gs - sp * gc);
         let (ca, sa) = dir;
         let bend = bending_moment(t, ch.y, ca, moment);
-        let (_, du_dm_el) = self.bending_curvature(bend, &section);
+        let (_, du_dm_el) = self.bending_curvature(bend, section);
         let dudm = du_dm_el + self.creep.gain(section.ei_n_mm2);
         let p = e.v1 - e.u * ch.y;
         let q = e.v2 + ch.dy;
@@ -904,7 +909,7 @@ impl Simulator {
         for i in 0..nn {
             let t = self.tension_at(i, tension);
             let e = c.strain[i];
-            parts[i] = self.colloc_node_partials(c.s[i], self.channel[i], c.trig[i], c.mom[i], t, self.cable_dir[i], e);
+            parts[i] = self.colloc_node_partials(c.s[i], &c.section[i], self.channel[i], c.trig[i], c.mom[i], t, self.cable_dir[i], e);
             let (sp, cp) = c.trig[i];
             let dx = e.v1 * cp - e.v2 * sp;
             let dy = e.v1 * sp + e.v2 * cp;
