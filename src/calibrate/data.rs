@@ -732,6 +732,28 @@ mod tests {
     }
 
     #[test]
+    fn the_geometry_header_gives_the_body_and_round_trips() {
+        let mut a = crate::model::Actuator { length_mm: 360.0, cable_anchor_mm: Some(305.0), ..Default::default() };
+        a.radius_profile_mm = vec![(0.0, 15.4), (305.0, 6.4), (360.0, 4.8)];
+        a.effects.friction_mu = 0.3;
+        let header = geometry_header(&a);
+        assert!(header.lines().all(|l| l.starts_with("# ")) && !header.contains("friction"), "{header}");
+        let text = format!("{header}measurement,routing,y0_mm,y1_mm,y2_mm,y3_mm,y4_mm,tension_n,direction,step,dwell_s,tip_x_mm,tip_y_mm,tip_angle_rad\n1,a,0,1,1,1,1,0,rest,0,0,360,0,0\n");
+        let p = Path::new("m.csv");
+        let table = parse_csv(p, &text).unwrap();
+        let body = actuator_of_front_matter(p, &table.front).unwrap().unwrap();
+        assert_eq!((body.length_mm, body.cable_anchor_mm, &body.radius_profile_mm), (360.0, Some(305.0), &a.radius_profile_mm));
+        assert_eq!(body.effects.friction_mu, 0.0);
+        assert_eq!(parse_measurements(p, &table).unwrap().rows.len(), 1);
+        // A bad body in the header is named.
+        let bad = parse_csv(p, "# radius_profile_mm = [[0.0, 5.0], [30.0, -1.0], [65.0, 4.0]]\nmeasurement\n").unwrap();
+        let e = actuator_of_front_matter(p, &bad.front).unwrap_err().to_string();
+        assert!(e.contains("m.csv") && e.contains("geometry header") && e.contains("s = 30 mm"), "{e}");
+        let e = actuator_of_front_matter(p, "lenght_mm = 3\n").unwrap_err().to_string();
+        assert!(e.contains("lenght_mm"), "{e}");
+    }
+
+    #[test]
     fn errors_name_the_row_and_column() {
         let missing = parse("measurement,routing\n1,a\n").unwrap_err().to_string();
         assert!(missing.contains("y0_mm"), "{missing}");

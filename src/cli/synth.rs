@@ -166,8 +166,10 @@ pub fn run(args: &SynthArgs) -> anyhow::Result<()> {
         (None, None) => Vec::new(),
         (Some(_), Some(text)) => parse_markers(text)?,
         (Some(_), None) => {
-            let (l, r) = (actuator.length_mm, actuator.radius_mm);
-            vec![(0.25 * l, r), (0.5 * l, -r), (0.75 * l, r), (l, -r)]
+            // On the surface: r(s) for a tapered body.
+            let l = actuator.length_mm;
+            let r = |f: f64| actuator.radius_at(f * l);
+            vec![(0.25 * l, r(0.25)), (0.5 * l, -r(0.5)), (0.75 * l, r(0.75)), (l, -r(1.0))]
         }
     };
     let spec = SynthSpec {

@@ -1197,6 +1197,26 @@ mod body_tests {
     }
 
     #[test]
+    fn rk4_agrees_with_collocation_on_a_cone_with_gravity() {
+        let mut a = Actuator::default();
+        a.radius_profile_mm = vec![(0.0, 6.5), (65.0, 4.0)];
+        a.effects.stiffness_gradient_beta = -0.5;
+        let rk4 = SolverOptions { method: SolverMethod::Rk4, steps_per_span: 192, ..SolverOptions::default() };
+        let mut sims = [Simulator::new(&a, &SolverOptions::default()).unwrap(), Simulator::new(&a, &rk4).unwrap()];
+        let mut poses = [Vec::new(), Vec::new()];
+        for (sim, out) in sims.iter_mut().zip(&mut poses) {
+            sim.set_routing_mm(&[1.0, -2.0, 3.5, 3.5, -3.5]).unwrap();
+            for k in 1..=8 {
+                out.push(sim.solve(0.25 * k as f64).unwrap());
+            }
+        }
+        for (p, q) in poses[0].iter().zip(&poses[1]) {
+            let tip = (p.tip_x_mm - q.tip_x_mm).hypot(p.tip_y_mm - q.tip_y_mm);
+            assert!(tip < 2e-5 && (p.tip_angle_rad - q.tip_angle_rad).abs() < 1e-6, "{p:?} {q:?}");
+        }
+    }
+
+    #[test]
     fn the_real_tentacle_solves_up_to_7_7_n() {
         // 360 mm, r 15.4 → 6.4 → 4.8 mm, tendon knotted at 305 mm, full gravity.
         let mut a = Actuator { length_mm: 360.0, cable_anchor_mm: Some(305.0), ..Actuator::default() };
