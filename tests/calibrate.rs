@@ -103,7 +103,7 @@ fn diagnose_writes_a_report_with_plots() {
     for key in ["parameter", "parameter_se", "holdout_rms_before", "holdout_rms_after"] {
         assert!(v[key].is_f64(), "{key}: {v}");
     }
-    assert_eq!(v["candidates"].as_array().unwrap().len(), 6);
+    assert_eq!(v["candidates"].as_array().unwrap().len(), 7, "one per candidate effect");
     let md = std::fs::read_to_string(out.join("report.md")).unwrap();
     assert!(md.contains("channel_offset") && md.contains("| rank |") && md.contains("Criterion"), "{md}");
     // Measured and simulated shape coefficients side by side, in the thesis basis.

@@ -126,7 +126,9 @@ pub fn mould_svg(routing: &Routing, radius_mm: f64, channel_diameter_mm: f64, te
 }
 
 /// Writes design.json, channel.csv, mould.svg and shape.png into `dir`
-/// (created if missing).
+/// (created if missing). mould.svg, a drawing of the uniform cylinder's
+/// mould, is left out for a non-uniform body (radius profile, segments,
+/// cable anchor); channel.csv then runs over the cable, [0, s_k].
 pub fn write_all(dir: &Path, objective: &Objective, eval: &Evaluation, record: &DesignRecord) -> Result<(), DesignError> {
     super::run::check_export_dir(dir)?;
     std::fs::create_dir_all(dir).map_err(io_error(format!("creating {}", dir.display())))?;
@@ -139,7 +141,9 @@ pub fn write_all(dir: &Path, objective: &Objective, eval: &Evaluation, record: &
     let routing = Routing::for_actuator(&eval.routing_mm, act)?;
     write("channel.csv", routing.channel_csv().as_bytes())?;
     // The thesis's channel: a PTFE tube of 1 mm outer diameter (§5.2).
-    write("mould.svg", mould_svg(&routing, act.radius_mm, 1.0, eval.tension_n).as_bytes())?;
+    if act.is_uniform_body() {
+        write("mould.svg", mould_svg(&routing, act.radius_mm, 1.0, eval.tension_n).as_bytes())?;
+    }
     shape_png(&dir.join("shape.png"), objective, eval)
 }
 
