@@ -181,6 +181,21 @@ fn next_step(fit: &cablemap::calibrate::FitResult) -> String {
     let a = &fit.actuator;
     let mut flags = vec![format!("--ea-n {}", sig5(a.ea_n)), format!("--ga-n {}", sig5(a.ga_n)), format!("--ei-n-mm2 {}", sig5(a.ei_n_mm2))];
     let mut toml = format!("[actuator]\nea_n = {}\nga_n = {}\nei_n_mm2 = {}\n", sig5(a.ea_n), sig5(a.ga_n), sig5(a.ei_n_mm2));
+    // A non-uniform body stays as it was given (the fitted rigidities are
+    // those of a section of radius radius_mm).
+    if !a.radius_profile_mm.is_empty() {
+        let points: Vec<String> = a.radius_profile_mm.iter().map(|(s, r)| format!("{s}:{r}")).collect();
+        let pairs: Vec<String> = a.radius_profile_mm.iter().map(|(s, r)| format!("[{s}, {r}]")).collect();
+        flags.push(format!("--radius-profile-mm \"{}\"", points.join(",")));
+        toml.push_str(&format!("radius_profile_mm = [{}]\n", pairs.join(", ")));
+    }
+    if let Some(k) = a.cable_anchor_mm {
+        flags.push(format!("--cable-anchor-mm {k}"));
+        toml.push_str(&format!("cable_anchor_mm = {k}\n"));
+    }
+    if !a.segments.is_empty() {
+        toml.push_str("# and the [[actuator.segments]] of the actuator file\n");
+    }
     let mut effects = String::new();
     for e in &fit.effects {
         use cablemap::calibrate::Effect;

@@ -245,7 +245,7 @@ impl Actuator {
     /// Whether the body is the uniform cylinder with the cable knotted at
     /// the tip (the thesis's rod, solved on the fast path).
     pub fn is_uniform_body(&self) -> bool {
-        self.radius_profile_mm.is_empty() && self.segments.is_empty() && self.cable_anchor_mm.map_or(true, |k| k == self.length_mm)
+        self.radius_profile_mm.is_empty() && self.segments.is_empty() && self.cable_anchor_mm.is_none_or(|k| k == self.length_mm)
     }
 
     /// The cable's length along the rod, s_k (mm): the anchor, or L.
