@@ -284,13 +284,14 @@ fn diagnose_names_the_hidden_effect_and_admits_what_it_cannot_name() {
 /// names it where the tip data alone do not.
 #[test]
 fn centrelines_name_effects_at_half_the_magnitude() {
-    let half: [(&str, f64); 6] = [
+    let half: [(&str, f64); 7] = [
         ("friction", 0.04),
         ("gravity", 1.5),
         ("stiffening", 1.5),
         ("clamp_compliance", 40.0),
         ("channel_offset", 0.2),
         ("creep", 0.1),
+        ("stiffness_gradient", -0.5 * std::f64::consts::LN_2),
     ];
     let mut jobs: Vec<Job> = half.iter().flat_map(|&(e, m)| [(e, m, 11, false), (e, m, 11, true)]).collect();
     jobs.push(("clamp_compliance", 150.0, 11, false));
