@@ -129,7 +129,7 @@ pub struct Body {
 }
 
 /// Distinct breakpoints closer than this (relative to L) are merged.
-const MERGE_TOLERANCE: f64 = 1e-9;
+pub(crate) const MERGE_TOLERANCE: f64 = 1e-9;
 
 impl Body {
     /// Resolves and checks the body of `a`; `None` for the uniform cylinder

@@ -1231,3 +1231,27 @@ mod body_tests {
         assert!(pose.tip_angle_rad > 3.0, "{pose:?}");
     }
 }
+
+#[cfg(test)]
+mod anchor_edge_tests {
+    use super::*;
+
+    /// An anchor a hair above a profile point is merged with it: the span
+    /// from there on carries no cable, as with the anchor exactly there.
+    #[test]
+    fn an_anchor_merged_into_a_breakpoint_ends_the_cable_there() {
+        let mut poses = Vec::new();
+        for anchor in [50.0, 50.0 + 1e-12] {
+            let mut a = Actuator::default();
+            a.gravity.enabled = false;
+            a.radius_profile_mm = vec![(0.0, 6.0), (50.0, 5.0), (65.0, 4.0)];
+            a.cable_anchor_mm = Some(anchor);
+            let mut sim = Simulator::new(&a, &SolverOptions::default()).unwrap();
+            sim.set_routing_mm(&[2.0; 5]).unwrap();
+            let pose = sim.solve(1.0).unwrap();
+            assert!(sim.centreline().iter().filter(|p| p.s_mm > 50.5).all(|p| p.u_per_mm == 0.0));
+            poses.push(pose);
+        }
+        assert!((poses[0].tip_angle_rad - poses[1].tip_angle_rad).abs() < 1e-9, "{poses:?}");
+    }
+}

@@ -488,11 +488,14 @@ impl Simulator {
         }
         let np = c.np();
         let anchor = self.actuator.cable_length_mm();
+        // Boundaries closer than this were merged (the anchor may have been
+        // merged into a breakpoint just below it).
+        let merged = crate::model::body::MERGE_TOLERANCE * self.actuator.length_mm;
         self.cable_end = c.s.len();
         c.section.clear();
         for span in 0..c.spans() {
             // Spans from the anchor on carry no cable (and have no channel).
-            let cable = c.start[span] < anchor;
+            let cable = c.start[span] + merged < anchor;
             if !cable && self.cable_end == c.s.len() {
                 self.cable_end = span * np;
             }
