@@ -54,18 +54,39 @@ pub fn is_temp_of(name: &str, final_name: &str) -> bool {
 /// the lock to tell a live writer's file from a killed writer's: the
 /// kernel drops the lock when the process dies, whatever pid namespace it
 /// ran in.
+///
+/// The file appears under `path` only once locked: it is created under
+/// `path` + [`CREATING_SUFFIX`], locked, then renamed. Otherwise another
+/// process cleaning up (another shard, a rerun) could find it unlocked in
+/// the instant between creation and locking, or hold the lock for that
+/// instant itself, and take a live writer's file for a killed one's.
 pub fn create_locked(path: &Path) -> std::io::Result<File> {
-    let file = File::create(path)?;
-    // A file system without locks falls back on the age rule.
-    let _ = file.try_lock();
+    let mut creating = path.as_os_str().to_owned();
+    creating.push(CREATING_SUFFIX);
+    let creating = PathBuf::from(creating);
+    let file = File::create(&creating)?;
+    // Nobody else locks a file being created. A file system without locks
+    // falls back on the age rule.
+    let _ = file.lock();
+    if let Err(e) = std::fs::rename(&creating, path) {
+        let _ = std::fs::remove_file(&creating);
+        return Err(e);
+    }
     Ok(file)
 }
+
+/// Ends the name of a temporary file while [`create_locked`] takes its
+/// lock; such a file counts as abandoned only by the age rule.
+pub const CREATING_SUFFIX: &str = "-new";
 
 /// Whether the temporary file at `path` was left by a writer that is gone:
 /// nobody holds its lock ([`create_locked`]), or, where locks are not
 /// supported, it is older than [`STALE_TEMP_S`]. A file that vanished is
 /// not abandoned (its writer renamed it into place).
 pub fn is_abandoned(path: &Path) -> bool {
+    if path.as_os_str().to_string_lossy().ends_with(CREATING_SUFFIX) {
+        return is_stale(path);
+    }
     let Ok(file) = File::open(path) else { return false };
     match file.try_lock() {
         Ok(()) => true,
@@ -270,6 +291,25 @@ mod tests {
             eprintln!("WARNING: this file system cannot exchange atomically; maps are replaced by two renames");
             assert!(a.join("from_a").exists() && b.join("from_b").exists());
         }
+    }
+
+    #[test]
+    fn a_temporary_is_locked_before_it_appears_under_its_name() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = temp_path(&dir.path().join("chunk.parquet"));
+        let file = create_locked(&path).unwrap();
+        let names: Vec<String> = std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+        assert_eq!(names, vec![path.file_name().unwrap().to_string_lossy().into_owned()], "no creating-name file is left");
+        assert!(!is_abandoned(&path), "a live writer's temporary is locked from the start");
+        drop(file);
+        assert!(is_abandoned(&path));
+        // A file still being created (unlocked for an instant) is left alone
+        // unless it is old: a killed writer's.
+        let mut creating = path.as_os_str().to_owned();
+        creating.push(CREATING_SUFFIX);
+        std::fs::write(&creating, b"").unwrap();
+        assert!(!is_abandoned(Path::new(&creating)));
+        assert!(is_temp_of(&Path::new(&creating).file_name().unwrap().to_string_lossy(), "chunk.parquet"));
     }
 
     #[test]
