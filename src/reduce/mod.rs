@@ -707,6 +707,22 @@ mod tests {
     }
 
     #[test]
+    fn the_tables_do_not_depend_on_the_memory_bound() {
+        // Bounds from one sample (a partition per cell) to all of them in
+        // memory, mirrored and not, quantile and explicit modes.
+        let rows = pseudo_rows(3000);
+        for mirrored in [false, true] {
+            for boundaries in [None, Some(ModeBoundaries { a0: [-0.2, 0.0, 0.2], a1: [-0.1, 0.1] })] {
+                let options = |memory_samples| ReduceOptions { memory_samples, mode_boundaries: boundaries, ..Default::default() };
+                let reference = format!("{:?}", run(&rows, mirrored, &options(usize::MAX)));
+                for memory_samples in [1, 7, 100, 1000] {
+                    assert_eq!(format!("{:?}", run(&rows, mirrored, &options(memory_samples))), reference, "memory {memory_samples}");
+                }
+            }
+        }
+    }
+
+    #[test]
     fn mirroring_doubles_all_but_the_self_mirror_routing() {
         let mut rows = pseudo_rows(100);
         rows.push(([0.0; 5], 1.5, "ok", 60.0, 0.2, [0.0, 0.0, 0.0]));

@@ -178,8 +178,28 @@ pub fn write_part(run_dir: &Path, map_dir: &Path, shard: u64, shards: u64) -> Re
         pass1: pass1.clone(),
     };
     let json = serde_json::to_vec_pretty(&record).expect("a part record serializes");
-    crate::io::write_atomic(&record_path, &json).map_err(|source| PartsError::Io { path: record_path.clone(), source })?;
+    remove_abandoned_temps(&dir, &record_path);
+    write_locked_atomic(&record_path, &json).map_err(|source| PartsError::Io { path: record_path.clone(), source })?;
     Ok(PartReport { record: record_path, chunks: end - first, rows: pass1.rows_read, samples: pass1.samples })
+}
+
+/// Writes `bytes` to `path` by a locked temporary (so that another copy of
+/// the part can tell it from a killed writer's), synced and renamed.
+fn write_locked_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    use std::io::Write;
+    let tmp = crate::io::temp_path(path);
+    let written = (|| {
+        let mut f = crate::io::create_locked(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    if written.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    written?;
+    crate::io::sync_dir(path.parent().unwrap_or(Path::new(".")));
+    Ok(())
 }
 
 /// Removes temporaries of `final_path` left by killed writers.
