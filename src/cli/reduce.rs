@@ -35,7 +35,8 @@ pub struct MapOptionArgs {
 }
 
 impl MapOptionArgs {
-    fn options(&self) -> anyhow::Result<ReduceOptions> {
+    /// The reduce options these arguments give.
+    pub fn options(&self) -> anyhow::Result<ReduceOptions> {
         let mode_boundaries = match (&self.a0_bounds, &self.a1_bounds) {
             (None, None) => None,
             (Some(a0), Some(a1)) => {
@@ -219,6 +220,12 @@ pub struct MapArgs {
 
 /// Runs `cablemap map`: the sweep (resumable) then the reduction.
 pub fn run_map(args: &MapArgs) -> anyhow::Result<()> {
+    if let Some(path) = args.spec.as_deref().filter(|p| std::fs::read_to_string(p).is_ok_and(|t| cablemap::study::is_study_toml(&t))) {
+        // A study spec: one sweep and map per variant, then the comparison.
+        let study = cablemap::study::StudySpec::load(path)?;
+        let threads = super::sweep::thread_count(args.threads)?;
+        return super::study::run_study(&study, path, &args.out, None, false, threads, args.allow_large, &args.map);
+    }
     let spec = super::sweep::load_spec(args.spec.as_deref())?;
     let threads = super::sweep::thread_count(args.threads)?;
     let options = SweepOptions { shard: 0, shards: 1, threads, progress: ProgressMode::Auto, allow_large: args.allow_large };
