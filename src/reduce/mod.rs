@@ -478,19 +478,17 @@ where
 {
     check_options(info, options)?;
     let scratch = spill::ScratchDir::new(&options.scratch_parent())?;
-    let path = scratch.path.join("samples");
-    let mut out = spill::SpillWriter::create(&path)?;
+    let mut out = spill::SampleSink::new(&scratch.path.join("samples"), options.memory_samples);
     let pass1 = samples::spill_samples(info, batches()?, 0, &mut out)?;
-    out.finish(false)?;
-    reduce_spilled(info, options, &[path], &pass1, &scratch.path, batches)
+    reduce_spilled(info, options, out.finish()?, &pass1, &scratch.path, batches)
 }
 
-/// The reduction after pass 1: from the samples in the scratch `files`
-/// (pass 1's results `pass1`), with pass 2 over `batches`.
+/// The reduction after pass 1: from its `samples` (in memory or in scratch
+/// files) and results `pass1`, with pass 2 over `batches`.
 fn reduce_spilled<F, I>(
     info: &RunInfo,
     options: &ReduceOptions,
-    files: &[PathBuf],
+    samples: spill::Samples,
     pass1: &samples::Pass1,
     scratch: &std::path::Path,
     mut batches: F,
@@ -503,11 +501,11 @@ where
     if pass1.samples == 0 {
         return Err(ReduceError::Empty { failed: tally.rows_failed() });
     }
-    let split = modes::split(files, options.mode_boundaries)?;
+    let split = modes::split(&samples, options.mode_boundaries)?;
     let grid = grid::Grid::spanning(&pass1.extent, options.cell_mm)?;
     let nk = info.order.min(CELL_STATS_ORDER) + 1;
     let setup = partition::CellSetup { grid: &grid, split: &split, nk, designs_per_cell: options.designs_per_cell };
-    let tabulated = partition::tabulate(files, pass1.samples, &setup, options.memory_samples, scratch)?;
+    let tabulated = partition::tabulate(samples, pass1.samples, &setup, options.memory_samples, scratch)?;
     let (cells, representatives) = (tabulated.cells, tabulated.representatives);
     let rows_converged = pass1.samples;
     let wanted = cells.picks.iter().map(|p| p.at).chain(representatives.iter().flatten().copied());

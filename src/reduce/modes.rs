@@ -4,9 +4,9 @@
 
 use super::cells::CellTable;
 use super::samples::{RowRef, Sample};
-use super::{select, spill};
+use super::select;
+use super::spill::Samples;
 use super::{Design, ModeBoundaries, ModeStats, ReduceError, MODES};
-use std::path::PathBuf;
 
 /// The boundaries used and the spreads that scale distances between modes.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -21,14 +21,14 @@ pub(crate) struct ModeSplit {
 
 /// Splits the run's simulations into modes: by `explicit` boundaries, or by
 /// quantiles of a_0 (25/50/75 %) and a_1 (1/3, 2/3). The samples are read
-/// from the scratch `files` (not empty).
-pub(crate) fn split(files: &[PathBuf], explicit: Option<ModeBoundaries>) -> Result<ModeSplit, ReduceError> {
+/// from `samples` (not empty).
+pub(crate) fn split(samples: &Samples, explicit: Option<ModeBoundaries>) -> Result<ModeSplit, ReduceError> {
     // Quantiles of a_0 and a_1 over the converged rows, exact (by
     // selection): they give the default mode boundaries and the spreads
     // (interquartile ranges) that scale the distance to a mode's median.
     let requests = [(0, 0.25), (0, 0.5), (0, 0.75), (1, 0.25), (1, 1.0 / 3.0), (1, 2.0 / 3.0), (1, 0.75)];
     let (q, _) = select::quantiles(2, &requests, |f| {
-        spill::for_each(files, |s| {
+        samples.for_each(|s| {
             f(0, s.a[0]);
             f(1, s.a[1]);
         })
@@ -59,12 +59,12 @@ pub(crate) struct Nearest {
 }
 
 impl Nearest {
-    /// Finds the modes' medians (exactly, by selection over the scratch `files`).
-    pub fn new(files: &[PathBuf], split: &ModeSplit) -> Result<Self, ReduceError> {
+    /// Finds the modes' medians (exactly, by selection over `samples`).
+    pub fn new(samples: &Samples, split: &ModeSplit) -> Result<Self, ReduceError> {
         let requests: Vec<(usize, f64)> = (0..2 * MODES).map(|g| (g, 0.5)).collect();
         let b = split.boundaries;
         let (q, _) = select::quantiles(2 * MODES, &requests, |f| {
-            spill::for_each(files, |s| {
+            samples.for_each(|s| {
                 let m = b.mode(s.a[0], s.a[1]);
                 f(2 * m, s.a[0]);
                 f(2 * m + 1, s.a[1]);

@@ -9,7 +9,7 @@ use super::cells::{self, CellTable};
 use super::grid::Grid;
 use super::modes::{ModeSplit, Nearest};
 use super::samples::{RowRef, Sample};
-use super::spill::{self, SpillWriter};
+use super::spill::{self, Samples, SpillWriter};
 use super::{ReduceError, MODES};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -37,17 +37,17 @@ pub(crate) struct CellSetup<'a> {
     pub designs_per_cell: usize,
 }
 
-/// Tabulates the `total` samples of the scratch `files`, holding at most
-/// `memory_samples` at a time (more only when one cell alone has more),
-/// writing partitions to `scratch`.
+/// Tabulates the `total` samples, holding at most `memory_samples` at a
+/// time (more only when one cell alone has more), writing partitions to
+/// `scratch`.
 pub(crate) fn tabulate(
-    files: &[PathBuf],
+    samples: Samples,
     total: u64,
     setup: &CellSetup,
     memory_samples: usize,
     scratch: &Path,
 ) -> Result<Tabulated, ReduceError> {
-    let mut nearest = Nearest::new(files, setup.split)?;
+    let mut nearest = Nearest::new(&samples, setup.split)?;
     let mut table = CellTable::default();
     let mut absorb = |samples: &mut Vec<Sample>| {
         for s in samples.iter() {
@@ -61,15 +61,17 @@ pub(crate) fn tabulate(
         }
     };
     let memory_samples = memory_samples.max(1);
-    if total <= memory_samples as u64 {
-        let mut samples = Vec::with_capacity(total as usize);
-        spill::for_each(files, |s| samples.push(*s))?;
-        absorb(&mut samples);
+    if let Samples::Memory(mut all) = samples {
+        absorb(&mut all);
+    } else if total <= memory_samples as u64 {
+        let mut all = Vec::with_capacity(total as usize);
+        samples.for_each(|s| all.push(*s))?;
+        absorb(&mut all);
     } else {
         // Counting pass: samples per cell, then cuts between cells so that
         // each partition holds at most `memory_samples`.
         let mut counts: HashMap<(i32, i32), u64> = HashMap::new();
-        spill::for_each(files, |s| *counts.entry(setup.grid.cell_of(s.x_mm, s.y_mm)).or_default() += 1)?;
+        samples.for_each(|s| *counts.entry(setup.grid.cell_of(s.x_mm, s.y_mm)).or_default() += 1)?;
         let mut keys: Vec<((i32, i32), u64)> = counts.into_iter().collect();
         keys.sort_unstable();
         let mut cuts: Vec<(i32, i32)> = Vec::new();
@@ -86,7 +88,7 @@ pub(crate) fn tabulate(
         let paths: Vec<PathBuf> = (0..partitions).map(|p| scratch.join(format!("partition-{p}"))).collect();
         let mut writers = paths.iter().map(|p| SpillWriter::with_buffer(p, PARTITION_BUFFER_BYTES)).collect::<Result<Vec<_>, _>>()?;
         let mut failed = None;
-        spill::for_each(files, |s| {
+        samples.for_each(|s| {
             let key = setup.grid.cell_of(s.x_mm, s.y_mm);
             let p = cuts.partition_point(|c| *c <= key);
             if let Err(e) = writers[p].push(s, false) {

@@ -294,7 +294,7 @@ pub fn merge_parts(run_dir: &Path, map_dir: &Path, options: &ReduceOptions) -> R
     let scratch = spill::ScratchDir::new(&options.scratch_parent())?;
     let names = columns::RowColumns::names(info.order);
     let names: Vec<&str> = names.iter().map(String::as_str).collect();
-    let map = super::reduce_spilled(&info, options, &files, &pass1, &scratch.path, || {
+    let map = super::reduce_spilled(&info, options, spill::Samples::Files(files), &pass1, &scratch.path, || {
         Ok(run.batches_projected(&names)?.map(|b| b.map_err(ReduceError::from)))
     })?;
     Ok((map, run.spec().clone()))

@@ -5,7 +5,7 @@
 
 use super::columns::RowColumns;
 use super::mirror::{copies, Mirror};
-use super::spill::{Extent, SpillWriter};
+use super::spill::{Extent, SampleOut};
 use super::{ReduceError, RunInfo, CELL_STATS_ORDER};
 use arrow::record_batch::RecordBatch;
 use std::collections::BTreeMap;
@@ -88,7 +88,7 @@ pub(crate) fn spill_samples(
     info: &RunInfo,
     batches: impl Iterator<Item = Result<RecordBatch, ReduceError>>,
     first_row: u32,
-    out: &mut SpillWriter,
+    out: &mut impl SampleOut,
 ) -> Result<Pass1, ReduceError> {
     let nk = info.order.min(CELL_STATS_ORDER) + 1;
     let mut pass = Pass1::default();

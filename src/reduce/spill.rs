@@ -109,6 +109,87 @@ impl SpillWriter {
     }
 }
 
+/// Where pass 1 put a run's samples: in memory (a run within the memory
+/// bound: no scratch file at all) or in scratch files.
+pub(crate) enum Samples {
+    /// Every sample, mirror images included.
+    Memory(Vec<Sample>),
+    /// Scratch files, read in order.
+    Files(Vec<PathBuf>),
+}
+
+impl Samples {
+    /// Calls `f` with every sample (the same sequence each time).
+    pub fn for_each(&self, mut f: impl FnMut(&Sample)) -> Result<(), ReduceError> {
+        match self {
+            Samples::Memory(v) => {
+                v.iter().for_each(f);
+                Ok(())
+            }
+            Samples::Files(paths) => for_each(paths, &mut f),
+        }
+    }
+}
+
+/// Where pass 1 writes samples.
+pub(crate) trait SampleOut {
+    /// Takes sample `s`, and its mirror image when `with_mirror`.
+    fn push(&mut self, s: &Sample, with_mirror: bool) -> Result<(), ReduceError>;
+}
+
+impl SampleOut for SpillWriter {
+    fn push(&mut self, s: &Sample, with_mirror: bool) -> Result<(), ReduceError> {
+        SpillWriter::push(self, s, with_mirror)
+    }
+}
+
+/// Pass 1's samples kept in memory up to a bound; beyond it, all of them go
+/// to a scratch file.
+pub(crate) struct SampleSink {
+    limit: usize,
+    memory: Vec<Sample>,
+    path: PathBuf,
+    writer: Option<SpillWriter>,
+}
+
+impl SampleSink {
+    /// Keeps up to `limit` samples in memory, then spills to `path`.
+    pub fn new(path: &Path, limit: usize) -> Self {
+        Self { limit, memory: Vec::with_capacity(limit.saturating_add(2).min(1 << 16)), path: path.to_path_buf(), writer: None }
+    }
+
+    /// The samples taken.
+    pub fn finish(self) -> Result<Samples, ReduceError> {
+        match self.writer {
+            Some(w) => {
+                w.finish(false)?;
+                Ok(Samples::Files(vec![self.path]))
+            }
+            None => Ok(Samples::Memory(self.memory)),
+        }
+    }
+}
+
+impl SampleOut for SampleSink {
+    fn push(&mut self, s: &Sample, with_mirror: bool) -> Result<(), ReduceError> {
+        if let Some(w) = &mut self.writer {
+            return w.push(s, with_mirror);
+        }
+        self.memory.push(*s);
+        if with_mirror {
+            self.memory.push(s.mirror());
+        }
+        if self.memory.len() > self.limit {
+            let mut w = SpillWriter::create(&self.path)?;
+            for m in std::mem::take(&mut self.memory) {
+                w.push(&m, false)?;
+            }
+            self.writer = Some(w);
+        }
+        Ok(())
+    }
+}
+
 /// Calls `f` with every sample of the files, in file order, each stored
 /// sample followed by its restored mirror image.
 pub(crate) fn for_each(files: &[PathBuf], mut f: impl FnMut(&Sample)) -> Result<(), ReduceError> {
