@@ -6,7 +6,9 @@
 # checks the result equals a single-process run (the chunk files are byte for
 # byte the same: chunking does not depend on the shard count); then runs the
 # whole chain (jobs/slurm/chain.sh: sweep array → reduce array → merge, by
-# afterok dependencies) and checks its map equals `cablemap map`'s; stops the
+# afterok dependencies) and checks its map equals `cablemap map`'s; runs a
+# 2 × 2 study as a 2-task array (jobs/slurm/study.sbatch) then its comparison
+# and checks both equal `cablemap study` in one process; stops the
 # daemons it started. Skips with a message, successfully, when the packages
 # cannot be installed. About a minute on a clean machine.
 set -euo pipefail
@@ -127,3 +129,35 @@ done
 diff <(grep -v '"run_dir"' "$work/single-map/map/summary.json") <(grep -v '"run_dir"' "$chain/map/summary.json") \
     || { echo "slurm-local: the chain's summary.json differs from cablemap map's"; exit 1; }
 echo "slurm-local: sweep → reduce → merge chain's map equals cablemap map's ($(ls "$chain/map.parts" | grep -c json) reduce parts)"
+
+# A 2 × 2 study of the quick grid as a 2-task array, then the comparison
+# after it (afterok); equal to the study run in one process.
+cat >"$work/study.toml" <<'TOML'
+[grid]
+levels = 3
+[tension]
+count = 5
+[output]
+chunk_routings = 16
+[study]
+[[study.axis]]
+name = "length_mm"
+values = [55.0, 75.0]
+[[study.axis]]
+name = "ei_n_mm2"
+scale = [0.8, 1.25]
+TOML
+study_job=$(SPEC="$work/study.toml" OUT="$work/study" CABLEMAP="$bin" sbatch --parsable --array=0-1 --cpus-per-task=1 --mem=0 \
+    --time=5 --chdir="$root" --output="$work/logs/%x-%A_%a.out" jobs/slurm/study.sbatch)
+sbatch --wait --dependency=afterok:"${study_job%%;*}" --kill-on-invalid-dep=yes --time=5 --mem=0 --chdir="$root" \
+    --output="$work/logs/study-compare-%j.out" --wrap "$bin study $work/study.toml --out $work/study --compare" \
+    || { echo "slurm-local: the study job failed"; cat "$work"/logs/*study*.out; exit 1; }
+cat "$work"/logs/cablemap-study-*.out
+"$bin" study "$work/study.toml" --out "$work/study-single" >/dev/null
+cmp "$work/study/comparison.csv" "$work/study-single/comparison.csv" || { echo "slurm-local: the study's comparison differs"; exit 1; }
+for i in 0 1 2 3; do
+    for t in cells.parquet modes.parquet designs.parquet; do
+        cmp -s "$work/study/v$i/map/$t" "$work/study-single/v$i/map/$t" || { echo "slurm-local: study variant $i's $t differs"; exit 1; }
+    done
+done
+echo "slurm-local: the study as a 2-task array then --compare equals cablemap study in one process (4 variants)"

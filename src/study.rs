@@ -558,7 +558,7 @@ impl Comparison {
         let mut h = format!(
             "<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>Study: {name}</title>\n<style>\
              body{{font-family:sans-serif;margin:1.5em}} table{{border-collapse:collapse}} td,th{{border:1px solid #ccc;padding:3px 6px;text-align:right}}\
-             td.l{{text-align:left}} .row{{display:flex;gap:1em;overflow-x:auto}} .v{{flex:0 0 auto;width:360px}} .v img{{width:100%;border:1px solid #ddd}}\
+             td.l{{text-align:left}} .row{{display:flex;flex-wrap:wrap;gap:1em}} .v{{flex:0 0 auto;width:360px}} .v img{{width:100%;border:1px solid #ddd}}\
              </style></head><body>\n<h1>Study: {name}</h1>\n<p>{n} variants, each a sweep and its feasibility map (<code>cablemap study</code>). \
              Areas are non-empty cells × cell area; mode areas count the cells where the mode occurs; a<sub>0</sub>, a<sub>1</sub> in mm⁻¹.</p>\n",
             name = esc(&self.name),
