@@ -172,7 +172,11 @@ pub struct Variant {
 impl Variant {
     /// `axis=value, …`.
     pub fn label(&self) -> String {
-        self.settings.iter().map(|s| format!("{}={}", s.axis, s.value)).collect::<Vec<_>>().join(", ")
+        self.settings
+            .iter()
+            .map(|s| format!("{}={}", s.axis, s.value))
+            .collect::<Vec<_>>()
+            .join(", ")
     }
 
     /// The variant's directory in the study directory `dir`.
@@ -222,20 +226,30 @@ fn fmt(v: f64) -> String {
 impl StudySpec {
     /// Reads a study spec file.
     pub fn load(path: &Path) -> Result<Self, StudyError> {
-        let text = crate::io::read_utf8(path).map_err(|source| StudyError::Io { path: path.to_path_buf(), source })?;
+        let text = crate::io::read_utf8(path).map_err(|source| StudyError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
         Self::from_toml(&text, &path.display().to_string())
     }
 
     /// Parses a study spec; `origin` names it in errors.
     pub fn from_toml(text: &str, origin: &str) -> Result<Self, StudyError> {
-        let bad = |message: String| StudyError::Spec { origin: origin.to_string(), message };
+        let bad = |message: String| StudyError::Spec {
+            origin: origin.to_string(),
+            message,
+        };
         let mut table: toml::Table = text.parse().map_err(|e: toml::de::Error| bad(e.to_string()))?;
-        let section = table.remove("study").ok_or_else(|| bad("no [study] section: a study spec is a sweep spec with a [study] section naming its axes".into()))?;
+        let section = table
+            .remove("study")
+            .ok_or_else(|| bad("no [study] section: a study spec is a sweep spec with a [study] section naming its axes".into()))?;
         let section: StudySection = section.try_into().map_err(|e: toml::de::Error| bad(format!("[study] {e}")))?;
         let base_text = toml::to_string(&table).map_err(|e| bad(e.to_string()))?;
         let base = SweepSpec::from_toml(&base_text, origin).map_err(|e| bad(format!("the base sweep spec: {e}")))?;
         if section.axis.is_empty() {
-            return Err(bad("[study] has no [[study.axis]]: give at least one axis (name and values or scale)".into()));
+            return Err(bad(
+                "[study] has no [[study.axis]]: give at least one axis (name and values or scale)".into(),
+            ));
         }
         let mut axes: Vec<(String, Vec<(String, Change)>)> = Vec::new();
         for a in &section.axis {
@@ -244,11 +258,17 @@ impl StudySpec {
                 return Err(bad(format!("[[study.axis]] {}: no values", a.name)));
             }
             if axes.iter().any(|(n, _)| *n == a.name) {
-                return Err(bad(format!("[[study.axis]] {} is given twice: give each axis once, with all its values", a.name)));
+                return Err(bad(format!(
+                    "[[study.axis]] {} is given twice: give each axis once, with all its values",
+                    a.name
+                )));
             }
             axes.push((a.name.clone(), changes));
         }
-        let count = axes.iter().try_fold(1usize, |n, (_, v)| n.checked_mul(v.len())).filter(|&n| n <= MAX_VARIANTS);
+        let count = axes
+            .iter()
+            .try_fold(1usize, |n, (_, v)| n.checked_mul(v.len()))
+            .filter(|&n| n <= MAX_VARIANTS);
         let Some(count) = count else {
             return Err(bad(format!("the axes give more than {MAX_VARIANTS} variants: use fewer values")));
         };
@@ -267,20 +287,36 @@ impl StudySpec {
             for ((name, values), &pick) in axes.iter().zip(&picks) {
                 let (value, change) = &values[pick];
                 apply(&mut json, change);
-                settings.push(Setting { axis: name.clone(), value: value.clone() });
+                settings.push(Setting {
+                    axis: name.clone(),
+                    value: value.clone(),
+                });
             }
-            let label = settings.iter().map(|s| format!("{}={}", s.axis, s.value)).collect::<Vec<_>>().join(", ");
+            let label = settings
+                .iter()
+                .map(|s| format!("{}={}", s.axis, s.value))
+                .collect::<Vec<_>>()
+                .join(", ");
             let spec: SweepSpec = serde_json::from_value(json).map_err(|e| bad(format!("variant {index} ({label}): {e}")))?;
             spec.validate().map_err(|source| StudyError::Variant {
                 origin: origin.to_string(),
                 index,
                 label: label.clone(),
-                source: crate::sweep::SweepError::BadSpec { origin: format!("variant {index}"), source },
+                source: crate::sweep::SweepError::BadSpec {
+                    origin: format!("variant {index}"),
+                    source,
+                },
             })?;
             variants.push(Variant { index, settings, spec });
         }
-        let name = section.name.unwrap_or_else(|| axes.iter().map(|(n, _)| n.as_str()).collect::<Vec<_>>().join(" × "));
-        Ok(Self { name, axes: axes.iter().map(|(n, v)| (n.clone(), v.len())).collect(), variants })
+        let name = section
+            .name
+            .unwrap_or_else(|| axes.iter().map(|(n, _)| n.as_str()).collect::<Vec<_>>().join(" × "));
+        Ok(Self {
+            name,
+            axes: axes.iter().map(|(n, v)| (n.clone(), v.len())).collect(),
+            variants,
+        })
     }
 
     /// The labelled changes of one axis.
@@ -291,7 +327,10 @@ impl StudySpec {
                 (Some(values), None) => values
                     .iter()
                     .map(|v| {
-                        let x = v.as_float().or_else(|| v.as_integer().map(|i| i as f64)).ok_or_else(|| format!("value {v} is not a number"))?;
+                        let x = v
+                            .as_float()
+                            .or_else(|| v.as_integer().map(|i| i as f64))
+                            .ok_or_else(|| format!("value {v} is not a number"))?;
                         Ok((fmt(x), Change::Number { key, value: x }))
                     })
                     .collect(),
@@ -311,11 +350,19 @@ impl StudySpec {
         }
         match a.name.as_str() {
             "tension_n" => {
-                let values = a.values.as_ref().filter(|_| a.scale.is_none()).ok_or("give values = [[min_n, max_n], ...] (no scale)")?;
+                let values = a
+                    .values
+                    .as_ref()
+                    .filter(|_| a.scale.is_none())
+                    .ok_or("give values = [[min_n, max_n], ...] (no scale)")?;
                 values
                     .iter()
                     .map(|v| {
-                        let pair: Option<Vec<f64>> = v.as_array().map(|p| p.iter().filter_map(|x| x.as_float().or_else(|| x.as_integer().map(|i| i as f64))).collect());
+                        let pair: Option<Vec<f64>> = v.as_array().map(|p| {
+                            p.iter()
+                                .filter_map(|x| x.as_float().or_else(|| x.as_integer().map(|i| i as f64)))
+                                .collect()
+                        });
                         match pair.as_deref() {
                             Some(&[lo, hi]) if v.as_array().is_some_and(|p| p.len() == 2) => {
                                 Ok((format!("{}–{} N", fmt(lo), fmt(hi)), Change::Tension { min_n: lo, max_n: hi }))
@@ -326,14 +373,27 @@ impl StudySpec {
                     .collect()
             }
             "effects" => {
-                let values = a.values.as_ref().filter(|_| a.scale.is_none()).ok_or("give values = [{...}, ...] (tables of [actuator.effects] settings; no scale)")?;
+                let values = a
+                    .values
+                    .as_ref()
+                    .filter(|_| a.scale.is_none())
+                    .ok_or("give values = [{...}, ...] (tables of [actuator.effects] settings; no scale)")?;
                 values
                     .iter()
                     .map(|v| {
-                        let t = v.as_table().ok_or_else(|| format!("value {v} is not a table of [actuator.effects] settings"))?;
+                        let t = v
+                            .as_table()
+                            .ok_or_else(|| format!("value {v} is not a table of [actuator.effects] settings"))?;
                         let json = serde_json::to_value(t).map_err(|e| e.to_string())?;
-                        let label = if t.is_empty() { "none".to_string() } else { t.iter().map(|(k, v)| format!("{k}:{v}")).collect::<Vec<_>>().join(" ") };
-                        Ok((format!("{{{label}}}"), Change::Effects(json.as_object().cloned().unwrap_or_default())))
+                        let label = if t.is_empty() {
+                            "none".to_string()
+                        } else {
+                            t.iter().map(|(k, v)| format!("{k}:{v}")).collect::<Vec<_>>().join(" ")
+                        };
+                        Ok((
+                            format!("{{{label}}}"),
+                            Change::Effects(json.as_object().cloned().unwrap_or_default()),
+                        ))
                     })
                     .collect()
             }
@@ -446,15 +506,31 @@ pub fn run_variant(
     reduce: &crate::reduce::ReduceOptions,
 ) -> Result<VariantRun, StudyError> {
     let start = std::time::Instant::now();
-    let options = crate::sweep::SweepOptions { shard: 0, shards: 1, ..sweep.clone() };
+    let options = crate::sweep::SweepOptions {
+        shard: 0,
+        shards: 1,
+        ..sweep.clone()
+    };
     let run = v.run_dir(dir);
-    let summary = crate::sweep::run_sweep(&v.spec, &run, &options).map_err(|source| StudyError::Sweep { index: v.index, label: v.label(), source })?;
-    let reduce_err = |source| StudyError::Reduce { index: v.index, label: v.label(), source };
+    let summary = crate::sweep::run_sweep(&v.spec, &run, &options).map_err(|source| StudyError::Sweep {
+        index: v.index,
+        label: v.label(),
+        source,
+    })?;
+    let reduce_err = |source| StudyError::Reduce {
+        index: v.index,
+        label: v.label(),
+        source,
+    };
     let mut reduce = reduce.clone();
     reduce.scratch_dir.get_or_insert_with(|| v.dir(dir));
     let (map, spec) = crate::reduce::reduce_run(&run, false, &reduce).map_err(reduce_err)?;
     crate::reduce::write_map_replacing(&v.map_dir(dir), &map, &spec.actuator, &spec.solver).map_err(reduce_err)?;
-    Ok(VariantRun { sweep: summary, map: map.summary, wall_s: start.elapsed().as_secs_f64() })
+    Ok(VariantRun {
+        sweep: summary,
+        map: map.summary,
+        wall_s: start.elapsed().as_secs_f64(),
+    })
 }
 
 /// One row of the comparison table.
@@ -497,12 +573,14 @@ pub fn compare(study: &StudySpec, dir: &Path) -> Result<Comparison, StudyError> 
     if !dir.join(STUDY_FILE).is_file() {
         return Err(StudyError::NoStudy { dir: dir.to_path_buf() });
     }
-    let mapped = |v: &Variant| {
-        read_summary(&v.map_dir(dir)).is_ok_and(|s| s.spec_hash == v.spec.hash_hex())
-    };
+    let mapped = |v: &Variant| read_summary(&v.map_dir(dir)).is_ok_and(|s| s.spec_hash == v.spec.hash_hex());
     let missing: Vec<usize> = study.variants.iter().filter(|v| !mapped(v)).map(|v| v.index).collect();
     if !missing.is_empty() {
-        return Err(StudyError::NotMapped { dir: dir.to_path_buf(), total: study.variants.len(), missing });
+        return Err(StudyError::NotMapped {
+            dir: dir.to_path_buf(),
+            total: study.variants.len(),
+            missing,
+        });
     }
     let mut rows = Vec::new();
     for v in &study.variants {
@@ -512,7 +590,9 @@ pub fn compare(study: &StudySpec, dir: &Path) -> Result<Comparison, StudyError> 
         let cells = read_cells(&map, s.order).map_err(err)?;
         let area = s.cell_mm * s.cell_mm;
         let range = |k: usize| {
-            cells.iter().fold([f64::INFINITY, f64::NEG_INFINITY], |[lo, hi], c| [lo.min(c.coefficients[k].min), hi.max(c.coefficients[k].max)])
+            cells.iter().fold([f64::INFINITY, f64::NEG_INFINITY], |[lo, hi], c| {
+                [lo.min(c.coefficients[k].min), hi.max(c.coefficients[k].max)]
+            })
         };
         rows.push(VariantRow {
             index: v.index,
@@ -527,7 +607,10 @@ pub fn compare(study: &StudySpec, dir: &Path) -> Result<Comparison, StudyError> 
             map: format!("v{}/map", v.index),
         });
     }
-    Ok(Comparison { name: study.name.clone(), variants: rows })
+    Ok(Comparison {
+        name: study.name.clone(),
+        variants: rows,
+    })
 }
 
 impl Comparison {
@@ -554,7 +637,12 @@ impl Comparison {
     /// The side-by-side page: the table, then each variant's reach and mode
     /// pictures in a row, linking to its map explorer.
     pub fn html(&self) -> String {
-        let esc = |t: &str| t.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;");
+        let esc = |t: &str| {
+            t.replace('&', "&amp;")
+                .replace('<', "&lt;")
+                .replace('>', "&gt;")
+                .replace('"', "&quot;")
+        };
         let mut h = format!(
             "<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>Study: {name}</title>\n<style>\
              body{{font-family:sans-serif;margin:1.5em}} table{{border-collapse:collapse}} td,th{{border:1px solid #ccc;padding:3px 6px;text-align:right}}\
@@ -570,7 +658,13 @@ impl Comparison {
         }
         h.push_str("<th>a0 range</th><th>a1 range</th><th>failed</th></tr>\n");
         for r in &self.variants {
-            h.push_str(&format!("<tr><td><a href=\"{}/index.html\">v{}</a></td><td class=\"l\">{}</td><td>{:.0}</td>", r.map, r.index, esc(&r.label), r.reach_area_mm2));
+            h.push_str(&format!(
+                "<tr><td><a href=\"{}/index.html\">v{}</a></td><td class=\"l\">{}</td><td>{:.0}</td>",
+                r.map,
+                r.index,
+                esc(&r.label),
+                r.reach_area_mm2
+            ));
             for a in r.mode_area_mm2 {
                 h.push_str(&format!("<td>{a:.0}</td>"));
             }
@@ -616,15 +710,21 @@ pub fn mapped_variants(dir: &Path) -> Result<Vec<(usize, String, PathBuf)>, Stud
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Err(StudyError::NoStudy { dir: dir.to_path_buf() }),
         Err(source) => return Err(StudyError::Io { path, source }),
     };
-    let v: serde_json::Value = serde_json::from_slice(&bytes)
-        .map_err(|e| StudyError::Io { path: path.clone(), source: std::io::Error::other(format!("not a study record: {e}")) })?;
+    let v: serde_json::Value = serde_json::from_slice(&bytes).map_err(|e| StudyError::Io {
+        path: path.clone(),
+        source: std::io::Error::other(format!("not a study record: {e}")),
+    })?;
     Ok(v["variants"]
         .as_array()
         .into_iter()
         .flatten()
         .map(|x| {
             let index = x["index"].as_u64().unwrap_or(0) as usize;
-            (index, x["label"].as_str().unwrap_or("").to_string(), dir.join(format!("v{index}")).join("map"))
+            (
+                index,
+                x["label"].as_str().unwrap_or("").to_string(),
+                dir.join(format!("v{index}")).join("map"),
+            )
         })
         .collect())
 }

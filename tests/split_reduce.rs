@@ -20,7 +20,11 @@ fn cablemap() -> Command {
 
 fn run(args: &[&str]) -> (bool, String, String) {
     let out = cablemap().args(args).output().expect("runs");
-    (out.status.success(), String::from_utf8_lossy(&out.stdout).into(), String::from_utf8_lossy(&out.stderr).into())
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into(),
+        String::from_utf8_lossy(&out.stderr).into(),
+    )
 }
 
 fn s(p: &Path) -> &str {
@@ -52,7 +56,16 @@ fn quick_run(tmp: &Path) -> (PathBuf, Vec<Vec<u8>>) {
 
 fn parts(run_dir: &Path, map: &Path, n: u64) {
     for i in 0..n {
-        let (ok, stdout, stderr) = run(&["reduce", s(run_dir), "--out", s(map), "--shard", &i.to_string(), "--shards", &n.to_string()]);
+        let (ok, stdout, stderr) = run(&[
+            "reduce",
+            s(run_dir),
+            "--out",
+            s(map),
+            "--shard",
+            &i.to_string(),
+            "--shards",
+            &n.to_string(),
+        ]);
         assert!(ok && stdout.contains(&format!("part {i} of {n}")), "{stdout}{stderr}");
     }
 }
@@ -106,12 +119,18 @@ fn missing_mixed_foreign_and_damaged_parts_are_refused_with_the_fix() {
     let map = tmp.path().join("map");
     // No parts at all.
     let (ok, _, stderr) = merge(&dir, &map);
-    assert!(!ok && stderr.contains("no reduce parts found") && stderr.contains("--shard I --shards N"), "{stderr}");
+    assert!(
+        !ok && stderr.contains("no reduce parts found") && stderr.contains("--shard I --shards N"),
+        "{stderr}"
+    );
     // One missing: named, with its command.
     run(&["reduce", s(&dir), "--out", s(&map), "--shard", "0", "--shards", "3"]);
     run(&["reduce", s(&dir), "--out", s(&map), "--shard", "2", "--shards", "3"]);
     let (ok, _, stderr) = merge(&dir, &map);
-    assert!(!ok && stderr.contains("1 of 3 parts missing (part 1)") && stderr.contains("--shard 1 --shards 3"), "{stderr}");
+    assert!(
+        !ok && stderr.contains("1 of 3 parts missing (part 1)") && stderr.contains("--shard 1 --shards 3"),
+        "{stderr}"
+    );
     assert!(!map.exists(), "no map is written from incomplete parts");
     // Parts of another split mixed in.
     run(&["reduce", s(&dir), "--out", s(&map), "--shard", "1", "--shards", "2"]);
@@ -132,14 +151,20 @@ fn missing_mixed_foreign_and_damaged_parts_are_refused_with_the_fix() {
     let hash = v["spec_sha256"].as_str().unwrap();
     std::fs::write(&record, text.replace(hash, &"0".repeat(hash.len()))).unwrap();
     let (ok, _, stderr) = merge(&dir, &map);
-    assert!(!ok && stderr.contains("part-1-of-2.json") && stderr.contains("another run"), "{stderr}");
+    assert!(
+        !ok && stderr.contains("part-1-of-2.json") && stderr.contains("another run"),
+        "{stderr}"
+    );
     // A cut-short samples file.
     std::fs::write(&record, &text).unwrap();
     let samples = parts_dir.join("part-0-of-2.samples");
     let bytes = std::fs::read(&samples).unwrap();
     std::fs::write(&samples, &bytes[..bytes.len() - 48]).unwrap();
     let (ok, _, stderr) = merge(&dir, &map);
-    assert!(!ok && stderr.contains("part-0-of-2.samples") && stderr.contains("run this part again"), "{stderr}");
+    assert!(
+        !ok && stderr.contains("part-0-of-2.samples") && stderr.contains("run this part again"),
+        "{stderr}"
+    );
     // Running that part again fixes it.
     run(&["reduce", s(&dir), "--out", s(&map), "--shard", "0", "--shards", "2"]);
     assert!(merge(&dir, &map).0);
@@ -151,17 +176,37 @@ fn a_part_killed_and_run_again_or_run_twice_at_once_gives_the_same_map() {
     let tmp = tempfile::tempdir().unwrap();
     let (dir, single) = quick_run(tmp.path());
     let map = tmp.path().join("map");
-    let args = |i: &str| vec!["reduce".to_string(), s(&dir).into(), "--out".into(), s(&map).into(), "--shard".into(), i.into(), "--shards".into(), "2".into()];
+    let args = |i: &str| {
+        vec![
+            "reduce".to_string(),
+            s(&dir).into(),
+            "--out".into(),
+            s(&map).into(),
+            "--shard".into(),
+            i.into(),
+            "--shards".into(),
+            "2".into(),
+        ]
+    };
     let started = Instant::now();
     assert!(cablemap().args(args("0")).stdout(Stdio::null()).status().unwrap().success());
     let full_us = started.elapsed().as_micros().max(1000) as u64;
-    let mut seed = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).unwrap().as_nanos() as u64 | 1;
+    let mut seed = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .unwrap()
+        .as_nanos() as u64
+        | 1;
     eprintln!("part kill test seed {seed}, one part {full_us} µs");
     for _ in 0..6 {
         seed ^= seed << 13;
         seed ^= seed >> 7;
         seed ^= seed << 17;
-        let mut child = cablemap().args(args("1")).stdout(Stdio::null()).stderr(Stdio::null()).spawn().unwrap();
+        let mut child = cablemap()
+            .args(args("1"))
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap();
         std::thread::sleep(Duration::from_micros(seed % full_us));
         let _ = child.kill();
         child.wait().unwrap();

@@ -10,7 +10,11 @@ fn run(args: &[&str]) -> (bool, String, String) {
         c.env_remove(v);
     }
     let out = c.args(args).output().expect("runs");
-    (out.status.success(), String::from_utf8_lossy(&out.stdout).into(), String::from_utf8_lossy(&out.stderr).into())
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into(),
+        String::from_utf8_lossy(&out.stderr).into(),
+    )
 }
 
 fn s(p: &Path) -> &str {
@@ -31,7 +35,10 @@ fn study_toml() -> String {
 
 /// A map's tables, byte for byte (summary.json without its run_dir).
 fn tables(map: &Path) -> Vec<Vec<u8>> {
-    let mut out: Vec<Vec<u8>> = ["cells.parquet", "modes.parquet", "designs.parquet"].iter().map(|f| std::fs::read(map.join(f)).unwrap()).collect();
+    let mut out: Vec<Vec<u8>> = ["cells.parquet", "modes.parquet", "designs.parquet"]
+        .iter()
+        .map(|f| std::fs::read(map.join(f)).unwrap())
+        .collect();
     let mut summary: serde_json::Value = serde_json::from_slice(&std::fs::read(map.join("summary.json")).unwrap()).unwrap();
     summary.as_object_mut().unwrap().remove("run_dir");
     out.push(summary.to_string().into_bytes());
@@ -51,26 +58,43 @@ fn a_two_by_two_study_maps_each_variant_as_its_spec_alone_and_compares_them() {
     let variants = [(55.0, 92.0), (55.0, 144.0), (75.0, 92.0), (75.0, 144.0)];
     for (i, (length, ei)) in variants.iter().enumerate() {
         let alone = tmp.path().join(format!("alone{i}.toml"));
-        std::fs::write(&alone, format!("[actuator]\nlength_mm = {length:?}\nei_n_mm2 = {ei:?}\n{QUICK_BASE}")).unwrap();
+        std::fs::write(
+            &alone,
+            format!("[actuator]\nlength_mm = {length:?}\nei_n_mm2 = {ei:?}\n{QUICK_BASE}"),
+        )
+        .unwrap();
         let out = tmp.path().join(format!("alone{i}"));
         let (ok, _, stderr) = run(&["map", s(&alone), "--out", s(&out)]);
         assert!(ok, "{stderr}");
         assert_eq!(tables(&dir.join(format!("v{i}/map"))), tables(&out.join("map")), "variant {i}");
         // The study's copy of the variant's spec gives the same run.
         let (ok, stdout, stderr) = run(&["sweep", s(&dir.join(format!("v{i}/spec.toml"))), "--out", s(&out.join("run"))]);
-        assert!(ok && stdout.contains("0 rows solved and written, 610 already done"), "{stdout}{stderr}");
+        assert!(
+            ok && stdout.contains("0 rows solved and written, 610 already done"),
+            "{stdout}{stderr}"
+        );
     }
     // The comparison: one row per variant, and the page shows every map.
     let csv = std::fs::read_to_string(dir.join("comparison.csv")).unwrap();
     assert_eq!(csv.lines().count(), 5, "{csv}");
-    assert!(csv.lines().nth(2).unwrap().starts_with("1,\"length_mm=55, ei_n_mm2=144\","), "{csv}");
+    assert!(
+        csv.lines().nth(2).unwrap().starts_with("1,\"length_mm=55, ei_n_mm2=144\","),
+        "{csv}"
+    );
     let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("comparison.json")).unwrap()).unwrap();
     for (i, row) in json["variants"].as_array().unwrap().iter().enumerate() {
-        let summary: serde_json::Value = serde_json::from_slice(&std::fs::read(dir.join(format!("v{i}/map/summary.json"))).unwrap()).unwrap();
+        let summary: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(dir.join(format!("v{i}/map/summary.json"))).unwrap()).unwrap();
         let cells = summary["cells"].as_f64().unwrap();
-        assert_eq!(row["reach_area_mm2"].as_f64().unwrap(), cells * summary["cell_mm"].as_f64().unwrap().powi(2));
+        assert_eq!(
+            row["reach_area_mm2"].as_f64().unwrap(),
+            cells * summary["cell_mm"].as_f64().unwrap().powi(2)
+        );
         let modes: f64 = row["mode_area_mm2"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).sum();
-        assert!(modes >= row["reach_area_mm2"].as_f64().unwrap(), "every cell holds at least one mode");
+        assert!(
+            modes >= row["reach_area_mm2"].as_f64().unwrap(),
+            "every cell holds at least one mode"
+        );
         assert!(row["a0_range"][0].as_f64().unwrap() < row["a0_range"][1].as_f64().unwrap());
     }
     // A stiffer rod of the same length reaches less.
@@ -78,7 +102,10 @@ fn a_two_by_two_study_maps_each_variant_as_its_spec_alone_and_compares_them() {
     assert!(reach(1) < reach(0) && reach(3) < reach(2), "{json}");
     let page = std::fs::read_to_string(dir.join("index.html")).unwrap();
     for i in 0..4 {
-        assert!(page.contains(&format!("v{i}/map/reach.png")) && page.contains(&format!("v{i}/map/modes.png")), "v{i}");
+        assert!(
+            page.contains(&format!("v{i}/map/reach.png")) && page.contains(&format!("v{i}/map/modes.png")),
+            "v{i}"
+        );
     }
     // Which variants reach a target.
     let (ok, stdout, stderr) = run(&["feasible", "--study", s(&dir), "--target", "x=50,y=5", "--json"]);
@@ -87,15 +114,28 @@ fn a_two_by_two_study_maps_each_variant_as_its_spec_alone_and_compares_them() {
     assert_eq!(v["variants"].as_array().unwrap().len(), 4);
     for row in v["variants"].as_array().unwrap() {
         let i = row["variant"].as_u64().unwrap();
-        let (ok, alone, _) = run(&["feasible", "--map", s(&dir.join(format!("v{i}/map"))), "--target", "x=50,y=5", "--json"]);
+        let (ok, alone, _) = run(&[
+            "feasible",
+            "--map",
+            s(&dir.join(format!("v{i}/map"))),
+            "--target",
+            "x=50,y=5",
+            "--json",
+        ]);
         assert!(ok);
         let alone: serde_json::Value = serde_json::from_str(alone.trim()).unwrap();
         assert_eq!(row["report"], alone, "variant {i}");
-        let listed = v["feasible_variants"].as_array().unwrap().contains(&serde_json::json!(format!("v{i}")));
+        let listed = v["feasible_variants"]
+            .as_array()
+            .unwrap()
+            .contains(&serde_json::json!(format!("v{i}")));
         assert_eq!(listed, alone["verdict"] == "feasible", "variant {i}");
     }
     let (ok, stdout, _) = run(&["feasible", "--study", s(&dir), "--target", "x=50,y=5"]);
-    assert!(ok && (stdout.contains("reach the target") || stdout.contains("no variant reaches")), "{stdout}");
+    assert!(
+        ok && (stdout.contains("reach the target") || stdout.contains("no variant reaches")),
+        "{stdout}"
+    );
 }
 
 #[test]
@@ -119,7 +159,11 @@ fn a_study_split_into_tasks_then_compared_equals_the_study_in_one_go() {
     let (ok, _, stderr) = run(&["study", s(&spec), "--out", s(&split), "--compare"]);
     assert!(ok, "{stderr}");
     for i in 0..4 {
-        assert_eq!(tables(&split.join(format!("v{i}/map"))), tables(&whole.join(format!("v{i}/map"))), "variant {i}");
+        assert_eq!(
+            tables(&split.join(format!("v{i}/map"))),
+            tables(&whole.join(format!("v{i}/map"))),
+            "variant {i}"
+        );
     }
     let strip = |p: &Path| std::fs::read_to_string(p.join("comparison.csv")).unwrap();
     assert_eq!(strip(&split), strip(&whole));

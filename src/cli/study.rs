@@ -42,7 +42,16 @@ pub struct StudyArgs {
 pub fn run(args: &StudyArgs) -> anyhow::Result<()> {
     let study = StudySpec::load(&args.spec)?;
     let threads = super::sweep::thread_count(args.threads)?;
-    run_study(&study, &args.spec, &args.out, args.shards.map(|n| (args.shard, n)), args.compare, threads, args.allow_large, &args.map)
+    run_study(
+        &study,
+        &args.spec,
+        &args.out,
+        args.shards.map(|n| (args.shard, n)),
+        args.compare,
+        threads,
+        args.allow_large,
+        &args.map,
+    )
 }
 
 /// Runs a study: the variants of one task (`shards` = Some((I, N))), or all
@@ -63,13 +72,23 @@ pub fn run_study(
         Some((shard, n)) => {
             anyhow::ensure!(n >= 1, "--shards must be at least 1");
             let (i, from) = super::sweep::shard_from_env(shard)?;
-            anyhow::ensure!(i < n, "task {i} (from {from}) is not below --shards {n}: tasks are numbered 0 to {}", n - 1);
+            anyhow::ensure!(
+                i < n,
+                "task {i} (from {from}) is not below --shards {n}: tasks are numbered 0 to {}",
+                n - 1
+            );
             (i, n, Some(from))
         }
         None => (0, 1, None),
     };
     if !compare_only {
-        let sweep = SweepOptions { shard: 0, shards: 1, threads, progress: ProgressMode::Quiet, allow_large };
+        let sweep = SweepOptions {
+            shard: 0,
+            shards: 1,
+            threads,
+            progress: ProgressMode::Quiet,
+            allow_large,
+        };
         let reduce = map.options()?;
         let mine: Vec<_> = study.variants_of_shard(shard, shards).collect();
         println!(
@@ -97,7 +116,11 @@ pub fn run_study(
             );
         }
         if from.is_some() {
-            println!("when every task is done: cablemap study {} --out {} --compare", spec_path.display(), out.display());
+            println!(
+                "when every task is done: cablemap study {} --out {} --compare",
+                spec_path.display(),
+                out.display()
+            );
             return Ok(());
         }
     }
@@ -106,7 +129,10 @@ pub fn run_study(
     if map.json {
         println!("{}", serde_json::to_string(&comparison)?);
     } else {
-        println!("{:>4}  {:>10}  {:>17}  {:>17}  {:>8}  settings", "v", "reach mm²", "a0 range", "a1 range", "failed");
+        println!(
+            "{:>4}  {:>10}  {:>17}  {:>17}  {:>8}  settings",
+            "v", "reach mm²", "a0 range", "a1 range", "failed"
+        );
         for r in &comparison.variants {
             println!(
                 "{:>4}  {:>10.0}  {:>8.4}…{:<8.4}  {:>8.4}…{:<8.4}  {:>8}  {}",

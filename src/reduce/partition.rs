@@ -86,7 +86,10 @@ pub(crate) fn tabulate(
         let partitions = cuts.len() + 1;
         // Partition pass.
         let paths: Vec<PathBuf> = (0..partitions).map(|p| scratch.join(format!("partition-{p}"))).collect();
-        let mut writers = paths.iter().map(|p| SpillWriter::with_buffer(p, PARTITION_BUFFER_BYTES)).collect::<Result<Vec<_>, _>>()?;
+        let mut writers = paths
+            .iter()
+            .map(|p| SpillWriter::with_buffer(p, PARTITION_BUFFER_BYTES))
+            .collect::<Result<Vec<_>, _>>()?;
         let mut failed = None;
         samples.for_each(|s| {
             let key = setup.grid.cell_of(s.x_mm, s.y_mm);
@@ -105,5 +108,8 @@ pub(crate) fn tabulate(
             absorb(&mut samples);
         }
     }
-    Ok(Tabulated { cells: table, representatives: nearest.representatives() })
+    Ok(Tabulated {
+        cells: table,
+        representatives: nearest.representatives(),
+    })
 }

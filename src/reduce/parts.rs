@@ -179,8 +179,16 @@ pub fn write_part(run_dir: &Path, map_dir: &Path, shard: u64, shards: u64) -> Re
     };
     let json = serde_json::to_vec_pretty(&record).expect("a part record serializes");
     remove_abandoned_temps(&dir, &record_path);
-    write_locked_atomic(&record_path, &json).map_err(|source| PartsError::Io { path: record_path.clone(), source })?;
-    Ok(PartReport { record: record_path, chunks: end - first, rows: pass1.rows_read, samples: pass1.samples })
+    write_locked_atomic(&record_path, &json).map_err(|source| PartsError::Io {
+        path: record_path.clone(),
+        source,
+    })?;
+    Ok(PartReport {
+        record: record_path,
+        chunks: end - first,
+        rows: pass1.rows_read,
+        samples: pass1.samples,
+    })
 }
 
 /// Writes `bytes` to `path` by a locked temporary (so that another copy of
@@ -220,12 +228,20 @@ fn read_parts(dir: &Path, run: &SweepRun) -> Result<(Vec<PathBuf>, Pass1), Parts
     let entries = match std::fs::read_dir(dir) {
         Ok(e) => e,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Err(PartsError::NoParts { dir: dir.to_path_buf() }),
-        Err(source) => return Err(PartsError::Io { path: dir.to_path_buf(), source }),
+        Err(source) => {
+            return Err(PartsError::Io {
+                path: dir.to_path_buf(),
+                source,
+            })
+        }
     };
     let mut found: Vec<(u64, u64)> = Vec::new();
     for e in entries.flatten() {
         let name = e.file_name().to_string_lossy().into_owned();
-        let parsed = name.strip_prefix("part-").and_then(|r| r.strip_suffix(".json")).and_then(|r| r.split_once("-of-"));
+        let parsed = name
+            .strip_prefix("part-")
+            .and_then(|r| r.strip_suffix(".json"))
+            .and_then(|r| r.split_once("-of-"));
         if let Some((i, n)) = parsed.and_then(|(i, n)| Some((i.parse::<u64>().ok()?, n.parse::<u64>().ok()?))) {
             found.push((i, n));
         }
@@ -237,23 +253,39 @@ fn read_parts(dir: &Path, run: &SweepRun) -> Result<(Vec<PathBuf>, Pass1), Parts
     counts.sort_unstable();
     counts.dedup();
     if counts.len() > 1 {
-        return Err(PartsError::Mixed { dir: dir.to_path_buf(), counts });
+        return Err(PartsError::Mixed {
+            dir: dir.to_path_buf(),
+            counts,
+        });
     }
     let shards = counts[0];
     let missing: Vec<u64> = (0..shards).filter(|i| !found.contains(&(*i, shards))).collect();
     if !missing.is_empty() {
-        return Err(PartsError::Missing { dir: dir.to_path_buf(), shards, missing });
+        return Err(PartsError::Missing {
+            dir: dir.to_path_buf(),
+            shards,
+            missing,
+        });
     }
     if let Some(&(i, _)) = found.iter().find(|p| p.0 >= shards) {
         let path = dir.join(part_name(i, shards, "json"));
-        return Err(PartsError::Mismatch { path, problem: format!("part {i} is beyond the {shards} parts: remove it") });
+        return Err(PartsError::Mismatch {
+            path,
+            problem: format!("part {i} is beyond the {shards} parts: remove it"),
+        });
     }
     let mut files = Vec::new();
     let mut pass1 = Pass1::default();
     for shard in 0..shards {
         let path = dir.join(part_name(shard, shards, "json"));
-        let mismatch = |problem: String| PartsError::Mismatch { path: path.clone(), problem };
-        let text = std::fs::read(&path).map_err(|source| PartsError::Io { path: path.clone(), source })?;
+        let mismatch = |problem: String| PartsError::Mismatch {
+            path: path.clone(),
+            problem,
+        };
+        let text = std::fs::read(&path).map_err(|source| PartsError::Io {
+            path: path.clone(),
+            source,
+        })?;
         let record: PartRecord = serde_json::from_slice(&text).map_err(|e| mismatch(format!("not a reduce part record ({e})")))?;
         if record.format != PART_FORMAT {
             return Err(mismatch(format!("format '{}', expected '{PART_FORMAT}'", record.format)));
@@ -267,11 +299,18 @@ fn read_parts(dir: &Path, run: &SweepRun) -> Result<(Vec<PathBuf>, Pass1), Parts
         let range = chunk_range(run.chunk_count(), shard, shards);
         let first_row: u64 = (0..range[0]).map(|i| run.chunk_rows(i)).sum();
         let rows: u64 = (range[0]..range[1]).map(|i| run.chunk_rows(i)).sum();
-        if record.run_chunks != run.chunk_count() || record.chunk_range != range || record.first_row != first_row || record.pass1.rows_read != rows {
+        if record.run_chunks != run.chunk_count()
+            || record.chunk_range != range
+            || record.first_row != first_row
+            || record.pass1.rows_read != rows
+        {
             return Err(mismatch("it covers other chunks or rows than the run has now".into()));
         }
         let samples = dir.join(part_name(shard, shards, "samples"));
-        let len = std::fs::metadata(&samples).map(|m| m.len()).map_err(|source| PartsError::Io { path: samples.clone(), source })?;
+        let len = std::fs::metadata(&samples).map(|m| m.len()).map_err(|source| PartsError::Io {
+            path: samples.clone(),
+            source,
+        })?;
         if len != record.records * RECORD_BYTES as u64 {
             return Err(PartsError::Mismatch {
                 path: samples,

@@ -105,7 +105,14 @@ where
         if let Some(i) = ranks.iter().position(|r| r.group == g && r.rank == rank && r.bits == 0) {
             return i;
         }
-        ranks.push(Rank { group: g, prefix: 0, bits: 0, rank, count: sizes[g], found: None });
+        ranks.push(Rank {
+            group: g,
+            prefix: 0,
+            bits: 0,
+            rank,
+            count: sizes[g],
+            found: None,
+        });
         ranks.len() - 1
     };
     let plan: Vec<Option<(usize, usize, f64)>> = requests
@@ -133,7 +140,17 @@ where
         }
         let collect: Vec<bool> = ranks.iter().map(|r| r.count <= COLLECT_MAX).collect();
         let mut collected: Vec<Vec<f64>> = vec![Vec::new(); ranks.len()];
-        let mut hists: Vec<Vec<u64>> = ranks.iter().enumerate().map(|(i, r)| if r.found.is_none() && !collect[i] { vec![0; BUCKETS] } else { Vec::new() }).collect();
+        let mut hists: Vec<Vec<u64>> = ranks
+            .iter()
+            .enumerate()
+            .map(|(i, r)| {
+                if r.found.is_none() && !collect[i] {
+                    vec![0; BUCKETS]
+                } else {
+                    Vec::new()
+                }
+            })
+            .collect();
         pass(&mut |g, v| {
             let k = key(v);
             for &i in &by_group[g] {
@@ -182,7 +199,18 @@ mod tests {
 
     #[test]
     fn keys_order_like_total_cmp() {
-        let vals = [f64::NEG_INFINITY, -1e300, -1.0, -1e-300, -0.0, 0.0, 1e-300, 1.0, 1e300, f64::INFINITY];
+        let vals = [
+            f64::NEG_INFINITY,
+            -1e300,
+            -1.0,
+            -1e-300,
+            -0.0,
+            0.0,
+            1e-300,
+            1.0,
+            1e300,
+            f64::INFINITY,
+        ];
         for w in vals.windows(2) {
             assert!(key(w[0]) < key(w[1]), "{w:?}");
         }
@@ -225,7 +253,9 @@ mod tests {
         // values share their top bits (so selection narrows more than once).
         let spread: Vec<f64> = (0..5000).map(|_| (next() >> 11) as f64 / (1u64 << 53) as f64 - 0.5).collect();
         let ties: Vec<f64> = (0..3000).map(|_| (next() % 7) as f64 * 0.25 - 0.5).collect();
-        let close: Vec<f64> = (0..(COLLECT_MAX as usize + 5000)).map(|i| 1.0 + (i as f64 * 7919.0 % 1e5) * 1e-12).collect();
+        let close: Vec<f64> = (0..(COLLECT_MAX as usize + 5000))
+            .map(|i| 1.0 + (i as f64 * 7919.0 % 1e5) * 1e-12)
+            .collect();
         check(&[spread, ties, vec![3.5], vec![], close], &ps);
     }
 }

@@ -34,7 +34,10 @@ pub(crate) struct Extent {
 
 impl Default for Extent {
     fn default() -> Self {
-        Self { x_mm: [f64::MAX, f64::MIN], y_mm: [f64::MAX, f64::MIN] }
+        Self {
+            x_mm: [f64::MAX, f64::MIN],
+            y_mm: [f64::MAX, f64::MIN],
+        }
     }
 }
 
@@ -54,7 +57,10 @@ impl Extent {
 
 /// The error of a scratch file.
 pub(crate) fn scratch_error(path: &Path, source: std::io::Error) -> ReduceError {
-    ReduceError::Scratch { path: path.to_path_buf(), source }
+    ReduceError::Scratch {
+        path: path.to_path_buf(),
+        source,
+    }
 }
 
 /// Writes records to one file.
@@ -80,7 +86,11 @@ impl SpillWriter {
 
     /// Writes to `file`, opened at `path`.
     pub fn from_file(path: &Path, file: File, bytes: usize) -> Self {
-        Self { path: path.to_path_buf(), out: BufWriter::with_capacity(bytes, file), records: 0 }
+        Self {
+            path: path.to_path_buf(),
+            out: BufWriter::with_capacity(bytes, file),
+            records: 0,
+        }
     }
 
     /// Writes sample `s`; `with_mirror` when its mirror image is to be
@@ -155,7 +165,12 @@ pub(crate) struct SampleSink {
 impl SampleSink {
     /// Keeps up to `limit` samples in memory, then spills to `path`.
     pub fn new(path: &Path, limit: usize) -> Self {
-        Self { limit, memory: Vec::with_capacity(limit.saturating_add(2).min(1 << 16)), path: path.to_path_buf(), writer: None }
+        Self {
+            limit,
+            memory: Vec::with_capacity(limit.saturating_add(2).min(1 << 16)),
+            path: path.to_path_buf(),
+            writer: None,
+        }
     }
 
     /// The samples taken.
@@ -200,7 +215,10 @@ pub(crate) fn for_each(files: &[PathBuf], mut f: impl FnMut(&Sample)) -> Result<
         loop {
             let n = read_full(&mut reader, &mut buf).map_err(|e| scratch_error(path, e))?;
             if n % RECORD_BYTES != 0 {
-                return Err(scratch_error(path, std::io::Error::other("the file ends inside a record: it was cut short")));
+                return Err(scratch_error(
+                    path,
+                    std::io::Error::other("the file ends inside a record: it was cut short"),
+                ));
             }
             for rec in buf[..n].chunks_exact(RECORD_BYTES) {
                 let (s, with_mirror) = decode(rec);
@@ -228,7 +246,15 @@ fn decode(rec: &[u8]) -> (Sample, bool) {
     let f = |i: usize| f64::from_le_bytes(rec[8 * i..8 * i + 8].try_into().expect("8 bytes"));
     let row = u32::from_le_bytes(rec[40..44].try_into().expect("4 bytes"));
     let flags = u32::from_le_bytes(rec[44..48].try_into().expect("4 bytes"));
-    let s = Sample { x_mm: f(0), y_mm: f(1), a: [f(2), f(3), f(4)], at: RowRef { row, mirrored: flags & IS_MIRROR != 0 } };
+    let s = Sample {
+        x_mm: f(0),
+        y_mm: f(1),
+        a: [f(2), f(3), f(4)],
+        at: RowRef {
+            row,
+            mirrored: flags & IS_MIRROR != 0,
+        },
+    };
     (s, flags & WITH_MIRROR != 0)
 }
 
@@ -297,14 +323,29 @@ mod tests {
         let dir = ScratchDir::new(&std::env::temp_dir()).unwrap();
         let path = dir.path.join("s");
         let mut w = SpillWriter::create(&path).unwrap();
-        let s = Sample { x_mm: 1.5, y_mm: -2.0, a: [0.1, -0.2, 0.3], at: RowRef { row: 7, mirrored: false } };
+        let s = Sample {
+            x_mm: 1.5,
+            y_mm: -2.0,
+            a: [0.1, -0.2, 0.3],
+            at: RowRef { row: 7, mirrored: false },
+        };
         w.push(&s, true).unwrap();
-        w.push(&Sample { at: RowRef { row: 8, mirrored: true }, ..s }, false).unwrap();
+        w.push(
+            &Sample {
+                at: RowRef { row: 8, mirrored: true },
+                ..s
+            },
+            false,
+        )
+        .unwrap();
         assert_eq!(w.finish(false).unwrap(), 2);
         let back = load(&path, 0).unwrap();
         assert_eq!(back.len(), 3);
         assert_eq!((back[0].x_mm, back[0].y_mm, back[0].a, back[0].at), (s.x_mm, s.y_mm, s.a, s.at));
-        assert_eq!((back[1].y_mm, back[1].a[1], back[1].at), (2.0, 0.2, RowRef { row: 7, mirrored: true }));
+        assert_eq!(
+            (back[1].y_mm, back[1].a[1], back[1].at),
+            (2.0, 0.2, RowRef { row: 7, mirrored: true })
+        );
         assert_eq!(back[2].at, RowRef { row: 8, mirrored: true });
         // A file cut inside a record is refused.
         let bytes = std::fs::read(&path).unwrap();
