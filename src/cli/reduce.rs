@@ -76,7 +76,8 @@ pub struct ReduceArgs {
     /// [default: $SLURM_ARRAY_TASK_ID, else $JOB_COMPLETION_INDEX, else 0].
     #[arg(long, value_name = "I", requires = "shards")]
     pub shard: Option<u64>,
-    /// Split the reduce into N parts (see --shard; then --merge).
+    /// Split the reduce into N parts (see --shard; then --merge, which takes
+    /// the map options such as --cell-mm).
     #[arg(long, value_name = "N", conflicts_with_all = ["merge", "partial"])]
     pub shards: Option<u64>,
     /// Write the map from the parts in MAP_DIR.parts/ (all N of them).
