@@ -170,6 +170,10 @@ fn a_study_split_into_tasks_then_compared_equals_the_study_in_one_go() {
     // Run again: resumable, nothing solved anew.
     let (ok, stdout, stderr) = run(&["study", s(&spec), "--out", s(&whole)]);
     assert!(ok && stdout.contains("0 rows solved (610 already done)"), "{stdout}{stderr}");
+    // With --json, stdout is the comparison alone.
+    let (ok, stdout, stderr) = run(&["study", s(&spec), "--out", s(&whole), "--json"]);
+    let v: serde_json::Value = serde_json::from_str(stdout.trim()).unwrap_or_else(|e| panic!("{e}: {stdout}{stderr}"));
+    assert!(ok && v["variants"].as_array().unwrap().len() == 4 && stderr.contains("v3 "), "{stdout}{stderr}");
     // Another study in the same directory is refused.
     std::fs::write(&spec, study_toml().replace("[55.0, 75.0]", "[60.0, 75.0]")).unwrap();
     let (ok, _, stderr) = run(&["study", s(&spec), "--out", s(&whole)]);

@@ -91,17 +91,19 @@ pub fn run_study(
         };
         let reduce = map.options()?;
         let mine: Vec<_> = study.variants_of_shard(shard, shards).collect();
-        println!(
+        // With --json, stdout carries only the comparison; progress goes to stderr.
+        let say = |line: String| if map.json { eprintln!("{line}") } else { println!("{line}") };
+        say(format!(
             "study '{}': {} variants{}; this task runs {}",
             study.name,
             study.variants.len(),
             from.map_or(String::new(), |f| format!(", task {shard} of {shards} ({f})")),
             mine.len()
-        );
+        ));
         for v in mine {
             let r = run_variant(v, out, &sweep, &reduce).with_context(|| format!("study {}", out.display()))?;
             let s = &r.map;
-            println!(
+            say(format!(
                 "v{} {}: {} rows solved ({} already done), {} simulations ({} failed), {} cells of {} mm; {:.1} s; map {}",
                 v.index,
                 v.label(),
@@ -113,14 +115,10 @@ pub fn run_study(
                 s.cell_mm,
                 r.wall_s,
                 v.map_dir(out).display()
-            );
+            ));
         }
         if from.is_some() {
-            println!(
-                "when every task is done: cablemap study {} --out {} --compare",
-                spec_path.display(),
-                out.display()
-            );
+            say(format!("when every task is done: cablemap study {} --out {} --compare", spec_path.display(), out.display()));
             return Ok(());
         }
     }
