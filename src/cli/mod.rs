@@ -9,6 +9,7 @@ pub mod feasible;
 pub mod mould;
 pub mod reduce;
 pub mod simulate;
+pub mod study;
 pub mod sweep;
 pub mod sweep_cables;
 pub mod synth;
