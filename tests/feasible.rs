@@ -124,6 +124,14 @@ fn design_refuses_a_map_made_for_another_rod() {
     let (ok, _, stderr) = run(&["design", "--map", map.to_str().unwrap(), "--target", "x=50,y=5", "--length-mm", "70"]);
     assert!(!ok);
     assert!(stderr.contains("the map was made for a rod of L = 65 mm"), "{stderr}");
+    // Same L and r, another body: a tapered rod, or a cable knotted before the tip.
+    for extra in [["--radius-profile-mm", "0:5,65:3"], ["--cable-anchor-mm", "50"]] {
+        let mut args = vec!["design", "--map", map.to_str().unwrap(), "--target", "x=50,y=5"];
+        args.extend(extra);
+        let (ok, _, stderr) = run(&args);
+        assert!(!ok, "{extra:?} was accepted");
+        assert!(stderr.contains("another body") && stderr.contains("uniform rod"), "{stderr}");
+    }
 }
 
 #[test]

@@ -123,6 +123,29 @@ impl MapDir {
                 ),
             ));
         }
+        let body = crate::reduce::MapBody::of(actuator);
+        if s.body != body {
+            let describe = |b: &crate::reduce::MapBody| {
+                if *b == crate::reduce::MapBody::default() {
+                    "the uniform rod with the cable knotted at the tip".to_string()
+                } else {
+                    format!(
+                        "radius profile {:?} mm, {} segment(s), cable anchor {}",
+                        b.radius_profile_mm,
+                        b.segments.len(),
+                        b.cable_anchor_mm.map_or("at the tip".into(), |k| format!("at {k} mm"))
+                    )
+                }
+            };
+            return Err(map_error(
+                &self.path,
+                format!(
+                    "the map was made for another body ({}) than the actuator's ({}); use a map swept for this body (the same radius profile, segments and cable anchor)",
+                    describe(&s.body),
+                    describe(&body)
+                ),
+            ));
+        }
         Ok(())
     }
 

@@ -143,6 +143,7 @@ fn write_planar_maps(spec: &CableSweepSpec, rows: &[Row], out: &Path) -> Result<
         run_dir: out.display().to_string(),
         spec_hash: format!("{:x}", Sha256::digest(toml::to_string(spec).unwrap_or_default().as_bytes())),
         length_basis: spec.output.length_basis,
+        body: super::MapBody::of(&spec.rod),
     };
     let options = ReduceOptions { cell_mm: spec.output.cell_mm, ..ReduceOptions::default() };
     let map = reduce_batches(&info, &options, || Ok(std::iter::once(Ok::<_, ReduceError>(batch.clone()))))?;

@@ -245,6 +245,35 @@ pub struct RunInfo {
     pub spec_hash: String,
     /// The length the run's a_i are per unit of.
     pub length_basis: LengthBasis,
+    /// The body beyond L and r (radius profile, segments, cable anchor).
+    pub body: MapBody,
+}
+
+/// What a map records of its actuator's body beyond L and r: the radius
+/// profile, segments and cable anchor. Empty for the thesis's uniform rod,
+/// whose summary.json then has none of these fields (as before they existed).
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct MapBody {
+    /// Radius profile (s, r) points, mm.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub radius_profile_mm: Vec<(f64, f64)>,
+    /// Segments of their own material.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub segments: Vec<crate::model::body::Segment>,
+    /// Where the cable is knotted, mm (none: the tip).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cable_anchor_mm: Option<f64>,
+}
+
+impl MapBody {
+    /// The body of `actuator`.
+    pub fn of(actuator: &crate::model::Actuator) -> Self {
+        MapBody {
+            radius_profile_mm: actuator.radius_profile_mm.clone(),
+            segments: actuator.segments.clone(),
+            cable_anchor_mm: actuator.cable_anchor_mm.filter(|&k| k != actuator.length_mm),
+        }
+    }
 }
 
 /// Boundaries of the characteristic modes: a_0 split into 4 ranges by three
@@ -367,6 +396,9 @@ pub struct MapSummary {
     /// written before this field existed were in the deformed basis.
     #[serde(default = "basis_of_maps_without_the_field")]
     pub length_basis: LengthBasis,
+    /// The actuator's body beyond L and r (absent: the uniform rod).
+    #[serde(default, flatten)]
+    pub body: MapBody,
 }
 
 /// Maps written before `length_basis` was recorded had deformed-length a_i.
@@ -549,6 +581,7 @@ where
         run_dir: info.run_dir.clone(),
         spec_hash: info.spec_hash.clone(),
         length_basis: info.length_basis,
+        body: info.body.clone(),
     };
     Ok(MapData { summary, cells: cells.cells, modes, designs })
 }
@@ -604,6 +637,7 @@ fn run_info(run: &crate::sweep::SweepRun) -> RunInfo {
         run_dir: run.dir().display().to_string(),
         spec_hash: run.manifest().spec_sha256.clone(),
         length_basis: spec.output.length_basis,
+        body: MapBody::of(&spec.actuator),
     }
 }
 
@@ -650,6 +684,7 @@ mod tests {
             run_dir: "test".into(),
             spec_hash: "x".into(),
             length_basis: LengthBasis::Rest,
+            body: MapBody::default(),
         }
     }
 
@@ -883,6 +918,7 @@ mod picture_tests {
             run_dir: "small".into(),
             spec_hash: "h".into(),
             length_basis: LengthBasis::Rest,
+            body: MapBody::default(),
         };
         let map = reduce_batches(&info, &ReduceOptions::default(), || Ok(vec![Ok(b.clone())].into_iter())).unwrap();
         let dir = std::env::var_os("CABLEMAP_KEEP_MAP").map(std::path::PathBuf::from);

@@ -345,6 +345,7 @@ mod tests {
             run_dir: "test".into(),
             spec_hash: "h".into(),
             length_basis: LengthBasis::Rest,
+            body: Default::default(),
         }
     }
 

@@ -87,6 +87,7 @@ pub fn write_map(dir: &Path, rows: &[Row]) {
         run_dir: "tests/common (simulated in the test)".into(),
         spec_hash: "test".into(),
         length_basis: cablemap::shape::LengthBasis::Rest,
+        body: Default::default(),
     };
     let b = batch(rows);
     let map = reduce_batches(&info, &ReduceOptions::default(), || Ok(vec![Ok(b.clone())].into_iter())).unwrap();
