@@ -2,6 +2,7 @@
 //! run each command. `main.rs` only parses and dispatches.
 
 pub mod bench;
+pub mod cable_map;
 pub mod calibrate;
 pub mod design;
 pub mod diagnose;
@@ -10,7 +11,6 @@ pub mod mould;
 pub mod reduce;
 pub mod simulate;
 pub mod sweep;
-pub mod sweep_cables;
 pub mod synth;
 
 use cablemap::model::{Actuator, SolverOptions};

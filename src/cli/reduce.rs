@@ -11,9 +11,9 @@ use std::time::Instant;
 /// Map options shared by `reduce` and `map`.
 #[derive(Debug, Clone, Args)]
 pub struct MapOptionArgs {
-    /// Grid cell size, mm.
-    #[arg(long, value_name = "MM", default_value_t = 1.0)]
-    pub cell_mm: f64,
+    /// Grid cell size, mm [default: 1; a cable sweep: its spec's output.cell_mm].
+    #[arg(long, value_name = "MM")]
+    pub cell_mm: Option<f64>,
     /// Explicit a_0 boundaries of the modes: three ascending values (mm⁻¹)
     /// [default: 25/50/75 % quantiles of the data].
     #[arg(long, value_name = "B1,B2,B3", allow_hyphen_values = true)]
@@ -43,7 +43,7 @@ impl MapOptionArgs {
             }
             _ => anyhow::bail!("give both --a0-bounds and --a1-bounds, or neither (quantiles of the data)"),
         };
-        Ok(ReduceOptions { cell_mm: self.cell_mm, mode_boundaries, designs_per_cell: self.designs_per_cell })
+        Ok(ReduceOptions { cell_mm: self.cell_mm.unwrap_or(1.0), mode_boundaries, designs_per_cell: self.designs_per_cell })
     }
 }
 
@@ -61,6 +61,14 @@ pub struct ReduceArgs {
     pub partial: bool,
     #[command(flatten)]
     pub map: MapOptionArgs,
+}
+
+/// Reduces `run` (either kind of sweep) into `out` and prints a summary.
+pub fn reduce_any_into(run: &Path, out: &Path, partial: bool, args: &MapOptionArgs) -> anyhow::Result<()> {
+    match cablemap::sweep::run_kind(run)? {
+        cablemap::sweep::RunKind::Planar => reduce_into(run, out, partial, args).map(|_| ()),
+        cablemap::sweep::RunKind::Cables => super::cable_map::reduce_cables_into(run, out, partial, args.cell_mm, &args.options()?, args.json),
+    }
 }
 
 /// Reduces `run` into `out` and prints a summary.
@@ -110,7 +118,7 @@ fn with_flags(e: ReduceError) -> anyhow::Error {
 
 /// Runs `cablemap reduce`.
 pub fn run(args: &ReduceArgs) -> anyhow::Result<()> {
-    reduce_into(&args.run, &args.out, args.partial, &args.map).map(|_| ())
+    reduce_any_into(&args.run, &args.out, args.partial, &args.map)
 }
 
 /// Arguments of `cablemap map`.
@@ -134,9 +142,12 @@ pub struct MapArgs {
 
 /// Runs `cablemap map`: the sweep (resumable) then the reduction.
 pub fn run_map(args: &MapArgs) -> anyhow::Result<()> {
-    let spec = super::sweep::load_spec(args.spec.as_deref())?;
+    let spec = super::sweep::load_any_spec(args.spec.as_deref())?;
     let threads = super::sweep::thread_count(args.threads)?;
     let options = SweepOptions { shard: 0, shards: 1, threads, progress: ProgressMode::Auto, allow_large: args.allow_large };
-    super::sweep::sweep_and_report(&spec, &args.out.join("run"), &options, false)?;
-    reduce_into(&args.out.join("run"), &args.out.join("map"), false, &args.map).map(|_| ())
+    match &spec {
+        super::sweep::AnySpec::Planar(spec) => super::sweep::sweep_and_report(spec, &args.out.join("run"), &options, false)?,
+        super::sweep::AnySpec::Cables(spec) => super::sweep::sweep_and_report(spec, &args.out.join("run"), &options, false)?,
+    }
+    reduce_any_into(&args.out.join("run"), &args.out.join("map"), false, &args.map)
 }
