@@ -25,7 +25,7 @@ bin=$(cargo metadata --format-version 1 --no-deps | "$venv/bin/python" -c 'impor
 "$venv/bin/python" tests/python/check_sweep.py "$work/quick" "$work/failures"
 
 echo "== Python read-back of a cable sweep (pyarrow, pandas, polars)"
-"$bin" sweep-cables jobs/spatial-pair.toml --out "$work/cables" > /dev/null
+"$bin" map jobs/spatial-pair.toml --out "$work/cables" > /dev/null
 "$venv/bin/python" tests/python/check_cable_sweep.py "$work/cables"
 
 echo "== Python read-back of maps (pandas, polars)"

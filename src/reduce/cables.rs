@@ -325,6 +325,14 @@ fn planar_batch(spec: &CableSweepSpec, grids: &[Vec<f64>], batch: &RecordBatch) 
         .map_err(|e| CableSweepError::Write { context: "building the planar map rows".into(), message: e.to_string() }.into())
 }
 
+/// Largest distance, mm, between a representative's stored tip and the tip
+/// of its solve again for drawing.
+const REDRAW_TOLERANCE_MM: f64 = 1e-3;
+
+fn tip_gap_mm(tip: &[f64; 3], d: &super::Design) -> f64 {
+    (tip[0] - d.tip_x_mm).hypot(tip[1] - d.tip_y_mm)
+}
+
 /// Each mode's representative solved again with all the cables of its row
 /// (its [`row_key`]) and drawn in the x–y plane, cable 1's path shown.
 fn draw_modes(spec: &CableSweepSpec, map: &MapData) -> ModeDrawings {
@@ -338,6 +346,17 @@ fn draw_modes(spec: &CableSweepSpec, map: &MapData) -> ModeDrawings {
         let (id, k) = row_of_key(d.routing_id as u64, combinations);
         let actuator = spec.actuator_at(id, k);
         match simulate_spatial(&actuator, &spec.solver, 1, spec.output.length_basis) {
+            // The sweep reached the row along its tension path; a solve from
+            // zero could in principle land on another equilibrium: then the
+            // drawing would not be the row's, and is not made.
+            Ok(sim) if tip_gap_mm(&sim.pose.tip_mm, d) > REDRAW_TOLERANCE_MM => {
+                drawings.shapes.push(None);
+                let message = format!(
+                    "the solve from zero ends at ({:.3}, {:.3}) mm, not at the row's tip ({:.3}, {:.3}) mm",
+                    sim.pose.tip_mm[0], sim.pose.tip_mm[1], d.tip_x_mm, d.tip_y_mm
+                );
+                drawings.failures.push(DrawingError::Simulation { mode: m.mode, source: message.into() });
+            }
             Ok(sim) => {
                 let centreline = sim.nodes.iter().map(|n| (n.p_mm[0], n.p_mm[1])).collect();
                 // The body x-axis (first column of R) in the x–y plane.
