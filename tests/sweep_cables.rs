@@ -140,6 +140,8 @@ fn a_spatial_pair_map_writes_rows_and_reach_maps() {
     assert_eq!(summary["planar"], false);
     assert_eq!(summary["cell_mm"], 2.0, "the spec's output.cell_mm");
     assert!(!out.join("map/planar").exists(), "a spatial run has no planar maps");
+    let (ok, _, stderr) = run(&["feasible", "--map", s(&out.join("map")), "--target", "x=50,y=5,a0=-0.02,a1=0"]);
+    assert!(!ok && stderr.contains("spatial cable sweep") && stderr.contains("no feasibility map"), "{stderr}");
     // The same command again resumes: nothing is solved twice, the map is replaced.
     let before = chunks(&out.join("run"));
     let (ok, stdout, stderr) = run(&["map", s(&spec), "--out", s(&out)]);
@@ -204,6 +206,11 @@ levels_mm = [-2.0, 2.0]
     }
     let data = std::fs::read_to_string(planar.join("explorer-data.js")).unwrap();
     assert!(!data.contains("Not drawn"), "every mode representative is drawn");
+    // `feasible` reads the planar map, and points there from the cable map.
+    let (ok, _, stderr) = run(&["feasible", "--map", s(&out.join("map")), "--target", "x=50,y=5,a0=-0.02,a1=0"]);
+    assert!(!ok && stderr.contains("map of a cable sweep") && stderr.contains("planar"), "{stderr}");
+    let (ok, _, stderr) = run(&["feasible", "--map", s(&planar), "--target", "x=50,y=5,a0=-0.02,a1=0"]);
+    assert!(ok, "{stderr}");
 }
 
 #[test]
