@@ -13,6 +13,7 @@
 //! [output]
 //! order = 3                        # a0…a3, a_bend_y0…, a_twist0…
 //! cell_mm = 1.0                    # reach-map cell / voxel size
+//! chunk_routings = 64             # routings per chunk file (engine chunks)
 //!
 //! [[cable]]                        # an antagonistic pair
 //! y_mm = [2, 2, 2, 2, 2]           # fixed values (swept points override them)
@@ -652,6 +653,30 @@ levels_mm = [0.0, 1.5, -1.5]
         let last = spec.actuator_for(11, &dims);
         assert_eq!(last.cables[0].y_mm, [2.0, 3.0, 2.0, 3.0, 2.0]);
         assert_eq!(last.cables[1].z_mm, [0.0, 0.0, 0.0, 0.0, -1.5]);
+    }
+
+    #[test]
+    fn a_routings_rows_are_in_grid_order_and_actuator_at_rebuilds_each() {
+        let spec = CableSweepSpec::from_toml(SPEC, "test").unwrap();
+        let layout = spec.layout();
+        assert_eq!((layout.routings, layout.tensions), (12, 6));
+        let mut worker = spec.worker().unwrap();
+        let rows = spec.solve(&mut worker, 7).unwrap();
+        assert_eq!(rows.len(), 6);
+        let grids = spec.tension_grids();
+        for (k, row) in rows.iter().enumerate() {
+            assert_eq!(row.routing_id, 7);
+            let combo: Vec<usize> = row.tensions.iter().zip(&grids).map(|(t, g)| g.iter().position(|v| v == t).unwrap()).collect();
+            assert_eq!(combination_index(&combo, &grids), k, "grid order, cable 1 slowest");
+            let actuator = spec.actuator_at(7, k);
+            assert_eq!(actuator.cables.iter().map(|c| c.tension_n).collect::<Vec<_>>(), row.tensions);
+            assert_eq!(actuator.cables.iter().map(|c| (c.y_mm, c.z_mm)).collect::<Vec<_>>(), row.cables);
+        }
+        // The batch has the fixed schema whatever the rows' nulls.
+        let schema = spec.schema();
+        let batch = spec.batch(&schema, &[rows]);
+        assert_eq!(batch.schema(), schema);
+        assert_eq!(batch.num_rows(), 6);
     }
 
     #[test]
