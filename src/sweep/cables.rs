@@ -13,7 +13,7 @@
 //! [output]
 //! order = 3                        # a0…a3, a_bend_y0…, a_twist0…
 //! cell_mm = 1.0                    # reach-map cell / voxel size
-//! chunk_routings = 64             # routings per chunk file (engine chunks)
+//! chunk_routings = 64              # routings per chunk file (engine chunks)
 //!
 //! [[cable]]                        # an antagonistic pair
 //! y_mm = [2, 2, 2, 2, 2]           # fixed values (swept points override them)
