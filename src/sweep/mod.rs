@@ -64,6 +64,16 @@ pub enum SweepError {
     /// DIR has no manifest (reading or status).
     #[error("{} holds no sweep: {} is missing (run `cablemap sweep SPEC --out {}` first)", dir.display(), dir.join(store::MANIFEST).display(), dir.display())]
     NoRun { dir: PathBuf },
+    /// DIR holds a sweep of another kind (planar vs cables).
+    #[error("{} holds a sweep of another kind ('{found}', not '{wanted}'): a spec with [[cable]] tables and a planar spec need separate run directories; use another --out directory", dir.display())]
+    OtherKind {
+        /// The run directory.
+        dir: PathBuf,
+        /// Its manifest's format.
+        found: String,
+        /// The format this command reads or writes.
+        wanted: String,
+    },
     /// The manifest is unreadable.
     #[error("manifest {} is damaged: {message}. Restore it, or start the sweep in a new directory", path.display())]
     CorruptManifest { path: PathBuf, message: String },

@@ -276,13 +276,12 @@ impl RunDir {
                 let format = serde_json::from_str::<serde_json::Value>(&text)
                     .ok()
                     .and_then(|v| v.get("format").and_then(|f| f.as_str()).map(str::to_string));
-                let message = match format {
+                return Err(match format {
                     Some(f) if f != S::FORMAT && [FORMAT, super::cables::CABLES_FORMAT].contains(&f.as_str()) => {
-                        format!("format '{f}' is not '{}': it is a run of another kind of sweep than this command reads", S::FORMAT)
+                        SweepError::OtherKind { dir: self.root.clone(), found: f, wanted: S::FORMAT.into() }
                     }
-                    _ => e.to_string(),
-                };
-                return Err(SweepError::CorruptManifest { path, message });
+                    _ => SweepError::CorruptManifest { path, message: e.to_string() },
+                });
             }
         };
         if manifest.format != S::FORMAT {
