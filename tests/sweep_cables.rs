@@ -227,6 +227,7 @@ fn planar_pair_mode_pictures_are_drawn_from_a_solve_of_all_cables() {
     assert!(stdout.contains("planar run: feasibility map"), "{stdout}");
     let data = std::fs::read_to_string(out.join("map/planar/explorer-data.js")).unwrap();
     assert!(!data.contains("Not drawn"), "every representative's solve from zero reaches its row's tip");
+    assert_eq!(data.matches("\"further_cables\":[[[").count(), 12, "each mode's drawing has cable 2's path too");
     let png = image::open(out.join("map/planar/modes.png")).unwrap();
     assert!(png.width() > 1000);
 }

@@ -334,7 +334,7 @@ fn tip_gap_mm(tip: &[f64; 3], d: &super::Design) -> f64 {
 }
 
 /// Each mode's representative solved again with all the cables of its row
-/// (its [`row_key`]) and drawn in the x–y plane, cable 1's path shown.
+/// (its [`row_key`]) and drawn in the x–y plane with every cable's path.
 fn draw_modes(spec: &CableSweepSpec, map: &MapData) -> ModeDrawings {
     let combinations = spec.tension_combinations();
     let mut drawings = ModeDrawings::default();
@@ -361,11 +361,14 @@ fn draw_modes(spec: &CableSweepSpec, map: &MapData) -> ModeDrawings {
                 let centreline = sim.nodes.iter().map(|n| (n.p_mm[0], n.p_mm[1])).collect();
                 // The body x-axis (first column of R) in the x–y plane.
                 let frame_angle_rad = sim.nodes.iter().map(|n| n.rotation[1][0].atan2(n.rotation[0][0])).collect();
-                let cable = sim.cable_paths_mm().first().map(|p| p.iter().map(|q| (q[0], q[1])).collect()).unwrap_or_default();
+                let mut paths = sim.cable_paths_mm().into_iter().map(|p| p.iter().map(|q| (q[0], q[1])).collect::<Vec<_>>());
+                let cable = paths.next().unwrap_or_default();
+                let further_cables = paths.collect();
                 drawings.shapes.push(Some(BodyDrawing {
                     centreline,
                     frame_angle_rad,
                     cable,
+                    further_cables,
                     radius_mm: spec.rod.radius_mm,
                     label: format!("mode {}", m.mode),
                     colour: plotters::style::full_palette::BLUE_800,
