@@ -114,7 +114,7 @@ pub fn bench_solver(
     let mut a = [0.0; 4];
     let (mut passes, mut solves, mut failures) = (0u64, 0u64, 0usize);
     for y in routings {
-        let routing = Routing::new(y, actuator.length_mm, actuator.radius_mm)?;
+        let routing = Routing::for_actuator(y, actuator)?;
         let start = Instant::now();
         sim.set_routing(&routing);
         for &t in &ladder {

@@ -54,11 +54,57 @@ pub fn is_temp_of(name: &str, final_name: &str) -> bool {
 /// the lock to tell a live writer's file from a killed writer's: the
 /// kernel drops the lock when the process dies, whatever pid namespace it
 /// ran in.
+///
+/// On Linux the file appears under `path` already locked: it is created
+/// unnamed (`O_TMPFILE`), locked, then linked in. Otherwise another process
+/// cleaning up (another shard, a rerun) could find it unlocked in the
+/// instant between creating and locking it, or hold the lock for that
+/// instant itself, and take a live writer's file for a killed one's; and a
+/// writer killed before the link leaves nothing behind. Where the file
+/// system cannot do that, the file is created and then locked.
 pub fn create_locked(path: &Path) -> std::io::Result<File> {
+    #[cfg(target_os = "linux")]
+    if let Some(file) = create_locked_unnamed(path)? {
+        return Ok(file);
+    }
     let file = File::create(path)?;
     // A file system without locks falls back on the age rule.
     let _ = file.try_lock();
     Ok(file)
+}
+
+/// [`create_locked`] by `O_TMPFILE` and `linkat`; `None` where the file
+/// system or `/proc` does not allow it. Written by hand: std has no
+/// unnamed temporary files, and the tempfile crate's are not locked first.
+#[cfg(target_os = "linux")]
+fn create_locked_unnamed(path: &Path) -> std::io::Result<Option<File>> {
+    use std::ffi::CString;
+    use std::os::fd::FromRawFd;
+    use std::os::unix::ffi::OsStrExt;
+    let c = |p: &Path| CString::new(p.as_os_str().as_bytes()).map_err(std::io::Error::other);
+    let dir = c(parent_dir(path))?;
+    // SAFETY: a valid NUL-terminated path; the returned descriptor is owned below.
+    let fd = unsafe { libc::open(dir.as_ptr(), libc::O_TMPFILE | libc::O_RDWR | libc::O_CLOEXEC, 0o644 as libc::c_uint) };
+    if fd < 0 {
+        let e = std::io::Error::last_os_error();
+        return match e.raw_os_error() {
+            Some(libc::EOPNOTSUPP | libc::EISDIR | libc::EINVAL) => Ok(None),
+            _ => Err(e),
+        };
+    }
+    // SAFETY: `fd` was just opened and is owned by nothing else.
+    let file = unsafe { File::from_raw_fd(fd) };
+    let _ = file.lock();
+    let proc_path = CString::new(format!("/proc/self/fd/{fd}")).map_err(std::io::Error::other)?;
+    let target = c(path)?;
+    // SAFETY: valid NUL-terminated paths; linkat does not retain them.
+    let linked = unsafe { libc::linkat(libc::AT_FDCWD, proc_path.as_ptr(), libc::AT_FDCWD, target.as_ptr(), libc::AT_SYMLINK_FOLLOW) };
+    if linked != 0 {
+        let e = std::io::Error::last_os_error();
+        // No /proc (a bare container): fall back on create-then-lock.
+        return if e.raw_os_error() == Some(libc::ENOENT) && !Path::new("/proc/self/fd").exists() { Ok(None) } else { Err(e) };
+    }
+    Ok(Some(file))
 }
 
 /// Whether the temporary file at `path` was left by a writer that is gone:
@@ -270,6 +316,20 @@ mod tests {
             eprintln!("WARNING: this file system cannot exchange atomically; maps are replaced by two renames");
             assert!(a.join("from_a").exists() && b.join("from_b").exists());
         }
+    }
+
+    #[test]
+    fn a_temporary_is_locked_before_it_appears_under_its_name() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = temp_path(&dir.path().join("chunk.parquet"));
+        let mut file = create_locked(&path).unwrap();
+        file.write_all(b"data").unwrap();
+        let names: Vec<String> = std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+        assert_eq!(names, vec![path.file_name().unwrap().to_string_lossy().into_owned()]);
+        assert_eq!(std::fs::read(&path).unwrap(), b"data", "the named file is the one written");
+        assert!(!is_abandoned(&path), "a live writer's temporary is locked from the start");
+        drop(file);
+        assert!(is_abandoned(&path));
     }
 
     #[test]

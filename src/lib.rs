@@ -13,6 +13,7 @@ pub mod mould;
 pub mod plot;
 pub mod reduce;
 pub mod shape;
+pub mod study;
 pub mod sweep;
 
 /// Any error of the library, by layer.

@@ -40,6 +40,9 @@ enum Command {
     /// The main job: sweep (resumable) then reduce; the thesis sweep when no SPEC is given.
     #[command(allow_negative_numbers = true)]
     Map(cli::reduce::MapArgs),
+    /// Maps of actuator variants: a sweep and map per variant of a study spec, compared side by side.
+    #[command(allow_negative_numbers = true)]
+    Study(cli::study::StudyArgs),
     /// Fit EA, GA, EI (and optionally effects) to measurements (thesis eq. 2.14).
     #[command(allow_negative_numbers = true)]
     Calibrate(cli::calibrate::CalibrateArgs),
@@ -64,6 +67,7 @@ fn main() -> ExitCode {
         Command::Status(args) => cli::sweep::run_status_command(args),
         Command::Reduce(args) => cli::reduce::run(args),
         Command::Map(args) => cli::reduce::run_map(args),
+        Command::Study(args) => cli::study::run(args),
         Command::Calibrate(args) => cli::calibrate::run(args),
         Command::Diagnose(args) => cli::diagnose::run(args),
         Command::Synth(args) => cli::synth::run(args),

@@ -56,6 +56,9 @@ pub struct BodyDrawing {
     pub further_cables: Vec<Vec<(f64, f64)>>,
     /// Rod radius, mm.
     pub radius_mm: f64,
+    /// Radius r(s) at each centreline point, mm, for a non-uniform body;
+    /// empty: `radius_mm` everywhere.
+    pub radii_mm: Vec<f64>,
     /// Legend label.
     pub label: String,
     /// Line colour.
@@ -72,18 +75,33 @@ impl BodyDrawing {
             cable: sim.centreline.iter().map(|c| (c.cable_x_mm, c.cable_y_mm)).collect(),
             further_cables: Vec::new(),
             radius_mm,
+            radii_mm: Vec::new(),
             label,
             colour,
         }
     }
 
-    /// The body outline at ±r about the centreline, as two polylines.
+    /// The drawing of a simulated `actuator`: the outline follows its
+    /// radius r(s) (a tapered or segmented body), else ±`radius_mm`.
+    pub fn of_body(sim: &crate::model::Simulation, actuator: &crate::model::Actuator, label: String, colour: RGBColor) -> Self {
+        let mut d = Self::of_simulation(sim, actuator.radius_mm, label, colour);
+        if let Ok(Some(body)) = crate::model::Body::of(actuator) {
+            d.radii_mm = sim.centreline.iter().map(|c| body.radius_at(c.s_mm)).collect();
+        }
+        d
+    }
+
+    /// The body outline at ±r(s) about the centreline, as two polylines.
     pub fn outline(&self) -> (Vec<(f64, f64)>, Vec<(f64, f64)>) {
         let side = |sign: f64| -> Vec<(f64, f64)> {
             self.centreline
                 .iter()
                 .zip(&self.frame_angle_rad)
-                .map(|(&(x, y), &phi)| (x - sign * self.radius_mm * phi.sin(), y + sign * self.radius_mm * phi.cos()))
+                .enumerate()
+                .map(|(i, (&(x, y), &phi))| {
+                    let r = self.radii_mm.get(i).copied().unwrap_or(self.radius_mm);
+                    (x - sign * r * phi.sin(), y + sign * r * phi.cos())
+                })
                 .collect()
         };
         (side(1.0), side(-1.0))

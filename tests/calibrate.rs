@@ -103,7 +103,7 @@ fn diagnose_writes_a_report_with_plots() {
     for key in ["parameter", "parameter_se", "holdout_rms_before", "holdout_rms_after"] {
         assert!(v[key].is_f64(), "{key}: {v}");
     }
-    assert_eq!(v["candidates"].as_array().unwrap().len(), 6);
+    assert_eq!(v["candidates"].as_array().unwrap().len(), 7, "one per candidate effect");
     let md = std::fs::read_to_string(out.join("report.md")).unwrap();
     assert!(md.contains("channel_offset") && md.contains("| rank |") && md.contains("Criterion"), "{md}");
     // Measured and simulated shape coefficients side by side, in the thesis basis.
@@ -170,13 +170,15 @@ fn diagnose_jobs(dir: &Path, jobs: &[Job], same_data: bool) -> Vec<serde_json::V
 /// for the null case), the parameter is within ±25 % and the held-out error
 /// shrinks at least 1.5×. Effects outside the candidate list (a rod cured
 /// pre-curved, a stiff glue joint at the clamp), with and without centreline
-/// data, get `unexplained`: not `none`, not a wrong name. Prints the
-/// confusion matrix.
+/// data, get `unexplained`: not `none`, not a wrong name (except that the
+/// glue joint, a stiffness varying along s, may be named
+/// `stiffness_gradient` from tip data alone, never with centrelines).
+/// Prints the confusion matrix.
 #[test]
 fn diagnose_names_the_hidden_effect_and_admits_what_it_cannot_name() {
     // (effect, magnitude): about five times the probes near the detection
     // limit listed in docs/measurements.md (default protocol and noise).
-    let library: [(&str, f64); 7] = [
+    let library: [(&str, f64); 8] = [
         ("none", 0.0),
         ("friction", 0.08),
         ("gravity", 2.0),
@@ -184,12 +186,14 @@ fn diagnose_names_the_hidden_effect_and_admits_what_it_cannot_name() {
         ("clamp_compliance", 20.0),
         ("channel_offset", 0.4),
         ("creep", 0.2),
+        // β = ln 0.5: EI halves from clamp to tip.
+        ("stiffness_gradient", std::f64::consts::LN_2 * -1.0),
     ];
     // Out of the library: rest curvature 0.004 /mm over the whole rod, and
     // EI × 5 over the first 5 mm.
     let outside: [(&str, f64); 2] = [("rest_curvature", 0.004), ("glue_joint", 5.0)];
     let verdicts =
-        ["none", "friction", "gravity", "stiffening", "clamp_compliance", "channel_offset", "creep", "ambiguous", "unexplained", "inconclusive"];
+        ["none", "friction", "gravity", "stiffening", "clamp_compliance", "channel_offset", "creep", "stiffness_gradient", "ambiguous", "unexplained", "inconclusive"];
     let seeds = [11u64, 12, 13];
     let mut jobs: Vec<Job> = library.iter().flat_map(|&(e, m)| seeds.iter().map(move |&s| (e, m, s, false))).collect();
     for &(e, m) in &outside {
@@ -229,6 +233,15 @@ fn diagnose_names_the_hidden_effect_and_admits_what_it_cannot_name() {
             v["best"]["reduced_chi2"].as_f64().unwrap_or(f64::NAN),
         );
         let want = if library.iter().any(|c| c.0 == effect) { effect } else { "unexplained" };
+        // A stiff glue joint at the clamp is a stiffness varying along s:
+        // from the tips alone it is indistinguishable from a stiffness
+        // gradient (stiffer base, β < 0), which may name it; the centreline
+        // shows that the stiffening is local, and must leave it unexplained.
+        if effect == "glue_joint" && !shapes && verdict == "stiffness_gradient" {
+            let beta = p.unwrap();
+            assert!(beta < 0.0, "a stiff base is a negative gradient: {v}");
+            continue;
+        }
         if verdict != want {
             failures.push(format!("{label} seed {seed}: verdict {verdict}, expected {want}"));
             continue;
@@ -271,13 +284,14 @@ fn diagnose_names_the_hidden_effect_and_admits_what_it_cannot_name() {
 /// names it where the tip data alone do not.
 #[test]
 fn centrelines_name_effects_at_half_the_magnitude() {
-    let half: [(&str, f64); 6] = [
+    let half: [(&str, f64); 7] = [
         ("friction", 0.04),
         ("gravity", 1.5),
         ("stiffening", 1.5),
         ("clamp_compliance", 40.0),
         ("channel_offset", 0.2),
         ("creep", 0.1),
+        ("stiffness_gradient", -0.5 * std::f64::consts::LN_2),
     ];
     let mut jobs: Vec<Job> = half.iter().flat_map(|&(e, m)| [(e, m, 11, false), (e, m, 11, true)]).collect();
     jobs.push(("clamp_compliance", 150.0, 11, false));

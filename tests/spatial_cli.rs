@@ -164,6 +164,9 @@ fn bad_input_is_refused_with_a_clear_message() {
         (&["simulate", "--cable", "y=1,1,1,1,1 tension=1", "--friction-mu", "0.1"], "friction_mu"),
         (&["simulate", "--cable", "y=1,1,1,1,1 tension=1", "--order", "7"], "--steps-per-span"),
         (&["simulate", "--actuator", "/nonexistent/a.toml"], "/nonexistent/a.toml"),
+        (&["simulate", "--cable", "y=1,1,1,1,1 tension=1", "--radius-profile-mm", "0:5,65:3"], "uniform rod"),
+        (&["simulate", "--cable", "y=1,1,1,1,1 tension=1", "--cable-anchor-mm", "40"], "uniform rod"),
+        (&["simulate", "--cable", "y=1,1,1,1,1 tension=1", "--stiffness-gradient-beta", "-0.5"], "stiffness_gradient_beta"),
         (&["simulate"], "--cable"),
     ];
     for (args, needle) in cases {

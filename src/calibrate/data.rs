@@ -110,6 +110,10 @@ pub struct RoutingGroup {
 pub struct Dataset {
     /// Rows in file order.
     pub rows: Vec<Measurement>,
+    /// The actuator the file describes in its geometry header (`# key =
+    /// value` lines before the column names: `actuator_file = "x.toml"`
+    /// and/or actuator fields), if it has one.
+    pub actuator: Option<crate::model::Actuator>,
 }
 
 impl Dataset {
@@ -145,13 +149,52 @@ impl Dataset {
 struct Table {
     header: Vec<String>,
     rows: Vec<Vec<String>>,
+    /// The '#' lines before the header, '#' removed (CSV only).
+    front: String,
 }
 
 /// Reads a measurement file; `.parquet` files are read as Parquet, anything
 /// else as CSV.
 pub fn read_measurements(path: &Path) -> Result<Dataset, CalibrateError> {
     let table = read_table(path)?;
-    parse_measurements(path, &table)
+    let mut data = parse_measurements(path, &table)?;
+    data.actuator = actuator_of_front_matter(path, &table.front)?;
+    Ok(data)
+}
+
+/// The actuator of a measurement file's geometry header: TOML lines, each
+/// behind a '#' before the column names. `actuator_file = "name.toml"`
+/// (relative to the measurement file) loads an actuator file; any other
+/// keys are actuator fields (`length_mm = 360`, `radius_profile_mm =
+/// [[0, 15.4], [305, 6.4], [360, 4.8]]`, `cable_anchor_mm = 305`) set on
+/// top of it (or of the thesis's actuator). `None` without a header.
+fn actuator_of_front_matter(path: &Path, front: &str) -> Result<Option<crate::model::Actuator>, CalibrateError> {
+    use crate::model::Actuator;
+    let bad = |message: String| CalibrateError::Geometry { path: path.display().to_string(), message };
+    if front.trim().is_empty() {
+        return Ok(None);
+    }
+    let mut table: toml::Table = toml::from_str(front).map_err(|e| bad(e.to_string().trim_end().to_string()))?;
+    if table.is_empty() {
+        return Ok(None);
+    }
+    let base = match table.remove("actuator_file") {
+        None => Actuator::default(),
+        Some(toml::Value::String(name)) => {
+            let file = path.parent().unwrap_or(Path::new(".")).join(&name);
+            Actuator::from_toml_file(&file).map_err(|e| bad(e.to_string()))?
+        }
+        Some(other) => return Err(bad(format!("actuator_file = {other} must be a file name in quotes"))),
+    };
+    if table.is_empty() {
+        return Ok(Some(base));
+    }
+    let mut merged = toml::Table::try_from(&base).map_err(|e| bad(e.to_string()))?;
+    for (k, v) in table {
+        merged.insert(k, v);
+    }
+    let text = toml::to_string(&merged).map_err(|e| bad(e.to_string()))?;
+    Actuator::from_toml_str(&text).map(Some).map_err(bad)
 }
 
 fn read_table(path: &Path) -> Result<Table, CalibrateError> {
@@ -168,6 +211,21 @@ fn read_table(path: &Path) -> Result<Table, CalibrateError> {
 /// Splits CSV text into cells: comma-separated, fields optionally in double
 /// quotes ("" inside quotes is a quote), blank lines skipped.
 fn parse_csv(path: &Path, text: &str) -> Result<Table, CalibrateError> {
+    // The geometry header: '#' lines before the column names.
+    let text = text.trim_start_matches('\u{feff}');
+    let mut front = String::new();
+    let mut body_start = 0;
+    for line in text.split_inclusive('\n') {
+        let t = line.trim();
+        if t.starts_with('#') {
+            front.push_str(t.trim_start_matches('#'));
+            front.push('\n');
+        } else if !t.is_empty() {
+            break;
+        }
+        body_start += line.len();
+    }
+    let text = &text[body_start..];
     let mut lines = text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty());
     let Some((_, head)) = lines.next() else {
         return Err(CalibrateError::Empty { path: path.display().to_string() });
@@ -207,7 +265,7 @@ fn parse_csv(path: &Path, text: &str) -> Result<Table, CalibrateError> {
         }
         rows.push(cells);
     }
-    Ok(Table { header, rows })
+    Ok(Table { header, rows, front })
 }
 
 fn split_csv_line(line: &str) -> Result<Vec<String>, String> {
@@ -274,7 +332,7 @@ fn read_parquet_table(path: &Path) -> Result<Table, CalibrateError> {
     let Some(header) = header else {
         return Err(CalibrateError::Empty { path: path.display().to_string() });
     };
-    Ok(Table { header, rows })
+    Ok(Table { header, rows, front: String::new() })
 }
 
 /// Column lookup that names what is missing.
@@ -436,13 +494,42 @@ fn parse_measurements(path: &Path, table: &Table) -> Result<Dataset, CalibrateEr
             row: c.row,
         });
     }
-    Ok(Dataset { rows })
+    Ok(Dataset { rows, actuator: None })
 }
 
-/// Writes a measurement file as CSV (all columns, full precision).
+/// The geometry header of a measurement file for actuator `a`: its body
+/// (length, radius, radius profile, segments, cable anchor) as `# key =
+/// value` TOML lines. Rigidities and effects are left out: they are what
+/// calibrate and diagnose fit.
+pub fn geometry_header(a: &crate::model::Actuator) -> String {
+    #[derive(serde::Serialize)]
+    struct Geometry<'a> {
+        length_mm: f64,
+        radius_mm: f64,
+        #[serde(skip_serializing_if = "Option::is_none")]
+        cable_anchor_mm: Option<f64>,
+        #[serde(skip_serializing_if = "<[_]>::is_empty")]
+        radius_profile_mm: &'a [(f64, f64)],
+        #[serde(skip_serializing_if = "<[_]>::is_empty")]
+        segments: &'a [crate::model::Segment],
+    }
+    let g = Geometry {
+        length_mm: a.length_mm,
+        radius_mm: a.radius_mm,
+        cable_anchor_mm: a.cable_anchor_mm,
+        radius_profile_mm: &a.radius_profile_mm,
+        segments: &a.segments,
+    };
+    let text = toml::to_string(&g).unwrap_or_default();
+    text.lines().filter(|l| !l.trim().is_empty()).map(|l| format!("# {l}\n")).collect()
+}
+
+/// Writes a measurement file as CSV (all columns, full precision), with the
+/// geometry header of [`Dataset::actuator`] if it has one.
 pub fn measurements_csv(data: &Dataset) -> String {
     let with_noise = data.rows.iter().any(|m| m.noise_mm.is_some() || m.noise_deg.is_some());
-    let mut out = REQUIRED_COLUMNS.join(",");
+    let mut out = data.actuator.as_ref().map(geometry_header).unwrap_or_default();
+    out.push_str(&REQUIRED_COLUMNS.join(","));
     if with_noise {
         out.push_str(",noise_mm,noise_deg");
     }
@@ -603,7 +690,7 @@ mod tests {
         assert_eq!((d.rows[0].noise_mm, d.rows[0].noise_deg), (Some(0.8), None));
         assert_eq!((d.rows[1].noise_mm, d.rows[1].noise_deg), (None, Some(3.0)));
         let again = parse(&measurements_csv(&d)).unwrap();
-        assert_eq!(again, Dataset { rows: d.rows.clone() });
+        assert_eq!(again, Dataset { rows: d.rows.clone(), actuator: None });
         let bad = parse(&format!("{HEADER},noise_mm\n1,a,1,1,1,1,1,0.5,load,0,5,60,10,0.3,0\n")).unwrap_err().to_string();
         assert!(bad.contains("noise_mm") && bad.contains("row 1"), "{bad}");
     }
@@ -642,6 +729,28 @@ mod tests {
         std::fs::write(&path, b"not parquet").unwrap();
         let e = read_measurements(&path).unwrap_err().to_string();
         assert!(e.contains("m.parquet") && e.contains("Parquet"), "{e}");
+    }
+
+    #[test]
+    fn the_geometry_header_gives_the_body_and_round_trips() {
+        let mut a = crate::model::Actuator { length_mm: 360.0, cable_anchor_mm: Some(305.0), ..Default::default() };
+        a.radius_profile_mm = vec![(0.0, 15.4), (305.0, 6.4), (360.0, 4.8)];
+        a.effects.friction_mu = 0.3;
+        let header = geometry_header(&a);
+        assert!(header.lines().all(|l| l.starts_with("# ")) && !header.contains("friction"), "{header}");
+        let text = format!("{header}measurement,routing,y0_mm,y1_mm,y2_mm,y3_mm,y4_mm,tension_n,direction,step,dwell_s,tip_x_mm,tip_y_mm,tip_angle_rad\n1,a,0,1,1,1,1,0,rest,0,0,360,0,0\n");
+        let p = Path::new("m.csv");
+        let table = parse_csv(p, &text).unwrap();
+        let body = actuator_of_front_matter(p, &table.front).unwrap().unwrap();
+        assert_eq!((body.length_mm, body.cable_anchor_mm, &body.radius_profile_mm), (360.0, Some(305.0), &a.radius_profile_mm));
+        assert_eq!(body.effects.friction_mu, 0.0);
+        assert_eq!(parse_measurements(p, &table).unwrap().rows.len(), 1);
+        // A bad body in the header is named.
+        let bad = parse_csv(p, "# radius_profile_mm = [[0.0, 5.0], [30.0, -1.0], [65.0, 4.0]]\nmeasurement\n").unwrap();
+        let e = actuator_of_front_matter(p, &bad.front).unwrap_err().to_string();
+        assert!(e.contains("m.csv") && e.contains("geometry header") && e.contains("s = 30 mm"), "{e}");
+        let e = actuator_of_front_matter(p, "lenght_mm = 3\n").unwrap_err().to_string();
+        assert!(e.contains("lenght_mm"), "{e}");
     }
 
     #[test]

@@ -21,12 +21,21 @@ pub enum Effect {
     ChannelOffset,
     /// Viscoelastic creep in bending, fraction f (time constant held fixed).
     Creep,
+    /// Stiffness gradient β: EI(s) = EI·exp(β (s/L − ½)), EA and GA unchanged.
+    StiffnessGradient,
 }
 
 impl Effect {
     /// Every candidate, in a fixed order.
-    pub const ALL: [Effect; 6] =
-        [Effect::Friction, Effect::Gravity, Effect::Stiffening, Effect::ClampCompliance, Effect::ChannelOffset, Effect::Creep];
+    pub const ALL: [Effect; 7] = [
+        Effect::Friction,
+        Effect::Gravity,
+        Effect::Stiffening,
+        Effect::ClampCompliance,
+        Effect::ChannelOffset,
+        Effect::Creep,
+        Effect::StiffnessGradient,
+    ];
 
     /// The name used in reports, JSON and on the command line.
     pub fn name(self) -> &'static str {
@@ -37,6 +46,7 @@ impl Effect {
             Effect::ClampCompliance => "clamp_compliance",
             Effect::ChannelOffset => "channel_offset",
             Effect::Creep => "creep",
+            Effect::StiffnessGradient => "stiffness_gradient",
         }
     }
 
@@ -54,6 +64,7 @@ impl Effect {
             Effect::ClampCompliance => "clamp_stiffness_n_mm_per_rad",
             Effect::ChannelOffset => "channel_offset_mm",
             Effect::Creep => "creep_fraction",
+            Effect::StiffnessGradient => "stiffness_gradient_beta",
         }
     }
 
@@ -69,6 +80,7 @@ impl Effect {
             Effect::ClampCompliance => a.effects.clamp_stiffness_n_mm_per_rad = Some(value),
             Effect::ChannelOffset => a.effects.channel_offset_mm = value,
             Effect::Creep => a.effects.creep_fraction = value,
+            Effect::StiffnessGradient => a.effects.stiffness_gradient_beta = value,
         }
     }
 
@@ -82,6 +94,7 @@ impl Effect {
             Effect::ClampCompliance => return a.effects.clamp_stiffness_n_mm_per_rad,
             Effect::ChannelOffset => a.effects.channel_offset_mm,
             Effect::Creep => a.effects.creep_fraction,
+            Effect::StiffnessGradient => a.effects.stiffness_gradient_beta,
         };
         (v != 0.0).then_some(v)
     }
@@ -95,6 +108,7 @@ impl Effect {
             Effect::ClampCompliance => 300.0,
             Effect::ChannelOffset => 0.0,
             Effect::Creep => 0.05,
+            Effect::StiffnessGradient => 0.0,
         }
     }
 
@@ -108,6 +122,7 @@ impl Effect {
             Effect::ClampCompliance => (1.0..=1e5).contains(&value),
             Effect::ChannelOffset => value.abs() <= 2.0,
             Effect::Creep => value > 0.0 && value <= 0.9,
+            Effect::StiffnessGradient => value.abs() <= 5.0,
         }
     }
 
@@ -120,13 +135,14 @@ impl Effect {
             Effect::ClampCompliance => "1 ≤ k_θ ≤ 1e5 N·mm/rad",
             Effect::ChannelOffset => "|δ| ≤ 2 mm",
             Effect::Creep => "0 < f ≤ 0.9",
+            Effect::StiffnessGradient => "|β| ≤ 5 (EI(L)/EI(0) between 1/150 and 150)",
         }
     }
 
     /// Maps a parameter value to the fit's unconstrained coordinate.
     pub fn to_internal(self, value: f64) -> f64 {
         match self {
-            Effect::ChannelOffset => value,
+            Effect::ChannelOffset | Effect::StiffnessGradient => value,
             Effect::Creep => (value / (1.0 - value)).ln(),
             _ => value.ln(),
         }
@@ -135,7 +151,7 @@ impl Effect {
     /// Inverse of [`Effect::to_internal`].
     pub fn from_internal(self, x: f64) -> f64 {
         match self {
-            Effect::ChannelOffset => x,
+            Effect::ChannelOffset | Effect::StiffnessGradient => x,
             Effect::Creep => 1.0 / (1.0 + (-x).exp()),
             _ => x.exp(),
         }
@@ -144,7 +160,7 @@ impl Effect {
     /// d value / d internal coordinate at internal `x` (for standard errors).
     pub fn derivative(self, x: f64) -> f64 {
         match self {
-            Effect::ChannelOffset => 1.0,
+            Effect::ChannelOffset | Effect::StiffnessGradient => 1.0,
             Effect::Creep => {
                 let f = self.from_internal(x);
                 f * (1.0 - f)
@@ -159,6 +175,7 @@ impl Effect {
         let mut pair = [self, other];
         pair.sort();
         match (pair[0], pair[1]) {
+            (StiffnessGradient, _) | (_, StiffnessGradient) => "measure the centreline shape (curvature along the rod) on a straight routing: a stiffness gradient spreads the curvature unevenly along s (κ ∝ 1/EI(s)), the other effects do not",
             (Friction, Creep) => "repeat the load/unload protocol with two very different dwell times (e.g. 1 s and 60 s per step): a creep loop changes with dwell, a friction loop does not",
             (Gravity, _) | (_, Gravity) => "repeat a routing with the clamp tilted (clamp_tilt_rad ≠ 0, e.g. 0.5 rad): only the self-weight's effect changes with the tilt",
             (ClampCompliance, ChannelOffset) | (Stiffening, ClampCompliance) => "add a routing with y_c(0) = 0 (y0 = 0): clamp compliance vanishes there; also measure the centreline near the clamp (a rigid rotation at s = 0)",

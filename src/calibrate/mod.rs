@@ -35,6 +35,10 @@ pub enum CalibrateError {
     /// A row cannot be split into fields (or the file cannot be decoded).
     #[error("{path}: row {row}: {message}")]
     Malformed { path: String, row: usize, message: String },
+    /// The file's geometry header (`# key = value` lines before the CSV
+    /// header) is invalid.
+    #[error("{path}: the geometry header (the '#' lines before the column names): {message}; see docs/measurements.md")]
+    Geometry { path: String, message: String },
     /// Rows contradict each other.
     #[error("{path}: row {row}: {message}")]
     Inconsistent { path: String, row: usize, message: String },

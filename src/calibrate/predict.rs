@@ -35,7 +35,7 @@ pub fn predict_group(
 ) -> Result<Vec<Prediction>, CalibrateError> {
     let a = group_actuator(actuator, group);
     let first_row = data.rows[group.rows[0]].row;
-    let routing = Routing::new(group.routing_mm, a.length_mm, a.radius_mm)
+    let routing = Routing::for_actuator(group.routing_mm, &a)
         .map_err(|source| CalibrateError::Routing { routing: group.routing.clone(), row: first_row, source })?;
     let mut sim = Simulator::new(&a, options)?;
     sim.set_routing(&routing);
@@ -122,12 +122,12 @@ mod tests {
     fn a_tilted_clamp_lets_the_rod_sag_against_the_tilt() {
         // Clamp axis turned toward +y from the vertical: in the clamp's frame
         // gravity points toward −y, so the unloaded rod sags toward −y.
-        let data = Dataset { rows: vec![rest_row("t", 0.3)] };
+        let data = Dataset { rows: vec![rest_row("t", 0.3)], actuator: None };
         let groups = data.groups();
         let p = predict(&Actuator::default(), &SolverOptions::default(), &data, &groups, false).unwrap();
         let pose = p[0].as_ref().unwrap().pose;
         assert!(pose.tip_y_mm < -0.1 && pose.tip_angle_rad < 0.0, "{pose:?}");
-        let level = Dataset { rows: vec![rest_row("t", 0.0)] };
+        let level = Dataset { rows: vec![rest_row("t", 0.0)], actuator: None };
         let p0 = predict(&Actuator::default(), &SolverOptions::default(), &level, &level.groups(), false).unwrap();
         assert!(p0[0].as_ref().unwrap().pose.tip_y_mm.abs() < 1e-12);
     }
@@ -148,7 +148,7 @@ mod tests {
             ..rest_row("r", 0.0)
         };
         let angle = |rows: Vec<Measurement>| {
-            let data = Dataset { rows };
+            let data = Dataset { rows, actuator: None };
             let p = predict(&a, &SolverOptions::default(), &data, &data.groups(), false).unwrap();
             p.last().unwrap().as_ref().unwrap().pose.tip_angle_rad
         };

@@ -2,7 +2,7 @@
 
 use super::ActuatorArgs;
 use cablemap::bench::{bench_with_reference, sample_thesis_routings};
-use cablemap::model::{Actuator, SolverOptions};
+use cablemap::model::SolverOptions;
 use clap::Args;
 
 /// Arguments of `cablemap bench`.
@@ -24,7 +24,7 @@ pub struct BenchArgs {
 /// Runs the solver benchmark with gravity on and off.
 pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     anyhow::ensure!(args.routings > 0, "--routings must be at least 1");
-    let base = args.actuator.apply(&Actuator::default());
+    let base = args.actuator.resolve(None)?;
     let options = args.actuator.solver_options(&SolverOptions::default());
     let routings = sample_thesis_routings(args.routings, base.radius_mm);
     let rows = bench_with_reference(&base, &options, &routings, !args.no_reference)?;

@@ -10,7 +10,13 @@ use std::time::Instant;
 /// Reduces the cable sweep `run` into `out` and prints a summary.
 pub fn reduce_cables_into(run: &Path, out: &Path, partial: bool, cell_mm: Option<f64>, options: &ReduceOptions, json: bool) -> anyhow::Result<()> {
     let start = Instant::now();
-    let map = reduce_cable_run(run, partial, cell_mm, options, out).with_context(|| format!("reducing {}", run.display()))?;
+    // Scratch of the planar map beside the map, as for planar runs (same
+    // disk as the results, not a RAM-backed /tmp).
+    let mut options = options.clone();
+    if options.scratch_dir.is_none() {
+        options.scratch_dir = Some(out.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new(".")).to_path_buf());
+    }
+    let map = reduce_cable_run(run, partial, cell_mm, &options, out).with_context(|| format!("reducing {}", run.display()))?;
     let total_s = start.elapsed().as_secs_f64();
     let s = &map.summary;
     if json {

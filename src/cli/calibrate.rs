@@ -145,10 +145,10 @@ const LARGE_DATA_ROWS: usize = 2000;
 
 /// Runs `cablemap calibrate`.
 pub fn run(args: &CalibrateArgs) -> anyhow::Result<()> {
-    let base = args.actuator.apply(&Actuator::default());
+    let data = read_measurements(&args.data)?;
+    let base = args.actuator.resolve(data.actuator.as_ref())?;
     base.validate()?;
     let options = args.actuator.solver_options(&SolverOptions::default());
-    let data = read_measurements(&args.data)?;
     let (train, held) = split_holdout(&data, args.holdout.as_deref()).context("--holdout")?;
     let (mut spec, start, held_effects) = args.fit.spec(&base, &data)?;
     spec.effects = parse_effects(&args.effects)?;

@@ -4,7 +4,7 @@ use super::{ActuatorArgs, LengthBasisArgs};
 use anyhow::Context;
 use cablemap::design::run::DesignRequest;
 use cablemap::design::{self, ComponentResult, DesignError, DesignOutcome, Objective, SearchOptions, Target, Weights};
-use cablemap::model::{Actuator, SolverOptions};
+use cablemap::model::SolverOptions;
 use clap::Args;
 use std::io::Write;
 use std::path::PathBuf;
@@ -68,7 +68,7 @@ fn request(args: &DesignArgs) -> anyhow::Result<DesignRequest> {
         None => Weights::default(),
     };
     Ok(DesignRequest {
-        actuator: args.actuator.apply(&Actuator::default()),
+        actuator: args.actuator.resolve(None)?,
         options: args.actuator.solver_options(&SolverOptions::default()),
         target: Target::parse(&args.target).context("--target")?,
         weights,

@@ -7,7 +7,7 @@ use super::ActuatorArgs;
 use cablemap::calibrate::diagnose::{diagnose, DiagnoseSpec};
 use cablemap::calibrate::read_measurements;
 use cablemap::calibrate::report::write_report;
-use cablemap::model::{Actuator, SolverOptions};
+use cablemap::model::SolverOptions;
 use clap::Args;
 use std::io::Write;
 use std::path::PathBuf;
@@ -66,10 +66,10 @@ pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
         // Before the fits, not after them.
         cablemap::io::check_not_in_run_dir(&out_dir, "the report directory").map_err(anyhow::Error::msg).context("--out")?;
     }
-    let base = args.actuator.apply(&Actuator::default());
+    let data = read_measurements(&args.data)?;
+    let base = args.actuator.resolve(data.actuator.as_ref())?;
     base.validate()?;
     let options = args.actuator.solver_options(&SolverOptions::default());
-    let data = read_measurements(&args.data)?;
     let (fit, start, held_effects) = args.fit.spec(&base, &data)?;
     let spec = DiagnoseSpec {
         holdout: args.holdout.clone(),
@@ -181,6 +181,21 @@ fn next_step(fit: &cablemap::calibrate::FitResult) -> String {
     let a = &fit.actuator;
     let mut flags = vec![format!("--ea-n {}", sig5(a.ea_n)), format!("--ga-n {}", sig5(a.ga_n)), format!("--ei-n-mm2 {}", sig5(a.ei_n_mm2))];
     let mut toml = format!("[actuator]\nea_n = {}\nga_n = {}\nei_n_mm2 = {}\n", sig5(a.ea_n), sig5(a.ga_n), sig5(a.ei_n_mm2));
+    // A non-uniform body stays as it was given (the fitted rigidities are
+    // those of a section of radius radius_mm).
+    if !a.radius_profile_mm.is_empty() {
+        let points: Vec<String> = a.radius_profile_mm.iter().map(|(s, r)| format!("{s}:{r}")).collect();
+        let pairs: Vec<String> = a.radius_profile_mm.iter().map(|(s, r)| format!("[{s}, {r}]")).collect();
+        flags.push(format!("--radius-profile-mm \"{}\"", points.join(",")));
+        toml.push_str(&format!("radius_profile_mm = [{}]\n", pairs.join(", ")));
+    }
+    if let Some(k) = a.cable_anchor_mm {
+        flags.push(format!("--cable-anchor-mm {k}"));
+        toml.push_str(&format!("cable_anchor_mm = {k}\n"));
+    }
+    if !a.segments.is_empty() {
+        toml.push_str("# and the [[actuator.segments]] of the actuator file\n");
+    }
     let mut effects = String::new();
     for e in &fit.effects {
         use cablemap::calibrate::Effect;
@@ -195,6 +210,7 @@ fn next_step(fit: &cablemap::calibrate::FitResult) -> String {
             }
             Effect::ChannelOffset => ("--channel-offset-mm", "channel_offset_mm", fx.channel_offset_mm),
             Effect::Creep => ("--creep-fraction", "creep_fraction", fx.creep_fraction),
+            Effect::StiffnessGradient => ("--stiffness-gradient-beta", "stiffness_gradient_beta", fx.stiffness_gradient_beta),
         };
         flags.push(format!("{flag} {}", sig5(value)));
         if *e == Effect::Gravity {

@@ -1,6 +1,7 @@
 //! `cablemap feasible`: the map's verdict on a target (thesis §4.2).
 
-use cablemap::design::feasible::{check, FeasibilityReport};
+use anyhow::Context;
+use cablemap::design::feasible::{check, FeasibilityReport, Verdict};
 use cablemap::design::map::MapDir;
 use cablemap::design::{Target, Weights};
 use clap::Args;
@@ -11,8 +12,11 @@ use std::path::PathBuf;
 #[derive(Debug, Clone, Args)]
 pub struct FeasibleArgs {
     /// Feasibility map directory (`cablemap reduce` output).
-    #[arg(long, value_name = "MAP_DIR")]
-    pub map: PathBuf,
+    #[arg(long, value_name = "MAP_DIR", required_unless_present = "study", conflicts_with = "study")]
+    pub map: Option<PathBuf>,
+    /// A study directory (`cablemap study` output): the verdict of every variant's map.
+    #[arg(long, value_name = "DIR")]
+    pub study: Option<PathBuf>,
     /// Target, any subset of x, y (tip, mm) and a0, a1, … (1/mm),
     /// e.g. x=50,y=5,a0=-0.025,a1=-0.06,a2=0.015.
     #[arg(long, value_name = "K=V,…", allow_hyphen_values = true)]
@@ -32,13 +36,17 @@ pub struct FeasibleArgs {
 
 /// Runs `cablemap feasible`.
 pub fn run(args: &FeasibleArgs) -> anyhow::Result<()> {
-    let map = MapDir::open(&args.map)?;
     let target = Target::parse(&args.target)?;
     let weights = match &args.weights {
         Some(w) => Weights::parse(w)?,
         None => Weights::default(),
     };
     weights.check_against(&target)?;
+    let Some(map_dir) = &args.map else {
+        let study = args.study.as_ref().expect("clap requires --map or --study");
+        return run_study(study, &target, &weights, args);
+    };
+    let map = MapDir::open(map_dir)?;
     let report = check(&map, &target, args.basis.length_basis, &weights, args.nearest)?;
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
@@ -46,6 +54,38 @@ pub fn run(args: &FeasibleArgs) -> anyhow::Result<()> {
         writeln!(out, "{}", serde_json::to_value(&report)?)?;
     } else {
         write!(out, "{}", text(&report))?;
+    }
+    Ok(())
+}
+
+/// `feasible --study DIR`: every variant's verdict, and which reach the target.
+fn run_study(dir: &std::path::Path, target: &Target, weights: &Weights, args: &FeasibleArgs) -> anyhow::Result<()> {
+    let variants = cablemap::study::mapped_variants(dir)?;
+    let mut rows = Vec::new();
+    for (index, label, map_dir) in variants {
+        let map = MapDir::open(&map_dir).with_context(|| format!("variant {index} ({label}): run the study to finish its map"))?;
+        let report = check(&map, target, args.basis.length_basis, weights, args.nearest)?;
+        rows.push((index, label, report));
+    }
+    let reach: Vec<String> = rows.iter().filter(|r| r.2.verdict == Verdict::Feasible).map(|r| format!("v{}", r.0)).collect();
+    let stdout = std::io::stdout();
+    let mut out = stdout.lock();
+    if args.json {
+        let variants: Vec<_> = rows
+            .iter()
+            .map(|(i, label, r)| serde_json::json!({ "variant": i, "label": label, "verdict": r.verdict, "report": r }))
+            .collect();
+        writeln!(out, "{}", serde_json::json!({ "study": dir, "feasible_variants": reach, "variants": variants }))?;
+    } else {
+        for (i, label, r) in &rows {
+            let first = r.reasons.first().map_or(String::new(), |s| format!(": {s}"));
+            writeln!(out, "v{i:<3} {:<12} {label}{first}", r.verdict.as_str().to_uppercase())?;
+        }
+        if reach.is_empty() {
+            writeln!(out, "no variant reaches the target feasibly (see the BORDERLINE ones, or widen the study)")?;
+        } else {
+            writeln!(out, "reach the target: {} of {} variants ({})", reach.len(), rows.len(), reach.join(", "))?;
+        }
     }
     Ok(())
 }

@@ -10,6 +10,7 @@ pub mod feasible;
 pub mod mould;
 pub mod reduce;
 pub mod simulate;
+pub mod study;
 pub mod sweep;
 pub mod synth;
 
@@ -58,6 +59,9 @@ pub struct ActuatorArgs {
     /// Channel offset δ added to every y_i, mm [default: 0].
     #[arg(long, value_name = "MM", allow_hyphen_values = true)]
     pub channel_offset_mm: Option<f64>,
+    /// Stiffness gradient β: EI(s) = EI·exp(β (s/L − ½)), β = ln(EI(L)/EI(0)) [default: 0].
+    #[arg(long, value_name = "BETA", allow_hyphen_values = true)]
+    pub stiffness_gradient_beta: Option<f64>,
     /// Cable–channel friction coefficient μ (capstan law) [default: 0].
     #[arg(long, value_name = "MU")]
     pub friction_mu: Option<f64>,
@@ -70,6 +74,18 @@ pub struct ActuatorArgs {
     /// Creep: seconds each tension is held on a fresh rod in sweeps and design [default: 0].
     #[arg(long, value_name = "S")]
     pub creep_hold_s: Option<f64>,
+    /// Actuator TOML file (the fields of a sweep spec's [actuator] section, docs/model.md); the
+    /// flags above and below override it [default: the thesis's actuator].
+    #[arg(long, value_name = "FILE")]
+    pub actuator_file: Option<std::path::PathBuf>,
+    /// Radius profile r(s): points s:r in mm, piecewise linear from s = 0 to L, e.g.
+    /// "0:15.4,305:6.4,360:4.8" (a cone is two points). EA, GA, EI stay those of a section of
+    /// radius --radius-mm and scale with r(s) [default: uniform radius].
+    #[arg(long, value_name = "S:R,...", value_parser = parse_radius_profile_arg)]
+    pub radius_profile_mm: Option<RadiusProfileArg>,
+    /// Where the cable is knotted, 0 < s_k ≤ L, mm; the routing spans [0, s_k] [default: the tip].
+    #[arg(long, value_name = "MM")]
+    pub cable_anchor_mm: Option<f64>,
     /// Solver method: `collocation` (spectral, the default) or `rk4` (the previous method).
     #[arg(long, value_enum, value_name = "METHOD")]
     pub method: Option<MethodArg>,
@@ -80,6 +96,14 @@ pub struct ActuatorArgs {
     /// (2·N + 1 points) [default: 24].
     #[arg(long, value_name = "N")]
     pub steps_per_span: Option<usize>,
+}
+
+/// A radius profile given on the command line.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RadiusProfileArg(pub Vec<(f64, f64)>);
+
+fn parse_radius_profile_arg(text: &str) -> Result<RadiusProfileArg, String> {
+    cablemap::model::body::parse_radius_profile(text).map(RadiusProfileArg)
 }
 
 /// Solver method on the command line.
@@ -111,6 +135,7 @@ impl ActuatorArgs {
         set(&mut a.effects.stiffening_alpha, self.stiffening_alpha);
         set(&mut a.effects.channel_offset_mm, self.channel_offset_mm);
         set(&mut a.effects.friction_mu, self.friction_mu);
+        set(&mut a.effects.stiffness_gradient_beta, self.stiffness_gradient_beta);
         set(&mut a.effects.creep_fraction, self.creep_fraction);
         set(&mut a.effects.creep_time_s, self.creep_time_s);
         set(&mut a.effects.creep_hold_s, self.creep_hold_s);
@@ -120,7 +145,24 @@ impl ActuatorArgs {
         if self.clamp_stiffness.is_some() {
             a.effects.clamp_stiffness_n_mm_per_rad = self.clamp_stiffness;
         }
+        if let Some(p) = &self.radius_profile_mm {
+            a.radius_profile_mm = p.0.clone();
+        }
+        if self.cable_anchor_mm.is_some() {
+            a.cable_anchor_mm = self.cable_anchor_mm;
+        }
         a
+    }
+
+    /// The actuator: `--actuator-file` if given, else `from_data` (the one a
+    /// measurement file gives), else the thesis's; with the flags applied.
+    pub fn resolve(&self, from_data: Option<&Actuator>) -> anyhow::Result<Actuator> {
+        let base = match (&self.actuator_file, from_data) {
+            (Some(path), _) => Actuator::from_toml_file(path).map_err(anyhow::Error::msg).map_err(|e| e.context("--actuator-file"))?,
+            (None, Some(a)) => a.clone(),
+            (None, None) => Actuator::default(),
+        };
+        Ok(self.apply(&base))
     }
 
     /// Solver options with the step override.

@@ -121,6 +121,7 @@ pub fn run(args: &MouldArgs) -> anyhow::Result<()> {
     };
     let actuator = args.actuator.apply(&base);
     actuator.validate()?;
+    cablemap::mould::check_uniform_body(&actuator)?;
     let routing = Routing::new(&ys, actuator.length_mm, actuator.radius_mm)?;
     let summary = MouldSet::new(&routing, actuator.radius_mm, &args.mould.params())
         .and_then(|set| set.write_all(&args.out))

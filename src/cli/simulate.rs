@@ -2,7 +2,7 @@
 
 use super::{parse_list, ActuatorArgs, LengthBasisArgs};
 use cablemap::model::record::{self, SimulationRecord};
-use cablemap::model::{simulate_held, Actuator, Hold, LoadDirection, Routing, SolverOptions};
+use cablemap::model::{simulate_held, Hold, LoadDirection, Routing, SolverOptions};
 use cablemap::plot::{draw_bodies, BodyDrawing};
 use anyhow::Context;
 use clap::Args;
@@ -27,7 +27,7 @@ pub struct SimulateArgs {
     /// A whole actuator (rod, torsion, gravity direction, cables) as TOML
     /// (docs/schema.md); --cable replaces its cables, rod flags override it.
     #[arg(long = "actuator", value_name = "FILE.toml")]
-    pub actuator_file: Option<PathBuf>,
+    pub spatial_actuator: Option<PathBuf>,
     /// Gravity along a global direction X,Y,Z (normalised; the weight per
     /// length still comes from the density). Uses the 3-D solver.
     #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
@@ -79,7 +79,7 @@ pub enum CoefficientRoute {
 
 /// Runs `cablemap simulate`.
 pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
-    if !args.cable.is_empty() || args.actuator_file.is_some() || args.gravity_direction.is_some() {
+    if !args.cable.is_empty() || args.spatial_actuator.is_some() || args.gravity_direction.is_some() {
         return run_spatial(args);
     }
     let (Some(routing_text), Some(tension)) = (&args.routing, args.tension_n) else {
@@ -87,7 +87,7 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
             "say what to simulate: --routing Y0,..,Y4 --tension-n T (one planar cable), --cable \"y=.. z=.. tension=T\" (repeatable), or --actuator FILE.toml"
         );
     };
-    let actuator = args.actuator.apply(&Actuator::default());
+    let actuator = args.actuator.resolve(None)?;
     actuator.validate()?;
     let options = args.actuator.solver_options(&SolverOptions::default());
     anyhow::ensure!(
@@ -96,7 +96,7 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         args.n_d
     );
     let y = parse_list(routing_text, "--routing")?;
-    let routing = Routing::new(&y, actuator.length_mm, actuator.radius_mm).context("--routing")?;
+    let routing = Routing::for_actuator(&y, &actuator).context("--routing")?;
     let direction = if args.direction == "unload" { LoadDirection::Unload } else { LoadDirection::Load };
     let hold = Hold { direction, dwell_s: args.dwell_s.unwrap_or(actuator.effects.creep_hold_s) };
     // The thesis route computes its own coefficients from the centreline
@@ -121,7 +121,7 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     }
     if let Some(path) = &args.png {
         let title = format!("routing [{}] mm, tension {:.3} N", fmt_list(&y), tension);
-        let drawing = BodyDrawing::of_simulation(&sim, actuator.radius_mm, "body (outline at ±r), cable in red".into(), BLUE_800);
+        let drawing = BodyDrawing::of_body(&sim, &actuator, "body (outline at ±r), cable in red".into(), BLUE_800);
         draw_bodies(path, &title, &[drawing], &[])?;
     }
     let stdout = std::io::stdout();
@@ -156,13 +156,22 @@ fn run_spatial(args: &SimulateArgs) -> anyhow::Result<()> {
     if let Some((_, flag)) = planar_only.iter().find(|(given, _)| *given) {
         anyhow::bail!("{flag} applies to the planar single-cable solver (--routing/--tension) only; the 3-D solver models the thesis's rod");
     }
-    let mut spatial = match &args.actuator_file {
-        Some(path) => SpatialActuator::read(path)?,
-        None => SpatialActuator::with_cables(Actuator::default(), Vec::new()),
+    // The rod: the spatial file's [rod], else an --actuator-file, else the
+    // thesis's; rod flags override either.
+    let mut spatial = match &args.spatial_actuator {
+        Some(path) => {
+            anyhow::ensure!(
+                args.actuator.actuator_file.is_none(),
+                "give the rod either in --actuator FILE's [rod] table or by --actuator-file, not both"
+            );
+            let mut spatial = SpatialActuator::read(path)?;
+            spatial.rod = args.actuator.apply(&spatial.rod);
+            spatial
+        }
+        None => SpatialActuator::with_cables(args.actuator.resolve(None)?, Vec::new()),
     };
-    spatial.rod = args.actuator.apply(&spatial.rod);
     if !args.cable.is_empty() {
-        spatial.cables = args.cable.iter().map(|c| c.parse::<Cable>()).collect::<Result<_, _>>()?;
+        spatial.cables = args.cable.iter().map(|c| c.parse::<Cable>()).collect::<Result<_, _>>().context("--cable")?;
     }
     if let (Some(routing), Some(tension)) = (&args.routing, args.tension_n) {
         let y = parse_list(routing, "--routing")?;

@@ -67,7 +67,13 @@ fn env_number<T: std::str::FromStr>(name: &str) -> anyhow::Result<Option<T>> {
 /// Shard index and where it came from: `--shard`, else SLURM's array task
 /// id, else the Kubernetes Indexed Job's completion index, else 0.
 fn shard_index(args: &SweepArgs) -> anyhow::Result<(u64, &'static str)> {
-    if let Some(s) = args.shard {
+    shard_from_env(args.shard)
+}
+
+/// `shard` if given, else SLURM's array task id, else the Kubernetes
+/// Indexed Job's completion index, else 0; and where it came from.
+pub fn shard_from_env(shard: Option<u64>) -> anyhow::Result<(u64, &'static str)> {
+    if let Some(s) = shard {
         return Ok((s, "--shard"));
     }
     for name in ["SLURM_ARRAY_TASK_ID", "JOB_COMPLETION_INDEX"] {

@@ -6,7 +6,7 @@ use cablemap::calibrate::data::{centrelines_csv, markers_csv, measurements_csv};
 use cablemap::calibrate::synth::{default_routings, synthesize_with_markers, SynthSpec};
 use cablemap::calibrate::Effect;
 use cablemap::model::routing::CONTROL_POINTS;
-use cablemap::model::{Actuator, SolverOptions};
+use cablemap::model::SolverOptions;
 use anyhow::{bail, Context};
 use clap::Args;
 use std::collections::BTreeMap;
@@ -132,7 +132,7 @@ fn parse_markers(text: &str) -> anyhow::Result<Vec<(f64, f64)>> {
 
 /// Runs `cablemap synth`.
 pub fn run(args: &SynthArgs) -> anyhow::Result<()> {
-    let mut actuator = args.actuator.apply(&Actuator::default());
+    let mut actuator = args.actuator.resolve(None)?;
     if let Some(hidden) = OUT_OF_LIBRARY.iter().find(|h| **h == args.effect) {
         let Some(m) = args.magnitude else {
             bail!("--effect {hidden} needs --magnitude ({})", if *hidden == "rest_curvature" { "the rest curvature in 1/mm, e.g. 0.004" } else { "the joint's EI factor, e.g. 5" });
@@ -166,8 +166,10 @@ pub fn run(args: &SynthArgs) -> anyhow::Result<()> {
         (None, None) => Vec::new(),
         (Some(_), Some(text)) => parse_markers(text)?,
         (Some(_), None) => {
-            let (l, r) = (actuator.length_mm, actuator.radius_mm);
-            vec![(0.25 * l, r), (0.5 * l, -r), (0.75 * l, r), (l, -r)]
+            // On the surface: r(s) for a tapered body.
+            let l = actuator.length_mm;
+            let r = |f: f64| actuator.radius_at(f * l);
+            vec![(0.25 * l, r(0.25)), (0.5 * l, -r(0.5)), (0.75 * l, r(0.75)), (l, -r(1.0))]
         }
     };
     let spec = SynthSpec {
@@ -193,7 +195,11 @@ pub fn run(args: &SynthArgs) -> anyhow::Result<()> {
         );
     }
     let points = if args.centreline_out.is_some() { args.centreline_points.max(2) } else { 0 };
-    let (data, centrelines, markers) = synthesize_with_markers(&spec, points)?;
+    let (mut data, centrelines, markers) = synthesize_with_markers(&spec, points)?;
+    if !spec.actuator.is_uniform_body() {
+        // The body goes into the file, so diagnose needs no geometry flags.
+        data.actuator = Some(spec.actuator.clone());
+    }
     cablemap::io::write_atomic(&args.out, measurements_csv(&data).as_bytes())
         .with_context(|| format!("writing {}", args.out.display()))?;
     if let Some(path) = &args.centreline_out {

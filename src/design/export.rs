@@ -126,7 +126,9 @@ pub fn mould_svg(routing: &Routing, radius_mm: f64, channel_diameter_mm: f64, te
 }
 
 /// Writes design.json, channel.csv, mould.svg and shape.png into `dir`
-/// (created if missing).
+/// (created if missing). mould.svg, a drawing of the uniform cylinder's
+/// mould, is left out for a non-uniform body (radius profile, segments,
+/// cable anchor); channel.csv then runs over the cable, [0, s_k].
 pub fn write_all(dir: &Path, objective: &Objective, eval: &Evaluation, record: &DesignRecord) -> Result<(), DesignError> {
     super::run::check_export_dir(dir)?;
     std::fs::create_dir_all(dir).map_err(io_error(format!("creating {}", dir.display())))?;
@@ -136,10 +138,12 @@ pub fn write_all(dir: &Path, objective: &Objective, eval: &Evaluation, record: &
     };
     write("design.json", record.to_file_text().as_bytes())?;
     let act = &objective.actuator;
-    let routing = Routing::new(&eval.routing_mm, act.length_mm, act.radius_mm)?;
+    let routing = Routing::for_actuator(&eval.routing_mm, act)?;
     write("channel.csv", routing.channel_csv().as_bytes())?;
     // The thesis's channel: a PTFE tube of 1 mm outer diameter (§5.2).
-    write("mould.svg", mould_svg(&routing, act.radius_mm, 1.0, eval.tension_n).as_bytes())?;
+    if act.is_uniform_body() {
+        write("mould.svg", mould_svg(&routing, act.radius_mm, 1.0, eval.tension_n).as_bytes())?;
+    }
     shape_png(&dir.join("shape.png"), objective, eval)
 }
 
@@ -149,10 +153,10 @@ pub fn write_all(dir: &Path, objective: &Objective, eval: &Evaluation, record: &
 /// design's ℓ and θ_0 (coefficients the target omits are the achieved ones).
 pub fn shape_png(path: &Path, objective: &Objective, eval: &Evaluation) -> Result<(), DesignError> {
     let act = &objective.actuator;
-    let routing = Routing::new(&eval.routing_mm, act.length_mm, act.radius_mm)?;
+    let routing = Routing::for_actuator(&eval.routing_mm, act)?;
     let sim = simulate(act, &objective.options, &routing, eval.tension_n, objective.target.order(), objective.length_basis)?;
     let mut bodies =
-        vec![crate::plot::BodyDrawing::of_simulation(&sim, act.radius_mm, "achieved body (outline at ±r), cable in red".into(), BLUE_800)];
+        vec![crate::plot::BodyDrawing::of_body(&sim, act, "achieved body (outline at ±r), cable in red".into(), BLUE_800)];
     let target = &objective.target;
     if target.highest_order().is_some() {
         let pose = &eval.pose;
@@ -169,6 +173,7 @@ pub fn shape_png(path: &Path, objective: &Objective, eval: &Evaluation) -> Resul
             cable: Vec::new(),
             further_cables: Vec::new(),
             radius_mm: 0.0,
+            radii_mm: Vec::new(),
             label: "target shape (target a_i; achieved ℓ and base angle)".into(),
             colour: GREEN_700,
         });

@@ -110,7 +110,7 @@ impl Objective {
         Simulator::new(&actuator, &options)?;
         crate::model::resolution::check_order(target.order(), &options).map_err(DesignError::BadTarget)?;
         weights.check_against(&target)?;
-        bounds.validate(actuator.radius_mm)?;
+        bounds.validate(actuator.channel_radius_mm())?;
         Ok(Self { actuator, options, target, weights, bounds, length_basis: LengthBasis::default() })
     }
 
@@ -140,7 +140,7 @@ impl Objective {
     /// fails, a continuation ladder from low tension (as `model::simulate`)
     /// takes over.
     pub fn evaluate(&self, sim: &mut Simulator, routing_mm: &ControlPoints, tension_n: f64) -> Result<Evaluation, SolveFailure> {
-        let routing = Routing::new(routing_mm, self.actuator.length_mm, self.actuator.radius_mm)
+        let routing = Routing::for_actuator(routing_mm, &self.actuator)
             .expect("design variables are kept inside the body by the bounds");
         sim.set_routing(&routing);
         let pose = match sim.solve(tension_n) {

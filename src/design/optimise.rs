@@ -146,7 +146,7 @@ pub fn grid_seeds(objective: &Objective, search: &SearchOptions) -> Vec<(f64, Se
             || (objective.simulator(), vec![0.0; order + 1]),
             |(sim, a), y| {
                 let mut out = Vec::with_capacity(2 * tensions.len());
-                let routing = match Routing::new(&y, objective.actuator.length_mm, objective.actuator.radius_mm) {
+                let routing = match Routing::for_actuator(&y, &objective.actuator) {
                     Ok(r) => r,
                     Err(_) => return out,
                 };

@@ -77,7 +77,7 @@ impl DesignRequest {
             return Err(DesignError::BadSearch("the number of starts must be at least 1".into()));
         }
         let [lo, hi] = map.map_or(DEFAULT_TENSION_RANGE_N, |m| m.summary.tension_range_n);
-        let mut bounds = Bounds::thesis(self.actuator.radius_mm, self.tension_min_n.unwrap_or(lo), self.tension_max_n.unwrap_or(hi));
+        let mut bounds = Bounds::thesis(self.actuator.channel_radius_mm(), self.tension_min_n.unwrap_or(lo), self.tension_max_n.unwrap_or(hi));
         if let Some(y) = self.max_offset_mm {
             bounds.max_offset_mm = y;
         }
@@ -115,7 +115,8 @@ pub fn run(request: &DesignRequest) -> Result<DesignRun, DesignError> {
         super::export::write_all(dir, &objective, &outcome.best, &record)?;
         if let Some(params) = &request.moulds {
             let act = &objective.actuator;
-            let routing = Routing::new(&outcome.best.routing_mm, act.length_mm, act.radius_mm)?;
+            crate::mould::check_uniform_body(act)?;
+            let routing = Routing::for_actuator(&outcome.best.routing_mm, act)?;
             moulds = Some(MouldSet::new(&routing, act.radius_mm, params)?.write_all(dir)?);
         }
     }

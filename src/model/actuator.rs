@@ -1,6 +1,7 @@
 //! Actuator parameters (thesis Table 2.1, model-notes §1) and the optional
 //! physical effects the thesis model leaves out (model-notes §6).
 
+use super::body::{Body, Segment};
 use serde::{Deserialize, Serialize};
 
 /// Default creep time constant T, s.
@@ -22,6 +23,20 @@ pub enum ParameterError {
     /// ([`crate::model::resolution`]).
     #[error("{0}")]
     Unresolved(String),
+    /// The body along s (radius profile, segments, cable anchor) is invalid
+    /// ([`crate::model::body::BodyError`]).
+    #[error("{0}")]
+    Body(String),
+}
+
+/// Why an actuator file could not be used.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("actuator file {path}: {message} (an actuator file holds the [actuator] fields of docs/model.md: length_mm, radius_mm, radius_profile_mm, segments, cable_anchor_mm, ...)")]
+pub struct ActuatorFileError {
+    /// The file.
+    pub path: String,
+    /// What is wrong.
+    pub message: String,
 }
 
 /// Self-weight of the rod.
@@ -100,6 +115,16 @@ pub struct Effects {
     /// existing specs and metadata are unchanged.
     #[serde(skip_serializing_if = "Hidden::is_off")]
     pub hidden: Hidden,
+    /// Stiffness gradient β: EI(s) = EI·exp(β (s/L − ½)) with EA, GA
+    /// unchanged (uneven curing, an unmodelled taper); β = ln(EI(L)/EI(0)),
+    /// β < 0 is softer toward the tip. Not written when 0, so existing specs
+    /// and metadata are unchanged.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub stiffness_gradient_beta: f64,
+}
+
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
 }
 
 /// Effects deliberately outside the diagnosis's candidate list, so that
@@ -143,6 +168,7 @@ impl Default for Effects {
             creep_time_s: DEFAULT_CREEP_TIME_S,
             creep_hold_s: 0.0,
             hidden: Hidden::default(),
+            stiffness_gradient_beta: 0.0,
         }
     }
 }
@@ -168,6 +194,22 @@ pub struct Actuator {
     pub gravity: Gravity,
     /// Effects beyond the thesis model.
     pub effects: Effects,
+    /// Radius profile r(s): points (s, r) in mm, piecewise linear, from s = 0
+    /// to L (a cone is two points). Empty: the uniform radius `radius_mm`.
+    /// EA, GA, EI (and the weight) are those of a section of radius
+    /// `radius_mm`, scaled by (r/radius_mm)², ², ⁴ (and ²). Not written when
+    /// empty, so existing files are unchanged.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub radius_profile_mm: Vec<(f64, f64)>,
+    /// Segments of their own material, clamp to tip ([`Segment`]); empty:
+    /// one material.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub segments: Vec<Segment>,
+    /// Where the cable is knotted, s_k ≤ L (mm); `None` is the tip. The
+    /// routing's five control points span [0, s_k]; beyond the knot the rod
+    /// carries no cable load, only its weight.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cable_anchor_mm: Option<f64>,
 }
 
 impl Default for Actuator {
@@ -181,6 +223,9 @@ impl Default for Actuator {
             density_g_cm3: 1.07,
             gravity: Gravity::default(),
             effects: Effects::default(),
+            radius_profile_mm: Vec::new(),
+            segments: Vec::new(),
+            cable_anchor_mm: None,
         }
     }
 }
@@ -195,6 +240,56 @@ impl Actuator {
         // ρ [g/cm³] = ρ·1e-6 kg/mm³; area π r² mm²; g m/s² → N/mm.
         let mass_kg_per_mm = self.density_g_cm3 * 1e-6 * std::f64::consts::PI * self.radius_mm.powi(2);
         self.gravity.scale * mass_kg_per_mm * self.gravity.g_m_s2
+    }
+
+    /// Whether the body is the uniform cylinder with the cable knotted at
+    /// the tip (the thesis's rod, solved on the fast path).
+    pub fn is_uniform_body(&self) -> bool {
+        self.radius_profile_mm.is_empty() && self.segments.is_empty() && self.cable_anchor_mm.is_none_or(|k| k == self.length_mm)
+    }
+
+    /// The cable's length along the rod, s_k (mm): the anchor, or L.
+    pub fn cable_length_mm(&self) -> f64 {
+        self.cable_anchor_mm.unwrap_or(self.length_mm)
+    }
+
+    /// Radius r(s), mm (the profile's, or `radius_mm`). Assumes a valid body.
+    pub fn radius_at(&self, s_mm: f64) -> f64 {
+        match Body::of(self) {
+            Ok(Some(b)) => b.radius_at(s_mm),
+            _ => self.radius_mm,
+        }
+    }
+
+    /// The smallest radius along the cable's length [0, s_k], mm: bounds on
+    /// the control points below it keep the channel inside the body (the
+    /// spline stays in its control polygon's hull). `radius_mm` for the
+    /// uniform cylinder.
+    pub fn channel_radius_mm(&self) -> f64 {
+        match Body::of(self) {
+            Ok(Some(b)) => b.min_radius_mm(0.0, self.cable_length_mm()),
+            _ => self.radius_mm,
+        }
+    }
+
+    /// The largest radius along the rod, mm.
+    pub fn max_radius_mm(&self) -> f64 {
+        self.radius_profile_mm.iter().map(|p| p.1).fold(if self.radius_profile_mm.is_empty() { self.radius_mm } else { 0.0 }, f64::max)
+    }
+
+    /// Reads an actuator TOML file (the fields of [`Actuator`], as in a sweep
+    /// spec's `[actuator]` section; missing fields are the thesis's), checked
+    /// with [`Actuator::validate`]. This module owns the actuator file format.
+    pub fn from_toml_file(path: &std::path::Path) -> Result<Actuator, ActuatorFileError> {
+        let text = std::fs::read_to_string(path).map_err(|e| ActuatorFileError { path: path.display().to_string(), message: e.to_string() })?;
+        Actuator::from_toml_str(&text).map_err(|message| ActuatorFileError { path: path.display().to_string(), message })
+    }
+
+    /// Parses actuator TOML text (see [`Actuator::from_toml_file`]).
+    pub fn from_toml_str(text: &str) -> Result<Actuator, String> {
+        let a: Actuator = toml::from_str(text).map_err(|e| e.to_string().trim_end().to_string())?;
+        a.validate().map_err(|e| e.to_string())?;
+        Ok(a)
     }
 
     /// Checks every parameter; the solver calls this before it starts.
@@ -269,6 +364,15 @@ impl Actuator {
                 expected: "a finite length ≥ 0 mm",
             });
         }
+        let beta = self.effects.stiffness_gradient_beta;
+        if !(beta.is_finite() && beta.abs() <= 20.0) {
+            return Err(ParameterError::OutOfRange {
+                name: "effects.stiffness_gradient_beta",
+                value: beta,
+                expected: "|β| ≤ 20 (β = ln(EI(L)/EI(0)))",
+            });
+        }
+        Body::of(self)?;
         let delta = self.effects.channel_offset_mm;
         if !(delta.is_finite() && delta.abs() < self.radius_mm) {
             return Err(ParameterError::OutOfRange {

@@ -2,12 +2,14 @@
 //! static rod–cable solver.
 
 pub mod actuator;
+pub mod body;
 pub mod record;
 pub mod routing;
 pub mod resolution;
 pub mod solver;
 pub mod spatial;
 
+pub use body::{Body, BodyError, Segment};
 pub use actuator::{Actuator, Effects, Gravity, LoadDirection, ParameterError};
 pub use routing::{ControlPoints, Routing, RoutingError};
 pub use solver::{simulate, simulate_held, CentrelinePoint, Hold, SimulateError, Simulation, Simulator, SolveFailure, SolverMethod, SolverOptions, TipPose, STATUS_OK};

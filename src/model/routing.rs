@@ -98,6 +98,12 @@ pub enum RoutingError {
     /// A control point lies on or outside the rod surface.
     #[error("control point y{index} = {value} mm is outside the body: every |y_i| must be below the radius r = {radius_mm} mm")]
     OutsideBody { index: usize, value: f64, radius_mm: f64 },
+    /// The channel leaves a non-uniform body somewhere along s.
+    #[error("the channel at s = {s_mm:.2} mm is at y_c = {y_mm:.3} mm, outside the body (radius r(s) = {radius_mm:.3} mm there): move the control points nearer the axis, or widen the radius profile there")]
+    ChannelOutsideBody { s_mm: f64, y_mm: f64, radius_mm: f64 },
+    /// The actuator's body (profile, segments, anchor) is invalid.
+    #[error("{0}")]
+    Body(String),
     /// Rod length or radius is not positive and finite.
     #[error("rod length ({length_mm} mm) and radius ({radius_mm} mm) must be positive and finite")]
     BadGeometry { length_mm: f64, radius_mm: f64 },
@@ -207,6 +213,45 @@ impl Routing {
         let mut y = [0.0; CONTROL_POINTS];
         y.copy_from_slice(y_mm);
         Ok(Self::from_points_unchecked(y, length_mm))
+    }
+
+    /// Builds the routing of actuator `a`: over the cable's length [0, s_k]
+    /// (the anchor, or L), with the channel checked against r(s) along s
+    /// for a non-uniform body. For the uniform body this is
+    /// [`Routing::new`] with the actuator's length and radius.
+    pub fn for_actuator(y_mm: impl AsRef<[f64]>, a: &super::Actuator) -> Result<Self, RoutingError> {
+        let body = super::body::Body::of(a).map_err(|e| RoutingError::Body(e.to_string()))?;
+        let Some(body) = body else {
+            if a.is_uniform_body() {
+                return Routing::new(y_mm, a.length_mm, a.radius_mm);
+            }
+            // Uniform radius, cable knotted before the tip.
+            return Routing::new(y_mm, a.cable_length_mm(), a.radius_mm);
+        };
+        let y_mm = y_mm.as_ref();
+        if y_mm.len() != CONTROL_POINTS {
+            return Err(RoutingError::WrongCount(y_mm.len()));
+        }
+        for (index, &value) in y_mm.iter().enumerate() {
+            if !value.is_finite() {
+                return Err(RoutingError::NotFinite { index, value });
+            }
+        }
+        let mut y = [0.0; CONTROL_POINTS];
+        y.copy_from_slice(y_mm);
+        let routing = Self::from_points_unchecked(y, a.cable_length_mm());
+        // The channel itself (not the control polygon) against r(s), on the
+        // drawing grid and at the profile's points (where r has its kinks).
+        let mut at: Vec<f64> = routing.channel_samples().iter().map(|p| p.0).collect();
+        at.extend(body.breakpoints_mm().into_iter().filter(|&s| s <= routing.length_mm));
+        for s in at {
+            let y = routing.channel_at(s).y_mm;
+            let r = body.radius_at(s);
+            if !(y.abs() < r) {
+                return Err(RoutingError::ChannelOutsideBody { s_mm: s, y_mm: y, radius_mm: r });
+            }
+        }
+        Ok(routing)
     }
 
     /// Builds the spline without checking against a radius (used for the

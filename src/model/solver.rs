@@ -48,6 +48,7 @@
 //! collocation's Newton fallback for heavy rods (a dense Jacobian).
 
 use super::actuator::{Actuator, LoadDirection, ParameterError};
+use super::body::{merge_sorted, Body};
 use super::routing::Routing;
 use crate::shape::LengthBasis;
 use serde::{Deserialize, Serialize};
@@ -262,6 +263,8 @@ struct Section {
     ga_n: f64,
     /// Bending rigidity EI, N·mm².
     ei_n_mm2: f64,
+    /// Radius r, mm (material stiffening's α r²).
+    radius_mm: f64,
 }
 
 /// Bending moment at a cut, N·mm: the cable's moment τ y_c cos α about the
@@ -295,6 +298,13 @@ pub struct Simulator {
     col: Option<Box<collocation::Colloc>>,
     /// RK4 state (also sized with collocation: it is small).
     rk4: rk4::Rk4,
+    /// The non-uniform body (radius profile, segments); `None` for the
+    /// uniform cylinder, solved on the fast path.
+    body: Option<Body>,
+    /// Index of the first point beyond the cable's anchor (the number of
+    /// points when the cable is knotted at the tip): from there on the cut
+    /// carries no cable load.
+    cable_end: usize,
 }
 
 /// How a solve is held: the direction of the last tension change (friction)
@@ -335,17 +345,30 @@ impl Simulator {
         } else {
             options.nodes_per_span
         };
+        let body = Body::of(actuator)?;
+        if options.method == SolverMethod::Rk4 && !actuator.is_uniform_body() && actuator.cable_length_mm() < actuator.length_mm {
+            return Err(ParameterError::Body(
+                "the rk4 reference method knots the cable at the tip only: use the default collocation method for a cable anchored before the tip".into(),
+            ));
+        }
+        let spans = span_boundaries(actuator, body.as_ref(), 0.5 * actuator.cable_length_mm()).len() - 1;
         // Per-point buffers: RK4 stage points, or collocation nodes.
         let points = match options.method {
             SolverMethod::Rk4 => 2 * (2 * n + 1),
-            SolverMethod::Collocation => 2 * (m + 1),
+            SolverMethod::Collocation => spans * (m + 1),
         };
-        let col = (options.method == SolverMethod::Collocation).then(|| Box::new(collocation::Colloc::new(m)));
+        let col = (options.method == SolverMethod::Collocation).then(|| Box::new(collocation::Colloc::new(m, spans)));
         let beta = actuator.gravity.direction_rad;
+        // A non-uniform body's weight is this factor times ∫ ρ r² (Body).
+        let weight_n_per_mm = match &body {
+            None => actuator.weight_n_per_mm(),
+            Some(_) if !actuator.gravity.enabled => 0.0,
+            Some(_) => actuator.gravity.scale * 1e-6 * std::f64::consts::PI * actuator.gravity.g_m_s2,
+        };
         Ok(Self {
             actuator: actuator.clone(),
             options: options.clone(),
-            weight_n_per_mm: actuator.weight_n_per_mm(),
+            weight_n_per_mm,
             gravity_cos: beta.cos(),
             gravity_sin: beta.sin(),
             routing: None,
@@ -356,6 +379,8 @@ impl Simulator {
             creep: Creep::new(&actuator.effects, actuator.ei_n_mm2, points),
             col,
             rk4: rk4::Rk4::new(n),
+            body,
+            cable_end: points,
         })
         .and_then(|mut sim: Simulator| {
             // Outside a protocol every solve is held like this from a virgin rod.
@@ -372,14 +397,16 @@ impl Simulator {
 
     /// Validates `y_mm` against the actuator and sets it as the routing.
     pub fn set_routing_mm(&mut self, y_mm: &[f64]) -> Result<(), super::routing::RoutingError> {
-        let routing = Routing::new(y_mm, self.actuator.length_mm, self.actuator.radius_mm)?;
+        let routing = Routing::for_actuator(y_mm, &self.actuator)?;
         self.set_routing(&routing);
         Ok(())
     }
 
     /// Sets the routing (precomputing the channel at every stage point) and
-    /// forgets the warm start.
+    /// forgets the warm start. The routing must span the cable's length
+    /// (build it with [`Routing::for_actuator`]).
     pub fn set_routing(&mut self, routing: &Routing) {
+        debug_assert!((routing.length_mm() - self.actuator.cable_length_mm()).abs() <= 1e-9 * self.actuator.length_mm);
         let delta = self.actuator.effects.channel_offset_mm;
         let built = if delta != 0.0 { routing.shifted(delta) } else { routing.clone() };
         if self.col.is_some() {
@@ -432,23 +459,55 @@ impl Simulator {
     }
 
     /// The section's rigidities at reference arc length `s` (mm): the
-    /// actuator's, with the test-only hidden stiffer base segment. The one
-    /// place a profile along s would enter.
+    /// actuator's, or the non-uniform body's ([`Body::section_at`]), with
+    /// the stiffness gradient and the test-only hidden stiffer base segment.
     #[inline]
     fn section_at(&self, s: f64) -> Section {
-        let a = &self.actuator;
-        let hidden = &a.effects.hidden;
-        let mut ei = a.ei_n_mm2;
-        if s < hidden.base_segment_mm {
-            ei *= hidden.base_segment_ei_factor;
-        }
-        Section { ea_n: a.ea_n, ga_n: a.ga_n, ei_n_mm2: ei }
+        self.section_at_side(s, false)
     }
 
-    /// The rod's weight beyond the cut at `s` (mm), N.
+    /// [`Simulator::section_at`], where a section that jumps at `s` (a
+    /// segment's end) is taken from the left with `left` (the last node of
+    /// a span), from the right otherwise.
+    #[inline]
+    fn section_at_side(&self, s: f64, left: bool) -> Section {
+        let a = &self.actuator;
+        let hidden = &a.effects.hidden;
+        let mut section = match &self.body {
+            None => Section { ea_n: a.ea_n, ga_n: a.ga_n, ei_n_mm2: a.ei_n_mm2, radius_mm: a.radius_mm },
+            Some(b) => {
+                let x = b.section_at_side(s, left);
+                Section { ea_n: x.ea_n, ga_n: x.ga_n, ei_n_mm2: x.ei_n_mm2, radius_mm: x.radius_mm }
+            }
+        };
+        if s < hidden.base_segment_mm {
+            section.ei_n_mm2 *= hidden.base_segment_ei_factor;
+        }
+        let beta = a.effects.stiffness_gradient_beta;
+        if beta != 0.0 {
+            section.ei_n_mm2 *= (beta * (s / a.length_mm - 0.5)).exp();
+        }
+        section
+    }
+
+    /// The rod's weight beyond the cut at `s` (mm), N: w·(L − s) for the
+    /// uniform rod, the closed-form ∫_s^L w dσ for a non-uniform body.
     #[inline]
     fn distal_weight_n(&self, s: f64) -> f64 {
-        self.weight_n_per_mm * (self.actuator.length_mm - s)
+        match &self.body {
+            None => self.weight_n_per_mm * (self.actuator.length_mm - s),
+            Some(b) => self.weight_n_per_mm * b.distal_density_area(s),
+        }
+    }
+
+    /// The cable tension at point `i` for base tension `tension`: friction's
+    /// profile, and none beyond the cable's anchor.
+    #[inline]
+    fn tension_at(&self, i: usize, tension: f64) -> f64 {
+        if i >= self.cable_end {
+            return 0.0;
+        }
+        tension * self.friction.ratio(i)
     }
 
     /// Curvature u from the bending moment `m` (N·mm) on `section` and du/dm.
@@ -458,19 +517,20 @@ impl Simulator {
     /// ([`Simulator::section_at`]).
     #[inline]
     fn bending_curvature(&self, m: f64, section: &Section) -> (f64, f64) {
-        let (u, du_dm) = self.elastic_curvature(m, section.ei_n_mm2);
+        let (u, du_dm) = self.elastic_curvature(m, section.ei_n_mm2, section.radius_mm);
         (u + self.actuator.effects.hidden.rest_curvature_per_mm, du_dm)
     }
 
-    /// The elastic part of [`Simulator::bending_curvature`] with rigidity `ei`.
+    /// The elastic part of [`Simulator::bending_curvature`] with rigidity
+    /// `ei` and radius `radius_mm`.
     #[inline]
-    fn elastic_curvature(&self, m: f64, ei: f64) -> (f64, f64) {
+    fn elastic_curvature(&self, m: f64, ei: f64, radius_mm: f64) -> (f64, f64) {
         let alpha = self.actuator.effects.stiffening_alpha;
         if alpha == 0.0 {
             return (m / ei, 1.0 / ei);
         }
         // Monotone cubic EI (u + c u³) = m, c = α r²: Newton from the linear guess.
-        let c = alpha * self.actuator.radius_mm.powi(2);
+        let c = alpha * radius_mm.powi(2);
         let mut u = m / ei;
         for _ in 0..STIFFENING_MAX_ITERATIONS {
             let f = ei * (u + c * u * u * u) - m;
@@ -484,7 +544,8 @@ impl Simulator {
         (u, 1.0 / (ei * (1.0 + 3.0 * c * u * u)))
     }
 
-    /// Solves the cut equations at one point for the cable angle α and the
+    /// Solves the cut equations at one point (arc length `s`, cross-section
+    /// `section`) for the cable angle α and the
     /// strains, starting Newton from the direction `dir0` = (cos α, sin α);
     /// `(sp, cp)` = sin, cos of φ; `tension` is the cable tension at the cut
     /// and `creep_offset` the creep's held curvature f E q₀ (1/mm). Returns
@@ -499,6 +560,7 @@ impl Simulator {
     fn strains_at(
         &self,
         s: f64,
+        section: &Section,
         ch: ChannelSample,
         (sp, cp): (f64, f64),
         moment: f64,
@@ -506,9 +568,8 @@ impl Simulator {
         dir0: (f64, f64),
         creep_offset: f64,
     ) -> Result<(Strains, (f64, f64)), SolveFailure> {
-        let section = self.section_at(s);
         let (ea, ga) = (section.ea_n, section.ga_n);
-        let creep_gain = self.creep.gain();
+        let creep_gain = self.creep.gain(section.ei_n_mm2);
         // Weight beyond the cut, in the body frame: Rᵀ W.
         let wl = self.distal_weight_n(s);
         let w1 = wl * (cp * self.gravity_cos + sp * self.gravity_sin);
@@ -518,7 +579,7 @@ impl Simulator {
             let v1 = 1.0 + (w1 - tension * ca) / ea;
             let v2 = (w2 - tension * sa) / ga;
             let m = bending_moment(tension, ch.y, ca, moment);
-            let (u_el, du_dm_el) = self.bending_curvature(m, &section);
+            let (u_el, du_dm_el) = self.bending_curvature(m, section);
             let u = u_el + creep_gain * m + creep_offset;
             let du_dm = du_dm_el + creep_gain;
             let p = v1 - u * ch.y;
@@ -607,6 +668,19 @@ impl Simulator {
         }
         self.rk4_centreline()
     }
+}
+
+/// The collocation's span boundaries from the clamp to the tip: the
+/// routing's knot `knot_mm`, the cable's anchor and the body's breakpoints
+/// (so that every span's integrands are smooth); [0, knot, L] for the
+/// uniform rod.
+fn span_boundaries(a: &Actuator, body: Option<&Body>, knot_mm: f64) -> Vec<f64> {
+    let length = a.length_mm;
+    let mut cuts = vec![0.0, knot_mm, a.cable_length_mm(), length];
+    if let Some(b) = body {
+        cuts.extend(b.breakpoints_mm());
+    }
+    merge_sorted(cuts, length)
 }
 
 /// Rotates the unit vector (cos a, sin a) by `delta` rad. Small angles (the
@@ -944,5 +1018,240 @@ mod tests {
         let want = tau * d / a.ei_n_mm2 * (a.length_mm - 5.0 + 5.0 / 5.0);
         // The rigidity jumps inside an RK4 step: first-order accurate there.
         assert!((glued.tip_angle_rad - want).abs() < 0.01 * want, "{} vs {want}", glued.tip_angle_rad);
+    }
+}
+
+#[cfg(test)]
+mod body_tests {
+    //! Non-uniform bodies (radius profile, segments, cable anchor) and the
+    //! stiffness gradient against closed forms and equilibrium.
+    use super::*;
+    use crate::model::body::Segment;
+
+    /// Gauss–Legendre 8-point nodes and weights on [−1, 1].
+    const GL8: [(f64, f64); 8] = [
+        (-0.960_289_856_497_536_3, 0.101_228_536_290_376_26),
+        (-0.796_666_477_413_626_7, 0.222_381_034_453_374_47),
+        (-0.525_532_409_916_329, 0.313_706_645_877_887_3),
+        (-0.183_434_642_495_649_8, 0.362_683_783_378_362),
+        (0.183_434_642_495_649_8, 0.362_683_783_378_362),
+        (0.525_532_409_916_329, 0.313_706_645_877_887_3),
+        (0.796_666_477_413_626_7, 0.222_381_034_453_374_47),
+        (0.960_289_856_497_536_3, 0.101_228_536_290_376_26),
+    ];
+
+    /// ∫_a^b f by composite 8-point Gauss–Legendre on `n` panels.
+    fn quad(f: impl Fn(f64) -> f64, a: f64, b: f64, n: usize) -> f64 {
+        let h = (b - a) / n as f64;
+        (0..n)
+            .map(|k| {
+                let c = a + (k as f64 + 0.5) * h;
+                GL8.iter().map(|&(x, w)| w * f(c + 0.5 * h * x)).sum::<f64>() * 0.5 * h
+            })
+            .sum()
+    }
+
+    /// The tip of a rod with curvature `kappa(s)` and stretch `v1(s)` (no
+    /// shear), integrated piecewise between `cuts` (where the integrands kink).
+    fn tip_by_quadrature(kappa: &dyn Fn(f64) -> f64, v1: &dyn Fn(f64) -> f64, cuts: &[f64]) -> (f64, f64, f64) {
+        let phi = |s: f64| -> f64 {
+            let mut total = 0.0;
+            for w in cuts.windows(2) {
+                if s <= w[0] {
+                    break;
+                }
+                total += quad(kappa, w[0], s.min(w[1]), 4);
+            }
+            total
+        };
+        let (mut x, mut y) = (0.0, 0.0);
+        for w in cuts.windows(2) {
+            x += quad(|s| v1(s) * phi(s).cos(), w[0], w[1], 40);
+            y += quad(|s| v1(s) * phi(s).sin(), w[0], w[1], 40);
+        }
+        (x, y, phi(cuts[cuts.len() - 1]))
+    }
+
+    fn tapered_thesis_rod() -> Actuator {
+        let mut a = Actuator::default();
+        a.radius_profile_mm = vec![(0.0, 6.0), (30.0, 5.0), (65.0, 4.0)];
+        a
+    }
+
+    #[test]
+    fn straight_routing_bends_as_tau_d_over_ei_of_s() {
+        let (tau, d) = (1.5, 3.0);
+        for beta in [0.0, -0.7] {
+            let mut a = tapered_thesis_rod();
+            a.gravity.enabled = false;
+            a.effects.stiffness_gradient_beta = beta;
+            a.segments = vec![
+                Segment { end_mm: 20.0, ea_n: Some(40.0), ga_n: None, ei_n_mm2: Some(150.0), density_g_cm3: None },
+                Segment { end_mm: 65.0, ea_n: None, ga_n: None, ei_n_mm2: None, density_g_cm3: None },
+            ];
+            let body = Body::of(&a).unwrap().unwrap();
+            let ei = |s: f64| body.section_at(s).ei_n_mm2 * (beta * (s / a.length_mm - 0.5)).exp();
+            let kappa = |s: f64| tau * d / ei(s);
+            let v1 = |s: f64| 1.0 - tau / body.section_at(s).ea_n;
+            let (x, y, phi) = tip_by_quadrature(&kappa, &v1, &[0.0, 20.0, 30.0, 65.0]);
+            let options = SolverOptions { nodes_per_span: 24, ..SolverOptions::default() };
+            let mut sim = Simulator::new(&a, &options).unwrap();
+            sim.set_routing_mm(&[d; 5]).unwrap();
+            let pose = sim.solve(tau).unwrap();
+            let err = (pose.tip_x_mm - x).hypot(pose.tip_y_mm - y);
+            eprintln!("angle {} vs {phi}; ell {}", pose.tip_angle_rad, pose.length_mm);
+            for p in sim.centreline().iter().step_by(6) { eprintln!("{} {} {} {}", p.s_mm, p.u_per_mm, kappa(p.s_mm), p.v1 - v1(p.s_mm)); }
+            assert!(err < 1e-8, "β {beta}: tip ({}, {}) vs ({x}, {y}): {err:e} mm", pose.tip_x_mm, pose.tip_y_mm);
+            assert!((pose.tip_angle_rad - phi).abs() < 1e-10);
+            // The curvature along the centreline is τ d / EI(s).
+            for p in sim.centreline().iter().step_by(7) {
+                assert!((p.u_per_mm - kappa(p.s_mm)).abs() < 1e-7 * kappa(p.s_mm), "s {}: {} vs {}", p.s_mm, p.u_per_mm, kappa(p.s_mm));
+            }
+        }
+    }
+
+    #[test]
+    fn beyond_the_anchor_the_rod_stays_straight_without_gravity() {
+        let (tau, d, anchor) = (1.2, 2.5, 45.0);
+        let mut a = tapered_thesis_rod();
+        a.gravity.enabled = false;
+        a.cable_anchor_mm = Some(anchor);
+        let mut sim = Simulator::new(&a, &SolverOptions::default()).unwrap();
+        sim.set_routing_mm(&[d; 5]).unwrap();
+        let pose = sim.solve(tau).unwrap();
+        let line = sim.centreline();
+        let at_anchor = line.iter().find(|p| p.s_mm > anchor).unwrap();
+        let body = Body::of(&a).unwrap().unwrap();
+        let phi_k = quad(|s| tau * d / body.section_at(s).ei_n_mm2, 0.0, 30.0, 8) + quad(|s| tau * d / body.section_at(s).ei_n_mm2, 30.0, anchor, 8);
+        assert!((pose.tip_angle_rad - phi_k).abs() < 1e-9, "{} vs {phi_k}", pose.tip_angle_rad);
+        for p in line.iter().filter(|p| p.s_mm > anchor) {
+            assert!(p.u_per_mm.abs() < 1e-12 && p.cable_tension_n == 0.0, "{p:?}");
+            assert!((p.tangent_angle_rad - pose.tip_angle_rad).abs() < 1e-12);
+            // On one straight line.
+            let (dx, dy) = (p.x_mm - at_anchor.x_mm, p.y_mm - at_anchor.y_mm);
+            assert!((dx * phi_k.sin() - dy * phi_k.cos()).abs() < 1e-9, "{p:?}");
+        }
+        // A routing spans the cable only: its control points sit on [0, s_k].
+        let r = Routing::for_actuator([d; 5], &a).unwrap();
+        assert_eq!(r.length_mm(), anchor);
+        assert!(Simulator::new(&a, &SolverOptions { method: SolverMethod::Rk4, ..SolverOptions::default() }).is_err());
+    }
+
+    #[test]
+    fn a_tapered_rod_under_its_weight_balances_the_base_moment() {
+        for (profile, direction) in [(vec![(0.0, 7.0), (65.0, 3.0)], 1.0), (vec![(0.0, 6.0), (30.0, 5.0), (65.0, 4.0)], 0.4)] {
+            let mut a = Actuator::default();
+            a.radius_profile_mm = profile;
+            a.gravity.direction_rad = direction;
+            a.gravity.scale = 20.0;
+            a.segments = vec![
+                Segment { end_mm: 40.0, ea_n: None, ga_n: None, ei_n_mm2: None, density_g_cm3: Some(1.5) },
+                Segment { end_mm: 65.0, ea_n: None, ga_n: None, ei_n_mm2: None, density_g_cm3: None },
+            ];
+            let options = SolverOptions { steps_per_span: 2000, ..SolverOptions::default() };
+            let mut sim = Simulator::new(&a, &options).unwrap();
+            sim.set_routing_mm(&[0.0; 5]).unwrap();
+            let pose = sim.solve(0.0).unwrap();
+            let line = sim.centreline();
+            let body = Body::of(&a).unwrap().unwrap();
+            let g = a.gravity.scale * a.gravity.g_m_s2 * 1e-6 * std::f64::consts::PI;
+            let w = |s: f64| g * body.density_at(s) * body.radius_at(s).powi(2);
+            let (c, sn) = (direction.cos(), direction.sin());
+            let (x0, y0) = (line[0].x_mm, line[0].y_mm);
+            // Trapezoid over the centreline (fine: 4001 points).
+            let mut moment = 0.0;
+            for pair in line.windows(2) {
+                let f = |p: &CentrelinePoint| w(p.s_mm) * ((p.y_mm - y0) * c - (p.x_mm - x0) * sn);
+                moment -= 0.5 * (f(&pair[0]) + f(&pair[1])) * (pair[1].s_mm - pair[0].s_mm);
+            }
+            let base = body.section_at(0.0).ei_n_mm2 * line[0].u_per_mm;
+            assert!(pose.tip_y_mm.abs() > 5.0, "the rod should bend: {pose:?}");
+            assert!((base - moment).abs() < 1e-5 * moment.abs(), "base moment {base} vs ∫ w lever {moment}");
+        }
+    }
+
+    #[test]
+    fn a_uniform_profile_and_one_material_match_the_uniform_rod() {
+        // The same spans: agreement to the fixed point's tolerance (the
+        // weight is summed differently, so rounding takes another path; the
+        // sweeps stop at 1e-9 rad, about 1e-7 mm at the tip); an extra
+        // breakpoint at 20 mm changes the discretisation, well below its error.
+        let mut flat = Actuator::default();
+        flat.radius_profile_mm = vec![(0.0, 5.0), (65.0, 5.0)];
+        flat.segments = vec![Segment { end_mm: 65.0, ea_n: None, ga_n: None, ei_n_mm2: None, density_g_cm3: None }];
+        flat.cable_anchor_mm = Some(65.0);
+        let mut split = flat.clone();
+        split.radius_profile_mm = vec![(0.0, 5.0), (20.0, 5.0), (65.0, 5.0)];
+        let route = [1.0, -2.0, 4.0, 4.0, -4.0];
+        let mut poses = Vec::new();
+        for a in [Actuator::default(), flat, split] {
+            let mut sim = Simulator::new(&a, &SolverOptions::default()).unwrap();
+            sim.set_routing_mm(&route).unwrap();
+            poses.push((1..=8).map(|k| sim.solve(0.25 * k as f64).unwrap()).collect::<Vec<_>>());
+        }
+        for (k, tol) in [(1, 1e-6), (2, 1e-6)] {
+            for (p, q) in poses[0].iter().zip(&poses[k]) {
+                assert!((p.tip_x_mm - q.tip_x_mm).abs() < tol && (p.tip_y_mm - q.tip_y_mm).abs() < tol, "{p:?} {q:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn rk4_agrees_with_collocation_on_a_cone_with_gravity() {
+        let mut a = Actuator::default();
+        a.radius_profile_mm = vec![(0.0, 6.5), (65.0, 4.0)];
+        a.effects.stiffness_gradient_beta = -0.5;
+        let rk4 = SolverOptions { method: SolverMethod::Rk4, steps_per_span: 192, ..SolverOptions::default() };
+        let mut sims = [Simulator::new(&a, &SolverOptions::default()).unwrap(), Simulator::new(&a, &rk4).unwrap()];
+        let mut poses = [Vec::new(), Vec::new()];
+        for (sim, out) in sims.iter_mut().zip(&mut poses) {
+            sim.set_routing_mm(&[1.0, -2.0, 3.5, 3.5, -3.5]).unwrap();
+            for k in 1..=8 {
+                out.push(sim.solve(0.25 * k as f64).unwrap());
+            }
+        }
+        for (p, q) in poses[0].iter().zip(&poses[1]) {
+            let tip = (p.tip_x_mm - q.tip_x_mm).hypot(p.tip_y_mm - q.tip_y_mm);
+            assert!(tip < 2e-5 && (p.tip_angle_rad - q.tip_angle_rad).abs() < 1e-6, "{p:?} {q:?}");
+        }
+    }
+
+    #[test]
+    fn the_real_tentacle_solves_up_to_7_7_n() {
+        // 360 mm, r 15.4 → 6.4 → 4.8 mm, tendon knotted at 305 mm, full gravity.
+        let mut a = Actuator { length_mm: 360.0, cable_anchor_mm: Some(305.0), ..Actuator::default() };
+        a.radius_profile_mm = vec![(0.0, 15.4), (305.0, 6.4), (360.0, 4.8)];
+        let mut sim = Simulator::new(&a, &SolverOptions::default()).unwrap();
+        sim.set_routing_mm(&[4.0; 5]).unwrap();
+        let mut last = None;
+        for k in 1..=31 {
+            last = Some(sim.solve(7.7 * k as f64 / 31.0).unwrap());
+        }
+        let pose = last.unwrap();
+        assert!(pose.tip_angle_rad > 3.0, "{pose:?}");
+    }
+}
+
+#[cfg(test)]
+mod anchor_edge_tests {
+    use super::*;
+
+    /// An anchor a hair above a profile point is merged with it: the span
+    /// from there on carries no cable, as with the anchor exactly there.
+    #[test]
+    fn an_anchor_merged_into_a_breakpoint_ends_the_cable_there() {
+        let mut poses = Vec::new();
+        for anchor in [50.0, 50.0 + 1e-12] {
+            let mut a = Actuator::default();
+            a.gravity.enabled = false;
+            a.radius_profile_mm = vec![(0.0, 6.0), (50.0, 5.0), (65.0, 4.0)];
+            a.cable_anchor_mm = Some(anchor);
+            let mut sim = Simulator::new(&a, &SolverOptions::default()).unwrap();
+            sim.set_routing_mm(&[2.0; 5]).unwrap();
+            let pose = sim.solve(1.0).unwrap();
+            assert!(sim.centreline().iter().filter(|p| p.s_mm > 50.5).all(|p| p.u_per_mm == 0.0));
+            poses.push(pose);
+        }
+        assert!((poses[0].tip_angle_rad - poses[1].tip_angle_rad).abs() < 1e-9, "{poses:?}");
     }
 }

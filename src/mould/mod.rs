@@ -82,12 +82,35 @@ pub enum MouldError {
          use a routing with |y_c| ≤ {limit_mm:.3} mm (design --max-offset-mm), a thinner tube, or --min-skin-mm"
     )]
     ChannelTooClose { tube_mm: f64, skin_mm: f64, s_mm: f64, y_mm: f64, radius_mm: f64, min_skin_mm: f64, limit_mm: f64 },
+    /// The actuator is not a uniform cylinder with the cable knotted at the tip.
+    #[error("moulds are made for uniform cylinders only, but this actuator has {0}: the two-part mould's tray and plate assume one radius and a channel to the tip; cast a tapered or segmented body in a mould of your own (channel.csv gives the channel)")]
+    NonUniformBody(String),
     /// Writing a file.
     #[error("{context}: {source}")]
     Io { context: String, source: std::io::Error },
     /// Drawing the preview.
     #[error(transparent)]
     Plot(#[from] crate::plot::PlotError),
+}
+
+/// Refuses a body the moulds cannot cast: a radius profile, segments or a
+/// cable knotted before the tip ([`MouldError::NonUniformBody`]).
+pub fn check_uniform_body(a: &crate::model::Actuator) -> Result<(), MouldError> {
+    let mut what = Vec::new();
+    if !a.radius_profile_mm.is_empty() {
+        what.push("a radius profile (radius_profile_mm)");
+    }
+    if !a.segments.is_empty() {
+        what.push("segments of their own material");
+    }
+    if a.cable_length_mm() < a.length_mm {
+        what.push("a cable anchored before the tip (cable_anchor_mm)");
+    }
+    if what.is_empty() {
+        Ok(())
+    } else {
+        Err(MouldError::NonUniformBody(what.join(" and ")))
+    }
 }
 
 /// One printed part.

@@ -370,6 +370,10 @@ fn draw_modes(spec: &CableSweepSpec, map: &MapData) -> ModeDrawings {
                     cable,
                     further_cables,
                     radius_mm: spec.rod.radius_mm,
+                    radii_mm: match crate::model::Body::of(&spec.rod) {
+                        Ok(Some(body)) => sim.nodes.iter().map(|n| body.radius_at(n.s_mm)).collect(),
+                        _ => Vec::new(),
+                    },
                     label: format!("mode {}", m.mode),
                     colour: plotters::style::full_palette::BLUE_800,
                 }));

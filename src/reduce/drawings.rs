@@ -66,9 +66,9 @@ impl ModeDrawings {
 }
 
 fn draw(mode: usize, d: &Design, actuator: &Actuator, solver: &SolverOptions) -> Result<BodyDrawing, DrawingError> {
-    let routing = crate::model::Routing::new(d.routing_mm, actuator.length_mm, actuator.radius_mm)
+    let routing = crate::model::Routing::for_actuator(d.routing_mm, actuator)
         .map_err(|source| DrawingError::Routing { mode, source })?;
     let sim = crate::model::simulate(actuator, solver, &routing, d.tension_n, 1, crate::shape::LengthBasis::default())
         .map_err(|e| DrawingError::Simulation { mode, source: Box::new(e) })?;
-    Ok(BodyDrawing::of_simulation(&sim, actuator.radius_mm, format!("mode {mode}"), plotters::style::full_palette::BLUE_800))
+    Ok(BodyDrawing::of_body(&sim, actuator, format!("mode {mode}"), plotters::style::full_palette::BLUE_800))
 }

@@ -1,7 +1,7 @@
 //! The grid of square cells over the reach: its origin is the lower-left
 //! corner of the lowest-left tip's cell, on multiples of the cell size.
 
-use super::samples::Sample;
+use super::spill::Extent;
 use super::{ReduceError, MAX_CELLS_PER_AXIS};
 
 /// A grid of `nx` × `ny` cells of `cell_mm`, cell (0, 0) with its
@@ -21,15 +21,9 @@ pub(crate) struct Grid {
 }
 
 impl Grid {
-    /// The grid covering every sample's tip (`samples` not empty).
-    pub fn spanning(samples: &[Sample], cell_mm: f64) -> Result<Self, ReduceError> {
-        let (mut xmin, mut xmax, mut ymin, mut ymax) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-        for s in samples {
-            xmin = xmin.min(s.x_mm);
-            xmax = xmax.max(s.x_mm);
-            ymin = ymin.min(s.y_mm);
-            ymax = ymax.max(s.y_mm);
-        }
+    /// The grid covering the tips' `extent` (of at least one tip).
+    pub fn spanning(extent: &Extent, cell_mm: f64) -> Result<Self, ReduceError> {
+        let ([xmin, xmax], [ymin, ymax]) = (extent.x_mm, extent.y_mm);
         let x0 = (xmin / cell_mm).floor() * cell_mm;
         let y0 = (ymin / cell_mm).floor() * cell_mm;
         // Cell indices are i32 in the tables: a cell so small that the reach

@@ -2,14 +2,22 @@
 //! model-notes §5; the output contract is docs/maps.md).
 //!
 //! [`reduce_batches`] runs the stages in order, each in its own module:
-//! - `samples` (pass 1): tip and a_0…a_2 of every converged row, the
-//!   mirrored half restored (the mirror rule lives in `mirror`);
-//! - `modes::split`: mode boundaries, given or by quantiles;
+//! - `samples` (pass 1): tip and a_0…a_2 of every converged row, written to
+//!   a scratch file (`spill`), the mirrored half restored on reading (the
+//!   mirror rule lives in `mirror`);
+//! - `modes::split`: mode boundaries, given or by exact quantiles (`select`:
+//!   a counting pass and selection passes over the scratch file);
 //! - `grid`: the cells over the reach;
-//! - `cells`: per cell its count, percentiles, mode counts and the designs kept;
-//! - `modes::representatives`: the simulation nearest each mode's median;
+//! - `partition`: the samples split by cell range into partitions that fit
+//!   in memory; per partition, `cells` (count, percentiles, mode counts and
+//!   the designs kept) and `modes::Nearest` (the simulation nearest each
+//!   mode's median);
 //! - `fetch` (pass 2): the full rows of the kept designs and representatives;
 //! - assembly into [`MapData`].
+//!
+//! Memory is bounded by [`ReduceOptions::memory_samples`], whatever the
+//! run's size, and the tables are the same for any bound (docs/maps.md).
+//! [`parts`] splits pass 1 across processes (cluster tasks) and merges.
 //!
 //! The map format (file and column names, writer, reader) is [`tables`];
 //! [`output`] writes a whole map directory, [`drawings`] the modes' bodies.
@@ -24,8 +32,12 @@ mod grid;
 mod mirror;
 mod modes;
 pub mod output;
+pub mod parts;
+mod partition;
 pub mod plots;
 mod samples;
+mod select;
+mod spill;
 pub mod stats;
 pub mod tables;
 
@@ -201,6 +213,17 @@ pub enum ReduceError {
     /// Drawing a picture.
     #[error(transparent)]
     Plot(#[from] crate::plot::PlotError),
+    /// A scratch file of the reduction could not be written or read.
+    #[error("scratch file {}: {source} (the reduction needs free disk space of about 48 bytes per converged row there)", path.display())]
+    Scratch {
+        /// The file.
+        path: PathBuf,
+        /// The error.
+        source: std::io::Error,
+    },
+    /// The parts of a split reduction do not make one map.
+    #[error("{0}")]
+    Parts(#[from] parts::PartsError),
 }
 
 /// What the reducer needs to know about the run it reads.
@@ -273,11 +296,28 @@ pub struct ReduceOptions {
     pub mode_boundaries: Option<ModeBoundaries>,
     /// Designs kept per cell in designs.parquet.
     pub designs_per_cell: usize,
+    /// Samples (48 bytes each) held in memory at once: the bound on the
+    /// reduction's memory, whatever the run's size (one cell's samples are
+    /// always held together). The tables do not depend on it.
+    pub memory_samples: usize,
+    /// Where the scratch files go (about 48 bytes per converged row);
+    /// `None` for the system's temporary directory.
+    pub scratch_dir: Option<PathBuf>,
 }
+
+/// Default of [`ReduceOptions::memory_samples`]: 8 Mi samples, 384 MiB.
+pub const DEFAULT_MEMORY_SAMPLES: usize = 8 << 20;
 
 impl Default for ReduceOptions {
     fn default() -> Self {
-        Self { cell_mm: 1.0, mode_boundaries: None, designs_per_cell: 16 }
+        Self { cell_mm: 1.0, mode_boundaries: None, designs_per_cell: 16, memory_samples: DEFAULT_MEMORY_SAMPLES, scratch_dir: None }
+    }
+}
+
+impl ReduceOptions {
+    /// The directory scratch files go in.
+    fn scratch_parent(&self) -> PathBuf {
+        self.scratch_dir.clone().unwrap_or_else(std::env::temp_dir)
     }
 }
 
@@ -441,17 +481,37 @@ where
     I: Iterator<Item = Result<RecordBatch, ReduceError>>,
 {
     check_options(info, options)?;
-    let (mut samples, tally) = samples::read_samples(info, batches()?)?;
-    if samples.is_empty() {
+    let scratch = spill::ScratchDir::new(&options.scratch_parent())?;
+    let mut out = spill::SampleSink::new(&scratch.path.join("samples"), options.memory_samples);
+    let pass1 = samples::spill_samples(info, batches()?, 0, &mut out)?;
+    reduce_spilled(info, options, out.finish()?, &pass1, &scratch.path, batches)
+}
+
+/// The reduction after pass 1: from its `samples` (in memory or in scratch
+/// files) and results `pass1`, with pass 2 over `batches`.
+fn reduce_spilled<F, I>(
+    info: &RunInfo,
+    options: &ReduceOptions,
+    samples: spill::Samples,
+    pass1: &samples::Pass1,
+    scratch: &std::path::Path,
+    mut batches: F,
+) -> Result<MapData, ReduceError>
+where
+    F: FnMut() -> Result<I, ReduceError>,
+    I: Iterator<Item = Result<RecordBatch, ReduceError>>,
+{
+    let tally = pass1.tally.clone();
+    if pass1.samples == 0 {
         return Err(ReduceError::Empty { failed: tally.rows_failed() });
     }
     let split = modes::split(&samples, options.mode_boundaries)?;
-    let grid = grid::Grid::spanning(&samples, options.cell_mm)?;
+    let grid = grid::Grid::spanning(&pass1.extent, options.cell_mm)?;
     let nk = info.order.min(CELL_STATS_ORDER) + 1;
-    let cells = cells::tabulate(&mut samples, &grid, &split.boundaries, nk, options.designs_per_cell);
-    let representatives = modes::representatives(&samples, &split);
-    let rows_converged = samples.len() as u64;
-    drop(samples);
+    let setup = partition::CellSetup { grid: &grid, split: &split, nk, designs_per_cell: options.designs_per_cell };
+    let tabulated = partition::tabulate(samples, pass1.samples, &setup, options.memory_samples, scratch)?;
+    let (cells, representatives) = (tabulated.cells, tabulated.representatives);
+    let rows_converged = pass1.samples;
     let wanted = cells.picks.iter().map(|p| p.at).chain(representatives.iter().flatten().copied());
     let rows = fetch::Fetched::read(info.order, wanted, batches()?)?;
     let designs = cells
@@ -525,21 +585,26 @@ pub fn reduce_run(
     use crate::sweep::{open_run, Completeness};
     let completeness = if partial { Completeness::AllowPartial } else { Completeness::Complete };
     let run = open_run(run_dir, completeness)?;
-    let spec = run.spec().clone();
-    let info = RunInfo {
+    let info = run_info(&run);
+    let names = columns::RowColumns::names(info.order);
+    let names: Vec<&str> = names.iter().map(String::as_str).collect();
+    let map = reduce_batches(&info, options, || Ok(run.batches_projected(&names)?.map(|b| b.map_err(ReduceError::from))))?;
+    Ok((map, run.spec().clone()))
+}
+
+/// What the reducer needs to know of an opened run.
+fn run_info(run: &crate::sweep::SweepRun) -> RunInfo {
+    let spec = run.spec();
+    RunInfo {
         mirrored: spec.grid.mirror_dedup,
         order: spec.output.order,
         tension_range_n: [spec.tension.min_n, spec.tension.max_n],
         radius_mm: spec.actuator.radius_mm,
         length_mm: spec.actuator.length_mm,
-        run_dir: run_dir.display().to_string(),
+        run_dir: run.dir().display().to_string(),
         spec_hash: run.manifest().spec_sha256.clone(),
         length_basis: spec.output.length_basis,
-    };
-    let columns = columns::RowColumns::names(info.order);
-    let names: Vec<&str> = columns.iter().map(String::as_str).collect();
-    let map = reduce_batches(&info, options, || Ok(run.batches_projected(&names)?.map(|b| b.map_err(ReduceError::from))))?;
-    Ok((map, spec))
+    }
 }
 
 #[cfg(test)]
@@ -640,6 +705,22 @@ mod tests {
         for d in &map.designs {
             let ix = ((d.tip_x_mm - map.summary.x_min_mm) / map.summary.cell_mm).floor() as i32;
             assert_eq!((ix, d.iy), (d.ix, ((d.tip_y_mm - map.summary.y_min_mm) / map.summary.cell_mm).floor() as i32));
+        }
+    }
+
+    #[test]
+    fn the_tables_do_not_depend_on_the_memory_bound() {
+        // Bounds from one sample (a partition per cell) to all of them in
+        // memory, mirrored and not, quantile and explicit modes.
+        let rows = pseudo_rows(3000);
+        for mirrored in [false, true] {
+            for boundaries in [None, Some(ModeBoundaries { a0: [-0.2, 0.0, 0.2], a1: [-0.1, 0.1] })] {
+                let options = |memory_samples| ReduceOptions { memory_samples, mode_boundaries: boundaries, ..Default::default() };
+                let reference = format!("{:?}", run(&rows, mirrored, &options(usize::MAX)));
+                for memory_samples in [1, 7, 100, 1000] {
+                    assert_eq!(format!("{:?}", run(&rows, mirrored, &options(memory_samples))), reference, "memory {memory_samples}");
+                }
+            }
         }
     }
 

@@ -4,7 +4,8 @@
 
 use super::cells::CellTable;
 use super::samples::{RowRef, Sample};
-use super::stats::{quantile_sorted, quantiles};
+use super::select;
+use super::spill::Samples;
 use super::{Design, ModeBoundaries, ModeStats, ReduceError, MODES};
 
 /// The boundaries used and the spreads that scale distances between modes.
@@ -19,20 +20,21 @@ pub(crate) struct ModeSplit {
 }
 
 /// Splits the run's simulations into modes: by `explicit` boundaries, or by
-/// quantiles of a_0 (25/50/75 %) and a_1 (1/3, 2/3). `samples` not empty.
-pub(crate) fn split(samples: &[Sample], explicit: Option<ModeBoundaries>) -> Result<ModeSplit, ReduceError> {
-    // Quantiles of a_0 and a_1 over the converged rows, sorted once: they
-    // give the default mode boundaries and the spreads (interquartile
-    // ranges) that scale the distance to a mode's median.
-    let sorted = |k: usize| -> Vec<f64> {
-        let mut v: Vec<f64> = samples.iter().map(|s| s.a[k]).collect();
-        v.sort_unstable_by(f64::total_cmp);
-        v
-    };
-    let (a0, a1) = (sorted(0), sorted(1));
-    let q0 = [0.25, 0.5, 0.75].map(|p| quantile_sorted(&a0, p));
-    let q1 = [0.25, 1.0 / 3.0, 2.0 / 3.0, 0.75].map(|p| quantile_sorted(&a1, p));
-    drop((a0, a1));
+/// quantiles of a_0 (25/50/75 %) and a_1 (1/3, 2/3). The samples are read
+/// from `samples` (not empty).
+pub(crate) fn split(samples: &Samples, explicit: Option<ModeBoundaries>) -> Result<ModeSplit, ReduceError> {
+    // Quantiles of a_0 and a_1 over the converged rows, exact (by
+    // selection): they give the default mode boundaries and the spreads
+    // (interquartile ranges) that scale the distance to a mode's median.
+    let requests = [(0, 0.25), (0, 0.5), (0, 0.75), (1, 0.25), (1, 1.0 / 3.0), (1, 2.0 / 3.0), (1, 0.75)];
+    let (q, _) = select::quantiles(2, &requests, |f| {
+        samples.for_each(|s| {
+            f(0, s.a[0]);
+            f(1, s.a[1]);
+        })
+    })?;
+    let q: Vec<f64> = q.into_iter().map(|v| v.expect("the run has samples")).collect();
+    let (q0, q1) = ([q[0], q[1], q[2]], [q[3], q[4], q[5], q[6]]);
     let spread = [(q0[2] - q0[0]).max(1e-12), (q1[3] - q1[0]).max(1e-12)];
     let (boundaries, source) = match explicit {
         Some(b) => (b, "explicit"),
@@ -47,24 +49,50 @@ pub(crate) fn split(samples: &[Sample], explicit: Option<ModeBoundaries>) -> Res
     Ok(ModeSplit { boundaries, source, spread })
 }
 
-/// Per mode, the simulation nearest the mode's median (a_0, a_1), distances
-/// scaled by the spreads; ties go to the lowest simulation.
-pub(crate) fn representatives(samples: &[Sample], split: &ModeSplit) -> [Option<RowRef>; MODES] {
-    let mut by_mode: Vec<Vec<&Sample>> = vec![Vec::new(); MODES];
-    for s in samples {
-        by_mode[split.boundaries.mode(s.a[0], s.a[1])].push(s);
+/// Per mode, the search for its representative: the simulation nearest the
+/// mode's median (a_0, a_1), distances scaled by the spreads, ties to the
+/// lowest simulation (so the samples may be offered in any order).
+pub(crate) struct Nearest {
+    split: ModeSplit,
+    medians: [Option<[f64; 2]>; MODES],
+    best: [Option<(f64, RowRef)>; MODES],
+}
+
+impl Nearest {
+    /// Finds the modes' medians (exactly, by selection over `samples`).
+    pub fn new(samples: &Samples, split: &ModeSplit) -> Result<Self, ReduceError> {
+        let requests: Vec<(usize, f64)> = (0..2 * MODES).map(|g| (g, 0.5)).collect();
+        let b = split.boundaries;
+        let (q, _) = select::quantiles(2 * MODES, &requests, |f| {
+            samples.for_each(|s| {
+                let m = b.mode(s.a[0], s.a[1]);
+                f(2 * m, s.a[0]);
+                f(2 * m + 1, s.a[1]);
+            })
+        })?;
+        let medians = std::array::from_fn(|m| q[2 * m].zip(q[2 * m + 1]).map(|(a0, a1)| [a0, a1]));
+        Ok(Self { split: *split, medians, best: [None; MODES] })
     }
-    let [s0, s1] = split.spread;
-    std::array::from_fn(|m| {
-        let members = &by_mode[m];
-        if members.is_empty() {
-            return None;
+
+    /// Considers sample `s`.
+    pub fn offer(&mut self, s: &Sample) {
+        let m = self.split.boundaries.mode(s.a[0], s.a[1]);
+        let Some([m0, m1]) = self.medians[m] else { return };
+        let [s0, s1] = self.split.spread;
+        let d = ((s.a[0] - m0) / s0).powi(2) + ((s.a[1] - m1) / s1).powi(2);
+        let better = match self.best[m] {
+            None => true,
+            Some((bd, bat)) => d.total_cmp(&bd).then(s.at.cmp(&bat)).is_lt(),
+        };
+        if better {
+            self.best[m] = Some((d, s.at));
         }
-        let med = |k: usize| quantiles(&members.iter().map(|s| s.a[k]).collect::<Vec<_>>(), &[0.5])[0];
-        let (m0, m1) = (med(0), med(1));
-        let d = |s: &Sample| ((s.a[0] - m0) / s0).powi(2) + ((s.a[1] - m1) / s1).powi(2);
-        members.iter().min_by(|p, q| d(p).total_cmp(&d(q)).then(p.at.cmp(&q.at))).map(|s| s.at)
-    })
+    }
+
+    /// The representatives found.
+    pub fn representatives(&self) -> [Option<RowRef>; MODES] {
+        self.best.map(|b| b.map(|(_, at)| at))
+    }
 }
 
 /// The modes table from the cells and the representatives' full rows.

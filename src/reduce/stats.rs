@@ -1,9 +1,9 @@
 //! Order statistics for the maps: exact percentiles by selection.
 //!
 //! Percentiles use linear interpolation between order statistics
-//! (position p·(n−1), numpy's default "linear" method), computed exactly by
-//! sorting each cell's values. Memory is one value per row and coefficient,
-//! so it grows with the run (see docs/performance.md for the scaling note).
+//! (position p·(n−1), numpy's default "linear" method), computed exactly:
+//! within a cell by sorting its values, over the whole run by selection
+//! passes (`select`), both through [`position`] so they agree bit for bit.
 
 /// The `p`-quantile (0 ≤ p ≤ 1) of sorted `values` by linear interpolation.
 ///
@@ -11,11 +11,16 @@
 /// If `values` is empty.
 pub fn quantile_sorted(values: &[f64], p: f64) -> f64 {
     assert!(!values.is_empty(), "quantile of an empty set");
-    let pos = p.clamp(0.0, 1.0) * (values.len() - 1) as f64;
-    let lo = pos.floor() as usize;
-    let hi = pos.ceil() as usize;
-    let frac = pos - lo as f64;
+    let (lo, hi, frac) = position(values.len(), p);
     values[lo] + (values[hi] - values[lo]) * frac
+}
+
+/// The ranks (lo, hi) between which the `p`-quantile of `n` > 0 sorted
+/// values lies, and the fraction of the way from lo to hi.
+pub fn position(n: usize, p: f64) -> (usize, usize, f64) {
+    let pos = p.clamp(0.0, 1.0) * (n - 1) as f64;
+    let lo = pos.floor() as usize;
+    (lo, pos.ceil() as usize, pos - lo as f64)
 }
 
 /// Quantiles of unsorted values (sorts a copy).

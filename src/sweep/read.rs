@@ -152,6 +152,11 @@ impl<S: RunSpec> SweepRun<S> {
         self.chunks.len()
     }
 
+    /// Rows of the `index`-th complete chunk file.
+    pub fn chunk_rows(&self, index: usize) -> u64 {
+        self.chunks[index].rows
+    }
+
     /// The rows of the `index`-th complete chunk file (0 ≤ index <
     /// [`Self::chunk_count`]), optionally only the named columns. Chunks
     /// are independent, so a reader can process them in parallel, e.g.

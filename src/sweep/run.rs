@@ -307,7 +307,7 @@ fn solve_routing(
     id: u64,
 ) -> Result<SolvedRouting, SweepError> {
     let y_mm = plan.routing_mm(id);
-    let routing = Routing::new(&y_mm, spec.actuator.length_mm, spec.actuator.radius_mm)?;
+    let routing = Routing::for_actuator(y_mm, &spec.actuator)?;
     sim.set_routing(&routing);
     let rows = tensions_n.iter().map(|&t| solve_row(sim, t, &spec.output)).collect();
     Ok(SolvedRouting { id, routing_mm: y_mm, rows })

@@ -200,7 +200,9 @@ impl SweepSpec {
             )));
         }
         let delta = self.actuator.effects.channel_offset_mm;
-        if (g.extent_r * self.actuator.radius_mm).abs() + delta.abs() >= self.actuator.radius_mm {
+        // A tapered body's levels are fractions of its narrowest radius along the cable.
+        let r = self.actuator.channel_radius_mm();
+        if (g.extent_r * r).abs() + delta.abs() >= r {
             return Err(SpecError::setting("grid", format!("extent_r = {} with channel_offset_mm = {delta} puts the channel beyond ±r: reduce one of them",
                 g.extent_r
             )));
@@ -288,7 +290,7 @@ impl SweepSpec {
         if n == 1 {
             return vec![0.0];
         }
-        let half = self.grid.extent_r * self.actuator.radius_mm;
+        let half = self.grid.extent_r * self.actuator.channel_radius_mm();
         let d = f64::from(n - 1);
         (0..n).map(|i| half * (2.0 * f64::from(i) - d) / d).collect()
     }

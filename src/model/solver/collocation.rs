@@ -56,11 +56,17 @@ pub(super) struct Colloc {
     q: Vec<f64>,
     /// Nodes on [−1, 1], x_j = −cos(π j / m).
     x: Vec<f64>,
-    /// Node arc lengths s, mm: span 0 then span 1 (the knot appears in both).
+    /// Node arc lengths s, mm: span 0, span 1, … (a boundary appears in
+    /// both spans it joins).
     s: Vec<f64>,
-    /// Half length and start of each span, mm.
-    half: [f64; 2],
-    start: [f64; 2],
+    /// Half length and start of each span, mm: two spans (the routing's
+    /// knot) for the uniform rod, more at a non-uniform body's breakpoints
+    /// and the cable's anchor.
+    half: Vec<f64>,
+    start: Vec<f64>,
+    /// The cross-section at each node (a span's last node takes a jump
+    /// at its end from the left).
+    section: Vec<super::Section>,
     /// Frame angle φ and gravity's distal moment M at the nodes.
     phi: Vec<f64>,
     mom: Vec<f64>,
@@ -109,17 +115,18 @@ struct Partials {
 }
 
 impl Colloc {
-    pub(super) fn new(m: usize) -> Self {
+    pub(super) fn new(m: usize, spans: usize) -> Self {
         let np = m + 1;
-        let nn = 2 * np;
+        let nn = spans * np;
         let x: Vec<f64> = (0..np).map(|j| -(std::f64::consts::PI * j as f64 / m as f64).cos()).collect();
         let mut c = Self {
             m,
             q: integration_matrix(m),
             x,
             s: vec![0.0; nn],
-            half: [0.0; 2],
-            start: [0.0; 2],
+            half: vec![0.0; spans],
+            start: vec![0.0; spans],
+            section: Vec::with_capacity(nn),
             phi: vec![0.0; nn],
             mom: vec![0.0; nn],
             px: vec![0.0; nn],
@@ -190,6 +197,11 @@ impl Colloc {
         self.m + 1
     }
 
+    /// The number of spans.
+    fn spans(&self) -> usize {
+        self.half.len()
+    }
+
     /// Σ_k q[j][k] f[k] over one span's values `f`.
     #[inline]
     fn row_dot(&self, j: usize, f: &[f64]) -> f64 {
@@ -202,7 +214,7 @@ impl Colloc {
     fn integrate_forward(&self, f: &[f64], start: f64, out: &mut [f64]) {
         let np = self.np();
         let mut begin = start;
-        for span in 0..2 {
+        for span in 0..self.spans() {
             let base = span * np;
             let fs = &f[base..base + np];
             let h = self.half[span];
@@ -468,11 +480,25 @@ impl Simulator {
     pub(super) fn colloc_set_routing(&mut self, built: &super::Routing) {
         let mut c = self.col.take().expect("collocation state");
         let knot = built.knot_mm();
-        let length = self.actuator.length_mm;
-        c.start = [0.0, knot];
-        c.half = [knot / 2.0, (length - knot) / 2.0];
+        let bounds = super::span_boundaries(&self.actuator, self.body.as_ref(), knot);
+        assert_eq!(bounds.len() - 1, c.spans(), "span count fixed by the actuator");
+        for span in 0..c.spans() {
+            c.start[span] = bounds[span];
+            c.half[span] = (bounds[span + 1] - bounds[span]) / 2.0;
+        }
         let np = c.np();
-        for span in 0..2 {
+        let anchor = self.actuator.cable_length_mm();
+        // Boundaries closer than this were merged (the anchor may have been
+        // merged into a breakpoint just below it).
+        let merged = crate::model::body::MERGE_TOLERANCE * self.actuator.length_mm;
+        self.cable_end = c.s.len();
+        c.section.clear();
+        for span in 0..c.spans() {
+            // Spans from the anchor on carry no cable (and have no channel).
+            let cable = c.start[span] + merged < anchor;
+            if !cable && self.cable_end == c.s.len() {
+                self.cable_end = span * np;
+            }
             for j in 0..np {
                 let i = span * np + j;
                 // Exact end points, so the knot and the tip are hit exactly.
@@ -482,8 +508,13 @@ impl Simulator {
                     _ => c.start[span] + c.half[span] * (1.0 + c.x[j]),
                 };
                 c.s[i] = s;
-                let ch = built.channel_at(s);
-                self.channel[i] = ChannelSample { y: ch.y_mm, dy: ch.dy_ds };
+                c.section.push(self.section_at_side(s, j == np - 1));
+                self.channel[i] = if cable {
+                    let ch = built.channel_at(s.min(built.length_mm()));
+                    ChannelSample { y: ch.y_mm, dy: ch.dy_ds }
+                } else {
+                    ChannelSample::default()
+                };
             }
         }
         self.col = Some(c);
@@ -564,11 +595,12 @@ impl Simulator {
     fn colloc_strains(&mut self, c: &mut Colloc, tension: f64) -> Result<(), SolveFailure> {
         for i in 0..c.s.len() {
             let ch = self.channel[i];
-            let t = tension * self.friction.ratio(i);
-            let (e, dir) = self.strains_at(c.s[i], ch, c.trig[i], c.mom[i], t, self.cable_dir[i], self.creep.offset(i))?;
+            let t = self.tension_at(i, tension);
+            let (e, dir) = self.strains_at(c.s[i], &c.section[i], ch, c.trig[i], c.mom[i], t, self.cable_dir[i], self.creep.offset(i))?;
             self.cable_dir[i] = dir;
             if self.creep.is_on() {
-                self.creep.record_moment(i, bending_moment(t, ch.y, dir.0, c.mom[i]));
+                let ei = c.section[i].ei_n_mm2;
+                self.creep.record_moment(i, bending_moment(t, ch.y, dir.0, c.mom[i]), ei);
             }
             c.strain[i] = e;
             c.du[i] = e.u;
@@ -579,7 +611,7 @@ impl Simulator {
     /// Frame angle at the clamp from node 0's bending moment.
     fn colloc_clamp_angle(&self, c: &Colloc, tension: f64) -> f64 {
         match self.actuator.effects.clamp_stiffness_n_mm_per_rad {
-            Some(k) => bending_moment(tension * self.friction.ratio(0), self.channel[0].y, self.cable_dir[0].0, c.mom[0]) / k,
+            Some(k) => bending_moment(self.tension_at(0, tension), self.channel[0].y, self.cable_dir[0].0, c.mom[0]) / k,
             None => 0.0,
         }
     }
@@ -602,7 +634,7 @@ impl Simulator {
         let np = c.np();
         let mut change: f64 = 0.0;
         let mut end = 0.0;
-        for span in (0..2).rev() {
+        for span in (0..c.spans()).rev() {
             let base = span * np;
             let h = c.half[span];
             let fm = &c.dmom[base..base + np];
@@ -632,7 +664,7 @@ impl Simulator {
         }
         let np = c.np();
         let (mut x0, mut y0, mut s0) = (0.0, 0.0, 0.0);
-        for span in 0..2 {
+        for span in 0..c.spans() {
             let base = span * np;
             let h = c.half[span];
             let (fx, fy, fs) = (&c.dx[base..base + np], &c.dy[base..base + np], &c.dsig[base..base + np]);
@@ -692,7 +724,7 @@ impl Simulator {
         }
         let mut change: f64 = 0.0;
         let mut turning = 0.0;
-        for span in 0..2 {
+        for span in 0..c.spans() {
             let base = span * np;
             let values = &psi[base..base + np];
             for j in 0..np {
@@ -832,8 +864,7 @@ impl Simulator {
     /// Strains at a node with their derivatives with respect to φ and M
     /// (implicit function theorem on the cable-direction equation).
     #[allow(clippy::too_many_arguments)]
-    fn colloc_node_partials(&self, s: f64, ch: ChannelSample, (sp, cp): (f64, f64), moment: f64, t: f64, dir: (f64, f64), e: Strains) -> Partials {
-        let section = self.section_at(s);
+    fn colloc_node_partials(&self, s: f64, section: &super::Section, ch: ChannelSample, (sp, cp): (f64, f64), moment: f64, t: f64, dir: (f64, f64), e: Strains) -> Partials {
         let (ea, ga) = (section.ea_n, section.ga_n);
         let wl = self.distal_weight_n(s);
         let (gc, gs) = (self.gravity_cos, self.gravity_sin);
@@ -841,8 +872,8 @@ impl Simulator {
         let w2 = wl * (cp * gs - sp * gc);
         let (ca, sa) = dir;
         let bend = bending_moment(t, ch.y, ca, moment);
-        let (_, du_dm_el) = self.bending_curvature(bend, &section);
-        let dudm = du_dm_el + self.creep.gain();
+        let (_, du_dm_el) = self.bending_curvature(bend, section);
+        let dudm = du_dm_el + self.creep.gain(section.ei_n_mm2);
         let p = e.v1 - e.u * ch.y;
         let q = e.v2 + ch.dy;
         let (dv1a, dv2a, dua) = (t * sa / ea, -t * ca / ga, -t * ch.y * sa * dudm);
@@ -879,9 +910,9 @@ impl Simulator {
         let (gc, gs) = (self.gravity_cos, self.gravity_sin);
         let mut parts = vec![Partials::default(); nn];
         for i in 0..nn {
-            let t = tension * self.friction.ratio(i);
+            let t = self.tension_at(i, tension);
             let e = c.strain[i];
-            parts[i] = self.colloc_node_partials(c.s[i], self.channel[i], c.trig[i], c.mom[i], t, self.cable_dir[i], e);
+            parts[i] = self.colloc_node_partials(c.s[i], &c.section[i], self.channel[i], c.trig[i], c.mom[i], t, self.cable_dir[i], e);
             let (sp, cp) = c.trig[i];
             let dx = e.v1 * cp - e.v2 * sp;
             let dy = e.v1 * sp + e.v2 * cp;
@@ -892,10 +923,11 @@ impl Simulator {
         if let Some(j) = jac.as_deref_mut() {
             j.fill(0.0);
         }
-        for span in 0..2 {
+        let last = c.spans() - 1;
+        for span in 0..c.spans() {
             let base = span * np;
-            let phi_anchor = if span == 0 { 0 } else { np - 1 };
-            let mom_anchor = if span == 0 { np } else { nn - 1 };
+            let phi_anchor = if span == 0 { 0 } else { base - 1 };
+            let mom_anchor = if span < last { base + np } else { nn - 1 };
             let h = c.half[span];
             let us = &c.du[base..base + np];
             let ms = &c.dmom[base..base + np];
@@ -927,7 +959,7 @@ impl Simulator {
                 }
                 // M equations: M_i = M_anchor − ∫_{s_i}^{end} M' (tip: M = 0).
                 let r = nn + i;
-                if span == 1 && j == np - 1 {
+                if span == last && j == np - 1 {
                     res[r] = c.mom[i] * scale;
                     if let Some(jm) = jac.as_deref_mut() {
                         jm[(r, nn + i)] += scale;
@@ -979,7 +1011,7 @@ impl Simulator {
         let tip = c.s.len() - 1;
         let ell = c.sigma[tip];
         let theta = |i: usize| c.phi[i] + c.strain[i].v2.atan2(c.strain[i].v1);
-        for span in 0..2 {
+        for span in 0..c.spans() {
             for j in 0..np {
                 let i = span * np + j;
                 let weight = c.half[span] * c.q[(np - 1) * np + j] * theta(i) * 2.0 * c.dsig[i] / ell;
@@ -1020,13 +1052,14 @@ impl Simulator {
         (0..count)
             .map(|k| {
                 let s = length * k as f64 / (count - 1) as f64;
-                let span = usize::from(s >= c.start[1]);
+                let span = c.start[1..].iter().take_while(|&&b| s >= b).count();
                 let x = ((s - c.start[span]) / c.half[span] - 1.0).clamp(-1.0, 1.0);
                 let base = span * np;
                 let at = |f: &[f64]| c.interpolate(&f[base..base + np], x);
                 let (px, py, phi) = (at(&c.px), at(&c.py), at(&c.phi));
                 let (v1, v2, u) = (at(&v1), at(&v2), at(&u));
-                let yc = routing.channel_at(s).y_mm;
+                let cable = s <= routing.length_mm();
+                let yc = if cable { routing.channel_at(s).y_mm } else { 0.0 };
                 let (sp, cp) = phi.sin_cos();
                 CentrelinePoint {
                     s_mm: s,
@@ -1041,7 +1074,7 @@ impl Simulator {
                     channel_y_mm: yc,
                     cable_x_mm: px - sp * yc,
                     cable_y_mm: py + cp * yc,
-                    cable_tension_n: tension * at(self.friction.ratios()),
+                    cable_tension_n: if cable { tension * at(self.friction.ratios()) } else { 0.0 },
                 }
             })
             .collect()
@@ -1058,7 +1091,7 @@ mod tests {
         // degree ≤ m: the weights must give its exact values between nodes.
         let poly = |x: f64| x * x * x - 0.5 * x + 0.2;
         for m in [4, 10, 16] {
-            let c = Colloc::new(m);
+            let c = Colloc::new(m, 2);
             let np = m + 1;
             let f: Vec<f64> = c.x.iter().map(|&x| poly(x)).collect();
             for j in 1..np {
@@ -1075,7 +1108,7 @@ mod tests {
     #[test]
     fn integration_matrix_is_exact_for_polynomials() {
         for m in [4, 7, 12, 20] {
-            let c = Colloc::new(m);
+            let c = Colloc::new(m, 2);
             let np = m + 1;
             for degree in 0..=m {
                 let f: Vec<f64> = c.x.iter().map(|x| x.powi(degree as i32)).collect();

@@ -20,8 +20,9 @@ pub(super) struct Creep {
     fraction: f64,
     /// Creep time T, s.
     time_s: f64,
-    /// Bending rigidity EI, N·mm².
-    ei_n_mm2: f64,
+    /// Bending rigidity EI at each point in the last pass, N·mm² (it
+    /// varies along a non-uniform body).
+    ei_n_mm2: Vec<f64>,
     /// Internal curvature q at each point, 1/mm.
     q: Vec<f64>,
     /// Bending moment at each point in the last pass, N·mm.
@@ -30,8 +31,9 @@ pub(super) struct Creep {
     dwell_s: f64,
     /// E = exp(−(1 − f) d / T) for the current dwell.
     decay: f64,
-    /// Extra compliance of the held step, f (1 − E)/((1 − f) EI), 1/(N·mm²).
-    gain: f64,
+    /// Extra compliance of the held step times EI, f (1 − E) (the gain at a
+    /// point is this over (1 − f) EI).
+    gain_times_ei: f64,
     /// Whether every solve starts from a rod with no load history (the
     /// default, held `effects.creep_hold_s`), or follows a protocol set by
     /// `Simulator::set_hold`.
@@ -45,12 +47,12 @@ impl Creep {
         Self {
             fraction: effects.creep_fraction,
             time_s: effects.creep_time_s,
-            ei_n_mm2,
+            ei_n_mm2: vec![ei_n_mm2; points],
             q: vec![0.0; points],
             moment: vec![0.0; points],
             dwell_s: 0.0,
             decay: 1.0,
-            gain: 0.0,
+            gain_times_ei: 0.0,
             virgin_holds: true,
         }
     }
@@ -67,10 +69,10 @@ impl Creep {
         let f = self.fraction;
         if f > 0.0 {
             self.decay = (-(1.0 - f) * dwell_s / self.time_s).exp();
-            self.gain = f * (1.0 - self.decay) / ((1.0 - f) * self.ei_n_mm2);
+            self.gain_times_ei = f * (1.0 - self.decay);
         } else {
             self.decay = 1.0;
-            self.gain = 0.0;
+            self.gain_times_ei = 0.0;
         }
     }
 
@@ -92,9 +94,9 @@ impl Creep {
     pub(super) fn end_solve(&mut self) {
         if self.fraction > 0.0 && self.dwell_s > 0.0 && !self.virgin_holds {
             let f = self.fraction;
-            let scale = 1.0 / (self.ei_n_mm2 * (1.0 - f));
             let e = self.decay;
-            for (q, &m) in self.q.iter_mut().zip(&self.moment) {
+            for ((q, &m), &ei) in self.q.iter_mut().zip(&self.moment).zip(&self.ei_n_mm2) {
+                let scale = 1.0 / (ei * (1.0 - f));
                 let q_inf = m * scale;
                 *q = q_inf + (*q - q_inf) * e;
             }
@@ -106,10 +108,16 @@ impl Creep {
         self.q.iter_mut().for_each(|q| *q = 0.0);
     }
 
-    /// du/dm added to the elastic compliance over the hold, 1/(N·mm²).
+    /// du/dm added to the elastic compliance over the hold at a point of
+    /// bending rigidity `ei_n_mm2`, f (1 − E)/((1 − f) EI), 1/(N·mm²).
     #[inline]
-    pub(super) fn gain(&self) -> f64 {
-        self.gain
+    pub(super) fn gain(&self, ei_n_mm2: f64) -> f64 {
+        let f = self.fraction;
+        if f > 0.0 {
+            self.gain_times_ei / ((1.0 - f) * ei_n_mm2)
+        } else {
+            0.0
+        }
     }
 
     /// The held curvature f E q₀ at point `k`, 1/mm.
@@ -123,10 +131,12 @@ impl Creep {
         }
     }
 
-    /// Records the bending moment `m` (N·mm) at point `k` in this pass.
+    /// Records the bending moment `m` (N·mm) and the bending rigidity
+    /// `ei_n_mm2` at point `k` in this pass.
     #[inline]
-    pub(super) fn record_moment(&mut self, k: usize, m: f64) {
+    pub(super) fn record_moment(&mut self, k: usize, m: f64, ei_n_mm2: f64) {
         self.moment[k] = m;
+        self.ei_n_mm2[k] = ei_n_mm2;
     }
 }
 
@@ -146,10 +156,10 @@ mod tests {
         c.follow_protocol();
         c.set_dwell(d);
         let e = (-(1.0 - f) * d / t_s).exp();
-        assert!((c.gain() - f * (1.0 - e) / ((1.0 - f) * ei)).abs() < 1e-18);
+        assert!((c.gain(ei) - f * (1.0 - e) / ((1.0 - f) * ei)).abs() < 1e-18);
         assert_eq!(c.offset(0), 0.0);
         c.begin_solve();
-        c.record_moment(0, m);
+        c.record_moment(0, m, ei);
         c.end_solve();
         // q after the hold, and the held curvature it leaves for the next step.
         let q1 = m / (ei * (1.0 - f)) * (1.0 - e);
@@ -157,8 +167,8 @@ mod tests {
         assert_eq!(c.offset(1), 0.0);
         // No dwell: the history stays as it is.
         c.set_dwell(0.0);
-        assert_eq!(c.gain(), 0.0);
-        c.record_moment(0, 5.0);
+        assert_eq!(c.gain(ei), 0.0);
+        c.record_moment(0, 5.0, ei);
         c.end_solve();
         assert!((c.offset(0) - f * q1).abs() < 1e-15);
     }
@@ -167,7 +177,7 @@ mod tests {
     fn outside_a_protocol_every_solve_starts_from_a_virgin_rod() {
         let mut c = creep(0.3, 10.0);
         c.set_dwell(5.0);
-        c.record_moment(0, 2.0);
+        c.record_moment(0, 2.0, 100.0);
         c.end_solve();
         assert_eq!(c.offset(0), 0.0, "a virgin hold keeps no history");
         c.q[0] = 1.0;
@@ -176,6 +186,6 @@ mod tests {
         // Without creep nothing happens at all.
         let mut off = creep(0.0, 10.0);
         off.set_dwell(5.0);
-        assert!(!off.is_on() && off.gain() == 0.0 && off.offset(0) == 0.0);
+        assert!(!off.is_on() && off.gain(100.0) == 0.0 && off.offset(0) == 0.0);
     }
 }

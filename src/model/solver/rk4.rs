@@ -117,14 +117,16 @@ impl Simulator {
         let ch = self.channel[k];
         let local_tension = tension * self.friction.ratio(k);
         let creep_offset = self.creep.offset(k);
-        let (e, dir) = self.strains_at(s, ch, (sp, cp), st.moment, local_tension, self.cable_dir[k], creep_offset)?;
+        let section = self.section_at(s);
+        let (e, dir) = self.strains_at(s, &section, ch, (sp, cp), st.moment, local_tension, self.cable_dir[k], creep_offset)?;
         self.cable_dir[k] = dir;
         // Only friction (cable angles) and creep (moments) need these.
         if self.friction.is_on() {
             self.friction.record_cable_direction(k, (sp, cp), dir);
         }
         if self.creep.is_on() {
-            self.creep.record_moment(k, bending_moment(local_tension, ch.y, dir.0, st.moment));
+            let ei = section.ei_n_mm2;
+            self.creep.record_moment(k, bending_moment(local_tension, ch.y, dir.0, st.moment), ei);
         }
         let dx = e.v1 * cp - e.v2 * sp;
         let dy = e.v1 * sp + e.v2 * cp;
@@ -150,7 +152,7 @@ impl Simulator {
         let mut phi: f64 = 0.0;
         for _ in 0..CLAMP_MAX_ITERATIONS {
             let (_, (ca, _)) =
-                self.strains_at(0.0, ch, phi.sin_cos(), moment0, tension, self.cable_dir[0], self.creep.offset(0))?;
+                self.strains_at(0.0, &self.section_at(0.0), ch, phi.sin_cos(), moment0, tension, self.cable_dir[0], self.creep.offset(0))?;
             let m = bending_moment(tension, ch.y, ca, moment0);
             let next = m / k_theta;
             if (next - phi).abs() < CLAMP_TOLERANCE_RAD {

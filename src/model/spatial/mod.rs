@@ -55,6 +55,9 @@ pub enum SpatialError {
     /// The spatial solver models the thesis's rod only.
     #[error("effects.{0} is not modelled by the spatial solver (it models the thesis's rod: no friction, stiffening, clamp compliance, channel offset or creep); leave it at its default")]
     UnsupportedEffect(&'static str),
+    /// A tapered or segmented rod, or a rod-level cable anchor.
+    #[error("the spatial solver models a uniform rod: leave out radius_profile_mm and segments, and give each cable its own anchor (anchor=S) instead of cable_anchor_mm")]
+    NonUniformRod,
     /// The `--cable` text could not be read.
     #[error("cable \"{text}\": {why} (expected \"y=Y0,Y1,Y2,Y3,Y4 z=Z0,Z1,Z2,Z3,Z4 tension=T\", z= optional, anchor=S optional)")]
     CableSpec { text: String, why: String },
@@ -137,9 +140,13 @@ impl SpatialActuator {
             ("channel_offset_mm", e.channel_offset_mm != d.channel_offset_mm),
             ("creep_fraction", e.creep_fraction != d.creep_fraction),
             ("hidden", e.hidden != d.hidden),
+            ("stiffness_gradient_beta", e.stiffness_gradient_beta != d.stiffness_gradient_beta),
         ];
         if let Some((name, _)) = unsupported.iter().find(|(_, on)| *on) {
             return Err(SpatialError::UnsupportedEffect(name));
+        }
+        if !self.rod.is_uniform_body() {
+            return Err(SpatialError::NonUniformRod);
         }
         if let Some(gj) = self.gj_n_mm2 {
             if !(gj.is_finite() && gj > 0.0) {

@@ -196,7 +196,7 @@ mod tests {
         ] {
             let e = text.parse::<Cable>().unwrap_err().to_string();
             assert!(e.contains(needle), "{text}: {e}");
-            assert!(e.contains("--cable"), "{e}");
+            assert!(e.contains("cable \""), "{e}");
         }
     }
 }

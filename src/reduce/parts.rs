@@ -1,0 +1,362 @@
+//! A reduction split across processes (cluster array tasks): part I of N
+//! does pass 1 over its share of the run's chunk files and keeps the
+//! samples and tallies it found; the merge combines the parts and does the
+//! rest of the reduction. The merged map equals a single-process reduce
+//! for any N, since every later stage sees the same samples under the same
+//! row numbers (parts number their rows from their first chunk's offset).
+//!
+//! Parts live beside the map directory, in `MAP_DIR.parts/`: for part I of
+//! N, `part-I-of-N.samples` (scratch records, see `spill`) and
+//! `part-I-of-N.json` (what the part covers and found). Each file is
+//! written to a temporary name, synced and renamed into place, the record
+//! last; a part is done when its record is there. A part's content depends
+//! only on the run and (I, N), so a part re-run after a kill, or two copies
+//! of one part at once, leave the same files. The merge refuses missing,
+//! mismatched or mixed-N parts; `MAP_DIR.parts/` may be removed once the
+//! map is merged.
+
+use super::samples::Pass1;
+use super::spill::{self, SpillWriter, RECORD_BYTES};
+use super::{columns, run_info, MapData, ReduceError, ReduceOptions};
+use crate::sweep::{open_run, Completeness, SweepRun, SweepSpec};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// Format tag of a part record.
+pub const PART_FORMAT: &str = "cablemap-reduce-part/1";
+
+/// Why a split reduction's parts do not make a map.
+#[derive(Debug, thiserror::Error)]
+pub enum PartsError {
+    /// The part number is not below the number of parts.
+    #[error("part {shard} of {shards}: parts are numbered 0 to {}; the number of parts must be at least 1", shards.saturating_sub(1))]
+    BadShard {
+        /// The part asked for.
+        shard: u64,
+        /// The number of parts.
+        shards: u64,
+    },
+    /// No part has been written.
+    #[error("{}: no reduce parts found: run the parts first (part I of N for every I from 0 to N-1)", dir.display())]
+    NoParts {
+        /// The parts directory.
+        dir: PathBuf,
+    },
+    /// Some parts are missing.
+    #[error("{}: {} of {shards} parts missing (part {}): run those parts (again) before merging", dir.display(), missing.len(), list(missing))]
+    Missing {
+        /// The parts directory.
+        dir: PathBuf,
+        /// The number of parts.
+        shards: u64,
+        /// The missing parts.
+        missing: Vec<u64>,
+    },
+    /// Parts of different splits are mixed.
+    #[error("{}: holds parts of different splits (of {}): remove the directory and run the parts of one split", dir.display(), list(counts))]
+    Mixed {
+        /// The parts directory.
+        dir: PathBuf,
+        /// The numbers of parts found.
+        counts: Vec<u64>,
+    },
+    /// A part does not belong to this run or is damaged.
+    #[error("{}: {problem}: run this part again", path.display())]
+    Mismatch {
+        /// The part's file.
+        path: PathBuf,
+        /// What is wrong.
+        problem: String,
+    },
+    /// A part's record cannot be read or written.
+    #[error("{}: {source}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The error.
+        source: std::io::Error,
+    },
+}
+
+fn list(v: &[u64]) -> String {
+    v.iter().map(u64::to_string).collect::<Vec<_>>().join(", ")
+}
+
+/// What one part covers and found (`part-I-of-N.json`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+struct PartRecord {
+    format: String,
+    shard: u64,
+    shards: u64,
+    /// The run's spec hash.
+    spec_sha256: String,
+    /// The run's chunk files.
+    run_chunks: usize,
+    /// The chunk files this part read, [first, end).
+    chunk_range: [usize; 2],
+    /// Row number of its first row.
+    first_row: u64,
+    /// Records in the samples file.
+    records: u64,
+    /// Pass 1's tallies.
+    pass1: Pass1,
+}
+
+/// The parts directory of map directory `map_dir`: `MAP_DIR.parts`.
+pub fn parts_dir(map_dir: &Path) -> PathBuf {
+    let mut name = map_dir.file_name().map(|n| n.to_os_string()).unwrap_or_else(|| "map".into());
+    name.push(".parts");
+    map_dir.with_file_name(name)
+}
+
+fn part_name(shard: u64, shards: u64, ext: &str) -> String {
+    format!("part-{shard}-of-{shards}.{ext}")
+}
+
+/// The chunk files [first, end) of part `shard` of `shards` among `chunks`.
+fn chunk_range(chunks: usize, shard: u64, shards: u64) -> [usize; 2] {
+    let at = |i: u64| (i as u128 * chunks as u128 / shards as u128) as usize;
+    [at(shard), at(shard + 1)]
+}
+
+/// What a part did.
+#[derive(Debug, Clone)]
+pub struct PartReport {
+    /// The part's record file.
+    pub record: PathBuf,
+    /// Chunk files read.
+    pub chunks: usize,
+    /// Rows read.
+    pub rows: u64,
+    /// Converged simulations found (mirror images included).
+    pub samples: u64,
+}
+
+/// Writes part `shard` of `shards` of the reduction of the (complete) run
+/// in `run_dir` into `map_dir`'s parts directory.
+pub fn write_part(run_dir: &Path, map_dir: &Path, shard: u64, shards: u64) -> Result<PartReport, ReduceError> {
+    if shards == 0 || shard >= shards {
+        return Err(PartsError::BadShard { shard, shards }.into());
+    }
+    super::check_map_out(map_dir)?;
+    let run = open_run(run_dir, Completeness::Complete)?;
+    let info = run_info(&run);
+    let [first, end] = chunk_range(run.chunk_count(), shard, shards);
+    let first_row: u64 = (0..first).map(|i| run.chunk_rows(i)).sum();
+    let dir = parts_dir(map_dir);
+    std::fs::create_dir_all(&dir).map_err(|source| PartsError::Io { path: dir.clone(), source })?;
+    let samples_path = dir.join(part_name(shard, shards, "samples"));
+    let record_path = dir.join(part_name(shard, shards, "json"));
+    remove_abandoned_temps(&dir, &samples_path);
+    let tmp = crate::io::temp_path(&samples_path);
+    let file = crate::io::create_locked(&tmp).map_err(|e| spill::scratch_error(&tmp, e))?;
+    let written = (|| {
+        let mut out = SpillWriter::from_file(&tmp, file, spill::BUFFER_BYTES);
+        let names = columns::RowColumns::names(info.order);
+        let names: Vec<&str> = names.iter().map(String::as_str).collect();
+        let batches = (first..end).flat_map(|i| match run.chunk_batches(i, Some(&names)) {
+            Ok(b) => Box::new(b.map(|b| b.map_err(ReduceError::from))) as Box<dyn Iterator<Item = _>>,
+            Err(e) => Box::new(std::iter::once(Err(e.into()))),
+        });
+        let pass1 = super::samples::spill_samples(&info, batches, first_row as u32, &mut out)?;
+        let records = out.finish(true)?;
+        std::fs::rename(&tmp, &samples_path).map_err(|e| spill::scratch_error(&samples_path, e))?;
+        Ok::<_, ReduceError>((pass1, records))
+    })();
+    let (pass1, records) = written.inspect_err(|_| {
+        let _ = std::fs::remove_file(&tmp);
+    })?;
+    let record = PartRecord {
+        format: PART_FORMAT.into(),
+        shard,
+        shards,
+        spec_sha256: run.manifest().spec_sha256.clone(),
+        run_chunks: run.chunk_count(),
+        chunk_range: [first, end],
+        first_row,
+        records,
+        pass1: pass1.clone(),
+    };
+    let json = serde_json::to_vec_pretty(&record).expect("a part record serializes");
+    remove_abandoned_temps(&dir, &record_path);
+    write_locked_atomic(&record_path, &json).map_err(|source| PartsError::Io {
+        path: record_path.clone(),
+        source,
+    })?;
+    Ok(PartReport {
+        record: record_path,
+        chunks: end - first,
+        rows: pass1.rows_read,
+        samples: pass1.samples,
+    })
+}
+
+/// Writes `bytes` to `path` by a locked temporary (so that another copy of
+/// the part can tell it from a killed writer's), synced and renamed.
+fn write_locked_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    use std::io::Write;
+    let tmp = crate::io::temp_path(path);
+    let written = (|| {
+        let mut f = crate::io::create_locked(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    if written.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    written?;
+    crate::io::sync_dir(path.parent().unwrap_or(Path::new(".")));
+    Ok(())
+}
+
+/// Removes temporaries of `final_path` left by killed writers.
+fn remove_abandoned_temps(dir: &Path, final_path: &Path) {
+    let final_name = final_path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    if let Ok(entries) = std::fs::read_dir(dir) {
+        for e in entries.flatten() {
+            if crate::io::is_temp_of(&e.file_name().to_string_lossy(), &final_name) && crate::io::is_abandoned(&e.path()) {
+                let _ = std::fs::remove_file(e.path());
+            }
+        }
+    }
+}
+
+/// The parts of `dir`, checked against `run`: their sample files in part
+/// order and pass 1's combined results.
+fn read_parts(dir: &Path, run: &SweepRun) -> Result<(Vec<PathBuf>, Pass1), PartsError> {
+    let entries = match std::fs::read_dir(dir) {
+        Ok(e) => e,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Err(PartsError::NoParts { dir: dir.to_path_buf() }),
+        Err(source) => {
+            return Err(PartsError::Io {
+                path: dir.to_path_buf(),
+                source,
+            })
+        }
+    };
+    let mut found: Vec<(u64, u64)> = Vec::new();
+    for e in entries.flatten() {
+        let name = e.file_name().to_string_lossy().into_owned();
+        let parsed = name
+            .strip_prefix("part-")
+            .and_then(|r| r.strip_suffix(".json"))
+            .and_then(|r| r.split_once("-of-"));
+        if let Some((i, n)) = parsed.and_then(|(i, n)| Some((i.parse::<u64>().ok()?, n.parse::<u64>().ok()?))) {
+            found.push((i, n));
+        }
+    }
+    if found.is_empty() {
+        return Err(PartsError::NoParts { dir: dir.to_path_buf() });
+    }
+    let mut counts: Vec<u64> = found.iter().map(|p| p.1).collect();
+    counts.sort_unstable();
+    counts.dedup();
+    if counts.len() > 1 {
+        return Err(PartsError::Mixed {
+            dir: dir.to_path_buf(),
+            counts,
+        });
+    }
+    let shards = counts[0];
+    let missing: Vec<u64> = (0..shards).filter(|i| !found.contains(&(*i, shards))).collect();
+    if !missing.is_empty() {
+        return Err(PartsError::Missing {
+            dir: dir.to_path_buf(),
+            shards,
+            missing,
+        });
+    }
+    if let Some(&(i, _)) = found.iter().find(|p| p.0 >= shards) {
+        let path = dir.join(part_name(i, shards, "json"));
+        return Err(PartsError::Mismatch {
+            path,
+            problem: format!("part {i} is beyond the {shards} parts: remove it"),
+        });
+    }
+    let mut files = Vec::new();
+    let mut pass1 = Pass1::default();
+    for shard in 0..shards {
+        let path = dir.join(part_name(shard, shards, "json"));
+        let mismatch = |problem: String| PartsError::Mismatch {
+            path: path.clone(),
+            problem,
+        };
+        let text = std::fs::read(&path).map_err(|source| PartsError::Io {
+            path: path.clone(),
+            source,
+        })?;
+        let record: PartRecord = serde_json::from_slice(&text).map_err(|e| mismatch(format!("not a reduce part record ({e})")))?;
+        if record.format != PART_FORMAT {
+            return Err(mismatch(format!("format '{}', expected '{PART_FORMAT}'", record.format)));
+        }
+        if (record.shard, record.shards) != (shard, shards) {
+            return Err(mismatch(format!("it records part {} of {}", record.shard, record.shards)));
+        }
+        if record.spec_sha256 != run.manifest().spec_sha256 {
+            return Err(mismatch("it is a part of another run (its spec hash differs)".into()));
+        }
+        let range = chunk_range(run.chunk_count(), shard, shards);
+        let first_row: u64 = (0..range[0]).map(|i| run.chunk_rows(i)).sum();
+        let rows: u64 = (range[0]..range[1]).map(|i| run.chunk_rows(i)).sum();
+        if record.run_chunks != run.chunk_count()
+            || record.chunk_range != range
+            || record.first_row != first_row
+            || record.pass1.rows_read != rows
+        {
+            return Err(mismatch("it covers other chunks or rows than the run has now".into()));
+        }
+        let samples = dir.join(part_name(shard, shards, "samples"));
+        let len = std::fs::metadata(&samples).map(|m| m.len()).map_err(|source| PartsError::Io {
+            path: samples.clone(),
+            source,
+        })?;
+        if len != record.records * RECORD_BYTES as u64 {
+            return Err(PartsError::Mismatch {
+                path: samples,
+                problem: format!("{len} bytes where the part's record says {} samples", record.records),
+            });
+        }
+        files.push(samples);
+        pass1.merge(&record.pass1);
+    }
+    Ok((files, pass1))
+}
+
+/// Merges the parts in `map_dir`'s parts directory into the map of the
+/// run in `run_dir` (a complete run). Returns the map and the run's spec.
+pub fn merge_parts(run_dir: &Path, map_dir: &Path, options: &ReduceOptions) -> Result<(MapData, SweepSpec), ReduceError> {
+    let run = open_run(run_dir, Completeness::Complete)?;
+    let info = run_info(&run);
+    super::check_options(&info, options)?;
+    let (files, pass1) = read_parts(&parts_dir(map_dir), &run)?;
+    let scratch = spill::ScratchDir::new(&options.scratch_parent())?;
+    let names = columns::RowColumns::names(info.order);
+    let names: Vec<&str> = names.iter().map(String::as_str).collect();
+    let map = super::reduce_spilled(&info, options, spill::Samples::Files(files), &pass1, &scratch.path, || {
+        Ok(run.batches_projected(&names)?.map(|b| b.map_err(ReduceError::from)))
+    })?;
+    Ok((map, run.spec().clone()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn chunk_ranges_cover_every_chunk_once_for_any_split() {
+        for chunks in [0usize, 1, 5, 17] {
+            for shards in 1..25u64 {
+                let ranges: Vec<[usize; 2]> = (0..shards).map(|i| chunk_range(chunks, i, shards)).collect();
+                assert_eq!(ranges[0][0], 0);
+                assert_eq!(ranges.last().unwrap()[1], chunks);
+                assert!(ranges.windows(2).all(|w| w[0][1] == w[1][0]));
+            }
+        }
+    }
+
+    #[test]
+    fn the_parts_directory_sits_beside_the_map() {
+        assert_eq!(parts_dir(Path::new("out/map")), Path::new("out/map.parts"));
+    }
+}
