@@ -348,6 +348,9 @@ fn two_shards_then_reduce_equal_one_shard_and_status_reports_progress() {
         let (ok, _, stderr) = run(&["reduce", s(run_dir), "--out", s(&map)]);
         assert!(ok, "{stderr}");
     }
+    // The planar reduce's parts (--shard/--shards/--merge) are not for cable runs.
+    let (ok, _, stderr) = run(&["reduce", s(&two), "--out", s(&dir.path().join("m")), "--shard", "0", "--shards", "2"]);
+    assert!(!ok && stderr.contains("cable sweep") && stderr.contains("--shards"), "{stderr}");
     for file in ["reach_xy.parquet", "reach_xz.parquet", "reach_yz.parquet", "reach_3d.parquet"] {
         assert_eq!(std::fs::read(one.with_extension("map").join(file)).unwrap(), std::fs::read(two.with_extension("map").join(file)).unwrap(), "{file}");
     }
