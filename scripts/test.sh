@@ -25,8 +25,9 @@ bin=$(cargo metadata --format-version 1 --no-deps | "$venv/bin/python" -c 'impor
 "$venv/bin/python" tests/python/check_sweep.py "$work/quick" "$work/failures"
 
 echo "== Python read-back of a cable sweep (pyarrow, pandas, polars)"
-"$bin" sweep-cables jobs/spatial-pair.toml --out "$work/cables" > /dev/null
-"$venv/bin/python" tests/python/check_cable_sweep.py "$work/cables"
+"$bin" map jobs/spatial-pair.toml --out "$work/cables" > /dev/null
+"$bin" map jobs/antagonistic-pair.toml --out "$work/pair" > /dev/null
+"$venv/bin/python" tests/python/check_cable_sweep.py "$work/cables" "$work/pair"
 
 echo "== Python read-back of maps (pandas, polars)"
 "$bin" reduce "$work/quick" --out "$work/quick-map" --json > /dev/null
@@ -43,6 +44,8 @@ fi
 if { command -v chromium && command -v chromedriver; } >/dev/null 2>&1; then
     artefacts=${CABLEMAP_TEST_ARTEFACTS:-$(cargo metadata --format-version 1 --no-deps | "$venv/bin/python" -c 'import json,sys; print(json.load(sys.stdin)["target_directory"])')/test-artefacts}
     "$venv/bin/python" tests/python/check_explorer.py "$work/quick-map" "$bin" "$artefacts/explorer.png"
+    # A planar two-cable sweep's map: the same page.
+    "$venv/bin/python" tests/python/check_explorer.py "$work/pair/map/planar" "$bin" "$artefacts/explorer-pair.png"
 else
     echo "!!!!!!!! SKIPPED: the map explorer's browser check did not run: chromium and chromedriver are not"
     echo "!!!!!!!! installed and cannot be installed here (needs root and apt-get: apt-get install chromium chromium-driver)"

@@ -31,9 +31,6 @@ enum Command {
     /// Sweep a routing grid through a tension ladder into Parquet chunks (sharded, resumable).
     #[command(allow_negative_numbers = true)]
     Sweep(cli::sweep::SweepArgs),
-    /// Sweep several or spatial cables (control points per cable and axis, a tension grid per cable): rows and reach maps as Parquet.
-    #[command(allow_negative_numbers = true)]
-    SweepCables(cli::sweep_cables::SweepCablesArgs),
     /// Report a sweep directory: rows done per shard, failures, completeness.
     #[command(allow_negative_numbers = true)]
     Status(cli::sweep::StatusArgs),
@@ -67,7 +64,6 @@ fn main() -> ExitCode {
         Command::Feasible(args) => cli::feasible::run(args),
         Command::Mould(args) => cli::mould::run(args),
         Command::Sweep(args) => cli::sweep::run(args),
-        Command::SweepCables(args) => cli::sweep_cables::run(args),
         Command::Status(args) => cli::sweep::run_status_command(args),
         Command::Reduce(args) => cli::reduce::run(args),
         Command::Map(args) => cli::reduce::run_map(args),

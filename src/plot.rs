@@ -51,6 +51,9 @@ pub struct BodyDrawing {
     pub frame_angle_rad: Vec<f64>,
     /// Cable path (x, y), mm.
     pub cable: Vec<(f64, f64)>,
+    /// Paths of the further cables of a several-cable actuator (x, y), mm,
+    /// drawn like `cable` (empty for one cable).
+    pub further_cables: Vec<Vec<(f64, f64)>>,
     /// Rod radius, mm.
     pub radius_mm: f64,
     /// Radius r(s) at each centreline point, mm, for a non-uniform body;
@@ -70,6 +73,7 @@ impl BodyDrawing {
             centreline: sim.centreline.iter().map(|c| (c.x_mm, c.y_mm)).collect(),
             frame_angle_rad: sim.centreline.iter().map(|c| c.frame_angle_rad).collect(),
             cable: sim.centreline.iter().map(|c| (c.cable_x_mm, c.cable_y_mm)).collect(),
+            further_cables: Vec::new(),
             radius_mm,
             radii_mm: Vec::new(),
             label,
@@ -185,9 +189,9 @@ pub fn draw_bodies(path: &Path, title: &str, bodies: &[BodyDrawing], targets: &[
         chart
             .draw_series(LineSeries::new(page(&b.centreline), colour.mix(0.4).stroke_width(1)))
             .map_err(|e| PlotError::new(path, e))?;
-        chart
-            .draw_series(LineSeries::new(page(&b.cable), RED.stroke_width(2)))
-            .map_err(|e| PlotError::new(path, e))?;
+        for cable in std::iter::once(&b.cable).chain(&b.further_cables) {
+            chart.draw_series(LineSeries::new(page(cable), RED.stroke_width(2))).map_err(|e| PlotError::new(path, e))?;
+        }
         if let Some(&(x, y)) = b.centreline.last() {
             chart.draw_series(std::iter::once(Circle::new((y, -x), 5, colour.filled()))).map_err(|e| PlotError::new(path, e))?;
         }

@@ -1,13 +1,20 @@
-//! `cablemap sweep-cables` as a user runs it: rows with one tension column
-//! per cable and the 3-D tip, reach maps on the three coordinate planes and
-//! in 3-D, rejected routings, and agreement with `simulate --cable`.
+//! Cable sweeps as a user runs them (`cablemap map`/`sweep`/`status`/`reduce`
+//! with a spec of `[[cable]]` tables): rows with one tension column per cable
+//! and the 3-D tip, reach maps on the three coordinate planes and in 3-D,
+//! rejected routings, agreement with `simulate --cable`, and the sweep
+//! engine's guarantees (kill and resume, shards, status) on cable runs.
 
 mod process;
 
 use arrow::array::{Array, Float64Array, Int64Array, StringArray};
 use arrow::record_batch::RecordBatch;
 use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
+use cablemap::sweep::cables::CableSweepSpec;
+use cablemap::sweep::{open_run_of, Completeness};
+use std::collections::BTreeMap;
 use std::path::Path;
+use std::process::Stdio;
+use std::time::{Duration, Instant};
 
 const SPEC: &str = r#"
 gravity_direction = [0.6, 0, 0.8]
@@ -51,17 +58,40 @@ fn f64s(batch: &RecordBatch, name: &str) -> Vec<Option<f64>> {
     (0..a.len()).map(|i| a.is_valid(i).then(|| a.value(i))).collect()
 }
 
+/// Every row of a cable run (through the library's reader), in order.
+fn rows_of(run: &Path) -> RecordBatch {
+    let run = open_run_of::<CableSweepSpec>(run, Completeness::Complete).unwrap();
+    let batches: Vec<RecordBatch> = run.batches().map(|b| b.unwrap()).collect();
+    arrow::compute::concat_batches(&run.schema(), &batches).unwrap()
+}
+
+/// The run's chunk files, by name.
+fn chunks(run: &Path) -> BTreeMap<String, Vec<u8>> {
+    std::fs::read_dir(run.join("shards"))
+        .map(|d| {
+            d.map(|e| e.unwrap())
+                .filter(|e| !e.file_name().to_string_lossy().starts_with('.'))
+                .map(|e| (e.file_name().to_string_lossy().into_owned(), std::fs::read(e.path()).unwrap()))
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
 #[test]
-fn a_spatial_pair_sweep_writes_rows_and_reach_maps() {
+fn a_spatial_pair_map_writes_rows_and_reach_maps() {
     let dir = tempfile::tempdir().unwrap();
     let spec = dir.path().join("pair.toml");
     std::fs::write(&spec, SPEC).unwrap();
-    let out = dir.path().join("run");
-    let (ok, stdout, stderr) = run(&["sweep-cables", spec.to_str().unwrap(), "--out", out.to_str().unwrap(), "--threads", "2"]);
+    let out = dir.path().join("out");
+    let (ok, stdout, stderr) = run(&["map", s(&spec), "--out", s(&out), "--threads", "2"]);
     assert!(ok, "{stderr}");
     // 2 × 3 routings (cable 2 with y0 = 2 is still inside and apart), 3 × 2 tension pairs.
-    assert!(stdout.contains("6 routings"), "{stdout}");
-    let rows = read(&out.join("rows.parquet"));
+    assert!(stdout.contains("36 rows of 2 cable(s) (36 solved"), "{stdout}");
+    let rows = rows_of(&out.join("run"));
     assert_eq!(rows.num_rows(), 6 * 6);
     for name in ["tension1_n", "tension2_n", "tip_x_mm", "tip_y_mm", "tip_z_mm", "tip_tangent_z", "a0", "a2", "a_bend_y2", "a_twist0", "cable2_y0_mm", "cable1_z4_mm"] {
         assert!(rows.column_by_name(name).is_some(), "{name}");
@@ -70,15 +100,23 @@ fn a_spatial_pair_sweep_writes_rows_and_reach_maps() {
     let status = rows.column_by_name("status").unwrap().as_any().downcast_ref::<StringArray>().unwrap();
     let ok_rows = (0..rows.num_rows()).filter(|&i| status.value(i) == "ok").count();
     assert_eq!(ok_rows, 36);
+    // Rows in (routing, tension grid) order: cable 1's tension slowest.
+    let ids = rows.column_by_name("routing_id").unwrap().as_any().downcast_ref::<Int64Array>().unwrap();
+    let t1 = f64s(&rows, "tension1_n");
+    let t2 = f64s(&rows, "tension2_n");
+    for i in 1..rows.num_rows() {
+        let key = |i: usize| (ids.value(i), t1[i].unwrap(), t2[i].unwrap());
+        assert!(key(i - 1) < key(i), "rows {} and {i} out of order", i - 1);
+    }
     // Every solved tip is counted once in each map.
     for file in ["reach_xy.parquet", "reach_xz.parquet", "reach_yz.parquet", "reach_3d.parquet"] {
-        let m = read(&out.join("maps").join(file));
+        let m = read(&out.join("map").join(file));
         let counts = m.column_by_name("count").unwrap().as_any().downcast_ref::<Int64Array>().unwrap();
         assert_eq!(counts.iter().map(|c| c.unwrap()).sum::<i64>(), 36, "{file}");
     }
-    let png = image::open(out.join("maps/reach.png")).unwrap();
+    let png = image::open(out.join("map/reach.png")).unwrap();
     assert!(png.width() > 1000 && png.height() > 500);
-    let m = read(&out.join("maps/reach_3d.parquet"));
+    let m = read(&out.join("map/reach_3d.parquet"));
     for name in ["ix", "iy", "iz", "x_mm", "y_mm", "z_mm", "count"] {
         assert!(m.column_by_name(name).is_some(), "{name}");
     }
@@ -96,17 +134,29 @@ fn a_spatial_pair_sweep_writes_rows_and_reach_maps() {
         assert!((get(col) - v[key].as_f64().unwrap()).abs() < 1e-6, "{col}: {} vs {}", get(col), v[key]);
     }
     assert!((get("a_twist1") - v["a_twist"][1].as_f64().unwrap()).abs() < 1e-7);
-    let summary: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let summary: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("map/summary.json")).unwrap()).unwrap();
     assert_eq!(summary["rows"], 36);
+    assert_eq!(summary["kind"], "cables");
     assert_eq!(summary["planar"], false);
-    assert!(!out.join("maps/planar").exists(), "a spatial run has no planar maps");
-    // Not resumable: the same directory again is refused.
-    let (ok, _, stderr) = run(&["sweep-cables", spec.to_str().unwrap(), "--out", out.to_str().unwrap()]);
-    assert!(!ok && stderr.contains("not empty"), "{stderr}");
+    assert_eq!(summary["cell_mm"], 2.0, "the spec's output.cell_mm");
+    assert!(!out.join("map/planar").exists(), "a spatial run has no planar maps");
+    let (ok, _, stderr) = run(&["feasible", "--map", s(&out.join("map")), "--target", "x=50,y=5,a0=-0.02,a1=0"]);
+    assert!(!ok && stderr.contains("spatial cable sweep") && stderr.contains("no feasibility map"), "{stderr}");
+    // The same command again resumes: nothing is solved twice, the map is replaced.
+    let before = chunks(&out.join("run"));
+    let (ok, stdout, stderr) = run(&["map", s(&spec), "--out", s(&out)]);
+    assert!(ok, "{stderr}");
+    assert!(stdout.contains("0 rows solved and written, 36 already done"), "{stdout}");
+    assert_eq!(chunks(&out.join("run")), before);
+    // --cell-mm overrides the spec's cell size.
+    let (ok, _, stderr) = run(&["reduce", s(&out.join("run")), "--out", s(&out.join("map")), "--cell-mm", "0.5"]);
+    assert!(ok, "{stderr}");
+    let summary: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("map/summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["cell_mm"], 0.5);
 }
 
 #[test]
-fn rejected_routings_are_rows_with_a_status() {
+fn rejected_routings_are_rows_with_a_status_and_a_planar_run_gets_the_planar_map() {
     // Cable 2 swept onto cable 1's path at its second level.
     let spec_text = r#"
 [rod.gravity]
@@ -125,40 +175,214 @@ levels_mm = [-2.0, 2.0]
     let dir = tempfile::tempdir().unwrap();
     let spec = dir.path().join("s.toml");
     std::fs::write(&spec, spec_text).unwrap();
-    let out = dir.path().join("run");
-    let (ok, stdout, stderr) = run(&["sweep-cables", spec.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    let out = dir.path().join("out");
+    let (ok, stdout, stderr) = run(&["map", s(&spec), "--out", s(&out)]);
     assert!(ok, "{stderr}");
-    assert!(stdout.contains("(1 rejected)"), "{stdout}");
-    let rows = read(&out.join("rows.parquet"));
+    assert!(stdout.contains("2 of rejected routings"), "{stdout}");
+    let rows = rows_of(&out.join("run"));
     let status = rows.column_by_name("status").unwrap().as_any().downcast_ref::<StringArray>().unwrap();
     let statuses: Vec<&str> = (0..rows.num_rows()).map(|i| status.value(i)).collect();
     assert_eq!(statuses, ["ok", "ok", "invalid_routing", "invalid_routing"]);
     assert_eq!(f64s(&rows, "tip_x_mm")[2], None);
-    // A planar run: tips on the x–y plane, and the planar sweep's map tables.
+    // A planar run: tips on the x–y plane, and the planar sweep's map.
     assert!(f64s(&rows, "tip_z_mm")[0].unwrap().abs() < 1e-12);
-    let cells = read(&out.join("maps/planar/cells.parquet"));
+    let planar = out.join("map/planar");
+    let cells = read(&planar.join("cells.parquet"));
     let counts = cells.column_by_name("count").unwrap().as_any().downcast_ref::<Int64Array>().unwrap();
     assert_eq!(counts.iter().map(|c| c.unwrap()).sum::<i64>(), 2, "the two solved rows");
-    let designs = read(&out.join("maps/planar/designs.parquet"));
+    let designs = read(&planar.join("designs.parquet"));
     let ids = designs.column_by_name("routing_id").unwrap().as_any().downcast_ref::<Int64Array>().unwrap();
     let tips = f64s(&rows, "tip_x_mm");
     for (k, id) in ids.iter().enumerate() {
-        // routing_id there is the row number in rows.parquet.
+        // routing_id there is the row key: routing × combinations + combination,
+        // the row number of a complete run.
         assert_eq!(f64s(&designs, "tip_x_mm")[k], tips[id.unwrap() as usize]);
     }
-    let summary: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("maps/planar/summary.json")).unwrap()).unwrap();
+    let summary: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(planar.join("summary.json")).unwrap()).unwrap();
     assert_eq!(summary["rows_converged"], 2);
+    // The pictures and the explorer page, as for a planar sweep.
+    for file in ["reach.png", "modes.png", "a0_p10.png", "a1_gap.png", "index.html", "explorer-data.js"] {
+        assert!(planar.join(file).is_file(), "{file}");
+    }
+    let data = std::fs::read_to_string(planar.join("explorer-data.js")).unwrap();
+    assert!(!data.contains("Not drawn"), "every mode representative is drawn");
+    // `feasible` reads the planar map, and points there from the cable map.
+    let (ok, _, stderr) = run(&["feasible", "--map", s(&out.join("map")), "--target", "x=50,y=5,a0=-0.02,a1=0"]);
+    assert!(!ok && stderr.contains("map of a cable sweep") && stderr.contains("planar"), "{stderr}");
+    let (ok, _, stderr) = run(&["feasible", "--map", s(&planar), "--target", "x=50,y=5,a0=-0.02,a1=0"]);
+    assert!(ok, "{stderr}");
 }
 
 #[test]
-fn bad_specs_are_refused() {
+fn planar_pair_mode_pictures_are_drawn_from_a_solve_of_all_cables() {
+    // Two opposed cables whose tensions decide the bending direction. Each
+    // representative is solved again from zero with both cables; the reducer
+    // refuses (and names, "Not drawn") a drawing whose tip is more than 1 µm
+    // from the row's stored tip, so none may be missing.
+    let dir = tempfile::tempdir().unwrap();
+    let spec = Path::new(env!("CARGO_MANIFEST_DIR")).join("jobs/antagonistic-pair.toml");
+    let out = dir.path().join("out");
+    let (ok, stdout, stderr) = run(&["map", s(&spec), "--out", s(&out), "--threads", "2"]);
+    assert!(ok, "{stderr}");
+    assert!(stdout.contains("planar run: feasibility map"), "{stdout}");
+    let data = std::fs::read_to_string(out.join("map/planar/explorer-data.js")).unwrap();
+    assert!(!data.contains("Not drawn"), "every representative's solve from zero reaches its row's tip");
+    assert_eq!(data.matches("\"further_cables\":[[[").count(), 12, "each mode's drawing has cable 2's path too");
+    let png = image::open(out.join("map/planar/modes.png")).unwrap();
+    assert!(png.width() > 1000);
+}
+
+/// A cable spec of many small chunks, slow enough that kills land mid-run.
+const KILL_SPEC: &str = r#"
+gravity_direction = [1, 0, 0]
+[output]
+chunk_routings = 2
+[[cable]]
+y_mm = [2, 2, 2, 2, 2]
+tension_n = { min = 0.0, max = 1.5, count = 6 }
+[[cable.sweep]]
+axis = "z"
+points = [1, 2, 3]
+levels_mm = [-1.0, 0.0, 1.0, 2.0]
+[[cable]]
+y_mm = [-2, -2, -2, -2, -2]
+tension_n = { min = 0.0, max = 1.5, count = 6 }
+[[cable.sweep]]
+axis = "y"
+points = [2]
+levels_mm = [-3.0, -2.0, -1.0]
+"#;
+
+#[test]
+fn a_killed_cable_sweep_resumes_to_the_uninterrupted_rows() {
+    let dir = tempfile::tempdir().unwrap();
+    let spec = dir.path().join("kill.toml");
+    std::fs::write(&spec, KILL_SPEC).unwrap();
+    let reference = dir.path().join("reference");
+    let (ok, _, stderr) = run(&["sweep", s(&spec), "--out", s(&reference), "--quiet"]);
+    assert!(ok, "{stderr}");
+    let want = chunks(&reference);
+    // 4³ × 3 = 192 routings in chunks of 2.
+    assert_eq!(want.len(), 96);
+    let killed = dir.path().join("killed");
+    let mut interrupted = 0;
+    for round in 0..3u64 {
+        let mut child = process::cablemap()
+            .args(["sweep", s(&spec), "--out", s(&killed), "--quiet", "--threads", "1"])
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap();
+        // Killed after 1–3 more committed chunks (counted, not timed).
+        let before = chunks(&killed).len();
+        let ready = |d: &Path| d.join("manifest.json").exists() && chunks(d).len() > before + round as usize;
+        let deadline = Instant::now() + Duration::from_secs(300);
+        while !ready(&killed) && Instant::now() < deadline && child.try_wait().unwrap().is_none() {
+            std::thread::sleep(Duration::from_micros(200));
+        }
+        child.kill().unwrap(); // SIGKILL on Unix
+        child.wait().unwrap();
+        let partial = chunks(&killed);
+        // Whatever the moment, every chunk present equals the reference's.
+        for (name, bytes) in &partial {
+            assert_eq!(Some(bytes), want.get(name), "{name} differs after a kill in round {round}");
+        }
+        if partial.len() < want.len() {
+            interrupted += 1;
+        }
+    }
+    assert!(interrupted > 0, "no kill landed mid-run");
+    // Status names the partial run.
+    let (ok, stdout, stderr) = run(&["status", s(&killed), "--json"]);
+    assert!(ok, "{stderr}");
+    let v: serde_json::Value = serde_json::from_str(stdout.trim()).unwrap();
+    assert_eq!(v["format"], "cablemap-cables/1");
+    assert_eq!(v["rows_total"], 192 * 36);
+    assert_eq!(v["complete"], false);
+    // A partial run is refused by reduce unless asked for.
+    let (ok, _, stderr) = run(&["reduce", s(&killed), "--out", s(&dir.path().join("m"))]);
+    assert!(!ok && stderr.contains("incomplete"), "{stderr}");
+    let (ok, _, stderr) = run(&["reduce", s(&killed), "--out", s(&dir.path().join("m")), "--partial"]);
+    assert!(ok, "{stderr}");
+    // Resume finishes with the same bytes as the uninterrupted run.
+    let (ok, stdout, stderr) = run(&["sweep", s(&spec), "--out", s(&killed), "--quiet"]);
+    assert!(ok, "{stderr}");
+    assert!(stdout.contains("already done"), "{stdout}");
+    assert_eq!(chunks(&killed), want);
+}
+
+#[test]
+fn two_shards_then_reduce_equal_one_shard_and_status_reports_progress() {
+    let dir = tempfile::tempdir().unwrap();
+    let spec = dir.path().join("pair.toml");
+    std::fs::write(&spec, SPEC.replace("[output]", "[output]\nchunk_routings = 1")).unwrap();
+    let one = dir.path().join("one");
+    let (ok, _, stderr) = run(&["sweep", s(&spec), "--out", s(&one), "--quiet"]);
+    assert!(ok, "{stderr}");
+    let two = dir.path().join("two");
+    let (ok, stdout, stderr) = run(&["sweep", s(&spec), "--out", s(&two), "--shard", "0", "--shards", "2", "--quiet"]);
+    assert!(ok, "{stderr}");
+    assert!(stdout.contains("partial (other shards not done yet)"), "{stdout}");
+    // Status after one shard: its chunks done, the other shard's not.
+    let (ok, text, stderr) = run(&["status", s(&two)]);
+    assert!(ok, "{stderr}");
+    assert!(text.contains("kind       cable sweep (cablemap-cables/1)") && text.contains("6 routings x 6 tension combinations = 36 rows"), "{text}");
+    assert!(text.contains("state      partial: 18/36 rows"), "{text}");
+    let (_, json, _) = run(&["status", s(&two), "--json"]);
+    let v: serde_json::Value = serde_json::from_str(json.trim()).unwrap();
+    assert_eq!(v["shards"][0]["rows_done"], 18);
+    assert_eq!(v["shards"][1]["rows_done"], 0);
+    // A different shard count for the same directory is refused.
+    let (ok, _, stderr) = run(&["sweep", s(&spec), "--out", s(&two), "--shard", "0", "--shards", "3"]);
+    assert!(!ok && stderr.contains("--shards 2"), "{stderr}");
+    // Shard 1 from the SLURM array index, as on a cluster.
+    let out = process::cablemap()
+        .args(["sweep", s(&spec), "--out", s(&two), "--shards", "2", "--quiet"])
+        .env("SLURM_ARRAY_TASK_ID", "1")
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(chunks(&two), chunks(&one), "the same chunk files, whatever the sharding");
+    for run_dir in [&one, &two] {
+        let map = run_dir.with_extension("map");
+        let (ok, _, stderr) = run(&["reduce", s(run_dir), "--out", s(&map)]);
+        assert!(ok, "{stderr}");
+    }
+    // The planar reduce's parts (--shard/--shards/--merge) are not for cable runs.
+    let (ok, _, stderr) = run(&["reduce", s(&two), "--out", s(&dir.path().join("m")), "--shard", "0", "--shards", "2"]);
+    assert!(!ok && stderr.contains("cable sweep") && stderr.contains("--shards"), "{stderr}");
+    for file in ["reach_xy.parquet", "reach_xz.parquet", "reach_yz.parquet", "reach_3d.parquet"] {
+        assert_eq!(std::fs::read(one.with_extension("map").join(file)).unwrap(), std::fs::read(two.with_extension("map").join(file)).unwrap(), "{file}");
+    }
+}
+
+#[test]
+fn runs_of_the_other_kind_and_bad_specs_are_refused() {
     let dir = tempfile::tempdir().unwrap();
     let spec = dir.path().join("bad.toml");
     std::fs::write(&spec, SPEC.replace("points = [4]", "points = [9]")).unwrap();
-    let (ok, _, stderr) = run(&["sweep-cables", spec.to_str().unwrap(), "--out", dir.path().join("o").to_str().unwrap()]);
+    let (ok, _, stderr) = run(&["sweep", s(&spec), "--out", s(&dir.path().join("o"))]);
     assert!(!ok && stderr.contains("bad.toml") && stderr.contains("control point 9"), "{stderr}");
-    let (ok, _, stderr) = run(&["sweep-cables", "/nonexistent.toml", "--out", dir.path().join("o").to_str().unwrap()]);
+    let (ok, _, stderr) = run(&["map", "/nonexistent.toml", "--out", s(&dir.path().join("o"))]);
     assert!(!ok && stderr.contains("/nonexistent.toml"), "{stderr}");
+    std::fs::write(&spec, SPEC.replace("[output]", "[output]\nchunk_routings = 0")).unwrap();
+    let (ok, _, stderr) = run(&["sweep", s(&spec), "--out", s(&dir.path().join("o"))]);
+    assert!(!ok && stderr.contains("chunk_routings = 0"), "{stderr}");
+    // A cable spec into a planar run directory, and the other way round.
+    let planar = dir.path().join("planar");
+    let planar_spec = dir.path().join("planar.toml");
+    std::fs::write(&planar_spec, "[grid]\nlevels = 2\n[tension]\ncount = 2\n").unwrap();
+    assert!(run(&["sweep", s(&planar_spec), "--out", s(&planar), "--quiet"]).0);
+    std::fs::write(&spec, SPEC).unwrap();
+    let (ok, _, stderr) = run(&["sweep", s(&spec), "--out", s(&planar)]);
+    assert!(!ok && stderr.contains("cablemap-sweep/2") && stderr.contains("another kind"), "{stderr}");
+    let cables = dir.path().join("cables");
+    assert!(run(&["sweep", s(&spec), "--out", s(&cables), "--quiet"]).0);
+    let (ok, _, stderr) = run(&["sweep", s(&planar_spec), "--out", s(&cables)]);
+    assert!(!ok && stderr.contains("cablemap-cables/1"), "{stderr}");
+    // The planar library reader names the kind of a cable run.
+    let e = cablemap::sweep::open_run(&cables, Completeness::Complete).unwrap_err().to_string();
+    assert!(e.contains("cablemap-cables/1") && e.contains("another kind"), "{e}");
 }
 
 #[test]
@@ -166,7 +390,8 @@ fn the_shipped_job_specs_are_valid() {
     for name in ["antagonistic-pair.toml", "spatial-pair.toml"] {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("jobs").join(name);
         let text = std::fs::read_to_string(&path).unwrap();
-        let spec = cablemap::sweep::cables::CableSweepSpec::from_toml(&text, name).unwrap();
+        assert!(cablemap::sweep::is_cable_spec_toml(&text), "{name}");
+        let spec = CableSweepSpec::from_toml(&text, name).unwrap();
         assert!(spec.routings() > 1 && spec.tension_combinations() > 1);
     }
 }

@@ -2,6 +2,7 @@
 //! run each command. `main.rs` only parses and dispatches.
 
 pub mod bench;
+pub mod cable_map;
 pub mod calibrate;
 pub mod design;
 pub mod diagnose;
@@ -11,7 +12,6 @@ pub mod reduce;
 pub mod simulate;
 pub mod study;
 pub mod sweep;
-pub mod sweep_cables;
 pub mod synth;
 
 use cablemap::model::{Actuator, SolverOptions};

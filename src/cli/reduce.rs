@@ -11,9 +11,9 @@ use std::time::Instant;
 /// Map options shared by `reduce` and `map`.
 #[derive(Debug, Clone, Args)]
 pub struct MapOptionArgs {
-    /// Grid cell size, mm.
-    #[arg(long, value_name = "MM", default_value_t = 1.0)]
-    pub cell_mm: f64,
+    /// Grid cell size, mm [default: 1; a cable sweep: its spec's output.cell_mm].
+    #[arg(long, value_name = "MM")]
+    pub cell_mm: Option<f64>,
     /// Explicit a_0 boundaries of the modes: three ascending values (mm⁻¹)
     /// [default: 25/50/75 % quantiles of the data].
     #[arg(long, value_name = "B1,B2,B3", allow_hyphen_values = true)]
@@ -50,7 +50,7 @@ impl MapOptionArgs {
         };
         anyhow::ensure!(self.memory_samples >= 1, "--memory-samples must be at least 1");
         Ok(ReduceOptions {
-            cell_mm: self.cell_mm,
+            cell_mm: self.cell_mm.unwrap_or(1.0),
             mode_boundaries,
             designs_per_cell: self.designs_per_cell,
             memory_samples: self.memory_samples,
@@ -85,6 +85,14 @@ pub struct ReduceArgs {
     pub merge: bool,
     #[command(flatten)]
     pub map: MapOptionArgs,
+}
+
+/// Reduces `run` (either kind of sweep) into `out` and prints a summary.
+pub fn reduce_any_into(run: &Path, out: &Path, partial: bool, args: &MapOptionArgs) -> anyhow::Result<()> {
+    match cablemap::sweep::run_kind(run)? {
+        cablemap::sweep::RunKind::Planar => reduce_into(run, out, partial, args).map(|_| ()),
+        cablemap::sweep::RunKind::Cables => super::cable_map::reduce_cables_into(run, out, partial, args.cell_mm, &args.options()?, args.json),
+    }
 }
 
 /// How `reduce_into` gets the map.
@@ -168,6 +176,14 @@ fn with_flags(e: ReduceError, run: &Path, out: &Path) -> anyhow::Error {
 
 /// Runs `cablemap reduce`.
 pub fn run(args: &ReduceArgs) -> anyhow::Result<()> {
+    if matches!(cablemap::sweep::run_kind(&args.run), Ok(cablemap::sweep::RunKind::Cables)) {
+        anyhow::ensure!(
+            args.shards.is_none() && args.shard.is_none() && !args.merge,
+            "{} is a cable sweep: its reduce streams the chunks in one process and has no parts; drop --shard/--shards/--merge",
+            args.run.display()
+        );
+        return reduce_any_into(&args.run, &args.out, args.partial, &args.map);
+    }
     if let Some(shards) = args.shards {
         anyhow::ensure!(shards >= 1, "--shards must be at least 1");
         let (shard, from) = super::sweep::shard_from_env(args.shard)?;
@@ -227,9 +243,12 @@ pub fn run_map(args: &MapArgs) -> anyhow::Result<()> {
         let threads = super::sweep::thread_count(args.threads)?;
         return super::study::run_study(&study, path, &args.out, None, false, threads, args.allow_large, &args.map);
     }
-    let spec = super::sweep::load_spec(args.spec.as_deref())?;
+    let spec = super::sweep::load_any_spec(args.spec.as_deref())?;
     let threads = super::sweep::thread_count(args.threads)?;
     let options = SweepOptions { shard: 0, shards: 1, threads, progress: ProgressMode::Auto, allow_large: args.allow_large };
-    super::sweep::sweep_and_report(&spec, &args.out.join("run"), &options, false)?;
-    reduce_into(&args.out.join("run"), &args.out.join("map"), false, &args.map).map(|_| ())
+    match &spec {
+        super::sweep::AnySpec::Planar(spec) => super::sweep::sweep_and_report(spec, &args.out.join("run"), &options, false)?,
+        super::sweep::AnySpec::Cables(spec) => super::sweep::sweep_and_report(spec, &args.out.join("run"), &options, false)?,
+    }
+    reduce_any_into(&args.out.join("run"), &args.out.join("map"), false, &args.map)
 }

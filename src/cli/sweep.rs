@@ -1,7 +1,8 @@
 //! `cablemap sweep` and `cablemap status`: front ends of [`cablemap::sweep`].
 
 use cablemap::sweep::progress::ProgressMode;
-use cablemap::sweep::{run_status, run_sweep, RunStatus, SweepOptions, SweepSpec, SweepSummary};
+use cablemap::sweep::cables::CableSweepSpec;
+use cablemap::sweep::{run_kind, run_status_of, run_sweep_of, RunKind, RunSpec, RunStatus, SweepOptions, SweepSpec, SweepSummary};
 use anyhow::Context;
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -10,7 +11,8 @@ use std::time::Duration;
 /// Arguments of `cablemap sweep`.
 #[derive(Debug, Clone, Args)]
 pub struct SweepArgs {
-    /// Job spec (TOML); the built-in thesis spec (jobs/thesis.toml) when omitted.
+    /// Job spec (TOML); the built-in thesis spec (jobs/thesis.toml) when omitted. A spec with
+    /// [[cable]] tables is a sweep of several or spatial cables (docs/schema.md, "Cable sweeps").
     #[arg(value_name = "SPEC")]
     pub spec: Option<PathBuf>,
     /// Run directory: manifest.json and shards/*.parquet. Re-running resumes.
@@ -82,6 +84,25 @@ pub fn shard_from_env(shard: Option<u64>) -> anyhow::Result<(u64, &'static str)>
     Ok((0, "default"))
 }
 
+/// A job spec of either kind.
+pub enum AnySpec {
+    /// A planar single-cable sweep.
+    Planar(SweepSpec),
+    /// A sweep of several or spatial cables.
+    Cables(CableSweepSpec),
+}
+
+/// The spec at `path` (a cable sweep when it has `[[cable]]` tables), or
+/// the built-in thesis spec.
+pub fn load_any_spec(path: Option<&Path>) -> anyhow::Result<AnySpec> {
+    if let Some(path) = path {
+        if std::fs::read_to_string(path).is_ok_and(|t| cablemap::sweep::is_cable_spec_toml(&t)) {
+            return Ok(AnySpec::Cables(cablemap::sweep::cables::load_spec(path)?));
+        }
+    }
+    load_spec(path).map(AnySpec::Planar)
+}
+
 /// The sweep spec at `path`, or the built-in thesis spec.
 pub fn load_spec(path: Option<&Path>) -> anyhow::Result<SweepSpec> {
     Ok(match path {
@@ -111,14 +132,14 @@ pub fn thread_count(threads: Option<usize>) -> anyhow::Result<Option<usize>> {
 
 /// Runs one shard of `spec` into `out`, saying how to resume when
 /// interrupted, and prints the summary and the run's state.
-pub fn sweep_and_report(spec: &SweepSpec, out: &Path, options: &SweepOptions, json: bool) -> anyhow::Result<()> {
+pub fn sweep_and_report<S: RunSpec>(spec: &S, out: &Path, options: &SweepOptions, json: bool) -> anyhow::Result<()> {
     let again: Vec<String> = std::env::args().collect();
     say_how_to_resume_on_interrupt(format!(
         "\ninterrupted: every chunk already written is kept; resume with the same command:\n  {}\n",
         again.join(" ")
     ));
-    let summary = run_sweep(spec, out, options)?;
-    let status = run_status(out).with_context(|| format!("checking {} after the sweep", out.display()))?;
+    let summary = run_sweep_of(spec, out, options)?;
+    let status = run_status_of::<S>(out).with_context(|| format!("checking {} after the sweep", out.display()))?;
     if json {
         println!("{}", serde_json::json!({ "summary": summary, "run": status.to_json_value() }));
     } else {
@@ -129,7 +150,7 @@ pub fn sweep_and_report(spec: &SweepSpec, out: &Path, options: &SweepOptions, js
 
 /// Runs `cablemap sweep`.
 pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
-    let spec = load_spec(args.spec.as_deref())?;
+    let spec = load_any_spec(args.spec.as_deref())?;
     let threads = thread_count(args.threads)?;
     let progress = if args.quiet {
         ProgressMode::Quiet
@@ -148,12 +169,15 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
         args.shards
     );
     let options = SweepOptions { shard, shards: args.shards, threads, progress, allow_large: args.allow_large };
-    sweep_and_report(&spec, &args.out, &options, args.json)
+    match &spec {
+        AnySpec::Planar(spec) => sweep_and_report(spec, &args.out, &options, args.json),
+        AnySpec::Cables(spec) => sweep_and_report(spec, &args.out, &options, args.json),
+    }
 }
 
 /// The closing lines, each short enough for an 80-column terminal, and the
 /// next command.
-fn print_summary(s: &SweepSummary, status: &RunStatus) {
+fn print_summary<S: RunSpec>(s: &SweepSummary, status: &RunStatus<S>) {
     println!("shard {}/{}: {} rows solved and written, {} already done", s.shard, s.shards, s.rows_written, s.rows_skipped);
     if s.partial_chunks_removed + s.damaged_chunks_redone > 0 {
         println!("  {} abandoned partial chunks removed, {} damaged chunks redone", s.partial_chunks_removed, s.damaged_chunks_redone);
@@ -208,19 +232,33 @@ fn fmt_counts(counts: &std::collections::BTreeMap<String, u64>) -> String {
 
 /// Runs `cablemap status`.
 pub fn run_status_command(args: &StatusArgs) -> anyhow::Result<()> {
-    let s = run_status(&args.dir)?;
-    if args.json {
+    match run_kind(&args.dir)? {
+        RunKind::Planar => print_status(&run_status_of::<SweepSpec>(&args.dir)?, args.json),
+        RunKind::Cables => print_status(&run_status_of::<CableSweepSpec>(&args.dir)?, args.json),
+    }
+}
+
+fn print_status<S: RunSpec>(s: &RunStatus<S>, json: bool) -> anyhow::Result<()> {
+    if json {
         println!("{}", s.to_json_value());
         return Ok(());
     }
     let m = &s.manifest;
     println!("run        {}", s.dir.display());
+    if S::FORMAT != SweepSpec::FORMAT {
+        println!("kind       {} ({})", S::KIND, S::FORMAT);
+    }
     println!("spec       sha256 {} (cablemap {})", m.spec_sha256, m.tool_version);
     println!(
-        "sweep      {} routings x {} tensions = {} rows in {} chunks, {} shard(s)",
-        m.routings, m.tensions, m.total_rows, m.chunks, m.shards
+        "sweep      {} routings x {} {} = {} rows in {} chunks, {} shard(s)",
+        m.routings,
+        m.tensions,
+        if S::FORMAT == SweepSpec::FORMAT { "tensions" } else { "tension combinations" },
+        m.total_rows,
+        m.chunks,
+        m.shards
     );
-    println!("a_i        orders 0..={}, {}", m.spec.output.order, m.length_basis.describe());
+    println!("a_i        orders 0..={}, {}", m.spec.order(), m.length_basis.describe());
     println!("{:>6} {:>14} {:>22} {:>9}", "shard", "chunks", "rows", "failures");
     for sh in &s.shards {
         println!(

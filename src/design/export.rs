@@ -171,6 +171,7 @@ pub fn shape_png(path: &Path, objective: &Objective, eval: &Evaluation) -> Resul
             centreline: pts.iter().map(|p| (p[0], p[1])).collect(),
             frame_angle_rad: frame,
             cable: Vec::new(),
+            further_cables: Vec::new(),
             radius_mm: 0.0,
             radii_mm: Vec::new(),
             label: "target shape (target a_i; achieved ℓ and base angle)".into(),

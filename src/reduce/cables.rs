@@ -1,192 +1,208 @@
-//! Maps of a cable sweep (issue 16; docs/schema.md, "Cable sweeps"): reach
-//! counts per cell on the three coordinate planes and per 3-D voxel, a
-//! picture of the three planes, and for a planar run the planar map tables
-//! by the same reducer as a planar sweep. [`run_cable_sweep`] runs the whole
-//! job: the rows ([`crate::sweep::cables`]), then these maps.
+//! Maps of a cable sweep run (issue 16; docs/schema.md, "Cable sweeps"):
+//! reach counts per cell on the three coordinate planes and per 3-D voxel,
+//! a picture of the three planes, and for a planar run (every cable and
+//! gravity in the x–y plane) the planar feasibility map — tables, pictures
+//! and explorer page — by the same reducer as a planar sweep, in `planar/`.
+//!
+//! The run is read chunk by chunk ([`crate::sweep::open_run_of`]): the reach
+//! counts hold one entry per occupied cell, and the planar reducer streams
+//! the rows twice, so memory does not grow with the number of rows.
 
-use super::ReduceError;
+use super::drawings::{DrawingError, ModeDrawings};
+use super::output::{write_dir_replacing, write_map_drawn};
+use super::plots::Picture;
+use super::{reduce_batches, MapData, ReduceError, ReduceOptions, RunInfo};
 use crate::model::routing::CONTROL_POINTS;
+use crate::model::spatial::simulate_spatial;
 use crate::model::STATUS_OK;
+use crate::plot::BodyDrawing;
 use crate::shape::LengthBasis;
-use crate::sweep::cables::{
-    prepare_out_dir, solve_cable_sweep, write_parquet, write_rows, Axis, CableSweepError, CableSweepSpec, Row, STATUS_INVALID_ROUTING,
-};
-use arrow::array::{ArrayRef, Float64Array, Int32Array, Int64Array, StringArray};
-use arrow::datatypes::{DataType, Field, Schema};
+use crate::sweep::cables::{control_point_column, tension_column, write_parquet, Axis, CableSweepError, CableSweepSpec, STATUS_INVALID_ROUTING};
+use crate::sweep::{open_run_of, Completeness, RunSpec, SweepRun};
+use arrow::array::{Array, ArrayRef, AsArray, Float64Array, Int32Array, Int64Array};
+use arrow::datatypes::{DataType, Field, Float64Type, Int64Type, Schema};
 use arrow::record_batch::RecordBatch;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::Path;
 use std::sync::Arc;
 
-/// The three reach maps drawn side by side, in `maps/`.
+/// The three reach maps drawn side by side.
 pub const REACH_PICTURE: &str = "reach.png";
-/// Map tables written into `maps/` of a run directory.
+/// Reach tables of a cable map directory: x–y, x–z, y–z planes, 3-D voxels.
 pub const MAP_FILES: [&str; 4] = ["reach_xy.parquet", "reach_xz.parquet", "reach_yz.parquet", "reach_3d.parquet"];
+/// Folder (inside the map directory) of a planar run's feasibility map.
+pub const PLANAR_MAP_DIR: &str = "planar";
 
-/// What a cable sweep did.
-#[derive(Debug, Clone, Serialize)]
-pub struct CableSweepSummary {
-    /// Routings (swept combinations).
+/// `summary.json` of a cable map directory.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct CableMapSummary {
+    /// Always `cables`: tells this summary from a planar map's.
+    pub kind: String,
+    /// The run read.
+    pub run_dir: String,
+    /// SHA-256 of the run's spec.
+    pub spec_sha256: String,
+    /// Cables per actuator.
+    pub cables: usize,
+    /// Routings of the complete sweep.
     pub routings: u64,
-    /// Routings rejected (channel outside the body, two cables on one path, …).
-    pub invalid_routings: u64,
-    /// Rows written.
+    /// Tension combinations per routing.
+    pub tension_combinations: u64,
+    /// Rows read (all rows unless the map is of a partial run).
     pub rows: u64,
+    /// Rows of the complete sweep.
+    pub rows_total: u64,
     /// Rows solved.
     pub ok: u64,
     /// Rows whose solve failed.
     pub failed: u64,
+    /// Rows of rejected routings (channel outside the body, two cables on one path, …).
+    pub invalid_rows: u64,
     /// Whether every cable is planar and gravity lies in the x–y plane.
     pub planar: bool,
-    /// Reach-map cells: x–y, x–z, y–z, 3-D voxels.
+    /// Reach cell / voxel size, mm.
+    pub cell_mm: f64,
+    /// Occupied cells: x–y, x–z, y–z, 3-D voxels.
     pub cells: [u64; 4],
-    /// Wall time, s.
-    pub wall_s: f64,
-    /// Worker threads.
-    pub threads: usize,
+    /// The planar map's folder (`planar`), when one was written.
+    pub planar_map: Option<String>,
 }
 
-/// Runs a cable sweep into `out` (created; must be new or empty): solves the
-/// rows ([`crate::sweep::cables`]), writes rows.parquet and spec.toml, the
-/// reach maps in `maps/` (and a planar run's map tables in `maps/planar/`)
-/// and summary.json.
-pub fn run_cable_sweep(spec: &CableSweepSpec, out: &Path, threads: Option<usize>) -> Result<CableSweepSummary, ReduceError> {
-    let write_err = |context: String, e: &dyn std::fmt::Display| CableSweepError::Write { context, message: e.to_string() };
-    spec.validate("(given)")?;
-    prepare_out_dir(out)?;
-    let start = std::time::Instant::now();
-    let solved = solve_cable_sweep(spec, threads)?;
-    let rows = &solved.rows;
-    write_rows(spec, rows, out)?;
-    let cells = write_maps(&out.join("maps"), rows, spec.output.cell_mm).map_err(|e| write_err(format!("writing maps in {}", out.display()), &e))?;
-    let planar = spec.cables.iter().all(|c| c.z_mm.iter().all(|&z| z == 0.0) && c.sweeps.iter().all(|s| s.axis == Axis::Y))
-        && spec.gravity_direction.is_none_or(|g| g[2] == 0.0);
-    if planar && spec.output.order >= 1 {
-        write_planar_maps(spec, rows, out)?;
-    }
-    let ok = rows.iter().filter(|r| r.status == STATUS_OK).count() as u64;
-    let invalid_rows = rows.iter().filter(|r| r.status == STATUS_INVALID_ROUTING).count() as u64;
-    let summary = CableSweepSummary {
-        routings: solved.routings,
-        invalid_routings: invalid_rows / solved.tension_combinations as u64,
-        rows: rows.len() as u64,
-        ok,
-        failed: rows.len() as u64 - ok - invalid_rows,
-        planar,
-        cells,
-        wall_s: start.elapsed().as_secs_f64(),
-        threads: solved.threads,
-    };
-    let json = serde_json::to_string_pretty(&summary).map_err(|e| write_err("writing summary.json".into(), &e))?;
-    crate::io::write_atomic(&out.join("summary.json"), json.as_bytes()).map_err(|e| write_err("writing summary.json".into(), &e))?;
-    Ok(summary)
+/// What [`reduce_cable_run`] wrote.
+#[derive(Debug, Clone)]
+pub struct CableMap {
+    /// summary.json.
+    pub summary: CableMapSummary,
+    /// The planar map and its pictures (planar runs of order ≥ 1).
+    pub planar: Option<(MapData, Vec<Picture>)>,
 }
 
-/// Directory (inside the run) of a planar run's feasibility-map tables.
-pub const PLANAR_MAP_DIR: &str = "maps/planar";
-
-/// A planar run (every cable and gravity in the x–y plane) also gets the
-/// planar sweep's map tables (cells, modes, designs, summary.json;
-/// docs/maps.md) by the same reducer, in `maps/planar/`. The reducer reads
-/// the planar row layout, so each row is handed over with `routing_id` =
-/// its row number in rows.parquet (where every cable's routing and tension
-/// are), `y0_mm`…`y4_mm` and `tension_n` = cable 1's, and `tip_angle_rad` =
-/// the signed in-plane tangent angle, continuous from the clamp. No mirror images are added (a pair's
-/// mirror is another routing of the spec, if swept). The reducer's pictures
-/// are not drawn: they re-simulate single-cable representatives.
-fn write_planar_maps(spec: &CableSweepSpec, rows: &[Row], out: &Path) -> Result<(), ReduceError> {
-    use super::tables::write_tables;
-    use super::{reduce_batches, ReduceOptions, RunInfo};
-    use sha2::{Digest, Sha256};
-    let order = spec.output.order;
-    let mut fields = vec![Field::new("routing_id", DataType::Int64, false), Field::new("status", DataType::Utf8, false)];
-    let mut columns: Vec<ArrayRef> = vec![
-        Arc::new(Int64Array::from_iter_values(0..rows.len() as i64)),
-        Arc::new(StringArray::from(rows.iter().map(|r| r.status).collect::<Vec<_>>())),
-    ];
-    let mut push = |name: String, values: Vec<Option<f64>>| {
-        fields.push(Field::new(name, DataType::Float64, true));
-        columns.push(Arc::new(Float64Array::from(values)));
-    };
-    for p in 0..CONTROL_POINTS {
-        push(format!("y{p}_mm"), rows.iter().map(|r| Some(r.cables[0].0[p])).collect());
+/// Reduces the cable sweep in `run_dir` (refusing an unfinished run unless
+/// `partial`) into the map directory `out`, written as a whole like a planar
+/// map: reach tables and picture, summary.json, and for a planar run the
+/// planar map in `out/planar`. `cell_mm` (default: the spec's
+/// `output.cell_mm`) sizes the reach cells and the planar map's cells;
+/// `options` sets the planar map's modes and designs.
+pub fn reduce_cable_run(
+    run_dir: &Path,
+    partial: bool,
+    cell_mm: Option<f64>,
+    options: &ReduceOptions,
+    out: &Path,
+) -> Result<CableMap, ReduceError> {
+    super::check_map_out(out)?;
+    let completeness = if partial { Completeness::AllowPartial } else { Completeness::Complete };
+    let run: SweepRun<CableSweepSpec> = open_run_of(run_dir, completeness)?;
+    let spec = run.spec().clone();
+    let cell_mm = cell_mm.unwrap_or(spec.output.cell_mm);
+    if !(cell_mm.is_finite() && cell_mm > 0.0) {
+        return Err(ReduceError::CellSize { cell_mm });
     }
-    push("tension_n".into(), rows.iter().map(|r| Some(r.tensions[0])).collect());
-    push("tip_x_mm".into(), rows.iter().map(|r| r.pose.map(|p| p.tip_mm[0])).collect());
-    push("tip_y_mm".into(), rows.iter().map(|r| r.pose.map(|p| p.tip_mm[1])).collect());
-    // The planar sweep's tip angle is continuous from the clamp, not wrapped:
-    // unwrap atan2 toward θ_e − θ_0 = a_0·L (rest basis; a_0·ℓ deformed),
-    // the clamp's shear angle θ_0 being far below π.
-    let length = spec.rod.length_mm;
-    let basis = spec.output.length_basis;
-    let unwrapped = |r: &Row| {
-        let (p, a) = (r.pose?, r.a.as_ref()?);
-        let wrapped = p.tip_tangent[1].atan2(p.tip_tangent[0]);
-        let turn = a[2][0] * if basis == LengthBasis::Rest { length } else { p.length_mm };
-        let tau = std::f64::consts::TAU;
-        Some(wrapped + tau * ((turn - wrapped) / tau).round())
+    let reach = Reach::count(&run, cell_mm)?;
+    let planar = spec.is_planar() && spec.output.order >= 1;
+    let planar_map = if planar {
+        let options = ReduceOptions { cell_mm, ..options.clone() };
+        Some(planar_map(&run, &options)?)
+    } else {
+        None
     };
-    push("tip_angle_rad".into(), rows.iter().map(unwrapped).collect());
-    for i in 0..=order {
-        push(format!("a{i}"), rows.iter().map(|r| r.a.as_ref().map(|a| a[2][i])).collect());
-    }
-    let batch = RecordBatch::try_new(Arc::new(Schema::new(fields)), columns)
-        .map_err(|e| CableSweepError::Write { context: "building the planar map rows".into(), message: e.to_string() })?;
-    let tensions: Vec<f64> = spec.cables.iter().flat_map(|c| [c.tension_n.min, c.tension_n.max]).collect();
-    let info = RunInfo {
-        mirrored: false,
-        order,
-        tension_range_n: [tensions.iter().copied().fold(f64::MAX, f64::min), tensions.iter().copied().fold(0.0, f64::max)],
-        radius_mm: spec.rod.radius_mm,
-        length_mm: spec.rod.length_mm,
-        run_dir: out.display().to_string(),
-        spec_hash: format!("{:x}", Sha256::digest(toml::to_string(spec).unwrap_or_default().as_bytes())),
-        length_basis: spec.output.length_basis,
-        body: super::MapBody::of(&spec.rod),
+    let counts = run.status_counts();
+    let count = |s: &str| counts.get(s).copied().unwrap_or(0);
+    let rows = run.rows_done();
+    let layout = spec.layout();
+    let summary = CableMapSummary {
+        kind: "cables".into(),
+        run_dir: run_dir.display().to_string(),
+        spec_sha256: run.manifest().spec_sha256.clone(),
+        cables: spec.cables.len(),
+        routings: layout.routings,
+        tension_combinations: layout.tensions,
+        rows,
+        rows_total: run.rows_total(),
+        ok: count(STATUS_OK),
+        failed: rows - count(STATUS_OK) - count(STATUS_INVALID_ROUTING),
+        invalid_rows: count(STATUS_INVALID_ROUTING),
+        planar: spec.is_planar(),
+        cell_mm,
+        cells: reach.cells(),
+        planar_map: planar_map.is_some().then(|| PLANAR_MAP_DIR.to_string()),
     };
-    let options = ReduceOptions { cell_mm: spec.output.cell_mm, ..ReduceOptions::default() };
-    let map = reduce_batches(&info, &options, || Ok(std::iter::once(Ok::<_, ReduceError>(batch.clone()))))?;
-    let dir = out.join(PLANAR_MAP_DIR);
-    std::fs::create_dir_all(&dir).map_err(|e| CableSweepError::Write { context: format!("creating {}", dir.display()), message: e.to_string() })?;
-    write_tables(&dir, &map)?;
-    Ok(())
+    let planar = write_dir_replacing(out, |dir| {
+        let write_err = |context: String, message: String| ReduceError::from(CableSweepError::Write { context, message });
+        reach.write(dir).map_err(|m| write_err(format!("writing the reach maps in {}", dir.display()), m))?;
+        let json = serde_json::to_string_pretty(&summary).expect("summary serialises") + "\n";
+        let path = dir.join(super::tables::SUMMARY_FILE);
+        crate::io::write_atomic(&path, json.as_bytes()).map_err(|e| write_err(format!("writing {}", path.display()), e.to_string()))?;
+        planar_map
+            .map(|(map, drawings)| {
+                let pictures = write_map_drawn(&dir.join(PLANAR_MAP_DIR), &map, &spec.rod, &drawings)?;
+                Ok::<_, ReduceError>((map, pictures))
+            })
+            .transpose()
+    })?;
+    Ok(CableMap { summary, planar })
 }
 
-/// Counts of solved rows per cell (i = ⌊coordinate / cell⌋) on the three
-/// coordinate planes and per 3-D voxel; writes the four tables and returns
-/// their cell counts.
-fn write_maps(dir: &Path, rows: &[Row], cell_mm: f64) -> Result<[u64; 4], String> {
-    let tips: Vec<[f64; 3]> = rows.iter().filter_map(|r| r.pose.map(|p| p.tip_mm)).collect();
-    let index = |v: f64| (v / cell_mm).floor() as i32;
-    let planes: [(&str, [usize; 2], [&str; 2]); 3] =
-        [(MAP_FILES[0], [0, 1], ["x", "y"]), (MAP_FILES[1], [0, 2], ["x", "z"]), (MAP_FILES[2], [1, 2], ["y", "z"])];
-    let mut cells = [0u64; 4];
-    let mut pictures = Vec::new();
-    for (k, (file, axes, names)) in planes.iter().enumerate() {
-        let mut counts: BTreeMap<[i32; 2], i64> = BTreeMap::new();
-        for t in &tips {
-            *counts.entry([index(t[axes[0]]), index(t[axes[1]])]).or_default() += 1;
+/// Solved rows per cell on the three planes and per voxel.
+struct Reach {
+    cell_mm: f64,
+    planes: [BTreeMap<[i32; 2], i64>; 3],
+    voxels: BTreeMap<[i32; 3], i64>,
+    tips: u64,
+}
+
+/// The planes' files, axes (indices into the tip) and axis names.
+const PLANES: [(&str, [usize; 2], [&str; 2]); 3] =
+    [(MAP_FILES[0], [0, 1], ["x", "y"]), (MAP_FILES[1], [0, 2], ["x", "z"]), (MAP_FILES[2], [1, 2], ["y", "z"])];
+
+impl Reach {
+    /// Counts the solved tips of every written row, chunk by chunk.
+    fn count(run: &SweepRun<CableSweepSpec>, cell_mm: f64) -> Result<Self, ReduceError> {
+        let mut reach = Reach { cell_mm, planes: Default::default(), voxels: BTreeMap::new(), tips: 0 };
+        let index = |v: f64| (v / cell_mm).floor() as i32;
+        for batch in run.batches_projected(&["tip_x_mm", "tip_y_mm", "tip_z_mm"])? {
+            let batch = batch?;
+            let col = |name: &str| batch.column_by_name(name).expect("projected").as_primitive::<Float64Type>().clone();
+            let (x, y, z) = (col("tip_x_mm"), col("tip_y_mm"), col("tip_z_mm"));
+            for i in 0..batch.num_rows() {
+                if x.is_null(i) || y.is_null(i) || z.is_null(i) {
+                    continue;
+                }
+                let t = [x.value(i), y.value(i), z.value(i)];
+                let c = t.map(index);
+                for (k, (_, axes, _)) in PLANES.iter().enumerate() {
+                    *reach.planes[k].entry([c[axes[0]], c[axes[1]]]).or_default() += 1;
+                }
+                *reach.voxels.entry(c).or_default() += 1;
+                reach.tips += 1;
+            }
         }
-        cells[k] = counts.len() as u64;
-        write_parquet(&dir.join(file), counts_batch(&counts, names, cell_mm))?;
-        // Page: x down, the other coordinate across; y–z: y across, z down.
-        let plane = if names[0] == "x" {
-            crate::plot::spatial::ReachPlane { axes: (names[1], "x"), cells: counts.iter().map(|(c, &n)| (c[1], c[0], n)).collect() }
-        } else {
-            crate::plot::spatial::ReachPlane { axes: (names[0], names[1]), cells: counts.iter().map(|(c, &n)| (c[0], c[1], n)).collect() }
-        };
-        pictures.push(plane);
+        Ok(reach)
     }
-    let title = format!("reach: {} solutions, cells of {cell_mm} mm", tips.len());
-    crate::plot::spatial::draw_reach_maps(&dir.join(REACH_PICTURE), &title, &pictures, cell_mm).map_err(|e| e.to_string())?;
-    let mut counts: BTreeMap<[i32; 3], i64> = BTreeMap::new();
-    for t in &tips {
-        *counts.entry([index(t[0]), index(t[1]), index(t[2])]).or_default() += 1;
+
+    fn cells(&self) -> [u64; 4] {
+        [self.planes[0].len() as u64, self.planes[1].len() as u64, self.planes[2].len() as u64, self.voxels.len() as u64]
     }
-    cells[3] = counts.len() as u64;
-    write_parquet(&dir.join(MAP_FILES[3]), counts_batch(&counts, &["x", "y", "z"], cell_mm))?;
-    Ok(cells)
+
+    /// Writes the four tables and the picture into `dir`.
+    fn write(&self, dir: &Path) -> Result<(), String> {
+        let cell_mm = self.cell_mm;
+        let mut pictures = Vec::new();
+        for ((file, _, names), counts) in PLANES.iter().zip(&self.planes) {
+            write_parquet(&dir.join(file), counts_batch(counts, names, cell_mm))?;
+            // Page: x down, the other coordinate across; y–z: y across, z down.
+            let plane = if names[0] == "x" {
+                crate::plot::spatial::ReachPlane { axes: (names[1], "x"), cells: counts.iter().map(|(c, &n)| (c[1], c[0], n)).collect() }
+            } else {
+                crate::plot::spatial::ReachPlane { axes: (names[0], names[1]), cells: counts.iter().map(|(c, &n)| (c[0], c[1], n)).collect() }
+            };
+            pictures.push(plane);
+        }
+        let title = format!("reach: {} solutions, cells of {cell_mm} mm", self.tips);
+        crate::plot::spatial::draw_reach_maps(&dir.join(REACH_PICTURE), &title, &pictures, cell_mm).map_err(|e| e.to_string())?;
+        write_parquet(&dir.join(MAP_FILES[3]), counts_batch(&self.voxels, &["x", "y", "z"], cell_mm))
+    }
 }
 
 /// `i{axis}` (i32), `{axis}_mm` (cell centre, f64) per axis, then `count` (i64).
@@ -206,3 +222,180 @@ fn counts_batch<const N: usize>(counts: &BTreeMap<[i32; N], i64>, names: &[&str;
     RecordBatch::try_new(Arc::new(Schema::new(fields)), columns)
 }
 
+/// The row key of a cable sweep's row in its planar map (the map's
+/// `routing_id`): routing_id × tension combinations + the combination's
+/// index in grid order (cable 1's tension slowest). [`row_of_key`] inverts it.
+pub fn row_key(routing_id: u64, combination: u64, combinations: u64) -> u64 {
+    routing_id * combinations + combination
+}
+
+/// (routing_id, combination index) of a planar map's `routing_id` (see [`row_key`]).
+pub fn row_of_key(key: u64, combinations: u64) -> (u64, usize) {
+    (key / combinations, (key % combinations) as usize)
+}
+
+/// A planar run's feasibility map by the planar reducer, and its mode
+/// representatives drawn from a solve of all their cables. The reducer
+/// reads the planar row layout, so each row is handed over with
+/// `routing_id` = its [`row_key`] (where every cable's routing and tension
+/// are), `y0_mm`…`y4_mm` and `tension_n` = cable 1's, and `tip_angle_rad` =
+/// the signed in-plane tangent angle, continuous from the clamp. No mirror
+/// images are added (a pair's mirror is another routing of the spec, if swept).
+fn planar_map(run: &SweepRun<CableSweepSpec>, options: &ReduceOptions) -> Result<(MapData, ModeDrawings), ReduceError> {
+    let spec = run.spec();
+    let order = spec.output.order;
+    let tensions: Vec<f64> = spec.cables.iter().flat_map(|c| [c.tension_n.min, c.tension_n.max]).collect();
+    let info = RunInfo {
+        mirrored: false,
+        order,
+        tension_range_n: [tensions.iter().copied().fold(f64::MAX, f64::min), tensions.iter().copied().fold(0.0, f64::max)],
+        radius_mm: spec.rod.radius_mm,
+        length_mm: spec.rod.length_mm,
+        run_dir: run.dir().display().to_string(),
+        spec_hash: run.manifest().spec_sha256.clone(),
+        length_basis: spec.output.length_basis,
+        body: super::MapBody::of(&spec.rod),
+    };
+    let mut wanted: Vec<String> = vec!["routing_id".into(), "status".into()];
+    wanted.extend((0..CONTROL_POINTS).map(|p| control_point_column(1, Axis::Y, p)));
+    wanted.extend((1..=spec.cables.len()).map(tension_column));
+    wanted.extend(["tip_x_mm", "tip_y_mm", "tip_tangent_x", "tip_tangent_y", "length_mm"].map(String::from));
+    wanted.extend((0..=order).map(|i| format!("a{i}")));
+    let names: Vec<&str> = wanted.iter().map(String::as_str).collect();
+    let grids = spec.tension_grids();
+    let map = reduce_batches(&info, options, || {
+        let batches = run.batches_projected(&names)?;
+        Ok(batches.map(|b| planar_batch(spec, &grids, &b?)))
+    })?;
+    Ok((map.clone(), draw_modes(spec, &map)))
+}
+
+/// One batch of cable rows in the planar reducer's row layout.
+fn planar_batch(spec: &CableSweepSpec, grids: &[Vec<f64>], batch: &RecordBatch) -> Result<RecordBatch, ReduceError> {
+    let f = |name: &str| batch.column_by_name(name).expect("projected").as_primitive::<Float64Type>().clone();
+    let ids = batch.column_by_name("routing_id").expect("projected").as_primitive::<Int64Type>().clone();
+    let tensions: Vec<Float64Array> = (1..=grids.len()).map(|c| f(&tension_column(c))).collect();
+    let combinations: u64 = grids.iter().map(|g| g.len() as u64).product();
+    let n = batch.num_rows();
+    let mut keys = Vec::with_capacity(n);
+    for i in 0..n {
+        // Stored tensions are the grid's values bit for bit: find their indices.
+        let mut k = 0u64;
+        for (c, g) in grids.iter().enumerate() {
+            let t = tensions[c].value(i);
+            let j = g.iter().position(|&v| v == t).ok_or_else(|| {
+                CableSweepError::Write { context: "reading the cable rows".into(), message: format!("tension {t} N of cable {} is not on its grid", c + 1) }
+            })?;
+            k = k * g.len() as u64 + j as u64;
+        }
+        keys.push(row_key(ids.value(i) as u64, k, combinations) as i64);
+    }
+    let mut fields = vec![Field::new("routing_id", DataType::Int64, false), Field::new("status", DataType::Utf8, false)];
+    let mut columns: Vec<ArrayRef> = vec![Arc::new(Int64Array::from(keys)), batch.column_by_name("status").expect("projected").clone()];
+    let mut push = |name: String, column: ArrayRef| {
+        fields.push(Field::new(name, DataType::Float64, true));
+        columns.push(column);
+    };
+    for p in 0..CONTROL_POINTS {
+        push(format!("y{p}_mm"), batch.column_by_name(&control_point_column(1, Axis::Y, p)).expect("projected").clone());
+    }
+    push("tension_n".into(), Arc::new(tensions[0].clone()));
+    push("tip_x_mm".into(), batch.column_by_name("tip_x_mm").expect("projected").clone());
+    push("tip_y_mm".into(), batch.column_by_name("tip_y_mm").expect("projected").clone());
+    // The planar sweep's tip angle is continuous from the clamp, not wrapped:
+    // unwrap atan2 toward θ_e − θ_0 = a_0·L (rest basis; a_0·ℓ deformed),
+    // the clamp's shear angle θ_0 being far below π.
+    let (tx, ty, len, a0) = (f("tip_tangent_x"), f("tip_tangent_y"), f("length_mm"), f("a0"));
+    let rest = spec.output.length_basis == LengthBasis::Rest;
+    let angle: Float64Array = (0..n)
+        .map(|i| {
+            if tx.is_null(i) || ty.is_null(i) || a0.is_null(i) || len.is_null(i) {
+                return None;
+            }
+            let wrapped = ty.value(i).atan2(tx.value(i));
+            let turn = a0.value(i) * if rest { spec.rod.length_mm } else { len.value(i) };
+            let tau = std::f64::consts::TAU;
+            Some(wrapped + tau * ((turn - wrapped) / tau).round())
+        })
+        .collect();
+    push("tip_angle_rad".into(), Arc::new(angle));
+    for i in 0..=spec.output.order {
+        push(format!("a{i}"), batch.column_by_name(&format!("a{i}")).expect("projected").clone());
+    }
+    RecordBatch::try_new(Arc::new(Schema::new(fields)), columns)
+        .map_err(|e| CableSweepError::Write { context: "building the planar map rows".into(), message: e.to_string() }.into())
+}
+
+/// Largest distance, mm, between a representative's stored tip and the tip
+/// of its solve again for drawing.
+const REDRAW_TOLERANCE_MM: f64 = 1e-3;
+
+fn tip_gap_mm(tip: &[f64; 3], d: &super::Design) -> f64 {
+    (tip[0] - d.tip_x_mm).hypot(tip[1] - d.tip_y_mm)
+}
+
+/// Each mode's representative solved again with all the cables of its row
+/// (its [`row_key`]) and drawn in the x–y plane with every cable's path.
+fn draw_modes(spec: &CableSweepSpec, map: &MapData) -> ModeDrawings {
+    let combinations = spec.tension_combinations();
+    let mut drawings = ModeDrawings::default();
+    for m in &map.modes {
+        let Some(d) = &m.representative else {
+            drawings.shapes.push(None);
+            continue;
+        };
+        let (id, k) = row_of_key(d.routing_id as u64, combinations);
+        let actuator = spec.actuator_at(id, k);
+        match simulate_spatial(&actuator, &spec.solver, 1, spec.output.length_basis) {
+            // The sweep reached the row along its tension path; a solve from
+            // zero could in principle land on another equilibrium: then the
+            // drawing would not be the row's, and is not made.
+            Ok(sim) if tip_gap_mm(&sim.pose.tip_mm, d) > REDRAW_TOLERANCE_MM => {
+                drawings.shapes.push(None);
+                let message = format!(
+                    "the solve from zero ends at ({:.3}, {:.3}) mm, not at the row's tip ({:.3}, {:.3}) mm",
+                    sim.pose.tip_mm[0], sim.pose.tip_mm[1], d.tip_x_mm, d.tip_y_mm
+                );
+                drawings.failures.push(DrawingError::Simulation { mode: m.mode, source: message.into() });
+            }
+            Ok(sim) => {
+                let centreline = sim.nodes.iter().map(|n| (n.p_mm[0], n.p_mm[1])).collect();
+                // The body x-axis (first column of R) in the x–y plane.
+                let frame_angle_rad = sim.nodes.iter().map(|n| n.rotation[1][0].atan2(n.rotation[0][0])).collect();
+                let mut paths = sim.cable_paths_mm().into_iter().map(|p| p.iter().map(|q| (q[0], q[1])).collect::<Vec<_>>());
+                let cable = paths.next().unwrap_or_default();
+                let further_cables = paths.collect();
+                drawings.shapes.push(Some(BodyDrawing {
+                    centreline,
+                    frame_angle_rad,
+                    cable,
+                    further_cables,
+                    radius_mm: spec.rod.radius_mm,
+                    radii_mm: match crate::model::Body::of(&spec.rod) {
+                        Ok(Some(body)) => sim.nodes.iter().map(|n| body.radius_at(n.s_mm)).collect(),
+                        _ => Vec::new(),
+                    },
+                    label: format!("mode {}", m.mode),
+                    colour: plotters::style::full_palette::BLUE_800,
+                }));
+            }
+            Err(e) => {
+                drawings.shapes.push(None);
+                drawings.failures.push(DrawingError::Simulation { mode: m.mode, source: Box::new(e) });
+            }
+        }
+    }
+    drawings
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn row_keys_round_trip() {
+        for (id, k, n) in [(0, 0, 1), (3, 5, 6), (12, 120, 121)] {
+            assert_eq!(row_of_key(row_key(id, k, n), n), (id, k as usize));
+        }
+    }
+}

@@ -61,7 +61,7 @@ fn data(map: &MapData, actuator: &Actuator, shapes: &[Option<BodyDrawing>], pict
         .map(|m| {
             let rep = m.representative.as_ref().zip(shapes.get(m.mode).and_then(Option::as_ref)).map(|(r, shape)| {
                 let (left, right) = shape.outline();
-                json!({
+                let mut rep = json!({
                     "routing_mm": nums(r.routing_mm.0),
                     "tension_n": num(r.tension_n),
                     "tip_x_mm": num(r.tip_x_mm),
@@ -70,7 +70,12 @@ fn data(map: &MapData, actuator: &Actuator, shapes: &[Option<BodyDrawing>], pict
                     "left": points(&left),
                     "right": points(&right),
                     "cable": points(&shape.cable),
-                })
+                });
+                // Several cables only: single-cable maps keep their data as it was.
+                if !shape.further_cables.is_empty() {
+                    rep["further_cables"] = shape.further_cables.iter().map(|c| points(c)).collect();
+                }
+                rep
             });
             json!({
                 "mode": m.mode,

@@ -18,6 +18,13 @@ pub fn write_map_replacing(
     actuator: &crate::model::Actuator,
     solver: &crate::model::SolverOptions,
 ) -> Result<Vec<Picture>, ReduceError> {
+    write_dir_replacing(dir, |staging| write_map(staging, map, actuator, solver))
+}
+
+/// Writes the map directory `dir` as a whole by `write` (given the staging
+/// directory to fill), with [`write_map_replacing`]'s guarantees: a reader
+/// sees the old directory or the new one, never a mix.
+pub fn write_dir_replacing<T>(dir: &Path, write: impl FnOnce(&Path) -> Result<T, ReduceError>) -> Result<T, ReduceError> {
     let name = check_map_out(dir)?;
     let parent = match dir.parent() {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
@@ -37,10 +44,10 @@ pub fn write_map_replacing(
     };
     // Best effort: where locks are unsupported, staging is judged by its age.
     let _ = lock.try_lock();
-    let written = write_map(&staging, map, actuator, solver).and_then(|pictures| {
+    let written = write(&staging).and_then(|out| {
         crate::io::sync_dir(&staging);
         replace_dir(&staging, dir, &parent, &name).map_err(|source| ReduceError::Replace { path: dir.to_path_buf(), source })?;
-        Ok(pictures)
+        Ok(out)
     });
     if written.is_err() {
         let _ = std::fs::remove_dir_all(&staging);
@@ -118,10 +125,20 @@ pub fn write_map(
     actuator: &crate::model::Actuator,
     solver: &crate::model::SolverOptions,
 ) -> Result<Vec<Picture>, ReduceError> {
+    write_map_drawn(dir, map, actuator, &ModeDrawings::of_map(map, actuator, solver))
+}
+
+/// [`write_map`] with the mode representatives' bodies already drawn (a
+/// cable sweep draws them with the solver of several cables).
+pub fn write_map_drawn(
+    dir: &Path,
+    map: &MapData,
+    actuator: &crate::model::Actuator,
+    drawings: &ModeDrawings,
+) -> Result<Vec<Picture>, ReduceError> {
     std::fs::create_dir_all(dir).map_err(|source| ReduceError::CreateDir { path: dir.to_path_buf(), source })?;
     tables::write_tables(dir, map)?;
     let mut pictures = coefficient_pictures(dir, map)?;
-    let drawings = ModeDrawings::of_map(map, actuator, solver);
     plots::draw_modes(&dir.join("modes.png"), map, &drawings.shapes)?;
     pictures.push(Picture {
         file: "modes.png".into(),

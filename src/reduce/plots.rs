@@ -169,7 +169,9 @@ fn draw_cells(
         for side in [&left, &right] {
             chart.draw_series(LineSeries::new(page(side), body.colour.stroke_width(2))).map_err(|e| PlotError::new(path, e))?;
         }
-        chart.draw_series(LineSeries::new(page(&body.cable), RED.stroke_width(1))).map_err(|e| PlotError::new(path, e))?;
+        for cable in std::iter::once(&body.cable).chain(&body.further_cables) {
+            chart.draw_series(LineSeries::new(page(cable), RED.stroke_width(1))).map_err(|e| PlotError::new(path, e))?;
+        }
     }
     Ok(())
 }

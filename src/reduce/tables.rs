@@ -249,8 +249,18 @@ pub fn read_summary(dir: &Path) -> Result<MapSummary, ReadError> {
     let text = crate::io::read_utf8(&path).map_err(|e| {
         read_error(&path, format!("cannot read ({e}); give a map directory written by `cablemap reduce`"))
     })?;
-    let summary: MapSummary =
-        serde_json::from_str(&text).map_err(|e| read_error(&path, format!("does not match the map contract: {e}")))?;
+    let summary: MapSummary = serde_json::from_str(&text).map_err(|e| {
+        // A cable sweep's map (reduce::cables) is not a feasibility map; a
+        // planar one holds one in its `planar` folder.
+        match serde_json::from_str::<serde_json::Value>(&text).ok().filter(|v| v["kind"] == "cables") {
+            Some(v) if v["planar_map"].is_string() => read_error(&path, format!(
+                "is the map of a cable sweep (reach counts); its planar feasibility map is {}",
+                dir.join(super::cables::PLANAR_MAP_DIR).display()
+            )),
+            Some(_) => read_error(&path, "is the map of a spatial cable sweep (reach counts only): it has no feasibility map"),
+            None => read_error(&path, format!("does not match the map contract: {e}")),
+        }
+    })?;
     summary.mode_boundaries.validate().map_err(|e| read_error(&path, format!("mode_boundaries: {e}")))?;
     if !(summary.cell_mm > 0.0 && summary.cell_mm.is_finite()) {
         return Err(read_error(&path, format!("cell_mm must be positive, got {}", summary.cell_mm)));

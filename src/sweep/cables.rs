@@ -13,6 +13,7 @@
 //! [output]
 //! order = 3                        # a0…a3, a_bend_y0…, a_twist0…
 //! cell_mm = 1.0                    # reach-map cell / voxel size
+//! chunk_routings = 64              # routings per chunk file (engine chunks)
 //!
 //! [[cable]]                        # an antagonistic pair
 //! y_mm = [2, 2, 2, 2, 2]           # fixed values (swept points override them)
@@ -27,44 +28,45 @@
 //! tension_n = { min = 0.0, max = 2.0, count = 11 }
 //! ```
 //!
-//! Unlike the planar sweep this run is neither sharded nor resumable: it is
-//! solved in memory (at most [`MAX_CABLE_SWEEP_ROWS`] rows) and written at
-//! the end.
+//! It runs on the same engine as the planar sweep ([`super::run_sweep_of`]:
+//! sharded, resumable, checksummed chunks; [`super::kind::RunSpec`]): routing
+//! ids are the mixed-radix numbers of the swept levels (the first swept point
+//! fastest), and each routing's rows are its tension combinations in grid
+//! order (cable 1's tension slowest), solved in snake order for warm starts.
+//! The run's format tag is [`CABLES_FORMAT`]; a chunk holds
+//! `output.chunk_routings` routings.
 
 use crate::model::routing::CONTROL_POINTS;
 use crate::model::spatial::{Cable, SpatialActuator, SpatialError, SpatialOptions, SpatialSolver};
 use crate::model::{Actuator, STATUS_OK};
 use crate::shape::LengthBasis;
+use super::kind::{ChunkLayout, RunSpec};
+use super::SweepError;
 use arrow::array::{ArrayRef, Float64Array, Int32Array, Int64Array, StringArray};
-use arrow::datatypes::{DataType, Field, Schema};
+use arrow::datatypes::{DataType, Field, Schema, SchemaRef};
 use arrow::record_batch::RecordBatch;
 use parquet::arrow::ArrowWriter;
 use parquet::basic::{Compression, ZstdLevel};
 use parquet::file::properties::WriterProperties;
-use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
-use std::path::{Path, PathBuf};
+use sha2::{Digest, Sha256};
+use std::path::Path;
 use std::sync::Arc;
 
-/// Most rows of one cable sweep (it is built in memory).
-pub const MAX_CABLE_SWEEP_ROWS: u64 = 2_000_000;
+/// Format tag of cable sweep runs (manifest and chunk footers).
+pub const CABLES_FORMAT: &str = "cablemap-cables/1";
 /// Most values in one tension grid.
 pub const MAX_TENSION_COUNT: u32 = 10_000;
 /// Status of rows whose routing was rejected (e.g. two cables on one path).
 pub const STATUS_INVALID_ROUTING: &str = "invalid_routing";
 /// Status of rows whose solve failed.
 pub const STATUS_FAILED: &str = "failed";
-/// Rows file of a run directory.
-pub const ROWS_FILE: &str = "rows.parquet";
 /// Why a cable sweep could not run.
 #[derive(Debug, thiserror::Error)]
 pub enum CableSweepError {
     /// The spec is malformed or invalid.
     #[error("bad cable sweep spec {origin}: {message}")]
     BadSpec { origin: String, message: String },
-    /// The output directory holds something.
-    #[error("{} is not empty: a cable sweep writes into a new or empty directory (it is not resumable)", .0.display())]
-    NotEmpty(PathBuf),
     /// A file could not be written.
     #[error("{context}: {message}")]
     Write { context: String, message: String },
@@ -167,11 +169,14 @@ pub struct CableOutputSpec {
     pub length_basis: LengthBasis,
     /// Cell size of the reach maps, mm.
     pub cell_mm: f64,
+    /// Routings per chunk file (each chunk is built in memory: at most
+    /// [`super::spec::MAX_CHUNK_ROWS`] rows with the tension combinations).
+    pub chunk_routings: u32,
 }
 
 impl Default for CableOutputSpec {
     fn default() -> Self {
-        Self { order: 3, length_basis: LengthBasis::Rest, cell_mm: 1.0 }
+        Self { order: 3, length_basis: LengthBasis::Rest, cell_mm: 1.0, chunk_routings: 64 }
     }
 }
 
@@ -251,13 +256,22 @@ impl CableSweepSpec {
         if !(self.output.cell_mm.is_finite() && self.output.cell_mm > 0.0) {
             return Err(bad(format!("output.cell_mm = {} must be a positive length", self.output.cell_mm)));
         }
-        let rows = self.routings().saturating_mul(self.tension_combinations());
-        if rows > MAX_CABLE_SWEEP_ROWS {
-            return Err(bad(format!(
-                "{rows} rows ({} routings × {} tension combinations) is more than {MAX_CABLE_SWEEP_ROWS}: this sweep is built in memory; split the spec",
-                self.routings(),
-                self.tension_combinations()
-            )));
+        if self.output.chunk_routings == 0 {
+            return Err(bad("output.chunk_routings = 0: a chunk needs at least one routing".into()));
+        }
+        let max_chunk = super::spec::MAX_CHUNK_ROWS;
+        let combos = self.tension_combinations();
+        let chunk_rows = u64::from(self.output.chunk_routings).saturating_mul(combos);
+        if chunk_rows > max_chunk {
+            return Err(bad(if combos > max_chunk {
+                format!("{combos} tension combinations per routing (the product of the cables' tension_n.count) is more than {max_chunk} rows per chunk: use fewer tensions")
+            } else {
+                format!(
+                    "output.chunk_routings = {} × {combos} tension combinations gives {chunk_rows} rows per chunk, more than {max_chunk} (each chunk is built in memory): lower chunk_routings to ≤ {}",
+                    self.output.chunk_routings,
+                    max_chunk / combos
+                )
+            }));
         }
         // The base actuator (swept points at their first level) must be a valid rod.
         let base = self.actuator_for(0, &self.dimensions());
@@ -353,7 +367,7 @@ fn solve_routing(spec: &CableSweepSpec, id: u64, dims: &[Dimension], grids: &[Ve
         Ok(s) => s,
         Err(_) => return combos.iter().map(|c| row(c, STATUS_INVALID_ROUTING, 0, None, None)).collect(),
     };
-    let mut rows = Vec::with_capacity(combos.len());
+    let mut rows: Vec<Option<Row>> = vec![None; combos.len()];
     // Continuation from zero to the first combination (rungs of ≤ 0.25 N).
     let first = tensions_of(&combos[0]);
     let top = first.iter().copied().fold(0.0, f64::max);
@@ -365,68 +379,147 @@ fn solve_routing(spec: &CableSweepSpec, id: u64, dims: &[Dimension], grids: &[Ve
     }
     for combo in combos {
         let t = tensions_of(combo);
-        match solver.solve(&t) {
+        let solved = match solver.solve(&t) {
             Ok(pose) => match solver.coefficients(spec.output.order, spec.output.length_basis) {
-                Ok(a) => rows.push(row(combo, STATUS_OK, pose.passes as i32, Some(pose), Some(a))),
-                Err(_) => rows.push(row(combo, STATUS_FAILED, 0, None, None)),
+                Ok(a) if finite_row(&pose, &a) => row(combo, STATUS_OK, pose.passes as i32, Some(pose), Some(a)),
+                _ => row(combo, STATUS_FAILED, 0, None, None),
             },
-            Err(_) => rows.push(row(combo, STATUS_FAILED, 0, None, None)),
+            Err(_) => row(combo, STATUS_FAILED, 0, None, None),
+        };
+        rows[combination_index(combo, grids)] = Some(solved);
+    }
+    // Rows in grid order (cable 1's tension slowest), whatever the snake.
+    rows.into_iter().map(|r| r.expect("the snake visits every combination")).collect()
+}
+
+/// A solve whose outputs are all finite (others are stored as failures, so
+/// that no output is NaN).
+fn finite_row(pose: &crate::model::spatial::SpatialPose, a: &[Vec<f64>; 3]) -> bool {
+    let p = pose;
+    p.tip_mm.iter().chain(&p.tip_tangent).chain(&p.tip_body_y_axis).chain([&p.tip_angle_rad, &p.length_mm]).all(|v| v.is_finite())
+        && a.iter().flatten().all(|v| v.is_finite())
+}
+
+/// Position of a tension combination (per-cable grid indices) in grid
+/// order: cable 1's index most significant.
+pub fn combination_index(combo: &[usize], grids: &[Vec<f64>]) -> usize {
+    combo.iter().zip(grids).fold(0, |k, (&j, g)| k * g.len() + j)
+}
+
+impl CableSweepSpec {
+    /// Each cable's tension grid, N.
+    pub fn tension_grids(&self) -> Vec<Vec<f64>> {
+        self.cables.iter().map(|c| c.tension_n.values()).collect()
+    }
+
+    /// Whether the run is planar: every cable and its swept points lie in
+    /// the x–y plane (z ≡ 0) and gravity has no z component. Planar runs also
+    /// get the planar feasibility maps.
+    pub fn is_planar(&self) -> bool {
+        self.cables.iter().all(|c| c.z_mm.iter().all(|&z| z == 0.0) && c.sweeps.iter().all(|s| s.axis == Axis::Y))
+            && self.gravity_direction.is_none_or(|g| g[2] == 0.0)
+    }
+
+    /// Routing `id` and the tensions of its `k`-th combination (grid order):
+    /// the actuator of the row with `routing_id = id` at that combination,
+    /// e.g. to solve it again.
+    pub fn actuator_at(&self, id: u64, k: usize) -> SpatialActuator {
+        let mut actuator = self.actuator_for(id, &self.dimensions());
+        let grids = self.tension_grids();
+        let mut rest = k;
+        for (c, g) in actuator.cables.iter_mut().zip(&grids).rev() {
+            c.tension_n = g[rest % g.len()];
+            rest /= g.len();
         }
+        actuator
     }
-    rows
 }
 
-/// The solved rows of a cable sweep.
+/// What a worker of a cable sweep holds: the swept dimensions, the tension
+/// grids and their snake order (computed once per worker).
 #[derive(Debug, Clone)]
-pub struct SolvedCableSweep {
-    /// Rows in (routing, tension grid) order, independent of threads.
-    pub rows: Vec<Row>,
-    /// Routings (swept combinations).
-    pub routings: u64,
-    /// Tension combinations per routing.
-    pub tension_combinations: usize,
-    /// Worker threads used.
-    pub threads: usize,
+pub struct CableWorker {
+    dims: Vec<Dimension>,
+    grids: Vec<Vec<f64>>,
+    combos: Vec<Vec<usize>>,
 }
 
-/// Refuses an output directory that holds anything (a cable sweep is not
-/// resumable) and creates it with its `maps/` directory.
-pub fn prepare_out_dir(out: &Path) -> Result<(), CableSweepError> {
-    if out.exists() && std::fs::read_dir(out).map(|mut d| d.next().is_some()).unwrap_or(true) {
-        return Err(CableSweepError::NotEmpty(out.to_path_buf()));
+/// The sweep of several or spatial cables on the shared engine: each routing
+/// is solved by its own [`SpatialSolver`] through its tension combinations.
+impl RunSpec for CableSweepSpec {
+    const FORMAT: &'static str = CABLES_FORMAT;
+    const KIND: &'static str = "cable sweep";
+    type Worker = CableWorker;
+    type Solved = Vec<Row>;
+
+    fn check(&self) -> Result<(), String> {
+        self.validate("").map_err(|e| match e {
+            CableSweepError::BadSpec { message, .. } => message,
+            other => other.to_string(),
+        })
     }
-    std::fs::create_dir_all(out.join("maps"))
-        .map_err(|e| CableSweepError::Write { context: format!("creating {}", out.display()), message: e.to_string() })
+
+    fn check_run_size(&self, allow_large: bool) -> Result<(), SweepError> {
+        let rows = self.routings().saturating_mul(self.tension_combinations());
+        if rows > super::spec::MAX_ROWS && !allow_large {
+            return Err(SweepError::InvalidSpec {
+                origin: "(size)".into(),
+                message: format!(
+                    "the sweep has {rows} rows ({} routings × {} tension combinations), more than {}: check the levels and tension counts, \
+                     or pass --allow-large if the job is meant to be this big",
+                    self.routings(),
+                    self.tension_combinations(),
+                    super::spec::MAX_ROWS
+                ),
+            });
+        }
+        Ok(())
+    }
+
+    fn canonical_json(&self) -> String {
+        serde_json::to_string(self).expect("spec serialises")
+    }
+
+    fn hash_hex(&self) -> String {
+        Sha256::digest(self.canonical_json().as_bytes()).iter().map(|b| format!("{b:02x}")).collect()
+    }
+
+    fn length_basis(&self) -> LengthBasis {
+        self.output.length_basis
+    }
+
+    fn order(&self) -> usize {
+        self.output.order
+    }
+
+    fn layout(&self) -> ChunkLayout {
+        ChunkLayout::new(self.routings(), self.tension_combinations(), u64::from(self.output.chunk_routings))
+    }
+
+    fn schema(&self) -> SchemaRef {
+        rows_schema(self.cables.len(), self.output.order)
+    }
+
+    fn worker(&self) -> Result<CableWorker, SweepError> {
+        let grids = self.tension_grids();
+        Ok(CableWorker { dims: self.dimensions(), combos: snake(&grids), grids })
+    }
+
+    fn solve(&self, worker: &mut CableWorker, id: u64) -> Result<Vec<Row>, SweepError> {
+        Ok(solve_routing(self, id, &worker.dims, &worker.grids, &worker.combos))
+    }
+
+    fn batch(&self, schema: &SchemaRef, solved: &[Vec<Row>]) -> RecordBatch {
+        let rows: Vec<&Row> = solved.iter().flatten().collect();
+        rows_batch(schema, &rows, self.cables.len(), self.output.order)
+    }
 }
 
-/// Solves every routing of `spec` through the product of its tension grids
-/// on `threads` workers (all cores when None).
-pub fn solve_cable_sweep(spec: &CableSweepSpec, threads: Option<usize>) -> Result<SolvedCableSweep, CableSweepError> {
-    spec.validate("(given)")?;
-    let dims = spec.dimensions();
-    let grids: Vec<Vec<f64>> = spec.cables.iter().map(|c| c.tension_n.values()).collect();
-    let combos = snake(&grids);
-    let routings = spec.routings();
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads.unwrap_or(0))
-        .build()
-        .map_err(|e| CableSweepError::Write { context: "starting worker threads".into(), message: e.to_string() })?;
-    let threads_used = pool.current_num_threads();
-    let mut rows: Vec<Row> =
-        pool.install(|| (0..routings).into_par_iter().flat_map_iter(|id| solve_routing(spec, id, &dims, &grids, &combos)).collect());
-    // Rows in (routing, tension grid) order, independent of the snake and the threads.
-    rows.sort_by(|a, b| a.routing_id.cmp(&b.routing_id).then_with(|| a.tensions.partial_cmp(&b.tensions).unwrap()));
-    Ok(SolvedCableSweep { rows, routings, tension_combinations: combos.len(), threads: threads_used })
-}
-
-/// Writes `rows.parquet` (docs/schema.md, "Cable sweeps") and the spec as
-/// `spec.toml` into the run directory `out`.
-pub fn write_rows(spec: &CableSweepSpec, rows: &[Row], out: &Path) -> Result<(), CableSweepError> {
-    let write_err = |context: String, e: &dyn std::fmt::Display| CableSweepError::Write { context, message: e.to_string() };
-    let path = out.join(ROWS_FILE);
-    write_parquet(&path, rows_batch(rows, spec.cables.len(), spec.output.order)).map_err(|e| write_err(format!("writing {}", path.display()), &e))?;
-    let spec_text = toml::to_string(spec).map_err(|e| write_err("writing spec.toml".into(), &e))?;
-    crate::io::write_atomic(&out.join("spec.toml"), spec_text.as_bytes()).map_err(|e| write_err("writing spec.toml".into(), &e))
+/// Reads a cable sweep spec file.
+pub fn load_spec(path: &Path) -> Result<CableSweepSpec, CableSweepError> {
+    let text = crate::io::read_utf8(path)
+        .map_err(|e| CableSweepError::BadSpec { origin: path.display().to_string(), message: format!("cannot read it: {e}") })?;
+    CableSweepSpec::from_toml(&text, &path.display().to_string())
 }
 
 /// Name of a control-point column, e.g. `cable2_z3_mm`.
@@ -454,25 +547,42 @@ pub const POSE_COLUMNS: [&str; 11] = [
     "length_mm",
 ];
 
-/// The rows as one record batch in the `rows.parquet` layout.
-pub fn rows_batch(rows: &[Row], n_cables: usize, order: usize) -> Result<RecordBatch, arrow::error::ArrowError> {
+/// The row schema of a cable sweep of `n_cables` cables storing orders
+/// 0…`order` (docs/schema.md, "Cable sweeps"): inputs non-null, outputs
+/// nullable (null when the solve failed or the routing was rejected).
+pub fn rows_schema(n_cables: usize, order: usize) -> SchemaRef {
     let mut fields = vec![Field::new("routing_id", DataType::Int64, false)];
+    for c in 0..n_cables {
+        for axis in [Axis::Y, Axis::Z] {
+            fields.extend((0..CONTROL_POINTS).map(|p| Field::new(control_point_column(c + 1, axis, p), DataType::Float64, false)));
+        }
+    }
+    fields.extend((0..n_cables).map(|c| Field::new(tension_column(c + 1), DataType::Float64, false)));
+    fields.push(Field::new("status", DataType::Utf8, false));
+    fields.push(Field::new("iterations", DataType::Int32, false));
+    fields.extend(POSE_COLUMNS.iter().map(|n| Field::new(*n, DataType::Float64, true)));
+    for prefix in ["a", "a_bend_y", "a_twist"] {
+        fields.extend((0..=order).map(|i| Field::new(format!("{prefix}{i}"), DataType::Float64, true)));
+    }
+    Arc::new(Schema::new(fields))
+}
+
+/// The rows as one record batch of [`rows_schema`].
+pub fn rows_batch(schema: &SchemaRef, rows: &[&Row], n_cables: usize, order: usize) -> RecordBatch {
     let mut columns: Vec<ArrayRef> = vec![Arc::new(Int64Array::from_iter_values(rows.iter().map(|r| r.routing_id)))];
-    let mut f64_col = |name: String, values: Vec<Option<f64>>, fields: &mut Vec<Field>| {
-        fields.push(Field::new(name, DataType::Float64, values.iter().any(Option::is_none)));
-        columns.push(Arc::new(Float64Array::from(values)));
-    };
     for c in 0..n_cables {
         for axis in [Axis::Y, Axis::Z] {
             for p in 0..CONTROL_POINTS {
-                let v = rows.iter().map(|r| Some(if axis == Axis::Y { r.cables[c].0[p] } else { r.cables[c].1[p] })).collect();
-                f64_col(control_point_column(c + 1, axis, p), v, &mut fields);
+                let v = rows.iter().map(|r| if axis == Axis::Y { r.cables[c].0[p] } else { r.cables[c].1[p] });
+                columns.push(Arc::new(Float64Array::from_iter_values(v)));
             }
         }
     }
     for c in 0..n_cables {
-        f64_col(tension_column(c + 1), rows.iter().map(|r| Some(r.tensions[c])).collect(), &mut fields);
+        columns.push(Arc::new(Float64Array::from_iter_values(rows.iter().map(|r| r.tensions[c]))));
     }
+    columns.push(Arc::new(StringArray::from_iter_values(rows.iter().map(|r| r.status))));
+    columns.push(Arc::new(Int32Array::from_iter_values(rows.iter().map(|r| r.passes))));
     let pose_value = |r: &Row, k: usize| {
         r.pose.map(|p| match k {
             0..=2 => p.tip_mm[k],
@@ -482,22 +592,16 @@ pub fn rows_batch(rows: &[Row], n_cables: usize, order: usize) -> Result<RecordB
             _ => p.length_mm,
         })
     };
-    for (k, name) in POSE_COLUMNS.iter().enumerate() {
-        f64_col(name.to_string(), rows.iter().map(|r| pose_value(r, k)).collect(), &mut fields);
+    for k in 0..POSE_COLUMNS.len() {
+        columns.push(Arc::new(rows.iter().map(|r| pose_value(r, k)).collect::<Float64Array>()));
     }
     // In-plane series as a0… (the planar sweep's names), then the other two.
-    for (series, prefix) in [(2, "a"), (1, "a_bend_y"), (0, "a_twist")] {
+    for series in [2, 1, 0] {
         for i in 0..=order {
-            let v = rows.iter().map(|r| r.a.as_ref().map(|a| a[series][i])).collect();
-            f64_col(format!("{prefix}{i}"), v, &mut fields);
+            columns.push(Arc::new(rows.iter().map(|r| r.a.as_ref().map(|a| a[series][i])).collect::<Float64Array>()));
         }
     }
-    let status: Vec<&str> = rows.iter().map(|r| r.status).collect();
-    fields.insert(1 + 10 * n_cables + n_cables, Field::new("status", DataType::Utf8, false));
-    columns.insert(1 + 10 * n_cables + n_cables, Arc::new(StringArray::from(status)));
-    fields.insert(2 + 11 * n_cables, Field::new("iterations", DataType::Int32, false));
-    columns.insert(2 + 11 * n_cables, Arc::new(Int32Array::from_iter_values(rows.iter().map(|r| r.passes))));
-    RecordBatch::try_new(Arc::new(Schema::new(fields)), columns)
+    RecordBatch::try_new(schema.clone(), columns).expect("columns match the schema")
 }
 
 /// Writes one record batch as a zstd Parquet file, atomically.
@@ -549,6 +653,30 @@ levels_mm = [0.0, 1.5, -1.5]
         let last = spec.actuator_for(11, &dims);
         assert_eq!(last.cables[0].y_mm, [2.0, 3.0, 2.0, 3.0, 2.0]);
         assert_eq!(last.cables[1].z_mm, [0.0, 0.0, 0.0, 0.0, -1.5]);
+    }
+
+    #[test]
+    fn a_routings_rows_are_in_grid_order_and_actuator_at_rebuilds_each() {
+        let spec = CableSweepSpec::from_toml(SPEC, "test").unwrap();
+        let layout = spec.layout();
+        assert_eq!((layout.routings, layout.tensions), (12, 6));
+        let mut worker = spec.worker().unwrap();
+        let rows = spec.solve(&mut worker, 7).unwrap();
+        assert_eq!(rows.len(), 6);
+        let grids = spec.tension_grids();
+        for (k, row) in rows.iter().enumerate() {
+            assert_eq!(row.routing_id, 7);
+            let combo: Vec<usize> = row.tensions.iter().zip(&grids).map(|(t, g)| g.iter().position(|v| v == t).unwrap()).collect();
+            assert_eq!(combination_index(&combo, &grids), k, "grid order, cable 1 slowest");
+            let actuator = spec.actuator_at(7, k);
+            assert_eq!(actuator.cables.iter().map(|c| c.tension_n).collect::<Vec<_>>(), row.tensions);
+            assert_eq!(actuator.cables.iter().map(|c| (c.y_mm, c.z_mm)).collect::<Vec<_>>(), row.cables);
+        }
+        // The batch has the fixed schema whatever the rows' nulls.
+        let schema = spec.schema();
+        let batch = spec.batch(&schema, &[rows]);
+        assert_eq!(batch.schema(), schema);
+        assert_eq!(batch.num_rows(), 6);
     }
 
     #[test]

@@ -25,6 +25,7 @@
 //! help if warm starts crossed routings, which would make a row depend on
 //! its neighbours and on the sharding).
 
+use super::kind::ChunkLayout;
 use super::spec::SweepSpec;
 use crate::model::routing::{ControlPoints, CONTROL_POINTS};
 use std::ops::Range;
@@ -81,32 +82,34 @@ impl SweepPlan {
         ControlPoints(self.digits(id).map(|d| self.levels_mm[d]))
     }
 
+    /// The chunk and shard arithmetic of this plan (shared by every kind of sweep).
+    pub fn layout(&self) -> ChunkLayout {
+        ChunkLayout { routings: self.routings, tensions: self.tensions, chunk_routings: self.chunk_routings, chunks: self.chunks }
+    }
+
     /// Routing ids of chunk `chunk`.
     pub fn chunk_ids(&self, chunk: u64) -> Range<u64> {
-        let start = chunk * self.chunk_routings;
-        start.min(self.routings)..(start + self.chunk_routings).min(self.routings)
+        self.layout().chunk_ids(chunk)
     }
 
     /// Rows in chunk `chunk`.
     pub fn chunk_rows(&self, chunk: u64) -> u64 {
-        let ids = self.chunk_ids(chunk);
-        (ids.end - ids.start) * self.tensions
+        self.layout().chunk_rows(chunk)
     }
 
     /// Chunks owned by shard `shard` of `shards` (ascending).
     pub fn shard_chunks(&self, shard: u64, shards: u64) -> impl Iterator<Item = u64> {
-        assert!(shard < shards, "shard {shard} of {shards}");
-        (shard..self.chunks).step_by(shards as usize)
+        self.layout().shard_chunks(shard, shards)
     }
 
     /// Which shard of `shards` owns `chunk`.
     pub fn chunk_shard(&self, chunk: u64, shards: u64) -> u64 {
-        chunk % shards
+        self.layout().chunk_shard(chunk, shards)
     }
 
     /// Rows owned by shard `shard` of `shards`.
     pub fn shard_rows(&self, shard: u64, shards: u64) -> u64 {
-        self.shard_chunks(shard, shards).map(|c| self.chunk_rows(c)).sum()
+        self.layout().shard_rows(shard, shards)
     }
 }
 

@@ -2,6 +2,8 @@
 //! tension ladder, written as Parquet chunks (thesis Ch. 4, model-notes §5).
 //!
 //! - [`spec`]: the TOML job spec and its hash.
+//! - [`kind`]: what a kind of sweep provides the engine ([`RunSpec`]): the
+//!   planar spec, or [`cables`] (several or spatial cables).
 //! - [`enumerate`]: routing ids, mirror de-duplication, chunks and shards.
 //! - [`schema`]: the row schema (`docs/schema.md`) and batch building.
 //! - [`store`]: the run directory: manifest, atomic chunk files, checks.
@@ -12,6 +14,7 @@
 
 pub mod cables;
 pub mod enumerate;
+pub mod kind;
 pub mod progress;
 pub mod read;
 pub mod run;
@@ -21,10 +24,11 @@ pub mod status;
 pub mod store;
 
 pub use enumerate::SweepPlan;
-pub use read::{open_run, Completeness, SweepRun};
-pub use run::{run_sweep, SweepOptions, SweepSummary};
+pub use kind::{is_cable_spec_toml, run_kind, ChunkLayout, RunKind, RunSpec};
+pub use read::{open_run, open_run_of, Completeness, SweepRun};
+pub use run::{run_sweep, run_sweep_of, SweepOptions, SweepSummary};
 pub use spec::SweepSpec;
-pub use status::{run_status, RunStatus};
+pub use status::{run_status, run_status_of, RunStatus};
 
 use std::path::PathBuf;
 
@@ -40,6 +44,14 @@ pub enum SweepError {
         /// What is wrong.
         source: spec::SpecError,
     },
+    /// A spec of another kind than planar (a cable sweep) is malformed or invalid.
+    #[error("bad sweep spec {origin}: {message}")]
+    InvalidSpec {
+        /// The spec file, or where an in-memory spec came from.
+        origin: String,
+        /// What is wrong.
+        message: String,
+    },
     /// Shard index or count out of range.
     #[error("shard {shard} of {shards} is out of range: use 0 ≤ shard < shards (shards ≥ 1)")]
     BadShard { shard: u64, shards: u64 },
@@ -52,6 +64,16 @@ pub enum SweepError {
     /// DIR has no manifest (reading or status).
     #[error("{} holds no sweep: {} is missing (run `cablemap sweep SPEC --out {}` first)", dir.display(), dir.join(store::MANIFEST).display(), dir.display())]
     NoRun { dir: PathBuf },
+    /// DIR holds a sweep of another kind (planar vs cables).
+    #[error("{} holds a sweep of another kind ('{found}', not '{wanted}'): a spec with [[cable]] tables and a planar spec need separate run directories; use another --out directory", dir.display())]
+    OtherKind {
+        /// The run directory.
+        dir: PathBuf,
+        /// Its manifest's format.
+        found: String,
+        /// The format this command reads or writes.
+        wanted: String,
+    },
     /// The manifest is unreadable.
     #[error("manifest {} is damaged: {message}. Restore it, or start the sweep in a new directory", path.display())]
     CorruptManifest { path: PathBuf, message: String },

@@ -22,7 +22,7 @@
 //! chunk file at a time, in chunk order (routing id, then tension, rising),
 //! so memory does not grow with the number of rows.
 
-use super::schema::arrow_schema;
+use super::kind::RunSpec;
 use super::spec::SweepSpec;
 use super::store::{ChunkInfo, Manifest, RunDir};
 use super::SweepError;
@@ -46,11 +46,12 @@ pub enum Completeness {
     AllowPartial,
 }
 
-/// A checked run directory, ready to read.
+/// A checked run directory, ready to read: a planar sweep by default, or
+/// any kind of sweep `S` ([`open_run_of`]).
 #[derive(Debug, Clone)]
-pub struct SweepRun {
+pub struct SweepRun<S = SweepSpec> {
     dir: PathBuf,
-    manifest: Manifest,
+    manifest: Manifest<S>,
     chunks: Vec<ChunkInfo>,
 }
 
@@ -58,11 +59,17 @@ pub struct SweepRun {
 /// file in `DIR/shards` must be a chunk of this run with the right row
 /// count, and with [`Completeness::Complete`] every chunk must be present.
 pub fn open_run(dir: &Path, completeness: Completeness) -> Result<SweepRun, SweepError> {
+    open_run_of::<SweepSpec>(dir, completeness)
+}
+
+/// [`open_run`] for a sweep of kind `S` (e.g. `open_run_of::<CableSweepSpec>`
+/// for a cable sweep; [`super::run_kind`] tells which kind a directory holds).
+pub fn open_run_of<S: RunSpec>(dir: &Path, completeness: Completeness) -> Result<SweepRun<S>, SweepError> {
     let run = RunDir::new(dir);
-    let manifest = run.read_manifest()?.ok_or_else(|| SweepError::NoRun { dir: dir.to_path_buf() })?;
+    let manifest: Manifest<S> = run.read_manifest()?.ok_or_else(|| SweepError::NoRun { dir: dir.to_path_buf() })?;
     let scan = run.scan(&manifest)?;
     if !scan.damaged.is_empty() {
-        let plan = super::SweepPlan::new(&manifest.spec);
+        let plan = manifest.spec.layout();
         let list = scan
             .damaged
             .iter()
@@ -79,19 +86,19 @@ pub fn open_run(dir: &Path, completeness: Completeness) -> Result<SweepRun, Swee
     Ok(sweep)
 }
 
-impl SweepRun {
+impl<S: RunSpec> SweepRun<S> {
     /// The run directory.
     pub fn dir(&self) -> &Path {
         &self.dir
     }
 
     /// The spec the run was made with (all defaults filled in).
-    pub fn spec(&self) -> &SweepSpec {
+    pub fn spec(&self) -> &S {
         &self.manifest.spec
     }
 
     /// The manifest (spec hash, tool version, counts).
-    pub fn manifest(&self) -> &Manifest {
+    pub fn manifest(&self) -> &Manifest<S> {
         &self.manifest
     }
 
@@ -122,7 +129,7 @@ impl SweepRun {
 
     /// The Arrow schema of the rows (see `docs/schema.md`).
     pub fn schema(&self) -> SchemaRef {
-        arrow_schema(self.spec())
+        self.spec().schema()
     }
 
     /// All rows, as record batches of up to [`BATCH_ROWS`] rows, chunk by

@@ -16,6 +16,7 @@
 //! bounded by the chunks in flight, not by the number of rows.
 
 use super::enumerate::SweepPlan;
+use super::kind::{ChunkLayout, RunSpec};
 use super::progress::{Progress, ProgressMode};
 use super::schema::{arrow_schema, build_batch, SolvedRouting, SolvedRow};
 use super::spec::{OutputSpec, SweepSpec};
@@ -105,8 +106,15 @@ impl SweepSummary {
 
 /// Runs (or resumes) shard `options.shard` of `spec` into `dir`.
 pub fn run_sweep(spec: &SweepSpec, dir: &Path, options: &SweepOptions) -> Result<SweepSummary, SweepError> {
-    let started = Instant::now();
     spec.validate().map_err(|source| SweepError::BadSpec { origin: "(in memory)".into(), source })?;
+    run_sweep_of(spec, dir, options)
+}
+
+/// Runs (or resumes) shard `options.shard` of a sweep of any kind
+/// ([`RunSpec`]: planar, or several/spatial cables) into `dir`.
+pub fn run_sweep_of<S: RunSpec>(spec: &S, dir: &Path, options: &SweepOptions) -> Result<SweepSummary, SweepError> {
+    let started = Instant::now();
+    spec.check().map_err(|message| SweepError::InvalidSpec { origin: "(in memory)".into(), message })?;
     let (shard, shards) = (options.shard, options.shards);
     if shards == 0 || shard >= shards {
         return Err(SweepError::BadShard { shard, shards });
@@ -114,7 +122,7 @@ pub fn run_sweep(spec: &SweepSpec, dir: &Path, options: &SweepOptions) -> Result
     if options.threads == Some(0) {
         return Err(SweepError::BadThreads("0: use at least 1 thread".into()));
     }
-    spec.check_size(options.allow_large).map_err(|source| SweepError::BadSpec { origin: "(size)".into(), source })?;
+    spec.check_run_size(options.allow_large)?;
     let (threads_wanted, capped) = capped_threads(options.threads);
     if capped && options.progress != ProgressMode::Quiet {
         eprintln!(
@@ -125,7 +133,7 @@ pub fn run_sweep(spec: &SweepSpec, dir: &Path, options: &SweepOptions) -> Result
     }
     let run = RunDir::new(dir);
     let manifest = run.create_or_check(spec, shards)?;
-    let plan = SweepPlan::new(spec);
+    let plan: ChunkLayout = spec.layout();
     let scan = run.scan(&manifest)?;
 
     // Temporaries: an abandoned one is left by a killed writer; a locked one
@@ -190,9 +198,8 @@ pub fn run_sweep(spec: &SweepSpec, dir: &Path, options: &SweepOptions) -> Result
     }
     let progress = Progress::new(options.progress, label, shard_rows, rows_skipped);
 
-    let prototype = Simulator::new(&spec.actuator, &spec.solver)?;
-    let tensions = spec.tensions_n();
-    let schema = arrow_schema(spec);
+    let prototype = spec.worker()?;
+    let schema = spec.schema();
     let written: Vec<ChunkInfo> = pool.install(|| {
         pending
             .par_iter()
@@ -202,14 +209,14 @@ pub fn run_sweep(spec: &SweepSpec, dir: &Path, options: &SweepOptions) -> Result
                     .into_par_iter()
                     .map_init(
                         || prototype.clone(),
-                        |sim, id| {
-                            let solved = solve_routing(sim, &plan, spec, &tensions, id);
-                            progress.add(tensions.len() as u64);
+                        |worker, id| {
+                            let solved = spec.solve(worker, id);
+                            progress.add(plan.tensions);
                             solved
                         },
                     )
                     .collect::<Result<Vec<_>, _>>()?;
-                let batch = build_batch(&schema, spec.output.order, spec.output.centreline, &routings);
+                let batch = spec.batch(&schema, &routings);
                 run.write_chunk(&manifest, chunk, &batch)
             })
             .collect::<Result<Vec<_>, _>>()
@@ -235,6 +242,60 @@ pub fn run_sweep(spec: &SweepSpec, dir: &Path, options: &SweepOptions) -> Result
         wall_s,
         solves_per_s: rows_written as f64 / wall_s.max(1e-9),
     })
+}
+
+/// The planar single-cable sweep: one [`Simulator`] per worker, each
+/// routing solved through the rising tension ladder.
+impl RunSpec for SweepSpec {
+    const FORMAT: &'static str = super::store::FORMAT;
+    const KIND: &'static str = "planar single-cable sweep";
+    type Worker = Simulator;
+    type Solved = SolvedRouting;
+
+    fn check(&self) -> Result<(), String> {
+        self.validate().map_err(|e| e.to_string())
+    }
+
+    fn check_run_size(&self, allow_large: bool) -> Result<(), SweepError> {
+        self.check_size(allow_large).map_err(|source| SweepError::BadSpec { origin: "(size)".into(), source })
+    }
+
+    fn canonical_json(&self) -> String {
+        SweepSpec::canonical_json(self)
+    }
+
+    fn hash_hex(&self) -> String {
+        SweepSpec::hash_hex(self)
+    }
+
+    fn length_basis(&self) -> crate::shape::LengthBasis {
+        self.output.length_basis
+    }
+
+    fn order(&self) -> usize {
+        self.output.order
+    }
+
+    fn layout(&self) -> ChunkLayout {
+        SweepPlan::new(self).layout()
+    }
+
+    fn schema(&self) -> arrow::datatypes::SchemaRef {
+        arrow_schema(self)
+    }
+
+    fn worker(&self) -> Result<Simulator, SweepError> {
+        Ok(Simulator::new(&self.actuator, &self.solver)?)
+    }
+
+    fn solve(&self, worker: &mut Simulator, id: u64) -> Result<SolvedRouting, SweepError> {
+        // The plan holds only the levels (a few numbers): cheap per routing.
+        solve_routing(worker, &SweepPlan::new(self), self, &self.tensions_n(), id)
+    }
+
+    fn batch(&self, schema: &arrow::datatypes::SchemaRef, solved: &[SolvedRouting]) -> arrow::record_batch::RecordBatch {
+        build_batch(schema, self.output.order, self.output.centreline, solved)
+    }
 }
 
 /// Solves routing `id` through the tension ladder.

@@ -1,7 +1,8 @@
 //! `cablemap status DIR`: what a run directory holds: rows done per shard,
 //! failures by status, chunks in progress, and whether the run is complete.
 
-use super::enumerate::SweepPlan;
+use super::kind::RunSpec;
+use super::spec::SweepSpec;
 use super::store::{failures, total_status_counts, DamagedChunk, Manifest, RunDir};
 use super::SweepError;
 use serde::Serialize;
@@ -27,11 +28,11 @@ pub struct ShardStatus {
 
 /// The state of a run directory.
 #[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct RunStatus {
+pub struct RunStatus<S = SweepSpec> {
     /// The run directory.
     pub dir: PathBuf,
     /// The manifest.
-    pub manifest: Manifest,
+    pub manifest: Manifest<S>,
     /// One entry per shard.
     pub shards: Vec<ShardStatus>,
     /// Rows written over all shards.
@@ -49,7 +50,7 @@ pub struct RunStatus {
     pub complete: bool,
 }
 
-impl RunStatus {
+impl<S: RunSpec> RunStatus<S> {
     /// Written rows whose solve failed.
     pub fn failures(&self) -> u64 {
         failures(&self.status_counts)
@@ -58,7 +59,7 @@ impl RunStatus {
     /// The record `cablemap status --json` prints (and `sweep --json` under
     /// "run"): the manifest's identity, not the whole spec.
     pub fn to_json_value(&self) -> serde_json::Value {
-        serde_json::json!({
+        let mut value = serde_json::json!({
             "dir": self.dir,
             "spec_sha256": self.manifest.spec_sha256,
             "tool_version": self.manifest.tool_version,
@@ -71,15 +72,25 @@ impl RunStatus {
             "damaged": self.damaged,
             "complete": self.complete,
             "shards": self.shards,
-        })
+        });
+        // Planar records stay as they were; other kinds say what they are.
+        if S::FORMAT != super::store::FORMAT {
+            value["format"] = S::FORMAT.into();
+        }
+        value
     }
 }
 
 /// Reads and checks a run directory (manifest and every chunk footer).
 pub fn run_status(dir: &Path) -> Result<RunStatus, SweepError> {
+    run_status_of::<SweepSpec>(dir)
+}
+
+/// [`run_status`] for a sweep of kind `S`.
+pub fn run_status_of<S: RunSpec>(dir: &Path) -> Result<RunStatus<S>, SweepError> {
     let run = RunDir::new(dir);
-    let manifest = run.read_manifest()?.ok_or_else(|| SweepError::NoRun { dir: dir.to_path_buf() })?;
-    let plan = SweepPlan::new(&manifest.spec);
+    let manifest: Manifest<S> = run.read_manifest()?.ok_or_else(|| SweepError::NoRun { dir: dir.to_path_buf() })?;
+    let plan = manifest.spec.layout();
     let scan = run.scan(&manifest)?;
     let shards = manifest.shards.max(1);
     let mut per_shard: Vec<ShardStatus> = (0..shards)

@@ -23,7 +23,7 @@
 //! instead. Its spec hash and counts are recomputed on every read, so an
 //! edited manifest is refused.
 
-use super::enumerate::SweepPlan;
+use super::kind::RunSpec;
 use super::spec::SweepSpec;
 use crate::shape::LengthBasis;
 use super::SweepError;
@@ -74,17 +74,19 @@ pub mod keys {
 }
 
 /// The run's manifest (`DIR/manifest.json`). Written once, never changed.
+/// `S` is the kind of sweep ([`RunSpec`]): a planar [`SweepSpec`] by
+/// default, or a [`super::cables::CableSweepSpec`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct Manifest {
-    /// [`FORMAT`].
+pub struct Manifest<S = SweepSpec> {
+    /// [`FORMAT`] for planar runs, [`RunSpec::FORMAT`] of the kind otherwise.
     pub format: String,
     /// Version of the tool that created the run.
     pub tool_version: String,
     /// SHA-256 of the canonical spec JSON.
     pub spec_sha256: String,
     /// The spec with every default filled in.
-    pub spec: SweepSpec,
+    pub spec: S,
     /// The length the a_i columns are per unit of (the spec's
     /// `output.length_basis`, repeated here for readers of the manifest).
     pub length_basis: LengthBasis,
@@ -102,16 +104,16 @@ pub struct Manifest {
     pub total_rows: u64,
 }
 
-impl Manifest {
+impl<S: RunSpec> Manifest<S> {
     /// The manifest of a run of `spec` in `shards` shards.
-    pub fn new(spec: &SweepSpec, shards: u64) -> Self {
-        let plan = SweepPlan::new(spec);
+    pub fn new(spec: &S, shards: u64) -> Self {
+        let plan = spec.layout();
         Self {
-            format: FORMAT.into(),
+            format: S::FORMAT.into(),
             tool_version: TOOL_VERSION.into(),
             spec_sha256: spec.hash_hex(),
             spec: spec.clone(),
-            length_basis: spec.output.length_basis,
+            length_basis: spec.length_basis(),
             shards,
             routings: plan.routings,
             tensions: plan.tensions,
@@ -122,13 +124,13 @@ impl Manifest {
     }
 }
 
-impl Manifest {
+impl<S: RunSpec> Manifest<S> {
     /// Checks that the manifest is self-consistent: the spec hash is the
     /// hash of the spec it holds and the counts follow from that spec. A
     /// hand-edited field (a changed `tension.max_n`) fails here instead of
     /// silently changing what later stages report.
     pub fn verify(&self) -> Result<(), String> {
-        self.spec.validate().map_err(|e| format!("its spec is invalid ({e})"))?;
+        self.spec.check().map_err(|e| format!("its spec is invalid ({e})"))?;
         let hash = self.spec.hash_hex();
         if hash != self.spec_sha256 {
             return Err(format!(
@@ -259,31 +261,47 @@ impl RunDir {
     }
 
     /// Reads and parses the manifest; `Ok(None)` when there is none.
-    pub fn read_manifest(&self) -> Result<Option<Manifest>, SweepError> {
+    pub fn read_manifest<S: RunSpec>(&self) -> Result<Option<Manifest<S>>, SweepError> {
         let path = self.manifest_path();
         let text = match crate::io::read_utf8(&path) {
             Ok(t) => t,
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
             Err(source) => return Err(SweepError::Io { context: format!("reading {}", path.display()), source }),
         };
-        let manifest: Manifest =
-            serde_json::from_str(&text).map_err(|e| SweepError::CorruptManifest { path: path.clone(), message: e.to_string() })?;
-        if manifest.format != FORMAT {
+        let manifest: Manifest<S> = match serde_json::from_str(&text) {
+            Ok(m) => m,
+            Err(e) => {
+                // A run of the other kind (planar or cables) fails on its
+                // spec's fields: name its format instead.
+                let format = serde_json::from_str::<serde_json::Value>(&text)
+                    .ok()
+                    .and_then(|v| v.get("format").and_then(|f| f.as_str()).map(str::to_string));
+                return Err(match format {
+                    Some(f) if f != S::FORMAT && [FORMAT, super::cables::CABLES_FORMAT].contains(&f.as_str()) => {
+                        SweepError::OtherKind { dir: self.root.clone(), found: f, wanted: S::FORMAT.into() }
+                    }
+                    _ => SweepError::CorruptManifest { path, message: e.to_string() },
+                });
+            }
+        };
+        if manifest.format != S::FORMAT {
             return Err(SweepError::CorruptManifest {
                 path,
                 message: format!(
-                    "format '{}' is not '{FORMAT}' (a run made by another cablemap version; version 1 runs stored a_i \
+                    "format '{}' is not '{}' (a run made by another cablemap version; version 1 runs stored a_i \
                      per unit deformed length: sweep again into a new directory)",
-                    manifest.format
+                    manifest.format,
+                    S::FORMAT
                 ),
             });
         }
-        if manifest.length_basis != manifest.spec.output.length_basis {
+        if manifest.length_basis != manifest.spec.length_basis() {
             return Err(SweepError::CorruptManifest {
                 path,
                 message: format!(
                     "length_basis '{}' disagrees with the spec's output.length_basis '{}'",
-                    manifest.length_basis, manifest.spec.output.length_basis
+                    manifest.length_basis,
+                    manifest.spec.length_basis()
                 ),
             });
         }
@@ -294,7 +312,7 @@ impl RunDir {
     /// Creates DIR and its manifest for a new run, or checks that an
     /// existing run is the same job (spec, tool version, shard count).
     /// Returns the manifest in force.
-    pub fn create_or_check(&self, spec: &SweepSpec, shards: u64) -> Result<Manifest, SweepError> {
+    pub fn create_or_check<S: RunSpec>(&self, spec: &S, shards: u64) -> Result<Manifest<S>, SweepError> {
         let io = |what: &str, source| SweepError::Io { context: format!("{what} {}", self.root.display()), source };
         std::fs::create_dir_all(&self.root).map_err(|e| io("creating output directory", e))?;
         let wanted = Manifest::new(spec, shards);
@@ -346,7 +364,7 @@ impl RunDir {
 
     /// Writes the manifest under a temporary name and links it into place
     /// unless one exists. Returns false when another process won.
-    fn publish_manifest(&self, manifest: &Manifest) -> Result<bool, SweepError> {
+    fn publish_manifest<S: RunSpec>(&self, manifest: &Manifest<S>) -> Result<bool, SweepError> {
         let path = self.manifest_path();
         let tmp = crate::io::temp_path(&path);
         let text = serde_json::to_string_pretty(manifest).expect("manifest serialises") + "\n";
@@ -375,14 +393,14 @@ impl RunDir {
     /// Lists DIR/shards: verified chunk files (footer checked against the
     /// manifest) and temporary files. Anything else is an error, as is a
     /// chunk file that is unreadable or belongs to another job.
-    pub fn scan(&self, manifest: &Manifest) -> Result<Scan, SweepError> {
+    pub fn scan<S: RunSpec>(&self, manifest: &Manifest<S>) -> Result<Scan, SweepError> {
         for entry in list_dir(&self.root)? {
             let name = entry.to_string_lossy();
             if !is_run_entry(&name) {
                 return Err(SweepError::ForeignFile { path: self.root.join(&entry) });
             }
         }
-        let plan = SweepPlan::new(&manifest.spec);
+        let plan = manifest.spec.layout();
         let mut scan = Scan::default();
         let shards_dir = self.shards_dir();
         let mut names = match list_dir(&shards_dir) {
@@ -447,14 +465,14 @@ impl RunDir {
 
     /// Writes one chunk atomically: temporary file (unique to this writer),
     /// footer, fsync, checksum record, rename, directory fsync.
-    pub fn write_chunk(&self, manifest: &Manifest, chunk: u64, batch: &RecordBatch) -> Result<ChunkInfo, SweepError> {
+    pub fn write_chunk<S: RunSpec>(&self, manifest: &Manifest<S>, chunk: u64, batch: &RecordBatch) -> Result<ChunkInfo, SweepError> {
         let path = self.chunk_path(chunk);
         let tmp = crate::io::temp_path(&path);
         let io = |source| SweepError::Io { context: format!("writing {}", tmp.display()), source };
         let status_counts = count_statuses(batch);
         let kv = |k: &str, v: String| KeyValue::new(k.to_string(), v);
         let metadata = vec![
-            kv(keys::FORMAT, FORMAT.into()),
+            kv(keys::FORMAT, S::FORMAT.into()),
             kv(keys::VERSION, TOOL_VERSION.into()),
             kv(keys::SPEC_SHA256, manifest.spec_sha256.clone()),
             kv(keys::SPEC, manifest.spec.canonical_json()),
@@ -552,7 +570,7 @@ fn list_dir(dir: &Path) -> Result<Vec<std::ffi::OsString>, SweepError> {
 
 /// Reads a chunk file's footer and checks it is chunk `chunk` of this run
 /// with `rows` rows.
-pub fn check_chunk(path: &Path, chunk: u64, manifest: &Manifest, rows: u64) -> Result<ChunkInfo, SweepError> {
+pub fn check_chunk<S: RunSpec>(path: &Path, chunk: u64, manifest: &Manifest<S>, rows: u64) -> Result<ChunkInfo, SweepError> {
     let file =
         File::open(path).map_err(|source| SweepError::Io { context: format!("opening {}", path.display()), source })?;
     let meta = ParquetMetaDataReader::new()
@@ -564,8 +582,8 @@ pub fn check_chunk(path: &Path, chunk: u64, manifest: &Manifest, rows: u64) -> R
         .map(|v| v.iter().filter_map(|k| Some((k.key.as_str(), k.value.as_deref()?))).collect())
         .unwrap_or_default();
     let foreign = |reason: String| SweepError::ForeignChunk { path: path.to_path_buf(), reason };
-    if kv.get(keys::FORMAT) != Some(&FORMAT) {
-        return Err(foreign(format!("it has no '{}' = '{FORMAT}' metadata", keys::FORMAT)));
+    if kv.get(keys::FORMAT) != Some(&S::FORMAT) {
+        return Err(foreign(format!("it has no '{}' = '{}' metadata", keys::FORMAT, S::FORMAT)));
     }
     if kv.get(keys::SPEC_SHA256) != Some(&manifest.spec_sha256.as_str()) {
         return Err(foreign(format!(

@@ -1,10 +1,11 @@
-"""Reads a cable sweep (`cablemap sweep-cables`) with pyarrow, pandas and
-polars and checks the documented columns and dtypes (docs/schema.md, "Cable
-sweeps"): one row per routing and tension combination, one tension column per
-cable, the 3-D tip, failed solves as nulls, and reach maps whose counts add up
-to the solved rows.
+"""Reads a cable sweep (`cablemap map CABLE_SPEC --out DIR`: the run in
+DIR/run, its chunk files in DIR/run/shards, the maps in DIR/map) with pyarrow,
+pandas and polars and checks the documented columns and dtypes
+(docs/schema.md, "Cable sweeps"): one row per routing and tension
+combination, one tension column per cable, the 3-D tip, failed solves as
+nulls, and reach maps whose counts add up to the solved rows.
 
-Usage: check_cable_sweep.py RUN_DIR [RUN_DIR ...]
+Usage: check_cable_sweep.py DIR [DIR ...]
 Prints one line per check and a final "python: N passed, M failed"; exits 1 on
 any failure.
 """
@@ -23,15 +24,20 @@ POSE = ["tip_x_mm", "tip_y_mm", "tip_z_mm", "tip_tangent_x", "tip_tangent_y", "t
         "tip_body_y_x", "tip_body_y_y", "tip_body_y_z", "tip_angle_rad", "length_mm"]
 
 
-def spec_counts(run):
-    summary = json.loads((run / "summary.json").read_text())
-    return summary
+def spec_counts(out):
+    return json.loads((out / "map" / "summary.json").read_text())
+
+
+def manifest(out):
+    return json.loads((out / "run" / "manifest.json").read_text())
 
 
 def check_rows_pyarrow(run):
-    t = pq.read_table(run / "rows.parquet")
+    # The chunk folder is one Parquet dataset.
+    t = pq.read_table(run / "run" / "shards")
     s = spec_counts(run)
-    assert t.num_rows == s["rows"], (t.num_rows, s["rows"])
+    assert t.num_rows == s["rows"] == manifest(run)["total_rows"], (t.num_rows, s["rows"])
+    assert manifest(run)["format"] == "cablemap-cables/1"
     names = t.schema.names
     cables = sum(1 for n in names if n.startswith("tension") and n.endswith("_n"))
     assert cables >= 1
@@ -48,7 +54,7 @@ def check_rows_pyarrow(run):
 
 
 def check_rows_pandas(run):
-    df = pd.read_parquet(run / "rows.parquet")
+    df = pd.read_parquet(run / "run" / "shards")
     ok = df["status"] == "ok"
     assert ok.sum() == spec_counts(run)["ok"]
     assert df.loc[ok, POSE].notna().all().all()
@@ -56,6 +62,8 @@ def check_rows_pandas(run):
     # Unit tangents and body axes.
     t = df.loc[ok, ["tip_tangent_x", "tip_tangent_y", "tip_tangent_z"]].pow(2).sum(axis=1)
     assert (t.sub(1.0).abs() < 1e-9).all()
+    # Rows of a routing are contiguous, tension combinations in grid order.
+    assert df["routing_id"].is_monotonic_increasing
     # Every (routing, tensions) once.
     tens = [c for c in df.columns if c.startswith("tension")]
     assert not df.duplicated(["routing_id"] + tens).any()
@@ -64,7 +72,7 @@ def check_rows_pandas(run):
 def check_maps_polars(run):
     ok = spec_counts(run)["ok"]
     for name, axes in [("reach_xy", "xy"), ("reach_xz", "xz"), ("reach_yz", "yz"), ("reach_3d", "xyz")]:
-        m = pl.read_parquet(run / "maps" / f"{name}.parquet")
+        m = pl.read_parquet(run / "map" / f"{name}.parquet")
         assert m["count"].sum() == ok, (name, m["count"].sum(), ok)
         for a in axes:
             assert m[f"i{a}"].dtype == pl.Int32 and m[f"{a}_mm"].dtype == pl.Float64

@@ -1,0 +1,167 @@
+//! The kinds of sweep the engine runs. One engine ([`super::run`]) and one
+//! run directory ([`super::store`]) serve every kind: a kind is a spec that
+//! enumerates routings (ids 0..routings, each with the same number of rows)
+//! and solves one routing into rows of a fixed Arrow schema.
+//!
+//! - [`super::SweepSpec`]: one planar cable (`cablemap-sweep/2` runs).
+//! - [`super::cables::CableSweepSpec`]: several or spatial cables
+//!   (`cablemap-cables/1` runs), recognised by its `[[cable]]` tables.
+//!
+//! Chunks, shards and row counts follow from [`ChunkLayout`] alone, so
+//! sharding, resume, checksums and status are the same code for both.
+
+use super::SweepError;
+use crate::shape::LengthBasis;
+use arrow::datatypes::SchemaRef;
+use arrow::record_batch::RecordBatch;
+use std::ops::Range;
+use std::path::Path;
+
+/// Routings cut into chunks and chunks dealt to shards: index arithmetic only.
+///
+/// Chunk c holds routing ids [c·C, min((c+1)·C, R)); shard s of S owns the
+/// chunks with c mod S = s.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ChunkLayout {
+    /// Routings (ids 0..routings).
+    pub routings: u64,
+    /// Rows per routing.
+    pub tensions: u64,
+    /// Routings per chunk (≥ 1).
+    pub chunk_routings: u64,
+    /// Number of chunks.
+    pub chunks: u64,
+}
+
+impl ChunkLayout {
+    /// The layout of `routings` routings of `tensions` rows each, cut into
+    /// chunks of `chunk_routings`.
+    pub fn new(routings: u64, tensions: u64, chunk_routings: u64) -> Self {
+        Self { routings, tensions, chunk_routings, chunks: routings.div_ceil(chunk_routings.max(1)) }
+    }
+
+    /// Rows of the whole sweep.
+    pub fn total_rows(&self) -> u64 {
+        self.routings * self.tensions
+    }
+
+    /// Routing ids of chunk `chunk`.
+    pub fn chunk_ids(&self, chunk: u64) -> Range<u64> {
+        let start = chunk * self.chunk_routings;
+        start.min(self.routings)..(start + self.chunk_routings).min(self.routings)
+    }
+
+    /// Rows in chunk `chunk`.
+    pub fn chunk_rows(&self, chunk: u64) -> u64 {
+        let ids = self.chunk_ids(chunk);
+        (ids.end - ids.start) * self.tensions
+    }
+
+    /// Chunks owned by shard `shard` of `shards` (ascending).
+    pub fn shard_chunks(&self, shard: u64, shards: u64) -> impl Iterator<Item = u64> {
+        assert!(shard < shards, "shard {shard} of {shards}");
+        (shard..self.chunks).step_by(shards as usize)
+    }
+
+    /// Which shard of `shards` owns `chunk`.
+    pub fn chunk_shard(&self, chunk: u64, shards: u64) -> u64 {
+        chunk % shards
+    }
+
+    /// Rows owned by shard `shard` of `shards`.
+    pub fn shard_rows(&self, shard: u64, shards: u64) -> u64 {
+        self.shard_chunks(shard, shards).map(|c| self.chunk_rows(c)).sum()
+    }
+}
+
+/// A spec the sweep engine can run: it fixes the run's format tag, its
+/// chunk layout and row schema, and solves one routing at a time.
+pub trait RunSpec: Clone + PartialEq + std::fmt::Debug + serde::Serialize + serde::de::DeserializeOwned + Send + Sync {
+    /// Format tag of the run's manifest and chunk footers.
+    const FORMAT: &'static str;
+    /// What `cablemap status` calls this kind of run.
+    const KIND: &'static str;
+    /// Per-thread solver state, cloned from a prototype for each worker.
+    type Worker: Clone + Send + Sync;
+    /// One solved routing (all its rows), ready for [`Self::batch`].
+    type Solved: Send;
+
+    /// Checks the spec; the message names the setting.
+    fn check(&self) -> Result<(), String>;
+    /// Checks the whole sweep's size (refused above a bound unless `allow_large`).
+    fn check_run_size(&self, allow_large: bool) -> Result<(), SweepError>;
+    /// The spec with every default filled in, as compact JSON.
+    fn canonical_json(&self) -> String;
+    /// SHA-256 of [`Self::canonical_json`], hex.
+    fn hash_hex(&self) -> String;
+    /// The length the rows' a_i are per unit of.
+    fn length_basis(&self) -> LengthBasis;
+    /// Highest Legendre order stored.
+    fn order(&self) -> usize;
+    /// Routings, rows per routing, chunks.
+    fn layout(&self) -> ChunkLayout;
+    /// The Arrow schema of the rows (docs/schema.md).
+    fn schema(&self) -> SchemaRef;
+    /// The prototype worker.
+    fn worker(&self) -> Result<Self::Worker, SweepError>;
+    /// Solves routing `id`: [`ChunkLayout::tensions`] rows.
+    fn solve(&self, worker: &mut Self::Worker, id: u64) -> Result<Self::Solved, SweepError>;
+    /// The rows of a chunk's solved routings (in id order) as one batch of [`Self::schema`].
+    fn batch(&self, schema: &SchemaRef, solved: &[Self::Solved]) -> RecordBatch;
+}
+
+/// The kind of sweep a run directory holds, from its manifest's format tag.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RunKind {
+    /// A planar single-cable sweep ([`super::SweepSpec`]).
+    Planar,
+    /// A sweep of several or spatial cables ([`super::cables::CableSweepSpec`]).
+    Cables,
+}
+
+/// Which kind of sweep `dir` holds (read from `DIR/manifest.json`'s
+/// `format`); [`SweepError::NoRun`] without a manifest. Unknown formats are
+/// reported as planar, whose reader then names the format it expected.
+pub fn run_kind(dir: &Path) -> Result<RunKind, SweepError> {
+    let path = dir.join(super::store::MANIFEST);
+    let text = match crate::io::read_utf8(&path) {
+        Ok(t) => t,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Err(SweepError::NoRun { dir: dir.to_path_buf() }),
+        Err(source) => return Err(SweepError::Io { context: format!("reading {}", path.display()), source }),
+    };
+    let value: serde_json::Value =
+        serde_json::from_str(&text).map_err(|e| SweepError::CorruptManifest { path: path.clone(), message: e.to_string() })?;
+    Ok(match value.get("format").and_then(|f| f.as_str()) {
+        Some(f) if f == <super::cables::CableSweepSpec as RunSpec>::FORMAT => RunKind::Cables,
+        _ => RunKind::Planar,
+    })
+}
+
+/// Whether the TOML text of a spec is a cable sweep: it has `[[cable]]`
+/// tables (a planar spec has none). Unparsable text is reported as planar,
+/// whose parser then names the problem.
+pub fn is_cable_spec_toml(text: &str) -> bool {
+    text.parse::<toml::Table>().is_ok_and(|t| t.contains_key("cable"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn layout_covers_every_routing_once() {
+        let l = ChunkLayout::new(10, 3, 4);
+        assert_eq!(l.chunks, 3);
+        assert_eq!(l.chunk_ids(2), 8..10);
+        assert_eq!(l.chunk_rows(2), 6);
+        assert_eq!((0..2).map(|s| l.shard_rows(s, 2)).sum::<u64>(), l.total_rows());
+        assert_eq!(l.shard_chunks(1, 2).collect::<Vec<_>>(), vec![1]);
+    }
+
+    #[test]
+    fn cable_specs_are_told_by_their_cable_tables() {
+        assert!(is_cable_spec_toml("[[cable]]\ny_mm = [1, 1, 1, 1, 1]\n"));
+        assert!(!is_cable_spec_toml("[grid]\nlevels = 3\n"));
+        assert!(!is_cable_spec_toml("not toml ["));
+    }
+}
