@@ -252,6 +252,7 @@ impl CableSweepSpec {
                 }
             }
         }
+        crate::model::spatial::check_rod(&self.rod).map_err(|e| bad(format!("[rod] {e}")))?;
         crate::model::spatial::check_order(self.output.order, &self.solver).map_err(|e| bad(e.to_string()))?;
         if !(self.output.cell_mm.is_finite() && self.output.cell_mm > 0.0) {
             return Err(bad(format!("output.cell_mm = {} must be a positive length", self.output.cell_mm)));

@@ -80,6 +80,30 @@ pub enum SpatialError {
     },
 }
 
+/// Checks that the 3-D solver models `rod`: valid parameters, a uniform
+/// body, and none of the planar solver's effects.
+pub fn check_rod(rod: &Actuator) -> Result<(), SpatialError> {
+    rod.validate()?;
+    let e = &rod.effects;
+    let d = crate::model::Effects::default();
+    let unsupported = [
+        ("friction_mu", e.friction_mu != d.friction_mu),
+        ("stiffening_alpha", e.stiffening_alpha != d.stiffening_alpha),
+        ("clamp_stiffness_n_mm_per_rad", e.clamp_stiffness_n_mm_per_rad.is_some()),
+        ("channel_offset_mm", e.channel_offset_mm != d.channel_offset_mm),
+        ("creep_fraction", e.creep_fraction != d.creep_fraction),
+        ("hidden", e.hidden != d.hidden),
+        ("stiffness_gradient_beta", e.stiffness_gradient_beta != d.stiffness_gradient_beta),
+    ];
+    if let Some((name, _)) = unsupported.iter().find(|(_, on)| *on) {
+        return Err(SpatialError::UnsupportedEffect(name));
+    }
+    if !rod.is_uniform_body() {
+        return Err(SpatialError::NonUniformRod);
+    }
+    Ok(())
+}
+
 /// A whole spatial actuator: rod, torsion, gravity direction and cables.
 /// This is the `--actuator FILE.toml` format (see docs/schema.md).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -130,24 +154,7 @@ impl SpatialActuator {
 
     /// Checks everything and builds the cables' channels.
     pub fn validate(&self) -> Result<Vec<cable::Channel>, SpatialError> {
-        self.rod.validate()?;
-        let e = &self.rod.effects;
-        let d = crate::model::Effects::default();
-        let unsupported = [
-            ("friction_mu", e.friction_mu != d.friction_mu),
-            ("stiffening_alpha", e.stiffening_alpha != d.stiffening_alpha),
-            ("clamp_stiffness_n_mm_per_rad", e.clamp_stiffness_n_mm_per_rad.is_some()),
-            ("channel_offset_mm", e.channel_offset_mm != d.channel_offset_mm),
-            ("creep_fraction", e.creep_fraction != d.creep_fraction),
-            ("hidden", e.hidden != d.hidden),
-            ("stiffness_gradient_beta", e.stiffness_gradient_beta != d.stiffness_gradient_beta),
-        ];
-        if let Some((name, _)) = unsupported.iter().find(|(_, on)| *on) {
-            return Err(SpatialError::UnsupportedEffect(name));
-        }
-        if !self.rod.is_uniform_body() {
-            return Err(SpatialError::NonUniformRod);
-        }
+        check_rod(&self.rod)?;
         if let Some(gj) = self.gj_n_mm2 {
             if !(gj.is_finite() && gj > 0.0) {
                 return Err(ParameterError::NotPositive { name: "gj_n_mm2", value: gj }.into());
