@@ -86,10 +86,8 @@ fn request(args: &DesignArgs) -> anyhow::Result<DesignRequest> {
 
 /// Runs `cablemap design`.
 pub fn run(args: &DesignArgs) -> anyhow::Result<()> {
-    if let Some(dir) = &args.out {
-        design::run::check_export_dir(dir).context("--out")?;
-    }
     let done = design::run::run(&request(args)?).map_err(|e| match e {
+        DesignError::ExportDir { .. } => anyhow::Error::new(e).context("--out"),
         DesignError::BadSearch(_) => anyhow::Error::new(e).context("--starts / --tolerance-pct"),
         DesignError::Mould(m) => super::mould::with_flag(m),
         e => anyhow::Error::new(e),

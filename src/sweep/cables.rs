@@ -252,7 +252,6 @@ impl CableSweepSpec {
                 }
             }
         }
-        crate::model::spatial::check_rod(&self.rod).map_err(|e| bad(format!("[rod] {e}")))?;
         crate::model::spatial::check_order(self.output.order, &self.solver).map_err(|e| bad(e.to_string()))?;
         if !(self.output.cell_mm.is_finite() && self.output.cell_mm > 0.0) {
             return Err(bad(format!("output.cell_mm = {} must be a positive length", self.output.cell_mm)));
@@ -274,12 +273,13 @@ impl CableSweepSpec {
                 )
             }));
         }
-        // The base actuator (swept points at their first level) must be a valid rod.
+        // The base actuator (swept points at their first level) must be a
+        // rod the 3-D solver models; a routing's own faults are its rows' status.
         let base = self.actuator_for(0, &self.dimensions());
-        base.rod.validate().map_err(|e| bad(e.to_string()))?;
         match base.validate() {
             Err(SpatialError::Parameter(e)) => return Err(bad(e.to_string())),
-            Err(e @ (SpatialError::GravityDirection(_) | SpatialError::UnsupportedEffect(_))) => return Err(bad(e.to_string())),
+            Err(e @ (SpatialError::UnsupportedEffect(_) | SpatialError::NonUniformRod)) => return Err(bad(format!("[rod] {e}"))),
+            Err(e @ SpatialError::GravityDirection(_)) => return Err(bad(e.to_string())),
             _ => {}
         }
         Ok(())

@@ -82,7 +82,7 @@ pub enum SpatialError {
 
 /// Checks that the 3-D solver models `rod`: valid parameters, a uniform
 /// body, and none of the planar solver's effects.
-pub fn check_rod(rod: &Actuator) -> Result<(), SpatialError> {
+fn check_rod(rod: &Actuator) -> Result<(), SpatialError> {
     rod.validate()?;
     let e = &rod.effects;
     let d = crate::model::Effects::default();
