@@ -49,7 +49,7 @@ pub struct BodyDrawing {
     pub centreline: Vec<(f64, f64)>,
     /// Frame angle φ at each centreline point, rad (cross-sections ⊥ frame axis).
     pub frame_angle_rad: Vec<f64>,
-    /// Cable path (x, y), mm.
+    /// Cable path (x, y), mm, from the clamp to where the cable is knotted.
     pub cable: Vec<(f64, f64)>,
     /// Paths of the further cables of a several-cable actuator (x, y), mm,
     /// drawn like `cable` (empty for one cable).
@@ -72,7 +72,8 @@ impl BodyDrawing {
         BodyDrawing {
             centreline: sim.centreline.iter().map(|c| (c.x_mm, c.y_mm)).collect(),
             frame_angle_rad: sim.centreline.iter().map(|c| c.frame_angle_rad).collect(),
-            cable: sim.centreline.iter().map(|c| (c.cable_x_mm, c.cable_y_mm)).collect(),
+            // The cable ends at its anchor: the solver leaves the points beyond it NaN.
+            cable: sim.centreline.iter().filter(|c| c.cable_x_mm.is_finite()).map(|c| (c.cable_x_mm, c.cable_y_mm)).collect(),
             further_cables: Vec::new(),
             radius_mm,
             radii_mm: Vec::new(),

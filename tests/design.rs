@@ -158,8 +158,9 @@ fn text_output_is_a_table_5_1() {
 fn exports_json_csv_svg_png() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("export");
-    let (ok, _, stderr) = run(&["design", "--target", "x=55,y=20,a0=0.01", "--out", out.to_str().unwrap()]);
+    let (ok, stdout, stderr) = run(&["design", "--target", "x=55,y=20,a0=0.01", "--out", out.to_str().unwrap()]);
     assert!(ok, "{stderr}");
+    assert_eq!(reported_exports(&stdout, &out), files_in(&out), "{stdout}");
     let json: Value = serde_json::from_str(&std::fs::read_to_string(out.join("design.json")).unwrap()).unwrap();
     assert_eq!(json["routing_mm"].as_array().unwrap().len(), 5);
     let csv = std::fs::read_to_string(out.join("channel.csv")).unwrap();
@@ -172,6 +173,74 @@ fn exports_json_csv_svg_png() {
     assert!(svg.contains(r#"width="85mm""#) && svg.contains("id=\"channel\""));
     let png = std::fs::read(out.join("shape.png")).unwrap();
     assert_eq!(&png[..4], b"\x89PNG");
+}
+
+/// The files in `dir`, sorted.
+fn files_in(dir: &std::path::Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    names.sort();
+    names
+}
+
+/// The files `design` says it exported to `dir`, sorted.
+fn reported_exports(stdout: &str, dir: &std::path::Path) -> Vec<String> {
+    let suffix = format!(" to {}", dir.display());
+    let line = stdout.lines().find(|l| l.starts_with("exported ")).unwrap_or_else(|| panic!("no exported line: {stdout}"));
+    let mut names: Vec<String> =
+        line.strip_prefix("exported ").unwrap().strip_suffix(&suffix).expect("names the directory").split(", ").map(String::from).collect();
+    names.sort();
+    names
+}
+
+#[test]
+fn the_export_line_lists_exactly_the_files_written() {
+    let dir = tempfile::tempdir().unwrap();
+    // A tapered body: no mould.svg (its mould drawing is of a uniform cylinder).
+    let out = dir.path().join("tapered");
+    let (ok, stdout, stderr) =
+        run(&["design", "--target", "x=55,y=20", "--radius-profile-mm", "0:5,65:4", "--starts", "1", "--out", out.to_str().unwrap()]);
+    assert!(ok, "{stderr}");
+    assert_eq!(reported_exports(&stdout, &out), files_in(&out), "{stdout}");
+    assert_eq!(files_in(&out), ["channel.csv", "design.json", "shape.png"]);
+}
+
+/// The default design → mould path: `--moulds` designs within the offset
+/// the moulds cast (their own rule, 4.2 mm for the 1 mm tube and 0.3 mm skin
+/// in r = 5 mm) where the thesis's bound (4.995 mm) gives Target I a channel
+/// `mould` refuses; without it, the bound `mould` will need is said first.
+#[test]
+fn design_with_moulds_gives_a_channel_the_moulds_cast() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("d");
+    let target = "x=50,y=5,a0=-0.025,a1=-0.06,a2=0.015";
+    let (ok, stdout, stderr) = run(&["design", "--target", target, "--starts", "2", "--moulds", "--out", out.to_str().unwrap()]);
+    assert!(ok, "{stderr}");
+    let design: Value = serde_json::from_str(&std::fs::read_to_string(out.join("design.json")).unwrap()).unwrap();
+    let y: Vec<f64> = design["routing_mm"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+    assert!(y.iter().all(|y| y.abs() <= 4.2) && y.iter().any(|y| y.abs() > 4.19), "on the moulds' bound: {y:?}");
+    for file in ["mould1.stl", "mould2.stl", "mould.json", "design.json", "mould.svg"] {
+        assert!(out.join(file).is_file(), "{file}: {stdout}");
+    }
+    assert_eq!(reported_exports(&stdout, &out), ["channel.csv", "design.json", "mould.svg", "shape.png"]);
+    assert!(!stderr.contains("note:"), "{stderr}");
+    // Without --moulds: one line before the search, on stderr (stdout stays JSON).
+    let (ok, stdout, stderr) = run(&["design", "--target", "x=50,y=5", "--starts", "1", "--json"]);
+    assert!(ok, "{stderr}");
+    serde_json::from_str::<Value>(stdout.trim()).expect("stdout is one JSON object");
+    let notes: Vec<&str> = stderr.lines().filter(|l| l.starts_with("note:")).collect();
+    assert_eq!(notes.len(), 1, "{stderr}");
+    assert!(
+        notes[0].contains("needs |y_i| ≤ 4.200 mm") && notes[0].contains("allows 4.995 mm") && notes[0].contains("--moulds"),
+        "{stderr}"
+    );
+    // A bound within the moulds' needs no note; a body mould cannot cast is refused before the search.
+    let (_, _, stderr) = run(&["design", "--target", "x=50,y=5", "--starts", "1", "--max-offset-mm", "4", "--json"]);
+    assert!(!stderr.contains("note:"), "{stderr}");
+    let refused = dir.path().join("refused");
+    let (ok, _, stderr) =
+        run(&["design", "--target", "x=50,y=5", "--moulds", "--cable-anchor-mm", "50", "--out", refused.to_str().unwrap()]);
+    assert!(!ok && stderr.contains("uniform cylinders only"), "{stderr}");
+    assert!(!refused.exists(), "refused before anything was written");
 }
 
 #[test]

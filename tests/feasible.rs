@@ -47,7 +47,7 @@ fn a_simulated_design_inside_its_cells_percentiles_is_feasible_and_nearest() {
 fn a_tip_outside_the_reach_is_unreachable() {
     let v = feasible("x=80,y=0,a0=0.01");
     assert_eq!(v["verdict"], "unreachable", "{v}");
-    assert!(v["reasons"][0].as_str().unwrap().contains("outside the reachable area"), "{v}");
+    assert!(v["reasons"][0].as_str().unwrap().contains("outside the area the map's designs reach"), "{v}");
     assert!(!v["nearest"].as_array().unwrap().is_empty(), "nearest designs are still offered");
 }
 
@@ -81,9 +81,39 @@ fn text_report_names_the_verdict() {
     let (map, _) = common::map();
     let (ok, stdout, stderr) = run(&["feasible", "--map", map.to_str().unwrap(), "--target", "x=80,y=0"]);
     assert!(ok, "{stderr}");
-    assert!(stdout.starts_with("verdict   UNREACHABLE"), "{stdout}");
+    assert!(stdout.starts_with("verdict   not reached by any of the map's designs\n"), "{stdout}");
     assert!(stdout.contains("nearest simulated designs"));
     assert!(stdout.contains("the rod is 65 mm long"), "{stdout}");
+}
+
+/// A coefficient beyond every map design of its cells is "not reached by
+/// any of the map's designs", not UNREACHABLE (Table 5.1's Target I on the
+/// thesis map, which `design` meets exactly): the report says `design` may
+/// still reach it and ends on that command, the target filled in.
+#[test]
+fn a_target_no_map_design_reached_points_to_design() {
+    let (map, rows) = common::map();
+    let r = &rows[rows.len() / 2];
+    let target = format!("x={},y={},a0=1,a2=-0.5", r.tip_x_mm, r.tip_y_mm);
+    let (ok, stdout, stderr) = run(&["feasible", "--map", map.to_str().unwrap(), "--target", &target]);
+    assert!(ok, "{stderr}");
+    assert!(!stdout.to_lowercase().contains("unreachable") && !stdout.contains("outside everything"), "{stdout}");
+    let lines: Vec<&str> = stdout.lines().collect();
+    assert_eq!(lines[0], "verdict   not reached by any of the map's designs", "{stdout}");
+    assert!(
+        lines[1].contains("a0 = 1 is outside the range the map's designs reached") && lines[1].contains("`design` will tell"),
+        "{stdout}"
+    );
+    let next = lines.last().unwrap();
+    let want = format!("next      cablemap design --target x={},y={},a0=1,a2=-0.5 --map {}", r.tip_x_mm, r.tip_y_mm, map.display());
+    assert_eq!(*next, want, "{stdout}");
+    // The command's target is the one judged.
+    let given = next.split_whitespace().nth(4).unwrap();
+    assert_eq!(cablemap::design::Target::parse(given).unwrap(), cablemap::design::Target::parse(&target).unwrap());
+    // Other verdicts point the same way; JSON stays one object with the key `unreachable`.
+    let (_, stdout, _) = run(&["feasible", "--map", map.to_str().unwrap(), "--target", &format!("x={},y={}", r.tip_x_mm, r.tip_y_mm)]);
+    assert!(stdout.lines().last().unwrap().starts_with("next      cablemap design --target x="), "{stdout}");
+    assert_eq!(feasible(&target)["verdict"], "unreachable");
 }
 
 #[test]

@@ -30,8 +30,9 @@ pub struct DesignArgs {
     /// Upper tension bound τ_u, N [default: 2.0, or the map's].
     #[arg(long, value_name = "N")]
     pub tension_max_n: Option<f64>,
-    /// Largest |y_i| of a control point, mm [default: 0.999 r: the thesis's −r < y_i < r].
-    /// A channel of diameter d breaks the surface beyond r − d/2.
+    /// Largest |y_i| of a control point, mm [default: 0.999 r: the thesis's −r < y_i < r;
+    /// with --moulds at most what the moulds can cast]. A channel of diameter d breaks
+    /// the surface beyond r − d/2.
     #[arg(long, value_name = "MM")]
     pub max_offset_mm: Option<f64>,
     #[command(flatten)]
@@ -48,11 +49,12 @@ pub struct DesignArgs {
     /// Print one JSON object instead of a report.
     #[arg(long)]
     pub json: bool,
-    /// Write design.json, channel.csv, mould.svg (1:1, mm) and shape.png into this directory.
+    /// Write design.json, channel.csv, mould.svg (1:1, mm; uniform bodies only) and shape.png into this directory.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
-    /// With --out: also write the printable moulds (mould1.stl, mould2.stl, previews,
-    /// mould.json; see `cablemap mould`), with the mould options below.
+    /// With --out: design within the channel offset the moulds can cast (tube and skin,
+    /// see `cablemap mould`) and write the printable moulds too (mould1.stl, mould2.stl,
+    /// previews, mould.json), with the mould options below.
     #[arg(long, requires = "out")]
     pub moulds: bool,
     #[command(flatten)]
@@ -86,7 +88,16 @@ fn request(args: &DesignArgs) -> anyhow::Result<DesignRequest> {
 
 /// Runs `cablemap design`.
 pub fn run(args: &DesignArgs) -> anyhow::Result<()> {
-    let done = design::run::run(&request(args)?).map_err(|e| match e {
+    let request = request(args)?;
+    let mould = args.mould.params();
+    if let Some(b) = request.mould_bound_exceeded(&mould) {
+        // Before the search, on stderr (stdout may be --json).
+        eprintln!(
+            "note: `cablemap mould` (tube Ø {} mm, skin {} mm) needs |y_i| ≤ {:.3} mm, this search allows {:.3} mm: add --moulds to design within it",
+            mould.tube_diameter_mm, mould.min_skin_mm, b.mould_max_offset_mm, b.search_max_offset_mm
+        );
+    }
+    let done = design::run::run(&request).map_err(|e| match e {
         DesignError::ExportDir { .. } => anyhow::Error::new(e).context("--out"),
         DesignError::BadSearch(_) => anyhow::Error::new(e).context("--starts / --tolerance-pct"),
         DesignError::Mould(m) => super::mould::with_flag(m),
@@ -99,11 +110,11 @@ pub fn run(args: &DesignArgs) -> anyhow::Result<()> {
         return Ok(());
     }
     if let Some(f) = &done.feasibility {
-        writeln!(out, "map verdict  {}: {}\n", f.verdict.as_str(), f.reasons.join("; "))?;
+        writeln!(out, "map verdict  {}: {}\n", f.verdict.label(), f.reasons.join("; "))?;
     }
     write!(out, "{}", report(&done.objective, &done.outcome, &done.results, args.tolerance_pct))?;
     if let Some(dir) = &args.out {
-        writeln!(out, "exported design.json, channel.csv, mould.svg, shape.png to {}", dir.display())?;
+        writeln!(out, "exported {} to {}", done.exported.join(", "), dir.display())?;
     }
     if let (Some(dir), Some(summary)) = (&args.out, &done.moulds) {
         write!(out, "{}", super::mould::report(dir, summary))?;

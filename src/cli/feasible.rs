@@ -54,8 +54,27 @@ pub fn run(args: &FeasibleArgs) -> anyhow::Result<()> {
         writeln!(out, "{}", serde_json::to_value(&report)?)?;
     } else {
         write!(out, "{}", text(&report))?;
+        writeln!(out, "next      {}", design_command(&target, map_dir))?;
     }
     Ok(())
+}
+
+/// The command that designs for `target` with `map_dir`'s designs as seeds,
+/// ready to paste: `cablemap design --target x=…,a0=… --map MAP_DIR`.
+pub fn design_command(target: &Target, map_dir: &std::path::Path) -> String {
+    let components: Vec<String> = target.components.iter().map(|(c, v)| format!("{}={v}", c.key())).collect();
+    format!("cablemap design --target {} --map {}", components.join(","), shell_word(&map_dir.display().to_string()))
+}
+
+/// `text` as one shell word: as it is when it holds only characters no shell
+/// treats specially, else in single quotes.
+fn shell_word(text: &str) -> String {
+    let plain = |c: char| c.is_ascii_alphanumeric() || "-_./,:=+@%".contains(c);
+    if !text.is_empty() && text.chars().all(plain) {
+        text.to_string()
+    } else {
+        format!("'{}'", text.replace('\'', r"'\''"))
+    }
 }
 
 /// `feasible --study DIR`: every variant's verdict, and which reach the target.
@@ -79,10 +98,10 @@ fn run_study(dir: &std::path::Path, target: &Target, weights: &Weights, args: &F
     } else {
         for (i, label, r) in &rows {
             let first = r.reasons.first().map_or(String::new(), |s| format!(": {s}"));
-            writeln!(out, "v{i:<3} {:<12} {label}{first}", r.verdict.as_str().to_uppercase())?;
+            writeln!(out, "v{i:<3} {label}: {}{first}", r.verdict.label())?;
         }
         if reach.is_empty() {
-            writeln!(out, "no variant reaches the target feasibly (see the BORDERLINE ones, or widen the study)")?;
+            writeln!(out, "no variant reaches the target feasibly (see the borderline ones, or widen the study)")?;
         } else {
             writeln!(out, "reach the target: {} of {} variants ({})", reach.len(), rows.len(), reach.join(", "))?;
         }
@@ -92,7 +111,7 @@ fn run_study(dir: &std::path::Path, target: &Target, weights: &Weights, args: &F
 
 /// The text report.
 pub fn text(r: &FeasibilityReport) -> String {
-    let mut s = format!("verdict   {}\n", r.verdict.as_str().to_uppercase());
+    let mut s = format!("verdict   {}\n", r.verdict.label());
     for reason in &r.reasons {
         s.push_str(&format!("          - {reason}\n"));
     }

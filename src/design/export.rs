@@ -125,26 +125,38 @@ pub fn mould_svg(routing: &Routing, radius_mm: f64, channel_diameter_mm: f64, te
     svg
 }
 
-/// Writes design.json, channel.csv, mould.svg and shape.png into `dir`
-/// (created if missing). mould.svg, a drawing of the uniform cylinder's
-/// mould, is left out for a non-uniform body (radius profile, segments,
-/// cable anchor); channel.csv then runs over the cable, [0, s_k].
-pub fn write_all(dir: &Path, objective: &Objective, eval: &Evaluation, record: &DesignRecord) -> Result<(), DesignError> {
+/// Writes design.json, channel.csv, mould.svg (channel drawn `tube_diameter_mm`
+/// wide) and shape.png into `dir` (created if missing) and returns the names of the files written, in
+/// order, so that what is reported is what was written. mould.svg, a
+/// drawing of the uniform cylinder's mould, is left out for a non-uniform
+/// body (radius profile, segments, cable anchor); channel.csv then runs
+/// over the cable, [0, s_k].
+pub fn write_all(
+    dir: &Path,
+    objective: &Objective,
+    eval: &Evaluation,
+    record: &DesignRecord,
+    tube_diameter_mm: f64,
+) -> Result<Vec<String>, DesignError> {
     super::run::check_export_dir(dir)?;
     std::fs::create_dir_all(dir).map_err(io_error(format!("creating {}", dir.display())))?;
-    let write = |name: &str, bytes: &[u8]| {
+    let mut written = Vec::new();
+    let mut write = |name: &str, bytes: &[u8]| {
         let p = dir.join(name);
-        crate::io::write_atomic(&p, bytes).map_err(io_error(format!("writing {}", p.display())))
+        crate::io::write_atomic(&p, bytes).map_err(io_error(format!("writing {}", p.display())))?;
+        written.push(name.to_string());
+        Ok::<_, DesignError>(())
     };
     write("design.json", record.to_file_text().as_bytes())?;
     let act = &objective.actuator;
     let routing = Routing::for_actuator(&eval.routing_mm, act)?;
     write("channel.csv", routing.channel_csv().as_bytes())?;
-    // The thesis's channel: a PTFE tube of 1 mm outer diameter (§5.2).
     if act.is_uniform_body() {
-        write("mould.svg", mould_svg(&routing, act.radius_mm, 1.0, eval.tension_n).as_bytes())?;
+        write("mould.svg", mould_svg(&routing, act.radius_mm, tube_diameter_mm, eval.tension_n).as_bytes())?;
     }
-    shape_png(&dir.join("shape.png"), objective, eval)
+    shape_png(&dir.join("shape.png"), objective, eval)?;
+    written.push("shape.png".to_string());
+    Ok(written)
 }
 
 /// Draws the achieved body over the target: the target tip as a cross and,
@@ -207,6 +219,23 @@ mod tests {
         assert!((rows.first().unwrap()[1] - 1.0).abs() < 1e-9);
         assert!((rows.last().unwrap()[1] + 4.0).abs() < 1e-9);
         assert!(rows.iter().all(|row| row[1].abs() <= 4.0 + 1e-9));
+    }
+
+    /// The pictures (design's shape.png, simulate --png) draw a cable knotted
+    /// before the tip from the clamp to its anchor, not on to the tip.
+    #[test]
+    fn the_drawn_cable_ends_at_its_anchor() {
+        let anchor_mm = 41.7;
+        let act = crate::model::Actuator { cable_anchor_mm: Some(anchor_mm), ..Default::default() };
+        let routing = Routing::for_actuator([3.0, 1.0, -2.0, 3.0, 4.0], &act).unwrap();
+        let sim = simulate(&act, &Default::default(), &routing, 1.5, 2, crate::shape::LengthBasis::Rest).unwrap();
+        let drawing = BodyDrawing::of_body(&sim, &act, "body".into(), BLUE_800);
+        let knot = sim.centreline.iter().find(|c| c.s_mm == anchor_mm).expect("a centreline point at the anchor");
+        assert_eq!(drawing.cable.last(), Some(&(knot.cable_x_mm, knot.cable_y_mm)));
+        assert_eq!(drawing.cable.len(), sim.centreline.iter().filter(|c| c.s_mm <= anchor_mm).count());
+        // The channel's offset there (y_4 = 4 mm at the anchor): the path does not fall back onto the centreline.
+        assert!((knot.channel_y_mm - 4.0).abs() < 1e-9, "{knot:?}");
+        assert!(drawing.cable.iter().all(|p| p.0.is_finite() && p.1.is_finite()));
     }
 
     #[test]

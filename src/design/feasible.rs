@@ -21,18 +21,32 @@ pub enum Verdict {
     /// the extremes of the cell and its 8 neighbours, or the target's mode
     /// was not seen in the tip cell.
     Borderline,
-    /// No simulation put the tip in or next to the cell, or a coefficient lies
-    /// outside everything seen there.
+    /// Not reached by any of the map's designs: none put the tip in or next
+    /// to the cell, or a coefficient lies outside the range its designs
+    /// reached there. The map samples a grid of routings, so this does not
+    /// prove the target unreachable: `design` may still meet it between the
+    /// grid points (Table 5.1's Target I on the thesis map). Serialised
+    /// `unreachable`, the key JSON outputs have always used.
     Unreachable,
 }
 
 impl Verdict {
-    /// `feasible`, `borderline` or `unreachable`.
+    /// The machine-readable key: `feasible`, `borderline` or `unreachable`.
     pub fn as_str(&self) -> &'static str {
         match self {
             Verdict::Feasible => "feasible",
             Verdict::Borderline => "borderline",
             Verdict::Unreachable => "unreachable",
+        }
+    }
+
+    /// The verdict in words, for people: what the map saw, not more (the
+    /// explorer page, `assets/explorer.html`, uses the same words).
+    pub fn label(&self) -> &'static str {
+        match self {
+            Verdict::Feasible => "feasible",
+            Verdict::Borderline => "borderline",
+            Verdict::Unreachable => "not reached by any of the map's designs",
         }
     }
 }
@@ -173,13 +187,13 @@ pub fn check(map: &MapDir, target: &Target, basis: LengthBasis, weights: &Weight
     let mode = mode_check(map, target, if single { selected.first().copied() } else { None });
 
     let verdict = if tip_cell.neighbourhood_count == 0 {
-        reasons.insert(0, format!("no simulation of the map put the tip in or next to the {where_}: outside the reachable area"));
+        reasons.insert(0, format!("no simulation of the map put the tip in or next to the {where_}: outside the area the map's designs reach"));
         Verdict::Unreachable
     } else if let Some(out) = coefficients.iter().find(|c| !c.within_extremes) {
         reasons.insert(
             0,
             format!(
-                "{} = {} lies outside everything the map saw in and around the {where_} ([{:.5}, {:.5}]); \
+                "{} = {} is outside the range the map's designs reached in and around the {where_} ([{:.5}, {:.5}]); \
                  the map samples a grid of designs, so a design between its grid points may still reach it: `design` will tell",
                 out.component,
                 out.target,

@@ -25,7 +25,12 @@ impl Bounds {
     /// 0.999 r, since the routing must stay strictly inside the body) and
     /// τ_l ≤ τ ≤ τ_u.
     pub fn thesis(radius_mm: f64, tension_min_n: f64, tension_max_n: f64) -> Self {
-        Self { max_offset_mm: 0.999 * radius_mm, tension_min_n, tension_max_n }
+        Self { max_offset_mm: Self::thesis_max_offset_mm(radius_mm), tension_min_n, tension_max_n }
+    }
+
+    /// The thesis's largest |y_i| for radius `radius_mm`: 0.999 r, mm.
+    pub fn thesis_max_offset_mm(radius_mm: f64) -> f64 {
+        0.999 * radius_mm
     }
 
     /// Checks the bounds against the body radius.

@@ -32,7 +32,8 @@ pub struct DesignRequest {
     pub tension_min_n: Option<f64>,
     /// Upper tension bound, N; the map's, else [`DEFAULT_TENSION_RANGE_N`], when none.
     pub tension_max_n: Option<f64>,
-    /// Largest |y_i|, mm; the thesis's 0.999 r when none.
+    /// Largest |y_i|, mm; the thesis's 0.999 r when none. With `moulds`, no
+    /// more than the moulds can cast ([`MouldParams::max_channel_offset_mm`]).
     pub max_offset_mm: Option<f64>,
     /// The length the target's coefficients are per unit of.
     pub length_basis: LengthBasis,
@@ -44,7 +45,8 @@ pub struct DesignRequest {
     pub tolerance_pct: f64,
     /// Export directory (design.json, channel.csv, mould.svg, shape.png).
     pub out: Option<PathBuf>,
-    /// With `out`: also the printable moulds, with these parameters.
+    /// With `out`: also the printable moulds, with these parameters; the
+    /// search then keeps the channel where they can cast it.
     pub moulds: Option<MouldParams>,
 }
 
@@ -61,9 +63,28 @@ pub struct DesignRun {
     pub feasibility: Option<FeasibilityReport>,
     /// design.json's content.
     pub record: DesignRecord,
+    /// The names of the design's files written into `out` (design.json,
+    /// channel.csv, mould.svg for a uniform body, shape.png), in order;
+    /// empty without `out`. The moulds' files are in `moulds`.
+    pub exported: Vec<String>,
     /// The moulds written, when asked for.
     pub moulds: Option<MouldSummary>,
 }
+
+/// The channel offset `cablemap mould` will need, when a design's search
+/// allows more ([`DesignRequest::mould_bound_exceeded`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MouldBound {
+    /// The search's largest |y_i|, mm.
+    pub search_max_offset_mm: f64,
+    /// The largest |y_c| the moulds can cast, mm ([`MouldParams::max_channel_offset_mm`]).
+    pub mould_max_offset_mm: f64,
+}
+
+/// How far inside the moulds' limit `design --moulds` keeps the control
+/// points, mm: the spline's sum of control points may round a hair past
+/// them, and a channel exactly at the limit must still be accepted.
+const MOULD_ROUNDING_MM: f64 = 1e-9;
 
 impl DesignRequest {
     /// The objective, with bounds from the request, else the map's tension
@@ -78,11 +99,44 @@ impl DesignRequest {
         }
         let [lo, hi] = map.map_or(DEFAULT_TENSION_RANGE_N, |m| m.summary.tension_range_n);
         let mut bounds = Bounds::thesis(self.actuator.channel_radius_mm(), self.tension_min_n.unwrap_or(lo), self.tension_max_n.unwrap_or(hi));
-        if let Some(y) = self.max_offset_mm {
-            bounds.max_offset_mm = y;
+        bounds.max_offset_mm = self.requested_max_offset_mm();
+        if let Some(params) = &self.moulds {
+            bounds.max_offset_mm = bounds.max_offset_mm.min(params.max_channel_offset_mm(self.actuator.radius_mm) - MOULD_ROUNDING_MM);
         }
         Ok(Objective::new(self.actuator.clone(), self.options.clone(), self.target.clone(), self.weights.clone(), bounds)?
             .with_length_basis(self.length_basis))
+    }
+
+    /// The largest |y_i| asked for, mm: the request's, else the thesis's.
+    fn requested_max_offset_mm(&self) -> f64 {
+        self.max_offset_mm.unwrap_or_else(|| Bounds::thesis_max_offset_mm(self.actuator.channel_radius_mm()))
+    }
+
+    /// Without moulds asked for: the bound `cablemap mould` (with `mould`)
+    /// will need, when this search's is wider and the body is one mould
+    /// makes (uniform); `None` otherwise.
+    pub fn mould_bound_exceeded(&self, mould: &MouldParams) -> Option<MouldBound> {
+        if self.moulds.is_some() || crate::mould::check_uniform_body(&self.actuator).is_err() {
+            return None;
+        }
+        let bound = MouldBound {
+            search_max_offset_mm: self.requested_max_offset_mm(),
+            mould_max_offset_mm: mould.max_channel_offset_mm(self.actuator.radius_mm),
+        };
+        (bound.search_max_offset_mm > bound.mould_max_offset_mm).then_some(bound)
+    }
+
+    /// With moulds asked for: refuses, before any search, a body the moulds
+    /// cannot cast and mould parameters they refuse (checked on a straight
+    /// channel, which every usable parameter set casts).
+    fn check_moulds(&self) -> Result<(), DesignError> {
+        let Some(params) = &self.moulds else { return Ok(()) };
+        let act = &self.actuator;
+        crate::mould::check_uniform_body(act)?;
+        act.validate()?;
+        let straight = Routing::for_actuator(&[0.0; 5], act)?;
+        crate::mould::Moulds::new(&straight, act.radius_mm, params)?;
+        Ok(())
     }
 }
 
@@ -94,6 +148,7 @@ pub fn run(request: &DesignRequest) -> Result<DesignRun, DesignError> {
         // Before the search, not after it.
         check_export_dir(dir)?;
     }
+    request.check_moulds()?;
     let map = request.map.as_deref().map(MapDir::open).transpose()?;
     let objective = request.objective(map.as_ref())?;
     if let Some(m) = &map {
@@ -110,20 +165,75 @@ pub fn run(request: &DesignRequest) -> Result<DesignRun, DesignError> {
     if let Some(f) = &feasibility {
         record = record.with_feasibility(f, request.map.as_deref());
     }
-    let mut moulds = None;
+    let (mut exported, mut moulds) = (Vec::new(), None);
     if let Some(dir) = &request.out {
-        super::export::write_all(dir, &objective, &outcome.best, &record)?;
+        let tube_mm = request.moulds.as_ref().map_or(MouldParams::default().tube_diameter_mm, |p| p.tube_diameter_mm);
+        exported = super::export::write_all(dir, &objective, &outcome.best, &record, tube_mm)?;
         if let Some(params) = &request.moulds {
             let act = &objective.actuator;
-            crate::mould::check_uniform_body(act)?;
             let routing = Routing::for_actuator(&outcome.best.routing_mm, act)?;
             moulds = Some(MouldSet::new(&routing, act.radius_mm, params)?.write_all(dir)?);
         }
     }
-    Ok(DesignRun { objective, outcome, results, feasibility, record, moulds })
+    Ok(DesignRun { objective, outcome, results, feasibility, record, exported, moulds })
 }
 
 /// Refuses an export directory inside a sweep's run directory.
 pub fn check_export_dir(dir: &Path) -> Result<(), DesignError> {
     crate::io::check_not_in_run_dir(dir, "the export directory").map_err(|message| DesignError::ExportDir { message })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn request(moulds: Option<MouldParams>, max_offset_mm: Option<f64>) -> DesignRequest {
+        DesignRequest {
+            actuator: Actuator::default(),
+            options: SolverOptions::default(),
+            target: Target::parse("x=50,y=5").unwrap(),
+            weights: Weights::default(),
+            tension_min_n: None,
+            tension_max_n: None,
+            max_offset_mm,
+            length_basis: LengthBasis::Rest,
+            map: None,
+            search: SearchOptions::default(),
+            tolerance_pct: 5.0,
+            out: None,
+            moulds,
+        }
+    }
+
+    /// With moulds, the search keeps the control points (so, by the spline's
+    /// convex hull, the channel) within what `mould` casts: its own rule.
+    #[test]
+    fn moulds_bound_the_search_by_the_moulds_own_rule() {
+        let params = MouldParams::default();
+        let limit_mm = params.max_channel_offset_mm(5.0);
+        assert!(limit_mm < Bounds::thesis_max_offset_mm(5.0), "the thesis's bound exceeds the moulds': the case this guards");
+        let bound = |r: &DesignRequest| r.objective(None).unwrap().bounds.max_offset_mm;
+        let with = request(Some(params.clone()), None);
+        assert!(bound(&with) <= limit_mm && bound(&with) > limit_mm - 1e-6, "{}", bound(&with));
+        // A tighter bound of the user's stays; a wider one gives way to the moulds'.
+        assert_eq!(bound(&request(Some(params.clone()), Some(3.0))), 3.0);
+        assert!(bound(&request(Some(params.clone()), Some(4.9))) <= limit_mm);
+        // Another tube moves the bound with it.
+        let thin = MouldParams { tube_diameter_mm: 0.6, ..params.clone() };
+        assert!(bound(&request(Some(thin.clone()), None)) > limit_mm + 0.19);
+        // The design the search may return is one the moulds accept.
+        let act = Actuator::default();
+        let y = bound(&with);
+        let edge = Routing::for_actuator([y, y, -y, y, y], &act).unwrap();
+        assert!(crate::mould::Moulds::new(&edge, act.radius_mm, &params).is_ok());
+        // Without moulds: the thesis's bound, and the moulds' named.
+        assert_eq!(bound(&request(None, None)), Bounds::thesis_max_offset_mm(5.0));
+        let note = request(None, None).mould_bound_exceeded(&params).expect("the default bound exceeds the moulds'");
+        assert_eq!(note, MouldBound { search_max_offset_mm: Bounds::thesis_max_offset_mm(5.0), mould_max_offset_mm: limit_mm });
+        assert_eq!(request(None, Some(4.0)).mould_bound_exceeded(&params), None);
+        assert_eq!(request(Some(params.clone()), None).mould_bound_exceeded(&params), None);
+        let mut tapered = request(None, None);
+        tapered.actuator.radius_profile_mm = vec![(0.0, 5.0), (65.0, 4.0)];
+        assert_eq!(tapered.mould_bound_exceeded(&params), None, "mould makes no tapered body: nothing to say");
+    }
 }

@@ -63,16 +63,35 @@ pub const CENTRELINE_COLUMNS: [&str; 12] = [
     "cable_y_mm",
 ];
 
+/// The columns of the channel and the cable ([`CENTRELINE_COLUMNS`]' last
+/// three): empty in the rows beyond a cable's anchor, where there is neither.
+const CABLE_COLUMNS: std::ops::Range<usize> = 9..12;
+
 /// The centreline CSV text: a header of [`CENTRELINE_COLUMNS`], one row per
-/// solver node (numbers printed so they read back exactly).
+/// solver node (numbers printed so they read back exactly). For a cable
+/// anchored before the tip, a row lies exactly at the anchor, where the
+/// cable's path ends, and the rows beyond it leave `channel_y_mm`,
+/// `cable_x_mm` and `cable_y_mm` empty.
 pub fn centreline_csv(centreline: &[CentrelinePoint]) -> String {
+    // The solver marks "no channel or cable here" by NaN.
+    let cable = |v: f64| if v.is_nan() { String::new() } else { v.to_string() };
     let mut out = CENTRELINE_COLUMNS.join(",");
     out.push('\n');
     for c in centreline {
         out.push_str(&format!(
             "{},{},{},{},{},{},{},{},{},{},{},{}\n",
-            c.s_mm, c.x_mm, c.y_mm, c.frame_angle_rad, c.tangent_angle_rad, c.arc_length_mm, c.v1, c.v2, c.u_per_mm,
-            c.channel_y_mm, c.cable_x_mm, c.cable_y_mm
+            c.s_mm,
+            c.x_mm,
+            c.y_mm,
+            c.frame_angle_rad,
+            c.tangent_angle_rad,
+            c.arc_length_mm,
+            c.v1,
+            c.v2,
+            c.u_per_mm,
+            cable(c.channel_y_mm),
+            cable(c.cable_x_mm),
+            cable(c.cable_y_mm)
         ));
     }
     out
@@ -116,7 +135,7 @@ pub enum CentrelineCsvError {
 
 /// Reads a centreline CSV written by [`write_centreline_csv`]: one row of the
 /// 12 columns per node, in order (the cable tension is not in the file and
-/// reads as NaN).
+/// reads as NaN, as do the empty channel and cable fields beyond an anchor).
 pub fn read_centreline_csv(path: &Path) -> Result<Vec<CentrelinePoint>, CentrelineCsvError> {
     let name = path.display().to_string();
     let text = std::fs::read_to_string(path).map_err(|source| CentrelineCsvError::Io { path: name.clone(), source })?;
@@ -130,7 +149,11 @@ pub fn read_centreline_csv(path: &Path) -> Result<Vec<CentrelinePoint>, Centreli
         let row = |problem: String| CentrelineCsvError::Row { path: name.clone(), line: i + 2, problem };
         let v: Vec<f64> = line
             .split(',')
-            .map(|f| f.trim().parse::<f64>().map_err(|_| row(format!("'{}' is not a number", f.trim()))))
+            .enumerate()
+            .map(|(column, f)| match f.trim() {
+                "" if CABLE_COLUMNS.contains(&column) => Ok(f64::NAN),
+                f => f.parse::<f64>().map_err(|_| row(format!("'{f}' is not a number"))),
+            })
             .collect::<Result<_, _>>()?;
         if v.len() != CENTRELINE_COLUMNS.len() {
             return Err(row(format!("{} fields, expected {}", v.len(), CENTRELINE_COLUMNS.len())));
@@ -178,6 +201,44 @@ mod tests {
         }
         std::fs::write(&path, "s,x\n1,2\n").unwrap();
         assert!(matches!(read_centreline_csv(&path), Err(CentrelineCsvError::Header { .. })));
+    }
+
+    /// A cable knotted before the tip: its path ends on a row exactly at the
+    /// anchor, and beyond it the channel and cable columns are empty (not the
+    /// centreline, as if the cable ran on to the tip).
+    #[test]
+    fn an_anchored_cable_ends_at_its_anchor_in_the_csv() {
+        let anchor_mm = 45.3;
+        let a = Actuator { cable_anchor_mm: Some(anchor_mm), ..Actuator::default() };
+        let routing = Routing::for_actuator([0.0, 1.0, -2.0, 3.0, 0.5], &a).unwrap();
+        let sim = simulate(&a, &SolverOptions::default(), &routing, 1.5, 3, LengthBasis::Rest).unwrap();
+        let text = centreline_csv(&sim.centreline);
+        let rows: Vec<Vec<&str>> = text.lines().skip(1).map(|l| l.split(',').collect()).collect();
+        let at = rows.iter().position(|r| r[0].parse::<f64>().unwrap() == anchor_mm).expect("a row exactly at the anchor");
+        let end = routing.channel_at(anchor_mm).y_mm;
+        assert_eq!(rows[at][9].parse::<f64>().unwrap(), end, "the channel's offset at the anchor");
+        for (i, r) in rows.iter().enumerate() {
+            let cable_fields = &r[9..12];
+            if i <= at {
+                assert!(cable_fields.iter().all(|f| f.parse::<f64>().is_ok()), "row {i}: {r:?}");
+            } else {
+                assert!(cable_fields.iter().all(|f| f.is_empty()), "row {i} lies beyond the anchor: {r:?}");
+            }
+        }
+        assert!(at + 1 < rows.len() && (rows.last().unwrap()[0].parse::<f64>().unwrap() - a.length_mm).abs() < 1e-9);
+        // The empty fields read back as NaN, the rest exactly.
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("c.csv");
+        write_centreline_csv(&path, &sim).unwrap();
+        let back = read_centreline_csv(&path).unwrap();
+        for (b, c) in back.iter().zip(&sim.centreline) {
+            assert_eq!((b.s_mm, b.x_mm, b.y_mm), (c.s_mm, c.x_mm, c.y_mm));
+            let same = |p: f64, q: f64| p == q || (p.is_nan() && q.is_nan());
+            assert!(same(b.cable_x_mm, c.cable_x_mm) && same(b.channel_y_mm, c.channel_y_mm), "at s = {}", c.s_mm);
+        }
+        // An empty field anywhere else is still an error.
+        std::fs::write(&path, text.replacen(&format!("\n{},", rows[1][0]), "\n,", 1)).unwrap();
+        assert!(matches!(read_centreline_csv(&path), Err(CentrelineCsvError::Row { .. })));
     }
 
     #[test]

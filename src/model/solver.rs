@@ -229,11 +229,13 @@ pub struct CentrelinePoint {
     pub v2: f64,
     /// Curvature u, 1/mm.
     pub u_per_mm: f64,
-    /// Channel offset y_c in the body frame, mm.
+    /// Channel offset y_c in the body frame, mm; NaN beyond a cable's anchor
+    /// (no channel there).
     pub channel_y_mm: f64,
-    /// Cable position in the plane, mm.
+    /// Cable position in the plane, mm; NaN beyond a cable's anchor (the
+    /// centreline has a point exactly at the anchor, where the cable ends).
     pub cable_x_mm: f64,
-    /// Cable position in the plane, mm.
+    /// Cable position in the plane, mm; NaN beyond a cable's anchor.
     pub cable_y_mm: f64,
     /// Cable tension at this point, N (varies along s with friction).
     pub cable_tension_n: f64,

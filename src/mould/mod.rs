@@ -64,6 +64,17 @@ impl Default for MouldParams {
     }
 }
 
+impl MouldParams {
+    /// The largest channel offset |y_c| these moulds can cast in a body of
+    /// radius `radius_mm`: the tube's outer radius and `min_skin_mm` of
+    /// silicone must fit between the channel's centreline and the surface, mm.
+    /// [`Moulds::new`] refuses a channel beyond it; `design --moulds` bounds
+    /// its search by it.
+    pub fn max_channel_offset_mm(&self, radius_mm: f64) -> f64 {
+        radius_mm - self.tube_diameter_mm / 2.0 - self.min_skin_mm
+    }
+}
+
 /// Why moulds could not be made or written.
 #[derive(Debug, thiserror::Error)]
 pub enum MouldError {
@@ -252,7 +263,7 @@ impl Moulds {
         }
         let rho = p.tube_diameter_mm / 2.0;
         // The channel must keep min_skin of silicone to the surface everywhere.
-        let limit = radius_mm - rho - p.min_skin_mm;
+        let limit = p.max_channel_offset_mm(radius_mm);
         let n = (length / 0.05).ceil() as usize;
         let mut widest = 1.0_f64;
         for i in 0..=n {

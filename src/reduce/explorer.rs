@@ -169,6 +169,23 @@ mod tests {
         assert_eq!(num(0.0), json!(0.0));
     }
 
+    /// The page words its verdicts as `cablemap feasible` does: a target no
+    /// map design reached is "not reached by any of the map's designs" (not
+    /// UNREACHABLE: `design` may still meet it), with the CLI's hint and the
+    /// next command, the target filled in.
+    #[test]
+    fn the_page_says_what_the_map_saw_and_what_to_run_next() {
+        use crate::design::feasible::Verdict;
+        for v in [Verdict::Feasible, Verdict::Borderline, Verdict::Unreachable] {
+            assert!(PAGE.contains(&format!("{}: \"{}\"", v.as_str(), v.label())), "{} labelled as in Verdict::label", v.as_str());
+        }
+        assert!(!PAGE.contains("toUpperCase"), "no verdict in capitals");
+        assert!(!PAGE.contains("lies outside everything"));
+        assert!(PAGE.contains("so a design between its grid points may still reach it: `design` will tell"));
+        assert!(PAGE.contains("`cablemap design --target ${parts.join(\",\")} --map ${mapDir()}`"));
+        assert!(PAGE.contains(r#"<code id="verdict-next">${esc(r.next)}</code>"#));
+    }
+
     #[test]
     fn utc_date_is_well_formed() {
         let d = utc_now();

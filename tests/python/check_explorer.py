@@ -9,6 +9,7 @@ failure.
 """
 
 import json
+import re
 import subprocess
 import sys
 import tempfile
@@ -140,8 +141,23 @@ def check_targets():
         assert shown["tip"]["count"] == want["tip_cell"]["count"], (t, shown["tip"], want["tip_cell"])
         assert shown["tip"]["neighbourhood_count"] == want["tip_cell"]["neighbourhood_count"], t
         assert shown["mode"] == want["mode"]["mode"], (t, shown["mode"], want["mode"])
-        text = driver.find_element(By.ID, "verdict-text").text
-        assert text.lower() == want["verdict"], (text, want["verdict"])
+        shown_el = driver.find_element(By.ID, "verdict-text")
+        assert shown_el.get_attribute("data-verdict") == want["verdict"], (shown_el.get_attribute("data-verdict"), want["verdict"])
+        # The words of `cablemap feasible`'s text report, reasons included, and its next command.
+        text_out = subprocess.run([binary, "feasible", "--map", str(map_dir), "--target", t],
+                                  check=True, capture_output=True, text=True).stdout
+        assert text_out.startswith(f"verdict   {shown_el.text}\n"), (shown_el.text, text_out)
+        # Numbers are printed to other precisions on the page: compare the words.
+        words = lambda text: re.sub(r"-?\d[\d.]*(e[+-]?\d+)?", "#", text)
+        page = words(driver.find_element(By.ID, "verdict").text)
+        for reason in want["reasons"]:
+            assert words(reason) in page, (reason, page)
+        next_cli = [l for l in text_out.splitlines() if l.startswith("next      ")][0].split()[1:]
+        next_page = driver.find_element(By.ID, "verdict-next").text.split()
+        assert next_page[:3] == next_cli[:3] == ["cablemap", "design", "--target"], (next_page, next_cli)
+        assert next_page[4:] == next_cli[4:] == ["--map", str(map_dir)], (next_page, next_cli)
+        components = lambda arg: {k: float(v) for k, v in (kv.split("=") for kv in arg.split(","))}
+        assert components(next_page[3]) == components(next_cli[3]) == components(t), (next_page, next_cli, t)
         seen.add(want["verdict"])
     assert {"feasible", "unreachable"} <= seen, seen
     # Bad input gets a message, not a verdict.

@@ -1038,7 +1038,9 @@ impl Simulator {
     }
 
     /// The centreline of the last solve at 2·steps_per_span + 1 evenly spaced
-    /// points, interpolated from the nodes (spectrally accurate on each span).
+    /// points, interpolated from the nodes (spectrally accurate on each span),
+    /// plus one exactly at the anchor of a cable knotted before the tip, where
+    /// its path ends: beyond it the channel and cable fields are NaN.
     pub(super) fn colloc_centreline(&self) -> Vec<CentrelinePoint> {
         let c = self.col.as_ref().expect("collocation state");
         let routing = self.routing.as_ref().expect("routing");
@@ -1049,17 +1051,24 @@ impl Simulator {
         let v1: Vec<f64> = c.strain.iter().map(|e| e.v1).collect();
         let v2: Vec<f64> = c.strain.iter().map(|e| e.v2).collect();
         let u: Vec<f64> = c.strain.iter().map(|e| e.u).collect();
-        (0..count)
-            .map(|k| {
-                let s = length * k as f64 / (count - 1) as f64;
-                let span = c.start[1..].iter().take_while(|&&b| s >= b).count();
+        let anchor = self.actuator.cable_length_mm();
+        let mut samples: Vec<f64> = (0..count).map(|k| length * k as f64 / (count - 1) as f64).collect();
+        if anchor < length && !samples.contains(&anchor) {
+            samples.insert(samples.partition_point(|&s| s < anchor), anchor);
+        }
+        samples
+            .into_iter()
+            .map(|s| {
+                // The anchor's sample on the cable's side of its span boundary (the strains jump there).
+                let span = c.start[1..].iter().take_while(|&&b| if s == anchor { s > b } else { s >= b }).count();
                 let x = ((s - c.start[span]) / c.half[span] - 1.0).clamp(-1.0, 1.0);
                 let base = span * np;
                 let at = |f: &[f64]| c.interpolate(&f[base..base + np], x);
                 let (px, py, phi) = (at(&c.px), at(&c.py), at(&c.phi));
                 let (v1, v2, u) = (at(&v1), at(&v2), at(&u));
-                let cable = s <= routing.length_mm();
-                let yc = if cable { routing.channel_at(s).y_mm } else { 0.0 };
+                let cable = anchor >= length || s <= anchor;
+                // No channel and no cable beyond the anchor.
+                let yc = if cable { routing.channel_at(s).y_mm } else { f64::NAN };
                 let (sp, cp) = phi.sin_cos();
                 CentrelinePoint {
                     s_mm: s,
