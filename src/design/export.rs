@@ -125,12 +125,12 @@ pub fn mould_svg(routing: &Routing, radius_mm: f64, channel_diameter_mm: f64, te
     svg
 }
 
-/// Writes design.json, channel.csv, mould.svg (channel drawn `tube_diameter_mm`
-/// wide) and shape.png into `dir` (created if missing) and returns the names of the files written, in
-/// order, so that what is reported is what was written. mould.svg, a
-/// drawing of the uniform cylinder's mould, is left out for a non-uniform
-/// body (radius profile, segments, cable anchor); channel.csv then runs
-/// over the cable, [0, s_k].
+/// Writes design.json, channel.csv, mould.svg (the channel drawn
+/// `tube_diameter_mm` wide) and shape.png into `dir` (created if missing)
+/// and returns the names of the files written, in order, so that what is
+/// reported is what was written. mould.svg, a drawing of the uniform
+/// cylinder's mould, is left out for a non-uniform body (radius profile,
+/// segments, cable anchor); channel.csv then runs over the cable, [0, s_k].
 pub fn write_all(
     dir: &Path,
     objective: &Objective,

@@ -134,7 +134,7 @@ impl DesignRequest {
         let act = &self.actuator;
         crate::mould::check_uniform_body(act)?;
         act.validate()?;
-        let straight = Routing::for_actuator(&[0.0; 5], act)?;
+        let straight = Routing::for_actuator([0.0; 5], act)?;
         crate::mould::Moulds::new(&straight, act.radius_mm, params)?;
         Ok(())
     }
