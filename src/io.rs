@@ -473,7 +473,10 @@ mod tests {
                 let path = run.join(inside);
                 assert_eq!(enclosing_run_dir(&path), Some(run.clone()), "{}", path.display());
                 let e = check_not_in_run_dir(&path, "the map directory").unwrap_err();
-                assert!(e.contains("sweep run directory") && e.contains(if inside.is_empty() { " is the " } else { " is inside the " }), "{e}");
+                assert!(
+                    e.contains("sweep run directory") && e.contains(if inside.is_empty() { " is the " } else { " is inside the " }),
+                    "{e}"
+                );
             }
             assert!(write_atomic(&run.join("shards/x.csv"), b"x").is_err());
             write_atomic_in_run(&run.join("shards/x.csv"), b"x").unwrap();

@@ -363,11 +363,7 @@ fn absurd_shard_counts_memory_sizes_and_cells_are_refused_before_anything_is_wri
     }
     // A cable's anchor is not swept: off the rod, every row was invalid_routing and the sweep "succeeded".
     let cable = tmp.path().join("cable.toml");
-    std::fs::write(
-        &cable,
-        "[[cable]]\ny_mm = [2, 2, 2, 2, 2]\nanchor_mm = -1\ntension_n = { min = 0.5, max = 1.0, count = 2 }\n",
-    )
-    .unwrap();
+    std::fs::write(&cable, "[[cable]]\ny_mm = [2, 2, 2, 2, 2]\nanchor_mm = -1\ntension_n = { min = 0.5, max = 1.0, count = 2 }\n").unwrap();
     refused(&["sweep", s(&cable), "--out", s(&out)], &["cable 1: anchor_mm = -1", "length_mm"]);
     assert!(!out.exists());
     let (ok, _, stderr) = run_within(&["sweep", QUICK, "--out", s(&out)], &[("SLURM_CPUS_PER_TASK", "0")], limit);

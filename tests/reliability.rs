@@ -294,7 +294,9 @@ fn outputs_aimed_into_a_run_directory_are_refused_and_the_run_stays_usable() {
     let manifest = dir.join("manifest.json");
     let csv = dir.join("shards/centreline.csv");
     let nested = dir.join("shards/run");
-    let simulate = |csv: &Path| vec!["simulate".to_string(), "--routing".into(), "0,1,0,1,0".into(), "--tension".into(), "1".into(), "--csv".into(), s(csv).into()];
+    let simulate = |csv: &Path| {
+        vec!["simulate".to_string(), "--routing".into(), "0,1,0,1,0".into(), "--tension".into(), "1".into(), "--csv".into(), s(csv).into()]
+    };
     let simulations = [simulate(&manifest), simulate(&csv)];
     for args in [
         vec!["reduce", s(&dir), "--out", s(&dir)],

@@ -170,7 +170,9 @@ fn with_flags(e: ReduceError, run: &Path, out: &Path) -> anyhow::Error {
                 anyhow::anyhow!("{e}: `{}` for each missing I", part("I".into(), shards.to_string()))
             }
         }
-        ReduceError::Parts(PartsError::Damaged { shard, shards, .. }) => anyhow::anyhow!("{e}: `{}`", part(shard.to_string(), shards.to_string())),
+        ReduceError::Parts(PartsError::Damaged { shard, shards, .. }) => {
+            anyhow::anyhow!("{e}: `{}`", part(shard.to_string(), shards.to_string()))
+        }
         ReduceError::Parts(PartsError::NoParts { .. }) => anyhow::anyhow!("{e}: `{}` for I = 0 … N-1", part("I".into(), "N".into())),
         _ => e.into(),
     }

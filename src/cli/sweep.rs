@@ -267,7 +267,11 @@ fn print_shard_table(shards: &[cablemap::sweep::status::ShardStatus]) {
     println!(
         "  ({} shards: {finished} finished{}; `status --json` lists every shard)",
         shards.len(),
-        if more > 0 { format!(", {} unfinished listed, {more} more unfinished", SHARD_LINES) } else { format!(", {} unfinished listed", unfinished.len()) }
+        if more > 0 {
+            format!(", {} unfinished listed, {more} more unfinished", SHARD_LINES)
+        } else {
+            format!(", {} unfinished listed", unfinished.len())
+        }
     );
 }
 

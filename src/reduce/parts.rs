@@ -34,7 +34,10 @@ pub const PART_FORMAT: &str = "cablemap-reduce-part/2";
 pub enum PartsError {
     /// The part number is not below the number of parts, or there are
     /// more parts than a reduce may be split into.
-    #[error("part {shard} of {shards}: parts are numbered 0 to N-1, and the number of parts N must be 1 … {}", crate::sweep::MAX_SHARDS)]
+    #[error(
+        "part {shard} of {shards}: parts are numbered 0 to N-1, and the number of parts N must be 1 … {}",
+        crate::sweep::MAX_SHARDS
+    )]
     BadShard {
         /// The part asked for.
         shard: u64,
@@ -86,7 +89,11 @@ pub enum PartsError {
         problem: String,
     },
     /// Part records of a split into more parts than a reduce may have.
-    #[error("{}: holds parts of a split into {shards} parts, more than {}: remove the directory and split into fewer parts", dir.display(), crate::sweep::MAX_SHARDS)]
+    #[error(
+        "{}: holds parts of a split into {shards} parts, more than {}: remove the directory and split into fewer parts",
+        dir.display(),
+        crate::sweep::MAX_SHARDS
+    )]
     TooMany {
         /// The parts directory.
         dir: PathBuf,
@@ -144,7 +151,10 @@ impl PartRecord {
     /// parsed record is the JSON that was hashed).
     fn content_sha256(&self) -> String {
         use sha2::{Digest, Sha256};
-        let content = PartRecord { record_sha256: String::new(), ..self.clone() };
+        let content = PartRecord {
+            record_sha256: String::new(),
+            ..self.clone()
+        };
         crate::io::hex(&Sha256::digest(serde_json::to_vec(&content).expect("a part record serializes")))
     }
 }
@@ -227,7 +237,10 @@ pub fn write_part(run_dir: &Path, map_dir: &Path, shard: u64, shards: u64) -> Re
         samples_sha256,
         record_sha256: String::new(),
     };
-    let record = PartRecord { record_sha256: record.content_sha256(), ..record };
+    let record = PartRecord {
+        record_sha256: record.content_sha256(),
+        ..record
+    };
     let json = serde_json::to_vec_pretty(&record).expect("a part record serializes");
     remove_abandoned_temps(&dir, &record_path);
     write_locked_atomic(&record_path, &json).map_err(|source| PartsError::Io {
@@ -311,7 +324,10 @@ fn read_parts(dir: &Path, run: &SweepRun) -> Result<(Vec<PathBuf>, Pass1), Parts
     }
     let shards = counts[0];
     if shards > crate::sweep::MAX_SHARDS {
-        return Err(PartsError::TooMany { dir: dir.to_path_buf(), shards });
+        return Err(PartsError::TooMany {
+            dir: dir.to_path_buf(),
+            shards,
+        });
     }
     let missing: Vec<u64> = (0..shards).filter(|i| !found.contains(&(*i, shards))).collect();
     if !missing.is_empty() {
@@ -350,10 +366,21 @@ fn read_parts(dir: &Path, run: &SweepRun) -> Result<(Vec<PathBuf>, Pass1), Parts
         if record.spec_sha256 != run.manifest().spec_sha256 {
             return Err(mismatch("it is a part of another run (its spec hash differs)".into()));
         }
-        let damaged = |path: &Path, problem: String| PartsError::Damaged { path: path.to_path_buf(), shard, shards, problem };
+        let damaged = |path: &Path, problem: String| PartsError::Damaged {
+            path: path.to_path_buf(),
+            shard,
+            shards,
+            problem,
+        };
         let content = record.content_sha256();
         if content != record.record_sha256 {
-            return Err(damaged(&path, format!("its content hashes to {content}, not the recorded record_sha256 {}", record.record_sha256)));
+            return Err(damaged(
+                &path,
+                format!(
+                    "its content hashes to {content}, not the recorded record_sha256 {}",
+                    record.record_sha256
+                ),
+            ));
         }
         let range = chunk_range(run.chunk_count(), shard, shards);
         let first_row: u64 = (0..range[0]).map(|i| run.chunk_rows(i)).sum();
@@ -376,9 +403,18 @@ fn read_parts(dir: &Path, run: &SweepRun) -> Result<(Vec<PathBuf>, Pass1), Parts
                 problem: format!("{len} bytes where the part's record says {} samples", record.records),
             });
         }
-        let actual = crate::io::sha256_file(&samples).map_err(|source| PartsError::Io { path: samples.clone(), source })?;
+        let actual = crate::io::sha256_file(&samples).map_err(|source| PartsError::Io {
+            path: samples.clone(),
+            source,
+        })?;
         if actual != record.samples_sha256 {
-            return Err(damaged(&samples, format!("its SHA-256 is {actual}, not the {} recorded when it was written", record.samples_sha256)));
+            return Err(damaged(
+                &samples,
+                format!(
+                    "its SHA-256 is {actual}, not the {} recorded when it was written",
+                    record.samples_sha256
+                ),
+            ));
         }
         files.push(samples);
         pass1.merge(&record.pass1);
@@ -436,13 +472,19 @@ mod tests {
             samples_sha256: "cd".into(),
             record_sha256: String::new(),
         };
-        let record = PartRecord { record_sha256: record.content_sha256(), ..record };
+        let record = PartRecord {
+            record_sha256: record.content_sha256(),
+            ..record
+        };
         let read: PartRecord = serde_json::from_slice(&serde_json::to_vec_pretty(&record).unwrap()).unwrap();
         assert_eq!(read.content_sha256(), record.record_sha256);
         let mut edited = read.clone();
         edited.pass1.extent.x_mm[1] += 1e-12;
         assert_ne!(edited.content_sha256(), record.record_sha256);
-        assert_eq!(list(&(0..25).collect::<Vec<_>>()), format!("{}, … (5 more)", list(&(0..20).collect::<Vec<_>>())));
+        assert_eq!(
+            list(&(0..25).collect::<Vec<_>>()),
+            format!("{}, … (5 more)", list(&(0..20).collect::<Vec<_>>()))
+        );
     }
 
     #[test]

@@ -240,7 +240,8 @@ impl CableSweepSpec {
                 let length = self.rod.length_mm;
                 if !(anchor.is_finite() && anchor > 0.0 && anchor <= length) {
                     return Err(bad(format!(
-                        "cable {n}: anchor_mm = {} must lie on the rod, in (0, {length}] mm (the rod's length_mm; leave anchor_mm out for the tip)",
+                        "cable {n}: anchor_mm = {} must lie on the rod, in (0, {length}] mm (the rod's length_mm; leave \
+                         anchor_mm out for the tip)",
                         crate::io::fmt_num(anchor)
                     )));
                 }
@@ -722,7 +723,10 @@ levels_mm = [0.0, 1.5, -1.5]
             (SPEC.replace("[rod.gravity]", "[rod.effects]\nfriction_mu = 0.1\n[rod.gravity]"), "friction_mu"),
             (format!("{SPEC}\n[output]\norder = 7\n"), "steps_per_span"),
             (SPEC.replace("axis = \"z\"", "axis = \"x\""), "unknown variant"),
-            (SPEC.replace("y_mm = [2, 2, 2, 2, 2]", "y_mm = [2, 2, 2, 2, 2]\nanchor_mm = -1"), "cable 1: anchor_mm = -1 must lie on the rod"),
+            (
+                SPEC.replace("y_mm = [2, 2, 2, 2, 2]", "y_mm = [2, 2, 2, 2, 2]\nanchor_mm = -1"),
+                "cable 1: anchor_mm = -1 must lie on the rod",
+            ),
             (SPEC.replace("y_mm = [-2, -2, -2, -2, -2]", "y_mm = [-2, -2, -2, -2, -2]\nanchor_mm = 70"), "cable 2: anchor_mm = 70"),
             ("[rod]\n".to_string(), "cable"),
         ] {

@@ -56,7 +56,11 @@ pub enum SweepError {
     #[error("shard {shard} of {shards} is out of range: use 0 ≤ shard < shards (shards ≥ 1)")]
     BadShard { shard: u64, shards: u64 },
     /// More shards than a sweep may be split into.
-    #[error("a sweep is split into at most {} shards, not {shards}: use fewer shards (a shard per chunk file, {chunks} here, is the finest useful split)", run::MAX_SHARDS)]
+    #[error(
+        "a sweep is split into at most {} shards, not {shards}: use fewer shards (a shard per chunk file, {chunks} here, is the \
+         finest useful split)",
+        run::MAX_SHARDS
+    )]
     TooManyShards {
         /// The shard count asked for.
         shards: u64,
@@ -67,7 +71,11 @@ pub enum SweepError {
     #[error("{0}")]
     TooMuchMemory(String),
     /// The run directory would lie inside another run directory.
-    #[error("{} is inside the sweep run directory {}; a run there would make that run unusable: give a directory outside the run", dir.display(), run.display())]
+    #[error(
+        "{} is inside the sweep run directory {}; a run there would make that run unusable: give a directory outside the run",
+        dir.display(),
+        run.display()
+    )]
     InsideRun {
         /// The directory asked for.
         dir: PathBuf,

@@ -443,7 +443,9 @@ mod tests {
     #[test]
     fn the_centreline_size_is_the_solvers() {
         for method in ["collocation", "rk4"] {
-            let spec = SweepSpec::from_toml(&format!("[solver]\nmethod = \"{method}\"\nsteps_per_span = 30\n[output]\ncentreline = true\n"), "t").unwrap();
+            let spec =
+                SweepSpec::from_toml(&format!("[solver]\nmethod = \"{method}\"\nsteps_per_span = 30\n[output]\ncentreline = true\n"), "t")
+                    .unwrap();
             let mut sim = crate::model::Simulator::new(&spec.actuator, &spec.solver).unwrap();
             sim.set_routing_mm(&[1.0, 2.0, 0.0, -1.0, 1.0]).unwrap();
             sim.solve(1.5).unwrap();

@@ -140,7 +140,11 @@ impl<S: RunSpec> Manifest<S> {
         }
         if self.shards == 0 || self.shards > super::MAX_SHARDS {
             // Status keeps a line per shard: an absurd count must not be allocated.
-            return Err(format!("shards = {} is not 1 … {} (the file was edited, or written with an absurd --shards)", self.shards, super::MAX_SHARDS));
+            return Err(format!(
+                "shards = {} is not 1 … {} (the file was edited, or written with an absurd --shards)",
+                self.shards,
+                super::MAX_SHARDS
+            ));
         }
         let expected = Manifest { tool_version: self.tool_version.clone(), ..Manifest::new(&self.spec, self.shards) };
         if *self != expected {
