@@ -79,6 +79,10 @@ pub fn bench_with_reference(
     Ok(rows)
 }
 
+/// Most routings `bench` samples: the thesis grid's 9⁵ (more would only
+/// repeat them, and a count near `usize::MAX` cannot be allocated).
+pub const MAX_ROUTINGS: usize = 59_049;
+
 /// A deterministic sample of `count` routings from the thesis grid
 /// (9 levels ±0.8 r), spread over the grid by a multiplicative walk.
 pub fn sample_thesis_routings(count: usize, radius_mm: f64) -> Vec<ControlPoints> {

@@ -141,11 +141,28 @@ fn parent_dir(path: &Path) -> &Path {
 /// the directory. A reader never sees a half-written file, a crash never
 /// corrupts an existing one, and a failed write (a full disk) leaves no
 /// temporary file behind.
+///
+/// Every output file cablemap writes goes through here, so every writer
+/// gets the same two refusals, before anything is written: `path` must be
+/// new or a regular file ([`check_regular_or_new`]: the rename would
+/// otherwise replace a symlink, a FIFO or a device node such as
+/// `/dev/full` by a regular file), and it must not lie inside a sweep run
+/// directory at any depth ([`check_not_in_run_dir`]: `--csv RUN/manifest.json`
+/// would destroy the run). The sweep engine writes its own files inside
+/// its run with [`write_atomic_in_run`].
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    check_not_in_run_dir(path, "the output file").map_err(|m| std::io::Error::new(std::io::ErrorKind::InvalidInput, m))?;
+    write_atomic_in_run(path, bytes)
+}
+
+/// [`write_atomic`] for the sweep engine's own files inside its run
+/// directory (checksum records): only the regular-file check.
+pub fn write_atomic_in_run(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     let dir = parent_dir(path);
     if path.file_name().is_none() {
         return Err(std::io::Error::other("path has no file name"));
     }
+    check_regular_or_new(path)?;
     let tmp = temp_path(path);
     let written = (|| {
         let mut f = File::create(&tmp)?;
@@ -162,6 +179,59 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     Ok(())
 }
 
+/// Refuses to write over anything at `path` but a regular file: a
+/// directory, a symbolic link (even to a regular file: the link itself
+/// would be replaced), a FIFO, a socket or a device node. The error names
+/// the path and what it is. A path that does not exist is fine.
+pub fn check_regular_or_new(path: &Path) -> std::io::Result<()> {
+    let meta = match std::fs::symlink_metadata(path) {
+        Ok(m) => m,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
+        Err(e) => return Err(e),
+    };
+    let kind = file_kind(&meta.file_type());
+    if kind == "regular file" {
+        return Ok(());
+    }
+    Err(std::io::Error::new(
+        std::io::ErrorKind::InvalidInput,
+        format!(
+            "{} is a {kind}, not a regular file: cablemap writes only regular files, and would replace it by one; \
+             give the path of a new or a regular file",
+            path.display()
+        ),
+    ))
+}
+
+/// What a directory entry is, in words ("regular file", "FIFO (named pipe)", …).
+fn file_kind(t: &std::fs::FileType) -> &'static str {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if t.is_fifo() {
+            return "FIFO (named pipe)";
+        }
+        if t.is_char_device() {
+            return "character device";
+        }
+        if t.is_block_device() {
+            return "block device";
+        }
+        if t.is_socket() {
+            return "socket";
+        }
+    }
+    if t.is_symlink() {
+        "symbolic link"
+    } else if t.is_dir() {
+        "directory"
+    } else if t.is_file() {
+        "regular file"
+    } else {
+        "special file"
+    }
+}
+
 /// Fsyncs a directory so a rename in it is durable (best effort: some file
 /// systems refuse to open directories).
 pub fn sync_dir(dir: &Path) {
@@ -170,33 +240,53 @@ pub fn sync_dir(dir: &Path) {
     }
 }
 
-/// Whether `dir` is a sweep run directory: it has a cablemap sweep
-/// manifest (even a damaged one, as long as it names the format).
+/// Beginnings of the format tags of sweep manifests: `cablemap-sweep/N`
+/// (planar runs) and `cablemap-cables/N` (cable runs). The sweep layer's
+/// tags are checked against these by its tests.
+pub const RUN_FORMAT_PREFIXES: [&str; 2] = ["cablemap-sweep/", "cablemap-cables/"];
+
+/// Whether `dir` is a sweep run directory of either kind: it has a
+/// cablemap sweep manifest (even a damaged one, as long as it names the
+/// format).
 pub fn is_run_dir(dir: &Path) -> bool {
-    std::fs::read(dir.join("manifest.json")).is_ok_and(|b| b.windows(15).any(|w| w == b"cablemap-sweep/"))
+    std::fs::read(dir.join("manifest.json"))
+        .is_ok_and(|b| RUN_FORMAT_PREFIXES.iter().any(|p| b.windows(p.len()).any(|w| w == p.as_bytes())))
 }
 
-/// Refuses an output directory that is a sweep run directory or lies
-/// directly inside one: the run would then hold files cablemap's checks
-/// reject, and be unusable until cleaned by hand. `what` names the
-/// directory in the message (the command line adds its flag).
-pub fn check_not_in_run_dir(out: &Path, what: &str) -> Result<(), String> {
-    let parent = match out.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    for (candidate, inside) in [(out, false), (parent, true)] {
-        if is_run_dir(candidate) {
-            return Err(format!(
-                "{what} {} {} the sweep run directory {}; writing there would make the run unusable: \
-                 give a directory outside the run",
-                out.display(),
-                if inside { "is inside" } else { "is" },
-                candidate.display()
-            ));
+/// The sweep run directory that `path` is, or lies inside at any depth,
+/// if any. The path is resolved through its deepest existing ancestor
+/// (symbolic links and `..` included), so `RUN/shards/new/map`,
+/// `RUN/../RUN/x` and a relative path from inside the run are all found.
+pub fn enclosing_run_dir(path: &Path) -> Option<PathBuf> {
+    let mut existing = path;
+    let resolved = loop {
+        if let Ok(p) = std::fs::canonicalize(existing) {
+            break p;
         }
-    }
-    Ok(())
+        let parent = parent_dir(existing);
+        if parent == existing {
+            return None;
+        }
+        existing = parent;
+    };
+    resolved.ancestors().find(|d| is_run_dir(d)).map(Path::to_path_buf)
+}
+
+/// Refuses an output (a directory or a file) that is a sweep run
+/// directory or lies inside one at any depth: the run would then hold
+/// files cablemap's checks reject, or lose its own, and be unusable until
+/// cleaned by hand. `what` names the output in the message (the command
+/// line adds its flag).
+pub fn check_not_in_run_dir(out: &Path, what: &str) -> Result<(), String> {
+    let Some(run) = enclosing_run_dir(out) else { return Ok(()) };
+    let is_the_run = std::fs::canonicalize(out).is_ok_and(|o| o == run);
+    Err(format!(
+        "{what} {} {} the sweep run directory {}; writing there would make the run unusable: \
+         give a path outside the run",
+        out.display(),
+        if is_the_run { "is" } else { "is inside" },
+        run.display()
+    ))
 }
 
 /// A number for a message: plain for ordinary magnitudes, scientific for
@@ -206,6 +296,47 @@ pub fn fmt_num(v: f64) -> String {
         format!("{v:e}")
     } else {
         format!("{v}")
+    }
+}
+
+/// A byte count for a message, in binary units: `512 B`, `3.2 MiB`, `236.7 GiB`.
+pub fn fmt_bytes(bytes: u64) -> String {
+    const UNITS: [&str; 6] = ["B", "KiB", "MiB", "GiB", "TiB", "PiB"];
+    let mut value = bytes as f64;
+    let mut unit = 0;
+    while value >= 1024.0 && unit + 1 < UNITS.len() {
+        value /= 1024.0;
+        unit += 1;
+    }
+    if unit == 0 {
+        format!("{bytes} B")
+    } else {
+        format!("{value:.1} {}", UNITS[unit])
+    }
+}
+
+/// Memory this process may still use, bytes: the kernel's estimate of
+/// available memory (`MemAvailable`), or less where a cgroup (a container,
+/// a SLURM job) limits the process more. `None` where neither can be read
+/// (then no size is refused for memory alone).
+pub fn available_memory_bytes() -> Option<u64> {
+    let meminfo = std::fs::read_to_string("/proc/meminfo").ok().and_then(|text| {
+        let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+        let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+        Some(kib.saturating_mul(1024))
+    });
+    let read_u64 = |path: &str| std::fs::read_to_string(path).ok().and_then(|t| t.trim().parse::<u64>().ok());
+    // cgroup v2, then v1 (whose "no limit" is a huge number, harmless here).
+    let cgroup = match (read_u64("/sys/fs/cgroup/memory.max"), read_u64("/sys/fs/cgroup/memory.current")) {
+        (Some(max), Some(current)) => Some(max.saturating_sub(current)),
+        _ => match (read_u64("/sys/fs/cgroup/memory/memory.limit_in_bytes"), read_u64("/sys/fs/cgroup/memory/memory.usage_in_bytes")) {
+            (Some(max), Some(current)) => Some(max.saturating_sub(current)),
+            _ => None,
+        },
+    };
+    match (meminfo, cgroup) {
+        (Some(a), Some(b)) => Some(a.min(b)),
+        (a, b) => a.or(b),
     }
 }
 
@@ -300,6 +431,66 @@ mod tests {
         write_atomic(&dir.path().join("f"), b"ok").unwrap();
         assert_eq!(std::fs::read(dir.path().join("f")).unwrap(), b"ok");
         assert_eq!(sha256_file(&dir.path().join("f")).unwrap().len(), 64);
+    }
+
+    #[test]
+    fn only_regular_files_are_written_over() {
+        use std::os::unix::fs::FileTypeExt;
+        let dir = tempfile::tempdir().unwrap();
+        let regular = dir.path().join("regular");
+        std::fs::write(&regular, b"old").unwrap();
+        let link = dir.path().join("link");
+        std::os::unix::fs::symlink(&regular, &link).unwrap();
+        let fifo = dir.path().join("fifo");
+        let c = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
+        // SAFETY: a valid NUL-terminated path.
+        assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o644) }, 0);
+        let sub = dir.path().join("sub");
+        std::fs::create_dir(&sub).unwrap();
+        for (path, kind) in [(&link, "symbolic link"), (&fifo, "FIFO (named pipe)"), (&sub, "directory")] {
+            let e = write_atomic(path, b"new").unwrap_err();
+            assert!(e.to_string().contains(&format!("{} is a {kind}, not a regular file", path.display())), "{e}");
+        }
+        assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink());
+        assert!(std::fs::symlink_metadata(&fifo).unwrap().file_type().is_fifo());
+        assert_eq!(std::fs::read(&regular).unwrap(), b"old");
+        write_atomic(&regular, b"new").unwrap();
+        write_atomic(&dir.path().join("fresh"), b"new").unwrap();
+        assert_eq!(std::fs::read(&regular).unwrap(), b"new");
+        let names: Vec<_> = std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
+        assert_eq!(names.len(), 5, "no temporaries left: {names:?}");
+    }
+
+    #[test]
+    fn run_directories_of_either_kind_are_found_at_any_depth() {
+        let dir = tempfile::tempdir().unwrap();
+        for (name, format) in [("planar", "cablemap-sweep/2"), ("cables", "cablemap-cables/1")] {
+            let run = dir.path().join(name);
+            std::fs::create_dir_all(run.join("shards")).unwrap();
+            std::fs::write(run.join("manifest.json"), format!("{{\"format\": \"{format}\"}}")).unwrap();
+            let run = std::fs::canonicalize(&run).unwrap();
+            for inside in ["", "manifest.json", "shards/map", "shards/new/deeper/map", "shards/../x"] {
+                let path = run.join(inside);
+                assert_eq!(enclosing_run_dir(&path), Some(run.clone()), "{}", path.display());
+                let e = check_not_in_run_dir(&path, "the map directory").unwrap_err();
+                assert!(
+                    e.contains("sweep run directory") && e.contains(if inside.is_empty() { " is the " } else { " is inside the " }),
+                    "{e}"
+                );
+            }
+            assert!(write_atomic(&run.join("shards/x.csv"), b"x").is_err());
+            write_atomic_in_run(&run.join("shards/x.csv"), b"x").unwrap();
+        }
+        assert_eq!(enclosing_run_dir(&dir.path().join("elsewhere/map")), None);
+        assert!(check_not_in_run_dir(Path::new("relative/new/map"), "x").is_ok());
+    }
+
+    #[test]
+    fn byte_counts_read_in_binary_units() {
+        assert_eq!(fmt_bytes(512), "512 B");
+        assert_eq!(fmt_bytes(512 << 20), "512.0 MiB");
+        assert_eq!(fmt_bytes(u64::MAX), "16384.0 PiB");
+        assert!(available_memory_bytes().is_none_or(|b| b > 0));
     }
 
     #[test]

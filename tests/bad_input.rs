@@ -276,3 +276,139 @@ fn calibrate_on_a_large_file_states_its_cost_and_shows_progress() {
     assert!(!iterations.is_empty(), "{stderr}");
     assert!(iterations.len() as u64 <= v["iterations"].as_u64().unwrap(), "{stderr}\n{v}");
 }
+
+/// Runs `args`, killing it after `limit` (a hang is a failure, not a stuck suite).
+fn run_within(args: &[&str], env: &[(&str, &str)], limit: std::time::Duration) -> (bool, String, String) {
+    let mut child = cablemap().args(args).envs(env.iter().copied()).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap();
+    let started = std::time::Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if started.elapsed() > limit {
+            let _ = child.kill();
+            child.wait().unwrap();
+            panic!("{args:?} still running after {limit:?}");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let out = child.wait_with_output().unwrap();
+    let stderr: String = String::from_utf8_lossy(&out.stderr).into();
+    assert!(!stderr.contains("panicked") && out.status.code() != Some(101), "{args:?} panicked: {stderr}");
+    (out.status.success(), String::from_utf8_lossy(&out.stdout).into(), stderr)
+}
+
+#[test]
+fn output_files_never_replace_a_fifo_a_symlink_or_a_device_node() {
+    use std::os::unix::fs::FileTypeExt;
+    let tmp = tempfile::tempdir().unwrap();
+    let target = tmp.path().join("target.txt");
+    std::fs::write(&target, "precious").unwrap();
+    let link = tmp.path().join("link.csv");
+    std::os::unix::fs::symlink(&target, &link).unwrap();
+    let fifo = tmp.path().join("fifo.csv");
+    let c = |p: &Path| std::ffi::CString::new(p.to_str().unwrap()).unwrap();
+    // SAFETY: a valid NUL-terminated path.
+    assert_eq!(unsafe { libc::mkfifo(c(&fifo).as_ptr(), 0o644) }, 0);
+    // A copy of /dev/null's node (root only; elsewhere the FIFO and the link stand for it).
+    let device = tmp.path().join("null.csv");
+    // SAFETY: a valid NUL-terminated path; makedev(1, 3) is /dev/null.
+    let have_device = unsafe { libc::mknod(c(&device).as_ptr(), libc::S_IFCHR | 0o666, libc::makedev(1, 3)) } == 0;
+    let mut cases = vec![(link.clone(), "symbolic link"), (fifo.clone(), "FIFO")];
+    if have_device {
+        cases.push((device.clone(), "character device"));
+    }
+    for (path, kind) in &cases {
+        let csv = [&["simulate"][..], &R, &["--csv", s(path)]].concat();
+        let (ok, _, stderr) = run_within(&csv, &[], std::time::Duration::from_secs(60));
+        assert!(!ok && stderr.contains(s(path)) && stderr.contains(kind) && stderr.contains("not a regular file"), "{stderr}");
+        let (ok, _, stderr) = run_within(&["synth", "--force", "--out", s(path)], &[], std::time::Duration::from_secs(60));
+        assert!(!ok && stderr.contains(kind), "{stderr}");
+    }
+    assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink());
+    assert!(std::fs::symlink_metadata(&fifo).unwrap().file_type().is_fifo());
+    assert!(!have_device || std::fs::symlink_metadata(&device).unwrap().file_type().is_char_device());
+    assert_eq!(std::fs::read_to_string(&target).unwrap(), "precious");
+    // A regular file is still replaced.
+    let (ok, _, stderr) = run(&[&["simulate"][..], &R, &["--csv", s(&target)]].concat());
+    assert!(ok && std::fs::read_to_string(&target).unwrap().starts_with("s_mm"), "{stderr}");
+}
+
+#[test]
+fn absurd_shard_counts_memory_sizes_and_cells_are_refused_before_anything_is_written() {
+    let tmp = tempfile::tempdir().unwrap();
+    let limit = std::time::Duration::from_secs(60);
+    let out = tmp.path().join("run");
+    // Shard counts that overflowed an allocation (the manifest was already
+    // written, so every later status panicked too).
+    for shards in ["18446744073709551615", "4294967296"] {
+        refused(&["sweep", QUICK, "--out", s(&out), "--shard", "0", "--shards", shards], &["at most 1000000 shards", shards]);
+        assert!(!out.exists(), "--shards {shards}: a run directory was created");
+    }
+    refused(&["bench", "--routings", "18446744073709551615"], &["--routings", "59049"]);
+    // Sizes estimated before allocating: 992 M one-row chunks (tables of
+    // hundreds of GiB), and a centreline of 200 001 points per row.
+    for (text, needles) in [
+        (
+            "[grid]\nlevels = 63\nmirror_dedup = false\n[tension]\ncount = 1\nmax_n = 1.0\n[output]\nchunk_routings = 1\n",
+            &["of memory", "chunk_routings", "--allow-large"][..],
+        ),
+        (
+            "[grid]\nlevels = 3\n[tension]\ncount = 100\n[solver]\nsteps_per_span = 100000\n[output]\ncentreline = true\nchunk_routings = 16\n",
+            &["200001 centreline points", "steps_per_span", "centreline = false"][..],
+        ),
+    ] {
+        let spec = tmp.path().join("big.toml");
+        std::fs::write(&spec, text).unwrap();
+        let (ok, _, stderr) = run_within(&["sweep", s(&spec), "--out", s(&out)], &[], limit);
+        assert!(!ok && needles.iter().all(|n| stderr.contains(n)), "{text}: {stderr}");
+        assert!(!out.exists(), "{text}: a run directory was created");
+    }
+    // A cable's anchor is not swept: off the rod, every row was invalid_routing and the sweep "succeeded".
+    let cable = tmp.path().join("cable.toml");
+    std::fs::write(&cable, "[[cable]]\ny_mm = [2, 2, 2, 2, 2]\nanchor_mm = -1\ntension_n = { min = 0.5, max = 1.0, count = 2 }\n").unwrap();
+    refused(&["sweep", s(&cable), "--out", s(&out)], &["cable 1: anchor_mm = -1", "length_mm"]);
+    assert!(!out.exists());
+    let (ok, _, stderr) = run_within(&["sweep", QUICK, "--out", s(&out)], &[("SLURM_CPUS_PER_TASK", "0")], limit);
+    assert!(!ok && stderr.contains("SLURM_CPUS_PER_TASK = 0") && !stderr.contains("--threads"), "{stderr}");
+    // A finished run: a manifest edited to an absurd shard count is refused, not allocated.
+    assert!(run(&["sweep", QUICK, "--out", s(&out), "--quiet"]).0);
+    let edited = tmp.path().join("edited");
+    std::fs::create_dir(&edited).unwrap();
+    let manifest = std::fs::read_to_string(out.join("manifest.json")).unwrap();
+    std::fs::write(edited.join("manifest.json"), manifest.replace("\"shards\": 1,", "\"shards\": 18446744073709551615,")).unwrap();
+    refused(&["status", s(&edited)], &["shards = 18446744073709551615"]);
+    // A cell so large the map's corners overflowed hung the drawing; parts
+    // of an absurd split hung the merge.
+    let (ok, _, stderr) = run_within(&["reduce", s(&out), "--out", s(&tmp.path().join("m")), "--cell-mm", "1e308"], &[], limit);
+    assert!(!ok && stderr.contains("cell size 1e308 mm is larger") && stderr.contains("--cell-mm"), "{stderr}");
+    for shards in ["18446744073709551615", "4294967296"] {
+        refused(&["reduce", s(&out), "--out", s(&tmp.path().join("m")), "--shard", "0", "--shards", shards], &["1 … 1000000"]);
+    }
+    let parts = tmp.path().join("m.parts");
+    std::fs::create_dir(&parts).unwrap();
+    std::fs::write(parts.join("part-0-of-18446744073709551615.json"), "{}").unwrap();
+    let (ok, _, stderr) = run_within(&["reduce", s(&out), "--out", s(&tmp.path().join("m")), "--merge"], &[], limit);
+    assert!(!ok && stderr.contains("more than 1000000"), "{stderr}");
+    assert!(!tmp.path().join("m").exists());
+}
+
+#[test]
+fn status_of_many_shards_is_a_summary_and_a_directory_under_a_temporary_name_is_named() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("run");
+    // 40 shards of 8 chunks: shard 0 done, 1…7 not started, 8…39 own nothing.
+    assert!(run(&["sweep", QUICK, "--out", s(&dir), "--shard", "0", "--shards", "40", "--quiet"]).0);
+    let (ok, stdout, stderr) = run(&["status", s(&dir)]);
+    assert!(ok, "{stderr}");
+    let shard_lines = stdout.lines().filter(|l| l.trim_start().split(' ').next().is_some_and(|w| w.parse::<u64>().is_ok())).count();
+    assert_eq!(shard_lines, 7, "only the unfinished shards are listed: {stdout}");
+    assert!(stdout.contains("40 shards: 33 finished") && stdout.contains("status --json"), "{stdout}");
+    let (ok, stdout, _) = run(&["status", s(&dir), "--json"]);
+    let v: serde_json::Value = serde_json::from_str(stdout.trim()).unwrap();
+    assert!(ok && v["shards"].as_array().unwrap().len() == 40);
+    // A directory named like a chunk being written is not one: it is named,
+    // not removed as an abandoned temporary ("Is a directory").
+    let odd = dir.join("shards/.chunk-000001.parquet.tmp-abc");
+    std::fs::create_dir(&odd).unwrap();
+    let stderr = refused(&["sweep", QUICK, "--out", s(&dir), "--shard", "1", "--shards", "40", "--quiet"], &[s(&odd), "move it out"]);
+    assert!(!stderr.contains("Is a directory"), "{stderr}");
+    assert!(odd.is_dir());
+}

@@ -261,6 +261,24 @@ fn a_map_directory_is_only_replaced_when_it_is_a_map() {
     let (ok, _, stderr) = run(&["reduce", s(&dir), "--out", s(&notes)]);
     assert!(!ok && stderr.contains("not a cablemap map"), "{stderr}");
     assert_eq!(std::fs::read(notes.join("thesis.pdf")).unwrap(), b"pdf");
+    // A file named summary.json does not make a folder a map: only the
+    // format marker a reduce writes does (replacing deletes everything).
+    let lookalike = tmp.path().join("lookalike");
+    std::fs::create_dir_all(lookalike.join("sub")).unwrap();
+    std::fs::write(lookalike.join("summary.json"), "{}\n").unwrap();
+    std::fs::write(lookalike.join("thesis.tex"), "keep\n").unwrap();
+    let before = snapshot(&lookalike);
+    let (ok, _, stderr) = run(&["reduce", s(&dir), "--out", s(&lookalike)]);
+    assert!(!ok && stderr.contains("not a cablemap map") && stderr.contains("cablemap-map/"), "{stderr}");
+    assert_eq!(snapshot(&lookalike), before);
+    assert!(lookalike.join("sub").is_dir());
+    // A map cablemap wrote is replaced, and an empty directory is taken.
+    let map = tmp.path().join("map");
+    std::fs::create_dir(&map).unwrap();
+    for _ in 0..2 {
+        let (ok, _, stderr) = run(&["reduce", s(&dir), "--out", s(&map)]);
+        assert!(ok, "{stderr}");
+    }
 }
 
 #[test]
@@ -270,18 +288,62 @@ fn outputs_aimed_into_a_run_directory_are_refused_and_the_run_stays_usable() {
     assert!(sweep(Path::new(QUICK), &dir).0);
     let before = snapshot(&dir);
     let inside = dir.join("maps");
+    // At any depth, through `..`, and for output files as well as directories.
+    let deep = dir.join("shards/new/deeper/map");
+    let roundabout = dir.join("shards/../checksums/map");
+    let manifest = dir.join("manifest.json");
+    let csv = dir.join("shards/centreline.csv");
+    let nested = dir.join("shards/run");
+    let simulate = |csv: &Path| {
+        vec!["simulate".to_string(), "--routing".into(), "0,1,0,1,0".into(), "--tension".into(), "1".into(), "--csv".into(), s(csv).into()]
+    };
+    let simulations = [simulate(&manifest), simulate(&csv)];
     for args in [
         vec!["reduce", s(&dir), "--out", s(&dir)],
         vec!["reduce", s(&dir), "--out", s(&inside)],
+        vec!["reduce", s(&dir), "--out", s(&dir.join("shards/map"))],
+        vec!["reduce", s(&dir), "--out", s(&deep)],
+        vec!["reduce", s(&dir), "--out", s(&roundabout)],
+        vec!["reduce", s(&dir), "--out", s(&deep), "--shard", "0", "--shards", "2"],
         vec!["design", "--target", "x=50,y=5", "--out", s(&dir)],
         vec!["diagnose", "no-such.csv", "--out", s(&dir)],
         vec!["diagnose", "no-such.csv", "--out", s(&inside)],
-    ] {
+        vec!["sweep", QUICK, "--out", s(&nested), "--quiet"],
+    ]
+    .into_iter()
+    .chain(simulations.iter().map(|a| a.iter().map(String::as_str).collect()))
+    {
         let (ok, _, stderr) = run(&args);
         assert!(!ok && stderr.contains("sweep run directory") && stderr.contains("outside the run"), "{args:?}: {stderr}");
     }
     assert_eq!(snapshot(&dir), before);
     assert!(run(&["status", s(&dir)]).0);
+}
+
+/// A cable sweep of two routings and two tensions: a few milliseconds.
+const TINY_CABLE_SPEC: &str = "[rod.gravity]\nenabled = false\n[output]\nchunk_routings = 1\n[[cable]]\ny_mm = [2, 2, 2, 2, 2]\n\
+    tension_n = { min = 0.5, max = 1.0, count = 2 }\n[[cable.sweep]]\naxis = \"y\"\npoints = [2]\nlevels_mm = [1.0, 3.0]\n";
+
+#[test]
+fn a_cable_run_is_guarded_like_a_planar_run() {
+    let tmp = tempfile::tempdir().unwrap();
+    let spec = tmp.path().join("cables.toml");
+    std::fs::write(&spec, TINY_CABLE_SPEC).unwrap();
+    let dir = tmp.path().join("cabrun");
+    let (ok, _, stderr) = sweep(&spec, &dir);
+    assert!(ok, "{stderr}");
+    let before = snapshot(&dir);
+    for args in [
+        vec!["reduce", s(&dir), "--out", s(&dir.join("mymap"))],
+        vec!["design", "--target", "x=50,y=5", "--out", s(&dir.join("d"))],
+        vec!["simulate", "--routing", "0,1,0,1,0", "--tension", "1", "--csv", s(&dir.join("shards/c.csv"))],
+    ] {
+        let (ok, _, stderr) = run(&args);
+        assert!(!ok && stderr.contains("sweep run directory") && stderr.contains("outside the run"), "{args:?}: {stderr}");
+    }
+    assert_eq!(snapshot(&dir), before);
+    let (ok, _, stderr) = run(&["status", s(&dir)]);
+    assert!(ok, "{stderr}");
 }
 
 #[test]

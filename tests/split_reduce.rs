@@ -169,6 +169,34 @@ fn missing_mixed_foreign_and_damaged_parts_are_refused_with_the_fix() {
     run(&["reduce", s(&dir), "--out", s(&map), "--shard", "0", "--shards", "2"]);
     assert!(merge(&dir, &map).0);
     assert_eq!(tables(&map), single);
+    // Three flipped bytes in a samples file (same length): its checksum names it.
+    let mut bytes = std::fs::read(&samples).unwrap();
+    for at in [100, bytes.len() / 2, bytes.len() - 3] {
+        bytes[at] ^= 0x5a;
+    }
+    std::fs::write(&samples, &bytes).unwrap();
+    let (ok, _, stderr) = merge(&dir, &map);
+    assert!(
+        !ok && stderr.contains("part-0-of-2.samples") && stderr.contains("SHA-256") && stderr.contains("--shard 0 --shards 2`"),
+        "{stderr}"
+    );
+    assert_eq!(tables(&map), single, "the refused merge left the earlier map");
+    run(&["reduce", s(&dir), "--out", s(&map), "--shard", "0", "--shards", "2"]);
+    // An edited count and extent in a record (valid JSON, plausible numbers).
+    let mut v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&record).unwrap()).unwrap();
+    let rows = v["pass1"]["tally"]["rows_total"].as_u64().unwrap();
+    v["pass1"]["tally"]["rows_total"] = (rows + 10).into();
+    let x_max = v["pass1"]["extent"]["x_mm"][1].as_f64().unwrap();
+    v["pass1"]["extent"]["x_mm"][1] = (x_max + 40.0).into();
+    std::fs::write(&record, serde_json::to_string_pretty(&v).unwrap()).unwrap();
+    let (ok, _, stderr) = merge(&dir, &map);
+    assert!(
+        !ok && stderr.contains("part-1-of-2.json") && stderr.contains("record_sha256") && stderr.contains("--shard 1 --shards 2`"),
+        "{stderr}"
+    );
+    run(&["reduce", s(&dir), "--out", s(&map), "--shard", "1", "--shards", "2"]);
+    assert!(merge(&dir, &map).0);
+    assert_eq!(tables(&map), single);
 }
 
 #[test]

@@ -23,7 +23,12 @@ pub struct BenchArgs {
 
 /// Runs the solver benchmark with gravity on and off.
 pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
-    anyhow::ensure!(args.routings > 0, "--routings must be at least 1");
+    anyhow::ensure!(
+        (1..=cablemap::bench::MAX_ROUTINGS).contains(&args.routings),
+        "--routings {} must be 1 … {} (the thesis grid's 9⁵ routings)",
+        args.routings,
+        cablemap::bench::MAX_ROUTINGS
+    );
     let base = args.actuator.resolve(None)?;
     let options = args.actuator.solver_options(&SolverOptions::default());
     let routings = sample_thesis_routings(args.routings, base.radius_mm);

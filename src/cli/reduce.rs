@@ -161,6 +161,7 @@ fn with_flags(e: ReduceError, run: &Path, out: &Path) -> anyhow::Error {
     let part = |i: String, n: String| format!("cablemap reduce {} --out {} --shard {i} --shards {n}", run.display(), out.display());
     match &e {
         ReduceError::CellTooSmall { smallest_cell_mm, .. } => anyhow::anyhow!("{e} (use --cell-mm ≥ {smallest_cell_mm:.3e})"),
+        ReduceError::CellTooLarge { largest_cell_mm, .. } => anyhow::anyhow!("{e} (--cell-mm {largest_cell_mm} or less)"),
         ReduceError::ModesNotSplit { .. } => anyhow::anyhow!("{e}: --a0-bounds B1,B2,B3 and --a1-bounds C1,C2"),
         ReduceError::Parts(PartsError::Missing { shards, missing, .. }) => {
             if let [one] = missing.as_slice() {
@@ -168,6 +169,9 @@ fn with_flags(e: ReduceError, run: &Path, out: &Path) -> anyhow::Error {
             } else {
                 anyhow::anyhow!("{e}: `{}` for each missing I", part("I".into(), shards.to_string()))
             }
+        }
+        ReduceError::Parts(PartsError::Damaged { shard, shards, .. }) => {
+            anyhow::anyhow!("{e}: `{}`", part(shard.to_string(), shards.to_string()))
         }
         ReduceError::Parts(PartsError::NoParts { .. }) => anyhow::anyhow!("{e}: `{}` for I = 0 … N-1", part("I".into(), "N".into())),
         _ => e.into(),

@@ -122,11 +122,11 @@ pub fn load_spec(path: Option<&Path>) -> anyhow::Result<SweepSpec> {
 
 /// Worker threads: `threads`, else $SLURM_CPUS_PER_TASK, else one per core (None).
 pub fn thread_count(threads: Option<usize>) -> anyhow::Result<Option<usize>> {
-    let threads = match threads {
-        Some(t) => Some(t),
-        None => env_number::<usize>("SLURM_CPUS_PER_TASK")?,
+    let (threads, source) = match threads {
+        Some(t) => (Some(t), "--threads"),
+        None => (env_number::<usize>("SLURM_CPUS_PER_TASK")?, "environment variable SLURM_CPUS_PER_TASK"),
     };
-    anyhow::ensure!(threads != Some(0), "--threads must be at least 1");
+    anyhow::ensure!(threads != Some(0), "{source} = 0: at least 1 thread is needed");
     Ok(threads)
 }
 
@@ -238,6 +238,43 @@ pub fn run_status_command(args: &StatusArgs) -> anyhow::Result<()> {
     }
 }
 
+/// Most shards listed one per line by `status`; beyond, the table lists
+/// the unfinished ones up to this many and counts the rest (`--json` has
+/// every shard).
+const SHARD_LINES: usize = 32;
+
+/// The per-shard table of `status`: every shard for a few dozen, else a
+/// count of finished shards and the first unfinished ones.
+fn print_shard_table(shards: &[cablemap::sweep::status::ShardStatus]) {
+    let line = |sh: &cablemap::sweep::status::ShardStatus| {
+        println!(
+            "{:>6} {:>14} {:>22} {:>9}",
+            sh.shard,
+            format!("{}/{}", sh.chunks_done, sh.chunks_total),
+            format!("{}/{}", sh.rows_done, sh.rows_total),
+            sh.failures
+        )
+    };
+    println!("{:>6} {:>14} {:>22} {:>9}", "shard", "chunks", "rows", "failures");
+    if shards.len() <= SHARD_LINES {
+        shards.iter().for_each(line);
+        return;
+    }
+    let unfinished: Vec<_> = shards.iter().filter(|sh| sh.chunks_done < sh.chunks_total).collect();
+    unfinished.iter().take(SHARD_LINES).for_each(|sh| line(sh));
+    let finished = shards.len() - unfinished.len();
+    let more = unfinished.len().saturating_sub(SHARD_LINES);
+    println!(
+        "  ({} shards: {finished} finished{}; `status --json` lists every shard)",
+        shards.len(),
+        if more > 0 {
+            format!(", {} unfinished listed, {more} more unfinished", SHARD_LINES)
+        } else {
+            format!(", {} unfinished listed", unfinished.len())
+        }
+    );
+}
+
 fn print_status<S: RunSpec>(s: &RunStatus<S>, json: bool) -> anyhow::Result<()> {
     if json {
         println!("{}", s.to_json_value());
@@ -259,16 +296,7 @@ fn print_status<S: RunSpec>(s: &RunStatus<S>, json: bool) -> anyhow::Result<()> 
         m.shards
     );
     println!("a_i        orders 0..={}, {}", m.spec.order(), m.length_basis.describe());
-    println!("{:>6} {:>14} {:>22} {:>9}", "shard", "chunks", "rows", "failures");
-    for sh in &s.shards {
-        println!(
-            "{:>6} {:>14} {:>22} {:>9}",
-            sh.shard,
-            format!("{}/{}", sh.chunks_done, sh.chunks_total),
-            format!("{}/{}", sh.rows_done, sh.rows_total),
-            sh.failures
-        );
-    }
+    print_shard_table(&s.shards);
     println!("statuses   {}", fmt_counts(&s.status_counts));
     for d in &s.damaged {
         println!("damaged    {} ({}): rerun its shard's sweep command to move it aside and recompute it", d.path.display(), d.reason);

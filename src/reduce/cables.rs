@@ -37,6 +37,10 @@ pub const PLANAR_MAP_DIR: &str = "planar";
 /// `summary.json` of a cable map directory.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct CableMapSummary {
+    /// [`super::tables::MAP_FORMAT`]: marks the directory as a map written
+    /// by cablemap.
+    #[serde(default)]
+    pub format: String,
     /// Always `cables`: tells this summary from a planar map's.
     pub kind: String,
     /// The run read.
@@ -96,9 +100,7 @@ pub fn reduce_cable_run(
     let run: SweepRun<CableSweepSpec> = open_run_of(run_dir, completeness)?;
     let spec = run.spec().clone();
     let cell_mm = cell_mm.unwrap_or(spec.output.cell_mm);
-    if !(cell_mm.is_finite() && cell_mm > 0.0) {
-        return Err(ReduceError::CellSize { cell_mm });
-    }
+    super::check_cell_mm(cell_mm, spec.rod.length_mm)?;
     let reach = Reach::count(&run, cell_mm)?;
     let planar = spec.is_planar() && spec.output.order >= 1;
     let planar_map = if planar {
@@ -112,6 +114,7 @@ pub fn reduce_cable_run(
     let rows = run.rows_done();
     let layout = spec.layout();
     let summary = CableMapSummary {
+        format: super::tables::MAP_FORMAT.into(),
         kind: "cables".into(),
         run_dir: run_dir.display().to_string(),
         spec_sha256: run.manifest().spec_sha256.clone(),

@@ -96,6 +96,18 @@ pub enum ReduceError {
         /// The cell size given, mm.
         cell_mm: f64,
     },
+    /// The cell is larger than the rod's whole reach.
+    #[error(
+        "cell size {} mm is larger than the whole reach can be ({largest_cell_mm} mm: the tip stays within the rod's length \
+         of the clamp): use a cell size ≤ {largest_cell_mm} mm",
+        crate::io::fmt_num(*cell_mm)
+    )]
+    CellTooLarge {
+        /// The cell size given, mm.
+        cell_mm: f64,
+        /// The largest useful cell, mm (twice the rod's length).
+        largest_cell_mm: f64,
+    },
     /// The run has no a_1 column.
     #[error("the run stores only a_0; modes need a_1: sweep with order ≥ 1")]
     OrderTooLow,
@@ -146,9 +158,10 @@ pub enum ReduceError {
     },
     /// The map directory holds something other than a map.
     #[error(
-        "map directory {}: exists and is not a cablemap map (no summary.json), and a map directory is replaced as a whole: \
-         give a new directory, or an earlier map to replace",
-        path.display()
+        "map directory {}: exists and is not a cablemap map (no summary.json naming the format '{}'), and a map directory \
+         is replaced as a whole: give a new directory, or an earlier map to replace",
+        path.display(),
+        tables::MAP_FORMAT
     )]
     NotAMap {
         /// The directory.
@@ -353,6 +366,10 @@ impl ReduceOptions {
 /// The summary written as summary.json (docs/maps.md).
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct MapSummary {
+    /// [`tables::MAP_FORMAT`]: marks the directory as a map written by
+    /// cablemap (empty in maps written before the field existed).
+    #[serde(default)]
+    pub format: String,
     /// Cell size, mm.
     pub cell_mm: f64,
     /// Lower-left corner of cell (0, 0), mm.
@@ -561,6 +578,7 @@ where
     }
     let modes = modes::table(&cells, &split.boundaries, fetched);
     let summary = MapSummary {
+        format: tables::MAP_FORMAT.into(),
         cell_mm: grid.cell_mm,
         x_min_mm: grid.x_min_mm,
         y_min_mm: grid.y_min_mm,
@@ -588,14 +606,28 @@ where
 
 /// Refuses options the reduction cannot use, before reading the run.
 fn check_options(info: &RunInfo, options: &ReduceOptions) -> Result<(), ReduceError> {
-    if !(options.cell_mm.is_finite() && options.cell_mm > 0.0) {
-        return Err(ReduceError::CellSize { cell_mm: options.cell_mm });
-    }
+    check_cell_mm(options.cell_mm, info.length_mm)?;
     if info.order < 1 {
         return Err(ReduceError::OrderTooLow);
     }
     if let Some(b) = &options.mode_boundaries {
         b.validate()?;
+    }
+    Ok(())
+}
+
+/// Refuses a cell size that is not positive and finite, or larger than
+/// twice the rod's length `length_mm` (the whole reach, ±L about the clamp,
+/// in one or two cells per axis): beyond that a map says nothing, and its
+/// corners and pictures would overflow to infinity (a 1e308 mm cell hung
+/// the drawing of its axes).
+pub(crate) fn check_cell_mm(cell_mm: f64, length_mm: f64) -> Result<(), ReduceError> {
+    if !(cell_mm.is_finite() && cell_mm > 0.0) {
+        return Err(ReduceError::CellSize { cell_mm });
+    }
+    let largest_cell_mm = 2.0 * length_mm;
+    if cell_mm > largest_cell_mm {
+        return Err(ReduceError::CellTooLarge { cell_mm, largest_cell_mm });
     }
     Ok(())
 }
@@ -822,6 +854,12 @@ mod tests {
             ReduceError::CellTooSmall { smallest_cell_mm, .. } => assert!(*smallest_cell_mm > 1e-6 && *smallest_cell_mm < 1e-3),
             other => panic!("{other:?}"),
         }
+        // A cell larger than the whole reach (its corners overflowed and hung the drawing).
+        let e = reduce_batches(&info(false), &ReduceOptions { cell_mm: 1e308, ..Default::default() }, || {
+            Ok(vec![Ok(batch(&pseudo_rows(40)))].into_iter())
+        })
+        .unwrap_err();
+        assert!(matches!(e, ReduceError::CellTooLarge { largest_cell_mm, .. } if largest_cell_mm == 130.0), "{e:?}");
         // One routing cannot be split into modes by quantiles.
         let one: Vec<Row> = (0..5).map(|i| ([0.0, 1.0, 0.0, -1.0, 0.5], 1.0 + 0.1 * i as f64, "ok", 50.0, 2.0, [0.1, 0.2, 0.0])).collect();
         let e = reduce_batches(&info(false), &ReduceOptions::default(), || Ok(vec![Ok(batch(&one))].into_iter())).unwrap_err();

@@ -10,8 +10,8 @@ use std::path::{Path, PathBuf};
 /// staging directory beside it (`.NAME.tmp-TOKEN`), which then replaces
 /// `dir` by rename, so a reader sees the old map or the new one, never a
 /// mix (an interrupted reduce leaves the old map untouched). `dir` must be
-/// new, empty, or an earlier map (it has summary.json); it must not be, or
-/// lie directly inside, a sweep run directory.
+/// new, empty, or an earlier map (its summary.json names the map format);
+/// it must not be, or lie inside, a sweep run directory.
 pub fn write_map_replacing(
     dir: &Path,
     map: &MapData,
@@ -66,7 +66,7 @@ pub fn check_map_out(dir: &Path) -> Result<String, ReduceError> {
     };
     match std::fs::read_dir(dir) {
         Ok(mut entries) => {
-            if entries.next().is_some() && !dir.join(tables::SUMMARY_FILE).is_file() {
+            if entries.next().is_some() && !is_map_dir(dir) {
                 return Err(ReduceError::NotAMap { path: dir.to_path_buf() });
             }
         }
@@ -74,6 +74,22 @@ pub fn check_map_out(dir: &Path) -> Result<String, ReduceError> {
         Err(source) => return Err(ReduceError::MapDirUnreadable { path: dir.to_path_buf(), source }),
     }
     Ok(name)
+}
+
+/// Whether `dir` holds a map written by cablemap: its summary.json names
+/// the map format ([`tables::MAP_FORMAT`]). File names alone prove nothing
+/// (any folder may hold a `summary.json`), and replacing a map deletes
+/// everything in it.
+fn is_map_dir(dir: &Path) -> bool {
+    let path = dir.join(tables::SUMMARY_FILE);
+    // A summary is a few kB; a huge file is not one (and is not read whole).
+    if !std::fs::symlink_metadata(&path).is_ok_and(|m| m.is_file() && m.len() < 1 << 20) {
+        return false;
+    }
+    std::fs::read(&path)
+        .ok()
+        .and_then(|b| serde_json::from_slice::<serde_json::Value>(&b).ok())
+        .is_some_and(|v| v["format"].as_str().is_some_and(|f| f.starts_with(tables::MAP_FORMAT_PREFIX)))
 }
 
 /// Moves `staging` to `dir`: directly when `dir` is absent or empty, else

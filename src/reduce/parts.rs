@@ -9,7 +9,10 @@
 //! N, `part-I-of-N.samples` (scratch records, see `spill`) and
 //! `part-I-of-N.json` (what the part covers and found). Each file is
 //! written to a temporary name, synced and renamed into place, the record
-//! last; a part is done when its record is there. A part's content depends
+//! last; a part is done when its record is there. The record holds the
+//! SHA-256 of the samples file and of its own content, and the merge
+//! checks both: a flipped byte or an edited count is refused, naming the
+//! part to run again, instead of merging into a wrong map. A part's content depends
 //! only on the run and (I, N), so a part re-run after a kill, or two copies
 //! of one part at once, leave the same files. The merge refuses missing,
 //! mismatched or mixed-N parts; `MAP_DIR.parts/` may be removed once the
@@ -22,14 +25,19 @@ use crate::sweep::{open_run, Completeness, SweepRun, SweepSpec};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
-/// Format tag of a part record.
-pub const PART_FORMAT: &str = "cablemap-reduce-part/1";
+/// Format tag of a part record. Version 2: the record holds checksums of
+/// its samples file and of itself.
+pub const PART_FORMAT: &str = "cablemap-reduce-part/2";
 
 /// Why a split reduction's parts do not make a map.
 #[derive(Debug, thiserror::Error)]
 pub enum PartsError {
-    /// The part number is not below the number of parts.
-    #[error("part {shard} of {shards}: parts are numbered 0 to {}; the number of parts must be at least 1", shards.saturating_sub(1))]
+    /// The part number is not below the number of parts, or there are
+    /// more parts than a reduce may be split into.
+    #[error(
+        "part {shard} of {shards}: parts are numbered 0 to N-1, and the number of parts N must be 1 … {}",
+        crate::sweep::MAX_SHARDS
+    )]
     BadShard {
         /// The part asked for.
         shard: u64,
@@ -68,6 +76,30 @@ pub enum PartsError {
         /// What is wrong.
         problem: String,
     },
+    /// A part's files changed after they were written (a checksum differs).
+    #[error("{}: {problem}: the part was damaged or edited after it was written; run part {shard} of {shards} again", path.display())]
+    Damaged {
+        /// The part's file that failed its check.
+        path: PathBuf,
+        /// The part.
+        shard: u64,
+        /// The number of parts.
+        shards: u64,
+        /// What differs.
+        problem: String,
+    },
+    /// Part records of a split into more parts than a reduce may have.
+    #[error(
+        "{}: holds parts of a split into {shards} parts, more than {}: remove the directory and split into fewer parts",
+        dir.display(),
+        crate::sweep::MAX_SHARDS
+    )]
+    TooMany {
+        /// The parts directory.
+        dir: PathBuf,
+        /// The number of parts the records name.
+        shards: u64,
+    },
     /// A part's record cannot be read or written.
     #[error("{}: {source}", path.display())]
     Io {
@@ -78,8 +110,14 @@ pub enum PartsError {
     },
 }
 
+/// The numbers of `v` for a message: the first few, then how many more.
 fn list(v: &[u64]) -> String {
-    v.iter().map(u64::to_string).collect::<Vec<_>>().join(", ")
+    const SHOWN: usize = 20;
+    let mut text = v.iter().take(SHOWN).map(u64::to_string).collect::<Vec<_>>().join(", ");
+    if v.len() > SHOWN {
+        text.push_str(&format!(", … ({} more)", v.len() - SHOWN));
+    }
+    text
 }
 
 /// What one part covers and found (`part-I-of-N.json`).
@@ -100,6 +138,25 @@ struct PartRecord {
     records: u64,
     /// Pass 1's tallies.
     pass1: Pass1,
+    /// SHA-256 of the samples file, hex.
+    samples_sha256: String,
+    /// SHA-256 of this record's JSON with this field empty, hex.
+    record_sha256: String,
+}
+
+impl PartRecord {
+    /// SHA-256 of the record's content: its compact JSON with
+    /// `record_sha256` empty (serde writes the fields in declaration order
+    /// and f64 values so that they read back exactly, so the JSON of the
+    /// parsed record is the JSON that was hashed).
+    fn content_sha256(&self) -> String {
+        use sha2::{Digest, Sha256};
+        let content = PartRecord {
+            record_sha256: String::new(),
+            ..self.clone()
+        };
+        crate::io::hex(&Sha256::digest(serde_json::to_vec(&content).expect("a part record serializes")))
+    }
 }
 
 /// The parts directory of map directory `map_dir`: `MAP_DIR.parts`.
@@ -135,7 +192,7 @@ pub struct PartReport {
 /// Writes part `shard` of `shards` of the reduction of the (complete) run
 /// in `run_dir` into `map_dir`'s parts directory.
 pub fn write_part(run_dir: &Path, map_dir: &Path, shard: u64, shards: u64) -> Result<PartReport, ReduceError> {
-    if shards == 0 || shard >= shards {
+    if shards == 0 || shard >= shards || shards > crate::sweep::MAX_SHARDS {
         return Err(PartsError::BadShard { shard, shards }.into());
     }
     super::check_map_out(map_dir)?;
@@ -160,10 +217,11 @@ pub fn write_part(run_dir: &Path, map_dir: &Path, shard: u64, shards: u64) -> Re
         });
         let pass1 = super::samples::spill_samples(&info, batches, first_row as u32, &mut out)?;
         let records = out.finish(true)?;
+        let sha256 = crate::io::sha256_file(&tmp).map_err(|e| spill::scratch_error(&tmp, e))?;
         std::fs::rename(&tmp, &samples_path).map_err(|e| spill::scratch_error(&samples_path, e))?;
-        Ok::<_, ReduceError>((pass1, records))
+        Ok::<_, ReduceError>((pass1, records, sha256))
     })();
-    let (pass1, records) = written.inspect_err(|_| {
+    let (pass1, records, samples_sha256) = written.inspect_err(|_| {
         let _ = std::fs::remove_file(&tmp);
     })?;
     let record = PartRecord {
@@ -176,6 +234,12 @@ pub fn write_part(run_dir: &Path, map_dir: &Path, shard: u64, shards: u64) -> Re
         first_row,
         records,
         pass1: pass1.clone(),
+        samples_sha256,
+        record_sha256: String::new(),
+    };
+    let record = PartRecord {
+        record_sha256: record.content_sha256(),
+        ..record
     };
     let json = serde_json::to_vec_pretty(&record).expect("a part record serializes");
     remove_abandoned_temps(&dir, &record_path);
@@ -235,7 +299,7 @@ fn read_parts(dir: &Path, run: &SweepRun) -> Result<(Vec<PathBuf>, Pass1), Parts
             })
         }
     };
-    let mut found: Vec<(u64, u64)> = Vec::new();
+    let mut found: std::collections::BTreeSet<(u64, u64)> = std::collections::BTreeSet::new();
     for e in entries.flatten() {
         let name = e.file_name().to_string_lossy().into_owned();
         let parsed = name
@@ -243,7 +307,7 @@ fn read_parts(dir: &Path, run: &SweepRun) -> Result<(Vec<PathBuf>, Pass1), Parts
             .and_then(|r| r.strip_suffix(".json"))
             .and_then(|r| r.split_once("-of-"));
         if let Some((i, n)) = parsed.and_then(|(i, n)| Some((i.parse::<u64>().ok()?, n.parse::<u64>().ok()?))) {
-            found.push((i, n));
+            found.insert((i, n));
         }
     }
     if found.is_empty() {
@@ -259,6 +323,12 @@ fn read_parts(dir: &Path, run: &SweepRun) -> Result<(Vec<PathBuf>, Pass1), Parts
         });
     }
     let shards = counts[0];
+    if shards > crate::sweep::MAX_SHARDS {
+        return Err(PartsError::TooMany {
+            dir: dir.to_path_buf(),
+            shards,
+        });
+    }
     let missing: Vec<u64> = (0..shards).filter(|i| !found.contains(&(*i, shards))).collect();
     if !missing.is_empty() {
         return Err(PartsError::Missing {
@@ -296,6 +366,22 @@ fn read_parts(dir: &Path, run: &SweepRun) -> Result<(Vec<PathBuf>, Pass1), Parts
         if record.spec_sha256 != run.manifest().spec_sha256 {
             return Err(mismatch("it is a part of another run (its spec hash differs)".into()));
         }
+        let damaged = |path: &Path, problem: String| PartsError::Damaged {
+            path: path.to_path_buf(),
+            shard,
+            shards,
+            problem,
+        };
+        let content = record.content_sha256();
+        if content != record.record_sha256 {
+            return Err(damaged(
+                &path,
+                format!(
+                    "its content hashes to {content}, not the recorded record_sha256 {}",
+                    record.record_sha256
+                ),
+            ));
+        }
         let range = chunk_range(run.chunk_count(), shard, shards);
         let first_row: u64 = (0..range[0]).map(|i| run.chunk_rows(i)).sum();
         let rows: u64 = (range[0]..range[1]).map(|i| run.chunk_rows(i)).sum();
@@ -316,6 +402,19 @@ fn read_parts(dir: &Path, run: &SweepRun) -> Result<(Vec<PathBuf>, Pass1), Parts
                 path: samples,
                 problem: format!("{len} bytes where the part's record says {} samples", record.records),
             });
+        }
+        let actual = crate::io::sha256_file(&samples).map_err(|source| PartsError::Io {
+            path: samples.clone(),
+            source,
+        })?;
+        if actual != record.samples_sha256 {
+            return Err(damaged(
+                &samples,
+                format!(
+                    "its SHA-256 is {actual}, not the {} recorded when it was written",
+                    record.samples_sha256
+                ),
+            ));
         }
         files.push(samples);
         pass1.merge(&record.pass1);
@@ -353,6 +452,39 @@ mod tests {
                 assert!(ranges.windows(2).all(|w| w[0][1] == w[1][0]));
             }
         }
+    }
+
+    #[test]
+    fn a_records_checksum_survives_its_json_and_catches_an_edit() {
+        let mut pass1 = Pass1::default();
+        pass1.tally.rows_total = 1234;
+        pass1.extent.x_mm = [12.345678901234567, 1.0 / 3.0];
+        let record = PartRecord {
+            format: PART_FORMAT.into(),
+            shard: 1,
+            shards: 3,
+            spec_sha256: "ab".into(),
+            run_chunks: 8,
+            chunk_range: [3, 5],
+            first_row: 240,
+            records: 7,
+            pass1,
+            samples_sha256: "cd".into(),
+            record_sha256: String::new(),
+        };
+        let record = PartRecord {
+            record_sha256: record.content_sha256(),
+            ..record
+        };
+        let read: PartRecord = serde_json::from_slice(&serde_json::to_vec_pretty(&record).unwrap()).unwrap();
+        assert_eq!(read.content_sha256(), record.record_sha256);
+        let mut edited = read.clone();
+        edited.pass1.extent.x_mm[1] += 1e-12;
+        assert_ne!(edited.content_sha256(), record.record_sha256);
+        assert_eq!(
+            list(&(0..25).collect::<Vec<_>>()),
+            format!("{}, … (5 more)", list(&(0..20).collect::<Vec<_>>()))
+        );
     }
 
     #[test]

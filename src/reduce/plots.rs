@@ -327,6 +327,7 @@ mod tests {
 
     fn summary() -> MapSummary {
         MapSummary {
+            format: crate::reduce::tables::MAP_FORMAT.into(),
             cell_mm: 5.0,
             x_min_mm: 20.0,
             y_min_mm: -40.0,

@@ -19,6 +19,12 @@ use std::sync::Arc;
 
 /// The map's summary (JSON).
 pub const SUMMARY_FILE: &str = "summary.json";
+/// Format tag in every map's summary.json (`format`), planar and cable
+/// maps alike: the marker by which a reduce recognises a directory it may
+/// replace as a whole (`output::check_map_out`).
+pub const MAP_FORMAT: &str = "cablemap-map/1";
+/// What every [`MAP_FORMAT`] begins with, whatever its version.
+pub const MAP_FORMAT_PREFIX: &str = "cablemap-map/";
 /// One row per non-empty cell.
 pub const CELLS_FILE: &str = "cells.parquet";
 /// One row per characteristic mode.

@@ -234,6 +234,18 @@ impl CableSweepSpec {
             if t.count == 0 || t.count > MAX_TENSION_COUNT {
                 return Err(bad(format!("cable {n}: tension_n.count = {} must be 1 … {MAX_TENSION_COUNT}", t.count)));
             }
+            // The anchor is not swept: outside the rod, every routing's rows
+            // would be invalid_routing.
+            if let Some(anchor) = c.anchor_mm {
+                let length = self.rod.length_mm;
+                if !(anchor.is_finite() && anchor > 0.0 && anchor <= length) {
+                    return Err(bad(format!(
+                        "cable {n}: anchor_mm = {} must lie on the rod, in (0, {length}] mm (the rod's length_mm; leave \
+                         anchor_mm out for the tip)",
+                        crate::io::fmt_num(anchor)
+                    )));
+                }
+            }
             let mut seen = std::collections::BTreeSet::new();
             for s in &c.sweeps {
                 if s.levels_mm.is_empty() || s.levels_mm.iter().any(|v| !v.is_finite()) {
@@ -501,6 +513,13 @@ impl RunSpec for CableSweepSpec {
         rows_schema(self.cables.len(), self.output.order)
     }
 
+    fn row_bytes(&self) -> u64 {
+        // Per copy: the Row (its cables' control points, tensions, pose and
+        // three series) or its columns; three copies as for planar rows.
+        let (cables, terms) = (self.cables.len() as u64, self.output.order as u64 + 1);
+        3 * (256 + 96 * cables + 24 * terms)
+    }
+
     fn worker(&self) -> Result<CableWorker, SweepError> {
         let grids = self.tension_grids();
         Ok(CableWorker { dims: self.dimensions(), combos: snake(&grids), grids })
@@ -704,6 +723,11 @@ levels_mm = [0.0, 1.5, -1.5]
             (SPEC.replace("[rod.gravity]", "[rod.effects]\nfriction_mu = 0.1\n[rod.gravity]"), "friction_mu"),
             (format!("{SPEC}\n[output]\norder = 7\n"), "steps_per_span"),
             (SPEC.replace("axis = \"z\"", "axis = \"x\""), "unknown variant"),
+            (
+                SPEC.replace("y_mm = [2, 2, 2, 2, 2]", "y_mm = [2, 2, 2, 2, 2]\nanchor_mm = -1"),
+                "cable 1: anchor_mm = -1 must lie on the rod",
+            ),
+            (SPEC.replace("y_mm = [-2, -2, -2, -2, -2]", "y_mm = [-2, -2, -2, -2, -2]\nanchor_mm = 70"), "cable 2: anchor_mm = 70"),
             ("[rod]\n".to_string(), "cable"),
         ] {
             let e = CableSweepSpec::from_toml(&text, "spec.toml").unwrap_err().to_string();

@@ -102,6 +102,10 @@ pub trait RunSpec: Clone + PartialEq + std::fmt::Debug + serde::Serialize + serd
     fn layout(&self) -> ChunkLayout;
     /// The Arrow schema of the rows (docs/schema.md).
     fn schema(&self) -> SchemaRef;
+    /// Estimated bytes one row takes in memory while its chunk is built
+    /// (every copy: solved rows, Arrow batch, encoder buffer); sizes the
+    /// engine's memory check.
+    fn row_bytes(&self) -> u64;
     /// The prototype worker.
     fn worker(&self) -> Result<Self::Worker, SweepError>;
     /// Solves routing `id`: [`ChunkLayout::tensions`] rows.
@@ -156,6 +160,13 @@ mod tests {
         assert_eq!(l.chunk_rows(2), 6);
         assert_eq!((0..2).map(|s| l.shard_rows(s, 2)).sum::<u64>(), l.total_rows());
         assert_eq!(l.shard_chunks(1, 2).collect::<Vec<_>>(), vec![1]);
+    }
+
+    #[test]
+    fn every_run_format_is_one_io_recognises_as_a_run() {
+        for format in [super::super::store::FORMAT, super::super::cables::CABLES_FORMAT] {
+            assert!(crate::io::RUN_FORMAT_PREFIXES.iter().any(|p| format.starts_with(p)), "{format}");
+        }
     }
 
     #[test]

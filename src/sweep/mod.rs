@@ -26,7 +26,7 @@ pub mod store;
 pub use enumerate::SweepPlan;
 pub use kind::{is_cable_spec_toml, run_kind, ChunkLayout, RunKind, RunSpec};
 pub use read::{open_run, open_run_of, Completeness, SweepRun};
-pub use run::{run_sweep, run_sweep_of, SweepOptions, SweepSummary};
+pub use run::{run_sweep, run_sweep_of, SweepOptions, SweepSummary, MAX_SHARDS};
 pub use spec::SweepSpec;
 pub use status::{run_status, run_status_of, RunStatus};
 
@@ -55,6 +55,33 @@ pub enum SweepError {
     /// Shard index or count out of range.
     #[error("shard {shard} of {shards} is out of range: use 0 ≤ shard < shards (shards ≥ 1)")]
     BadShard { shard: u64, shards: u64 },
+    /// More shards than a sweep may be split into.
+    #[error(
+        "a sweep is split into at most {} shards, not {shards}: use fewer shards (a shard per chunk file, {chunks} here, is the \
+         finest useful split)",
+        run::MAX_SHARDS
+    )]
+    TooManyShards {
+        /// The shard count asked for.
+        shards: u64,
+        /// The run's chunk files.
+        chunks: u64,
+    },
+    /// The sweep would need more memory than the machine has free.
+    #[error("{0}")]
+    TooMuchMemory(String),
+    /// The run directory would lie inside another run directory.
+    #[error(
+        "{} is inside the sweep run directory {}; a run there would make that run unusable: give a directory outside the run",
+        dir.display(),
+        run.display()
+    )]
+    InsideRun {
+        /// The directory asked for.
+        dir: PathBuf,
+        /// The run directory it lies in.
+        run: PathBuf,
+    },
     /// A thread count of 0 or unparsable.
     #[error("invalid thread count: {0}")]
     BadThreads(String),

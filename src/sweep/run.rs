@@ -53,6 +53,52 @@ impl Default for SweepOptions {
 /// made a 610-solve job take over a minute), so larger requests are capped.
 pub const MAX_THREADS_PER_CORE: usize = 4;
 
+/// Most shards a sweep may be split into. Status keeps a line per shard
+/// and a shard per chunk file is the finest useful split; far beyond any
+/// cluster array (SLURM's default MaxArraySize is 1001).
+pub const MAX_SHARDS: u64 = 1_000_000;
+
+/// Estimated bytes the engine keeps per chunk file of the run: the shard's
+/// chunk lists and, for each chunk found, its path and status counts (scan,
+/// resume, status).
+const CHUNK_TABLE_BYTES: u64 = 512;
+
+/// Estimated bytes of one shard's line in a status.
+const SHARD_STATUS_BYTES: u64 = 64;
+
+/// Refuses, before anything is allocated or written, a sweep whose
+/// estimated memory (chunks being built, one per thread, and the tables of
+/// chunk files and shards) is more than the machine has available, unless
+/// `allow_large`. The message gives the figures and what to change.
+fn check_memory<S: RunSpec>(spec: &S, shards: u64, threads: usize, allow_large: bool) -> Result<(), SweepError> {
+    let layout = spec.layout();
+    let chunk_rows = layout.chunk_routings.min(layout.routings).saturating_mul(layout.tensions);
+    let chunk_bytes = chunk_rows.saturating_mul(spec.row_bytes());
+    let in_flight = (threads as u64).clamp(1, layout.chunks.max(1));
+    let building = in_flight.saturating_mul(chunk_bytes);
+    let tables = layout.chunks.saturating_mul(CHUNK_TABLE_BYTES).saturating_add(shards.saturating_mul(SHARD_STATUS_BYTES));
+    let needed = building.saturating_add(tables);
+    let Some(available) = crate::io::available_memory_bytes() else { return Ok(()) };
+    if needed <= available || allow_large {
+        return Ok(());
+    }
+    let fmt = crate::io::fmt_bytes;
+    let advice = if tables >= building {
+        format!("raise output.chunk_routings (now {}) for fewer, larger chunk files", layout.chunk_routings)
+    } else {
+        "lower output.chunk_routings or the thread count (--threads)".to_string()
+    };
+    Err(SweepError::TooMuchMemory(format!(
+        "the sweep would need about {} of memory, more than the {} available: {in_flight} chunk(s) of {chunk_rows} rows built at once \
+         ({} each) and the tables of its {} chunk files ({}): {advice}, or pass --allow-large to run it anyway",
+        fmt(needed),
+        fmt(available),
+        fmt(chunk_bytes),
+        layout.chunks,
+        fmt(tables)
+    )))
+}
+
 /// The thread count to use for a request of `requested` threads (`None`:
 /// one per core), capped at [`MAX_THREADS_PER_CORE`] per core. Returns the
 /// count and whether it was capped.
@@ -119,11 +165,21 @@ pub fn run_sweep_of<S: RunSpec>(spec: &S, dir: &Path, options: &SweepOptions) ->
     if shards == 0 || shard >= shards {
         return Err(SweepError::BadShard { shard, shards });
     }
+    if shards > MAX_SHARDS {
+        return Err(SweepError::TooManyShards { shards, chunks: spec.layout().chunks });
+    }
     if options.threads == Some(0) {
         return Err(SweepError::BadThreads("0: use at least 1 thread".into()));
     }
     spec.check_run_size(options.allow_large)?;
     let (threads_wanted, capped) = capped_threads(options.threads);
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    check_memory(spec, shards, threads_wanted.unwrap_or(cores), options.allow_large)?;
+    if let Some(run) = crate::io::enclosing_run_dir(dir) {
+        if std::fs::canonicalize(dir).ok().as_ref() != Some(&run) {
+            return Err(SweepError::InsideRun { dir: dir.to_path_buf(), run });
+        }
+    }
     if capped && options.progress != ProgressMode::Quiet {
         eprintln!(
             "sweep: --threads {} is more than {MAX_THREADS_PER_CORE} per core; using {}",
@@ -282,6 +338,10 @@ impl RunSpec for SweepSpec {
 
     fn schema(&self) -> arrow::datatypes::SchemaRef {
         arrow_schema(self)
+    }
+
+    fn row_bytes(&self) -> u64 {
+        SweepSpec::row_bytes(self)
     }
 
     fn worker(&self) -> Result<Simulator, SweepError> {

@@ -46,6 +46,19 @@ pub const MAX_STEPS_PER_SPAN: usize = 100_000;
 pub const MAX_CHUNK_ROWS: u64 = 2_000_000;
 /// Most rows of a sweep without `--allow-large` (≈1600 × the thesis sweep).
 pub const MAX_ROWS: u64 = 1_000_000_000;
+/// Most memory one chunk may take while it is built (its solved rows, the
+/// Arrow batch and the Parquet encoder's buffers; [`SweepSpec::row_bytes`]).
+/// Chunks are built one per thread at once, so this bounds the sweep's
+/// memory per thread whatever the centreline's resolution. Rows without a
+/// centreline reach it near [`MAX_CHUNK_ROWS`].
+pub const MAX_CHUNK_BYTES: u64 = 2 << 30;
+/// Estimated bytes of one row's fixed columns in memory, counted once in
+/// each of the copies a chunk passes through ([`ROW_COPIES`]): the solved
+/// row (its pose and a_i vector), the Arrow columns, the encoder's buffer.
+const ROW_FIXED_BYTES: u64 = 256;
+/// Copies of a chunk's rows held at once while it is built: the solved
+/// rows, the Arrow batch, the encoded Parquet row group.
+const ROW_COPIES: u64 = 3;
 
 /// A complete sweep job. Every section may be omitted (thesis defaults).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
@@ -237,6 +250,10 @@ impl SweepSpec {
             return Err(SpecError::setting("output", "chunk_routings = 0: a chunk needs at least one routing"));
         }
         let chunk_rows = u64::from(o.chunk_routings) * u64::from(t.count);
+        let chunk_bytes = chunk_rows.saturating_mul(self.row_bytes());
+        if chunk_rows <= MAX_CHUNK_ROWS && chunk_bytes > MAX_CHUNK_BYTES {
+            return Err(SpecError::setting("output", self.chunk_bytes_advice(chunk_rows, chunk_bytes)));
+        }
         if chunk_rows > MAX_CHUNK_ROWS {
             return Err(SpecError::setting("output", format!("chunk_routings = {} × [tension] count = {} gives {chunk_rows} rows per chunk, more than \
                  {MAX_CHUNK_ROWS} (each chunk is built in memory): lower chunk_routings to ≤ {}",
@@ -246,6 +263,60 @@ impl SweepSpec {
             )));
         }
         Ok(())
+    }
+
+    /// Points of each row's stored centreline: the solvers' nodes from
+    /// clamp to tip, two knot spans of `steps_per_span` steps (both
+    /// methods; docs/schema.md); 0 when no centreline is stored.
+    pub fn centreline_points(&self) -> u64 {
+        if self.output.centreline {
+            2 * self.solver.steps_per_span as u64 + 1
+        } else {
+            0
+        }
+    }
+
+    /// Estimated bytes one row takes in memory while its chunk is built,
+    /// all copies together ([`ROW_COPIES`]): fixed columns and a_i, and the
+    /// centreline's x and y lists when stored.
+    pub fn row_bytes(&self) -> u64 {
+        let per_copy = ROW_FIXED_BYTES + 8 * (self.output.order as u64 + 1) + 16 * self.centreline_points();
+        ROW_COPIES * per_copy
+    }
+
+    /// What to change when a chunk of `chunk_rows` rows would take
+    /// `chunk_bytes` (more than [`MAX_CHUNK_BYTES`]).
+    fn chunk_bytes_advice(&self, chunk_rows: u64, chunk_bytes: u64) -> String {
+        let o = &self.output;
+        let routing_bytes = u64::from(self.tension.count) * self.row_bytes();
+        let what = if o.centreline {
+            format!(
+                "with centreline = true each row holds {} centreline points ([solver] steps_per_span = {})",
+                self.centreline_points(),
+                self.solver.steps_per_span
+            )
+        } else {
+            "each chunk is built in memory".to_string()
+        };
+        let fix = match MAX_CHUNK_BYTES / routing_bytes.max(1) {
+            0 => format!(
+                "one routing's {} rows alone take {}: lower [solver] steps_per_span or [tension] count, or set centreline = false",
+                self.tension.count,
+                crate::io::fmt_bytes(routing_bytes)
+            ),
+            most if o.centreline => {
+                format!("lower chunk_routings to ≤ {most} (or [solver] steps_per_span, or set centreline = false)")
+            }
+            most => format!("lower chunk_routings to ≤ {most}"),
+        };
+        format!(
+            "chunk_routings = {} × [tension] count = {} gives {chunk_rows} rows per chunk taking about {} of memory while it is \
+             built, more than {} ({what}): {fix}",
+            o.chunk_routings,
+            self.tension.count,
+            crate::io::fmt_bytes(chunk_bytes),
+            crate::io::fmt_bytes(MAX_CHUNK_BYTES)
+        )
     }
 
     /// Checks the size of the whole sweep: more than [`MAX_ROWS`] rows is
@@ -352,12 +423,35 @@ mod tests {
         assert!(err("[output]\norder = 12\n").contains("[solver] nodes_per_span = 12"));
         assert!(err("[solver]\nmethod = \"rk4\"\n[output]\norder = 9\n").contains("[solver] steps_per_span = 80"));
         assert!(err("[tension]\ncount = 100000\n").contains("chunk_routings"));
+        // The chunk limit counts the centreline's points, not rows alone.
+        let centreline = "[solver]\nsteps_per_span = 100000\n[output]\ncentreline = true\n";
+        let e = err(&format!("{centreline}chunk_routings = 1\n[tension]\ncount = 300\n"));
+        assert!(e.contains("200001 centreline points") && e.contains("one routing's 300 rows alone"), "{e}");
+        let e = err(&format!("{centreline}chunk_routings = 16\n[tension]\ncount = 20\n"));
+        assert!(e.contains("lower chunk_routings to ≤ 11") && e.contains("centreline = false"), "{e}");
+        assert!(SweepSpec::from_toml(&format!("{centreline}chunk_routings = 11\n[tension]\ncount = 20\n"), "t").is_ok());
+        // Without a centreline the row limit is the one that bites.
+        assert!(SweepSpec::from_toml("[tension]\ncount = 7812\n", "t").is_ok());
         let huge = SweepSpec::from_toml("[grid]\nlevels = 99\n", "t").unwrap();
         assert!(huge.check_size(false).unwrap_err().to_string().contains("--allow-large"));
         assert!(huge.check_size(true).is_ok());
         assert!(SweepSpec::thesis().check_size(false).is_ok());
         assert!(SweepSpec::is_blank_toml("\n# nothing\n  \n"));
         assert!(!SweepSpec::is_blank_toml("[grid]\n"));
+    }
+
+    #[test]
+    fn the_centreline_size_is_the_solvers() {
+        for method in ["collocation", "rk4"] {
+            let spec =
+                SweepSpec::from_toml(&format!("[solver]\nmethod = \"{method}\"\nsteps_per_span = 30\n[output]\ncentreline = true\n"), "t")
+                    .unwrap();
+            let mut sim = crate::model::Simulator::new(&spec.actuator, &spec.solver).unwrap();
+            sim.set_routing_mm(&[1.0, 2.0, 0.0, -1.0, 1.0]).unwrap();
+            sim.solve(1.5).unwrap();
+            assert_eq!(sim.centreline().len() as u64, spec.centreline_points(), "{method}");
+        }
+        assert_eq!(SweepSpec::thesis().centreline_points(), 0);
     }
 
     #[test]

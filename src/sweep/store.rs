@@ -138,10 +138,15 @@ impl<S: RunSpec> Manifest<S> {
                 self.spec_sha256
             ));
         }
-        let expected = Manifest { tool_version: self.tool_version.clone(), ..Manifest::new(&self.spec, self.shards) };
-        if self.shards == 0 {
-            return Err("shards = 0".into());
+        if self.shards == 0 || self.shards > super::MAX_SHARDS {
+            // Status keeps a line per shard: an absurd count must not be allocated.
+            return Err(format!(
+                "shards = {} is not 1 … {} (the file was edited, or written with an absurd --shards)",
+                self.shards,
+                super::MAX_SHARDS
+            ));
         }
+        let expected = Manifest { tool_version: self.tool_version.clone(), ..Manifest::new(&self.spec, self.shards) };
         if *self != expected {
             return Err(format!(
                 "its counts do not follow from its spec (routings {} tensions {} chunk_routings {} chunks {} total_rows {}; \
@@ -413,6 +418,15 @@ impl RunDir {
             let path = shards_dir.join(&entry);
             let name = entry.to_string_lossy();
             if let Some(chunk) = temp_chunk(&name) {
+                // Writers create temporaries as files: anything else under
+                // such a name (a directory) is not theirs, and removing it
+                // as an abandoned chunk would fail. One that vanished was
+                // renamed into place by its writer.
+                match std::fs::symlink_metadata(&path) {
+                    Ok(m) if !m.is_file() => return Err(SweepError::ForeignFile { path }),
+                    Err(e) if e.kind() == std::io::ErrorKind::NotFound => continue,
+                    _ => {}
+                }
                 scan.temporaries.push((chunk, path));
                 continue;
             }
@@ -503,7 +517,7 @@ impl RunDir {
             // has its record. Two copies of a shard write identical bytes
             // (results do not depend on threads), so their records agree.
             let sum = crate::io::sha256_file(&tmp)?;
-            crate::io::write_atomic(&self.checksum_path(chunk), format!("{sum}\n").as_bytes())?;
+            crate::io::write_atomic_in_run(&self.checksum_path(chunk), format!("{sum}\n").as_bytes())?;
             // Renamed while still locked: a cleaner never sees it unlocked
             // under its temporary name.
             std::fs::rename(&tmp, &path)?;
@@ -638,6 +652,16 @@ mod tests {
         assert_eq!(temp_chunk(".chunk-000007.parquet.tmp-1-00ab12cd34ef5678-3"), Some(7));
         assert_eq!(temp_chunk(".chunk-000007.parquet.tmp-42/x"), None);
         assert!(is_manifest_temp(".manifest.json.tmp-12-345"));
+    }
+
+    #[test]
+    fn an_absurd_shard_count_is_refused_before_status_allocates_it() {
+        let spec = SweepSpec::from_toml("[grid]\nlevels = 3\n", "t").unwrap();
+        assert!(Manifest::new(&spec, super::super::MAX_SHARDS).verify().is_ok());
+        for shards in [0, super::super::MAX_SHARDS + 1, u64::MAX] {
+            let e = Manifest::new(&spec, shards).verify().unwrap_err();
+            assert!(e.contains(&format!("shards = {shards} is not 1")), "{e}");
+        }
     }
 
     #[test]
