@@ -279,6 +279,19 @@ fn a_map_directory_is_only_replaced_when_it_is_a_map() {
         let (ok, _, stderr) = run(&["reduce", s(&dir), "--out", s(&map)]);
         assert!(ok, "{stderr}");
     }
+    // A map written before the marker existed (no `format`) is still
+    // replaced, as long as it holds only what maps are made of.
+    let summary_path = map.join("summary.json");
+    let mut summary: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&summary_path).unwrap()).unwrap();
+    summary.as_object_mut().unwrap().remove("format");
+    std::fs::write(&summary_path, serde_json::to_string(&summary).unwrap()).unwrap();
+    let (ok, _, stderr) = run(&["reduce", s(&dir), "--out", s(&map)]);
+    assert!(ok, "an unmarked old map must be replaceable: {stderr}");
+    std::fs::write(&summary_path, serde_json::to_string(&summary).unwrap()).unwrap();
+    std::fs::write(map.join("my-notes.txt"), "keep\n").unwrap();
+    let (ok, _, stderr) = run(&["reduce", s(&dir), "--out", s(&map)]);
+    assert!(!ok && stderr.contains("not a cablemap map"), "{stderr}");
+    assert_eq!(std::fs::read_to_string(map.join("my-notes.txt")).unwrap(), "keep\n");
 }
 
 #[test]

@@ -86,10 +86,37 @@ fn is_map_dir(dir: &Path) -> bool {
     if !std::fs::symlink_metadata(&path).is_ok_and(|m| m.is_file() && m.len() < 1 << 20) {
         return false;
     }
-    std::fs::read(&path)
-        .ok()
-        .and_then(|b| serde_json::from_slice::<serde_json::Value>(&b).ok())
-        .is_some_and(|v| v["format"].as_str().is_some_and(|f| f.starts_with(tables::MAP_FORMAT_PREFIX)))
+    let Some(summary) = std::fs::read(&path).ok().and_then(|b| serde_json::from_slice::<serde_json::Value>(&b).ok()) else {
+        return false;
+    };
+    if summary["format"].as_str().is_some_and(|f| f.starts_with(tables::MAP_FORMAT_PREFIX)) {
+        return true;
+    }
+    // Maps written before the marker existed: replaced only when the summary
+    // reads as a map summary and the folder holds nothing but the kinds of
+    // file a map consists of, so a user's own files are never deleted.
+    let legacy_summary = summary.get("format").is_none()
+        && (serde_json::from_value::<super::MapSummary>(summary.clone()).is_ok()
+            || serde_json::from_value::<super::cables::CableMapSummary>(summary).is_ok());
+    legacy_summary && holds_only_map_files(dir, 0)
+}
+
+/// Whether every entry below `dir` is a regular file of a kind maps are
+/// made of (tables, pictures, the page, summaries), in at most one level of
+/// sub-folders (a cable map's `planar/`).
+fn holds_only_map_files(dir: &Path, depth: usize) -> bool {
+    const MAP_FILE_ENDINGS: [&str; 6] = [".parquet", ".png", ".json", ".html", ".csv", ".js"];
+    let Ok(entries) = std::fs::read_dir(dir) else { return false };
+    entries.into_iter().all(|entry| {
+        let Ok(entry) = entry else { return false };
+        let Ok(kind) = entry.file_type() else { return false };
+        let name = entry.file_name().to_string_lossy().into_owned();
+        if kind.is_dir() {
+            depth == 0 && holds_only_map_files(&entry.path(), depth + 1)
+        } else {
+            kind.is_file() && MAP_FILE_ENDINGS.iter().any(|e| name.ends_with(e))
+        }
+    })
 }
 
 /// Moves `staging` to `dir`: directly when `dir` is absent or empty, else
