@@ -276,3 +276,15 @@ fn calibrate_on_a_large_file_states_its_cost_and_shows_progress() {
     assert!(!iterations.is_empty(), "{stderr}");
     assert!(iterations.len() as u64 <= v["iterations"].as_u64().unwrap(), "{stderr}\n{v}");
 }
+
+// --- advice: wrong advice and formatting (issue "What a new user and a hostile probe found") ---
+
+/// A target written with spaces or semicolons between its components is
+/// told to use commas, not that "50 y=5" is not a number.
+#[test]
+fn a_target_without_commas_is_told_to_use_them() {
+    for target in ["x=50 y=5", "x=50;y=5"] {
+        refused(&["design", "--target", target], &["separate components with commas", "x=50,y=5"]);
+        refused(&["feasible", "--map", "nowhere", "--target", target], &["separate components with commas"]);
+    }
+}
