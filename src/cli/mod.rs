@@ -243,6 +243,10 @@ fn nearer_suggestion(mut e: clap::Error, mut cmd: clap::Command, args: &[std::ff
     if distance > (given.chars().count() / 3).max(1) || tied_with_clap {
         return e;
     }
+    if clap_choice.is_none() {
+        // Clap's "to pass '--x' as a value, use '-- --x'", which it gives only when it has no flag to suggest.
+        e.remove(ContextKind::Suggested);
+    }
     e.insert(ContextKind::SuggestedArg, ContextValue::String(format!("--{nearest}")));
     // Clap's usage line shows its own suggestion as if given; show the plain usage.
     e.insert(ContextKind::Usage, ContextValue::StyledStr(sub.render_usage()));
