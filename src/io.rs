@@ -340,6 +340,36 @@ pub fn available_memory_bytes() -> Option<u64> {
     }
 }
 
+/// A number rounded to `digits` significant digits for people to read (whole
+/// numbers keep their integer digits: 1234, not 1230):
+/// plain decimal for ordinary magnitudes (1e-4 ≤ |v| < 1e6), scientific
+/// otherwise, trailing zeros dropped (`1.54`, `-0.01235`, `3.2e-7`, not
+/// `1.5400e0` or `-0.012345678901234567`). Files keep full precision.
+pub fn fmt_sig(v: f64, digits: usize) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return format!("{v}");
+    }
+    let digits = digits.max(1);
+    let trim = |m: &str| if m.contains('.') { m.trim_end_matches('0').trim_end_matches('.').to_string() } else { m.to_string() };
+    if !(1e-4..1e6).contains(&v.abs()) {
+        let text = format!("{v:.prec$e}", prec = digits - 1);
+        let (mantissa, exponent) = text.split_once('e').expect("scientific format has an exponent");
+        return format!("{}e{exponent}", trim(mantissa));
+    }
+    let decimals = (digits as i32 - 1 - v.abs().log10().floor() as i32).max(0) as usize;
+    trim(&format!("{v:.decimals$}"))
+}
+
+/// The subdirectories of `dir` that hold a file named `file` (sorted; none
+/// when `dir` is unreadable): where a user who gave the parent of a run or a
+/// map meant to point.
+pub fn subdirs_holding(dir: &Path, file: &str) -> Vec<PathBuf> {
+    let Ok(entries) = std::fs::read_dir(dir) else { return Vec::new() };
+    let mut found: Vec<PathBuf> = entries.filter_map(|e| e.ok()).map(|e| e.path()).filter(|p| p.join(file).is_file()).collect();
+    found.sort();
+    found
+}
+
 /// Reads a UTF-8 text file. A file in another encoding (Latin-1, UTF-16
 /// from a spreadsheet) is an error saying so and how to fix it, instead of
 /// the bare "stream did not contain valid UTF-8".
@@ -403,6 +433,20 @@ pub fn hex(bytes: &[u8]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn numbers_for_people_have_the_significant_digits_asked_for() {
+        assert_eq!(fmt_sig(1.54, 3), "1.54");
+        assert_eq!(fmt_sig(1.5400000001, 5), "1.54");
+        assert_eq!(fmt_sig(-0.012345678901234567, 4), "-0.01235");
+        assert_eq!(fmt_sig(115.1172, 5), "115.12");
+        assert_eq!(fmt_sig(12345.67, 5), "12346");
+        assert_eq!(fmt_sig(9.99996, 5), "10");
+        assert_eq!(fmt_sig(3.2e-7, 3), "3.2e-7");
+        assert_eq!(fmt_sig(-4.56789e8, 3), "-4.57e8");
+        assert_eq!(fmt_sig(0.0, 3), "0");
+        assert_eq!(fmt_sig(f64::NAN, 3), "NaN");
+    }
 
     #[test]
     fn tokens_are_unique_and_temp_names_recognised() {

@@ -412,3 +412,15 @@ fn status_of_many_shards_is_a_summary_and_a_directory_under_a_temporary_name_is_
     assert!(!stderr.contains("Is a directory"), "{stderr}");
     assert!(odd.is_dir());
 }
+
+// --- advice: wrong advice and formatting (issue "What a new user and a hostile probe found") ---
+
+/// A target written with spaces or semicolons between its components is
+/// told to use commas, not that "50 y=5" is not a number.
+#[test]
+fn a_target_without_commas_is_told_to_use_them() {
+    for target in ["x=50 y=5", "x=50;y=5"] {
+        refused(&["design", "--target", target], &["separate components with commas", "x=50,y=5"]);
+        refused(&["feasible", "--map", "nowhere", "--target", target], &["separate components with commas"]);
+    }
+}

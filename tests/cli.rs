@@ -153,10 +153,15 @@ fn diagnose_prints_pasteable_next_steps() {
     let dir = tempfile::tempdir().unwrap();
     let data = dir.path().join("friction.csv");
     let (ok, _, err) = run(&["synth", "--effect", "friction", "--magnitude", "0.1", "--out", data.to_str().unwrap()]);
-    assert!(ok, "{err}");
+    assert!(ok && !err.contains("warning"), "a visible effect gets no warning: {err}");
     let (ok, out, err) = run(&["diagnose", data.to_str().unwrap(), "--no-report"]);
     assert!(ok, "{err}");
     assert!(out.starts_with("verdict: friction"), "{out}");
+    // The candidate table stays aligned past `stiffness_gradient`.
+    let candidates: Vec<&str> =
+        out.lines().skip_while(|l| !l.starts_with("candidates")).skip(1).take_while(|l| l.starts_with("  ")).collect();
+    let columns: Vec<Option<usize>> = candidates.iter().map(|l| l.find("ΔBIC").map(|i| l[..i].chars().count())).collect();
+    assert!(candidates.len() == 7 && columns.iter().all(|c| c.is_some() && *c == columns[0]), "{out}");
     let flags = out.lines().find_map(|l| l.trim().strip_prefix("simulate / design / calibrate flags: ")).unwrap_or_else(|| panic!("{out}"));
     assert!(flags.contains("--ei-n-mm2 ") && flags.contains("--friction-mu 0.0"), "{flags}");
     assert!(out.contains("[actuator.effects]") && out.contains("friction_mu = "), "{out}");
@@ -180,4 +185,102 @@ fn diagnose_report_goes_beside_the_data_by_default() {
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     assert!(dir.path().join("lab-diagnosis").join("report.md").exists());
     assert_eq!(std::fs::read_dir(cwd.path()).unwrap().count(), 0, "the current directory was written to");
+}
+
+// --- advice: wrong advice and formatting (issue "What a new user and a hostile probe found") ---
+
+/// The folder `map --out DIR` writes holds the run in `DIR/run` and the map
+/// in `DIR/map`: every command given the wrong one of the three says which
+/// to give, and the summaries print numbers and ranges as people write them.
+#[test]
+fn the_map_folder_its_run_and_its_map_are_told_apart() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("thesis");
+    let d = dir.to_str().unwrap();
+    let (run_dir, map_dir) = (format!("{d}/run"), format!("{d}/map"));
+    let quick = concat!(env!("CARGO_MANIFEST_DIR"), "/jobs/quick.toml");
+    let (ok, out, err) = run(&["map", quick, "--out", d]);
+    assert!(ok, "{err}");
+    // `map` reduces by itself: no advice to reduce half-way.
+    assert!(!out.contains("next: cablemap reduce"), "{out}");
+    // Mode boundaries to a few significant digits (summary.json keeps them all).
+    let modes = out.lines().find(|l| l.contains("modes by")).unwrap_or_else(|| panic!("{out}"));
+    let longest_digits = modes.split(|c: char| !c.is_ascii_digit()).map(str::len).max().unwrap();
+    assert!(longest_digits <= 6 && modes.contains("a0 [") && modes.contains("a1 ["), "{modes}");
+    let other = tmp.path().join("other");
+    let o = other.to_str().unwrap();
+    let refused = |args: &[&str]| -> String {
+        let (ok, out, err) = run(args);
+        assert!(!ok, "{args:?} was accepted: {out}");
+        err
+    };
+    for command in [&["reduce", d, "--out", o][..], &["status", d]] {
+        let err = refused(command);
+        assert!(err.contains(&format!("give {run_dir}")) && !err.contains("cablemap sweep SPEC"), "{command:?}: {err}");
+    }
+    for command in [&["reduce", &map_dir, "--out", o][..], &["status", &map_dir]] {
+        let err = refused(command);
+        let named = err.contains(&format!("{map_dir} is a map")) && err.contains(&format!("made from the run {run_dir}"));
+        assert!(named, "{command:?}: {err}");
+    }
+    let err = refused(&["feasible", "--map", d, "--target", "x=50,y=5"]);
+    assert!(err.contains(&format!("give {map_dir}")), "{err}");
+    let typo = format!("{d}/rn");
+    let err = refused(&["reduce", &typo, "--out", o]);
+    assert!(err.contains(&format!("{typo} holds no sweep: it does not exist")) && err.contains(&run_dir), "{err}");
+    assert!(!err.contains("manifest.json is missing"), "{err}");
+    assert!(!other.exists());
+    // `status` names the coefficients a_0…a_3, not a Rust range.
+    let (ok, out, err) = run(&["status", &run_dir]);
+    assert!(ok && out.contains("a_0…a_3") && !out.contains("0..="), "{out}{err}");
+    // The `sweep` command itself still says what comes next.
+    let (ok, out, err) = run(&["sweep", quick, "--out", &run_dir, "--quiet"]);
+    assert!(ok && out.contains(&format!("next: cablemap reduce {run_dir} --out MAP_DIR")), "{out}{err}");
+}
+
+/// An unknown flag gets the flag one typo away (`--pgn` is `--png` with two
+/// letters swapped), not clap's pick by Jaro similarity (`--ga-n`).
+#[test]
+fn a_mistyped_flag_is_answered_with_the_flag_meant() {
+    let (ok, _, err) = run(&["simulate", "--routing", "1,1,1,1,1", "--tension-n", "1", "--pgn", "x.png"]);
+    assert!(!ok && err.contains("'--png'") && !err.contains("ga-n"), "{err}");
+    // Where clap's suggestion is already the nearest, it stays.
+    let (ok, _, err) = run(&["simulate", "--routing", "1,1,1,1,1", "--tension-n", "1", "--jsn"]);
+    assert!(!ok && err.contains("'--json'"), "{err}");
+}
+
+/// Standard errors print as plain decimals (`± 0.0512`), not `± 5.1200e-2`.
+#[test]
+fn calibrate_prints_standard_errors_as_plain_decimals() {
+    let tmp = tempfile::tempdir().unwrap();
+    let data = tmp.path().join("d.csv");
+    let routings = "a:3,2.5,2,1.5,1;s:-2,-3,0,3,3.5";
+    let (ok, _, err) = run(&["synth", "--out", data.to_str().unwrap(), "--routings", routings, "--load-steps", "3"]);
+    assert!(ok, "{err}");
+    let (ok, out, err) = run(&["calibrate", data.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    let errors: Vec<&str> = out.lines().filter_map(|l| l.split_once(" ± ").map(|(_, se)| se.trim())).collect();
+    assert_eq!(errors.len(), 3, "EA, GA, EI: {out}");
+    for se in errors {
+        assert!(se.parse::<f64>().is_ok_and(|v| v > 0.0) && !se.contains('e'), "'{se}' in {out}");
+    }
+}
+
+/// `synth` warns when the hidden effect is smaller than the noise can show:
+/// stiffening α = 3 on the 360 mm tentacle moves no tip coordinate by 0.8 mm
+/// (2 × the 0.4 mm noise), so a diagnosis answers `none`.
+#[test]
+fn synth_warns_when_the_noise_hides_the_effect() {
+    let tmp = tempfile::tempdir().unwrap();
+    let data = tmp.path().join("t.csv");
+    let tentacle = ["--length-mm", "360", "--radius-profile-mm", "0:15.4,305:6.4,360:4.8", "--cable-anchor-mm", "305"];
+    let mut args = vec!["synth", "--out", data.to_str().unwrap(), "--effect", "stiffening", "--magnitude", "3"];
+    args.extend(tentacle);
+    let (ok, _, err) = run(&args);
+    assert!(ok, "{err}");
+    assert!(err.contains("warning: the hidden effect moves the simulated tips by at most 0.") && err.contains("(sd 0.4 mm, 1°)"), "{err}");
+    // With less noise the same effect shows, and no warning is given.
+    args.extend(["--noise-mm", "0.1", "--noise-deg", "0.2", "--force"]);
+    let (ok, _, err) = run(&args);
+    assert!(ok && !err.contains("warning"), "{err}");
 }

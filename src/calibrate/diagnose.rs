@@ -412,8 +412,7 @@ fn fit_of(fits: &[(Effect, FitResult)], e: Effect) -> FitResult {
 }
 
 fn chi2_text(f: &FitResult) -> String {
-    let p = if f.p_value < 1e-99 { "p < 1e-99".to_string() } else { format!("p = {:.1e}", f.p_value) };
-    format!("χ² = {:.1} on {} dof, χ²/dof = {:.2}, {p}", f.chi2, f.dof, f.reduced_chi2)
+    format!("χ² = {:.1} on {} dof, χ²/dof = {:.2}, {}", f.chi2, f.dof, f.reduced_chi2, super::report::p_text(f.p_value))
 }
 
 /// Runs the whole workflow on `data` with `base` as the starting actuator.

@@ -98,24 +98,37 @@ fn candidate_table(out: &mut String, cands: &[Candidate]) {
     }
 }
 
+/// A p-value in a table column headed p: `0.031`, `2.4e-7`, or `< 1e-99`
+/// below what the χ² tail resolves.
 fn pval(p: f64) -> String {
     if !p.is_finite() {
         "—".into()
     } else if p < 1e-99 {
         "< 1e-99".into()
     } else {
-        format!("{p:.2e}")
+        crate::io::fmt_sig(p, 2)
+    }
+}
+
+/// A p-value in a sentence: `p = 0.031`, `p = 2.4e-7`, or `p < 1e-99`
+/// (never `p = < 1e-99`).
+pub fn p_text(p: f64) -> String {
+    let value = pval(p);
+    if value.starts_with('<') {
+        format!("p {value}")
+    } else {
+        format!("p = {value}")
     }
 }
 
 /// One line on a fit's adequacy: χ², dof, χ²/dof, p, outliers, convergence.
 fn adequacy_line(f: &FitResult) -> String {
     let mut line = format!(
-        "χ² = {} on {} degrees of freedom, χ²/dof = {}, p = {}",
+        "χ² = {} on {} degrees of freedom, χ²/dof = {}, {}",
         num(f.chi2),
         f.dof,
         num(f.reduced_chi2),
-        pval(f.p_value)
+        p_text(f.p_value)
     );
     if !f.outliers.is_empty() {
         let _ = write!(line, "; readings set aside as outliers (measurement ids): {}", f.outliers.iter().map(|i| i.to_string()).collect::<Vec<_>>().join(", "));
@@ -578,4 +591,42 @@ fn shape_plot(
     }
     draw_legend(&mut chart, path, SeriesLabelPosition::LowerLeft, 13)?;
     root.present().map_err(|e| PlotError::new(path, e))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn fit_with_p(p_value: f64) -> FitResult {
+        FitResult {
+            effects: Vec::new(),
+            actuator: crate::model::Actuator::default(),
+            parameters: Vec::new(),
+            correlation: Vec::new(),
+            rss: 1.0,
+            n_residuals: 10,
+            bic: 0.0,
+            chi2: 5000.0,
+            dof: 9,
+            reduced_chi2: 555.6,
+            p_value,
+            outliers: Vec::new(),
+            flags: Vec::new(),
+            implausible: false,
+            rms_mm: 1.0,
+            per_routing: Vec::new(),
+            iterations: 3,
+            converged: true,
+            predictions: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn p_values_read_as_sentences() {
+        let line = adequacy_line(&fit_with_p(0.0));
+        assert!(line.contains("p < 1e-99") && !line.contains("p = <"), "{line}");
+        assert!(adequacy_line(&fit_with_p(0.031)).contains("p = 0.031"));
+        assert_eq!(p_text(2.4e-7), "p = 2.4e-7");
+        assert_eq!(p_text(f64::NAN), "p = —");
+    }
 }

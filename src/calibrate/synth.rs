@@ -140,33 +140,7 @@ pub fn synthesize_with_markers(spec: &SynthSpec, points: usize) -> Result<(Datas
     }
     spec.actuator.validate()?;
     // Noise-free rows first (the measured fields are filled below).
-    let steps = protocol(spec);
-    let mut data = Dataset::default();
-    for (id, y) in &spec.routings {
-        let clamp_tilt_rad = spec.routing_tilts_rad.get(id).copied().unwrap_or(spec.clamp_tilt_rad);
-        if !clamp_tilt_rad.is_finite() {
-            return Err(CalibrateError::Invalid(format!("routing {id}: clamp tilt {clamp_tilt_rad} must be finite")));
-        }
-        for (k, &(tension_n, direction, dwell_s)) in steps.iter().enumerate() {
-            let measurement = data.rows.len() as i64 + 1;
-            data.rows.push(Measurement {
-                measurement,
-                routing: id.clone(),
-                routing_mm: ControlPoints(*y),
-                tension_n,
-                direction,
-                step: k as i64,
-                dwell_s,
-                tip_x_mm: 0.0,
-                tip_y_mm: 0.0,
-                tip_angle_rad: 0.0,
-                clamp_tilt_rad,
-                noise_mm: None,
-                noise_deg: None,
-                row: measurement as usize,
-            });
-        }
-    }
+    let mut data = protocol_rows(spec)?;
     let mut rng = Rng::new(spec.seed);
     let mut marker_rng = Rng::new(spec.seed ^ 0x6d61_726b_6572);
     let mut centrelines = CentrelinePoints::new();
@@ -202,6 +176,83 @@ pub fn synthesize_with_markers(spec: &SynthSpec, points: usize) -> Result<(Datas
     }
     Ok((data, centrelines, markers))
 }
+
+/// The protocol's readings of every routing with the measured fields
+/// still zero: what [`synthesize_with_markers`] fills with noisy model
+/// values and [`hidden_effect_size`] predicts twice.
+fn protocol_rows(spec: &SynthSpec) -> Result<Dataset, CalibrateError> {
+    let steps = protocol(spec);
+    let mut data = Dataset::default();
+    for (id, y) in &spec.routings {
+        let clamp_tilt_rad = spec.routing_tilts_rad.get(id).copied().unwrap_or(spec.clamp_tilt_rad);
+        if !clamp_tilt_rad.is_finite() {
+            return Err(CalibrateError::Invalid(format!("routing {id}: clamp tilt {clamp_tilt_rad} must be finite")));
+        }
+        for (k, &(tension_n, direction, dwell_s)) in steps.iter().enumerate() {
+            let measurement = data.rows.len() as i64 + 1;
+            data.rows.push(Measurement {
+                measurement,
+                routing: id.clone(),
+                routing_mm: ControlPoints(*y),
+                tension_n,
+                direction,
+                step: k as i64,
+                dwell_s,
+                tip_x_mm: 0.0,
+                tip_y_mm: 0.0,
+                tip_angle_rad: 0.0,
+                clamp_tilt_rad,
+                noise_mm: None,
+                noise_deg: None,
+                row: measurement as usize,
+            });
+        }
+    }
+    Ok(data)
+}
+
+/// How far a hidden effect moves the simulated, noise-free readings: the
+/// largest change of tip position and of tip angle over the protocol.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EffectSize {
+    /// Largest change of tip x or of tip y between the two models, mm (per
+    /// coordinate, as the noise `noise_mm` is).
+    pub max_tip_shift_mm: f64,
+    /// Largest tip angle change between the two models, degrees.
+    pub max_angle_shift_deg: f64,
+}
+
+/// An effect is taken as visible in the data when some reading moves by at
+/// least this many noise standard deviations.
+pub const VISIBLE_NOISE_SDS: f64 = 2.0;
+
+impl EffectSize {
+    /// Whether no reading moves by [`VISIBLE_NOISE_SDS`] noise standard
+    /// deviations, in position or in angle: the noise then hides the effect
+    /// and a diagnosis will rightly answer `none`.
+    pub fn hidden_by_noise(&self, noise_mm: f64, noise_deg: f64) -> bool {
+        self.max_tip_shift_mm < VISIBLE_NOISE_SDS * noise_mm && self.max_angle_shift_deg < VISIBLE_NOISE_SDS * noise_deg
+    }
+}
+
+/// The size of the effect hidden in `spec.actuator`: its noise-free readings
+/// against those of `without` (the same actuator without the effect) on the
+/// same protocol.
+pub fn hidden_effect_size(spec: &SynthSpec, without: &Actuator) -> Result<EffectSize, CalibrateError> {
+    let data = protocol_rows(spec)?;
+    let mut size = EffectSize { max_tip_shift_mm: 0.0, max_angle_shift_deg: 0.0 };
+    for g in &data.groups() {
+        let with_effect = predict_group(&spec.actuator, &spec.options, &data, g, false)?;
+        let plain = predict_group(without, &spec.options, &data, g, false)?;
+        for (a, b) in with_effect.iter().zip(&plain) {
+            let shift = (a.pose.tip_x_mm - b.pose.tip_x_mm).abs().max((a.pose.tip_y_mm - b.pose.tip_y_mm).abs());
+            size.max_tip_shift_mm = size.max_tip_shift_mm.max(shift);
+            size.max_angle_shift_deg = size.max_angle_shift_deg.max((a.pose.tip_angle_rad - b.pose.tip_angle_rad).abs().to_degrees());
+        }
+    }
+    Ok(size)
+}
+
 
 /// `count` points at equal index spacing along a polyline (clamp and tip included).
 pub fn resample(line: &[[f64; 2]], count: usize) -> Vec<[f64; 2]> {
@@ -243,5 +294,21 @@ mod tests {
         assert!((0.2..0.7).contains(&rms), "{rms}");
         // Same seed, same data.
         assert_eq!(synthesize(&noisy, 0).unwrap().0, d1);
+    }
+
+    #[test]
+    fn an_effect_below_the_noise_is_told_from_one_above_it() {
+        let spec = |alpha: f64| {
+            let mut actuator = Actuator::default();
+            actuator.effects.stiffening_alpha = alpha;
+            SynthSpec { actuator, routings: default_routings()[..2].to_vec(), ..SynthSpec::default() }
+        };
+        let weak = hidden_effect_size(&spec(0.01), &Actuator::default()).unwrap();
+        assert!(weak.max_tip_shift_mm > 0.0 && weak.hidden_by_noise(0.4, 1.0), "{weak:?}");
+        let strong = hidden_effect_size(&spec(30.0), &Actuator::default()).unwrap();
+        assert!(!strong.hidden_by_noise(0.4, 1.0), "{strong:?}");
+        // The same effect shows once the noise is small enough.
+        assert!(!weak.hidden_by_noise(weak.max_tip_shift_mm / 4.0, weak.max_angle_shift_deg / 4.0), "{weak:?}");
+        assert_eq!(hidden_effect_size(&spec(0.0), &Actuator::default()).unwrap().max_tip_shift_mm, 0.0);
     }
 }

@@ -211,7 +211,7 @@ pub fn run(args: &CalibrateArgs) -> anyhow::Result<()> {
         if p.fixed {
             writeln!(out, "  {:<30} {:>14.6}   (held)", p.name, p.value)?;
         } else {
-            writeln!(out, "  {:<30} {:>14.6} ± {:<12.4e}", p.name, p.value, p.se)?;
+            writeln!(out, "  {:<30} {:>14.6} ± {}", p.name, p.value, cablemap::io::fmt_sig(p.se, 3))?;
         }
     }
     for e in &held_effects {
@@ -244,12 +244,12 @@ pub fn run(args: &CalibrateArgs) -> anyhow::Result<()> {
     }
     writeln!(
         out,
-        "overall tip RMS {:.4} mm; χ² = {:.1} on {} dof (χ²/dof = {:.3}, p = {:.2e}){}",
+        "overall tip RMS {:.4} mm; χ² = {:.1} on {} dof (χ²/dof = {:.3}, {}){}",
         result.rms_mm,
         result.chi2,
         result.dof,
         result.reduced_chi2,
-        result.p_value,
+        cablemap::calibrate::report::p_text(result.p_value),
         if result.p_value < 1e-3 { ": well above the stated noise (p < 1e-3)" } else { ": consistent with the stated noise" }
     )?;
     if !result.outliers.is_empty() {

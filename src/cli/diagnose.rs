@@ -102,7 +102,8 @@ pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
         }
     }
     for n in &d.named {
-        writeln!(out, "  {} {} = {} ± {:.3e} (ΔBIC {:.1})", n.effect, n.parameter_name, value(n.parameter), n.parameter_se, n.delta_bic)?;
+        let se = cablemap::io::fmt_sig(n.parameter_se, 3);
+        writeln!(out, "  {} {} = {} ± {se} (ΔBIC {:.1})", n.effect, n.parameter_name, value(n.parameter), n.delta_bic)?;
     }
     if let Some(m) = &d.separating_measurement {
         writeln!(out, "  cannot tell {} from {}: {m}", d.ambiguous_between[0], d.ambiguous_between[1])?;
@@ -110,11 +111,11 @@ pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
     let b = &d.baseline;
     writeln!(
         out,
-        "thesis model: χ²/dof = {:.3} ({:.1} on {} dof, p = {:.2e}){}",
+        "thesis model: χ²/dof = {:.3} ({:.1} on {} dof, {}){}",
         b.reduced_chi2,
         b.chi2,
         b.dof,
-        b.p_value,
+        cablemap::calibrate::report::p_text(b.p_value),
         if b.converged { "" } else { ", NOT converged" }
     )?;
     if !b.outliers.is_empty() {
@@ -124,19 +125,8 @@ pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
         writeln!(out, "  warning: {f}")?;
     }
     writeln!(out, "candidates (ΔBIC against the thesis model):")?;
-    for c in &d.candidates {
-        writeln!(
-            out,
-            "  {}. {:<17} {:<30} {:>12} ± {:<10.3e} ΔBIC {:>9.2}  χ²/dof {:>8.3}{}",
-            c.rank,
-            c.effect,
-            c.parameter_name,
-            value(c.parameter),
-            c.parameter_se,
-            c.delta_bic,
-            c.reduced_chi2,
-            c.failure().map(|f| format!("  (not counted: {f})")).unwrap_or_default()
-        )?;
+    for line in candidate_lines(&d.candidates) {
+        writeln!(out, "{line}")?;
     }
     if let (Some(h), Some(b), Some(a)) = (&d.holdout, d.holdout_rms_before, d.holdout_rms_after) {
         if d.extended.effects.is_empty() {
@@ -153,6 +143,35 @@ pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
         writeln!(out, "report: {}", p.display())?;
     }
     Ok(())
+}
+
+/// The candidate table, one line each, its columns as wide as their longest
+/// entry (`stiffness_gradient`, `clamp_stiffness_n_mm_per_rad`), so the
+/// numbers line up whatever the effect.
+fn candidate_lines(candidates: &[cablemap::calibrate::diagnose::Candidate]) -> Vec<String> {
+    let width = |text: &dyn Fn(&cablemap::calibrate::diagnose::Candidate) -> String| {
+        candidates.iter().map(|c| text(c).chars().count()).max().unwrap_or(0)
+    };
+    let rank_w = width(&|c| c.rank.to_string());
+    let effect_w = width(&|c| c.effect.to_string());
+    let parameter_w = width(&|c| c.parameter_name.to_string());
+    let se_w = width(&|c| cablemap::io::fmt_sig(c.parameter_se, 3));
+    candidates
+        .iter()
+        .map(|c| {
+            format!(
+                "  {:>rank_w$}. {:<effect_w$} {:<parameter_w$} {:>12} ± {:<se_w$} ΔBIC {:>9.2}  χ²/dof {:>8.3}{}",
+                c.rank,
+                c.effect,
+                c.parameter_name,
+                value(c.parameter),
+                cablemap::io::fmt_sig(c.parameter_se, 3),
+                c.delta_bic,
+                c.reduced_chi2,
+                c.failure().map(|f| format!("  (not counted: {f})")).unwrap_or_default()
+            )
+        })
+        .collect()
 }
 
 /// A parameter value for the summary: fixed point unless very large or small.
@@ -234,7 +253,44 @@ fn next_step(fit: &cablemap::calibrate::FitResult) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::sig5;
+    use super::{candidate_lines, sig5};
+    use cablemap::calibrate::diagnose::Candidate;
+
+    fn candidate(rank: usize, effect: &'static str, parameter_name: &'static str, parameter_se: f64) -> Candidate {
+        Candidate {
+            rank,
+            effect,
+            parameter_name,
+            parameter: 0.1,
+            parameter_se,
+            delta_bic: -12.5,
+            rms_mm: 0.4,
+            chi2: 100.0,
+            dof: 90,
+            reduced_chi2: 1.1,
+            p_value: 0.2,
+            converged: true,
+            plausible: true,
+            flags: Vec::new(),
+            error: None,
+        }
+    }
+
+    #[test]
+    fn candidate_columns_line_up_for_the_longest_names() {
+        let lines = candidate_lines(&[
+            candidate(1, "friction", "friction_mu", 1.54),
+            candidate(2, "stiffness_gradient", "stiffness_gradient_beta", 0.0021),
+            candidate(3, "clamp_compliance", "clamp_stiffness_n_mm_per_rad", 1234.4),
+        ]);
+        let column = |l: &str, what: &str| l.chars().collect::<String>().find(what).map(|i| l[..i].chars().count());
+        for what in ["±", "ΔBIC", "χ²/dof"] {
+            let at: Vec<_> = lines.iter().map(|l| column(l, what)).collect();
+            assert!(at.iter().all(|a| a.is_some() && *a == at[0]), "{what} at {at:?}:\n{}", lines.join("\n"));
+        }
+        // Standard errors in plain decimals, not `1.540e0`.
+        assert!(lines[0].contains("± 1.54 ") && lines[1].contains("± 0.0021") && lines[2].contains("± 1234 "), "{}", lines.join("\n"));
+    }
 
     #[test]
     fn five_significant_digits() {

@@ -137,7 +137,7 @@ pub fn reduce_from(run: &Path, out: &Path, source: Source, args: &MapOptionArgs)
         );
     } else {
         println!(
-            "map {}: {} simulations ({} converged, {} failed{}) in {} cells of {} mm; modes by {}: a0 {:?}, a1 {:?} (mm⁻¹, {} basis)",
+            "map {}: {} simulations ({} converged, {} failed{}) in {} cells of {} mm; modes by {}: a0 {}, a1 {} (mm⁻¹, {} basis)",
             out.display(),
             s.rows_total,
             s.rows_converged,
@@ -146,13 +146,20 @@ pub fn reduce_from(run: &Path, out: &Path, source: Source, args: &MapOptionArgs)
             s.cells,
             s.cell_mm,
             s.mode_boundaries_source,
-            s.mode_boundaries.a0,
-            s.mode_boundaries.a1,
+            boundaries_text(&s.mode_boundaries.a0),
+            boundaries_text(&s.mode_boundaries.a1),
             s.length_basis
         );
         println!("reduced in {reduced_s:.2} s, tables and {} pictures written in {total_s:.2} s; open {}", pictures.len(), out.join("index.html").display());
     }
     Ok(map)
+}
+
+/// Mode boundaries to 4 significant digits, `[-0.02, -0.0134, 0.0071]`:
+/// enough to tell the modes apart; summary.json keeps full precision.
+fn boundaries_text(bounds: &[f64]) -> String {
+    let values: Vec<String> = bounds.iter().map(|&b| cablemap::io::fmt_sig(b, 4)).collect();
+    format!("[{}]", values.join(", "))
 }
 
 /// The library's error, with the flag that fixes it where there is one.
@@ -253,6 +260,6 @@ pub fn run_map(args: &MapArgs) -> anyhow::Result<()> {
     match &spec {
         super::sweep::AnySpec::Planar(spec) => super::sweep::sweep_and_report(spec, &args.out.join("run"), &options, false)?,
         super::sweep::AnySpec::Cables(spec) => super::sweep::sweep_and_report(spec, &args.out.join("run"), &options, false)?,
-    }
+    };
     reduce_any_into(&args.out.join("run"), &args.out.join("map"), false, &args.map)
 }

@@ -131,8 +131,9 @@ pub fn thread_count(threads: Option<usize>) -> anyhow::Result<Option<usize>> {
 }
 
 /// Runs one shard of `spec` into `out`, saying how to resume when
-/// interrupted, and prints the summary and the run's state.
-pub fn sweep_and_report<S: RunSpec>(spec: &S, out: &Path, options: &SweepOptions, json: bool) -> anyhow::Result<()> {
+/// interrupted, and prints the summary and the run's state. Returns whether
+/// the run is complete.
+pub fn sweep_and_report<S: RunSpec>(spec: &S, out: &Path, options: &SweepOptions, json: bool) -> anyhow::Result<bool> {
     let again: Vec<String> = std::env::args().collect();
     say_how_to_resume_on_interrupt(format!(
         "\ninterrupted: every chunk already written is kept; resume with the same command:\n  {}\n",
@@ -145,7 +146,7 @@ pub fn sweep_and_report<S: RunSpec>(spec: &S, out: &Path, options: &SweepOptions
     } else {
         print_summary(&summary, &status);
     }
-    Ok(())
+    Ok(status.complete)
 }
 
 /// Runs `cablemap sweep`.
@@ -169,14 +170,18 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
         args.shards
     );
     let options = SweepOptions { shard, shards: args.shards, threads, progress, allow_large: args.allow_large };
-    match &spec {
-        AnySpec::Planar(spec) => sweep_and_report(spec, &args.out, &options, args.json),
-        AnySpec::Cables(spec) => sweep_and_report(spec, &args.out, &options, args.json),
+    let complete = match &spec {
+        AnySpec::Planar(spec) => sweep_and_report(spec, &args.out, &options, args.json)?,
+        AnySpec::Cables(spec) => sweep_and_report(spec, &args.out, &options, args.json)?,
+    };
+    // Only here: `map` reduces by itself, so the hint belongs to `sweep` alone.
+    if complete && !args.json {
+        println!("next: cablemap reduce {} --out MAP_DIR", args.out.display());
     }
+    Ok(())
 }
 
-/// The closing lines, each short enough for an 80-column terminal, and the
-/// next command.
+/// The closing lines, each short enough for an 80-column terminal.
 fn print_summary<S: RunSpec>(s: &SweepSummary, status: &RunStatus<S>) {
     println!("shard {}/{}: {} rows solved and written, {} already done", s.shard, s.shards, s.rows_written, s.rows_skipped);
     if s.partial_chunks_removed + s.damaged_chunks_redone > 0 {
@@ -191,9 +196,6 @@ fn print_summary<S: RunSpec>(s: &SweepSummary, status: &RunStatus<S>) {
         status.rows_total,
         if status.complete { "complete" } else { "partial (other shards not done yet)" }
     );
-    if status.complete {
-        println!("next: cablemap reduce {} --out MAP_DIR", status.dir.display());
-    }
 }
 
 /// On Ctrl-C (SIGINT) or SIGTERM: say what is kept and how to resume, then
@@ -223,6 +225,16 @@ fn say_how_to_resume_on_interrupt(resume: String) {
 #[cfg(not(unix))]
 fn say_how_to_resume_on_interrupt(_resume: String) {}
 
+/// The coefficients a run stores, as people write them: `a_0…a_3` (not the
+/// Rust range `0..=3`).
+fn coefficient_range(order: usize) -> String {
+    if order == 0 {
+        "a_0".into()
+    } else {
+        format!("a_0…a_{order}")
+    }
+}
+
 fn fmt_counts(counts: &std::collections::BTreeMap<String, u64>) -> String {
     if counts.is_empty() {
         return "(no rows)".into();
@@ -232,7 +244,10 @@ fn fmt_counts(counts: &std::collections::BTreeMap<String, u64>) -> String {
 
 /// Runs `cablemap status`.
 pub fn run_status_command(args: &StatusArgs) -> anyhow::Result<()> {
-    match run_kind(&args.dir)? {
+    // A map given for its run is named as such (the reduce layer knows maps).
+    let kind = run_kind(&args.dir)
+        .map_err(|e| cablemap::reduce::map_given_as_run(&e).map_or_else(|| anyhow::Error::from(e), anyhow::Error::from))?;
+    match kind {
         RunKind::Planar => print_status(&run_status_of::<SweepSpec>(&args.dir)?, args.json),
         RunKind::Cables => print_status(&run_status_of::<CableSweepSpec>(&args.dir)?, args.json),
     }
@@ -295,7 +310,7 @@ fn print_status<S: RunSpec>(s: &RunStatus<S>, json: bool) -> anyhow::Result<()> 
         m.chunks,
         m.shards
     );
-    println!("a_i        orders 0..={}, {}", m.spec.order(), m.length_basis.describe());
+    println!("a_i        {}, {}", coefficient_range(m.spec.order()), m.length_basis.describe());
     print_shard_table(&s.shards);
     println!("statuses   {}", fmt_counts(&s.status_counts));
     for d in &s.damaged {
@@ -311,4 +326,15 @@ fn print_status<S: RunSpec>(s: &RunStatus<S>, json: bool) -> anyhow::Result<()> 
         s.rows_total
     );
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::coefficient_range;
+
+    #[test]
+    fn coefficient_ranges_read_as_written_by_hand() {
+        assert_eq!(coefficient_range(0), "a_0");
+        assert_eq!(coefficient_range(3), "a_0…a_3");
+    }
 }

@@ -3,7 +3,7 @@
 
 use super::{parse_list, ActuatorArgs};
 use cablemap::calibrate::data::{centrelines_csv, markers_csv, measurements_csv};
-use cablemap::calibrate::synth::{default_routings, synthesize_with_markers, SynthSpec};
+use cablemap::calibrate::synth::{default_routings, hidden_effect_size, synthesize_with_markers, SynthSpec, VISIBLE_NOISE_SDS};
 use cablemap::calibrate::Effect;
 use cablemap::model::routing::CONTROL_POINTS;
 use cablemap::model::SolverOptions;
@@ -133,6 +133,8 @@ fn parse_markers(text: &str) -> anyhow::Result<Vec<(f64, f64)>> {
 /// Runs `cablemap synth`.
 pub fn run(args: &SynthArgs) -> anyhow::Result<()> {
     let mut actuator = args.actuator.resolve(None)?;
+    // The actuator as it would be without the hidden effect, to size the effect against the noise.
+    let without_effect = actuator.clone();
     if let Some(hidden) = OUT_OF_LIBRARY.iter().find(|h| **h == args.effect) {
         let Some(m) = args.magnitude else {
             bail!("--effect {hidden} needs --magnitude ({})", if *hidden == "rest_curvature" { "the rest curvature in 1/mm, e.g. 0.004" } else { "the joint's EI factor, e.g. 5" });
@@ -216,5 +218,19 @@ pub fn run(args: &SynthArgs) -> anyhow::Result<()> {
         args.effect,
         args.magnitude.map(|m| format!(" = {m}")).unwrap_or_default()
     );
+    if args.effect != "none" {
+        let size = hidden_effect_size(&spec, &without_effect)?;
+        if size.hidden_by_noise(spec.noise_mm, spec.noise_deg) {
+            eprintln!(
+                "warning: the hidden effect moves the simulated tips by at most {} mm (in x or y) and {}°, less than \
+                 {VISIBLE_NOISE_SDS}× the noise (sd {} mm, {}°): the data cannot show it and a diagnosis will rightly answer \
+                 `none`; raise --magnitude or lower --noise-mm/--noise-deg",
+                cablemap::io::fmt_sig(size.max_tip_shift_mm, 2),
+                cablemap::io::fmt_sig(size.max_angle_shift_deg, 2),
+                spec.noise_mm,
+                spec.noise_deg
+            );
+        }
+    }
     Ok(())
 }

@@ -190,7 +190,12 @@ fn parse_pairs(text: &str, example: &str) -> Result<Vec<(String, Component, f64)
             let component = Component::parse(key).ok_or_else(|| {
                 format!("unknown component '{key}'; use x, y (tip, mm) or a0 … a{MAX_ORDER} (curvature coefficients, 1/mm)")
             })?;
-            let number: f64 = value.trim().parse().map_err(|_| format!("{key}: '{}' is not a finite number", value.trim()))?;
+            let number: f64 = value.trim().parse().map_err(|_| {
+                let value = value.trim();
+                // "x=50 y=5" or "x=50;y=5": another component written into this one's value.
+                let separator = if value.contains(['=', ' ', ';', '\t']) { "; separate components with commas, " } else { "; " };
+                format!("{key}: '{value}' is not a finite number{separator}{example}")
+            })?;
             Ok((key.to_string(), component, number))
         })
         .collect()
@@ -228,6 +233,16 @@ mod tests {
         for bad in ["", "x", "x=abc", "z=1", "x=1,x=2", "a=1", "a99=1", "y=nan"] {
             assert!(Target::parse(bad).is_err(), "{bad} should be rejected");
         }
+    }
+
+    #[test]
+    fn components_run_together_are_told_to_use_commas() {
+        for bad in ["x=50 y=5", "x=50;y=5"] {
+            let e = Target::parse(bad).unwrap_err().to_string();
+            assert!(e.contains("'50") && e.contains("separate components with commas") && e.contains("x=50,y=5"), "{bad}: {e}");
+        }
+        let e = Target::parse("x=abc").unwrap_err().to_string();
+        assert!(e.contains("'abc' is not a finite number") && !e.contains("commas"), "{e}");
     }
 
     #[test]

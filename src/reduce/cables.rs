@@ -97,7 +97,7 @@ pub fn reduce_cable_run(
 ) -> Result<CableMap, ReduceError> {
     super::check_map_out(out)?;
     let completeness = if partial { Completeness::AllowPartial } else { Completeness::Complete };
-    let run: SweepRun<CableSweepSpec> = open_run_of(run_dir, completeness)?;
+    let run: SweepRun<CableSweepSpec> = open_run_of(run_dir, completeness).map_err(super::run_open_error)?;
     let spec = run.spec().clone();
     let cell_mm = cell_mm.unwrap_or(spec.output.cell_mm);
     super::check_cell_mm(cell_mm, spec.rod.length_mm)?;

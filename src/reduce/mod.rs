@@ -150,6 +150,17 @@ pub enum ReduceError {
     /// The map directory is, or lies inside, a sweep run directory.
     #[error("{0}")]
     MapInRun(String),
+    /// A map directory was given where a sweep run is read.
+    #[error(
+        "{} is a map (written by `cablemap reduce`), not a sweep run; it was made from the run {run_dir}: give that run directory",
+        dir.display()
+    )]
+    MapNotRun {
+        /// The directory given.
+        dir: PathBuf,
+        /// The run the map records it was made from.
+        run_dir: String,
+    },
     /// The map directory is given as `.` or `..`.
     #[error("map directory {}: give a map directory by name (not '.' or '..'): it is replaced as a whole", path.display())]
     MapDirUnnamed {
@@ -640,6 +651,19 @@ pub const MAX_CELLS_PER_AXIS: usize = 100_000;
 /// coefficient is a curvature.
 pub const COEFFICIENT_UNIT: &str = "mm⁻¹";
 
+/// [`ReduceError::MapNotRun`] when `e` says a directory holds no sweep and
+/// that directory holds a map: the map was given in its run's place.
+pub fn map_given_as_run(e: &crate::sweep::SweepError) -> Option<ReduceError> {
+    let crate::sweep::SweepError::NoRun { dir, .. } = e else { return None };
+    tables::recorded_run_dir(dir).map(|run_dir| ReduceError::MapNotRun { dir: dir.clone(), run_dir })
+}
+
+/// A sweep error from opening a run directory, told as a map given in the
+/// run's place when the directory holds one.
+pub fn run_open_error(e: crate::sweep::SweepError) -> ReduceError {
+    map_given_as_run(&e).unwrap_or(ReduceError::Sweep(e))
+}
+
 /// Reduces the sweep run in `run_dir` (refusing an unfinished run unless
 /// `partial`). Returns the map and the run's spec (for drawing).
 pub fn reduce_run(
@@ -649,7 +673,7 @@ pub fn reduce_run(
 ) -> Result<(MapData, crate::sweep::SweepSpec), ReduceError> {
     use crate::sweep::{open_run, Completeness};
     let completeness = if partial { Completeness::AllowPartial } else { Completeness::Complete };
-    let run = open_run(run_dir, completeness)?;
+    let run = open_run(run_dir, completeness).map_err(run_open_error)?;
     let info = run_info(&run);
     let names = columns::RowColumns::names(info.order);
     let names: Vec<&str> = names.iter().map(String::as_str).collect();

@@ -196,7 +196,7 @@ pub fn write_part(run_dir: &Path, map_dir: &Path, shard: u64, shards: u64) -> Re
         return Err(PartsError::BadShard { shard, shards }.into());
     }
     super::check_map_out(map_dir)?;
-    let run = open_run(run_dir, Completeness::Complete)?;
+    let run = open_run(run_dir, Completeness::Complete).map_err(super::run_open_error)?;
     let info = run_info(&run);
     let [first, end] = chunk_range(run.chunk_count(), shard, shards);
     let first_row: u64 = (0..first).map(|i| run.chunk_rows(i)).sum();
@@ -425,7 +425,7 @@ fn read_parts(dir: &Path, run: &SweepRun) -> Result<(Vec<PathBuf>, Pass1), Parts
 /// Merges the parts in `map_dir`'s parts directory into the map of the
 /// run in `run_dir` (a complete run). Returns the map and the run's spec.
 pub fn merge_parts(run_dir: &Path, map_dir: &Path, options: &ReduceOptions) -> Result<(MapData, SweepSpec), ReduceError> {
-    let run = open_run(run_dir, Completeness::Complete)?;
+    let run = open_run(run_dir, Completeness::Complete).map_err(super::run_open_error)?;
     let info = run_info(&run);
     super::check_options(&info, options)?;
     let (files, pass1) = read_parts(&parts_dir(map_dir), &run)?;

@@ -252,8 +252,9 @@ fn read_error(path: &Path, message: impl Into<String>) -> ReadError {
 /// Reads and checks `summary.json` of map directory `dir`.
 pub fn read_summary(dir: &Path) -> Result<MapSummary, ReadError> {
     let path = dir.join(SUMMARY_FILE);
-    let text = crate::io::read_utf8(&path).map_err(|e| {
-        read_error(&path, format!("cannot read ({e}); give a map directory written by `cablemap reduce`"))
+    let text = crate::io::read_utf8(&path).map_err(|e| match e.kind() {
+        std::io::ErrorKind::NotFound => read_error(&path, missing_summary_text(dir)),
+        _ => read_error(&path, format!("cannot read ({e}); give a map directory written by `cablemap reduce`")),
     })?;
     let summary: MapSummary = serde_json::from_str(&text).map_err(|e| {
         // A cable sweep's map (reduce::cables) is not a feasibility map; a
@@ -276,6 +277,36 @@ pub fn read_summary(dir: &Path) -> Result<MapSummary, ReadError> {
         return Err(read_error(&path, format!("tension_range_n [{lo}, {hi}] is not a range")));
     }
     Ok(summary)
+}
+
+/// Why a directory has no `summary.json`, pointing at the map the user
+/// meant: the `map` folder of `cablemap map --out DIR`, maps inside it, or
+/// the map still to be made of a run.
+fn missing_summary_text(dir: &Path) -> String {
+    let maps = crate::io::subdirs_holding(dir, SUMMARY_FILE);
+    let names: Vec<String> = maps.iter().map(|p| p.display().to_string()).collect();
+    match names.as_slice() {
+        _ if !dir.exists() => format!("{} does not exist; give a map directory written by `cablemap reduce`", dir.display()),
+        _ if crate::io::is_run_dir(dir) => {
+            let d = dir.display();
+            format!("is missing: {d} is a sweep run, not a map; reduce it first (`cablemap reduce {d} --out MAP_DIR`)")
+        }
+        [] => "is missing; give a map directory written by `cablemap reduce`".into(),
+        [one] => {
+            let d = dir.display();
+            format!("is missing: {d} holds no map itself, but {one} inside it does (the map `cablemap map --out {d}` writes); give {one}")
+        }
+        _ => format!("is missing: {} holds no map itself; the maps inside it: {}; give one of them", dir.display(), names.join(", ")),
+    }
+}
+
+/// The run directory a map directory records it was made from (planar or
+/// cable map), or `None` when `dir` holds no map: how a map given in place
+/// of a run is told apart from an empty folder.
+pub fn recorded_run_dir(dir: &Path) -> Option<String> {
+    let text = crate::io::read_utf8(&dir.join(SUMMARY_FILE)).ok()?;
+    let value: serde_json::Value = serde_json::from_str(&text).ok()?;
+    value.get("run_dir")?.as_str().map(str::to_string)
 }
 
 /// Reads every record batch of a parquet file.

@@ -124,13 +124,13 @@ pub enum RunKind {
 }
 
 /// Which kind of sweep `dir` holds (read from `DIR/manifest.json`'s
-/// `format`); [`SweepError::NoRun`] without a manifest. Unknown formats are
+/// `format`); [`SweepError::no_run`] without a manifest. Unknown formats are
 /// reported as planar, whose reader then names the format it expected.
 pub fn run_kind(dir: &Path) -> Result<RunKind, SweepError> {
     let path = dir.join(super::store::MANIFEST);
     let text = match crate::io::read_utf8(&path) {
         Ok(t) => t,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Err(SweepError::NoRun { dir: dir.to_path_buf() }),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Err(SweepError::no_run(dir)),
         Err(source) => return Err(SweepError::Io { context: format!("reading {}", path.display()), source }),
     };
     let value: serde_json::Value =

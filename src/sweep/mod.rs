@@ -88,9 +88,22 @@ pub enum SweepError {
     /// DIR exists, has no manifest and is not empty.
     #[error("{} is not a cablemap sweep directory (it has no manifest.json but holds '{entry}'): give a new or empty directory to --out", dir.display())]
     NotARunDir { dir: PathBuf, entry: String },
-    /// DIR has no manifest (reading or status).
-    #[error("{} holds no sweep: {} is missing (run `cablemap sweep SPEC --out {}` first)", dir.display(), dir.join(store::MANIFEST).display(), dir.display())]
-    NoRun { dir: PathBuf },
+    /// DIR has no manifest (reading or status); built by [`SweepError::no_run`].
+    #[error("{}", status::no_run_text(dir, runs_inside))]
+    NoRun {
+        /// The directory given.
+        dir: PathBuf,
+        /// Run directories directly inside it (the `run` of `cablemap map --out DIR`).
+        runs_inside: Vec<PathBuf>,
+    },
+    /// DIR does not exist (reading or status); built by [`SweepError::no_run`].
+    #[error("{} holds no sweep: it does not exist{}", dir.display(), status::runs_beside_text(runs_beside))]
+    NoRunDir {
+        /// The directory given.
+        dir: PathBuf,
+        /// Run directories beside it (what a typo in its last name meant).
+        runs_beside: Vec<PathBuf>,
+    },
     /// DIR holds a sweep of another kind (planar vs cables).
     #[error("{} holds a sweep of another kind ('{found}', not '{wanted}'): a spec with [[cable]] tables and a planar spec need separate run directories; use another --out directory", dir.display())]
     OtherKind {

@@ -66,7 +66,7 @@ pub fn open_run(dir: &Path, completeness: Completeness) -> Result<SweepRun, Swee
 /// for a cable sweep; [`super::run_kind`] tells which kind a directory holds).
 pub fn open_run_of<S: RunSpec>(dir: &Path, completeness: Completeness) -> Result<SweepRun<S>, SweepError> {
     let run = RunDir::new(dir);
-    let manifest: Manifest<S> = run.read_manifest()?.ok_or_else(|| SweepError::NoRun { dir: dir.to_path_buf() })?;
+    let manifest: Manifest<S> = run.read_manifest()?.ok_or_else(|| SweepError::no_run(dir))?;
     let scan = run.scan(&manifest)?;
     if !scan.damaged.is_empty() {
         let plan = manifest.spec.layout();

@@ -81,6 +81,55 @@ impl<S: RunSpec> RunStatus<S> {
     }
 }
 
+impl SweepError {
+    /// The error for a directory without a sweep manifest, saying what the
+    /// directory is instead: missing (with the runs beside it, for a typo in
+    /// its name), or the parent of runs (`cablemap map --out DIR` keeps its
+    /// sweep in `DIR/run`), so the advice points at the run, not at a new
+    /// sweep into a folder the sweep would refuse.
+    pub fn no_run(dir: &Path) -> Self {
+        let runs_in = |d: &Path| -> Vec<PathBuf> {
+            crate::io::subdirs_holding(d, super::store::MANIFEST).into_iter().filter(|p| crate::io::is_run_dir(p)).collect()
+        };
+        if std::fs::symlink_metadata(dir).is_err() {
+            let parent = dir.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+            return SweepError::NoRunDir { dir: dir.to_path_buf(), runs_beside: runs_in(parent) };
+        }
+        SweepError::NoRun { dir: dir.to_path_buf(), runs_inside: runs_in(dir) }
+    }
+}
+
+/// The text of [`SweepError::NoRun`].
+pub(super) fn no_run_text(dir: &Path, runs_inside: &[PathBuf]) -> String {
+    let list = || runs_inside.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ");
+    match runs_inside {
+        [] => format!(
+            "{} holds no sweep: {} is missing (run `cablemap sweep SPEC --out {}` first)",
+            dir.display(),
+            dir.join(super::store::MANIFEST).display(),
+            dir.display()
+        ),
+        [run] if run.file_name().is_some_and(|n| n == "run") => format!(
+            "{} holds no sweep itself: it is the folder `cablemap map --out {}` writes, whose sweep is {}; give {}",
+            dir.display(),
+            dir.display(),
+            run.display(),
+            run.display()
+        ),
+        _ => format!("{} holds no sweep itself, but the run directories inside it do: give one of {}", dir.display(), list()),
+    }
+}
+
+/// The end of [`SweepError::NoRunDir`]'s text: the run directories beside
+/// the missing one, if any.
+pub(super) fn runs_beside_text(runs_beside: &[PathBuf]) -> String {
+    if runs_beside.is_empty() {
+        return String::new();
+    }
+    let list: Vec<String> = runs_beside.iter().map(|p| p.display().to_string()).collect();
+    format!(" (the run directories beside it: {}; a typo?)", list.join(", "))
+}
+
 /// Reads and checks a run directory (manifest and every chunk footer).
 pub fn run_status(dir: &Path) -> Result<RunStatus, SweepError> {
     run_status_of::<SweepSpec>(dir)
@@ -89,7 +138,7 @@ pub fn run_status(dir: &Path) -> Result<RunStatus, SweepError> {
 /// [`run_status`] for a sweep of kind `S`.
 pub fn run_status_of<S: RunSpec>(dir: &Path) -> Result<RunStatus<S>, SweepError> {
     let run = RunDir::new(dir);
-    let manifest: Manifest<S> = run.read_manifest()?.ok_or_else(|| SweepError::NoRun { dir: dir.to_path_buf() })?;
+    let manifest: Manifest<S> = run.read_manifest()?.ok_or_else(|| SweepError::no_run(dir))?;
     let plan = manifest.spec.layout();
     let scan = run.scan(&manifest)?;
     let shards = manifest.shards.max(1);
