@@ -5,7 +5,7 @@
 //! at equal aspect: one mm across is one mm down.
 
 use super::{CellStats, MapData, MapSummary, MODES};
-use crate::plot::{body_series, clamp_half_width_mm, draw_series_on, register_fonts, BodyDrawing, PlotError, FONT};
+use crate::plot::{body_series, clamp_half_width_mm, draw_series_on, register_fonts, BodyDrawing, PageChart, PlotError, FONT};
 use plotters::prelude::*;
 use plotters::style::colors::colormaps::ViridisRGB;
 use std::path::Path;
@@ -159,17 +159,7 @@ fn draw_cells(
         .y_label_area_size(y_label_area(label_size))
         .build_cartesian_2d(frame.y_mm.0..frame.y_mm.1, -frame.x_mm.1..-frame.x_mm.0)
         .map_err(|e| PlotError::new(path, e))?;
-    chart
-        .configure_mesh()
-        .disable_mesh()
-        .x_desc("tip y (mm)")
-        .y_desc("tip x (mm, down)")
-        .y_label_formatter(&|v| format!("{:.0}", -v + 0.0))
-        .x_label_formatter(&|v| format!("{v:.0}"))
-        .label_style((FONT, label_size))
-        .axis_desc_style((FONT, label_size))
-        .draw()
-        .map_err(|e| PlotError::new(path, e))?;
+    draw_page_axes(&mut chart, path, ("tip y (mm)", "tip x (mm, down)"), label_size, (10, 10))?;
     chart
         .draw_series(cells.iter().map(|&(ix, iy, v)| {
             let (xa, ya) = (x0 + ix as f64 * c, y0 + iy as f64 * c);
@@ -183,6 +173,25 @@ fn draw_cells(
         .draw_series(std::iter::once(Circle::new((0.0, -summary.length_mm), 4, BLACK.stroke_width(1))))
         .map_err(|e| PlotError::new(path, e))?;
     Ok(())
+}
+
+/// Draws the axes of a page chart without grid lines: whole-mm tick labels
+/// (`ticks` across and down; the clamp axis counted downward) and the axis
+/// descriptions `descs` (across, down), all at `label_size`.
+fn draw_page_axes(chart: &mut PageChart, path: &Path, descs: (&str, &str), label_size: u32, ticks: (usize, usize)) -> Result<(), PlotError> {
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_labels(ticks.0)
+        .y_labels(ticks.1)
+        .x_desc(descs.0)
+        .y_desc(descs.1)
+        .y_label_formatter(&|v| format!("{:.0}", -v + 0.0))
+        .x_label_formatter(&|v| format!("{v:.0}"))
+        .label_style((FONT, label_size))
+        .axis_desc_style((FONT, label_size))
+        .draw()
+        .map_err(|e| PlotError::new(path, e))
 }
 
 /// Pixels around a thumbnail's plot area.
@@ -223,19 +232,7 @@ fn draw_thumbnail(area: &Area, path: &Path, body: &BodyDrawing, label_size: u32)
         .y_label_area_size(y_label_area(label_size))
         .build_cartesian_2d(y.0..y.1, -x.1..-x.0)
         .map_err(|e| PlotError::new(path, e))?;
-    chart
-        .configure_mesh()
-        .disable_mesh()
-        .x_labels(4)
-        .y_labels(6)
-        .x_desc("y (mm)")
-        .y_desc("x (mm, down)")
-        .y_label_formatter(&|v| format!("{:.0}", -v + 0.0))
-        .x_label_formatter(&|v| format!("{v:.0}"))
-        .label_style((FONT, label_size))
-        .axis_desc_style((FONT, label_size))
-        .draw()
-        .map_err(|e| PlotError::new(path, e))?;
+    draw_page_axes(&mut chart, path, ("y (mm)", "x (mm, down)"), label_size, (4, 6))?;
     for s in &series {
         draw_series_on(&mut chart, path, s)?;
     }
