@@ -51,6 +51,14 @@ fn simulate_writes_csv_and_png() {
     let bytes = std::fs::read(&png).unwrap();
     assert_eq!(&bytes[1..4], b"PNG");
     assert!(bytes.len() > 10_000, "picture has content");
+    // The picture is named where it went: after the report, or on stderr
+    // with --json, whose stdout stays one JSON object.
+    assert!(stdout.lines().last().unwrap().starts_with(&format!("wrote {}", png.display())), "{stdout}");
+    let (ok, stdout, stderr) = run(&["simulate", "--routing", "0,4,1,2,-2", "--tension", "1.7", "--json", "--png", png.to_str().unwrap()]);
+    assert!(ok, "{stderr}");
+    let v: serde_json::Value = serde_json::from_str(&stdout).expect("stdout is the JSON object alone");
+    assert_eq!(v["status"], "ok");
+    assert!(stderr.contains(&format!("wrote {}", png.display())), "{stderr}");
 }
 
 #[test]

@@ -51,6 +51,14 @@ fn map_runs_sweep_then_reduce_and_counts_add_up() {
     for file in ["reach.png", "a0_p10.png", "a0_p90.png", "a0_gap.png", "a1_gap.png", "a2_gap.png", "modes.png", "index.html", "designs.parquet"] {
         assert!(map.join(file).exists(), "{file} missing");
     }
+    // 610 solves over 1 mm cells are speckle: the summary (stderr beside
+    // --json) and the page say so, with the cell size that reads as regions.
+    assert!(stderr.contains("sparse map") && stderr.contains("--cell-mm 2"), "{stderr}");
+    let page_data = std::fs::read_to_string(map.join("explorer-data.js")).unwrap();
+    assert!(page_data.contains("\"sparse_note\":\"sparse map") && page_data.contains("--cell-mm 2"), "no note on the page");
+    let coarse = dir.path().join("m2");
+    let (ok, stdout, stderr) = run(&["reduce", out.join("run").to_str().unwrap(), "--out", coarse.to_str().unwrap(), "--cell-mm", "2"]);
+    assert!(ok && !stdout.contains("sparse"), "{stdout}{stderr}");
     // Resumable like the sweep: a second run solves nothing new and maps the same.
     let (ok, stdout2, stderr) = run(&["map", QUICK, "--out", out.to_str().unwrap(), "--json"]);
     assert!(ok, "{stderr}");

@@ -131,6 +131,7 @@ fn csv_and_png_are_written() {
     ]);
     assert!(ok, "{err}");
     assert!(out.contains("tip tangent") && out.contains("cable 2"), "{out}");
+    assert!(out.lines().last().unwrap().starts_with(&format!("wrote {}", png.display())), "the picture is named: {out}");
     let text = std::fs::read_to_string(&csv).unwrap();
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();

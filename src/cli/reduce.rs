@@ -152,6 +152,14 @@ pub fn reduce_from(run: &Path, out: &Path, source: Source, args: &MapOptionArgs)
         );
         println!("reduced in {reduced_s:.2} s, tables and {} pictures written in {total_s:.2} s; open {}", pictures.len(), out.join("index.html").display());
     }
+    // With --json on stderr: stdout stays the JSON object alone.
+    if let Some(note) = cablemap::reduce::plots::Density::sparse_note(s, &map.cells) {
+        if args.json {
+            eprintln!("{note}");
+        } else {
+            println!("{note}");
+        }
+    }
     Ok(map)
 }
 

@@ -121,13 +121,14 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     }
     if let Some(path) = &args.png {
         let title = format!("routing [{}] mm, tension {:.3} N", fmt_list(&y), tension);
-        let drawing = BodyDrawing::of_body(&sim, &actuator, "body (outline at ±r), cable in red".into(), BLUE_800);
+        let drawing = BodyDrawing::of_body(&sim, &actuator, "body (outline at ±r)".into(), BLUE_800);
         draw_bodies(path, &title, &[drawing], &[])?;
     }
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
     if args.json {
         writeln!(out, "{}", SimulationRecord::from(&sim).to_json_line())?;
+        report_png(args);
         return Ok(());
     }
     let p = &sim.pose;
@@ -142,7 +143,23 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         writeln!(out, "a_{i:<12} {a:.8e} mm^-1")?;
     }
     writeln!(out, "iterations     {} integration pass(es)", p.iterations)?;
+    drop(out);
+    report_png(args);
     Ok(())
+}
+
+/// Names the picture `--png` wrote, after the results: on stdout with the
+/// text report (as `design` names its exports), on stderr with `--json`,
+/// whose stdout stays the JSON object alone.
+fn report_png(args: &SimulateArgs) {
+    if let Some(path) = &args.png {
+        let line = format!("wrote {} (the deformed body, cable and tip; axes in mm)", path.display());
+        if args.json {
+            eprintln!("{line}");
+        } else {
+            println!("{line}");
+        }
+    }
 }
 
 /// Several or spatial cables: the 3-D solver (`model::spatial`).
@@ -207,6 +224,8 @@ fn run_spatial(args: &SimulateArgs) -> anyhow::Result<()> {
     } else {
         write!(out, "{}", record::report(&sim))?;
     }
+    drop(out);
+    report_png(args);
     Ok(())
 }
 

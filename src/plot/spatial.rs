@@ -2,7 +2,7 @@
 //! x–y (looking along z) and x–z (looking along y), on one scale, with the
 //! body's silhouette, the centreline, every cable's path and the tip.
 
-use super::{register_fonts, PlotError, FONT};
+use super::{clamp_series, draw_legend, draw_series_on, legend_size, register_fonts, Mark, PictureSeries, PlotError, FONT};
 use crate::model::spatial::SpatialSimulation;
 use plotters::prelude::*;
 use plotters::style::full_palette::{BLUE_800, BROWN, ORANGE, PURPLE};
@@ -58,54 +58,48 @@ pub fn draw_spatial(path: &Path, title: &str, sim: &SpatialSimulation) -> Result
             .draw()
             .map_err(|e| PlotError::new(path, e))?;
         let a = view.axis;
-        let page = |p: [f64; 3]| (p[a], -p[0]);
-        chart
-            .draw_series(std::iter::once(Rectangle::new([(-8.0, 3.0), (8.0, 0.0)], BLACK.mix(0.5).filled())))
-            .map_err(|e| PlotError::new(path, e))?;
+        // Series in the view's body frame (x, lateral), as the planar pictures.
+        let in_view = |p: [f64; 3]| (p[0], p[a]);
         let (left, right) = silhouette(sim, a, radius);
-        for side in [&left, &right] {
-            chart
-                .draw_series(LineSeries::new(side.iter().copied(), BLUE_800.stroke_width(2)))
-                .map_err(|e| PlotError::new(path, e))?;
-        }
-        if let (Some(&l), Some(&r)) = (left.last(), right.last()) {
-            chart.draw_series(LineSeries::new([l, r], BLUE_800.stroke_width(2))).map_err(|e| PlotError::new(path, e))?;
-        }
-        chart
-            .draw_series(LineSeries::new(sim.nodes.iter().map(|n| page(n.p_mm)), BLUE_800.mix(0.4).stroke_width(1)))
-            .map_err(|e| PlotError::new(path, e))?
-            .label("body (silhouette of radius r)")
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLUE_800.stroke_width(2)));
+        let tip: Vec<(f64, f64)> = left.last().into_iter().chain(right.last()).copied().collect();
+        let mut series = vec![clamp_series(radius)];
+        series.push(PictureSeries {
+            legend: "body (silhouette of radius r)".into(),
+            colour: BLUE_800.to_rgba(),
+            mark: Mark::Lines { paths: [left, right, tip].into_iter().filter(|p| p.len() > 1).collect(), width_px: 2 },
+        });
+        series.push(PictureSeries {
+            legend: "centreline".into(),
+            colour: BLUE_800.mix(0.4),
+            mark: Mark::Lines { paths: vec![sim.nodes.iter().map(|n| in_view(n.p_mm)).collect()], width_px: 1 },
+        });
         for (i, cable) in paths.iter().enumerate() {
-            let colour = CABLE_COLOURS[i % CABLE_COLOURS.len()];
-            let tension = sim.actuator.cables[i].tension_n;
-            chart
-                .draw_series(LineSeries::new(cable.iter().map(|&p| page(p)), colour.stroke_width(2)))
-                .map_err(|e| PlotError::new(path, e))?
-                .label(format!("cable {} ({tension:.2} N)", i + 1))
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2)));
+            series.push(PictureSeries {
+                legend: format!("cable {} ({:.2} N)", i + 1, sim.actuator.cables[i].tension_n),
+                colour: CABLE_COLOURS[i % CABLE_COLOURS.len()].to_rgba(),
+                mark: Mark::Lines { paths: vec![cable.iter().map(|&p| in_view(p)).collect()], width_px: 2 },
+            });
         }
         if let Some(n) = sim.nodes.last() {
-            chart.draw_series(std::iter::once(Circle::new(page(n.p_mm), 5, BLUE_800.filled()))).map_err(|e| PlotError::new(path, e))?;
+            let mark = Mark::Dot { at: in_view(n.p_mm), radius_px: 5 };
+            series.push(PictureSeries { legend: "tip".into(), colour: BLUE_800.to_rgba(), mark });
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .label_font((FONT, 13))
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .draw()
-            .map_err(|e| PlotError::new(path, e))?;
+        for s in &series {
+            draw_series_on(&mut chart, path, s)?;
+        }
+        // The legend in the plot's upper right corner (the rod hangs from the top centre).
+        let plot = chart.plotting_area().strip_coord_spec();
+        let (w, _) = legend_size(&plot, &series);
+        draw_legend(&plot, path, &series, (plot.dim_in_pixel().0 as i32 - w - 10, 10))?;
     }
     root.present().map_err(|e| PlotError::new(path, e))?;
     Ok(())
 }
 
-/// Page points of one side of a body outline.
+/// Points (x, lateral) of one side of a body outline, mm.
 type Outline = Vec<(f64, f64)>;
 
-/// The body's outline in the view plane (x, lateral axis `a`), as page
-/// points: at each node the cross-section (a disc of radius r spanned by
+/// The body's outline in the view plane (x, lateral axis `a`), mm: at each node the cross-section (a disc of radius r spanned by
 /// the body y and z axes) reaches r·|(b_y·N, b_z·N)| along the in-view
 /// normal N of the projected centreline.
 fn silhouette(sim: &SpatialSimulation, a: usize, radius: f64) -> (Outline, Outline) {
@@ -124,8 +118,8 @@ fn silhouette(sim: &SpatialSimulation, a: usize, radius: f64) -> (Outline, Outli
         let r = n.rotation;
         let dot = |col: usize| r[0][col] * nx + r[a][col] * nl;
         let reach = radius * dot(1).hypot(dot(2));
-        left.push((n.p_mm[a] + reach * nl, -(n.p_mm[0] + reach * nx)));
-        right.push((n.p_mm[a] - reach * nl, -(n.p_mm[0] - reach * nx)));
+        left.push((n.p_mm[0] + reach * nx, n.p_mm[a] + reach * nl));
+        right.push((n.p_mm[0] - reach * nx, n.p_mm[a] - reach * nl));
     }
     (left, right)
 }

@@ -90,6 +90,7 @@ fn data(map: &MapData, actuator: &Actuator, shapes: &[Option<BodyDrawing>], pict
     json!({
         "summary": map.summary,
         "length_basis_description": map.summary.length_basis.describe(),
+        "sparse_note": super::plots::Density::sparse_note(&map.summary, &map.cells),
         "actuator": actuator,
         "effects_in_use": effects_in_use(actuator),
         "written_utc": written_utc,
