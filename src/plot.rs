@@ -43,6 +43,17 @@ impl PlotError {
     }
 }
 
+/// The bitmap a PNG is drawn into at `path`, after the checks every output
+/// file gets ([`crate::io::write_atomic`]'s): never over a symbolic link,
+/// FIFO, device or directory, never inside a sweep run directory. plotters
+/// writes the file itself when the drawing is presented, so the checks
+/// come first here.
+pub fn png_backend(path: &Path, size_px: (u32, u32)) -> Result<BitMapBackend<'_>, PlotError> {
+    crate::io::check_regular_or_new(path).map_err(|e| PlotError::new(path, e))?;
+    crate::io::check_not_in_run_dir(path, "the picture").map_err(|e| PlotError::new(path, e))?;
+    Ok(BitMapBackend::new(path, size_px))
+}
+
 /// One deformed actuator to draw.
 #[derive(Debug, Clone)]
 pub struct BodyDrawing {
@@ -387,7 +398,7 @@ pub fn draw_bodies(path: &Path, title: &str, bodies: &[BodyDrawing], targets: &[
     let series = body_series(bodies, targets);
     // The legend goes under the chart, where it covers nothing.
     let legend_h = LEGEND_ROW_PX as u32 * series.len() as u32 + 2 * LEGEND_PAD_PX as u32 + 10;
-    let root = BitMapBackend::new(path, (800, 800 + legend_h)).into_drawing_area();
+    let root = png_backend(path, (800, 800 + legend_h))?.into_drawing_area();
     root.fill(&WHITE).map_err(|e| PlotError::new(path, e))?;
     let (plot, below) = root.split_vertically(800);
     let ((x0, x1), (y0, y1)) = bounds(&series_points(&series));

@@ -321,6 +321,10 @@ fn output_files_never_replace_a_fifo_a_symlink_or_a_device_node() {
         assert!(!ok && stderr.contains(s(path)) && stderr.contains(kind) && stderr.contains("not a regular file"), "{stderr}");
         let (ok, _, stderr) = run_within(&["synth", "--force", "--out", s(path)], &[], std::time::Duration::from_secs(60));
         assert!(!ok && stderr.contains(kind), "{stderr}");
+        // Pictures too (plotters writes them itself, so they are checked first).
+        let png = [&["simulate"][..], &R, &["--png", s(path)]].concat();
+        let (ok, _, stderr) = run_within(&png, &[], std::time::Duration::from_secs(60));
+        assert!(!ok && stderr.contains(kind) && stderr.contains("not a regular file"), "{stderr}");
     }
     assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink());
     assert!(std::fs::symlink_metadata(&fifo).unwrap().file_type().is_fifo());

@@ -310,7 +310,10 @@ fn outputs_aimed_into_a_run_directory_are_refused_and_the_run_stays_usable() {
     let simulate = |csv: &Path| {
         vec!["simulate".to_string(), "--routing".into(), "0,1,0,1,0".into(), "--tension".into(), "1".into(), "--csv".into(), s(csv).into()]
     };
-    let simulations = [simulate(&manifest), simulate(&csv)];
+    let mut picture = simulate(&manifest);
+    picture[5] = "--png".into();
+    picture[6] = s(&dir.join("shards/picture.png")).into();
+    let simulations = [simulate(&manifest), simulate(&csv), picture];
     for args in [
         vec!["reduce", s(&dir), "--out", s(&dir)],
         vec!["reduce", s(&dir), "--out", s(&inside)],

@@ -377,7 +377,7 @@ fn draw_legend<'a, 'b: 'a>(chart: &mut Chart<'a, 'b>, path: &Path, position: Ser
 fn residual_plot(path: &Path, data: &Dataset, groups: &[RoutingGroup], d: &Diagnosis, after: Option<&str>, w: f64) -> Result<(), PlotError> {
     register_fonts();
     let height = if after.is_some() { 800 } else { 420 };
-    let root = BitMapBackend::new(path, (1100, height)).into_drawing_area();
+    let root = crate::plot::png_backend(path, (1100, height))?.into_drawing_area();
     root.fill(&WHITE).map_err(|e| PlotError::new(path, e))?;
     let panels = root.split_evenly((if after.is_some() { 2 } else { 1 }, 1));
     let order: Vec<usize> = groups.iter().flat_map(|g| g.rows.iter().copied()).collect();
@@ -457,7 +457,7 @@ fn loop_plot(path: &Path, data: &Dataset, groups: &[RoutingGroup], d: &Diagnosis
     register_fonts();
     let cols = groups.len().clamp(1, 3);
     let rows = groups.len().div_ceil(cols).max(1);
-    let root = BitMapBackend::new(path, (420 * cols as u32, 360 * rows as u32)).into_drawing_area();
+    let root = crate::plot::png_backend(path, (420 * cols as u32, 360 * rows as u32))?.into_drawing_area();
     root.fill(&WHITE).map_err(|e| PlotError::new(path, e))?;
     let panels = root.split_evenly((rows, cols));
     let orange = RGBColor(230, 120, 0);
@@ -548,7 +548,7 @@ fn shape_plot(
     let (y0, y1) = pts.iter().fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.1), b.max(p.1)));
     let span = (x1 - x0).max(y1 - y0) + 10.0;
     let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
-    let root = BitMapBackend::new(path, (850, 850)).into_drawing_area();
+    let root = crate::plot::png_backend(path, (850, 850))?.into_drawing_area();
     root.fill(&WHITE).map_err(|e| PlotError::new(path, e))?;
     let title = "shapes at the top tension: measured vs simulated";
     let mut chart = crate::plot::hanging_chart(&root, path, title, (cx - span / 2.0, cx + span / 2.0), (cy - span / 2.0, cy + span / 2.0))?;

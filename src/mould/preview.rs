@@ -13,7 +13,7 @@ pub fn write_png(path: &Path, set: &MouldSet, number: u8) -> Result<(), PlotErro
     let m = &set.moulds;
     let kinds = MouldSet::kinds(number);
     let (_, placed) = set.plate(number);
-    let root = BitMapBackend::new(path, (1400, 1100)).into_drawing_area();
+    let root = crate::plot::png_backend(path, (1400, 1100))?.into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(&e))?;
     let (top, bottom) = root.split_vertically(620);
     // The section at true aspect on the left, notes on the right.

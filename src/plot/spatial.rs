@@ -20,7 +20,7 @@ struct View {
 /// Draws `sim` as two side-by-side views into `path` (PNG, 1400 × 760 px).
 pub fn draw_spatial(path: &Path, title: &str, sim: &SpatialSimulation) -> Result<(), PlotError> {
     register_fonts();
-    let root = BitMapBackend::new(path, (1400, 760)).into_drawing_area();
+    let root = crate::plot::png_backend(path, (1400, 760))?.into_drawing_area();
     root.fill(&WHITE).map_err(|e| PlotError::new(path, e))?;
     let root = root.titled(title, (FONT, 22)).map_err(|e| PlotError::new(path, e))?;
     let panels = root.split_evenly((1, 2));
@@ -141,7 +141,7 @@ pub fn draw_reach_maps(path: &Path, title: &str, planes: &[ReachPlane<'_>], cell
     use plotters::style::colors::colormaps::ViridisRGB;
     register_fonts();
     let panel = 560u32;
-    let root = BitMapBackend::new(path, (panel * planes.len().max(1) as u32, panel + 110)).into_drawing_area();
+    let root = crate::plot::png_backend(path, (panel * planes.len().max(1) as u32, panel + 110))?.into_drawing_area();
     root.fill(&WHITE).map_err(|e| PlotError::new(path, e))?;
     let root = root.titled(title, (FONT, 20)).map_err(|e| PlotError::new(path, e))?;
     let max = planes.iter().flat_map(|p| p.cells.iter().map(|c| c.2)).max().unwrap_or(1).max(1) as f64;

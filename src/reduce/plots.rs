@@ -341,7 +341,7 @@ pub fn draw_heatmap_laid_out(
     let label_size = 17;
     let (map_w, map_h) = layout.frame.area_size(layout.plot_w_px, label_size);
     let size = (map_w, TITLE_H + map_h + BAR_H);
-    let root = BitMapBackend::new(path, size).into_drawing_area();
+    let root = crate::plot::png_backend(path, size)?.into_drawing_area();
     root.fill(&WHITE).map_err(|e| PlotError::new(path, e))?;
     let shown_value = |v: f64| if scale == Scale::Log { v.max(1.0).log10() } else { v };
     let shown: Vec<(i32, i32, f64)> = cells.iter().map(|&(i, j, v)| (i, j, shown_value(v))).collect();
@@ -507,7 +507,7 @@ pub fn draw_modes(path: &Path, map: &MapData, shapes: &[Option<BodyDrawing>]) ->
     register_fonts();
     let layout = ModesLayout::of(&map.summary);
     let frame = MapFrame::of(&map.summary);
-    let root = BitMapBackend::new(path, layout.size_px).into_drawing_area();
+    let root = crate::plot::png_backend(path, layout.size_px)?.into_drawing_area();
     root.fill(&WHITE).map_err(|e| PlotError::new(path, e))?;
     let (head, rest) = root.split_vertically(MODES_HEAD_H);
     let (body, bar) = rest.split_vertically(4 * layout.panel_px.1);
