@@ -209,6 +209,21 @@ pub fn fmt_num(v: f64) -> String {
     }
 }
 
+/// A number to about three significant digits, for estimates in messages:
+/// plain where that is short ("0.0123", "98.1"), else in scientific
+/// notation ("9.81e4", "1.23e-7").
+pub fn fmt_approx(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return format!("{v}");
+    }
+    let magnitude = v.abs().log10().floor();
+    if (-3.0..4.0).contains(&magnitude) {
+        format!("{:.*}", (2.0 - magnitude).max(0.0) as usize, v)
+    } else {
+        format!("{v:.2e}")
+    }
+}
+
 /// Reads a UTF-8 text file. A file in another encoding (Latin-1, UTF-16
 /// from a spreadsheet) is an error saying so and how to fix it, instead of
 /// the bare "stream did not contain valid UTF-8".

@@ -12,19 +12,19 @@ use std::path::{Path, PathBuf};
 #[derive(Debug, Clone, Args)]
 pub struct MouldParamArgs {
     /// Wall and floor thickness around the cavity, mm.
-    #[arg(long, value_name = "MM", default_value_t = MouldParams::default().wall_mm)]
+    #[arg(long, value_name = "MM", allow_hyphen_values = true, default_value_t = MouldParams::default().wall_mm)]
     pub wall_mm: f64,
     /// Outer diameter of the PTFE tube that forms the channel, mm (thesis §5.2: 1).
-    #[arg(long, value_name = "MM", default_value_t = MouldParams::default().tube_diameter_mm)]
+    #[arg(long, value_name = "MM", allow_hyphen_values = true, default_value_t = MouldParams::default().tube_diameter_mm)]
     pub tube_diameter_mm: f64,
     /// Play between mating printed features (pins in holes, tube notches), mm.
-    #[arg(long, value_name = "MM", default_value_t = MouldParams::default().clearance_mm)]
+    #[arg(long, value_name = "MM", allow_hyphen_values = true, default_value_t = MouldParams::default().clearance_mm)]
     pub clearance_mm: f64,
     /// Clamp block: body cast before the clamp face (s < 0) for the clamp to hold, mm; 0 for none.
-    #[arg(long, value_name = "MM", default_value_t = MouldParams::default().clamp_mm)]
+    #[arg(long, value_name = "MM", allow_hyphen_values = true, default_value_t = MouldParams::default().clamp_mm)]
     pub clamp_mm: f64,
     /// Least silicone between the channel and the body surface, mm.
-    #[arg(long, value_name = "MM", default_value_t = MouldParams::default().min_skin_mm)]
+    #[arg(long, value_name = "MM", allow_hyphen_values = true, default_value_t = MouldParams::default().min_skin_mm)]
     pub min_skin_mm: f64,
 }
 

@@ -102,18 +102,23 @@ mod tests {
         assert!(check_order(100, &collocation(64)).unwrap_err().contains("highest supported order 16"));
     }
 
-    /// The solver itself (not `simulate`, which would refuse coarse cases).
-    fn coefficients(options: &SolverOptions, order: usize) -> Vec<f64> {
+    /// The solver itself (not `simulate`, which would refuse coarse cases);
+    /// `None` when the solver refuses the solve as unresolved.
+    fn coefficients(options: &SolverOptions, order: usize) -> Option<Vec<f64>> {
         let actuator = Actuator::default();
         let routing = Routing::new(&[-4.0, 4.0, -4.0, 4.0, -4.0], actuator.length_mm, actuator.radius_mm).unwrap();
         let mut sim = Simulator::new(&actuator, options).unwrap();
         sim.set_routing(&routing);
         for t in [0.5, 1.0, 1.5, 2.0] {
-            sim.solve(t).unwrap();
+            match sim.solve(t) {
+                Ok(_) => {}
+                Err(crate::model::SolveFailure::Unresolved { .. }) => return None,
+                Err(e) => panic!("{e}"),
+            }
         }
         let mut a = vec![0.0; order + 1];
         sim.coefficients_into(crate::shape::LengthBasis::Rest, &mut a);
-        a
+        Some(a)
     }
 
     /// The claim behind the tables, re-measured at a few entries: a_k at
@@ -124,13 +129,15 @@ mod tests {
         let cases: [(fn(usize) -> SolverOptions, &[usize; 17], usize, usize); 4] =
             [(rk4, &REQUIRED_STEPS_PER_SPAN, 5, 1024), (rk4, &REQUIRED_STEPS_PER_SPAN, 9, 1024), (collocation, &REQUIRED_NODES_PER_SPAN, 9, 64), (collocation, &REQUIRED_NODES_PER_SPAN, 12, 64)];
         for (make, table, order, fine_n) in cases {
-            let fine = coefficients(&make(fine_n), order);
-            let coarse = coefficients(&make(table[order]), order);
+            let fine = coefficients(&make(fine_n), order).unwrap();
+            let coarse = coefficients(&make(table[order]), order).unwrap();
             for k in 0..=order {
                 assert!((coarse[k] - fine[k]).abs() <= ORDER_TOLERANCE_PER_MM, "a_{k} at order {order}: {} vs {}", coarse[k], fine[k]);
             }
-            let below = coefficients(&make(table[order] / 2), order);
-            assert!((below[order] - fine[order]).abs() > ORDER_TOLERANCE_PER_MM / 10.0, "order {order} at half the table");
+            // Half the table is off (or, at its coarsest, refused outright).
+            if let Some(below) = coefficients(&make(table[order] / 2), order) {
+                assert!((below[order] - fine[order]).abs() > ORDER_TOLERANCE_PER_MM / 10.0, "order {order} at half the table");
+            }
         }
     }
 }

@@ -57,6 +57,7 @@ mod collocation;
 mod continuation;
 mod creep;
 mod friction;
+mod probe;
 mod rk4;
 
 use creep::Creep;
@@ -66,7 +67,7 @@ use friction::Friction;
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SolveFailure {
     /// The tension is negative or not finite.
-    #[error("tension {0} N is invalid: a cable pulls with a finite tension ≥ 0 N")]
+    #[error("tension {} N is invalid: a cable pulls with a finite tension ≥ 0 N", crate::io::fmt_num(*.0))]
     InvalidTension(f64),
     /// The per-point cable-direction equation did not converge.
     #[error("the cable-direction equation did not converge at s = {s_mm:.3} mm; try smaller tension steps from a lower tension")]
@@ -93,6 +94,26 @@ pub enum SolveFailure {
     /// Newton's method with continuation in the weight.
     #[error("the equilibrium under the rod's weight did not converge (reached {reached_percent:.0} % of the weight); try smaller tension steps from a lower tension, more nodes per span, or a smaller gravity scale")]
     WeightNotConverged { reached_percent: f64 },
+    /// The discretisation does not resolve the solution: the a posteriori
+    /// error estimate of `what` is above `tolerance` (or the tip lies
+    /// farther from the clamp than the stretched rod is long).
+    #[error(
+        "the solver's discretisation does not resolve this shape: {what} is off by about {} {unit} (tolerance {} {unit}); {advice}",
+        crate::io::fmt_approx(*estimate),
+        crate::io::fmt_approx(*tolerance)
+    )]
+    Unresolved {
+        /// What is off: "the tip position", "a_11", ….
+        what: String,
+        /// Its estimated error.
+        estimate: f64,
+        /// The error accepted.
+        tolerance: f64,
+        /// The unit of both.
+        unit: &'static str,
+        /// Which setting to raise.
+        advice: String,
+    },
 }
 
 impl SolveFailure {
@@ -108,6 +129,7 @@ impl SolveFailure {
             SolveFailure::NonFinite { .. } => "non_finite",
             SolveFailure::FrictionNotConverged => "friction_not_converged",
             SolveFailure::WeightNotConverged { .. } => "weight_not_converged",
+            SolveFailure::Unresolved { .. } => "unresolved",
         }
     }
 }
@@ -125,6 +147,27 @@ const CLAMP_TOLERANCE_RAD: f64 = 1e-14;
 
 /// Collocation intervals per span used at least when material stiffening is on.
 pub const MIN_NODES_WITH_STIFFENING: usize = 16;
+
+/// Tip position error a solve may have, mm: its a posteriori estimate must
+/// stay below this plus [`TIP_TOLERANCE_PER_LENGTH`] times the rod's length
+/// ([`tip_tolerance_mm`]), or the solve is refused as unresolved.
+pub const TIP_TOLERANCE_MM: f64 = 5e-4;
+/// The part of the tip tolerance proportional to the rod's length.
+pub const TIP_TOLERANCE_PER_LENGTH: f64 = 1e-5;
+
+/// The tip position error accepted on a rod of `length_mm`, mm.
+pub fn tip_tolerance_mm(length_mm: f64) -> f64 {
+    TIP_TOLERANCE_MM + TIP_TOLERANCE_PER_LENGTH * length_mm
+}
+
+/// Most collocation intervals per span.
+pub const MAX_NODES_PER_SPAN: usize = 64;
+/// Most RK4 steps per span.
+pub const MAX_STEPS_PER_SPAN: usize = 100_000;
+
+/// Orders a_0 … a_{ESTIMATED_ORDERS−1} get an error estimate (above the
+/// highest order any check allows).
+const ESTIMATED_ORDERS: usize = 24;
 
 /// Status string of a successful solve.
 pub const STATUS_OK: &str = "ok";
@@ -305,6 +348,22 @@ pub struct Simulator {
     /// points when the cable is knotted at the tip): from there on the cut
     /// carries no cable load.
     cable_end: usize,
+    /// The estimated error of the tangent angle along the last solve, rad
+    /// (the coefficients' error estimate starts from it).
+    theta_error_rad: f64,
+    /// The estimated error of the largest coefficient asked for in the
+    /// last [`Simulator::coefficients_into`], mm⁻¹, and its index.
+    coefficient_error: (f64, usize),
+    /// The routing as given (before the channel offset), for the probe.
+    given_routing: Option<Routing>,
+    /// The hold of the solves (the probe's are held alike).
+    hold: Hold,
+    /// A finer solver that settles an error estimate above the tolerance
+    /// by a solve at twice the intervals ([`probe`]); made when first needed.
+    probe: Option<Box<probe::Probe>>,
+    /// Whether this solver is itself a probe (its solves are the
+    /// reference: they are not estimated).
+    is_probe: bool,
 }
 
 /// How a solve is held: the direction of the last tension change (friction)
@@ -322,14 +381,14 @@ impl Simulator {
     pub fn new(actuator: &Actuator, options: &SolverOptions) -> Result<Self, ParameterError> {
         actuator.validate()?;
         // The upper bound keeps a typo (2e9 steps) from exhausting memory.
-        if options.steps_per_span < 2 || options.steps_per_span % 2 != 0 || options.steps_per_span > 100_000 {
+        if options.steps_per_span < 2 || options.steps_per_span % 2 != 0 || options.steps_per_span > MAX_STEPS_PER_SPAN {
             return Err(ParameterError::OutOfRange {
                 name: "steps_per_span",
                 value: options.steps_per_span as f64,
                 expected: "an even number from 2 to 100000",
             });
         }
-        if options.method == SolverMethod::Collocation && !(4..=64).contains(&options.nodes_per_span) {
+        if options.method == SolverMethod::Collocation && !(4..=MAX_NODES_PER_SPAN).contains(&options.nodes_per_span) {
             return Err(ParameterError::OutOfRange {
                 name: "nodes_per_span",
                 value: options.nodes_per_span as f64,
@@ -381,6 +440,12 @@ impl Simulator {
             rk4: rk4::Rk4::new(n),
             body,
             cable_end: points,
+            theta_error_rad: 0.0,
+            coefficient_error: (0.0, 0),
+            given_routing: None,
+            hold: Hold::default(),
+            probe: None,
+            is_probe: false,
         })
         .and_then(|mut sim: Simulator| {
             // Outside a protocol every solve is held like this from a virgin rod.
@@ -415,6 +480,10 @@ impl Simulator {
             self.rk4_set_routing(&built);
         }
         self.routing = Some(built);
+        self.given_routing = Some(routing.clone());
+        if let Some(p) = self.probe.as_mut() {
+            p.stale();
+        }
         self.reset_warm_start();
         self.reset_history();
         self.last = None;
@@ -455,6 +524,10 @@ impl Simulator {
         }
         self.friction.set_slip_sign(hold.direction.slip_sign());
         self.creep.set_dwell(hold.dwell_s);
+        self.hold = hold;
+        if let Some(p) = self.probe.as_mut() {
+            p.stale();
+        }
         Ok(())
     }
 
@@ -480,7 +553,7 @@ impl Simulator {
                 Section { ea_n: x.ea_n, ga_n: x.ga_n, ei_n_mm2: x.ei_n_mm2, radius_mm: x.radius_mm }
             }
         };
-        if s < hidden.base_segment_mm {
+        if s < hidden.base_segment_mm || (left && s == hidden.base_segment_mm) {
             section.ei_n_mm2 *= hidden.base_segment_ei_factor;
         }
         let beta = a.effects.stiffness_gradient_beta;
@@ -623,6 +696,9 @@ impl Simulator {
             return Err(SolveFailure::InvalidTension(tension_n));
         }
         self.creep.begin_solve();
+        if let Some(p) = self.probe.as_mut() {
+            p.forget_solve();
+        }
         let result = self.solve_inner(tension_n);
         match &result {
             Ok(pose) => self.last = Some(*pose),
@@ -634,15 +710,81 @@ impl Simulator {
         result
     }
 
+    #[cfg(test)]
+    pub(super) fn solve_inner_unchecked(&mut self, tension: f64) -> Result<(), SolveFailure> {
+        let passes = self.colloc_solve(tension)?;
+        self.last = Some(self.colloc_pose(tension, passes));
+        Ok(())
+    }
+
     fn solve_inner(&mut self, tension: f64) -> Result<TipPose, SolveFailure> {
-        if self.col.is_some() {
+        // The error estimate comes before the creep history moves on, so
+        // that a refused solve leaves the history as it was.
+        let (pose, (theta_error, tip_error)) = if self.col.is_some() {
             let passes = self.colloc_solve(tension)?;
-            self.creep.end_solve();
-            return Ok(self.colloc_pose(tension, passes));
-        }
-        let passes = self.rk4_solve(tension)?;
+            (self.colloc_pose(tension, passes), self.colloc_error_estimate())
+        } else {
+            let passes = self.rk4_solve(tension)?;
+            (self.rk4_pose(tension, passes), self.rk4_error_estimate(tension)?)
+        };
+        self.theta_error_rad = self.check_resolved(&pose, theta_error, tip_error)?;
         self.creep.end_solve();
-        Ok(self.rk4_pose(tension, passes))
+        Ok(pose)
+    }
+
+    /// Refuses a pose with a non-finite number, an estimated tip error
+    /// `tip_error_mm` above [`tip_tolerance_mm`] (unless a probe at twice
+    /// the intervals agrees to within it), or a tip farther from the
+    /// clamp than the stretched rod is long (which no curve can do).
+    /// Returns the estimated error of the tangent angle, rad.
+    fn check_resolved(&mut self, pose: &TipPose, theta_error_rad: f64, tip_error_mm: f64) -> Result<f64, SolveFailure> {
+        let scalars = [pose.tip_x_mm, pose.tip_y_mm, pose.tip_angle_rad, pose.tip_frame_angle_rad, pose.base_angle_rad, pose.length_mm];
+        if !scalars.iter().all(|v| v.is_finite()) {
+            return Err(SolveFailure::NonFinite { s_mm: self.actuator.length_mm });
+        }
+        if self.is_probe {
+            return Ok(0.0);
+        }
+        let tolerance = tip_tolerance_mm(self.actuator.length_mm);
+        let reach = pose.tip_x_mm.hypot(pose.tip_y_mm);
+        if reach > pose.length_mm + tolerance {
+            return Err(self.unresolved(
+                format!("the tip (|tip| = {} mm is more than the stretched length ℓ = {} mm)", crate::io::fmt_num(reach), crate::io::fmt_num(pose.length_mm)),
+                reach - pose.length_mm,
+                tolerance,
+                "mm",
+            ));
+        }
+        if tip_error_mm <= tolerance {
+            return Ok(theta_error_rad);
+        }
+        // The estimate is an upper bound, often far above the error: a
+        // solve at twice the intervals tells.
+        match self.probe_pose(pose.tension_n) {
+            Some(Ok(fine)) => {
+                let difference = (pose.tip_x_mm - fine.tip_x_mm).hypot(pose.tip_y_mm - fine.tip_y_mm);
+                if difference <= tolerance {
+                    return Ok((pose.tip_angle_rad - fine.tip_angle_rad).abs());
+                }
+                Err(self.unresolved("the tip position".into(), difference, tolerance, "mm"))
+            }
+            _ => Err(self.unresolved("the tip position".into(), tip_error_mm, tolerance, "mm")),
+        }
+    }
+
+    /// [`SolveFailure::Unresolved`] with the setting to raise for this
+    /// solver's method.
+    fn unresolved(&self, what: String, estimate: f64, tolerance: f64, unit: &'static str) -> SolveFailure {
+        SolveFailure::Unresolved { what, estimate, tolerance, unit, advice: resolution_advice(&self.options, self.resolution()) }
+    }
+
+    /// The resolution in use: collocation intervals per span (at least
+    /// [`MIN_NODES_WITH_STIFFENING`] with stiffening), or RK4 steps per span.
+    pub fn resolution(&self) -> usize {
+        match &self.col {
+            Some(c) => c.intervals(),
+            None => self.options.steps_per_span,
+        }
     }
 
     /// Legendre curvature coefficients a_0 … a_{n−1} (n = `out.len()`) of the
@@ -651,13 +793,42 @@ impl Simulator {
     ///
     /// # Panics
     /// If the last solve failed or none was made.
+    ///
+    /// Also estimates their error ([`Simulator::coefficient_error_per_mm`]);
+    /// [`Simulator::coefficients_checked`] refuses coefficients the
+    /// discretisation does not resolve.
     pub fn coefficients_into(&mut self, basis: LengthBasis, out: &mut [f64]) {
         assert!(self.last.is_some(), "coefficients_into needs a successful solve");
-        if self.col.is_some() {
-            self.colloc_coefficients(basis, out);
-            return;
+        let estimate = if self.col.is_some() { self.colloc_coefficients(basis, out) } else { self.rk4_coefficients(basis, out) };
+        self.coefficient_error = if estimate.0 <= super::resolution::ORDER_TOLERANCE_PER_MM || self.is_probe {
+            estimate
+        } else {
+            // As for the tip: a solve at twice the intervals tells.
+            self.probe_coefficient_difference(basis, out).unwrap_or(estimate)
+        };
+    }
+
+    /// The estimated error of the coefficients of the last
+    /// [`Simulator::coefficients_into`]: the largest over a_0 … a_n, mm⁻¹,
+    /// and the index k of the a_k it belongs to.
+    pub fn coefficient_error_per_mm(&self) -> (f64, usize) {
+        self.coefficient_error
+    }
+
+    /// [`Simulator::coefficients_into`], refusing coefficients whose
+    /// estimated error is above [`super::resolution::ORDER_TOLERANCE_PER_MM`]
+    /// or that are not finite.
+    pub fn coefficients_checked(&mut self, basis: LengthBasis, out: &mut [f64]) -> Result<(), SolveFailure> {
+        self.coefficients_into(basis, out);
+        if !out.iter().all(|a| a.is_finite()) {
+            return Err(SolveFailure::NonFinite { s_mm: self.actuator.length_mm });
         }
-        self.rk4_coefficients(basis, out);
+        let (error, k) = self.coefficient_error;
+        let tolerance = super::resolution::ORDER_TOLERANCE_PER_MM;
+        if !(error <= tolerance) {
+            return Err(self.unresolved(format!("a_{k}"), error, tolerance, "mm⁻¹"));
+        }
+        Ok(())
     }
 
     /// The centreline of the last successful solve, clamp to tip.
@@ -670,6 +841,25 @@ impl Simulator {
     }
 }
 
+/// What to raise when a solve at `resolution` (intervals or steps per
+/// span) with `options` is not resolved.
+fn resolution_advice(options: &SolverOptions, resolution: usize) -> String {
+    match options.method {
+        SolverMethod::Collocation if resolution < MAX_NODES_PER_SPAN => format!(
+            "raise --nodes-per-span (now {resolution}, at most {MAX_NODES_PER_SPAN}; sweep spec: [solver] nodes_per_span), e.g. --nodes-per-span {}",
+            (2 * resolution).min(MAX_NODES_PER_SPAN)
+        ),
+        SolverMethod::Collocation => format!(
+            "{MAX_NODES_PER_SPAN} intervals per span, the most, do not resolve it: use --method rk4 with more --steps-per-span \
+             (sweep spec: [solver] method = \"rk4\", steps_per_span), or a lower tension"
+        ),
+        SolverMethod::Rk4 => format!(
+            "raise --steps-per-span (now {resolution}, at most {MAX_STEPS_PER_SPAN}; sweep spec: [solver] steps_per_span), e.g. --steps-per-span {}",
+            (4 * resolution).min(MAX_STEPS_PER_SPAN)
+        ),
+    }
+}
+
 /// The collocation's span boundaries from the clamp to the tip: the
 /// routing's knot `knot_mm`, the cable's anchor and the body's breakpoints
 /// (so that every span's integrands are smooth); [0, knot, L] for the
@@ -679,6 +869,11 @@ fn span_boundaries(a: &Actuator, body: Option<&Body>, knot_mm: f64) -> Vec<f64> 
     let mut cuts = vec![0.0, knot_mm, a.cable_length_mm(), length];
     if let Some(b) = body {
         cuts.extend(b.breakpoints_mm());
+    }
+    // The test-only stiff base segment's rigidity jumps at its end.
+    let hidden = &a.effects.hidden;
+    if hidden.base_segment_ei_factor != 1.0 && hidden.base_segment_mm > 0.0 && hidden.base_segment_mm < length {
+        cuts.push(hidden.base_segment_mm);
     }
     merge_sorted(cuts, length)
 }
@@ -755,6 +950,48 @@ pub fn simulate_held(
     hold: Hold,
 ) -> Result<Simulation, SimulateError> {
     super::resolution::check_order(order, options).map_err(ParameterError::Unresolved)?;
+    // A solve the discretisation does not resolve is repeated, from the
+    // bottom of the ladder, at a finer one, up to the most there is.
+    let mut options = options.clone();
+    loop {
+        match simulate_at(actuator, &options, routing, tension_n, order, basis, hold) {
+            Err(SimulateError::Solve(SolveFailure::Unresolved { .. })) if refined(&mut options) => continue,
+            result => return result,
+        }
+    }
+}
+
+/// Raises `options`' resolution one step for an unresolved solve (1.5×
+/// the collocation intervals, up to [`MAX_NODES_PER_SPAN`]; 2× the RK4
+/// steps, up to [`MAX_AUTO_STEPS_PER_SPAN`]); false at the most.
+fn refined(options: &mut SolverOptions) -> bool {
+    match options.method {
+        SolverMethod::Collocation if options.nodes_per_span < MAX_NODES_PER_SPAN => {
+            options.nodes_per_span = (options.nodes_per_span * 3 / 2).clamp(options.nodes_per_span + 2, MAX_NODES_PER_SPAN);
+            true
+        }
+        SolverMethod::Rk4 if options.steps_per_span < MAX_AUTO_STEPS_PER_SPAN => {
+            options.steps_per_span = (2 * options.steps_per_span).min(MAX_AUTO_STEPS_PER_SPAN);
+            true
+        }
+        _ => false,
+    }
+}
+
+/// Most RK4 steps per span [`simulate`] refines to by itself (a solve
+/// there takes tens of milliseconds; more must be asked for).
+pub const MAX_AUTO_STEPS_PER_SPAN: usize = 6144;
+
+/// One try of [`simulate_held`] at `options`' resolution.
+fn simulate_at(
+    actuator: &Actuator,
+    options: &SolverOptions,
+    routing: &Routing,
+    tension_n: f64,
+    order: usize,
+    basis: LengthBasis,
+    hold: Hold,
+) -> Result<Simulation, SimulateError> {
     let mut sim = Simulator::new(actuator, options)?;
     sim.set_routing(routing);
     // A ladder of tensions: cheap, and it keeps Newton and the shooting in
@@ -770,7 +1007,7 @@ pub fn simulate_held(
     }
     let pose = pose.expect("at least one rung");
     let mut a = vec![0.0; order + 1];
-    sim.coefficients_into(basis, &mut a);
+    sim.coefficients_checked(basis, &mut a)?;
     Ok(Simulation { routing_mm: routing.control_points_mm(), pose, a, length_basis: basis, centreline: sim.centreline() })
 }
 
@@ -1253,5 +1490,66 @@ mod anchor_edge_tests {
             poses.push(pose);
         }
         assert!((poses[0].tip_angle_rad - poses[1].tip_angle_rad).abs() < 1e-9, "{poses:?}");
+    }
+}
+
+
+#[cfg(test)]
+mod dbg_rk4 {
+    use super::*;
+    #[test]
+    fn dbg_rk4_estimates() {
+        let mut rng = crate::calibrate::rng::Rng::new(11);
+        let (mut worst_tip, mut worst_a) = (0.0f64, 0.0f64);
+        let mut ratios = Vec::new();
+        for _ in 0..120 {
+            let mut a = Actuator::default();
+            let u = |rng: &mut crate::calibrate::rng::Rng, lo: f64, hi: f64| lo * (hi / lo).powf(rng.uniform());
+            a.length_mm = u(&mut rng, 30.0, 300.0);
+            a.radius_mm = u(&mut rng, 2.0, 8.0);
+            a.ei_n_mm2 = u(&mut rng, 20.0, 400.0);
+            a.gravity.enabled = rng.uniform() < 0.5;
+            let y: Vec<f64> = (0..5).map(|_| (2.0 * rng.uniform() - 1.0) * 0.8 * a.radius_mm).collect();
+            let t = u(&mut rng, 0.3, 3.0) * a.ei_n_mm2 / a.length_mm / a.radius_mm;
+            let reference = simulate(&a, &SolverOptions { nodes_per_span: 64, ..SolverOptions::default() }, &Routing::for_actuator(&y, &a).unwrap(), t, 5, LengthBasis::Rest);
+            let Ok(reference) = reference else { continue };
+            for n in [8, 16, 24, 48] {
+                let o = SolverOptions { method: SolverMethod::Rk4, steps_per_span: n, ..SolverOptions::default() };
+                let mut sim = Simulator::new(&a, &o).unwrap();
+                sim.set_routing_mm(&y).unwrap();
+                let rungs = ((t / 0.25).ceil() as usize).max(1);
+                let mut ok = true;
+                let mut est = (0.0, 0.0);
+                for k in 1..=rungs {
+                    let tt = t * k as f64 / rungs as f64;
+                    match sim.rk4_solve(tt) { Ok(p) => { sim.last = Some(sim.rk4_pose(tt, p)); est = sim.rk4_error_estimate(tt).unwrap(); sim.theta_error_rad = est.0; } Err(_) => { ok = false; break } }
+                }
+                if !ok { continue }
+                let pose = sim.last.unwrap();
+                let mut c = [0.0; 6];
+                let (ae, _) = sim.rk4_coefficients(LengthBasis::Rest, &mut c);
+                let tip = (pose.tip_x_mm - reference.pose.tip_x_mm).hypot(pose.tip_y_mm - reference.pose.tip_y_mm);
+                let aerr = c.iter().zip(&reference.a).map(|(p, q)| (p - q).abs()).fold(0.0, f64::max);
+                if tip > 1e-6 { worst_tip = worst_tip.max(tip / est.1); ratios.push(tip / est.1); }
+                if aerr > 1e-7 { worst_a = worst_a.max(aerr / ae); }
+            }
+        }
+        let a = Actuator::default();
+        let o = SolverOptions { method: SolverMethod::Rk4, ..SolverOptions::default() };
+        let mut sim = Simulator::new(&a, &o).unwrap();
+        let (mut tmax, mut amax) = (0.0f64, 0.0f64);
+        for y in crate::bench::sample_thesis_routings(400, 5.0) {
+            sim.set_routing_mm(&y.0).unwrap();
+            for k in 0..21 {
+                let tt = 1.0 + k as f64 / 20.0;
+                let p = sim.rk4_solve(tt).unwrap(); sim.last = Some(sim.rk4_pose(tt, p)); let est = sim.rk4_error_estimate(tt).unwrap(); sim.theta_error_rad = est.0;
+                let mut c = [0.0; 6];
+                let (ae, _) = sim.rk4_coefficients(LengthBasis::Rest, &mut c);
+                tmax = tmax.max(est.1); amax = amax.max(ae);
+            }
+        }
+        eprintln!("thesis rk4-24: tip est max {tmax:.3e}, a_0..5 est max {amax:.3e}");
+        ratios.sort_by(f64::total_cmp);
+        eprintln!("rk4: worst tip true/est {worst_tip:.3e} median {:.3e}, worst a true/est {worst_a:.3e}", ratios[ratios.len() / 2]);
     }
 }
