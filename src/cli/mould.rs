@@ -66,7 +66,7 @@ pub struct MouldArgs {
 /// A mould error, with the flag of the parameter it names.
 pub fn with_flag(e: MouldError) -> anyhow::Error {
     match &e {
-        MouldError::BadParameter { name, .. } if *name != "sizes" => {
+        MouldError::BadParameter { name, .. } if *name != "station_step_mm" => {
             let flag = format!("--{}", name.replace('_', "-"));
             anyhow::Error::new(e).context(flag)
         }
@@ -124,7 +124,7 @@ pub fn run(args: &MouldArgs) -> anyhow::Result<()> {
     cablemap::mould::check_uniform_body(&actuator)?;
     let routing = Routing::new(&ys, actuator.length_mm, actuator.radius_mm)?;
     let summary = MouldSet::new(&routing, actuator.radius_mm, &args.mould.params())
-        .and_then(|set| set.write_all(&args.out))
+        .and_then(|set| set.write_dir(&args.out))
         .map_err(with_flag)?;
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
