@@ -710,13 +710,6 @@ impl Simulator {
         result
     }
 
-    #[cfg(test)]
-    pub(super) fn solve_inner_unchecked(&mut self, tension: f64) -> Result<(), SolveFailure> {
-        let passes = self.colloc_solve(tension)?;
-        self.last = Some(self.colloc_pose(tension, passes));
-        Ok(())
-    }
-
     fn solve_inner(&mut self, tension: f64) -> Result<TipPose, SolveFailure> {
         // The error estimate comes before the creep history moves on, so
         // that a refused solve leaves the history as it was.
@@ -1494,62 +1487,3 @@ mod anchor_edge_tests {
 }
 
 
-#[cfg(test)]
-mod dbg_rk4 {
-    use super::*;
-    #[test]
-    fn dbg_rk4_estimates() {
-        let mut rng = crate::calibrate::rng::Rng::new(11);
-        let (mut worst_tip, mut worst_a) = (0.0f64, 0.0f64);
-        let mut ratios = Vec::new();
-        for _ in 0..120 {
-            let mut a = Actuator::default();
-            let u = |rng: &mut crate::calibrate::rng::Rng, lo: f64, hi: f64| lo * (hi / lo).powf(rng.uniform());
-            a.length_mm = u(&mut rng, 30.0, 300.0);
-            a.radius_mm = u(&mut rng, 2.0, 8.0);
-            a.ei_n_mm2 = u(&mut rng, 20.0, 400.0);
-            a.gravity.enabled = rng.uniform() < 0.5;
-            let y: Vec<f64> = (0..5).map(|_| (2.0 * rng.uniform() - 1.0) * 0.8 * a.radius_mm).collect();
-            let t = u(&mut rng, 0.3, 3.0) * a.ei_n_mm2 / a.length_mm / a.radius_mm;
-            let reference = simulate(&a, &SolverOptions { nodes_per_span: 64, ..SolverOptions::default() }, &Routing::for_actuator(&y, &a).unwrap(), t, 5, LengthBasis::Rest);
-            let Ok(reference) = reference else { continue };
-            for n in [8, 16, 24, 48] {
-                let o = SolverOptions { method: SolverMethod::Rk4, steps_per_span: n, ..SolverOptions::default() };
-                let mut sim = Simulator::new(&a, &o).unwrap();
-                sim.set_routing_mm(&y).unwrap();
-                let rungs = ((t / 0.25).ceil() as usize).max(1);
-                let mut ok = true;
-                let mut est = (0.0, 0.0);
-                for k in 1..=rungs {
-                    let tt = t * k as f64 / rungs as f64;
-                    match sim.rk4_solve(tt) { Ok(p) => { sim.last = Some(sim.rk4_pose(tt, p)); est = sim.rk4_error_estimate(tt).unwrap(); sim.theta_error_rad = est.0; } Err(_) => { ok = false; break } }
-                }
-                if !ok { continue }
-                let pose = sim.last.unwrap();
-                let mut c = [0.0; 6];
-                let (ae, _) = sim.rk4_coefficients(LengthBasis::Rest, &mut c);
-                let tip = (pose.tip_x_mm - reference.pose.tip_x_mm).hypot(pose.tip_y_mm - reference.pose.tip_y_mm);
-                let aerr = c.iter().zip(&reference.a).map(|(p, q)| (p - q).abs()).fold(0.0, f64::max);
-                if tip > 1e-6 { worst_tip = worst_tip.max(tip / est.1); ratios.push(tip / est.1); }
-                if aerr > 1e-7 { worst_a = worst_a.max(aerr / ae); }
-            }
-        }
-        let a = Actuator::default();
-        let o = SolverOptions { method: SolverMethod::Rk4, ..SolverOptions::default() };
-        let mut sim = Simulator::new(&a, &o).unwrap();
-        let (mut tmax, mut amax) = (0.0f64, 0.0f64);
-        for y in crate::bench::sample_thesis_routings(400, 5.0) {
-            sim.set_routing_mm(&y.0).unwrap();
-            for k in 0..21 {
-                let tt = 1.0 + k as f64 / 20.0;
-                let p = sim.rk4_solve(tt).unwrap(); sim.last = Some(sim.rk4_pose(tt, p)); let est = sim.rk4_error_estimate(tt).unwrap(); sim.theta_error_rad = est.0;
-                let mut c = [0.0; 6];
-                let (ae, _) = sim.rk4_coefficients(LengthBasis::Rest, &mut c);
-                tmax = tmax.max(est.1); amax = amax.max(ae);
-            }
-        }
-        eprintln!("thesis rk4-24: tip est max {tmax:.3e}, a_0..5 est max {amax:.3e}");
-        ratios.sort_by(f64::total_cmp);
-        eprintln!("rk4: worst tip true/est {worst_tip:.3e} median {:.3e}, worst a true/est {worst_a:.3e}", ratios[ratios.len() / 2]);
-    }
-}
