@@ -51,7 +51,8 @@ pub struct MouldArgs {
     /// A design.json written by `cablemap design --out`: its routing and actuator.
     #[arg(long, value_name = "FILE")]
     pub design: Option<PathBuf>,
-    /// Directory for mould1.stl, mould2.stl, mould1.png, mould2.png, channel.csv, mould.json.
+    /// Directory for mould1.stl, mould2.stl, mould1.png, mould2.png, channel.csv, mould.json: new,
+    /// empty or an earlier mould directory, written as a whole (a killed run leaves nothing partial).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
     /// Print mould.json instead of a report.

@@ -112,7 +112,7 @@ mod tests {
         for t in [0.5, 1.0, 1.5, 2.0] {
             match sim.solve(t) {
                 Ok(_) => {}
-                Err(crate::model::SolveFailure::Unresolved { .. }) => return None,
+                Err(crate::model::SolveFailure::Unresolved(_)) => return None,
                 Err(e) => panic!("{e}"),
             }
         }
@@ -192,7 +192,7 @@ mod tests {
                     let tip = (sim.pose.tip_x_mm - fine.pose.tip_x_mm).hypot(sim.pose.tip_y_mm - fine.pose.tip_y_mm);
                     prop_assert!(tip <= crate::model::solver::tip_tolerance_mm(length_mm), "tip off by {tip} mm");
                 }
-                Err(SimulateError::Solve(SolveFailure::Unresolved { .. })) => {}
+                Err(SimulateError::Solve(SolveFailure::Unresolved(_))) => {}
                 // A solve that does not converge is another matter (the fine one did).
                 Err(_) => {}
             }

@@ -95,25 +95,32 @@ pub enum SolveFailure {
     #[error("the equilibrium under the rod's weight did not converge (reached {reached_percent:.0} % of the weight); try smaller tension steps from a lower tension, more nodes per span, or a smaller gravity scale")]
     WeightNotConverged { reached_percent: f64 },
     /// The discretisation does not resolve the solution: the a posteriori
-    /// error estimate of `what` is above `tolerance` (or the tip lies
-    /// farther from the clamp than the stretched rod is long).
-    #[error(
-        "the solver's discretisation does not resolve this shape: {what} is off by about {} {unit} (tolerance {} {unit}); {advice}",
-        crate::io::fmt_approx(*estimate),
-        crate::io::fmt_approx(*tolerance)
-    )]
-    Unresolved {
-        /// What is off: "the tip position", "a_11", ….
-        what: String,
-        /// Its estimated error.
-        estimate: f64,
-        /// The error accepted.
-        tolerance: f64,
-        /// The unit of both.
-        unit: &'static str,
-        /// Which setting to raise.
-        advice: String,
-    },
+    /// error estimate of something reported is above its tolerance (or
+    /// the tip lies farther from the clamp than the stretched rod is long).
+    #[error(transparent)]
+    Unresolved(Unresolved),
+}
+
+/// What a solve does not resolve, by how much, and what to raise (the
+/// planar and the 3-D solvers' [`SolveFailure::Unresolved`] and
+/// [`super::spatial::SpatialFailure::Unresolved`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error(
+    "the solver's discretisation does not resolve this shape: {what} is off by about {} {unit} (tolerance {} {unit}); {advice}",
+    crate::io::fmt_approx(*estimate),
+    crate::io::fmt_approx(*tolerance)
+)]
+pub struct Unresolved {
+    /// What is off: "the tip position", "a_11", "a_bend_z[3]", ….
+    pub what: String,
+    /// Its estimated error.
+    pub estimate: f64,
+    /// The error accepted.
+    pub tolerance: f64,
+    /// The unit of both.
+    pub unit: &'static str,
+    /// Which setting to raise, and how.
+    pub advice: String,
 }
 
 impl SolveFailure {
@@ -129,7 +136,7 @@ impl SolveFailure {
             SolveFailure::NonFinite { .. } => "non_finite",
             SolveFailure::FrictionNotConverged => "friction_not_converged",
             SolveFailure::WeightNotConverged { .. } => "weight_not_converged",
-            SolveFailure::Unresolved { .. } => "unresolved",
+            SolveFailure::Unresolved(_) => "unresolved",
         }
     }
 }
@@ -768,7 +775,7 @@ impl Simulator {
     /// [`SolveFailure::Unresolved`] with the setting to raise for this
     /// solver's method.
     fn unresolved(&self, what: String, estimate: f64, tolerance: f64, unit: &'static str) -> SolveFailure {
-        SolveFailure::Unresolved { what, estimate, tolerance, unit, advice: resolution_advice(&self.options, self.resolution()) }
+        SolveFailure::Unresolved(Unresolved { what, estimate, tolerance, unit, advice: resolution_advice(&self.options, self.resolution()) })
     }
 
     /// The resolution in use: collocation intervals per span (at least
@@ -832,6 +839,21 @@ impl Simulator {
         }
         self.rk4_centreline()
     }
+}
+
+/// The largest of the per-order coefficient `errors` (one that is not a
+/// number counts as largest) and its order, converted like the
+/// coefficients from the deformed basis into `basis`.
+fn largest_error(errors: impl Iterator<Item = f64>, basis: LengthBasis, deformed_length_mm: f64, rest_length_mm: f64) -> (f64, usize) {
+    let mut worst = (0.0f64, 0usize);
+    for (n, error) in errors.enumerate() {
+        if !(error <= worst.0) {
+            worst = (error, n);
+        }
+    }
+    let mut error = [worst.0];
+    basis.convert_from_deformed(&mut error, deformed_length_mm, rest_length_mm);
+    (error[0], worst.1)
 }
 
 /// What to raise when a solve at `resolution` (intervals or steps per
@@ -945,10 +967,29 @@ pub fn simulate_held(
     super::resolution::check_order(order, options).map_err(ParameterError::Unresolved)?;
     // A solve the discretisation does not resolve is repeated, from the
     // bottom of the ladder, at a finer one, up to the most there is.
+    let attempt = |options: &SolverOptions| -> Result<Simulation, SimulateError> {
+        let mut sim = Simulator::new(actuator, options)?;
+        sim.set_routing(routing);
+        // A ladder of tensions: cheap, and it keeps Newton and the shooting in
+        // their basin for curled-up shapes.
+        let rungs = if tension_n.is_finite() { ((tension_n / 0.25).ceil() as usize).max(1) } else { 1 };
+        let mut pose = None;
+        for k in 1..=rungs {
+            let t = tension_n * k as f64 / rungs as f64;
+            if k == rungs {
+                sim.set_hold(hold)?;
+            }
+            pose = Some(sim.solve(t)?);
+        }
+        let pose = pose.expect("at least one rung");
+        let mut a = vec![0.0; order + 1];
+        sim.coefficients_checked(basis, &mut a)?;
+        Ok(Simulation { routing_mm: routing.control_points_mm(), pose, a, length_basis: basis, centreline: sim.centreline() })
+    };
     let mut options = options.clone();
     loop {
-        match simulate_at(actuator, &options, routing, tension_n, order, basis, hold) {
-            Err(SimulateError::Solve(SolveFailure::Unresolved { .. })) if refined(&mut options) => continue,
+        match attempt(&options) {
+            Err(SimulateError::Solve(SolveFailure::Unresolved(_))) if refined(&mut options) => continue,
             result => return result,
         }
     }
@@ -975,33 +1016,18 @@ fn refined(options: &mut SolverOptions) -> bool {
 /// there takes tens of milliseconds; more must be asked for).
 pub const MAX_AUTO_STEPS_PER_SPAN: usize = 6144;
 
-/// One try of [`simulate_held`] at `options`' resolution.
-fn simulate_at(
-    actuator: &Actuator,
-    options: &SolverOptions,
-    routing: &Routing,
-    tension_n: f64,
-    order: usize,
-    basis: LengthBasis,
-    hold: Hold,
-) -> Result<Simulation, SimulateError> {
-    let mut sim = Simulator::new(actuator, options)?;
-    sim.set_routing(routing);
-    // A ladder of tensions: cheap, and it keeps Newton and the shooting in
-    // their basin for curled-up shapes.
-    let rungs = if tension_n.is_finite() { ((tension_n / 0.25).ceil() as usize).max(1) } else { 1 };
-    let mut pose = None;
-    for k in 1..=rungs {
-        let t = tension_n * k as f64 / rungs as f64;
-        if k == rungs {
-            sim.set_hold(hold)?;
-        }
-        pose = Some(sim.solve(t)?);
-    }
-    let pose = pose.expect("at least one rung");
-    let mut a = vec![0.0; order + 1];
-    sim.coefficients_checked(basis, &mut a)?;
-    Ok(Simulation { routing_mm: routing.control_points_mm(), pose, a, length_basis: basis, centreline: sim.centreline() })
+/// A random rod far from the thesis's (length, radius, rigidities, with or
+/// without gravity), a routing within ±0.8 r and a tension bending it by
+/// about 0.3–3 rad: the error estimates' test cases.
+#[cfg(test)]
+fn random_case(rng: &mut crate::calibrate::rng::Rng) -> (Actuator, Vec<f64>, f64) {
+    let mut span = |lo: f64, hi: f64| lo * (hi / lo).powf(rng.uniform());
+    let mut a = Actuator::default();
+    (a.length_mm, a.radius_mm, a.ei_n_mm2, a.ea_n, a.ga_n) = (span(30.0, 300.0), span(2.0, 8.0), span(20.0, 400.0), span(15.0, 60.0), span(1.0, 5.0));
+    let tension = span(0.3, 3.0) * a.ei_n_mm2 / a.length_mm / a.radius_mm;
+    a.gravity.enabled = rng.uniform() < 0.5;
+    let y = (0..5).map(|_| (2.0 * rng.uniform() - 1.0) * 0.8 * a.radius_mm).collect();
+    (a, y, tension)
 }
 
 #[cfg(test)]

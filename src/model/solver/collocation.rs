@@ -1186,24 +1186,18 @@ impl Simulator {
             }
         }
         let (theta0, theta_e) = (theta(0), theta(tip));
-        let mut worst = (0.0f64, 0usize);
         for (n, a) in out.iter_mut().enumerate() {
             let sign = if n % 2 == 0 { 1.0 } else { -1.0 };
-            let scale = (2 * n + 1) as f64 / ell;
-            *a = scale * (theta_e - sign * theta0 - *a);
-            let nf = n as f64;
-            let error = match quadrature_error.get(n) {
-                Some(q) => scale * (ESTIMATE_SAFETY * q / (c.m * c.m) as f64 + self.theta_error_rad * (2.0 + (2.0 * nf * (nf + 1.0)).sqrt())),
-                None => f64::INFINITY,
-            };
-            if !(error <= worst.0) {
-                worst = (error, n);
-            }
+            *a = (2 * n + 1) as f64 / ell * (theta_e - sign * theta0 - *a);
         }
+        let errors = (0..out.len()).map(|n| {
+            let nf = n as f64;
+            let angles = self.theta_error_rad * (2.0 + (2.0 * nf * (nf + 1.0)).sqrt());
+            quadrature_error.get(n).map_or(f64::INFINITY, |q| (2.0 * nf + 1.0) / ell * (ESTIMATE_SAFETY * q / (c.m * c.m) as f64 + angles))
+        });
+        let worst = super::largest_error(errors, basis, ell, self.actuator.length_mm);
         basis.convert_from_deformed(out, ell, self.actuator.length_mm);
-        let mut error = [worst.0];
-        basis.convert_from_deformed(&mut error, ell, self.actuator.length_mm);
-        (error[0], worst.1)
+        worst
     }
 
     /// The centreline of the last solve at 2·steps_per_span + 1 evenly spaced
@@ -1284,12 +1278,7 @@ mod tests {
         let mut rng = crate::calibrate::rng::Rng::new(7);
         let mut checked = 0;
         for _ in 0..12 {
-            let mut span = |lo: f64, hi: f64| lo * (hi / lo).powf(rng.uniform());
-            let mut a = Actuator::default();
-            (a.length_mm, a.radius_mm, a.ei_n_mm2, a.ea_n, a.ga_n) = (span(30.0, 300.0), span(2.0, 8.0), span(20.0, 400.0), span(15.0, 60.0), span(1.0, 5.0));
-            let tension = span(0.3, 3.0) * a.ei_n_mm2 / a.length_mm / a.radius_mm;
-            a.gravity.enabled = rng.uniform() < 0.5;
-            let y: Vec<f64> = (0..5).map(|_| (2.0 * rng.uniform() - 1.0) * 0.8 * a.radius_mm).collect();
+            let (a, y, tension) = super::super::random_case(&mut rng);
             let Some((fine, fine_a, _, _)) = estimated(&a, 64, &y, tension, 12) else { continue };
             for m in [6, 8, 10, 12, 16] {
                 let order = crate::model::resolution::REQUIRED_NODES_PER_SPAN.iter().rposition(|&n| n <= m).unwrap().min(12);

@@ -366,20 +366,10 @@ impl Simulator {
         let estimated = out.len().min(super::ESTIMATED_ORDERS);
         shape::legendre_from_tangent(&r.coarse_theta, &r.coarse_sigma, &r.coarse_speed, 2.0 * h, &mut coarse[..estimated]);
         let ell = r.sigma[r.sigma.len() - 1] - r.sigma[0];
-        let mut worst = (0.0f64, 0usize);
-        for (n, a) in out.iter().enumerate() {
-            let error = match coarse.get(n) {
-                Some(c) => (a - c).abs(),
-                None => f64::INFINITY,
-            };
-            if !(error <= worst.0) {
-                worst = (error, n);
-            }
-        }
+        let errors = out.iter().enumerate().map(|(n, a)| coarse.get(n).map_or(f64::INFINITY, |c| (a - c).abs()));
+        let worst = super::largest_error(errors, basis, ell, self.actuator.length_mm);
         basis.convert_from_deformed(out, ell, self.actuator.length_mm);
-        let mut error = [worst.0];
-        basis.convert_from_deformed(&mut error, ell, self.actuator.length_mm);
-        (error[0], worst.1)
+        worst
     }
 
     /// The centreline of the last solve at the nodes.
@@ -417,7 +407,7 @@ impl Simulator {
 
 #[cfg(test)]
 mod tests {
-    use crate::model::{simulate, Actuator, Routing, Simulator, SolverMethod, SolverOptions};
+    use crate::model::{simulate, Routing, Simulator, SolverMethod, SolverOptions};
     use crate::shape::LengthBasis;
 
     /// RK4's estimates (the differences to a pass at twice the step) bound
@@ -428,12 +418,7 @@ mod tests {
         let mut rng = crate::calibrate::rng::Rng::new(11);
         let mut checked = 0;
         for _ in 0..12 {
-            let mut span = |lo: f64, hi: f64| lo * (hi / lo).powf(rng.uniform());
-            let mut a = Actuator::default();
-            (a.length_mm, a.radius_mm, a.ei_n_mm2) = (span(30.0, 300.0), span(2.0, 8.0), span(20.0, 400.0));
-            let tension = span(0.3, 3.0) * a.ei_n_mm2 / a.length_mm / a.radius_mm;
-            a.gravity.enabled = rng.uniform() < 0.5;
-            let y: Vec<f64> = (0..5).map(|_| (2.0 * rng.uniform() - 1.0) * 0.8 * a.radius_mm).collect();
+            let (a, y, tension) = super::super::random_case(&mut rng);
             let fine = SolverOptions { nodes_per_span: 64, ..SolverOptions::default() };
             let Ok(reference) = simulate(&a, &fine, &Routing::for_actuator(&y, &a).unwrap(), tension, 5, LengthBasis::Rest) else { continue };
             for n in [8, 16, 24] {

@@ -249,7 +249,7 @@ pub fn simulate_spatial(
         let steps = options.steps_per_span;
         let failure = match &coarse {
             Some(c) => unresolved_part(&fine, c, steps),
-            None => Some(SpatialFailure::Unresolved { what: "the tip position".into(), estimate: f64::INFINITY, tolerance: 0.0, unit: "mm", steps }),
+            None => Some(unresolved("the tip position".into(), f64::INFINITY, 0.0, "mm", steps)),
         };
         let Some(failure) = failure else {
             return Ok(fine);
@@ -265,11 +265,17 @@ pub fn simulate_spatial(
 /// Most RK4 steps per span [`simulate_spatial`] refines to by itself.
 pub const MAX_AUTO_SPATIAL_STEPS_PER_SPAN: usize = 2560;
 
+/// [`SpatialFailure::Unresolved`] for `what` at `steps` per span.
+fn unresolved(what: String, estimate: f64, tolerance: f64, unit: &'static str, steps: usize) -> SpatialFailure {
+    let advice = format!("raise --steps-per-span above {steps} (sweep spec: [solver] steps_per_span), or lower the tensions");
+    SpatialFailure::Unresolved(crate::model::solver::Unresolved { what, estimate, tolerance, unit, advice })
+}
+
 /// What of `fine` (at `steps` per span) is not resolved, judged against
 /// `coarse` (at fewer steps): the tip or a coefficient further off than
 /// its tolerance, or a tip beyond the stretched length. `None` if all is.
 fn unresolved_part(fine: &SpatialSimulation, coarse: &SpatialSimulation, steps: usize) -> Option<SpatialFailure> {
-    let unresolved = |what: String, estimate: f64, tolerance: f64, unit| Some(SpatialFailure::Unresolved { what, estimate, tolerance, unit, steps });
+    let unresolved = |what: String, estimate: f64, tolerance: f64, unit| Some(unresolved(what, estimate, tolerance, unit, steps));
     let tolerance = crate::model::solver::tip_tolerance_mm(fine.actuator.rod.length_mm);
     let [x, y, z] = fine.pose.tip_mm;
     let reach = (x * x + y * y + z * z).sqrt();

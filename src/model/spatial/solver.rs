@@ -149,23 +149,8 @@ pub enum SpatialFailure {
     /// solve at half the steps is above the tolerance, up to the most steps
     /// tried ([`super::simulate_spatial`]), or the tip lies farther from the
     /// clamp than the stretched rod is long.
-    #[error(
-        "the spatial solver's steps do not resolve this shape: {what} is off by about {} {unit} at {steps} steps per span (tolerance {} {unit}); raise --steps-per-span above {steps} (sweep spec: [solver] steps_per_span), or lower the tensions",
-        crate::io::fmt_approx(*estimate),
-        crate::io::fmt_approx(*tolerance)
-    )]
-    Unresolved {
-        /// What is off: "the tip position", "a_bend_z[3]", ….
-        what: String,
-        /// Its estimated error.
-        estimate: f64,
-        /// The error accepted.
-        tolerance: f64,
-        /// The unit of both.
-        unit: &'static str,
-        /// The steps per span of the last try.
-        steps: usize,
-    },
+    #[error(transparent)]
+    Unresolved(crate::model::solver::Unresolved),
 }
 
 impl SpatialFailure {
@@ -176,7 +161,7 @@ impl SpatialFailure {
             SpatialFailure::Local { .. } => "cut_equations_not_converged",
             SpatialFailure::Gravity { .. } => "gravity_not_converged",
             SpatialFailure::NonFinite => "non_finite",
-            SpatialFailure::Unresolved { .. } => "unresolved",
+            SpatialFailure::Unresolved(_) => "unresolved",
         }
     }
 }
