@@ -482,6 +482,10 @@ fn errors_print_short_numbers_accept_negative_values_and_refuse_absurd_angles() 
     assert!(!stderr.contains("0000000000"), "{stderr}");
     // A clamp tilt is an angle.
     refused(&[&["simulate"][..], &R, &["--gravity-direction-rad", "1e300"]].concat(), &["gravity.direction_rad", "2π"]);
+    // A tension the continuation would climb for hours (on a rod stiff enough not to give way first).
+    let stiff = ["--ea-n", "1e12", "--ga-n", "1e12", "--ei-n-mm2", "1e15"];
+    refused(&[&["simulate", "--routing", "1,1,1,1,1", "--tension", "1e7"][..], &stiff].concat(), &["tension_n = 10000000", "25000 N"]);
+    refused(&["simulate", "--cable", "y=1,1,1,1,1 tension=1e7"], &["10000000", "25000 N"]);
     // The smallest cell printed is the actual bound: a cell just below it is
     // refused with a number above the one given, and the number printed works.
     let tmp = tempfile::tempdir().unwrap();

@@ -965,6 +965,7 @@ pub fn simulate_held(
     hold: Hold,
 ) -> Result<Simulation, SimulateError> {
     super::resolution::check_order(order, options).map_err(ParameterError::Unresolved)?;
+    check_ladder_tension("tension_n", tension_n)?;
     // A solve the discretisation does not resolve is repeated, from the
     // bottom of the ladder, at a finer one, up to the most there is.
     let attempt = |options: &SolverOptions| -> Result<Simulation, SimulateError> {
@@ -993,6 +994,23 @@ pub fn simulate_held(
             result => return result,
         }
     }
+}
+
+/// Highest tension the continuation ladders of [`simulate`] and
+/// [`super::spatial::simulate_spatial`] climb to, N: 10⁵ rungs of 0.25 N
+/// (a few seconds); an absurd tension is refused rather than climbed for hours.
+pub const MAX_LADDER_TENSION_N: f64 = 25_000.0;
+
+/// Refuses a tension above [`MAX_LADDER_TENSION_N`] (parameter `name`).
+pub fn check_ladder_tension(name: &'static str, tension_n: f64) -> Result<(), ParameterError> {
+    if tension_n > MAX_LADDER_TENSION_N {
+        return Err(ParameterError::OutOfRange {
+            name,
+            value: tension_n,
+            expected: "a tension of at most 25000 N (solves climb to it in steps of 0.25 N; the thesis's cable pulls up to 2 N)",
+        });
+    }
+    Ok(())
 }
 
 /// Raises `options`' resolution one step for an unresolved solve (1.5×

@@ -239,6 +239,8 @@ pub fn simulate_spatial(
     basis: LengthBasis,
 ) -> Result<SpatialSimulation, SpatialError> {
     solver::check_order(order, options)?;
+    let top = actuator.cables.iter().map(|c| c.tension_n).fold(0.0, f64::max);
+    crate::model::solver::check_ladder_tension("cable tension_n", top)?;
     let half = SpatialOptions { steps_per_span: (options.steps_per_span / 2).max(2), ..options.clone() };
     // A coarse solve that fails says nothing about the fine one: the
     // comparison then moves one level up.
