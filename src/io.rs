@@ -416,6 +416,93 @@ pub fn exchange(a: &Path, b: &Path) -> std::io::Result<bool> {
     }
 }
 
+/// Which step of [`write_dir_replacing`] failed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DirStep {
+    /// Creating the parent or the staging directory (the path given).
+    Create,
+    /// Putting the staging directory in place of the output (the output given).
+    Replace,
+}
+
+/// Writes the directory `dir` as a whole: `write` fills a staging directory
+/// beside it (`.NAME.tmp-TOKEN`, locked while it is written), which then
+/// replaces `dir` ([`replace_dir`]), so a reader sees the old directory or
+/// the new one, never a mix, and a killed writer leaves the old one whole
+/// (the next writer clears its leftovers). `name` is `dir`'s file name;
+/// the caller has checked that `dir` may be replaced. `fail` makes the
+/// caller's error for a failed step.
+pub fn write_dir_replacing<T, E>(
+    dir: &Path,
+    name: &str,
+    write: impl FnOnce(&Path) -> Result<T, E>,
+    fail: impl Fn(DirStep, PathBuf, std::io::Error) -> E,
+) -> Result<T, E> {
+    let parent = parent_dir(dir).to_path_buf();
+    std::fs::create_dir_all(&parent).map_err(|source| fail(DirStep::Create, parent.clone(), source))?;
+    remove_abandoned_staging(&parent, name);
+    let staging = parent.join(format!(".{name}.tmp-{}", unique_token()));
+    std::fs::create_dir(&staging).map_err(|source| fail(DirStep::Create, staging.clone(), source))?;
+    // Held while writing so that another writer does not clear it away.
+    let lock = match File::open(&staging) {
+        Ok(lock) => lock,
+        Err(source) => {
+            let _ = std::fs::remove_dir_all(&staging);
+            return Err(fail(DirStep::Create, staging, source));
+        }
+    };
+    // Best effort: where locks are unsupported, staging is judged by its age.
+    let _ = lock.try_lock();
+    let written = write(&staging).and_then(|out| {
+        sync_dir(&staging);
+        replace_dir(&staging, dir, &parent, name).map_err(|source| fail(DirStep::Replace, dir.to_path_buf(), source))?;
+        Ok(out)
+    });
+    if written.is_err() {
+        let _ = std::fs::remove_dir_all(&staging);
+    }
+    drop(lock);
+    written
+}
+
+/// Moves `staging` to `dir`: directly when `dir` is absent or empty, else
+/// by an atomic exchange (Linux), else by moving the old directory aside
+/// first and deleting it after (a moment without `dir`, never a mixed one).
+fn replace_dir(staging: &Path, dir: &Path, parent: &Path, name: &str) -> std::io::Result<()> {
+    match std::fs::rename(staging, dir) {
+        Ok(()) => {}
+        Err(_) if dir.is_dir() && exchange(staging, dir)? => {
+            // `staging` now holds the old directory.
+            let _ = std::fs::remove_dir_all(staging);
+        }
+        Err(_) if dir.is_dir() => {
+            let old = parent.join(format!(".{name}.old-{}", unique_token()));
+            std::fs::rename(dir, &old)?;
+            if let Err(e) = std::fs::rename(staging, dir) {
+                let _ = std::fs::rename(&old, dir);
+                return Err(e);
+            }
+            let _ = std::fs::remove_dir_all(&old);
+        }
+        Err(e) => return Err(e),
+    }
+    sync_dir(parent);
+    Ok(())
+}
+
+/// Removes staging and old directories of `name` left by killed writers
+/// (no writer holds their lock, or they are stale).
+fn remove_abandoned_staging(parent: &Path, name: &str) {
+    let Ok(entries) = std::fs::read_dir(parent) else { return };
+    for entry in entries.flatten() {
+        let file_name = entry.file_name().to_string_lossy().into_owned();
+        let left = is_temp_of(&file_name, name) || file_name.strip_prefix(&format!(".{name}.old-")).is_some_and(|t| !t.is_empty());
+        if left && entry.path().is_dir() && is_abandoned(&entry.path()) {
+            let _ = std::fs::remove_dir_all(entry.path());
+        }
+    }
+}
+
 /// SHA-256 of a file's bytes, hex.
 pub fn sha256_file(path: &Path) -> std::io::Result<String> {
     use sha2::{Digest, Sha256};

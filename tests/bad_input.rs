@@ -428,3 +428,231 @@ fn a_target_without_commas_is_told_to_use_them() {
         refused(&["feasible", "--map", "nowhere", "--target", target], &["separate components with commas"]);
     }
 }
+
+// ---------------------------------------------------------------------------
+// What a new user and a hostile probe found (issue "honest"): the solver
+// resolves what it reports, non-finite results, measurement files, mould
+// limits and unclear errors.
+
+/// `simulate --json` with `extra`, parsed; the exit status too.
+fn simulate_json(extra: &[&str]) -> (bool, serde_json::Value, String) {
+    let (ok, stdout, stderr) = run(&[&["simulate", "--json"][..], extra].concat());
+    let v = serde_json::from_str(stdout.trim()).unwrap_or(serde_json::Value::Null);
+    (ok, v, stderr)
+}
+
+fn numbers(v: &serde_json::Value) -> Vec<f64> {
+    v.as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect()
+}
+
+#[test]
+fn absurd_parameters_are_refused_by_name_instead_of_non_finite_results_reported_ok() {
+    let planar = ["--routing", "1,1,1,1,1", "--tension-n", "1.5"];
+    for (extra, name) in [
+        (&["--ga-n", "5e-324"][..], "ga_n = 5e-324"),
+        (&["--ga-n", "1e-310"], "ga_n = 1e-310"),
+        (&["--length-mm", "5e-324"], "length_mm = 5e-324"),
+        (&["--density-g-cm3", "1e300"], "density_g_cm3 = 1e300"),
+        (&["--gravity-scale", "1e300"], "gravity.scale = 1e300"),
+        (&["--length-mm", "1e300", "--no-gravity"], "length_mm = 1e300"),
+    ] {
+        let (ok, v, stderr) = simulate_json(&[&planar[..], extra].concat());
+        assert!(!ok && v["status"] != "ok", "{extra:?} accepted: {v}");
+        assert!(stderr.contains(name) && stderr.contains(" to "), "{extra:?}: no parameter and range in: {stderr}");
+    }
+    let (ok, v, stderr) = simulate_json(&["--cable", "y=1,1,1,1,1 tension=1.5", "--length-mm", "1e-300"]);
+    assert!(!ok && v["status"] != "ok" && stderr.contains("length_mm = 1e-300"), "{v} {stderr}");
+    // A solve that cannot be resolved is refused with its status in the JSON record.
+    let (ok, v, stderr) = simulate_json(&[&planar[..], &["--length-mm", "1e5", "--no-gravity"]].concat());
+    assert!(!ok && v["status"] == "unresolved" && stderr.contains("does not resolve"), "{v} {stderr}");
+}
+
+#[test]
+fn coiling_rods_are_resolved_before_they_are_reported() {
+    // 13 turns of an exact circular arc (a straight routing without gravity).
+    let coil = [
+        "--routing", "0.147,0.147,0.147,0.147,0.147", "--tension", "8", "--length-mm", "189.8", "--radius-mm", "0.5184",
+        "--ei-n-mm2", "2.6536", "--ea-n", "32.048", "--ga-n", "1.2513", "--no-gravity",
+    ];
+    let (ok, v, stderr) = simulate_json(&coil);
+    assert!(ok, "{stderr}");
+    let (ok, fine, stderr) = simulate_json(&[&coil[..], &["--nodes-per-span", "64"]].concat());
+    assert!(ok, "{stderr}");
+    let (x, y) = (v["tip_x_mm"].as_f64().unwrap(), v["tip_y_mm"].as_f64().unwrap());
+    assert!((x - 1.1025).abs() < 1e-3 && (y - 2.9783).abs() < 1e-3, "tip ({x}, {y}): the 13-turn arc ends at (1.10, 2.98)");
+    assert!((x - fine["tip_x_mm"].as_f64().unwrap()).hypot(y - fine["tip_y_mm"].as_f64().unwrap()) < 1e-3);
+    // Several cables on a 10 m rod: the tip within the stretched length, and
+    // where a solve at 1280 steps per span puts it.
+    let cables = ["--cable", "y=1,-2,3,0.5,-3 z=0.5,0.5,0,0,-1 tension=1.2", "--cable", "y=-2,-2,-2,-2,-2 tension=0.5", "--length-mm", "1e4", "--no-gravity"];
+    let tip = |v: &serde_json::Value| ["tip_x_mm", "tip_y_mm", "tip_z_mm"].map(|k| v[k].as_f64().unwrap());
+    let (ok, v, stderr) = simulate_json(&cables);
+    assert!(ok, "{stderr}");
+    let p = tip(&v);
+    let reach = p.iter().map(|c| c * c).sum::<f64>().sqrt();
+    assert!(reach <= v["length_mm"].as_f64().unwrap(), "|tip| = {reach} mm beyond ℓ = {}", v["length_mm"]);
+    let (ok, fine, stderr) = simulate_json(&[&cables[..], &["--steps-per-span", "1280"]].concat());
+    assert!(ok, "{stderr}");
+    let q = tip(&fine);
+    let off = (0..3).map(|i| (p[i] - q[i]).powi(2)).sum::<f64>().sqrt();
+    assert!(off < 0.1, "{p:?} vs {q:?} at 1280 steps: {off} mm");
+}
+
+#[test]
+fn high_orders_off_the_thesis_rod_are_within_the_promised_tolerance() {
+    let rod = [
+        "--routing", "0.9837509673644185,-2.326467243062671,-2.5569015396039316,3.4514597946044425,2.244894957755583",
+        "--tension", "4.678486105953747", "--length-mm", "134.95512015867718", "--ei-n-mm2", "39.48677215002417", "--order", "11",
+    ];
+    let (ok, v, stderr) = simulate_json(&rod);
+    assert!(ok, "{stderr}");
+    let (ok, fine, stderr) = simulate_json(&[&rod[..], &["--nodes-per-span", "64"]].concat());
+    assert!(ok, "{stderr}");
+    for (k, (a, b)) in numbers(&v["a"]).iter().zip(numbers(&fine["a"])).enumerate() {
+        assert!((a - b).abs() <= 5e-5, "a_{k}: {a} vs {b} at 64 intervals");
+    }
+}
+
+#[test]
+fn measurement_files_with_duplicate_columns_wrong_units_cr_lines_or_absurd_tilts_are_named() {
+    use cablemap::calibrate::data::read_measurements;
+    let tmp = tempfile::tempdir().unwrap();
+    let good = tmp.path().join("m.csv");
+    assert!(run(&["synth", "--out", s(&good), "--load-steps", "3"]).0);
+    let text = std::fs::read_to_string(&good).unwrap();
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|c| *c == name).unwrap();
+    let edit = |name: &str, f: &dyn Fn(usize, &mut Vec<String>)| {
+        let path = tmp.path().join(name);
+        let lines: Vec<String> = text
+            .lines()
+            .enumerate()
+            .map(|(i, l)| {
+                let mut cells: Vec<String> = l.split(',').map(String::from).collect();
+                f(i, &mut cells);
+                cells.join(",")
+            })
+            .collect();
+        std::fs::write(&path, lines.join("\n") + "\n").unwrap();
+        path
+    };
+    // A column given twice: which one is meant is not clear.
+    let twice = edit("twice.csv", &|i, c| c.push(if i == 0 { "tip_x_mm".into() } else { "0".into() }));
+    let e = read_measurements(&twice).unwrap_err().to_string();
+    assert!(e.contains("twice.csv") && e.contains("'tip_x_mm' twice"), "{e}");
+    // Tips in µm: far beyond any shape of the rod, with the likely cause.
+    let (ix, iy) = (col("tip_x_mm"), col("tip_y_mm"));
+    let microns = edit("um.csv", &|i, c| {
+        if i > 0 {
+            for k in [ix, iy] {
+                c[k] = (c[k].parse::<f64>().unwrap() * 1000.0).to_string();
+            }
+        }
+    });
+    refused(&["calibrate", s(&microns)], &["farther from the clamp than the rod is long", "µm"]);
+    // Lines ending in CR alone are lines.
+    let cr = tmp.path().join("cr.csv");
+    std::fs::write(&cr, text.replace('\n', "\r")).unwrap();
+    let (a, b) = (read_measurements(&good).unwrap(), read_measurements(&cr).unwrap_or_else(|e| panic!("{e}")));
+    assert_eq!(format!("{:?}", a.rows), format!("{:?}", b.rows));
+    // A clamp tilt no clamp has.
+    let tilted = edit("tilt.csv", &|i, c| {
+        if i > 0 {
+            c[col("clamp_tilt_rad")] = "1e300".into();
+        }
+    });
+    let e = read_measurements(&tilted).unwrap_err().to_string();
+    assert!(e.contains("clamp_tilt_rad") && e.contains("2π"), "{e}");
+}
+
+#[test]
+fn moulds_of_absurd_sizes_are_refused_quickly_and_their_output_is_atomic() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("M");
+    let out_text = s(&out).to_string();
+    let mould = |extra: &[&str]| -> Vec<String> {
+        ["mould", "--routing", "1,-2,3,0.5,-3", "--out", &out_text].iter().chain(extra).map(|a| a.to_string()).collect()
+    };
+    let refused = |args: Vec<String>, needles: &[&str]| refused(&args.iter().map(String::as_str).collect::<Vec<_>>(), needles);
+    let run = |args: Vec<String>| run(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    for (extra, flag) in [
+        (&["--wall-mm", "1e308"][..], "--wall-mm"),
+        (&["--clamp-mm", "1e308"], "--clamp-mm"),
+        (&["--wall-mm", "1e6"], "--wall-mm"),
+        (&["--clamp-mm", "1e7"], "--clamp-mm"),
+        (&["--length-mm", "1e6"], "--length-mm"),
+        (&["--length-mm", "1e9"], "length_mm"),
+        (&["--wall-mm", "nan"], "--wall-mm"),
+        (&["--wall-mm", "2000", "--length-mm", "9000"], "triangles"),
+    ] {
+        let stderr = refused(mould(extra), &[flag]);
+        assert!(!stderr.contains("MouldParams {"), "{extra:?}: a debug dump: {stderr}");
+        assert!(!out.exists(), "{extra:?} left {}", out.display());
+    }
+    // A large radius is a large mould, made quickly (its preview too).
+    let started = std::time::Instant::now();
+    assert!(run(mould(&["--radius-mm", "5000"])).0);
+    assert!(started.elapsed().as_secs() < 20);
+    // Written again over an earlier mould directory; a directory of other files is refused.
+    assert!(run(mould(&[])).0);
+    let names = |d: &Path| {
+        let mut v: Vec<String> = std::fs::read_dir(d).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+        v.sort();
+        v
+    };
+    let whole = names(&out);
+    assert_eq!(whole, ["channel.csv", "mould.json", "mould1.png", "mould1.stl", "mould2.png", "mould2.stl"]);
+    let other = tmp.path().join("other");
+    std::fs::create_dir(&other).unwrap();
+    std::fs::write(other.join("notes.txt"), "mine").unwrap();
+    refused(["mould", "--routing", "1,-2,3,0.5,-3", "--out", s(&other)].map(String::from).to_vec(), &["not a mould directory"]);
+    // Killed while writing, a run leaves the mould directory as it was or whole, never partial.
+    let fresh = tmp.path().join("K");
+    let mut child = cablemap()
+        .args(["mould", "--routing", "1,-2,3,0.5,-3", "--length-mm", "2000", "--out", s(&fresh)])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(300));
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert!(!fresh.exists() || names(&fresh) == whole, "a killed run left {:?}", names(&fresh));
+    assert!(names(tmp.path()).iter().all(|n| !n.starts_with(".K.tmp") || tmp.path().join(n).is_dir()));
+    assert!(run(["mould", "--routing", "1,-2,3,0.5,-3", "--out", s(&fresh)].map(String::from).to_vec()).0);
+    assert_eq!(names(&fresh), whole);
+    assert!(!names(tmp.path()).iter().any(|n| n.starts_with(".K.")), "leftovers: {:?}", names(tmp.path()));
+}
+
+#[test]
+fn errors_print_short_numbers_accept_negative_values_and_refuse_absurd_angles() {
+    // Negative numbers reach validation (not "unexpected argument '-1'").
+    refused(&[&["simulate"][..], &R, &["--length-mm", "-1e-300"]].concat(), &["length_mm = -1e-300", "positive"]);
+    // Huge numbers print short.
+    let stderr = refused(&["simulate", "--routing", "1e300,1,1,1,1", "--tension", "1"], &["1e300"]);
+    assert!(!stderr.contains("0000000000"), "{stderr}");
+    let stderr = refused(&["simulate", "--routing", "1,1,1,1,1", "--tension", "1e300"], &["1e300 N"]);
+    assert!(!stderr.contains("0000000000"), "{stderr}");
+    // A clamp tilt is an angle.
+    refused(&[&["simulate"][..], &R, &["--gravity-direction-rad", "1e300"]].concat(), &["gravity.direction_rad", "2π"]);
+    // A tension the continuation would climb for hours (on a rod stiff enough not to give way first).
+    let stiff = ["--ea-n", "1e12", "--ga-n", "1e12", "--ei-n-mm2", "1e15"];
+    refused(&[&["simulate", "--routing", "1,1,1,1,1", "--tension", "1e7"][..], &stiff].concat(), &["tension_n = 10000000", "25000 N"]);
+    refused(&["simulate", "--cable", "y=1,1,1,1,1 tension=1e7"], &["10000000", "25000 N"]);
+    // The smallest cell printed is the actual bound: a cell just below it is
+    // refused with a number above the one given, and the number printed works.
+    let tmp = tempfile::tempdir().unwrap();
+    let run_dir = tmp.path().join("q");
+    assert!(run(&["sweep", QUICK, "--out", s(&run_dir), "--quiet"]).0);
+    let bound_in = |stderr: &str| -> f64 { stderr.rsplit("use --cell-mm ≥ ").next().unwrap().trim().trim_end_matches(')').parse().unwrap() };
+    let reduce = |cell: &str, name: &str| run(&["reduce", s(&run_dir), "--out", s(&tmp.path().join(name)), "--cell-mm", cell]);
+    let (ok, _, stderr) = reduce("1e-9", "tiny");
+    assert!(!ok, "{stderr}");
+    let bound = bound_in(&stderr);
+    let below = format!("{:.3e}", bound * (1.0 - 1e-9));
+    let (ok, _, stderr) = reduce(&below, "below");
+    if !ok {
+        assert!(bound_in(&stderr) > below.parse::<f64>().unwrap(), "{below} refused with a bound no larger: {stderr}");
+    }
+    let (ok, _, stderr) = reduce(&bound.to_string(), "at");
+    assert!(ok, "the bound {bound} printed was refused: {stderr}");
+}

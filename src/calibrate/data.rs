@@ -211,6 +211,10 @@ fn read_table(path: &Path) -> Result<Table, CalibrateError> {
 /// Splits CSV text into cells: comma-separated, fields optionally in double
 /// quotes ("" inside quotes is a quote), blank lines skipped.
 fn parse_csv(path: &Path, text: &str) -> Result<Table, CalibrateError> {
+    // Lines that end in CR alone (classic Mac OS, some instrument software)
+    // are lines too; CR LF and LF need nothing (str::lines drops the CR).
+    let text: std::borrow::Cow<str> =
+        if text.contains('\r') && !text.contains('\n') { text.replace('\r', "\n").into() } else { text.into() };
     // The geometry header: '#' lines before the column names.
     let text = text.trim_start_matches('\u{feff}');
     let mut front = String::new();
@@ -380,7 +384,28 @@ impl Cells<'_> {
     }
 }
 
+/// Refuses a header that names a column twice: which of the two a reader
+/// takes is arbitrary, so neither is (the error names both positions).
+fn check_unique_columns(path: &Path, table: &Table) -> Result<(), CalibrateError> {
+    let mut seen: HashMap<&str, usize> = HashMap::new();
+    for (i, name) in table.header.iter().enumerate() {
+        if let Some(first) = seen.insert(name.as_str(), i) {
+            return Err(CalibrateError::Malformed {
+                path: path.display().to_string(),
+                row: 0,
+                message: format!(
+                    "the header names column '{name}' twice (columns {} and {}); give each column once, so it is clear which values are meant",
+                    first + 1,
+                    i + 1
+                ),
+            });
+        }
+    }
+    Ok(())
+}
+
 fn parse_measurements(path: &Path, table: &Table) -> Result<Dataset, CalibrateError> {
+    check_unique_columns(path, table)?;
     let mut idx = [usize::MAX; REQUIRED_COLUMNS.len()];
     for (slot, name) in idx.iter_mut().zip(REQUIRED_COLUMNS).take(N_REQUIRED) {
         *slot = column_index(path, table, name)?;
@@ -433,6 +458,10 @@ fn parse_measurements(path: &Path, table: &Table) -> Result<Dataset, CalibrateEr
             Some(k) if !cells[k].is_empty() => c.float(k, "clamp_tilt_rad")?,
             _ => 0.0,
         };
+        if clamp_tilt_rad.abs() > std::f64::consts::TAU {
+            let k = tilt_idx.expect("read from the column");
+            return Err(c.bad("clamp_tilt_rad", &cells[k], "an angle in radians (|θ| ≤ 2π); was it given in degrees?"));
+        }
         let noise = |k: Option<usize>, name: &str| -> Result<Option<f64>, CalibrateError> {
             match k {
                 Some(k) if !cells[k].is_empty() => {

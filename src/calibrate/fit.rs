@@ -599,6 +599,37 @@ pub fn fit(
     fit_observed(base, options, data, groups, spec, &mut |_| {})
 }
 
+/// How much farther than the rod is long a measured tip may lie from the
+/// clamp: the rod stretches by a few per cent at most, and a camera's error
+/// is a fraction of its length.
+const MAX_TIP_REACH_PER_LENGTH: f64 = 1.5;
+
+/// Refuses data whose tips lie farther from the clamp than the rod could
+/// reach: no parameter of the model can fit them, so the fit would
+/// "converge" on nonsense. The likely cause is the unit (µm for mm).
+fn check_tips_within_reach(data: &Dataset, base: &Actuator) -> Result<(), CalibrateError> {
+    let Some(far) = data.rows.iter().max_by(|a, b| a.tip_x_mm.hypot(a.tip_y_mm).total_cmp(&b.tip_x_mm.hypot(b.tip_y_mm))) else {
+        return Ok(());
+    };
+    let reach = far.tip_x_mm.hypot(far.tip_y_mm);
+    let length = base.length_mm;
+    if reach <= MAX_TIP_REACH_PER_LENGTH * length {
+        return Ok(());
+    }
+    let ratio = reach / length;
+    let unit = if (300.0..3000.0).contains(&ratio) { " — are they in µm?" } else { "" };
+    Err(CalibrateError::Invalid(format!(
+        "the measurements are absurdly far from any shape the rod can take: the tips are up to {}× farther from the clamp than \
+         the rod is long (tip_x_mm = {}, tip_y_mm = {} on row {}; L = {} mm){unit}; give the tips in mm (check the units, the \
+         column order and the rod length)",
+        crate::io::fmt_sig(ratio, 3),
+        crate::io::fmt_num(far.tip_x_mm),
+        crate::io::fmt_num(far.tip_y_mm),
+        far.row,
+        crate::io::fmt_num(length)
+    )))
+}
+
 /// Where a running fit is: reported after every accepted step.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FitProgress {
@@ -626,6 +657,7 @@ pub fn fit_observed(
     }
     spec.noise.validate()?;
     base.validate()?;
+    check_tips_within_reach(data, base)?;
     let slots = layout(data, groups, &spec.shapes);
     let mut x: Vec<f64> = vec![base.ea_n.ln(), base.ga_n.ln(), base.ei_n_mm2.ln()];
     x.extend(spec.effects.iter().map(|e| e.to_internal(e.current(base).unwrap_or_else(|| e.start()))));

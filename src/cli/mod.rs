@@ -23,22 +23,22 @@ use clap::Args;
 #[derive(Debug, Clone, Args, Default)]
 pub struct ActuatorArgs {
     /// Rod length L, mm [default: 65].
-    #[arg(long, value_name = "MM")]
+    #[arg(long, value_name = "MM", allow_hyphen_values = true)]
     pub length_mm: Option<f64>,
     /// Rod radius r, mm [default: 5].
-    #[arg(long, value_name = "MM")]
+    #[arg(long, value_name = "MM", allow_hyphen_values = true)]
     pub radius_mm: Option<f64>,
     /// Axial rigidity EA, N [default: 26.6964].
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", allow_hyphen_values = true)]
     pub ea_n: Option<f64>,
     /// Shear rigidity GA, N [default: 1.70866].
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", allow_hyphen_values = true)]
     pub ga_n: Option<f64>,
     /// Bending rigidity EI, N·mm² [default: 115.117].
-    #[arg(long, value_name = "N_MM2")]
+    #[arg(long, value_name = "N_MM2", allow_hyphen_values = true)]
     pub ei_n_mm2: Option<f64>,
     /// Material density, g/cm³ [default: 1.07].
-    #[arg(long, value_name = "G_CM3")]
+    #[arg(long, value_name = "G_CM3", allow_hyphen_values = true)]
     pub density_g_cm3: Option<f64>,
     /// Turn self-weight off (the thesis's rod hangs: gravity is on by default).
     #[arg(long)]
@@ -47,14 +47,14 @@ pub struct ActuatorArgs {
     #[arg(long, value_name = "RAD", allow_hyphen_values = true)]
     pub gravity_direction_rad: Option<f64>,
     /// Scale on the nominal self-weight [default: 1].
-    #[arg(long, value_name = "K")]
+    #[arg(long, value_name = "K", allow_hyphen_values = true)]
     pub gravity_scale: Option<f64>,
     /// Material stiffening α: moment EI·u·(1 + α (r u)²) [default: 0].
-    #[arg(long, value_name = "ALPHA")]
+    #[arg(long, value_name = "ALPHA", allow_hyphen_values = true)]
     pub stiffening_alpha: Option<f64>,
     /// Clamp rotational stiffness k_θ, N·mm/rad: the effect `clamp_compliance`
     /// (`--clamp-stiffness` is the old name) [default: rigid clamp].
-    #[arg(long = "clamp-stiffness-n-mm-per-rad", alias = "clamp-stiffness", value_name = "N_MM_PER_RAD")]
+    #[arg(long = "clamp-stiffness-n-mm-per-rad", alias = "clamp-stiffness", value_name = "N_MM_PER_RAD", allow_hyphen_values = true)]
     pub clamp_stiffness: Option<f64>,
     /// Channel offset δ added to every y_i, mm [default: 0].
     #[arg(long, value_name = "MM", allow_hyphen_values = true)]
@@ -63,16 +63,16 @@ pub struct ActuatorArgs {
     #[arg(long, value_name = "BETA", allow_hyphen_values = true)]
     pub stiffness_gradient_beta: Option<f64>,
     /// Cable–channel friction coefficient μ (capstan law) [default: 0].
-    #[arg(long, value_name = "MU")]
+    #[arg(long, value_name = "MU", allow_hyphen_values = true)]
     pub friction_mu: Option<f64>,
     /// Creep: fraction f of the bending rigidity that relaxes (0 ≤ f < 1) [default: 0].
-    #[arg(long, value_name = "F")]
+    #[arg(long, value_name = "F", allow_hyphen_values = true)]
     pub creep_fraction: Option<f64>,
     /// Creep time constant T, s [default: 10].
-    #[arg(long, value_name = "S")]
+    #[arg(long, value_name = "S", allow_hyphen_values = true)]
     pub creep_time_s: Option<f64>,
     /// Creep: seconds each tension is held on a fresh rod in sweeps and design [default: 0].
-    #[arg(long, value_name = "S")]
+    #[arg(long, value_name = "S", allow_hyphen_values = true)]
     pub creep_hold_s: Option<f64>,
     /// Actuator TOML file (the fields of a sweep spec's [actuator] section, docs/model.md); the
     /// flags above and below override it [default: the thesis's actuator].
@@ -84,7 +84,7 @@ pub struct ActuatorArgs {
     #[arg(long, value_name = "S:R,...", value_parser = parse_radius_profile_arg)]
     pub radius_profile_mm: Option<RadiusProfileArg>,
     /// Where the cable is knotted, 0 < s_k ≤ L, mm; the routing spans [0, s_k] [default: the tip].
-    #[arg(long, value_name = "MM")]
+    #[arg(long, value_name = "MM", allow_hyphen_values = true)]
     pub cable_anchor_mm: Option<f64>,
     /// Solver method: `collocation` (spectral, the default) or `rk4` (the previous method).
     #[arg(long, value_enum, value_name = "METHOD")]

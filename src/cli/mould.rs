@@ -12,19 +12,19 @@ use std::path::{Path, PathBuf};
 #[derive(Debug, Clone, Args)]
 pub struct MouldParamArgs {
     /// Wall and floor thickness around the cavity, mm.
-    #[arg(long, value_name = "MM", default_value_t = MouldParams::default().wall_mm)]
+    #[arg(long, value_name = "MM", allow_hyphen_values = true, default_value_t = MouldParams::default().wall_mm)]
     pub wall_mm: f64,
     /// Outer diameter of the PTFE tube that forms the channel, mm (thesis §5.2: 1).
-    #[arg(long, value_name = "MM", default_value_t = MouldParams::default().tube_diameter_mm)]
+    #[arg(long, value_name = "MM", allow_hyphen_values = true, default_value_t = MouldParams::default().tube_diameter_mm)]
     pub tube_diameter_mm: f64,
     /// Play between mating printed features (pins in holes, tube notches), mm.
-    #[arg(long, value_name = "MM", default_value_t = MouldParams::default().clearance_mm)]
+    #[arg(long, value_name = "MM", allow_hyphen_values = true, default_value_t = MouldParams::default().clearance_mm)]
     pub clearance_mm: f64,
     /// Clamp block: body cast before the clamp face (s < 0) for the clamp to hold, mm; 0 for none.
-    #[arg(long, value_name = "MM", default_value_t = MouldParams::default().clamp_mm)]
+    #[arg(long, value_name = "MM", allow_hyphen_values = true, default_value_t = MouldParams::default().clamp_mm)]
     pub clamp_mm: f64,
     /// Least silicone between the channel and the body surface, mm.
-    #[arg(long, value_name = "MM", default_value_t = MouldParams::default().min_skin_mm)]
+    #[arg(long, value_name = "MM", allow_hyphen_values = true, default_value_t = MouldParams::default().min_skin_mm)]
     pub min_skin_mm: f64,
 }
 
@@ -51,7 +51,8 @@ pub struct MouldArgs {
     /// A design.json written by `cablemap design --out`: its routing and actuator.
     #[arg(long, value_name = "FILE")]
     pub design: Option<PathBuf>,
-    /// Directory for mould1.stl, mould2.stl, mould1.png, mould2.png, channel.csv, mould.json.
+    /// Directory for mould1.stl, mould2.stl, mould1.png, mould2.png, channel.csv, mould.json: new,
+    /// empty or an earlier mould directory, written as a whole (a killed run leaves nothing partial).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
     /// Print mould.json instead of a report.
@@ -66,7 +67,7 @@ pub struct MouldArgs {
 /// A mould error, with the flag of the parameter it names.
 pub fn with_flag(e: MouldError) -> anyhow::Error {
     match &e {
-        MouldError::BadParameter { name, .. } if *name != "sizes" => {
+        MouldError::BadParameter { name, .. } if *name != "station_step_mm" => {
             let flag = format!("--{}", name.replace('_', "-"));
             anyhow::Error::new(e).context(flag)
         }
@@ -124,7 +125,7 @@ pub fn run(args: &MouldArgs) -> anyhow::Result<()> {
     cablemap::mould::check_uniform_body(&actuator)?;
     let routing = Routing::new(&ys, actuator.length_mm, actuator.radius_mm)?;
     let summary = MouldSet::new(&routing, actuator.radius_mm, &args.mould.params())
-        .and_then(|set| set.write_all(&args.out))
+        .and_then(|set| set.write_dir(&args.out))
         .map_err(with_flag)?;
     let stdout = std::io::stdout();
     let mut out = stdout.lock();

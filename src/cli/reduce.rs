@@ -175,8 +175,8 @@ fn with_flags(e: ReduceError, run: &Path, out: &Path) -> anyhow::Error {
     use cablemap::reduce::parts::PartsError;
     let part = |i: String, n: String| format!("cablemap reduce {} --out {} --shard {i} --shards {n}", run.display(), out.display());
     match &e {
-        ReduceError::CellTooSmall { smallest_cell_mm, .. } => anyhow::anyhow!("{e} (use --cell-mm ≥ {smallest_cell_mm:.3e})"),
-        ReduceError::CellTooLarge { largest_cell_mm, .. } => anyhow::anyhow!("{e} (--cell-mm {largest_cell_mm} or less)"),
+        ReduceError::CellTooSmall { smallest_cell_mm, .. } => anyhow::anyhow!("{e} (use --cell-mm ≥ {})", cablemap::io::fmt_num(*smallest_cell_mm)),
+        ReduceError::CellTooLarge { largest_cell_mm, .. } => anyhow::anyhow!("{e} (--cell-mm {} or less)", cablemap::io::fmt_num(*largest_cell_mm)),
         ReduceError::ModesNotSplit { .. } => anyhow::anyhow!("{e}: --a0-bounds B1,B2,B3 and --a1-bounds C1,C2"),
         ReduceError::Parts(PartsError::Missing { shards, missing, .. }) => {
             if let [one] = missing.as_slice() {

@@ -2,7 +2,7 @@
 
 use super::{parse_list, ActuatorArgs, LengthBasisArgs};
 use cablemap::model::record::{self, SimulationRecord};
-use cablemap::model::{simulate_held, Hold, LoadDirection, Routing, SolverOptions};
+use cablemap::model::{simulate_held, Hold, LoadDirection, Routing, SimulateError, SolverOptions};
 use cablemap::plot::{draw_bodies, BodyDrawing};
 use anyhow::Context;
 use clap::Args;
@@ -57,7 +57,7 @@ pub struct SimulateArgs {
     pub direction: String,
     /// Seconds held at the tension before the reading, from a rod with no
     /// load history (creep) [default: --creep-hold-s, else 0].
-    #[arg(long, value_name = "S")]
+    #[arg(long, value_name = "S", allow_hyphen_values = true)]
     pub dwell_s: Option<f64>,
     #[command(flatten)]
     pub basis: LengthBasisArgs,
@@ -107,8 +107,11 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         CoefficientRoute::Thesis => args.order.min(cablemap::model::resolution::max_order(&options)),
     };
     let basis = args.basis.length_basis;
-    let mut sim = simulate_held(&actuator, &options, &routing, tension, exact_order, basis, hold)
-        .with_context(|| format!("simulating routing {y:?} at {} N", tension))?;
+    let solved = simulate_held(&actuator, &options, &routing, tension, exact_order, basis, hold);
+    if let (Err(SimulateError::Solve(failure)), true) = (&solved, args.json) {
+        print_failure_json(failure.status(), &failure.to_string())?;
+    }
+    let mut sim = solved.with_context(|| format!("simulating routing {y:?} at {} N", cablemap::io::fmt_num(tension)))?;
     if args.coefficients == CoefficientRoute::Thesis {
         let points: Vec<[f64; 2]> = sim.centreline.iter().map(|c| [c.x_mm, c.y_mm]).collect();
         sim.a = cablemap::shape::thesis_coefficients(&points, args.order, args.n_d)
@@ -164,7 +167,7 @@ fn report_png(args: &SimulateArgs) {
 
 /// Several or spatial cables: the 3-D solver (`model::spatial`).
 fn run_spatial(args: &SimulateArgs) -> anyhow::Result<()> {
-    use cablemap::model::spatial::{record, Cable, SpatialActuator, SpatialOptions};
+    use cablemap::model::spatial::{record, Cable, SpatialActuator, SpatialError, SpatialOptions};
     let planar_only = [
         (args.coefficients == CoefficientRoute::Thesis, "--coefficients thesis"),
         (args.direction != "load", "--direction"),
@@ -208,7 +211,11 @@ fn run_spatial(args: &SimulateArgs) -> anyhow::Result<()> {
     if let Some(steps) = args.actuator.steps_per_span {
         options.steps_per_span = steps;
     }
-    let sim = cablemap::model::spatial::simulate_spatial(&spatial, &options, args.order, args.basis.length_basis)?;
+    let solved = cablemap::model::spatial::simulate_spatial(&spatial, &options, args.order, args.basis.length_basis);
+    if let (Err(SpatialError::Solve(failure)), true) = (&solved, args.json) {
+        print_failure_json(failure.status(), &failure.to_string())?;
+    }
+    let sim = solved?;
     if let Some(path) = &args.csv {
         record::write_centreline_csv(path, &sim).with_context(|| format!("writing centreline CSV {}", path.display()))?;
     }
@@ -226,6 +233,15 @@ fn run_spatial(args: &SimulateArgs) -> anyhow::Result<()> {
     }
     drop(out);
     report_png(args);
+    Ok(())
+}
+
+/// With `--json`, a failed solve is a record too: its status (the one a
+/// sweep stores for it, e.g. `non_finite`, `unresolved`) and the message,
+/// on stdout; the error itself still goes to stderr with a non-zero exit.
+fn print_failure_json(status: &str, message: &str) -> anyhow::Result<()> {
+    let record = serde_json::json!({ "status": status, "error": message });
+    writeln!(std::io::stdout().lock(), "{record}")?;
     Ok(())
 }
 

@@ -10,6 +10,60 @@ pub const DEFAULT_CREEP_TIME_S: f64 = 10.0;
 /// Standard gravity, m/s².
 pub const STANDARD_GRAVITY_M_S2: f64 = 9.81;
 
+/// A plausible range of a parameter: far beyond any rod cablemap models,
+/// yet refusing values whose products in the solver overflow or vanish.
+#[derive(Debug, Clone, Copy)]
+pub struct PlausibleRange {
+    /// Smallest value accepted.
+    pub min: f64,
+    /// Largest value accepted.
+    pub max: f64,
+    /// The range and an example in words, for the error.
+    pub expected: &'static str,
+}
+
+impl PlausibleRange {
+    /// Refuses `value` of parameter `name` outside the range.
+    pub fn check(&self, name: &'static str, value: f64) -> Result<(), ParameterError> {
+        if (self.min..=self.max).contains(&value) {
+            Ok(())
+        } else {
+            Err(ParameterError::OutOfRange { name, value, expected: self.expected })
+        }
+    }
+}
+
+/// Rod length, mm.
+pub const PLAUSIBLE_LENGTH_MM: PlausibleRange =
+    PlausibleRange { min: 1e-3, max: 1e6, expected: "a length from 1e-3 to 1e6 mm (the thesis rod: 65 mm)" };
+/// Rod radius, mm.
+pub const PLAUSIBLE_RADIUS_MM: PlausibleRange =
+    PlausibleRange { min: 1e-4, max: 1e4, expected: "a radius from 1e-4 to 1e4 mm (the thesis rod: 5 mm)" };
+/// Axial and shear rigidity, N.
+pub const PLAUSIBLE_FORCE_N: PlausibleRange =
+    PlausibleRange { min: 1e-9, max: 1e12, expected: "a rigidity from 1e-9 to 1e12 N (the thesis rod: EA 26.7 N, GA 1.71 N)" };
+/// Bending rigidity, N·mm².
+pub const PLAUSIBLE_EI_N_MM2: PlausibleRange =
+    PlausibleRange { min: 1e-9, max: 1e18, expected: "a bending rigidity from 1e-9 to 1e18 N·mm² (the thesis rod: 115 N·mm²)" };
+/// Density, g/cm³.
+pub const PLAUSIBLE_DENSITY_G_CM3: PlausibleRange =
+    PlausibleRange { min: 0.0, max: 100.0, expected: "0, or a density up to 100 g/cm³ (silicone: 1.07; osmium, the densest element: 22.6)" };
+/// Acceleration of gravity, m/s².
+pub const PLAUSIBLE_G_M_S2: PlausibleRange =
+    PlausibleRange { min: 0.0, max: 1e4, expected: "0, or an acceleration up to 1e4 m/s² (Earth: 9.81)" };
+/// Scale on the weight.
+pub const PLAUSIBLE_GRAVITY_SCALE: PlausibleRange =
+    PlausibleRange { min: 0.0, max: 1e6, expected: "0, or a scale up to 1e6 on the nominal weight (1 is the rod's own)" };
+/// Friction coefficient.
+pub const PLAUSIBLE_FRICTION_MU: PlausibleRange =
+    PlausibleRange { min: 0.0, max: 100.0, expected: "0, or a friction coefficient up to 100 (PTFE on silicone: about 0.1–0.5)" };
+/// Material stiffening α.
+pub const PLAUSIBLE_STIFFENING_ALPHA: PlausibleRange =
+    PlausibleRange { min: 0.0, max: 1e6, expected: "0, or a stiffening up to 1e6" };
+/// Clamp stiffness, N·mm/rad.
+pub const PLAUSIBLE_CLAMP_STIFFNESS: PlausibleRange =
+    PlausibleRange { min: 1e-9, max: 1e18, expected: "a clamp stiffness from 1e-9 to 1e18 N·mm/rad" };
+
 /// Why a parameter set was rejected.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ParameterError {
@@ -306,29 +360,45 @@ impl Actuator {
                 return Err(ParameterError::NotPositive { name, value });
             }
         }
+        // Absurd sizes (a subnormal rigidity, a kilometre-long rod) are
+        // refused here with a plausible range: the solver's products of them
+        // would overflow or vanish into non-finite results. Within these
+        // ranges every product the solver forms stays finite.
+        for (name, value, range) in [
+            ("length_mm", self.length_mm, PLAUSIBLE_LENGTH_MM),
+            ("radius_mm", self.radius_mm, PLAUSIBLE_RADIUS_MM),
+            ("ea_n", self.ea_n, PLAUSIBLE_FORCE_N),
+            ("ga_n", self.ga_n, PLAUSIBLE_FORCE_N),
+            ("ei_n_mm2", self.ei_n_mm2, PLAUSIBLE_EI_N_MM2),
+        ] {
+            range.check(name, value)?;
+        }
         let non_negative = [
-            ("density_g_cm3", self.density_g_cm3),
-            ("gravity.g_m_s2", self.gravity.g_m_s2),
-            ("gravity.scale", self.gravity.scale),
-            ("effects.friction_mu", self.effects.friction_mu),
-            ("effects.stiffening_alpha", self.effects.stiffening_alpha),
+            ("density_g_cm3", self.density_g_cm3, PLAUSIBLE_DENSITY_G_CM3),
+            ("gravity.g_m_s2", self.gravity.g_m_s2, PLAUSIBLE_G_M_S2),
+            ("gravity.scale", self.gravity.scale, PLAUSIBLE_GRAVITY_SCALE),
+            ("effects.friction_mu", self.effects.friction_mu, PLAUSIBLE_FRICTION_MU),
+            ("effects.stiffening_alpha", self.effects.stiffening_alpha, PLAUSIBLE_STIFFENING_ALPHA),
         ];
-        for (name, value) in non_negative {
+        for (name, value, range) in non_negative {
             if !(value.is_finite() && value >= 0.0) {
                 return Err(ParameterError::OutOfRange { name, value, expected: "a finite number ≥ 0" });
             }
+            range.check(name, value)?;
         }
-        if !self.gravity.direction_rad.is_finite() {
+        let tilt = self.gravity.direction_rad;
+        if !(tilt.is_finite() && tilt.abs() <= std::f64::consts::TAU) {
             return Err(ParameterError::OutOfRange {
                 name: "gravity.direction_rad",
-                value: self.gravity.direction_rad,
-                expected: "a finite angle in rad",
+                value: tilt,
+                expected: "an angle in rad with |θ| ≤ 2π (was it given in degrees?)",
             });
         }
         if let Some(k) = self.effects.clamp_stiffness_n_mm_per_rad {
             if !(k.is_finite() && k > 0.0) {
                 return Err(ParameterError::NotPositive { name: "effects.clamp_stiffness_n_mm_per_rad", value: k });
             }
+            PLAUSIBLE_CLAMP_STIFFNESS.check("effects.clamp_stiffness_n_mm_per_rad", k)?;
         }
         let f = self.effects.creep_fraction;
         if !(f.is_finite() && (0.0..1.0).contains(&f)) {

@@ -43,25 +43,25 @@ pub enum BodyError {
     #[error("{what} {index} is not a finite number; give finite values in mm")]
     NotFinite { what: &'static str, index: usize },
     /// Profile points must rise strictly in s.
-    #[error("radius profile point {index} (s = {s_mm} mm) is not after the previous one (s = {previous_mm} mm): give the points in increasing s, each s once")]
+    #[error("radius profile point {index} (s = {} mm) is not after the previous one (s = {} mm): give the points in increasing s, each s once", crate::io::fmt_num(*s_mm), crate::io::fmt_num(*previous_mm))]
     ProfileOutOfOrder { index: usize, s_mm: f64, previous_mm: f64 },
     /// A profile radius is not positive.
-    #[error("radius profile point {index} has r = {r_mm} mm at s = {s_mm} mm: every radius must be > 0 mm")]
+    #[error("radius profile point {index} has r = {} mm at s = {} mm: every radius must be > 0 mm", crate::io::fmt_num(*r_mm), crate::io::fmt_num(*s_mm))]
     RadiusNotPositive { index: usize, s_mm: f64, r_mm: f64 },
     /// The profile does not cover the rod.
-    #[error("the radius profile runs from s = {first_mm} mm to s = {last_mm} mm but must run from s = 0 to the rod length L = {length_mm} mm: add points at 0 and L (a cone is two points, \"0:R0,L:R1\")")]
+    #[error("the radius profile runs from s = {} mm to s = {} mm but must run from s = 0 to the rod length L = {} mm: add points at 0 and L (a cone is two points, \"0:R0,L:R1\")", crate::io::fmt_num(*first_mm), crate::io::fmt_num(*last_mm), crate::io::fmt_num(*length_mm))]
     ProfileDoesNotCover { first_mm: f64, last_mm: f64, length_mm: f64 },
     /// The profile has fewer than two points.
     #[error("a radius profile needs at least two points s:r (a cone is two), got {0}")]
     ProfileTooShort(usize),
     /// Segment ends must rise strictly and the last must be L.
-    #[error("segment {index} ends at s = {end_mm} mm, {problem}")]
+    #[error("segment {index} ends at s = {} mm, {problem}", crate::io::fmt_num(*end_mm))]
     BadSegment { index: usize, end_mm: f64, problem: String },
     /// A segment's material value is not positive.
-    #[error("segment {index}: {name} = {value} must be a positive, finite number (density ≥ 0)")]
+    #[error("segment {index}: {name} = {} must be a positive, finite number (density ≥ 0)", crate::io::fmt_num(*value))]
     BadSegmentMaterial { index: usize, name: &'static str, value: f64 },
     /// The cable anchor lies outside the rod.
-    #[error("the cable anchor s_k = {anchor_mm} mm is outside the rod: give 0 < s_k ≤ L = {length_mm} mm (omit it to knot the cable at the tip)")]
+    #[error("the cable anchor s_k = {} mm is outside the rod: give 0 < s_k ≤ L = {} mm (omit it to knot the cable at the tip)", crate::io::fmt_num(*anchor_mm), crate::io::fmt_num(*length_mm))]
     AnchorOutside { anchor_mm: f64, length_mm: f64 },
 }
 

@@ -12,4 +12,4 @@ pub mod spatial;
 pub use body::{Body, BodyError, Segment};
 pub use actuator::{Actuator, Effects, Gravity, LoadDirection, ParameterError};
 pub use routing::{ControlPoints, Routing, RoutingError};
-pub use solver::{simulate, simulate_held, CentrelinePoint, Hold, SimulateError, Simulation, Simulator, SolveFailure, SolverMethod, SolverOptions, TipPose, STATUS_OK};
+pub use solver::{simulate, simulate_held, CentrelinePoint, Hold, SimulateError, Simulation, Simulator, SolveFailure, SolverMethod, SolverOptions, TipPose, Unresolved, STATUS_OK};

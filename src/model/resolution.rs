@@ -102,18 +102,23 @@ mod tests {
         assert!(check_order(100, &collocation(64)).unwrap_err().contains("highest supported order 16"));
     }
 
-    /// The solver itself (not `simulate`, which would refuse coarse cases).
-    fn coefficients(options: &SolverOptions, order: usize) -> Vec<f64> {
+    /// The solver itself (not `simulate`, which would refuse coarse cases);
+    /// `None` when the solver refuses the solve as unresolved.
+    fn coefficients(options: &SolverOptions, order: usize) -> Option<Vec<f64>> {
         let actuator = Actuator::default();
         let routing = Routing::new(&[-4.0, 4.0, -4.0, 4.0, -4.0], actuator.length_mm, actuator.radius_mm).unwrap();
         let mut sim = Simulator::new(&actuator, options).unwrap();
         sim.set_routing(&routing);
         for t in [0.5, 1.0, 1.5, 2.0] {
-            sim.solve(t).unwrap();
+            match sim.solve(t) {
+                Ok(_) => {}
+                Err(crate::model::SolveFailure::Unresolved(_)) => return None,
+                Err(e) => panic!("{e}"),
+            }
         }
         let mut a = vec![0.0; order + 1];
         sim.coefficients_into(crate::shape::LengthBasis::Rest, &mut a);
-        a
+        Some(a)
     }
 
     /// The claim behind the tables, re-measured at a few entries: a_k at
@@ -124,13 +129,74 @@ mod tests {
         let cases: [(fn(usize) -> SolverOptions, &[usize; 17], usize, usize); 4] =
             [(rk4, &REQUIRED_STEPS_PER_SPAN, 5, 1024), (rk4, &REQUIRED_STEPS_PER_SPAN, 9, 1024), (collocation, &REQUIRED_NODES_PER_SPAN, 9, 64), (collocation, &REQUIRED_NODES_PER_SPAN, 12, 64)];
         for (make, table, order, fine_n) in cases {
-            let fine = coefficients(&make(fine_n), order);
-            let coarse = coefficients(&make(table[order]), order);
+            let fine = coefficients(&make(fine_n), order).unwrap();
+            let coarse = coefficients(&make(table[order]), order).unwrap();
             for k in 0..=order {
                 assert!((coarse[k] - fine[k]).abs() <= ORDER_TOLERANCE_PER_MM, "a_{k} at order {order}: {} vs {}", coarse[k], fine[k]);
             }
-            let below = coefficients(&make(table[order] / 2), order);
-            assert!((below[order] - fine[order]).abs() > ORDER_TOLERANCE_PER_MM / 10.0, "order {order} at half the table");
+            // Half the table is off (or, at its coarsest, refused outright).
+            if let Some(below) = coefficients(&make(table[order] / 2), order) {
+                assert!((below[order] - fine[order]).abs() > ORDER_TOLERANCE_PER_MM / 10.0, "order {order} at half the table");
+            }
+        }
+    }
+
+    use crate::model::{simulate, SolveFailure, SimulateError};
+    use proptest::prelude::*;
+
+    /// A random rod, far from the thesis's: length, radius, rigidities, a
+    /// cone sometimes, gravity sometimes.
+    fn body(length_mm: f64, radius_mm: f64, ei_n_mm2: f64, ea_n: f64, ga_n: f64, taper: f64, gravity: bool) -> Actuator {
+        let mut a = Actuator { length_mm, radius_mm, ei_n_mm2, ea_n, ga_n, ..Actuator::default() };
+        a.gravity.enabled = gravity;
+        if taper < 0.9 {
+            a.radius_profile_mm = vec![(0.0, radius_mm), (length_mm, radius_mm * taper)];
+        }
+        a
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(16))]
+        /// The promise of docs/reliability.md for any body and tension: what
+        /// `simulate` reports (refining by itself where it must) lies within
+        /// the tolerances of a solve at 64 intervals per span, or it is
+        /// refused as unresolved. (On main before the a posteriori check,
+        /// about one random order-11 solve in ten was out of tolerance.)
+        #[test]
+        fn reported_coefficients_match_a_high_resolution_solve(
+            length_mm in 30.0f64..300.0,
+            radius_mm in 2.0f64..8.0,
+            ei_n_mm2 in 20.0f64..400.0,
+            ea_n in 15.0f64..60.0,
+            ga_n in 1.0f64..5.0,
+            taper in 0.5f64..1.5,
+            gravity in any::<bool>(),
+            y in proptest::array::uniform5(-0.8f64..0.8),
+            bend in 0.2f64..3.0,
+            order in 0usize..=11,
+            use_rk4 in proptest::bool::weighted(0.2),
+        ) {
+            let a = body(length_mm, radius_mm, ei_n_mm2, ea_n, ga_n, taper, gravity);
+            let y: Vec<f64> = y.iter().map(|v| v * a.channel_radius_mm()).collect();
+            let routing = Routing::for_actuator(&y, &a).unwrap();
+            // About `bend` radians of bending from the cable's moment τ·|y|·L/EI.
+            let tension = bend * ei_n_mm2 / length_mm / radius_mm;
+            let (options, order) = if use_rk4 && a.is_uniform_body() { (rk4(24), order.min(5)) } else { (SolverOptions::default(), order) };
+            let basis = crate::shape::LengthBasis::Rest;
+            let Ok(fine) = simulate(&a, &collocation(64), &routing, tension, order, basis) else { return Ok(()) };
+            match simulate(&a, &options, &routing, tension, order, basis) {
+                Ok(sim) => {
+                    for k in 0..=order {
+                        prop_assert!((sim.a[k] - fine.a[k]).abs() <= ORDER_TOLERANCE_PER_MM, "a_{k}: {} vs {} at 64 intervals", sim.a[k], fine.a[k]);
+                    }
+                    let tip = (sim.pose.tip_x_mm - fine.pose.tip_x_mm).hypot(sim.pose.tip_y_mm - fine.pose.tip_y_mm);
+                    prop_assert!(tip <= crate::model::solver::tip_tolerance_mm(length_mm), "tip off by {tip} mm");
+                }
+                Err(SimulateError::Solve(SolveFailure::Unresolved(_))) => {}
+                // A solve that does not converge is another matter (the fine one did).
+                Err(_) => {}
+            }
         }
     }
 }
+

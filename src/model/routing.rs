@@ -96,7 +96,7 @@ pub enum RoutingError {
     #[error("control point y{index} is not a finite number ({value}); give finite offsets in mm")]
     NotFinite { index: usize, value: f64 },
     /// A control point lies on or outside the rod surface.
-    #[error("control point y{index} = {value} mm is outside the body: every |y_i| must be below the radius r = {radius_mm} mm")]
+    #[error("control point y{index} = {} mm is outside the body: every |y_i| must be below the radius r = {} mm", crate::io::fmt_num(*value), crate::io::fmt_num(*radius_mm))]
     OutsideBody { index: usize, value: f64, radius_mm: f64 },
     /// The channel leaves a non-uniform body somewhere along s.
     #[error("the channel at s = {s_mm:.2} mm is at y_c = {y_mm:.3} mm, outside the body (radius r(s) = {radius_mm:.3} mm there): move the control points nearer the axis, or widen the radius profile there")]
@@ -105,7 +105,7 @@ pub enum RoutingError {
     #[error("{0}")]
     Body(String),
     /// Rod length or radius is not positive and finite.
-    #[error("rod length ({length_mm} mm) and radius ({radius_mm} mm) must be positive and finite")]
+    #[error("rod length ({} mm) and radius ({} mm) must be positive and finite", crate::io::fmt_num(*length_mm), crate::io::fmt_num(*radius_mm))]
     BadGeometry { length_mm: f64, radius_mm: f64 },
 }
 

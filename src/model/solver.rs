@@ -57,6 +57,7 @@ mod collocation;
 mod continuation;
 mod creep;
 mod friction;
+mod probe;
 mod rk4;
 
 use creep::Creep;
@@ -66,7 +67,7 @@ use friction::Friction;
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SolveFailure {
     /// The tension is negative or not finite.
-    #[error("tension {0} N is invalid: a cable pulls with a finite tension ≥ 0 N")]
+    #[error("tension {} N is invalid: a cable pulls with a finite tension ≥ 0 N", crate::io::fmt_num(*.0))]
     InvalidTension(f64),
     /// The per-point cable-direction equation did not converge.
     #[error("the cable-direction equation did not converge at s = {s_mm:.3} mm; try smaller tension steps from a lower tension")]
@@ -93,6 +94,33 @@ pub enum SolveFailure {
     /// Newton's method with continuation in the weight.
     #[error("the equilibrium under the rod's weight did not converge (reached {reached_percent:.0} % of the weight); try smaller tension steps from a lower tension, more nodes per span, or a smaller gravity scale")]
     WeightNotConverged { reached_percent: f64 },
+    /// The discretisation does not resolve the solution: the a posteriori
+    /// error estimate of something reported is above its tolerance (or
+    /// the tip lies farther from the clamp than the stretched rod is long).
+    #[error(transparent)]
+    Unresolved(Unresolved),
+}
+
+/// What a solve does not resolve, by how much, and what to raise (the
+/// planar and the 3-D solvers' [`SolveFailure::Unresolved`] and
+/// [`super::spatial::SpatialFailure::Unresolved`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error(
+    "the solver's discretisation does not resolve this shape: {what} is off by about {} {unit} (tolerance {} {unit}); {advice}",
+    crate::io::fmt_sig(*estimate, 3),
+    crate::io::fmt_sig(*tolerance, 3)
+)]
+pub struct Unresolved {
+    /// What is off: "the tip position", "a_11", "a_bend_z[3]", ….
+    pub what: String,
+    /// Its estimated error.
+    pub estimate: f64,
+    /// The error accepted.
+    pub tolerance: f64,
+    /// The unit of both.
+    pub unit: &'static str,
+    /// Which setting to raise, and how.
+    pub advice: String,
 }
 
 impl SolveFailure {
@@ -108,6 +136,7 @@ impl SolveFailure {
             SolveFailure::NonFinite { .. } => "non_finite",
             SolveFailure::FrictionNotConverged => "friction_not_converged",
             SolveFailure::WeightNotConverged { .. } => "weight_not_converged",
+            SolveFailure::Unresolved(_) => "unresolved",
         }
     }
 }
@@ -125,6 +154,27 @@ const CLAMP_TOLERANCE_RAD: f64 = 1e-14;
 
 /// Collocation intervals per span used at least when material stiffening is on.
 pub const MIN_NODES_WITH_STIFFENING: usize = 16;
+
+/// Tip position error a solve may have, mm: its a posteriori estimate must
+/// stay below this plus [`TIP_TOLERANCE_PER_LENGTH`] times the rod's length
+/// ([`tip_tolerance_mm`]), or the solve is refused as unresolved.
+pub const TIP_TOLERANCE_MM: f64 = 5e-4;
+/// The part of the tip tolerance proportional to the rod's length.
+pub const TIP_TOLERANCE_PER_LENGTH: f64 = 1e-5;
+
+/// The tip position error accepted on a rod of `length_mm`, mm.
+pub fn tip_tolerance_mm(length_mm: f64) -> f64 {
+    TIP_TOLERANCE_MM + TIP_TOLERANCE_PER_LENGTH * length_mm
+}
+
+/// Most collocation intervals per span.
+pub const MAX_NODES_PER_SPAN: usize = 64;
+/// Most RK4 steps per span.
+pub const MAX_STEPS_PER_SPAN: usize = 100_000;
+
+/// Orders a_0 … a_{ESTIMATED_ORDERS−1} get an error estimate (above the
+/// highest order any check allows).
+const ESTIMATED_ORDERS: usize = 24;
 
 /// Status string of a successful solve.
 pub const STATUS_OK: &str = "ok";
@@ -307,6 +357,22 @@ pub struct Simulator {
     /// points when the cable is knotted at the tip): from there on the cut
     /// carries no cable load.
     cable_end: usize,
+    /// The estimated error of the tangent angle along the last solve, rad
+    /// (the coefficients' error estimate starts from it).
+    theta_error_rad: f64,
+    /// The estimated error of the largest coefficient asked for in the
+    /// last [`Simulator::coefficients_into`], mm⁻¹, and its index.
+    coefficient_error: (f64, usize),
+    /// The routing as given (before the channel offset), for the probe.
+    given_routing: Option<Routing>,
+    /// The hold of the solves (the probe's are held alike).
+    hold: Hold,
+    /// A finer solver that settles an error estimate above the tolerance
+    /// by a solve at twice the intervals ([`probe`]); made when first needed.
+    probe: Option<Box<probe::Probe>>,
+    /// Whether this solver is itself a probe (its solves are the
+    /// reference: they are not estimated).
+    is_probe: bool,
 }
 
 /// How a solve is held: the direction of the last tension change (friction)
@@ -324,14 +390,14 @@ impl Simulator {
     pub fn new(actuator: &Actuator, options: &SolverOptions) -> Result<Self, ParameterError> {
         actuator.validate()?;
         // The upper bound keeps a typo (2e9 steps) from exhausting memory.
-        if options.steps_per_span < 2 || options.steps_per_span % 2 != 0 || options.steps_per_span > 100_000 {
+        if options.steps_per_span < 2 || options.steps_per_span % 2 != 0 || options.steps_per_span > MAX_STEPS_PER_SPAN {
             return Err(ParameterError::OutOfRange {
                 name: "steps_per_span",
                 value: options.steps_per_span as f64,
                 expected: "an even number from 2 to 100000",
             });
         }
-        if options.method == SolverMethod::Collocation && !(4..=64).contains(&options.nodes_per_span) {
+        if options.method == SolverMethod::Collocation && !(4..=MAX_NODES_PER_SPAN).contains(&options.nodes_per_span) {
             return Err(ParameterError::OutOfRange {
                 name: "nodes_per_span",
                 value: options.nodes_per_span as f64,
@@ -383,6 +449,12 @@ impl Simulator {
             rk4: rk4::Rk4::new(n),
             body,
             cable_end: points,
+            theta_error_rad: 0.0,
+            coefficient_error: (0.0, 0),
+            given_routing: None,
+            hold: Hold::default(),
+            probe: None,
+            is_probe: false,
         })
         .and_then(|mut sim: Simulator| {
             // Outside a protocol every solve is held like this from a virgin rod.
@@ -417,6 +489,10 @@ impl Simulator {
             self.rk4_set_routing(&built);
         }
         self.routing = Some(built);
+        self.given_routing = Some(routing.clone());
+        if let Some(p) = self.probe.as_mut() {
+            p.stale();
+        }
         self.reset_warm_start();
         self.reset_history();
         self.last = None;
@@ -457,6 +533,10 @@ impl Simulator {
         }
         self.friction.set_slip_sign(hold.direction.slip_sign());
         self.creep.set_dwell(hold.dwell_s);
+        self.hold = hold;
+        if let Some(p) = self.probe.as_mut() {
+            p.stale();
+        }
         Ok(())
     }
 
@@ -482,7 +562,7 @@ impl Simulator {
                 Section { ea_n: x.ea_n, ga_n: x.ga_n, ei_n_mm2: x.ei_n_mm2, radius_mm: x.radius_mm }
             }
         };
-        if s < hidden.base_segment_mm {
+        if s < hidden.base_segment_mm || (left && s == hidden.base_segment_mm) {
             section.ei_n_mm2 *= hidden.base_segment_ei_factor;
         }
         let beta = a.effects.stiffness_gradient_beta;
@@ -625,6 +705,9 @@ impl Simulator {
             return Err(SolveFailure::InvalidTension(tension_n));
         }
         self.creep.begin_solve();
+        if let Some(p) = self.probe.as_mut() {
+            p.forget_solve();
+        }
         let result = self.solve_inner(tension_n);
         match &result {
             Ok(pose) => self.last = Some(*pose),
@@ -637,14 +720,73 @@ impl Simulator {
     }
 
     fn solve_inner(&mut self, tension: f64) -> Result<TipPose, SolveFailure> {
-        if self.col.is_some() {
+        // The error estimate comes before the creep history moves on, so
+        // that a refused solve leaves the history as it was.
+        let (pose, (theta_error, tip_error)) = if self.col.is_some() {
             let passes = self.colloc_solve(tension)?;
-            self.creep.end_solve();
-            return Ok(self.colloc_pose(tension, passes));
-        }
-        let passes = self.rk4_solve(tension)?;
+            (self.colloc_pose(tension, passes), self.colloc_error_estimate())
+        } else {
+            let passes = self.rk4_solve(tension)?;
+            (self.rk4_pose(tension, passes), self.rk4_error_estimate(tension)?)
+        };
+        self.theta_error_rad = self.check_resolved(&pose, theta_error, tip_error)?;
         self.creep.end_solve();
-        Ok(self.rk4_pose(tension, passes))
+        Ok(pose)
+    }
+
+    /// Refuses a pose with a non-finite number, an estimated tip error
+    /// `tip_error_mm` above [`tip_tolerance_mm`] (unless a probe at twice
+    /// the intervals agrees to within it), or a tip farther from the
+    /// clamp than the stretched rod is long (which no curve can do).
+    /// Returns the estimated error of the tangent angle, rad.
+    fn check_resolved(&mut self, pose: &TipPose, theta_error_rad: f64, tip_error_mm: f64) -> Result<f64, SolveFailure> {
+        let scalars = [pose.tip_x_mm, pose.tip_y_mm, pose.tip_angle_rad, pose.tip_frame_angle_rad, pose.base_angle_rad, pose.length_mm];
+        if !scalars.iter().all(|v| v.is_finite()) {
+            return Err(SolveFailure::NonFinite { s_mm: self.actuator.length_mm });
+        }
+        if self.is_probe {
+            return Ok(0.0);
+        }
+        let tolerance = tip_tolerance_mm(self.actuator.length_mm);
+        let reach = pose.tip_x_mm.hypot(pose.tip_y_mm);
+        if reach > pose.length_mm + tolerance {
+            return Err(self.unresolved(
+                format!("the tip (|tip| = {} mm is more than the stretched length ℓ = {} mm)", crate::io::fmt_num(reach), crate::io::fmt_num(pose.length_mm)),
+                reach - pose.length_mm,
+                tolerance,
+                "mm",
+            ));
+        }
+        if tip_error_mm <= tolerance {
+            return Ok(theta_error_rad);
+        }
+        // The estimate is an upper bound, often far above the error: a
+        // solve at twice the intervals tells.
+        match self.probe_pose(pose.tension_n) {
+            Some(Ok(fine)) => {
+                let difference = (pose.tip_x_mm - fine.tip_x_mm).hypot(pose.tip_y_mm - fine.tip_y_mm);
+                if difference <= tolerance {
+                    return Ok((pose.tip_angle_rad - fine.tip_angle_rad).abs());
+                }
+                Err(self.unresolved("the tip position".into(), difference, tolerance, "mm"))
+            }
+            _ => Err(self.unresolved("the tip position".into(), tip_error_mm, tolerance, "mm")),
+        }
+    }
+
+    /// [`SolveFailure::Unresolved`] with the setting to raise for this
+    /// solver's method.
+    fn unresolved(&self, what: String, estimate: f64, tolerance: f64, unit: &'static str) -> SolveFailure {
+        SolveFailure::Unresolved(Unresolved { what, estimate, tolerance, unit, advice: resolution_advice(&self.options, self.resolution()) })
+    }
+
+    /// The resolution in use: collocation intervals per span (at least
+    /// [`MIN_NODES_WITH_STIFFENING`] with stiffening), or RK4 steps per span.
+    pub fn resolution(&self) -> usize {
+        match &self.col {
+            Some(c) => c.intervals(),
+            None => self.options.steps_per_span,
+        }
     }
 
     /// Legendre curvature coefficients a_0 … a_{n−1} (n = `out.len()`) of the
@@ -653,13 +795,42 @@ impl Simulator {
     ///
     /// # Panics
     /// If the last solve failed or none was made.
+    ///
+    /// Also estimates their error ([`Simulator::coefficient_error_per_mm`]);
+    /// [`Simulator::coefficients_checked`] refuses coefficients the
+    /// discretisation does not resolve.
     pub fn coefficients_into(&mut self, basis: LengthBasis, out: &mut [f64]) {
         assert!(self.last.is_some(), "coefficients_into needs a successful solve");
-        if self.col.is_some() {
-            self.colloc_coefficients(basis, out);
-            return;
+        let estimate = if self.col.is_some() { self.colloc_coefficients(basis, out) } else { self.rk4_coefficients(basis, out) };
+        self.coefficient_error = if estimate.0 <= super::resolution::ORDER_TOLERANCE_PER_MM || self.is_probe {
+            estimate
+        } else {
+            // As for the tip: a solve at twice the intervals tells.
+            self.probe_coefficient_difference(basis, out).unwrap_or(estimate)
+        };
+    }
+
+    /// The estimated error of the coefficients of the last
+    /// [`Simulator::coefficients_into`]: the largest over a_0 … a_n, mm⁻¹,
+    /// and the index k of the a_k it belongs to.
+    pub fn coefficient_error_per_mm(&self) -> (f64, usize) {
+        self.coefficient_error
+    }
+
+    /// [`Simulator::coefficients_into`], refusing coefficients whose
+    /// estimated error is above [`super::resolution::ORDER_TOLERANCE_PER_MM`]
+    /// or that are not finite.
+    pub fn coefficients_checked(&mut self, basis: LengthBasis, out: &mut [f64]) -> Result<(), SolveFailure> {
+        self.coefficients_into(basis, out);
+        if !out.iter().all(|a| a.is_finite()) {
+            return Err(SolveFailure::NonFinite { s_mm: self.actuator.length_mm });
         }
-        self.rk4_coefficients(basis, out);
+        let (error, k) = self.coefficient_error;
+        let tolerance = super::resolution::ORDER_TOLERANCE_PER_MM;
+        if !(error <= tolerance) {
+            return Err(self.unresolved(format!("a_{k}"), error, tolerance, "mm⁻¹"));
+        }
+        Ok(())
     }
 
     /// The centreline of the last successful solve, clamp to tip.
@@ -672,6 +843,40 @@ impl Simulator {
     }
 }
 
+/// The largest of the per-order coefficient `errors` (one that is not a
+/// number counts as largest) and its order, converted like the
+/// coefficients from the deformed basis into `basis`.
+fn largest_error(errors: impl Iterator<Item = f64>, basis: LengthBasis, deformed_length_mm: f64, rest_length_mm: f64) -> (f64, usize) {
+    let mut worst = (0.0f64, 0usize);
+    for (n, error) in errors.enumerate() {
+        if !(error <= worst.0) {
+            worst = (error, n);
+        }
+    }
+    let mut error = [worst.0];
+    basis.convert_from_deformed(&mut error, deformed_length_mm, rest_length_mm);
+    (error[0], worst.1)
+}
+
+/// What to raise when a solve at `resolution` (intervals or steps per
+/// span) with `options` is not resolved.
+fn resolution_advice(options: &SolverOptions, resolution: usize) -> String {
+    match options.method {
+        SolverMethod::Collocation if resolution < MAX_NODES_PER_SPAN => format!(
+            "raise --nodes-per-span (now {resolution}, at most {MAX_NODES_PER_SPAN}; sweep spec: [solver] nodes_per_span), e.g. --nodes-per-span {}",
+            (2 * resolution).min(MAX_NODES_PER_SPAN)
+        ),
+        SolverMethod::Collocation => format!(
+            "{MAX_NODES_PER_SPAN} intervals per span, the most, do not resolve it: use --method rk4 with more --steps-per-span \
+             (sweep spec: [solver] method = \"rk4\", steps_per_span), or a lower tension"
+        ),
+        SolverMethod::Rk4 => format!(
+            "raise --steps-per-span (now {resolution}, at most {MAX_STEPS_PER_SPAN}; sweep spec: [solver] steps_per_span), e.g. --steps-per-span {}",
+            (4 * resolution).min(MAX_STEPS_PER_SPAN)
+        ),
+    }
+}
+
 /// The collocation's span boundaries from the clamp to the tip: the
 /// routing's knot `knot_mm`, the cable's anchor and the body's breakpoints
 /// (so that every span's integrands are smooth); [0, knot, L] for the
@@ -681,6 +886,11 @@ fn span_boundaries(a: &Actuator, body: Option<&Body>, knot_mm: f64) -> Vec<f64> 
     let mut cuts = vec![0.0, knot_mm, a.cable_length_mm(), length];
     if let Some(b) = body {
         cuts.extend(b.breakpoints_mm());
+    }
+    // The test-only stiff base segment's rigidity jumps at its end.
+    let hidden = &a.effects.hidden;
+    if hidden.base_segment_ei_factor != 1.0 && hidden.base_segment_mm > 0.0 && hidden.base_segment_mm < length {
+        cuts.push(hidden.base_segment_mm);
     }
     merge_sorted(cuts, length)
 }
@@ -757,23 +967,87 @@ pub fn simulate_held(
     hold: Hold,
 ) -> Result<Simulation, SimulateError> {
     super::resolution::check_order(order, options).map_err(ParameterError::Unresolved)?;
-    let mut sim = Simulator::new(actuator, options)?;
-    sim.set_routing(routing);
-    // A ladder of tensions: cheap, and it keeps Newton and the shooting in
-    // their basin for curled-up shapes.
-    let rungs = if tension_n.is_finite() { ((tension_n / 0.25).ceil() as usize).max(1) } else { 1 };
-    let mut pose = None;
-    for k in 1..=rungs {
-        let t = tension_n * k as f64 / rungs as f64;
-        if k == rungs {
-            sim.set_hold(hold)?;
+    check_ladder_tension("tension_n", tension_n)?;
+    // A solve the discretisation does not resolve is repeated, from the
+    // bottom of the ladder, at a finer one, up to the most there is.
+    let attempt = |options: &SolverOptions| -> Result<Simulation, SimulateError> {
+        let mut sim = Simulator::new(actuator, options)?;
+        sim.set_routing(routing);
+        // A ladder of tensions: cheap, and it keeps Newton and the shooting in
+        // their basin for curled-up shapes.
+        let rungs = if tension_n.is_finite() { ((tension_n / 0.25).ceil() as usize).max(1) } else { 1 };
+        let mut pose = None;
+        for k in 1..=rungs {
+            let t = tension_n * k as f64 / rungs as f64;
+            if k == rungs {
+                sim.set_hold(hold)?;
+            }
+            pose = Some(sim.solve(t)?);
         }
-        pose = Some(sim.solve(t)?);
+        let pose = pose.expect("at least one rung");
+        let mut a = vec![0.0; order + 1];
+        sim.coefficients_checked(basis, &mut a)?;
+        Ok(Simulation { routing_mm: routing.control_points_mm(), pose, a, length_basis: basis, centreline: sim.centreline() })
+    };
+    let mut options = options.clone();
+    loop {
+        match attempt(&options) {
+            Err(SimulateError::Solve(SolveFailure::Unresolved(_))) if refined(&mut options) => continue,
+            result => return result,
+        }
     }
-    let pose = pose.expect("at least one rung");
-    let mut a = vec![0.0; order + 1];
-    sim.coefficients_into(basis, &mut a);
-    Ok(Simulation { routing_mm: routing.control_points_mm(), pose, a, length_basis: basis, centreline: sim.centreline() })
+}
+
+/// Highest tension the continuation ladders of [`simulate`] and
+/// [`super::spatial::simulate_spatial`] climb to, N: 10⁵ rungs of 0.25 N
+/// (a few seconds); an absurd tension is refused rather than climbed for hours.
+pub const MAX_LADDER_TENSION_N: f64 = 25_000.0;
+
+/// Refuses a tension above [`MAX_LADDER_TENSION_N`] (parameter `name`).
+pub fn check_ladder_tension(name: &'static str, tension_n: f64) -> Result<(), ParameterError> {
+    if tension_n > MAX_LADDER_TENSION_N {
+        return Err(ParameterError::OutOfRange {
+            name,
+            value: tension_n,
+            expected: "a tension of at most 25000 N (solves climb to it in steps of 0.25 N; the thesis's cable pulls up to 2 N)",
+        });
+    }
+    Ok(())
+}
+
+/// Raises `options`' resolution one step for an unresolved solve (1.5×
+/// the collocation intervals, up to [`MAX_NODES_PER_SPAN`]; 2× the RK4
+/// steps, up to [`MAX_AUTO_STEPS_PER_SPAN`]); false at the most.
+fn refined(options: &mut SolverOptions) -> bool {
+    match options.method {
+        SolverMethod::Collocation if options.nodes_per_span < MAX_NODES_PER_SPAN => {
+            options.nodes_per_span = (options.nodes_per_span * 3 / 2).clamp(options.nodes_per_span + 2, MAX_NODES_PER_SPAN);
+            true
+        }
+        SolverMethod::Rk4 if options.steps_per_span < MAX_AUTO_STEPS_PER_SPAN => {
+            options.steps_per_span = (2 * options.steps_per_span).min(MAX_AUTO_STEPS_PER_SPAN);
+            true
+        }
+        _ => false,
+    }
+}
+
+/// Most RK4 steps per span [`simulate`] refines to by itself (a solve
+/// there takes tens of milliseconds; more must be asked for).
+pub const MAX_AUTO_STEPS_PER_SPAN: usize = 6144;
+
+/// A random rod far from the thesis's (length, radius, rigidities, with or
+/// without gravity), a routing within ±0.8 r and a tension bending it by
+/// about 0.3–3 rad: the error estimates' test cases.
+#[cfg(test)]
+fn random_case(rng: &mut crate::calibrate::rng::Rng) -> (Actuator, Vec<f64>, f64) {
+    let mut span = |lo: f64, hi: f64| lo * (hi / lo).powf(rng.uniform());
+    let mut a = Actuator::default();
+    (a.length_mm, a.radius_mm, a.ei_n_mm2, a.ea_n, a.ga_n) = (span(30.0, 300.0), span(2.0, 8.0), span(20.0, 400.0), span(15.0, 60.0), span(1.0, 5.0));
+    let tension = span(0.3, 3.0) * a.ei_n_mm2 / a.length_mm / a.radius_mm;
+    a.gravity.enabled = rng.uniform() < 0.5;
+    let y = (0..5).map(|_| (2.0 * rng.uniform() - 1.0) * 0.8 * a.radius_mm).collect();
+    (a, y, tension)
 }
 
 #[cfg(test)]
@@ -1257,3 +1531,5 @@ mod anchor_edge_tests {
         assert!((poses[0].tip_angle_rad - poses[1].tip_angle_rad).abs() < 1e-9, "{poses:?}");
     }
 }
+
+

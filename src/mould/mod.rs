@@ -75,9 +75,39 @@ impl MouldParams {
     }
 }
 
+/// Largest size accepted for any mould dimension (body length and radius,
+/// wall, clamp block, tube), mm.
+pub const MAX_SIZE_MM: f64 = 10_000.0;
+
+/// Most triangles of the three parts together (about 50 bytes each in the
+/// STL files, several times that in memory while they are built).
+pub const MAX_TRIANGLES: f64 = 4e6;
+
+/// The file every mould directory holds: an output directory that has it
+/// (or is new or empty) may be replaced.
+pub const SUMMARY_FILE: &str = "mould.json";
+
 /// Why moulds could not be made or written.
 #[derive(Debug, thiserror::Error)]
 pub enum MouldError {
+    /// The meshes would be too large to build or print.
+    #[error(
+        "the moulds would have about {} triangles, more than {} (about {} MB of STL): the body ({} mm long, r = {} mm) with wall {} mm and clamp block {} mm is too large to mesh at the station step; give the sizes in mm, and mould a body of printable size",
+        crate::io::fmt_sig(*triangles, 3),
+        crate::io::fmt_sig(MAX_TRIANGLES, 3),
+        crate::io::fmt_sig(*triangles * 50.0 / 1e6, 3),
+        crate::io::fmt_num(*length_mm),
+        crate::io::fmt_num(*radius_mm),
+        crate::io::fmt_num(*wall_mm),
+        crate::io::fmt_num(*clamp_mm)
+    )]
+    TooLarge { triangles: f64, length_mm: f64, radius_mm: f64, wall_mm: f64, clamp_mm: f64 },
+    /// The output directory holds other files.
+    #[error("{}: the directory exists and is not a mould directory (it has files but no {SUMMARY_FILE}); give a new or empty directory, or one written by cablemap mould", path.display())]
+    NotAMouldDir { path: std::path::PathBuf },
+    /// The output directory has no name (".", "/").
+    #[error("{}: give the moulds a directory of their own by name (e.g. --out moulds)", path.display())]
+    OutUnnamed { path: std::path::PathBuf },
     /// A parameter is out of range.
     #[error("bad mould parameter {name}: {message}")]
     BadParameter {
@@ -222,9 +252,24 @@ impl Moulds {
     pub fn new(routing: &Routing, radius_mm: f64, params: &MouldParams) -> Result<Self, MouldError> {
         let p = params;
         let bad = |name: &'static str, message: String| Err(MouldError::BadParameter { name, message });
-        let finite = [p.wall_mm, p.tube_diameter_mm, p.clearance_mm, p.clamp_mm, p.min_skin_mm, p.station_step_mm, radius_mm];
-        if finite.iter().any(|v| !v.is_finite()) {
-            return bad("sizes", format!("every size must be a finite number of mm ({p:?}, r = {radius_mm})"));
+        let sizes = [
+            ("wall_mm", p.wall_mm),
+            ("tube_diameter_mm", p.tube_diameter_mm),
+            ("clearance_mm", p.clearance_mm),
+            ("clamp_mm", p.clamp_mm),
+            ("min_skin_mm", p.min_skin_mm),
+            ("station_step_mm", p.station_step_mm),
+            ("radius_mm", radius_mm),
+            ("length_mm", routing.length_mm()),
+        ];
+        for (name, value) in sizes {
+            if !value.is_finite() {
+                return bad(name, format!("{value} is not a number of mm: give a finite size"));
+            }
+            // Beyond any printer's bed; the meshes of such moulds would not fit in memory.
+            if value.abs() > MAX_SIZE_MM {
+                return bad(name, format!("{} mm is larger than {MAX_SIZE_MM} mm, beyond any printer: give the size in mm", crate::io::fmt_num(value)));
+            }
         }
         if p.tube_diameter_mm <= 0.0 || p.tube_diameter_mm > radius_mm {
             return bad("tube_diameter_mm", format!(
@@ -292,6 +337,10 @@ impl Moulds {
             y_half_mm: radius_mm + p.wall_mm + BAND_MM,
             sprue_depth_mm: radius_mm / 2.0,
         };
+        let triangles = moulds.estimated_triangles();
+        if triangles > MAX_TRIANGLES {
+            return Err(MouldError::TooLarge { triangles, length_mm: length, radius_mm, wall_mm: p.wall_mm, clamp_mm: p.clamp_mm });
+        }
         // The samples across the channel must lie inside the trough.
         let w = moulds.ridge_half_width_max_mm.max(rho + p.clearance_mm);
         for i in 0..=n {
@@ -304,6 +353,31 @@ impl Moulds {
             }
         }
         Ok(moulds)
+    }
+
+    /// At most how many triangles the three parts' meshes have (about
+    /// 1.7 times as many as they do: steps of zero height weld away),
+    /// counted from their stations and samples before any is built (see
+    /// [`mesh::heightfield_solid`]: a grid, four walls and a bottom fan).
+    pub fn estimated_triangles(&self) -> f64 {
+        [PartKind::Tray, PartKind::Lid, PartKind::Cover]
+            .into_iter()
+            .map(|kind| {
+                let features = self.features(kind);
+                let marks = self.station_marks(&features);
+                // The lid's stations fill the gaps between the marks (as
+                // `stations` does, counted without building them).
+                let n = match kind {
+                    PartKind::Lid => {
+                        let step = self.params.station_step_mm;
+                        1.0 + marks.windows(2).map(|w| if w[1].0 > w[0].0 { ((w[1].0 - w[0].0) / step).ceil() } else { 1.0 }).sum::<f64>()
+                    }
+                    PartKind::Tray | PartKind::Cover => marks.len() as f64,
+                };
+                let m = self.samples(kind, &features, marks[0]).len() as f64;
+                2.0 * (n - 1.0) * (m - 1.0) + 4.0 * (n + m) + 2.0 * (n + m)
+            })
+            .sum()
     }
 
     /// The routing the moulds are for.
@@ -488,15 +562,7 @@ impl Moulds {
     /// x stations of a part: ends, steps (twice), and for the lid a fill
     /// no wider than the station step so the crest follows y_c(s).
     fn stations(&self, kind: PartKind, features: &[Feature]) -> Vec<Sided> {
-        let [x0, x1] = self.x_range_mm;
-        let [c0, c1] = self.cavity_x_mm();
-        let mut steps: Vec<f64> = vec![c0, 0.0, c1];
-        steps.extend(features.iter().flat_map(|f| f.x_mm));
-        steps.sort_by(f64::total_cmp);
-        steps.dedup();
-        let mut marks: Vec<Sided> = vec![(x0, 0)];
-        marks.extend(steps.iter().flat_map(|x| [(*x, -1), (*x, 1)]));
-        marks.push((x1, 0));
+        let marks = self.station_marks(features);
         if kind != PartKind::Lid {
             return marks;
         }
@@ -510,6 +576,20 @@ impl Moulds {
             out.push(pair[1]);
         }
         out
+    }
+
+    /// The stations every part has: the ends and every step (twice).
+    fn station_marks(&self, features: &[Feature]) -> Vec<Sided> {
+        let [x0, x1] = self.x_range_mm;
+        let [c0, c1] = self.cavity_x_mm();
+        let mut steps: Vec<f64> = vec![c0, 0.0, c1];
+        steps.extend(features.iter().flat_map(|f| f.x_mm));
+        steps.sort_by(f64::total_cmp);
+        steps.dedup();
+        let mut marks: Vec<Sided> = vec![(x0, 0)];
+        marks.extend(steps.iter().flat_map(|x| [(*x, -1), (*x, 1)]));
+        marks.push((x1, 0));
+        marks
     }
 
     /// Builds one part in its print frame.
@@ -756,8 +836,33 @@ impl MouldSet {
         }
     }
 
+    /// Writes the mould directory `dir` as a whole: its files are written
+    /// into a staging directory beside it, which then replaces `dir`
+    /// ([`crate::io::write_dir_replacing`]), so a killed run leaves no
+    /// partial `dir` (and an earlier one whole). `dir` must be new, empty or
+    /// an earlier mould directory (it has [`SUMMARY_FILE`]).
+    pub fn write_dir(&self, dir: &Path) -> Result<MouldSummary, MouldError> {
+        let name = dir.file_name().map(|n| n.to_string_lossy().into_owned()).filter(|n| n != "." && n != "..");
+        let Some(name) = name else {
+            return Err(MouldError::OutUnnamed { path: dir.to_path_buf() });
+        };
+        let holds_files = std::fs::read_dir(dir).is_ok_and(|mut entries| entries.next().is_some());
+        if holds_files && !dir.join(SUMMARY_FILE).is_file() {
+            return Err(MouldError::NotAMouldDir { path: dir.to_path_buf() });
+        }
+        crate::io::write_dir_replacing(dir, &name, |staging| self.write_all(staging), |step, path, source| {
+            let what = match step {
+                crate::io::DirStep::Create => "creating",
+                crate::io::DirStep::Replace => "putting the new moulds in place at",
+            };
+            MouldError::Io { context: format!("{what} {}", path.display()), source }
+        })
+    }
+
     /// Writes mould1.stl, mould2.stl, mould1.png, mould2.png, channel.csv and
-    /// mould.json into `dir` (created if missing).
+    /// mould.json into `dir` (created if missing), in place: [`MouldSet::write_dir`]
+    /// is what `cablemap mould` uses; `design --moulds` writes them among
+    /// its own files.
     pub fn write_all(&self, dir: &Path) -> Result<MouldSummary, MouldError> {
         let io = |context: String| move |source| MouldError::Io { context, source };
         std::fs::create_dir_all(dir).map_err(io(format!("creating {}", dir.display())))?;
@@ -789,7 +894,7 @@ impl MouldSet {
             mould2_cavity_mm3: self.cavity_volume_mm3(2),
             mould2_body_mm3: self.body_volume_mm3(2),
         };
-        let path = dir.join("mould.json");
+        let path = dir.join(SUMMARY_FILE);
         let json = serde_json::to_string_pretty(&summary).expect("summary serialises") + "\n";
         crate::io::write_atomic(&path, json.as_bytes()).map_err(io(format!("writing {}", path.display())))?;
         Ok(summary)
@@ -1020,6 +1125,36 @@ mod tests {
             assert!(matches!(e, MouldError::BadParameter { .. }), "{bad:?}: {e}");
         }
         let short = Routing::new(&[0.0; 5], 10.0, 5.0).unwrap();
-        assert!(Moulds::new(&short, 5.0, &MouldParams { clamp_mm: 0.0, ..p }).is_err());
+        assert!(Moulds::new(&short, 5.0, &MouldParams { clamp_mm: 0.0, ..p.clone() }).is_err());
+        // A size that is not a number or beyond any printer is refused by name.
+        for (bad, name) in [
+            (MouldParams { wall_mm: f64::NAN, ..p.clone() }, "wall_mm"),
+            (MouldParams { wall_mm: 1e308, ..p.clone() }, "wall_mm"),
+            (MouldParams { clamp_mm: 1e7, ..p.clone() }, "clamp_mm"),
+        ] {
+            match Moulds::new(&ok, 5.0, &bad).unwrap_err() {
+                MouldError::BadParameter { name: got, message } => assert_eq!(got, name, "{message}"),
+                e => panic!("{e}"),
+            }
+        }
+    }
+
+    /// The size check counts the triangles before meshing: an upper bound
+    /// within twice the built meshes' (steps of zero height weld away), so
+    /// the limit means about what it says; and a
+    /// mould within every size limit but too large to mesh is refused.
+    #[test]
+    fn the_triangle_estimate_matches_the_meshes_and_bounds_them() {
+        for (length, wall) in [(65.0, 3.0), (300.0, 3.0), (65.0, 40.0)] {
+            let routing = Routing::new(&[1.0, -2.0, 3.0, 0.5, -3.0], length, 5.0).unwrap();
+            let params = MouldParams { wall_mm: wall, ..MouldParams::default() };
+            let set = MouldSet::new(&routing, 5.0, &params).unwrap();
+            let built: usize = [PartKind::Tray, PartKind::Lid, PartKind::Cover].iter().map(|k| set.part(*k).mesh.check().triangles).sum();
+            let estimate = set.moulds.estimated_triangles();
+            assert!(estimate >= built as f64 && estimate < 2.0 * built as f64, "L {length}, wall {wall}: {estimate} vs {built}");
+        }
+        let long = Routing::new(&[1.0, -2.0, 3.0, 0.5, -3.0], 9000.0, 5.0).unwrap();
+        let e = Moulds::new(&long, 5.0, &MouldParams { wall_mm: 2000.0, ..MouldParams::default() }).unwrap_err();
+        assert!(matches!(e, MouldError::TooLarge { .. }) && e.to_string().contains("triangles"), "{e}");
     }
 }

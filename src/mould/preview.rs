@@ -33,7 +33,9 @@ pub fn write_png(path: &Path, set: &MouldSet, number: u8) -> Result<(), PlotErro
         .build_cartesian_2d(x0 - 2.0..x1 + 2.0, -yh - 2.0..y_top + 2.0)
         .map_err(|e| err(&e))?;
     plan.configure_mesh().x_desc("x (mm)").y_desc("y on the plate (mm)").label_style((FONT, 14)).draw().map_err(|e| err(&e))?;
-    let cell = 0.25;
+    // 0.25 mm cells, or larger ones on a large mould: no more cells than
+    // the picture has pixels (about 1400 across, 300 per part down).
+    let cell = (0.25f64).max((x1 - x0) / 1400.0).max(2.0 * yh / 300.0);
     let (zlo, zhi) = (-(m.radius_mm() + 0.5), 1.6);
     for p in &placed {
         let nx = ((x1 - x0) / cell).ceil() as usize;

@@ -134,8 +134,9 @@ pub enum ReduceError {
     /// The cell is so small that the grid would exceed [`MAX_CELLS_PER_AXIS`].
     #[error(
         "cell size {} mm is too small: the reach ({reach_x_mm:.3} × {reach_y_mm:.3} mm) would span more than \
-         {MAX_CELLS_PER_AXIS} cells per axis; use a cell size ≥ {smallest_cell_mm:.3e} mm",
-        crate::io::fmt_num(*cell_mm)
+         {MAX_CELLS_PER_AXIS} cells per axis; use a cell size ≥ {} mm",
+        crate::io::fmt_num(*cell_mm),
+        crate::io::fmt_num(*smallest_cell_mm)
     )]
     CellTooSmall {
         /// The cell size given, mm.

@@ -4,7 +4,7 @@
 use super::drawings::ModeDrawings;
 use super::plots::{self, draw_heatmap, Picture, Scale};
 use super::{explorer, tables, CoefficientStats, MapData, ReduceError, COEFFICIENT_UNIT};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// Writes the map directory `dir` as a whole: everything is written into a
 /// staging directory beside it (`.NAME.tmp-TOKEN`), which then replaces
@@ -26,34 +26,10 @@ pub fn write_map_replacing(
 /// sees the old directory or the new one, never a mix.
 pub fn write_dir_replacing<T>(dir: &Path, write: impl FnOnce(&Path) -> Result<T, ReduceError>) -> Result<T, ReduceError> {
     let name = check_map_out(dir)?;
-    let parent = match dir.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    std::fs::create_dir_all(&parent).map_err(|source| ReduceError::CreateDir { path: parent.clone(), source })?;
-    remove_abandoned_staging(&parent, &name);
-    let staging = parent.join(format!(".{name}.tmp-{}", crate::io::unique_token()));
-    std::fs::create_dir(&staging).map_err(|source| ReduceError::CreateDir { path: staging.clone(), source })?;
-    // Held while writing so that another reduce does not clear it away.
-    let lock = match std::fs::File::open(&staging) {
-        Ok(lock) => lock,
-        Err(source) => {
-            let _ = std::fs::remove_dir_all(&staging);
-            return Err(ReduceError::CreateDir { path: staging, source });
-        }
-    };
-    // Best effort: where locks are unsupported, staging is judged by its age.
-    let _ = lock.try_lock();
-    let written = write(&staging).and_then(|out| {
-        crate::io::sync_dir(&staging);
-        replace_dir(&staging, dir, &parent, &name).map_err(|source| ReduceError::Replace { path: dir.to_path_buf(), source })?;
-        Ok(out)
-    });
-    if written.is_err() {
-        let _ = std::fs::remove_dir_all(&staging);
-    }
-    drop(lock);
-    written
+    crate::io::write_dir_replacing(dir, &name, write, |step, path, source| match step {
+        crate::io::DirStep::Create => ReduceError::CreateDir { path, source },
+        crate::io::DirStep::Replace => ReduceError::Replace { path, source },
+    })
 }
 
 /// Checks that `dir` can take a map (see [`write_map_replacing`]) before
@@ -117,45 +93,6 @@ fn holds_only_map_files(dir: &Path, depth: usize) -> bool {
             kind.is_file() && MAP_FILE_ENDINGS.iter().any(|e| name.ends_with(e))
         }
     })
-}
-
-/// Moves `staging` to `dir`: directly when `dir` is absent or empty, else
-/// by an atomic exchange (Linux), else by moving the old map aside first
-/// and deleting it after (a moment without `dir`, never a mixed one).
-fn replace_dir(staging: &Path, dir: &Path, parent: &Path, name: &str) -> std::io::Result<()> {
-    match std::fs::rename(staging, dir) {
-        Ok(()) => {}
-        Err(_) if dir.is_dir() && crate::io::exchange(staging, dir)? => {
-            // `staging` now holds the old map.
-            let _ = std::fs::remove_dir_all(staging);
-        }
-        Err(_) if dir.is_dir() => {
-            let old = parent.join(format!(".{name}.old-{}", crate::io::unique_token()));
-            std::fs::rename(dir, &old)?;
-            if let Err(e) = std::fs::rename(staging, dir) {
-                let _ = std::fs::rename(&old, dir);
-                return Err(e);
-            }
-            let _ = std::fs::remove_dir_all(&old);
-        }
-        Err(e) => return Err(e),
-    }
-    crate::io::sync_dir(parent);
-    Ok(())
-}
-
-/// Removes staging and old-map directories of `name` left by killed
-/// reduces (no writer holds their lock, or they are stale).
-fn remove_abandoned_staging(parent: &Path, name: &str) {
-    let Ok(entries) = std::fs::read_dir(parent) else { return };
-    for entry in entries.flatten() {
-        let file_name = entry.file_name().to_string_lossy().into_owned();
-        let left = crate::io::is_temp_of(&file_name, name)
-            || file_name.strip_prefix(&format!(".{name}.old-")).is_some_and(|t| !t.is_empty());
-        if left && entry.path().is_dir() && crate::io::is_abandoned(&entry.path()) {
-            let _ = std::fs::remove_dir_all(entry.path());
-        }
-    }
 }
 
 /// Writes the whole map directory: tables, pictures and index.html.

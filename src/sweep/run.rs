@@ -379,7 +379,10 @@ fn solve_row(sim: &mut Simulator, tension_n: f64, output: &OutputSpec) -> Solved
     match sim.solve(tension_n) {
         Ok(pose) => {
             let mut a = vec![0.0; output.order + 1];
-            sim.coefficients_into(output.length_basis, &mut a);
+            // Coefficients the discretisation does not resolve are a failure too.
+            if let Err(failure) = sim.coefficients_checked(output.length_basis, &mut a) {
+                return failed(failure.status());
+            }
             let scalars = [pose.tip_x_mm, pose.tip_y_mm, pose.tip_angle_rad, pose.base_angle_rad, pose.length_mm];
             if !scalars.iter().chain(&a).all(|v| v.is_finite()) {
                 // Stored as a failure so that outputs are never NaN.

@@ -32,7 +32,7 @@ pub enum SpatialError {
     #[error("an actuator needs 1 to {MAX_CABLES} cables, got {0}")]
     CableCount(usize),
     /// A tension is negative or not finite.
-    #[error("cable {cable}: tension {tension_n} N is invalid: a cable pulls with a finite tension ≥ 0 N")]
+    #[error("cable {cable}: tension {} N is invalid: a cable pulls with a finite tension ≥ 0 N", crate::io::fmt_num(*tension_n))]
     Tension { cable: usize, tension_n: f64 },
     /// A control point is bad.
     #[error("cable {cable}, {axis} control points: {source}")]
@@ -44,7 +44,7 @@ pub enum SpatialError {
     #[error("cables {first} and {second} have the same path (identical y and z control points); two cables cannot share a channel: merge them into one cable with the summed tension, or move one")]
     SamePath { first: usize, second: usize },
     /// An anchor lies outside the rod.
-    #[error("cable {cable}: anchor s_k = {anchor_mm} mm must lie in (0, L = {length_mm} mm]")]
+    #[error("cable {cable}: anchor s_k = {} mm must lie in (0, L = {} mm]", crate::io::fmt_num(*anchor_mm), crate::io::fmt_num(*length_mm))]
     Anchor { cable: usize, anchor_mm: f64, length_mm: f64 },
     /// Gravity direction is zero or not finite.
     #[error("gravity direction {0:?} must be a finite, non-zero 3-vector (it is normalised; the weight per length comes from the density)")]
@@ -159,6 +159,7 @@ impl SpatialActuator {
             if !(gj.is_finite() && gj > 0.0) {
                 return Err(ParameterError::NotPositive { name: "gj_n_mm2", value: gj }.into());
             }
+            crate::model::actuator::PLAUSIBLE_EI_N_MM2.check("gj_n_mm2", gj)?;
         }
         self.gravity_unit()?;
         cable::validate(&self.rod, &self.cables)
@@ -222,6 +223,15 @@ impl SpatialSimulation {
 /// together from zero (rungs of at most 0.25 N on the largest) so that large
 /// deformations start from a nearby solution, and computes the coefficients
 /// a_0 … a_order in `basis`.
+///
+/// The result is checked against the same solve at half the steps (RK4's
+/// error falls as h⁴, so their difference is well above the finer one's
+/// error): the tip within [`crate::model::solver::tip_tolerance_mm`], every
+/// coefficient within [`crate::model::resolution::ORDER_TOLERANCE_PER_MM`].
+/// Where they differ by more, the steps are doubled (the last solve is the
+/// next comparison), up to [`MAX_AUTO_SPATIAL_STEPS_PER_SPAN`]; beyond, the
+/// solve is refused as unresolved. A tip farther from the clamp than the
+/// stretched rod is long is refused too.
 pub fn simulate_spatial(
     actuator: &SpatialActuator,
     options: &SpatialOptions,
@@ -229,6 +239,75 @@ pub fn simulate_spatial(
     basis: LengthBasis,
 ) -> Result<SpatialSimulation, SpatialError> {
     solver::check_order(order, options)?;
+    let top = actuator.cables.iter().map(|c| c.tension_n).fold(0.0, f64::max);
+    crate::model::solver::check_ladder_tension("cable tension_n", top)?;
+    let half = SpatialOptions { steps_per_span: (options.steps_per_span / 2).max(2), ..options.clone() };
+    // A coarse solve that fails says nothing about the fine one: the
+    // comparison then moves one level up.
+    let mut coarse = solve_ladder(actuator, &half, order, basis).ok();
+    let mut options = options.clone();
+    loop {
+        let fine = solve_ladder(actuator, &options, order, basis)?;
+        let steps = options.steps_per_span;
+        let failure = match &coarse {
+            Some(c) => unresolved_part(&fine, c, steps),
+            None => Some(unresolved("the tip position".into(), f64::INFINITY, 0.0, "mm", steps)),
+        };
+        let Some(failure) = failure else {
+            return Ok(fine);
+        };
+        if steps >= MAX_AUTO_SPATIAL_STEPS_PER_SPAN {
+            return Err(failure.into());
+        }
+        options.steps_per_span = (2 * steps).min(MAX_AUTO_SPATIAL_STEPS_PER_SPAN);
+        coarse = Some(fine);
+    }
+}
+
+/// Most RK4 steps per span [`simulate_spatial`] refines to by itself.
+pub const MAX_AUTO_SPATIAL_STEPS_PER_SPAN: usize = 2560;
+
+/// [`SpatialFailure::Unresolved`] for `what` at `steps` per span.
+fn unresolved(what: String, estimate: f64, tolerance: f64, unit: &'static str, steps: usize) -> SpatialFailure {
+    let advice = format!("raise --steps-per-span above {steps} (sweep spec: [solver] steps_per_span), or lower the tensions");
+    SpatialFailure::Unresolved(crate::model::solver::Unresolved { what, estimate, tolerance, unit, advice })
+}
+
+/// What of `fine` (at `steps` per span) is not resolved, judged against
+/// `coarse` (at fewer steps): the tip or a coefficient further off than
+/// its tolerance, or a tip beyond the stretched length. `None` if all is.
+fn unresolved_part(fine: &SpatialSimulation, coarse: &SpatialSimulation, steps: usize) -> Option<SpatialFailure> {
+    let unresolved = |what: String, estimate: f64, tolerance: f64, unit| Some(unresolved(what, estimate, tolerance, unit, steps));
+    let tolerance = crate::model::solver::tip_tolerance_mm(fine.actuator.rod.length_mm);
+    let [x, y, z] = fine.pose.tip_mm;
+    let reach = (x * x + y * y + z * z).sqrt();
+    if reach > fine.pose.length_mm + tolerance {
+        let what = format!(
+            "the tip (|tip| = {} mm is more than the stretched length ℓ = {} mm)",
+            crate::io::fmt_num(reach),
+            crate::io::fmt_num(fine.pose.length_mm)
+        );
+        return unresolved(what, reach - fine.pose.length_mm, tolerance, "mm");
+    }
+    let tip_difference = (0..3).map(|i| (fine.pose.tip_mm[i] - coarse.pose.tip_mm[i]).powi(2)).sum::<f64>().sqrt();
+    if !(tip_difference <= tolerance) {
+        return unresolved("the tip position".into(), tip_difference, tolerance, "mm");
+    }
+    let series = [("a_twist", &fine.a_twist, &coarse.a_twist), ("a_bend_y", &fine.a_bend_y, &coarse.a_bend_y), ("a_bend_z", &fine.a_bend_z, &coarse.a_bend_z)];
+    let a_tolerance = crate::model::resolution::ORDER_TOLERANCE_PER_MM;
+    for (name, f, c) in series {
+        for (k, (p, q)) in f.iter().zip(c.iter()).enumerate() {
+            if !((p - q).abs() <= a_tolerance) {
+                return unresolved(format!("{name}[{k}]"), (p - q).abs(), a_tolerance, "mm⁻¹");
+            }
+        }
+    }
+    None
+}
+
+/// One ladder of [`simulate_spatial`] at `options`' steps, without the
+/// resolution check (but refusing non-finite results).
+fn solve_ladder(actuator: &SpatialActuator, options: &SpatialOptions, order: usize, basis: LengthBasis) -> Result<SpatialSimulation, SpatialError> {
     let mut solver = SpatialSolver::new(actuator, options)?;
     let top = actuator.cables.iter().map(|c| c.tension_n).fold(0.0, f64::max);
     let rungs = ((top / 0.25).ceil() as usize).max(1);
@@ -237,7 +316,12 @@ pub fn simulate_spatial(
         pose = Some(solver.solve_scaled(k as f64 / rungs as f64)?);
     }
     let pose = pose.expect("at least one rung");
-    let [a_twist, a_bend_y, a_bend_z] = solver.coefficients(order, basis)?;
+    solver.settle_moments()?;
+    let [a_twist, a_bend_y, a_bend_z] = solver.coefficients_unchecked(order, basis);
+    let finite = pose.tip_mm.iter().chain(&[pose.length_mm, pose.tip_angle_rad]).chain(&a_twist).chain(&a_bend_y).chain(&a_bend_z).all(|v| v.is_finite());
+    if !finite {
+        return Err(SpatialFailure::NonFinite.into());
+    }
     Ok(SpatialSimulation {
         actuator: actuator.clone(),
         pose,

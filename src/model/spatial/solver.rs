@@ -142,6 +142,28 @@ pub enum SpatialFailure {
     /// Gravity's moment iteration did not converge.
     #[error("gravity's moment did not converge in {passes} passes (residual {residual_n_mm:.3e} N·mm); the rod may be too heavy for its stiffness")]
     Gravity { passes: u32, residual_n_mm: f64 },
+    /// A number of the result is not finite.
+    #[error("the solve gave a non-finite tip or coefficient; check the rod's parameters (rigidities, length, density) for absurd values")]
+    NonFinite,
+    /// The steps do not resolve the solution: its difference to the same
+    /// solve at half the steps is above the tolerance, up to the most steps
+    /// tried ([`super::simulate_spatial`]), or the tip lies farther from the
+    /// clamp than the stretched rod is long.
+    #[error(transparent)]
+    Unresolved(crate::model::solver::Unresolved),
+}
+
+impl SpatialFailure {
+    /// Short machine-readable status (as the planar solver's
+    /// [`crate::model::SolveFailure::status`]).
+    pub fn status(&self) -> &'static str {
+        match self {
+            SpatialFailure::Local { .. } => "cut_equations_not_converged",
+            SpatialFailure::Gravity { .. } => "gravity_not_converged",
+            SpatialFailure::NonFinite => "non_finite",
+            SpatialFailure::Unresolved(_) => "unresolved",
+        }
+    }
 }
 
 /// Per-point, per-cable channel data in body coordinates.
@@ -774,6 +796,13 @@ impl SpatialSolver {
     /// a_0 … a_order in 1/mm (see the module comment), from the moments the
     /// last (converged) pass accumulated.
     pub fn coefficients(&mut self, order: usize, basis: LengthBasis) -> Result<[Vec<f64>; 3], SpatialError> {
+        self.settle_moments()?;
+        check_order(order, &self.options)?;
+        Ok(self.coefficients_unchecked(order, basis))
+    }
+
+    /// Makes the coefficient moments those of the last solve.
+    pub(super) fn settle_moments(&mut self) -> Result<(), SpatialError> {
         assert!(self.last.is_some(), "coefficients needs a successful solve");
         if !self.moments_valid {
             // The converged pass was a chord pass: one full pass at the
@@ -783,7 +812,13 @@ impl SpatialSolver {
             self.pass(m0)?;
             self.moments_valid = true;
         }
-        check_order(order, &self.options)?;
+        Ok(())
+    }
+
+    /// [`SpatialSolver::coefficients`] of the last solve without the
+    /// order check (the error estimate's coarse solve computes the same
+    /// orders at half the steps); needs valid moments.
+    pub(super) fn coefficients_unchecked(&self, order: usize, basis: LengthBasis) -> [Vec<f64>; 3] {
         let moments = &self.moments;
         let length = self.rod.length_mm;
         let ell = self.last.expect("checked").length_mm;
@@ -805,7 +840,7 @@ impl SpatialSolver {
                 })
                 .collect()
         });
-        Ok(out)
+        out
     }
 }
 
