@@ -217,7 +217,9 @@ fn design_with_moulds_gives_a_channel_the_moulds_cast() {
     assert!(ok, "{stderr}");
     let design: Value = serde_json::from_str(&std::fs::read_to_string(out.join("design.json")).unwrap()).unwrap();
     let y: Vec<f64> = design["routing_mm"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
-    assert!(y.iter().all(|y| y.abs() <= 4.2) && y.iter().any(|y| y.abs() > 4.19), "on the moulds' bound: {y:?}");
+    // The default bound (4.995 mm) lets Target I's routing reach
+    // |y_3| = 4.91 mm; with --moulds every |y_i| stays within 4.2 mm.
+    assert!(y.iter().all(|y| y.abs() <= 4.2 + 1e-9), "within the moulds' bound: {y:?}");
     for file in ["mould1.stl", "mould2.stl", "mould.json", "design.json", "mould.svg"] {
         assert!(out.join(file).is_file(), "{file}: {stdout}");
     }
