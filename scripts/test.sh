@@ -61,7 +61,7 @@ if have_chromium; then
     echo 0 > "$work/chromium.rc"
 elif [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null; then
     echo "== installing chromium and chromium-driver (Debian packages) for the map explorer's browser check:"
-    echo "   once per machine, about 1-3 minutes and 300 MB (apt-get, in the background while cargo builds)"
+    echo "   once per machine, about 3 minutes and 400 MB (apt-get, in the background while cargo builds)"
     install_chromium &
 else
     echo 1 > "$work/chromium.rc"
@@ -105,10 +105,10 @@ step() {
     local name=$1
     shift
     local out=$work/logs/step-${name//[^a-z0-9]/-}.out
-    if "$@" > "$out" 2>&1; then
-        return 0
-    fi
-    echo "FAIL $name: $* exited with status $?"
+    "$@" > "$out" 2>&1
+    local rc=$?
+    [ "$rc" != 0 ] || return 0
+    echo "FAIL $name: $* exited with status $rc"
     tail -n 20 "$out"
     record "$name" 0 1
     return 1
