@@ -16,7 +16,11 @@
 set -uo pipefail
 cd "$(dirname "$0")/.."
 
-target=$(cargo metadata --format-version 1 --no-deps | python3 -c 'import json,sys; print(json.load(sys.stdin)["target_directory"])')
+if ! target=$(cargo metadata --format-version 1 --no-deps | python3 -c 'import json,sys; print(json.load(sys.stdin)["target_directory"])' 2>/dev/null); then
+    echo "error: cannot read cargo's target directory (cargo metadata | python3): the suite needs Rust's cargo and Python 3 on PATH" >&2
+    echo "0 passed, 1 failed"
+    exit 1
+fi
 bin=$target/release/cablemap
 venv=${CABLEMAP_VENV:-$target/python-venv}
 artefacts=${CABLEMAP_TEST_ARTEFACTS:-$target/test-artefacts}
@@ -94,7 +98,11 @@ check() {
     passed=$(echo "$line" | awk '{print $2+0}')
     failed=$(echo "$line" | awk '{print $4+0}')
     if [ -z "$line" ] || { [ "$rc" != 0 ] && [ "$failed" = 0 ]; }; then
-        echo "FAIL $name: exited with status $rc before counting its checks"
+        if [ -n "$line" ]; then
+            echo "FAIL $name: exited with status $rc after \"$line\""
+        else
+            echo "FAIL $name: exited with status $rc before counting its checks"
+        fi
         failed=$((failed + 1))
     fi
     record "$name" "$passed" "$failed"

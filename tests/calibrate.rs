@@ -96,8 +96,8 @@ fn diagnose_writes_a_report_with_plots() {
     args.extend(DIAGNOSIS_SOLVER);
     synth(&data, &args);
     let out = dir.path().join("report");
-    let mut args =
-        vec!["diagnose", data.to_str().unwrap(), "--holdout", "arc", "--centrelines", lines.to_str().unwrap(), "--out", out.to_str().unwrap(), "--json"];
+    let (data_arg, lines_arg, out_arg) = (data.to_str().unwrap(), lines.to_str().unwrap(), out.to_str().unwrap());
+    let mut args = vec!["diagnose", data_arg, "--holdout", "arc", "--centrelines", lines_arg, "--out", out_arg, "--json"];
     args.extend(DIAGNOSIS_SOLVER);
     let (ok, stdout, stderr) = cablemap(&args);
     assert!(ok, "{stderr}");
@@ -309,9 +309,8 @@ fn diagnose_names_the_hidden_effect_and_admits_what_it_cannot_name() {
 /// confusion-matrix test, every library effect is named correctly with
 /// centreline data; near the detection limit of clamp compliance (k_θ = 150
 /// N·mm/rad) the centreline names it where the tip data alone (the same
-/// tips) do not. (Tip-only verdicts at half magnitude are in
-/// docs/measurements.md; the test does not rerun them, as it asserts nothing
-/// of them.)
+/// tips) do not. (The other tip-only diagnoses at half magnitude are not
+/// run: the test asserted nothing of them.)
 #[test]
 fn centrelines_name_effects_at_half_the_magnitude() {
     let half: [(&str, f64); 7] = [
