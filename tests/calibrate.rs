@@ -92,11 +92,14 @@ fn diagnose_writes_a_report_with_plots() {
     let dir = tempfile::tempdir().unwrap();
     let data = dir.path().join("d.csv");
     let lines = dir.path().join("c.csv");
-    synth(&data, &["--effect", "channel_offset", "--magnitude", "0.4", "--seed", "5", "--centreline-out", lines.to_str().unwrap()]);
+    let mut args = vec!["--effect", "channel_offset", "--magnitude", "0.4", "--seed", "5", "--centreline-out", lines.to_str().unwrap()];
+    args.extend(DIAGNOSIS_SOLVER);
+    synth(&data, &args);
     let out = dir.path().join("report");
-    let (ok, stdout, stderr) = cablemap(&[
-        "diagnose", data.to_str().unwrap(), "--holdout", "arc", "--centrelines", lines.to_str().unwrap(), "--out", out.to_str().unwrap(), "--json",
-    ]);
+    let (data_arg, lines_arg, out_arg) = (data.to_str().unwrap(), lines.to_str().unwrap(), out.to_str().unwrap());
+    let mut args = vec!["diagnose", data_arg, "--holdout", "arc", "--centrelines", lines_arg, "--out", out_arg, "--json"];
+    args.extend(DIAGNOSIS_SOLVER);
+    let (ok, stdout, stderr) = cablemap(&args);
     assert!(ok, "{stderr}");
     let v = json(&stdout);
     assert_eq!(v["verdict"], "channel_offset");
@@ -112,6 +115,29 @@ fn diagnose_writes_a_report_with_plots() {
     for png in ["residuals.png", "loops.png", "shapes.png"] {
         let bytes = std::fs::read(out.join(png)).unwrap();
         assert!(bytes.starts_with(b"\x89PNG") && bytes.len() > 10_000, "{png}");
+    }
+}
+
+/// Solver resolution of the diagnosis tests, for synthesis and fits alike: 6
+/// collocation intervals per span instead of the default 10. At 6 the tip
+/// is within 2.7e-4 mm of the converged solve (docs/performance.md,
+/// "Accuracy"), 1/1500 of the 0.4 mm noise, so verdicts, parameters and
+/// held-out errors are the default resolution's (compared for every
+/// diagnosis in this file: equal to the digits printed, the last digit of
+/// two k_θ aside) for about a quarter less CPU. Stiffening solves use at
+/// least 16 intervals either way. Not for the glue joint: see
+/// [`solver_for`].
+const DIAGNOSIS_SOLVER: [&str; 2] = ["--nodes-per-span", "6"];
+
+/// The solver flags for data with `effect` hidden: [`DIAGNOSIS_SOLVER`],
+/// except for the glue joint, a stiff 5 mm at the clamp, which 6 intervals
+/// per span resolve visibly less finely (χ²/dof of the thesis model 6.75
+/// instead of 7.10 on seed 11), so it keeps the default resolution.
+fn solver_for(effect: &str) -> &'static [&'static str] {
+    if effect == "glue_joint" {
+        &[]
+    } else {
+        &DIAGNOSIS_SOLVER
     }
 }
 
@@ -146,8 +172,10 @@ fn diagnose_jobs(dir: &Path, jobs: &[Job], same_data: bool) -> Vec<serde_json::V
                                 args.extend(["--centreline-out", lines.to_str().unwrap()]);
                             }
                             args.extend(t.iter().map(|s| s.as_str()));
+                            args.extend(solver_for(effect));
                             synth(&path, &args);
                             let mut d = vec!["diagnose", path.to_str().unwrap(), "--holdout", "arc", "--no-report", "--json"];
+                            d.extend(solver_for(effect));
                             if shapes {
                                 d.extend(["--centrelines", lines.to_str().unwrap()]);
                             }
@@ -279,9 +307,10 @@ fn diagnose_names_the_hidden_effect_and_admits_what_it_cannot_name() {
 
 /// Centreline data sharpen the diagnosis. At half the magnitudes of the
 /// confusion-matrix test, every library effect is named correctly with
-/// centreline data (tip-only verdicts are printed alongside); near the
-/// detection limit of clamp compliance (k_θ = 150 N·mm/rad) the centreline
-/// names it where the tip data alone do not.
+/// centreline data; near the detection limit of clamp compliance (k_θ = 150
+/// N·mm/rad) the centreline names it where the tip data alone (the same
+/// tips) do not. (The other tip-only diagnoses at half magnitude are not
+/// run: the test asserted nothing of them.)
 #[test]
 fn centrelines_name_effects_at_half_the_magnitude() {
     let half: [(&str, f64); 7] = [
@@ -293,7 +322,7 @@ fn centrelines_name_effects_at_half_the_magnitude() {
         ("creep", 0.1),
         ("stiffness_gradient", -0.5 * std::f64::consts::LN_2),
     ];
-    let mut jobs: Vec<Job> = half.iter().flat_map(|&(e, m)| [(e, m, 11, false), (e, m, 11, true)]).collect();
+    let mut jobs: Vec<Job> = half.iter().map(|&(e, m)| (e, m, 11, true)).collect();
     jobs.push(("clamp_compliance", 150.0, 11, false));
     jobs.push(("clamp_compliance", 150.0, 11, true));
     let dir = tempfile::tempdir().unwrap();
@@ -359,10 +388,13 @@ fn two_outliers_do_not_flip_the_verdict() {
                         args.extend(["--magnitude", "0.08"]);
                     }
                     args.extend(t.iter().map(|s| s.as_str()));
+                    args.extend(DIAGNOSIS_SOLVER);
                     synth(&path, &args);
                     // Reading 4 (base_offset, loading) and reading 19 (s_curve, loading).
                     spoil_two_readings(&path, 4, 19, 15.0);
-                    let (ok, stdout, stderr) = cablemap(&["diagnose", path.to_str().unwrap(), "--holdout", "arc", "--no-report", "--json"]);
+                    let mut d = vec!["diagnose", path.to_str().unwrap(), "--holdout", "arc", "--no-report", "--json"];
+                    d.extend(DIAGNOSIS_SOLVER);
+                    let (ok, stdout, stderr) = cablemap(&d);
                     assert!(ok, "{stderr}");
                     (want.to_string(), json(&stdout))
                 })
@@ -503,8 +535,11 @@ fn diagnose_adds_a_second_effect_stepwise() {
     let t = truth_args();
     let mut extra: Vec<&str> = vec!["--seed", "3", "--effect", "friction", "--magnitude", "0.08", "--channel-offset-mm", "0.4"];
     extra.extend(t.iter().map(|s| s.as_str()));
+    extra.extend(DIAGNOSIS_SOLVER);
     synth(&data, &extra);
-    let (ok, stdout, stderr) = cablemap(&["diagnose", data.to_str().unwrap(), "--holdout", "arc", "--no-report", "--json"]);
+    let mut d = vec!["diagnose", data.to_str().unwrap(), "--holdout", "arc", "--no-report", "--json"];
+    d.extend(DIAGNOSIS_SOLVER);
+    let (ok, stdout, stderr) = cablemap(&d);
     assert!(ok, "{stderr}");
     let v = json(&stdout);
     let effects = v["effects"].as_array().unwrap();
