@@ -10,7 +10,7 @@
 //! steps per span and secant shooting, [`SolverMethod::Rk4`]) in the same
 //! run, so the speed-up is measured under the same load.
 
-use crate::model::{Actuator, ControlPoints, Routing, Simulator, SolverMethod, SolverOptions};
+use crate::model::{Rod, ControlPoints, Routing, Simulator, SolverMethod, SolverOptions};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -58,7 +58,7 @@ pub fn reference_options() -> SolverOptions {
 /// off, each with `options` and, if `with_reference`, with
 /// [`reference_options`] right after on the same routings.
 pub fn bench_with_reference(
-    actuator: &Actuator,
+    actuator: &Rod,
     options: &SolverOptions,
     routings: &[ControlPoints],
     with_reference: bool,
@@ -102,7 +102,7 @@ pub fn sample_thesis_routings(count: usize, radius_mm: f64) -> Vec<ControlPoints
 /// Times continuation solves: for each routing, `tensions` evenly spaced
 /// from `tension_min_n` to `tension_max_n`.
 pub fn bench_solver(
-    actuator: &Actuator,
+    actuator: &Rod,
     options: &SolverOptions,
     routings: &[ControlPoints],
     tension_min_n: f64,
@@ -179,21 +179,21 @@ pub fn sample_spatial_pairs(count: usize, radius_mm: f64) -> Vec<[crate::model::
 /// 2.0 N (continuation, as a sweep would step it), coefficients a_0 … a_3 of
 /// all three series included. `gravity` is the direction (None: off).
 pub fn bench_spatial(
-    rod: &Actuator,
+    rod: &Rod,
     options: &crate::model::spatial::SpatialOptions,
     pairs: &[[crate::model::spatial::Cable; 2]],
     tensions: usize,
     gravity: Option<[f64; 3]>,
     label: &str,
 ) -> Result<BenchFigures, crate::Error> {
-    use crate::model::spatial::{SpatialActuator, SpatialSolver};
+    use crate::model::spatial::{Actuator, SpatialSolver};
     let mut rod = rod.clone();
     rod.gravity.enabled = gravity.is_some();
     let mut per_solve = Vec::with_capacity(pairs.len());
     let (mut passes, mut solves, mut failures) = (0u64, 0u64, 0usize);
     let mut sink = 0.0;
     for pair in pairs {
-        let mut actuator = SpatialActuator::with_cables(rod.clone(), pair.to_vec());
+        let mut actuator = Actuator::with_cables(rod.clone(), pair.to_vec());
         actuator.gravity_direction = gravity;
         let start = Instant::now();
         let mut solver = SpatialSolver::new(&actuator, options)?;

@@ -96,7 +96,7 @@ impl BodyDrawing {
 
     /// The drawing of a simulated `actuator`: the outline follows its
     /// radius r(s) (a tapered or segmented body), else ±`radius_mm`.
-    pub fn of_body(sim: &crate::model::Simulation, actuator: &crate::model::Actuator, label: String, colour: RGBColor) -> Self {
+    pub fn of_body(sim: &crate::model::Simulation, actuator: &crate::model::Rod, label: String, colour: RGBColor) -> Self {
         let mut d = Self::of_simulation(sim, actuator.radius_mm, label, colour);
         if let Ok(Some(body)) = crate::model::Body::of(actuator) {
             d.radii_mm = sim.centreline.iter().map(|c| body.radius_at(c.s_mm)).collect();

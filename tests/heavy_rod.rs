@@ -5,15 +5,15 @@
 //! own: refinement, the equilibrium of the distal free body evaluated from
 //! the output shape alone, and the previous RK4 method where it converges.
 
-use cablemap::model::{simulate, Actuator, Routing, Simulation, SolverMethod, SolverOptions};
+use cablemap::model::{simulate, Rod, Routing, Simulation, SolverMethod, SolverOptions};
 use cablemap::shape::LengthBasis;
 use std::process::Command;
 
 const CHANNEL_MM: [f64; 5] = [11.4, 8.75, 6.1, 3.45, 0.8];
 const TENSIONS_N: [f64; 4] = [1.5, 3.0, 5.0, 7.7];
 
-fn heavy(ei_n_mm2: f64, ea_n: f64) -> Actuator {
-    let mut a = Actuator::default();
+fn heavy(ei_n_mm2: f64, ea_n: f64) -> Rod {
+    let mut a = Rod::default();
     a.length_mm = 360.0;
     a.radius_mm = 12.0;
     a.density_g_cm3 = 1.16;
@@ -24,7 +24,7 @@ fn heavy(ei_n_mm2: f64, ea_n: f64) -> Actuator {
     a
 }
 
-fn solve(a: &Actuator, options: &SolverOptions, tension_n: f64) -> Simulation {
+fn solve(a: &Rod, options: &SolverOptions, tension_n: f64) -> Simulation {
     let routing = Routing::new(&CHANNEL_MM, a.length_mm, a.radius_mm).unwrap();
     simulate(a, options, &routing, tension_n, 3, LengthBasis::Rest)
         .unwrap_or_else(|e| panic!("EI {} EA {} at {tension_n} N: {e}", a.ei_n_mm2, a.ea_n))

@@ -3,7 +3,7 @@
 //! `tests/data/reference/`, see its README) and against the straight-routing
 //! analytic solution (model-notes §3).
 
-use cablemap::model::{simulate, Actuator, Routing, SolverOptions};
+use cablemap::model::{simulate, Rod, Routing, SolverOptions};
 use cablemap::shape::LengthBasis;
 use proptest::prelude::*;
 use serde_json::Value;
@@ -16,8 +16,8 @@ fn load(name: &str) -> Vec<Value> {
     v["cases"].as_array().unwrap().clone()
 }
 
-fn actuator_for(case: &Value) -> Actuator {
-    let mut a = Actuator::default();
+fn actuator_for(case: &Value) -> Rod {
+    let mut a = Rod::default();
     let w = case["gravity_N_per_mm"].as_f64().unwrap();
     a.gravity.enabled = w > 0.0;
     if w > 0.0 {
@@ -78,8 +78,8 @@ fn reference_large_deformation() {
     check_file("large-deformation.json");
 }
 
-fn no_gravity() -> Actuator {
-    let mut a = Actuator::default();
+fn no_gravity() -> Rod {
+    let mut a = Rod::default();
     a.gravity.enabled = false;
     a
 }
@@ -117,9 +117,9 @@ fn zero_tension_gives_the_straight_rod() {
     assert!((sim.pose.tip_x_mm - 65.0).abs() < 1e-12 && sim.pose.tip_y_mm.abs() < 1e-12);
     assert!(sim.a.iter().all(|v| v.abs() < 1e-12));
     // With gravity the hanging rod only stretches under its own weight.
-    let sim = simulate(&Actuator::default(), &SolverOptions::default(), &routing, 0.0, 3, LengthBasis::Rest).unwrap();
-    let w = Actuator::default().weight_n_per_mm();
-    let stretch = w * 65.0 * 65.0 / 2.0 / Actuator::default().ea_n;
+    let sim = simulate(&Rod::default(), &SolverOptions::default(), &routing, 0.0, 3, LengthBasis::Rest).unwrap();
+    let w = Rod::default().weight_n_per_mm();
+    let stretch = w * 65.0 * 65.0 / 2.0 / Rod::default().ea_n;
     assert!((sim.pose.tip_x_mm - 65.0 - stretch).abs() < 1e-9 && sim.pose.tip_y_mm.abs() < 1e-12);
 }
 
@@ -132,7 +132,7 @@ proptest! {
         tension in 0.0f64..2.0,
         gravity in any::<bool>(),
     ) {
-        let mut a = Actuator::default();
+        let mut a = Rod::default();
         a.gravity.enabled = gravity;
         let opts = SolverOptions::default();
         let r = Routing::new(&y, 65.0, 5.0).unwrap();

@@ -3,8 +3,8 @@
 //! shooting solver), analytic solutions, symmetries and agreement with the
 //! planar solver.
 
-use cablemap::model::spatial::{simulate_spatial, Cable, SpatialActuator, SpatialError, SpatialOptions, SpatialSimulation};
-use cablemap::model::{simulate, Actuator, Routing, SolverOptions};
+use cablemap::model::spatial::{simulate_spatial, Cable, Actuator, SpatialError, SpatialOptions, SpatialSimulation};
+use cablemap::model::{simulate, Rod, Routing, SolverOptions};
 use cablemap::shape::LengthBasis;
 use serde_json::Value;
 use std::path::PathBuf;
@@ -28,8 +28,8 @@ fn arr3(v: &Value) -> [f64; 3] {
     vec_of(v).try_into().unwrap()
 }
 
-fn actuator_for(case: &Value) -> SpatialActuator {
-    let mut rod = Actuator::default();
+fn actuator_for(case: &Value) -> Actuator {
+    let mut rod = Rod::default();
     let g = arr3(&case["gravity_N_per_mm"]);
     let w = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
     rod.gravity.enabled = w > 0.0;
@@ -39,7 +39,7 @@ fn actuator_for(case: &Value) -> SpatialActuator {
         .iter()
         .map(|c| Cable::spatial(arr5(&c["routing_y_mm"]), arr5(&c["routing_z_mm"]), c["tension_N"].as_f64().unwrap()))
         .collect();
-    let mut a = SpatialActuator::with_cables(rod, cables);
+    let mut a = Actuator::with_cables(rod, cables);
     if w > 0.0 {
         // The reference's weight is exactly ρ π r² g: only the direction is an input.
         assert!((a.rod.weight_n_per_mm() - w).abs() < 1e-12, "{w}");
@@ -48,7 +48,7 @@ fn actuator_for(case: &Value) -> SpatialActuator {
     a
 }
 
-fn run(a: &SpatialActuator) -> SpatialSimulation {
+fn run(a: &Actuator) -> SpatialSimulation {
     simulate_spatial(a, &SpatialOptions::default(), 3, LengthBasis::Rest).unwrap()
 }
 
@@ -95,8 +95,8 @@ fn every_reference_case_agrees() {
     eprintln!("worst: tip {:.2e} mm, tangent {:.2e} rad, body y {:.2e} rad, length {:.2e} mm", worst[0], worst[1], worst[2], worst[3]);
 }
 
-fn no_gravity() -> Actuator {
-    let mut a = Actuator::default();
+fn no_gravity() -> Rod {
+    let mut a = Rod::default();
     a.gravity.enabled = false;
     a
 }
@@ -105,7 +105,7 @@ fn no_gravity() -> Actuator {
 fn constant_offset_bends_at_constant_curvature_about_the_perpendicular_axis() {
     // Offset (d_y, d_z) = (2.4, −3.2), |d| = 4 mm, τ = 1.5 N.
     let (dy, dz, tau) = (2.4, -3.2, 1.5);
-    let a = SpatialActuator::with_cables(no_gravity(), vec![Cable::spatial([dy; 5], [dz; 5], tau)]);
+    let a = Actuator::with_cables(no_gravity(), vec![Cable::spatial([dy; 5], [dz; 5], tau)]);
     // Fine steps: this checks the model, not RK4's error (≈ 6e-6 mm at the default).
     let sim = simulate_spatial(&a, &SpatialOptions { steps_per_span: 128, ..SpatialOptions::default() }, 3, LengthBasis::Rest).unwrap();
     let rod = &a.rod;
@@ -141,7 +141,7 @@ fn constant_offset_bends_at_constant_curvature_about_the_perpendicular_axis() {
 fn two_opposed_equal_cables_only_compress() {
     for (dy, dz) in [(3.0, 0.0), (1.2, -2.5)] {
         let tau = 1.7;
-        let a = SpatialActuator::with_cables(
+        let a = Actuator::with_cables(
             no_gravity(),
             vec![Cable::spatial([dy; 5], [dz; 5], tau), Cable::spatial([-dy; 5], [-dz; 5], tau)],
         );
@@ -162,10 +162,10 @@ fn pair() -> Vec<Cable> {
 
 #[test]
 fn rotating_every_routing_by_90_degrees_rotates_the_solution() {
-    let a = SpatialActuator::with_cables(no_gravity(), pair());
+    let a = Actuator::with_cables(no_gravity(), pair());
     // Rotation by +90° about x: (y, z) → (−z, y).
     let turned: Vec<Cable> = pair().into_iter().map(|c| Cable::spatial(c.z_mm.map(|z| -z), c.y_mm, c.tension_n)).collect();
-    let b = SpatialActuator::with_cables(no_gravity(), turned);
+    let b = Actuator::with_cables(no_gravity(), turned);
     let (s, t) = (run(&a), run(&b));
     let rot = |p: [f64; 3]| [p[0], -p[2], p[1]];
     assert!(dist(rot(s.pose.tip_mm), t.pose.tip_mm) < 1e-9, "{:?} {:?}", s.pose.tip_mm, t.pose.tip_mm);
@@ -184,9 +184,9 @@ fn rotating_every_routing_by_90_degrees_rotates_the_solution() {
 #[test]
 fn swapping_cables_changes_nothing() {
     let mut cables = pair();
-    let a = SpatialActuator::with_cables(Actuator::default(), cables.clone());
+    let a = Actuator::with_cables(Rod::default(), cables.clone());
     cables.reverse();
-    let b = SpatialActuator::with_cables(Actuator::default(), cables);
+    let b = Actuator::with_cables(Rod::default(), cables);
     let (s, t) = (run(&a), run(&b));
     assert!(dist(s.pose.tip_mm, t.pose.tip_mm) < 1e-10);
     assert!(angle(s.pose.tip_tangent, t.pose.tip_tangent) < 1e-12);
@@ -198,9 +198,9 @@ fn swapping_cables_changes_nothing() {
 
 #[test]
 fn mirroring_y_mirrors_the_solution() {
-    let a = SpatialActuator::with_cables(no_gravity(), pair());
+    let a = Actuator::with_cables(no_gravity(), pair());
     let mirrored: Vec<Cable> = pair().into_iter().map(|c| Cable::spatial(c.y_mm.map(|y| -y), c.z_mm, c.tension_n)).collect();
-    let b = SpatialActuator::with_cables(no_gravity(), mirrored);
+    let b = Actuator::with_cables(no_gravity(), mirrored);
     let (s, t) = (run(&a), run(&b));
     let m = |p: [f64; 3]| [p[0], -p[1], p[2]];
     assert!(dist(m(s.pose.tip_mm), t.pose.tip_mm) < 1e-9);
@@ -225,13 +225,13 @@ fn planar_cases_agree_with_the_planar_solver() {
     for gravity in [false, true] {
         for (k, y) in routings.iter().enumerate() {
             let tension = 0.6 + 0.45 * k as f64;
-            let mut rod = Actuator::default();
+            let mut rod = Rod::default();
             rod.gravity.enabled = gravity;
             rod.gravity.direction_rad = 0.3 * k as f64; // tilted clamps too
             let routing = Routing::new(y, rod.length_mm, rod.radius_mm).unwrap();
             let fine = SolverOptions { nodes_per_span: 32, ..SolverOptions::default() };
             let planar = simulate(&rod, &fine, &routing, tension, 3, LengthBasis::Rest).unwrap();
-            let a = SpatialActuator::with_cables(rod.clone(), vec![Cable::planar(*y, tension)]);
+            let a = Actuator::with_cables(rod.clone(), vec![Cable::planar(*y, tension)]);
             let opts = SpatialOptions { steps_per_span: 256, ..SpatialOptions::default() };
             let s = simulate_spatial(&a, &opts, 3, LengthBasis::Rest).unwrap();
             let tip = [planar.pose.tip_x_mm, planar.pose.tip_y_mm, 0.0];
@@ -259,10 +259,10 @@ fn default_resolution_is_close_to_a_fine_one_on_planar_cases() {
     // The default (10 steps per span) on a strongly curved S at the thesis's
     // top tension, against the planar solver: within the reference tolerance.
     let y = [4.0, -3.0, 2.0, -4.0, 4.0];
-    let rod = Actuator::default();
+    let rod = Rod::default();
     let routing = Routing::new(&y, rod.length_mm, rod.radius_mm).unwrap();
     let planar = simulate(&rod, &SolverOptions { nodes_per_span: 32, ..SolverOptions::default() }, &routing, 2.0, 3, LengthBasis::Rest).unwrap();
-    let s = run(&SpatialActuator::with_cables(rod, vec![Cable::planar(y, 2.0)]));
+    let s = run(&Actuator::with_cables(rod, vec![Cable::planar(y, 2.0)]));
     let d = dist(s.pose.tip_mm, [planar.pose.tip_x_mm, planar.pose.tip_y_mm, 0.0]);
     eprintln!("default resolution: tip off by {d:.2e} mm");
     assert!(d < 5e-4, "{d}");
@@ -270,8 +270,8 @@ fn default_resolution_is_close_to_a_fine_one_on_planar_cases() {
 
 #[test]
 fn bad_input_gets_clear_errors() {
-    let rod = Actuator::default();
-    let err = |cables: Vec<Cable>| simulate_spatial(&SpatialActuator::with_cables(rod.clone(), cables), &SpatialOptions::default(), 3, LengthBasis::Rest).unwrap_err();
+    let rod = Rod::default();
+    let err = |cables: Vec<Cable>| simulate_spatial(&Actuator::with_cables(rod.clone(), cables), &SpatialOptions::default(), 3, LengthBasis::Rest).unwrap_err();
     // Each coordinate below r, the distance √2·3.6 = 5.09 mm above it.
     let e = err(vec![Cable::spatial([3.6; 5], [3.6; 5], 1.0)]);
     assert!(matches!(e, SpatialError::OutsideBody { cable: 1, .. }), "{e}");
@@ -279,7 +279,7 @@ fn bad_input_gets_clear_errors() {
     assert!(matches!(e, SpatialError::SamePath { first: 1, second: 2 }), "{e}");
     let e = err(vec![Cable::planar([1.0; 5], 1.0), Cable::planar([-1.0; 5], -0.5)]);
     assert!(e.to_string().contains("cable 2") && e.to_string().contains("-0.5"), "{e}");
-    let mut a = SpatialActuator::with_cables(rod.clone(), vec![Cable::planar([1.0; 5], 1.0)]);
+    let mut a = Actuator::with_cables(rod.clone(), vec![Cable::planar([1.0; 5], 1.0)]);
     a.gravity_direction = Some([0.0, 0.0, 0.0]);
     assert!(matches!(simulate_spatial(&a, &SpatialOptions::default(), 3, LengthBasis::Rest), Err(SpatialError::GravityDirection(_))));
     a.gravity_direction = None;
@@ -291,7 +291,7 @@ fn bad_input_gets_clear_errors() {
 #[test]
 fn gravity_along_z_bends_the_rod_out_of_plane() {
     // A planar cable with gravity along +z: the planar solver cannot do this.
-    let mut a = SpatialActuator::with_cables(Actuator::default(), vec![Cable::planar([2.0; 5], 1.0)]);
+    let mut a = Actuator::with_cables(Rod::default(), vec![Cable::planar([2.0; 5], 1.0)]);
     a.gravity_direction = Some([0.0, 0.0, 1.0]);
     let s = run(&a);
     assert!(s.pose.tip_mm[2] > 0.1, "{:?}", s.pose.tip_mm);
@@ -303,12 +303,12 @@ fn gravity_along_z_bends_the_rod_out_of_plane() {
 fn an_anchor_before_the_tip_leaves_the_distal_part_straight() {
     let mut cable = Cable::planar([2.0; 5], 1.0);
     cable.anchor_mm = Some(40.0);
-    let s = run(&SpatialActuator::with_cables(no_gravity(), vec![cable]));
+    let s = run(&Actuator::with_cables(no_gravity(), vec![cable]));
     for n in s.nodes.iter().filter(|n| n.s_mm > 40.0 + 1e-9) {
         assert!(n.u_per_mm.iter().all(|u| u.abs() < 1e-12), "{n:?}");
     }
     // Up to the anchor: constant curvature τ d/EI as for a tip anchor.
-    let rod = Actuator::default();
+    let rod = Rod::default();
     for n in s.nodes.iter().filter(|n| n.s_mm < 40.0 - 1e-9) {
         assert!((n.u_per_mm[2] - 2.0 / rod.ei_n_mm2).abs() < 1e-10);
     }
@@ -325,9 +325,9 @@ mod properties {
     }
 
     fn solve(cables: Vec<Cable>, gravity: Option<[f64; 3]>) -> SpatialSimulation {
-        let mut rod = Actuator::default();
+        let mut rod = Rod::default();
         rod.gravity.enabled = gravity.is_some();
-        let mut a = SpatialActuator::with_cables(rod, cables);
+        let mut a = Actuator::with_cables(rod, cables);
         a.gravity_direction = gravity;
         run(&a)
     }

@@ -113,7 +113,7 @@ pub struct Dataset {
     /// The actuator the file describes in its geometry header (`# key =
     /// value` lines before the column names: `actuator_file = "x.toml"`
     /// and/or actuator fields), if it has one.
-    pub actuator: Option<crate::model::Actuator>,
+    pub actuator: Option<crate::model::Rod>,
 }
 
 impl Dataset {
@@ -168,8 +168,8 @@ pub fn read_measurements(path: &Path) -> Result<Dataset, CalibrateError> {
 /// keys are actuator fields (`length_mm = 360`, `radius_profile_mm =
 /// [[0, 15.4], [305, 6.4], [360, 4.8]]`, `cable_anchor_mm = 305`) set on
 /// top of it (or of the thesis's actuator). `None` without a header.
-fn actuator_of_front_matter(path: &Path, front: &str) -> Result<Option<crate::model::Actuator>, CalibrateError> {
-    use crate::model::Actuator;
+fn actuator_of_front_matter(path: &Path, front: &str) -> Result<Option<crate::model::Rod>, CalibrateError> {
+    use crate::model::Rod;
     let bad = |message: String| CalibrateError::Geometry { path: path.display().to_string(), message };
     if front.trim().is_empty() {
         return Ok(None);
@@ -179,10 +179,10 @@ fn actuator_of_front_matter(path: &Path, front: &str) -> Result<Option<crate::mo
         return Ok(None);
     }
     let base = match table.remove("actuator_file") {
-        None => Actuator::default(),
+        None => Rod::default(),
         Some(toml::Value::String(name)) => {
             let file = path.parent().unwrap_or(Path::new(".")).join(&name);
-            Actuator::from_toml_file(&file).map_err(|e| bad(e.to_string()))?
+            Rod::from_toml_file(&file).map_err(|e| bad(e.to_string()))?
         }
         Some(other) => return Err(bad(format!("actuator_file = {other} must be a file name in quotes"))),
     };
@@ -194,7 +194,7 @@ fn actuator_of_front_matter(path: &Path, front: &str) -> Result<Option<crate::mo
         merged.insert(k, v);
     }
     let text = toml::to_string(&merged).map_err(|e| bad(e.to_string()))?;
-    Actuator::from_toml_str(&text).map(Some).map_err(bad)
+    Rod::from_toml_str(&text).map(Some).map_err(bad)
 }
 
 fn read_table(path: &Path) -> Result<Table, CalibrateError> {
@@ -530,7 +530,7 @@ fn parse_measurements(path: &Path, table: &Table) -> Result<Dataset, CalibrateEr
 /// (length, radius, radius profile, segments, cable anchor) as `# key =
 /// value` TOML lines. Rigidities and effects are left out: they are what
 /// calibrate and diagnose fit.
-pub fn geometry_header(a: &crate::model::Actuator) -> String {
+pub fn geometry_header(a: &crate::model::Rod) -> String {
     #[derive(serde::Serialize)]
     struct Geometry<'a> {
         length_mm: f64,
@@ -762,7 +762,7 @@ mod tests {
 
     #[test]
     fn the_geometry_header_gives_the_body_and_round_trips() {
-        let mut a = crate::model::Actuator { length_mm: 360.0, cable_anchor_mm: Some(305.0), ..Default::default() };
+        let mut a = crate::model::Rod { length_mm: 360.0, cable_anchor_mm: Some(305.0), ..Default::default() };
         a.radius_profile_mm = vec![(0.0, 15.4), (305.0, 6.4), (360.0, 4.8)];
         a.effects.friction_mu = 0.3;
         let header = geometry_header(&a);

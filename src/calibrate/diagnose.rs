@@ -25,7 +25,7 @@ use super::effect::Effect;
 use super::fit::{closest_on_centreline, fit, residuals, rms_per_routing, FitResult, FitSpec, RoutingRms};
 use super::predict::{predict, Prediction};
 use super::CalibrateError;
-use crate::model::{Actuator, SolverOptions};
+use crate::model::{Rod, SolverOptions};
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -362,7 +362,7 @@ fn decide(ranked: &[Candidate], spec: &DiagnoseSpec) -> Decision {
 
 /// One round: every effect not yet in `base_effects` (nor held) is refitted with them.
 fn round(
-    base: &Actuator,
+    base: &Rod,
     options: &SolverOptions,
     data: &Dataset,
     train: &[RoutingGroup],
@@ -416,7 +416,7 @@ fn chi2_text(f: &FitResult) -> String {
 }
 
 /// Runs the whole workflow on `data` with `base` as the starting actuator.
-pub fn diagnose(base: &Actuator, options: &SolverOptions, data: &Dataset, spec: &DiagnoseSpec) -> Result<Diagnosis, CalibrateError> {
+pub fn diagnose(base: &Rod, options: &SolverOptions, data: &Dataset, spec: &DiagnoseSpec) -> Result<Diagnosis, CalibrateError> {
     if !(spec.alpha > 0.0 && spec.alpha < 1.0) {
         return Err(CalibrateError::Invalid(format!("the noise test's level must lie in (0, 1), got {}", spec.alpha)));
     }

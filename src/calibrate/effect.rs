@@ -2,7 +2,7 @@
 //! the actuator, how it is parameterised for the fit (positivity by logs,
 //! a fraction by a logit) and what values are physically plausible.
 
-use crate::model::Actuator;
+use crate::model::Rod;
 use serde::Serialize;
 
 /// An effect the thesis model leaves out, with one fitted parameter.
@@ -69,7 +69,7 @@ impl Effect {
     }
 
     /// Sets the effect's parameter on `a`.
-    pub fn apply(self, a: &mut Actuator, value: f64) {
+    pub fn apply(self, a: &mut Rod, value: f64) {
         match self {
             Effect::Friction => a.effects.friction_mu = value,
             Effect::Gravity => {
@@ -86,7 +86,7 @@ impl Effect {
 
     /// The effect's value on `a` if it is switched on there (a fit then
     /// starts from it), `None` if `a` has the thesis model's value.
-    pub fn current(self, a: &Actuator) -> Option<f64> {
+    pub fn current(self, a: &Rod) -> Option<f64> {
         let v = match self {
             Effect::Friction => a.effects.friction_mu,
             Effect::Gravity => return (a.gravity.enabled && a.gravity.scale != 1.0 && a.gravity.scale > 0.0).then_some(a.gravity.scale),

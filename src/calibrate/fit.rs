@@ -34,7 +34,7 @@ use super::effect::Effect;
 use super::predict::{predict, Prediction};
 use super::stats;
 use super::CalibrateError;
-use crate::model::{Actuator, CentrelinePoint, SolverOptions};
+use crate::model::{Rod, CentrelinePoint, SolverOptions};
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -208,7 +208,7 @@ pub struct FitResult {
     /// Effects that were fitted.
     pub effects: Vec<Effect>,
     /// The base actuator with the fitted values.
-    pub actuator: Actuator,
+    pub actuator: Rod,
     /// EA, GA, EI, then each effect's parameter.
     pub parameters: Vec<FittedParameter>,
     /// Correlation matrix of the parameters (same order).
@@ -509,7 +509,7 @@ const RIGIDITY_RANGE: f64 = 1e3;
 
 /// The fit problem: maps the unconstrained coordinates to an actuator.
 struct Problem<'a> {
-    base: &'a Actuator,
+    base: &'a Rod,
     options: &'a SolverOptions,
     data: &'a Dataset,
     groups: &'a [RoutingGroup],
@@ -520,7 +520,7 @@ struct Problem<'a> {
 }
 
 impl Problem<'_> {
-    fn actuator(&self, x: &[f64]) -> Actuator {
+    fn actuator(&self, x: &[f64]) -> Rod {
         let mut a = self.base.clone();
         a.ea_n = x[0].exp();
         a.ga_n = x[1].exp();
@@ -590,7 +590,7 @@ impl Problem<'_> {
 /// starts from [`Effect::start`]). Effects set on `base` but not fitted stay
 /// as they are.
 pub fn fit(
-    base: &Actuator,
+    base: &Rod,
     options: &SolverOptions,
     data: &Dataset,
     groups: &[RoutingGroup],
@@ -607,7 +607,7 @@ const MAX_TIP_REACH_PER_LENGTH: f64 = 1.5;
 /// Refuses data whose tips lie farther from the clamp than the rod could
 /// reach: no parameter of the model can fit them, so the fit would
 /// "converge" on nonsense. The likely cause is the unit (µm for mm).
-fn check_tips_within_reach(data: &Dataset, base: &Actuator) -> Result<(), CalibrateError> {
+fn check_tips_within_reach(data: &Dataset, base: &Rod) -> Result<(), CalibrateError> {
     let Some(far) = data.rows.iter().max_by(|a, b| a.tip_x_mm.hypot(a.tip_y_mm).total_cmp(&b.tip_x_mm.hypot(b.tip_y_mm))) else {
         return Ok(());
     };
@@ -642,7 +642,7 @@ pub struct FitProgress {
 /// [`fit`], calling `observe` after every accepted step, so that a long fit
 /// (10⁵ readings) can show progress.
 pub fn fit_observed(
-    base: &Actuator,
+    base: &Rod,
     options: &SolverOptions,
     data: &Dataset,
     groups: &[RoutingGroup],
@@ -910,7 +910,7 @@ pub fn parse_held(name: &str) -> Option<Held> {
 
 /// Applies `--fix` values to the starting actuator: returns it with the
 /// values set, which rigidities are held, and which effects are held.
-pub fn apply_held(base: &Actuator, held: &[(Held, f64)]) -> Result<(Actuator, [bool; 3], Vec<Effect>), CalibrateError> {
+pub fn apply_held(base: &Rod, held: &[(Held, f64)]) -> Result<(Rod, [bool; 3], Vec<Effect>), CalibrateError> {
     let mut a = base.clone();
     let mut fixed = [false; 3];
     let mut effects = Vec::new();
@@ -993,8 +993,8 @@ mod tests {
     use super::*;
     use crate::calibrate::synth::{default_routings, synthesize, SynthSpec};
 
-    fn truth() -> Actuator {
-        Actuator { ea_n: 30.0, ga_n: 1.5, ei_n_mm2: 100.0, ..Actuator::default() }
+    fn truth() -> Rod {
+        Rod { ea_n: 30.0, ga_n: 1.5, ei_n_mm2: 100.0, ..Rod::default() }
     }
 
     #[test]
@@ -1010,7 +1010,7 @@ mod tests {
         let (data, _) = synthesize(&spec, 0).unwrap();
         let t0 = std::time::Instant::now();
         let mut seen = Vec::new();
-        let result = fit_observed(&Actuator::default(), &SolverOptions::default(), &data, &data.groups(), &FitSpec::default(), &mut |p| {
+        let result = fit_observed(&Rod::default(), &SolverOptions::default(), &data, &data.groups(), &FitSpec::default(), &mut |p| {
             seen.push(p)
         })
         .unwrap();
@@ -1057,7 +1057,7 @@ mod tests {
     #[test]
     fn centreline_distances_and_markers_follow_the_geometry() {
         // A straight centreline along +x from the clamp to 65 mm, frame angle 0.
-        let mut a = Actuator::default();
+        let mut a = Rod::default();
         a.gravity.enabled = false;
         let mut sim = crate::model::Simulator::new(&a, &SolverOptions::default()).unwrap();
         sim.set_routing_mm(&[0.0; 5]).unwrap();
@@ -1094,7 +1094,7 @@ mod tests {
         for seed in 1..=3 {
             let spec = SynthSpec { actuator: t.clone(), seed, routings: default_routings()[..4].to_vec(), ..SynthSpec::default() };
             let (data, _) = synthesize(&spec, 0).unwrap();
-            let r = fit(&Actuator::default(), &SolverOptions::default(), &data, &data.groups(), &FitSpec::default()).unwrap();
+            let r = fit(&Rod::default(), &SolverOptions::default(), &data, &data.groups(), &FitSpec::default()).unwrap();
             for (p, want) in r.parameters.iter().zip([t.ea_n, t.ga_n, t.ei_n_mm2]) {
                 assert!(p.se > 0.0 && p.se.is_finite());
                 // 3.5 standard errors: a failure here is a real error, not bad luck (p < 5e-4).

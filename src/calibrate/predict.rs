@@ -4,7 +4,7 @@
 
 use super::data::{Dataset, Direction, RoutingGroup};
 use super::CalibrateError;
-use crate::model::{Actuator, CentrelinePoint, Hold, LoadDirection, Routing, Simulator, SolverOptions, TipPose};
+use crate::model::{Rod, CentrelinePoint, Hold, LoadDirection, Routing, Simulator, SolverOptions, TipPose};
 use rayon::prelude::*;
 
 /// The model's answer for one row.
@@ -18,7 +18,7 @@ pub struct Prediction {
 
 /// The actuator of one routing group: the clamp tilt turns gravity the
 /// other way in the clamp's frame (gravity direction −tilt from the axis).
-pub fn group_actuator(actuator: &Actuator, group: &RoutingGroup) -> Actuator {
+pub fn group_actuator(actuator: &Rod, group: &RoutingGroup) -> Rod {
     let mut a = actuator.clone();
     a.gravity.direction_rad -= group.clamp_tilt_rad;
     a
@@ -27,7 +27,7 @@ pub fn group_actuator(actuator: &Actuator, group: &RoutingGroup) -> Actuator {
 /// Solves the rows of one routing in protocol order, from an unloaded,
 /// virgin rod (no creep history) at the first row.
 pub fn predict_group(
-    actuator: &Actuator,
+    actuator: &Rod,
     options: &SolverOptions,
     data: &Dataset,
     group: &RoutingGroup,
@@ -75,7 +75,7 @@ pub fn predict_group(
 /// Solves every row of `groups` (in parallel over routings); the result is
 /// indexed like `data.rows`, `None` for rows of routings not in `groups`.
 pub fn predict(
-    actuator: &Actuator,
+    actuator: &Rod,
     options: &SolverOptions,
     data: &Dataset,
     groups: &[RoutingGroup],
@@ -124,11 +124,11 @@ mod tests {
         // gravity points toward −y, so the unloaded rod sags toward −y.
         let data = Dataset { rows: vec![rest_row("t", 0.3)], actuator: None };
         let groups = data.groups();
-        let p = predict(&Actuator::default(), &SolverOptions::default(), &data, &groups, false).unwrap();
+        let p = predict(&Rod::default(), &SolverOptions::default(), &data, &groups, false).unwrap();
         let pose = p[0].as_ref().unwrap().pose;
         assert!(pose.tip_y_mm < -0.1 && pose.tip_angle_rad < 0.0, "{pose:?}");
         let level = Dataset { rows: vec![rest_row("t", 0.0)], actuator: None };
-        let p0 = predict(&Actuator::default(), &SolverOptions::default(), &level, &level.groups(), false).unwrap();
+        let p0 = predict(&Rod::default(), &SolverOptions::default(), &level, &level.groups(), false).unwrap();
         assert!(p0[0].as_ref().unwrap().pose.tip_y_mm.abs() < 1e-12);
     }
 
@@ -136,7 +136,7 @@ mod tests {
     fn static_captures_are_not_chained_as_one_history() {
         // With creep, a reading after a long hold at a high tension carries
         // that history in a protocol, but not as an independent capture.
-        let mut a = Actuator::default();
+        let mut a = Rod::default();
         a.effects.creep_fraction = 0.3;
         let row = |id: i64, step: i64, tension_n: f64, direction: Direction, dwell_s: f64| Measurement {
             measurement: id,

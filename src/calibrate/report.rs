@@ -600,7 +600,7 @@ mod tests {
     fn fit_with_p(p_value: f64) -> FitResult {
         FitResult {
             effects: Vec::new(),
-            actuator: crate::model::Actuator::default(),
+            actuator: crate::model::Rod::default(),
             parameters: Vec::new(),
             correlation: Vec::new(),
             rss: 1.0,

@@ -11,13 +11,13 @@ use super::predict::predict_group;
 use super::rng::Rng;
 use super::CalibrateError;
 use crate::model::routing::CONTROL_POINTS;
-use crate::model::{Actuator, SolverOptions};
+use crate::model::{Rod, SolverOptions};
 
 /// What to generate.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SynthSpec {
     /// The true actuator, hidden effects included.
-    pub actuator: Actuator,
+    pub actuator: Rod,
     /// Solver settings.
     pub options: SolverOptions,
     /// Routings: (id, y0..y4 in mm).
@@ -62,7 +62,7 @@ pub fn default_routings() -> Vec<(String, [f64; CONTROL_POINTS])> {
 impl Default for SynthSpec {
     fn default() -> Self {
         Self {
-            actuator: Actuator::default(),
+            actuator: Rod::default(),
             options: SolverOptions::default(),
             routings: default_routings(),
             max_tension_n: 2.0,
@@ -238,7 +238,7 @@ impl EffectSize {
 /// The size of the effect hidden in `spec.actuator`: its noise-free readings
 /// against those of `without` (the same actuator without the effect) on the
 /// same protocol.
-pub fn hidden_effect_size(spec: &SynthSpec, without: &Actuator) -> Result<EffectSize, CalibrateError> {
+pub fn hidden_effect_size(spec: &SynthSpec, without: &Rod) -> Result<EffectSize, CalibrateError> {
     let data = protocol_rows(spec)?;
     let mut size = EffectSize { max_tip_shift_mm: 0.0, max_angle_shift_deg: 0.0 };
     for g in &data.groups() {
@@ -299,16 +299,16 @@ mod tests {
     #[test]
     fn an_effect_below_the_noise_is_told_from_one_above_it() {
         let spec = |alpha: f64| {
-            let mut actuator = Actuator::default();
+            let mut actuator = Rod::default();
             actuator.effects.stiffening_alpha = alpha;
             SynthSpec { actuator, routings: default_routings()[..2].to_vec(), ..SynthSpec::default() }
         };
-        let weak = hidden_effect_size(&spec(0.01), &Actuator::default()).unwrap();
+        let weak = hidden_effect_size(&spec(0.01), &Rod::default()).unwrap();
         assert!(weak.max_tip_shift_mm > 0.0 && weak.hidden_by_noise(0.4, 1.0), "{weak:?}");
-        let strong = hidden_effect_size(&spec(30.0), &Actuator::default()).unwrap();
+        let strong = hidden_effect_size(&spec(30.0), &Rod::default()).unwrap();
         assert!(!strong.hidden_by_noise(0.4, 1.0), "{strong:?}");
         // The same effect shows once the noise is small enough.
         assert!(!weak.hidden_by_noise(weak.max_tip_shift_mm / 4.0, weak.max_angle_shift_deg / 4.0), "{weak:?}");
-        assert_eq!(hidden_effect_size(&spec(0.0), &Actuator::default()).unwrap().max_tip_shift_mm, 0.0);
+        assert_eq!(hidden_effect_size(&spec(0.0), &Rod::default()).unwrap().max_tip_shift_mm, 0.0);
     }
 }

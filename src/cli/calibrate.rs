@@ -10,7 +10,7 @@ use cablemap::calibrate::fit::{apply_held, parse_held, rms_per_routing, Held, Lo
 use cablemap::calibrate::predict::predict;
 use cablemap::calibrate::fit::fit_observed;
 use cablemap::calibrate::{read_measurements, Effect, FitSpec};
-use cablemap::model::{Actuator, SolverOptions};
+use cablemap::model::{Rod, SolverOptions};
 use anyhow::bail;
 use clap::Args;
 use std::io::Write;
@@ -52,7 +52,7 @@ pub struct FitArgs {
 impl FitArgs {
     /// The fit settings and the starting actuator with held values set;
     /// also returns the held effects.
-    pub fn spec(&self, base: &Actuator, data: &Dataset) -> anyhow::Result<(FitSpec, Actuator, Vec<Effect>)> {
+    pub fn spec(&self, base: &Rod, data: &Dataset) -> anyhow::Result<(FitSpec, Rod, Vec<Effect>)> {
         let mut held: Vec<(Held, f64)> = Vec::new();
         for item in &self.fix {
             let Some((name, value)) = item.split_once('=') else {

@@ -14,11 +14,11 @@ pub mod study;
 pub mod sweep;
 pub mod synth;
 
-use cablemap::model::{Actuator, SolverOptions};
+use cablemap::model::{Rod, SolverOptions};
 use cablemap::shape::LengthBasis;
 use clap::Args;
 
-/// Actuator parameter overrides shared by every command that simulates.
+/// Rod parameter overrides shared by every command that simulates.
 /// Defaults are the thesis's (model-notes §1).
 #[derive(Debug, Clone, Args, Default)]
 pub struct ActuatorArgs {
@@ -74,7 +74,7 @@ pub struct ActuatorArgs {
     /// Creep: seconds each tension is held on a fresh rod in sweeps and design [default: 0].
     #[arg(long, value_name = "S", allow_hyphen_values = true)]
     pub creep_hold_s: Option<f64>,
-    /// Actuator TOML file (the fields of a sweep spec's [actuator] section, docs/model.md); the
+    /// Rod TOML file (the fields of a sweep spec's [actuator] section, docs/model.md); the
     /// flags above and below override it [default: the thesis's actuator].
     #[arg(long, value_name = "FILE")]
     pub actuator_file: Option<std::path::PathBuf>,
@@ -117,7 +117,7 @@ pub enum MethodArg {
 
 impl ActuatorArgs {
     /// Applies the overrides on top of `base`.
-    pub fn apply(&self, base: &Actuator) -> Actuator {
+    pub fn apply(&self, base: &Rod) -> Rod {
         let mut a = base.clone();
         let set = |slot: &mut f64, v: Option<f64>| {
             if let Some(v) = v {
@@ -156,11 +156,11 @@ impl ActuatorArgs {
 
     /// The actuator: `--actuator-file` if given, else `from_data` (the one a
     /// measurement file gives), else the thesis's; with the flags applied.
-    pub fn resolve(&self, from_data: Option<&Actuator>) -> anyhow::Result<Actuator> {
+    pub fn resolve(&self, from_data: Option<&Rod>) -> anyhow::Result<Rod> {
         let base = match (&self.actuator_file, from_data) {
-            (Some(path), _) => Actuator::from_toml_file(path).map_err(anyhow::Error::msg).map_err(|e| e.context("--actuator-file"))?,
+            (Some(path), _) => Rod::from_toml_file(path).map_err(anyhow::Error::msg).map_err(|e| e.context("--actuator-file"))?,
             (None, Some(a)) => a.clone(),
-            (None, None) => Actuator::default(),
+            (None, None) => Rod::default(),
         };
         Ok(self.apply(&base))
     }

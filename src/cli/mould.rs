@@ -1,7 +1,7 @@
 //! `cablemap mould`: printable moulds (binary STL) for a routing.
 
 use super::{parse_list, ActuatorArgs};
-use cablemap::model::{Actuator, Routing};
+use cablemap::model::{Rod, Routing};
 use cablemap::mould::{MouldError, MouldParams, MouldSet};
 use anyhow::Context;
 use clap::Args;
@@ -113,7 +113,7 @@ pub fn report(dir: &Path, s: &cablemap::mould::MouldSummary) -> String {
 /// Runs `cablemap mould`.
 pub fn run(args: &MouldArgs) -> anyhow::Result<()> {
     let (ys, base) = match (&args.routing, &args.design) {
-        (Some(r), _) => (parse_list(r, "--routing")?, Actuator::default()),
+        (Some(r), _) => (parse_list(r, "--routing")?, Rod::default()),
         (None, Some(d)) => {
             let file = cablemap::design::record::read_design_file(d).context("--design")?;
             (file.routing_mm, file.actuator)

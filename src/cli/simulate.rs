@@ -167,7 +167,7 @@ fn report_png(args: &SimulateArgs) {
 
 /// Several or spatial cables: the 3-D solver (`model::spatial`).
 fn run_spatial(args: &SimulateArgs) -> anyhow::Result<()> {
-    use cablemap::model::spatial::{record, Cable, SpatialActuator, SpatialError, SpatialOptions};
+    use cablemap::model::spatial::{record, Cable, Actuator, SpatialError, SpatialOptions};
     let planar_only = [
         (args.coefficients == CoefficientRoute::Thesis, "--coefficients thesis"),
         (args.direction != "load", "--direction"),
@@ -184,11 +184,11 @@ fn run_spatial(args: &SimulateArgs) -> anyhow::Result<()> {
                 args.actuator.actuator_file.is_none(),
                 "give the rod either in --actuator FILE's [rod] table or by --actuator-file, not both"
             );
-            let mut spatial = SpatialActuator::read(path)?;
+            let mut spatial = Actuator::read(path)?;
             spatial.rod = args.actuator.apply(&spatial.rod);
             spatial
         }
-        None => SpatialActuator::with_cables(args.actuator.resolve(None)?, Vec::new()),
+        None => Actuator::with_cables(args.actuator.resolve(None)?, Vec::new()),
     };
     if !args.cable.is_empty() {
         spatial.cables = args.cable.iter().map(|c| c.parse::<Cable>()).collect::<Result<_, _>>().context("--cable")?;

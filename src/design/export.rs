@@ -226,7 +226,7 @@ mod tests {
     #[test]
     fn the_drawn_cable_ends_at_its_anchor() {
         let anchor_mm = 41.7;
-        let act = crate::model::Actuator { cable_anchor_mm: Some(anchor_mm), ..Default::default() };
+        let act = crate::model::Rod { cable_anchor_mm: Some(anchor_mm), ..Default::default() };
         let routing = Routing::for_actuator([3.0, 1.0, -2.0, 3.0, 4.0], &act).unwrap();
         let sim = simulate(&act, &Default::default(), &routing, 1.5, 2, crate::shape::LengthBasis::Rest).unwrap();
         let drawing = BodyDrawing::of_body(&sim, &act, "body".into(), BLUE_800);

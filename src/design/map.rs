@@ -5,7 +5,7 @@
 use super::optimise::{Seed, SeedSource};
 use super::target::{Component, Target, Weights};
 use super::DesignError;
-use crate::model::Actuator;
+use crate::model::Rod;
 use crate::reduce::tables;
 use crate::shape::LengthBasis;
 use serde::Serialize;
@@ -112,7 +112,7 @@ impl MapDir {
     }
 
     /// Refuses to use a map made for a different rod.
-    pub fn check_actuator(&self, actuator: &Actuator) -> Result<(), DesignError> {
+    pub fn check_actuator(&self, actuator: &Rod) -> Result<(), DesignError> {
         let s = &self.summary;
         if (s.length_mm - actuator.length_mm).abs() > 1e-9 || (s.radius_mm - actuator.radius_mm).abs() > 1e-9 {
             return Err(map_error(

@@ -3,7 +3,7 @@
 
 use super::target::{Component, Target, Weights};
 use super::DesignError;
-use crate::model::{Actuator, ControlPoints, Routing, Simulator, SolveFailure, SolverOptions, TipPose};
+use crate::model::{Rod, ControlPoints, Routing, Simulator, SolveFailure, SolverOptions, TipPose};
 use crate::shape::LengthBasis;
 use serde::Serialize;
 
@@ -87,7 +87,7 @@ impl Evaluation {
 #[derive(Debug, Clone)]
 pub struct Objective {
     /// The actuator being designed.
-    pub actuator: Actuator,
+    pub actuator: Rod,
     /// Solver settings.
     pub options: SolverOptions,
     /// What to achieve.
@@ -108,7 +108,7 @@ pub const LADDER_STEP_N: f64 = 0.25;
 
 impl Objective {
     /// Builds and checks an objective.
-    pub fn new(actuator: Actuator, options: SolverOptions, target: Target, weights: Weights, bounds: Bounds) -> Result<Self, DesignError> {
+    pub fn new(actuator: Rod, options: SolverOptions, target: Target, weights: Weights, bounds: Bounds) -> Result<Self, DesignError> {
         actuator.validate()?;
         // The solver settings and the target's coefficient order, before any
         // search: every a_k compared must be resolved by the steps.
@@ -188,7 +188,7 @@ mod tests {
 
     #[test]
     fn cost_is_zero_at_a_simulated_target_and_weighted_elsewhere() {
-        let actuator = Actuator::default();
+        let actuator = Rod::default();
         let bounds = Bounds::thesis(actuator.radius_mm, 1.0, 2.0);
         let probe = Objective::new(actuator.clone(), SolverOptions::default(), Target::parse("x=1").unwrap(), Weights::default(), bounds).unwrap();
         let mut sim = probe.simulator();

@@ -561,10 +561,10 @@ pub fn compare(objective: &Objective, eval: &Evaluation, tolerance_pct: f64) -> 
 mod tests {
     use super::*;
     use crate::design::{Bounds, Target, Weights};
-    use crate::model::{Actuator, SolverOptions};
+    use crate::model::{Rod, SolverOptions};
 
     fn objective() -> Objective {
-        let act = Actuator::default();
+        let act = Rod::default();
         let bounds = Bounds::thesis(act.radius_mm, 1.0, 2.0);
         Objective::new(act, SolverOptions::default(), Target::parse("x=50,y=5").unwrap(), Weights::default(), bounds).unwrap()
     }

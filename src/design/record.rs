@@ -7,7 +7,7 @@ use super::objective::{Bounds, Objective};
 use super::optimise::{ComponentResult, DesignOutcome, StartReport};
 use super::DesignError;
 use crate::model::routing::ControlPoints;
-use crate::model::Actuator;
+use crate::model::Rod;
 use crate::shape::LengthBasis;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -21,7 +21,7 @@ pub struct DesignRecord {
     /// Achieved value of each target component (x, y in mm; a_i in mm⁻¹).
     pub achieved: BTreeMap<String, f64>,
     /// The actuator designed for.
-    pub actuator: Actuator,
+    pub actuator: Rod,
     /// Tangent angle at the clamp, rad.
     pub base_angle_rad: f64,
     /// Search bounds (tension range, largest control-point offset).
@@ -137,7 +137,7 @@ pub struct DesignFile {
     pub routing_mm: Vec<f64>,
     /// The actuator (the thesis's when the file has none).
     #[serde(default)]
-    pub actuator: Actuator,
+    pub actuator: Rod,
 }
 
 /// Reads the routing and actuator of a design.json written by `design --out`.
@@ -152,7 +152,7 @@ pub fn read_design_file(path: &Path) -> Result<DesignFile, DesignError> {
         .ok_or_else(|| bad("has no numeric routing_mm list".into()))?;
     let actuator = match v.get("actuator") {
         Some(a) => serde_json::from_value(a.clone()).map_err(|e| bad(format!("bad actuator object: {e}")))?,
-        None => Actuator::default(),
+        None => Rod::default(),
     };
     Ok(DesignFile { routing_mm, actuator })
 }

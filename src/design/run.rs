@@ -9,7 +9,7 @@ use super::optimise::{self, compare, ComponentResult, DesignOutcome, SearchOptio
 use super::record::DesignRecord;
 use super::target::{Target, Weights};
 use super::DesignError;
-use crate::model::{Actuator, Routing, SolverOptions};
+use crate::model::{Rod, Routing, SolverOptions};
 use crate::mould::{MouldParams, MouldSet, MouldSummary};
 use crate::shape::LengthBasis;
 use std::path::{Path, PathBuf};
@@ -21,7 +21,7 @@ pub const DEFAULT_TENSION_RANGE_N: [f64; 2] = [1.0, 2.0];
 #[derive(Debug, Clone)]
 pub struct DesignRequest {
     /// The actuator to design for (validated here).
-    pub actuator: Actuator,
+    pub actuator: Rod,
     /// Solver settings.
     pub options: SolverOptions,
     /// The target shape.
@@ -189,7 +189,7 @@ mod tests {
 
     fn request(moulds: Option<MouldParams>, max_offset_mm: Option<f64>) -> DesignRequest {
         DesignRequest {
-            actuator: Actuator::default(),
+            actuator: Rod::default(),
             options: SolverOptions::default(),
             target: Target::parse("x=50,y=5").unwrap(),
             weights: Weights::default(),
@@ -222,7 +222,7 @@ mod tests {
         let thin = MouldParams { tube_diameter_mm: 0.6, ..params.clone() };
         assert!(bound(&request(Some(thin.clone()), None)) > limit_mm + 0.19);
         // The design the search may return is one the moulds accept.
-        let act = Actuator::default();
+        let act = Rod::default();
         let y = bound(&with);
         let edge = Routing::for_actuator([y, y, -y, y, y], &act).unwrap();
         assert!(crate::mould::Moulds::new(&edge, act.radius_mm, &params).is_ok());

@@ -1,478 +1,91 @@
-//! Actuator parameters (thesis Table 2.1, model-notes §1) and the optional
-//! physical effects the thesis model leaves out (model-notes §6).
+//! The actuator: a rod ([`Rod`]: body along s, materials, effects,
+//! gravity) and 1–8 cables ([`Cable`]: channel y(s), z(s), anchor and
+//! actuation). The thesis's planar single-cable actuator is this type with
+//! one cable and z ≡ 0. This is the `--actuator FILE.toml` format
+//! (docs/schema.md).
 
-use super::body::{Body, Segment};
+use crate::model::cable::{self, Cable};
+use crate::model::spatial::{check_rod, SpatialError};
+use crate::model::{ParameterError, Rod};
 use serde::{Deserialize, Serialize};
 
-/// Default creep time constant T, s.
-pub const DEFAULT_CREEP_TIME_S: f64 = 10.0;
+/// GJ = EI / this factor when not given: for an isotropic material
+/// GJ/EI = G/E·(J/I) = 2/(2(1 + ν)) = 1/1.5 with ν = 0.5.
+pub const EI_OVER_GJ: f64 = 1.5;
 
-/// Standard gravity, m/s².
-pub const STANDARD_GRAVITY_M_S2: f64 = 9.81;
-
-/// A plausible range of a parameter: far beyond any rod cablemap models,
-/// yet refusing values whose products in the solver overflow or vanish.
-#[derive(Debug, Clone, Copy)]
-pub struct PlausibleRange {
-    /// Smallest value accepted.
-    pub min: f64,
-    /// Largest value accepted.
-    pub max: f64,
-    /// The range and an example in words, for the error.
-    pub expected: &'static str,
-}
-
-impl PlausibleRange {
-    /// Refuses `value` of parameter `name` outside the range.
-    pub fn check(&self, name: &'static str, value: f64) -> Result<(), ParameterError> {
-        if (self.min..=self.max).contains(&value) {
-            Ok(())
-        } else {
-            Err(ParameterError::OutOfRange { name, value, expected: self.expected })
-        }
-    }
-}
-
-/// Rod length, mm.
-pub const PLAUSIBLE_LENGTH_MM: PlausibleRange =
-    PlausibleRange { min: 1e-3, max: 1e6, expected: "a length from 1e-3 to 1e6 mm (the thesis rod: 65 mm)" };
-/// Rod radius, mm.
-pub const PLAUSIBLE_RADIUS_MM: PlausibleRange =
-    PlausibleRange { min: 1e-4, max: 1e4, expected: "a radius from 1e-4 to 1e4 mm (the thesis rod: 5 mm)" };
-/// Axial and shear rigidity, N.
-pub const PLAUSIBLE_FORCE_N: PlausibleRange =
-    PlausibleRange { min: 1e-9, max: 1e12, expected: "a rigidity from 1e-9 to 1e12 N (the thesis rod: EA 26.7 N, GA 1.71 N)" };
-/// Bending rigidity, N·mm².
-pub const PLAUSIBLE_EI_N_MM2: PlausibleRange =
-    PlausibleRange { min: 1e-9, max: 1e18, expected: "a bending rigidity from 1e-9 to 1e18 N·mm² (the thesis rod: 115 N·mm²)" };
-/// Density, g/cm³.
-pub const PLAUSIBLE_DENSITY_G_CM3: PlausibleRange =
-    PlausibleRange { min: 0.0, max: 100.0, expected: "0, or a density up to 100 g/cm³ (silicone: 1.07; osmium, the densest element: 22.6)" };
-/// Acceleration of gravity, m/s².
-pub const PLAUSIBLE_G_M_S2: PlausibleRange =
-    PlausibleRange { min: 0.0, max: 1e4, expected: "0, or an acceleration up to 1e4 m/s² (Earth: 9.81)" };
-/// Scale on the weight.
-pub const PLAUSIBLE_GRAVITY_SCALE: PlausibleRange =
-    PlausibleRange { min: 0.0, max: 1e6, expected: "0, or a scale up to 1e6 on the nominal weight (1 is the rod's own)" };
-/// Friction coefficient.
-pub const PLAUSIBLE_FRICTION_MU: PlausibleRange =
-    PlausibleRange { min: 0.0, max: 100.0, expected: "0, or a friction coefficient up to 100 (PTFE on silicone: about 0.1–0.5)" };
-/// Material stiffening α.
-pub const PLAUSIBLE_STIFFENING_ALPHA: PlausibleRange =
-    PlausibleRange { min: 0.0, max: 1e6, expected: "0, or a stiffening up to 1e6" };
-/// Clamp stiffness, N·mm/rad.
-pub const PLAUSIBLE_CLAMP_STIFFNESS: PlausibleRange =
-    PlausibleRange { min: 1e-9, max: 1e18, expected: "a clamp stiffness from 1e-9 to 1e18 N·mm/rad" };
-
-/// Why a parameter set was rejected.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum ParameterError {
-    /// A parameter that must be positive and finite is not.
-    #[error("parameter {name} = {} must be a positive, finite number", crate::io::fmt_num(*value))]
-    NotPositive { name: &'static str, value: f64 },
-    /// A parameter that must be finite is not, or lies outside its range.
-    #[error("parameter {name} = {} is out of range: {expected}", crate::io::fmt_num(*value))]
-    OutOfRange { name: &'static str, value: f64, expected: &'static str },
-    /// A coefficient order the discretisation does not resolve
-    /// ([`crate::model::resolution`]).
-    #[error("{0}")]
-    Unresolved(String),
-    /// The body along s (radius profile, segments, cable anchor) is invalid
-    /// ([`crate::model::body::BodyError`]).
-    #[error("{0}")]
-    Body(String),
-}
-
-/// Why an actuator file could not be used.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("actuator file {path}: {message} (an actuator file holds the [actuator] fields of docs/model.md: length_mm, radius_mm, radius_profile_mm, segments, cable_anchor_mm, ...)")]
-pub struct ActuatorFileError {
-    /// The file.
-    pub path: String,
-    /// What is wrong.
-    pub message: String,
-}
-
-/// Self-weight of the rod.
+/// A whole spatial actuator: rod, torsion, gravity direction and cables.
+/// This is the `--actuator FILE.toml` format (see docs/schema.md).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct Gravity {
-    /// Whether self-weight acts at all (the thesis's rod hangs: on by default).
-    pub enabled: bool,
-    /// Direction of gravity in the plane, measured from the clamp axis (+x)
-    /// toward +y, rad. 0 is a rod hanging straight down from its clamp; a
-    /// tilted clamp turns the rod against gravity.
-    pub direction_rad: f64,
-    /// Scale k on the nominal weight ρ·π r²·g (model-notes §6: gravity effect).
-    pub scale: f64,
-    /// Acceleration of gravity, m/s².
-    pub g_m_s2: f64,
-}
-
-impl Default for Gravity {
-    fn default() -> Self {
-        Self { enabled: true, direction_rad: 0.0, scale: 1.0, g_m_s2: STANDARD_GRAVITY_M_S2 }
-    }
-}
-
-/// Direction of the last tension change, which decides the sign of friction.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "lowercase")]
-pub enum LoadDirection {
-    /// Tension rising: friction opposes the cable sliding toward the base.
-    #[default]
-    Load,
-    /// Tension falling: friction acts the other way.
-    Unload,
-}
-
-impl LoadDirection {
-    /// The slip sign η in friction's capstan law dτ/ds = −η μ τ |ψ'|:
-    /// +1 loading, −1 unloading.
-    pub fn slip_sign(self) -> f64 {
-        match self {
-            LoadDirection::Load => 1.0,
-            LoadDirection::Unload => -1.0,
-        }
-    }
-}
-
-/// Physical effects beyond the thesis model, each with one parameter
-/// (model-notes §6). All default to "off" (the thesis model).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct Effects {
-    /// Cable–channel friction coefficient μ (capstan law along the channel).
-    pub friction_mu: f64,
-    /// Whether the tension was last rising or falling (sign of friction).
-    pub load_direction: LoadDirection,
-    /// Material stiffening α: bending moment EI·u·(1 + α (r u)²).
-    pub stiffening_alpha: f64,
-    /// Rotational stiffness of the clamp k_θ, N·mm/rad; `None` is a rigid clamp.
-    pub clamp_stiffness_n_mm_per_rad: Option<f64>,
-    /// Channel offset δ: the built channel sits at y_c + δ, mm.
-    pub channel_offset_mm: f64,
-    /// Viscoelastic creep in bending (standard linear solid): the fraction f
-    /// of the instantaneous bending rigidity that relaxes, 0 ≤ f < 1. Held
-    /// long enough at a moment m, the curvature creeps from m/EI to
-    /// m/(EI (1 − f)).
-    pub creep_fraction: f64,
-    /// Time constant T of the creep's dashpot, s (the curvature relaxes
-    /// like exp(−(1 − f) t / T) at a held moment).
-    pub creep_time_s: f64,
-    /// For solves outside a measured protocol (simulate, sweep, design):
-    /// how long each tension is held on a rod with no load history before
-    /// the shape is taken, s. 0 gives the instantaneous (elastic) shape.
-    pub creep_hold_s: f64,
-    /// Out-of-library effects, for synthetic test data only (they are not
-    /// diagnosis candidates): see [`Hidden`]. Not written when off, so
-    /// existing specs and metadata are unchanged.
-    #[serde(skip_serializing_if = "Hidden::is_off")]
-    pub hidden: Hidden,
-    /// Stiffness gradient β: EI(s) = EI·exp(β (s/L − ½)) with EA, GA
-    /// unchanged (uneven curing, an unmodelled taper); β = ln(EI(L)/EI(0)),
-    /// β < 0 is softer toward the tip. Not written when 0, so existing specs
-    /// and metadata are unchanged.
-    #[serde(skip_serializing_if = "is_zero")]
-    pub stiffness_gradient_beta: f64,
-}
-
-fn is_zero(v: &f64) -> bool {
-    *v == 0.0
-}
-
-/// Effects deliberately outside the diagnosis's candidate list, so that
-/// tests can check that the diagnosis says "unexplained" instead of naming
-/// a wrong effect (`cablemap synth --effect rest_curvature|glue_joint`).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct Hidden {
-    /// Rest (cured-in) curvature along the whole rod, 1/mm: the bending law
-    /// becomes m = EI (u − u₀).
-    pub rest_curvature_per_mm: f64,
-    /// Bending rigidity factor over `[0, base_segment_mm]` (a stiff glue
-    /// joint at the clamp); 1 is none.
-    pub base_segment_ei_factor: f64,
-    /// Length of the stiff base segment, mm.
-    pub base_segment_mm: f64,
-}
-
-impl Default for Hidden {
-    fn default() -> Self {
-        Self { rest_curvature_per_mm: 0.0, base_segment_ei_factor: 1.0, base_segment_mm: 0.0 }
-    }
-}
-
-impl Hidden {
-    /// Whether every hidden effect is off.
-    pub fn is_off(&self) -> bool {
-        *self == Hidden::default()
-    }
-}
-
-impl Default for Effects {
-    fn default() -> Self {
-        Self {
-            friction_mu: 0.0,
-            load_direction: LoadDirection::Load,
-            stiffening_alpha: 0.0,
-            clamp_stiffness_n_mm_per_rad: None,
-            channel_offset_mm: 0.0,
-            creep_fraction: 0.0,
-            creep_time_s: DEFAULT_CREEP_TIME_S,
-            creep_hold_s: 0.0,
-            hidden: Hidden::default(),
-            stiffness_gradient_beta: 0.0,
-        }
-    }
-}
-
-/// The actuator: geometry, rigidities, material and effects. Defaults are
-/// the thesis's fitted values (Table 2.1) for Dragon Skin 10 Medium.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
+#[serde(deny_unknown_fields)]
 pub struct Actuator {
-    /// Rod length L, mm.
-    pub length_mm: f64,
-    /// Rod radius r, mm.
-    pub radius_mm: f64,
-    /// Axial rigidity EA, N.
-    pub ea_n: f64,
-    /// Shear rigidity GA, N.
-    pub ga_n: f64,
-    /// Bending rigidity EI, N·mm².
-    pub ei_n_mm2: f64,
-    /// Material density, g/cm³.
-    pub density_g_cm3: f64,
-    /// Self-weight.
-    pub gravity: Gravity,
-    /// Effects beyond the thesis model.
-    pub effects: Effects,
-    /// Radius profile r(s): points (s, r) in mm, piecewise linear, from s = 0
-    /// to L (a cone is two points). Empty: the uniform radius `radius_mm`.
-    /// EA, GA, EI (and the weight) are those of a section of radius
-    /// `radius_mm`, scaled by (r/radius_mm)², ², ⁴ (and ²). Not written when
-    /// empty, so existing files are unchanged.
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub radius_profile_mm: Vec<(f64, f64)>,
-    /// Segments of their own material, clamp to tip ([`Segment`]); empty:
-    /// one material.
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub segments: Vec<Segment>,
-    /// Where the cable is knotted, s_k ≤ L (mm); `None` is the tip. The
-    /// routing's five control points span [0, s_k]; beyond the knot the rod
-    /// carries no cable load, only its weight.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub cable_anchor_mm: Option<f64>,
-}
-
-impl Default for Actuator {
-    fn default() -> Self {
-        Self {
-            length_mm: 65.0,
-            radius_mm: 5.0,
-            ea_n: 26.6964,
-            ga_n: 1.70866,
-            ei_n_mm2: 115.117,
-            density_g_cm3: 1.07,
-            gravity: Gravity::default(),
-            effects: Effects::default(),
-            radius_profile_mm: Vec::new(),
-            segments: Vec::new(),
-            cable_anchor_mm: None,
-        }
-    }
+    /// Rod parameters (thesis defaults); `rod.gravity.direction_rad` is
+    /// ignored when `gravity_direction` is given.
+    #[serde(default)]
+    pub rod: Rod,
+    /// Torsional rigidity GJ, N·mm²; `None` is EI/1.5.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gj_n_mm2: Option<f64>,
+    /// Gravity direction in the global frame (any length, normalised);
+    /// `None` takes the planar rod's in-plane direction (cos d, sin d, 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gravity_direction: Option<[f64; 3]>,
+    /// The cables (TOML: `[[cable]]` tables).
+    #[serde(rename = "cable")]
+    pub cables: Vec<Cable>,
 }
 
 impl Actuator {
-    /// Weight per unit length along the gravity direction, N/mm, including
-    /// the gravity scale; 0 when gravity is off.
-    pub fn weight_n_per_mm(&self) -> f64 {
-        if !self.gravity.enabled {
-            return 0.0;
+    /// The thesis rod with `cables`.
+    pub fn with_cables(rod: Rod, cables: Vec<Cable>) -> Self {
+        Self { rod, gj_n_mm2: None, gravity_direction: None, cables }
+    }
+
+    /// GJ in use, N·mm².
+    pub fn torsional_rigidity_n_mm2(&self) -> f64 {
+        self.gj_n_mm2.unwrap_or(self.rod.ei_n_mm2 / EI_OVER_GJ)
+    }
+
+    /// Unit gravity direction (global).
+    pub fn gravity_unit(&self) -> Result<[f64; 3], SpatialError> {
+        let g = match self.gravity_direction {
+            Some(g) => g,
+            None => {
+                let d = self.rod.gravity.direction_rad;
+                [d.cos(), d.sin(), 0.0]
+            }
+        };
+        let n = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
+        if !(n.is_finite() && n > 0.0) {
+            return Err(SpatialError::GravityDirection(g));
         }
-        // ρ [g/cm³] = ρ·1e-6 kg/mm³; area π r² mm²; g m/s² → N/mm.
-        let mass_kg_per_mm = self.density_g_cm3 * 1e-6 * std::f64::consts::PI * self.radius_mm.powi(2);
-        self.gravity.scale * mass_kg_per_mm * self.gravity.g_m_s2
+        Ok(g.map(|c| c / n))
     }
 
-    /// Whether the body is the uniform cylinder with the cable knotted at
-    /// the tip (the thesis's rod, solved on the fast path).
-    pub fn is_uniform_body(&self) -> bool {
-        self.radius_profile_mm.is_empty() && self.segments.is_empty() && self.cable_anchor_mm.is_none_or(|k| k == self.length_mm)
-    }
-
-    /// The cable's length along the rod, s_k (mm): the anchor, or L.
-    pub fn cable_length_mm(&self) -> f64 {
-        self.cable_anchor_mm.unwrap_or(self.length_mm)
-    }
-
-    /// Radius r(s), mm (the profile's, or `radius_mm`). Assumes a valid body.
-    pub fn radius_at(&self, s_mm: f64) -> f64 {
-        match Body::of(self) {
-            Ok(Some(b)) => b.radius_at(s_mm),
-            _ => self.radius_mm,
+    /// Checks everything and builds the cables' channels.
+    pub fn validate(&self) -> Result<Vec<cable::Channel>, SpatialError> {
+        check_rod(&self.rod)?;
+        if let Some(gj) = self.gj_n_mm2 {
+            if !(gj.is_finite() && gj > 0.0) {
+                return Err(ParameterError::NotPositive { name: "gj_n_mm2", value: gj }.into());
+            }
+            crate::model::rod::PLAUSIBLE_EI_N_MM2.check("gj_n_mm2", gj)?;
         }
+        self.gravity_unit()?;
+        cable::validate(&self.rod, &self.cables)
     }
 
-    /// The smallest radius along the cable's length [0, s_k], mm: bounds on
-    /// the control points below it keep the channel inside the body (the
-    /// spline stays in its control polygon's hull). `radius_mm` for the
-    /// uniform cylinder.
-    pub fn channel_radius_mm(&self) -> f64 {
-        match Body::of(self) {
-            Ok(Some(b)) => b.min_radius_mm(0.0, self.cable_length_mm()),
-            _ => self.radius_mm,
-        }
+    /// Reads the TOML format (docs/schema.md); `source` names the file in errors.
+    pub fn from_toml(text: &str, source: &str) -> Result<Self, SpatialError> {
+        toml::from_str(text).map_err(|e| SpatialError::Toml { source_name: source.to_string(), message: e.to_string() })
     }
 
-    /// The largest radius along the rod, mm.
-    pub fn max_radius_mm(&self) -> f64 {
-        self.radius_profile_mm.iter().map(|p| p.1).fold(if self.radius_profile_mm.is_empty() { self.radius_mm } else { 0.0 }, f64::max)
-    }
-
-    /// Reads an actuator TOML file (the fields of [`Actuator`], as in a sweep
-    /// spec's `[actuator]` section; missing fields are the thesis's), checked
-    /// with [`Actuator::validate`]. This module owns the actuator file format.
-    pub fn from_toml_file(path: &std::path::Path) -> Result<Actuator, ActuatorFileError> {
-        let text = std::fs::read_to_string(path).map_err(|e| ActuatorFileError { path: path.display().to_string(), message: e.to_string() })?;
-        Actuator::from_toml_str(&text).map_err(|message| ActuatorFileError { path: path.display().to_string(), message })
-    }
-
-    /// Parses actuator TOML text (see [`Actuator::from_toml_file`]).
-    pub fn from_toml_str(text: &str) -> Result<Actuator, String> {
-        let a: Actuator = toml::from_str(text).map_err(|e| e.to_string().trim_end().to_string())?;
-        a.validate().map_err(|e| e.to_string())?;
+    /// Reads and validates an actuator file.
+    pub fn read(path: &std::path::Path) -> Result<Self, SpatialError> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| SpatialError::Read { path: path.display().to_string(), message: e.to_string() })?;
+        let a = Self::from_toml(&text, &path.display().to_string())?;
+        a.validate()?;
         Ok(a)
     }
-
-    /// Checks every parameter; the solver calls this before it starts.
-    pub fn validate(&self) -> Result<(), ParameterError> {
-        let positive = [
-            ("length_mm", self.length_mm),
-            ("radius_mm", self.radius_mm),
-            ("ea_n", self.ea_n),
-            ("ga_n", self.ga_n),
-            ("ei_n_mm2", self.ei_n_mm2),
-        ];
-        for (name, value) in positive {
-            if !(value.is_finite() && value > 0.0) {
-                return Err(ParameterError::NotPositive { name, value });
-            }
-        }
-        // Absurd sizes (a subnormal rigidity, a kilometre-long rod) are
-        // refused here with a plausible range: the solver's products of them
-        // would overflow or vanish into non-finite results. Within these
-        // ranges every product the solver forms stays finite.
-        for (name, value, range) in [
-            ("length_mm", self.length_mm, PLAUSIBLE_LENGTH_MM),
-            ("radius_mm", self.radius_mm, PLAUSIBLE_RADIUS_MM),
-            ("ea_n", self.ea_n, PLAUSIBLE_FORCE_N),
-            ("ga_n", self.ga_n, PLAUSIBLE_FORCE_N),
-            ("ei_n_mm2", self.ei_n_mm2, PLAUSIBLE_EI_N_MM2),
-        ] {
-            range.check(name, value)?;
-        }
-        let non_negative = [
-            ("density_g_cm3", self.density_g_cm3, PLAUSIBLE_DENSITY_G_CM3),
-            ("gravity.g_m_s2", self.gravity.g_m_s2, PLAUSIBLE_G_M_S2),
-            ("gravity.scale", self.gravity.scale, PLAUSIBLE_GRAVITY_SCALE),
-            ("effects.friction_mu", self.effects.friction_mu, PLAUSIBLE_FRICTION_MU),
-            ("effects.stiffening_alpha", self.effects.stiffening_alpha, PLAUSIBLE_STIFFENING_ALPHA),
-        ];
-        for (name, value, range) in non_negative {
-            if !(value.is_finite() && value >= 0.0) {
-                return Err(ParameterError::OutOfRange { name, value, expected: "a finite number ≥ 0" });
-            }
-            range.check(name, value)?;
-        }
-        let tilt = self.gravity.direction_rad;
-        if !(tilt.is_finite() && tilt.abs() <= std::f64::consts::TAU) {
-            return Err(ParameterError::OutOfRange {
-                name: "gravity.direction_rad",
-                value: tilt,
-                expected: "an angle in rad with |θ| ≤ 2π (was it given in degrees?)",
-            });
-        }
-        if let Some(k) = self.effects.clamp_stiffness_n_mm_per_rad {
-            if !(k.is_finite() && k > 0.0) {
-                return Err(ParameterError::NotPositive { name: "effects.clamp_stiffness_n_mm_per_rad", value: k });
-            }
-            PLAUSIBLE_CLAMP_STIFFNESS.check("effects.clamp_stiffness_n_mm_per_rad", k)?;
-        }
-        let f = self.effects.creep_fraction;
-        if !(f.is_finite() && (0.0..1.0).contains(&f)) {
-            return Err(ParameterError::OutOfRange {
-                name: "effects.creep_fraction",
-                value: f,
-                expected: "0 ≤ f < 1 (the fraction of the bending rigidity that relaxes)",
-            });
-        }
-        let t = self.effects.creep_time_s;
-        if !(t.is_finite() && t > 0.0) {
-            return Err(ParameterError::NotPositive { name: "effects.creep_time_s", value: t });
-        }
-        let hold = self.effects.creep_hold_s;
-        if !(hold.is_finite() && hold >= 0.0) {
-            return Err(ParameterError::OutOfRange { name: "effects.creep_hold_s", value: hold, expected: "a finite time ≥ 0 s" });
-        }
-        let h = &self.effects.hidden;
-        if !h.rest_curvature_per_mm.is_finite() {
-            return Err(ParameterError::OutOfRange {
-                name: "effects.hidden.rest_curvature_per_mm",
-                value: h.rest_curvature_per_mm,
-                expected: "a finite curvature in 1/mm",
-            });
-        }
-        if !(h.base_segment_ei_factor.is_finite() && h.base_segment_ei_factor > 0.0) {
-            return Err(ParameterError::NotPositive { name: "effects.hidden.base_segment_ei_factor", value: h.base_segment_ei_factor });
-        }
-        if !(h.base_segment_mm.is_finite() && h.base_segment_mm >= 0.0) {
-            return Err(ParameterError::OutOfRange {
-                name: "effects.hidden.base_segment_mm",
-                value: h.base_segment_mm,
-                expected: "a finite length ≥ 0 mm",
-            });
-        }
-        let beta = self.effects.stiffness_gradient_beta;
-        if !(beta.is_finite() && beta.abs() <= 20.0) {
-            return Err(ParameterError::OutOfRange {
-                name: "effects.stiffness_gradient_beta",
-                value: beta,
-                expected: "|β| ≤ 20 (β = ln(EI(L)/EI(0)))",
-            });
-        }
-        Body::of(self)?;
-        let delta = self.effects.channel_offset_mm;
-        if !(delta.is_finite() && delta.abs() < self.radius_mm) {
-            return Err(ParameterError::OutOfRange {
-                name: "effects.channel_offset_mm",
-                value: delta,
-                expected: "|δ| below the radius",
-            });
-        }
-        Ok(())
-    }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn default_weight_matches_model_notes() {
-        let w = Actuator::default().weight_n_per_mm();
-        assert!((w - 8.244088901733995e-4).abs() < 1e-15, "{w}");
-        let mut off = Actuator::default();
-        off.gravity.enabled = false;
-        assert_eq!(off.weight_n_per_mm(), 0.0);
-    }
-
-    #[test]
-    fn validation_names_the_parameter() {
-        let mut a = Actuator::default();
-        a.ei_n_mm2 = -1.0;
-        let e = a.validate().unwrap_err().to_string();
-        assert!(e.contains("ei_n_mm2"), "{e}");
-    }
-}

@@ -11,7 +11,7 @@
 //! cut, ∫_s^L ρ r² dσ, has a closed form; the collocation puts span
 //! boundaries at the breakpoints so each span's integrands stay smooth.
 
-use super::actuator::{Actuator, ParameterError};
+use super::rod::{Rod, ParameterError};
 use serde::{Deserialize, Serialize};
 
 /// One segment of the body with its own material, from the previous
@@ -117,7 +117,7 @@ pub struct BodySection {
     pub radius_mm: f64,
 }
 
-/// A non-uniform body, resolved from an [`Actuator`]: pieces between the
+/// A non-uniform body, resolved from an [`Rod`]: pieces between the
 /// breakpoints and the closed-form weight beyond each breakpoint.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Body {
@@ -134,7 +134,7 @@ pub(crate) const MERGE_TOLERANCE: f64 = 1e-9;
 impl Body {
     /// Resolves and checks the body of `a`; `None` for the uniform cylinder
     /// (no profile, no segments), which the solver handles on its fast path.
-    pub fn of(a: &Actuator) -> Result<Option<Body>, BodyError> {
+    pub fn of(a: &Rod) -> Result<Option<Body>, BodyError> {
         check_anchor(a)?;
         if a.radius_profile_mm.is_empty() && a.segments.is_empty() {
             return Ok(None);
@@ -266,7 +266,7 @@ pub(crate) fn merge_sorted(mut cuts: Vec<f64>, length_mm: f64) -> Vec<f64> {
     out
 }
 
-fn check_anchor(a: &Actuator) -> Result<(), BodyError> {
+fn check_anchor(a: &Rod) -> Result<(), BodyError> {
     if let Some(k) = a.cable_anchor_mm {
         if !(k.is_finite() && k > 0.0 && k <= a.length_mm) {
             return Err(BodyError::AnchorOutside { anchor_mm: k, length_mm: a.length_mm });
@@ -298,7 +298,7 @@ fn check_profile(profile: &[(f64, f64)], length_mm: f64) -> Result<(), BodyError
     Ok(())
 }
 
-fn check_segments(a: &Actuator) -> Result<(), BodyError> {
+fn check_segments(a: &Rod) -> Result<(), BodyError> {
     let n = a.segments.len();
     let mut previous = 0.0;
     for (index, g) in a.segments.iter().enumerate() {
@@ -353,8 +353,8 @@ pub fn parse_radius_profile(text: &str) -> Result<Vec<(f64, f64)>, String> {
 mod tests {
     use super::*;
 
-    fn tapered() -> Actuator {
-        Actuator { length_mm: 360.0, radius_mm: 15.4, radius_profile_mm: vec![(0.0, 15.4), (305.0, 6.4), (360.0, 4.8)], ..Actuator::default() }
+    fn tapered() -> Rod {
+        Rod { length_mm: 360.0, radius_mm: 15.4, radius_profile_mm: vec![(0.0, 15.4), (305.0, 6.4), (360.0, 4.8)], ..Rod::default() }
     }
 
     #[test]
@@ -399,7 +399,7 @@ mod tests {
         a.cable_anchor_mm = Some(400.0);
         let e = Body::of(&a).unwrap_err().to_string();
         assert!(e.contains("anchor") && e.contains("400"), "{e}");
-        assert!(Body::of(&Actuator::default()).unwrap().is_none());
+        assert!(Body::of(&Rod::default()).unwrap().is_none());
         assert!(parse_radius_profile("0:15.4,305:6.4,360:4.8").unwrap().len() == 3);
         assert!(parse_radius_profile("0:15.4,305").unwrap_err().contains("s:r"));
     }

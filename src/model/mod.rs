@@ -2,6 +2,8 @@
 //! static rod–cable solver.
 
 pub mod actuator;
+pub mod cable;
+pub mod rod;
 pub mod body;
 pub mod record;
 pub mod routing;
@@ -10,6 +12,8 @@ pub mod solver;
 pub mod spatial;
 
 pub use body::{Body, BodyError, Segment};
-pub use actuator::{Actuator, Effects, Gravity, LoadDirection, ParameterError};
+pub use actuator::Actuator;
+pub use cable::{Cable, MAX_CABLES};
+pub use rod::{Rod, Effects, Gravity, LoadDirection, ParameterError};
 pub use routing::{ControlPoints, Routing, RoutingError};
 pub use solver::{simulate, simulate_held, CentrelinePoint, Hold, SimulateError, Simulation, Simulator, SolveFailure, SolverMethod, SolverOptions, TipPose, Unresolved, STATUS_OK};

@@ -180,10 +180,10 @@ pub fn read_centreline_csv(path: &Path) -> Result<Vec<CentrelinePoint>, Centreli
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::{simulate, Actuator, Routing, SolverOptions};
+    use crate::model::{simulate, Rod, Routing, SolverOptions};
 
     fn solve() -> Simulation {
-        let a = Actuator::default();
+        let a = Rod::default();
         let routing = Routing::new(&[0.0, 1.0, -2.0, 3.0, 0.5], a.length_mm, a.radius_mm).unwrap();
         simulate(&a, &SolverOptions::default(), &routing, 1.5, 3, LengthBasis::Rest).unwrap()
     }
@@ -209,7 +209,7 @@ mod tests {
     #[test]
     fn an_anchored_cable_ends_at_its_anchor_in_the_csv() {
         let anchor_mm = 45.3;
-        let a = Actuator { cable_anchor_mm: Some(anchor_mm), ..Actuator::default() };
+        let a = Rod { cable_anchor_mm: Some(anchor_mm), ..Rod::default() };
         let routing = Routing::for_actuator([0.0, 1.0, -2.0, 3.0, 0.5], &a).unwrap();
         let sim = simulate(&a, &SolverOptions::default(), &routing, 1.5, 3, LengthBasis::Rest).unwrap();
         let text = centreline_csv(&sim.centreline);

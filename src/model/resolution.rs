@@ -74,7 +74,7 @@ pub fn check_order(order: usize, options: &SolverOptions) -> Result<(), String> 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::{Actuator, Routing, Simulator};
+    use crate::model::{Rod, Routing, Simulator};
 
     fn rk4(steps: usize) -> SolverOptions {
         SolverOptions { method: SolverMethod::Rk4, steps_per_span: steps, ..SolverOptions::default() }
@@ -105,7 +105,7 @@ mod tests {
     /// The solver itself (not `simulate`, which would refuse coarse cases);
     /// `None` when the solver refuses the solve as unresolved.
     fn coefficients(options: &SolverOptions, order: usize) -> Option<Vec<f64>> {
-        let actuator = Actuator::default();
+        let actuator = Rod::default();
         let routing = Routing::new(&[-4.0, 4.0, -4.0, 4.0, -4.0], actuator.length_mm, actuator.radius_mm).unwrap();
         let mut sim = Simulator::new(&actuator, options).unwrap();
         sim.set_routing(&routing);
@@ -146,8 +146,8 @@ mod tests {
 
     /// A random rod, far from the thesis's: length, radius, rigidities, a
     /// cone sometimes, gravity sometimes.
-    fn body(length_mm: f64, radius_mm: f64, ei_n_mm2: f64, ea_n: f64, ga_n: f64, taper: f64, gravity: bool) -> Actuator {
-        let mut a = Actuator { length_mm, radius_mm, ei_n_mm2, ea_n, ga_n, ..Actuator::default() };
+    fn body(length_mm: f64, radius_mm: f64, ei_n_mm2: f64, ea_n: f64, ga_n: f64, taper: f64, gravity: bool) -> Rod {
+        let mut a = Rod { length_mm, radius_mm, ei_n_mm2, ea_n, ga_n, ..Rod::default() };
         a.gravity.enabled = gravity;
         if taper < 0.9 {
             a.radius_profile_mm = vec![(0.0, radius_mm), (length_mm, radius_mm * taper)];

@@ -219,7 +219,7 @@ impl Routing {
     /// (the anchor, or L), with the channel checked against r(s) along s
     /// for a non-uniform body. For the uniform body this is
     /// [`Routing::new`] with the actuator's length and radius.
-    pub fn for_actuator(y_mm: impl AsRef<[f64]>, a: &super::Actuator) -> Result<Self, RoutingError> {
+    pub fn for_actuator(y_mm: impl AsRef<[f64]>, a: &super::Rod) -> Result<Self, RoutingError> {
         let body = super::body::Body::of(a).map_err(|e| RoutingError::Body(e.to_string()))?;
         let Some(body) = body else {
             if a.is_uniform_body() {

@@ -47,7 +47,7 @@
 //! allocated once per [`Simulator`]; solving allocates nothing, except in
 //! collocation's Newton fallback for heavy rods (a dense Jacobian).
 
-use super::actuator::{Actuator, LoadDirection, ParameterError};
+use super::rod::{Rod, LoadDirection, ParameterError};
 use super::body::{merge_sorted, Body};
 use super::routing::Routing;
 use crate::shape::LengthBasis;
@@ -331,7 +331,7 @@ fn bending_moment(tension: f64, channel_y_mm: f64, cos_alpha: f64, distal_moment
 /// (in rising order for the best warm starts). Holds all buffers it needs.
 #[derive(Debug, Clone)]
 pub struct Simulator {
-    actuator: Actuator,
+    actuator: Rod,
     options: SolverOptions,
     weight_n_per_mm: f64,
     gravity_cos: f64,
@@ -387,7 +387,7 @@ pub struct Hold {
 
 impl Simulator {
     /// Creates a solver for `actuator`; fails on invalid parameters.
-    pub fn new(actuator: &Actuator, options: &SolverOptions) -> Result<Self, ParameterError> {
+    pub fn new(actuator: &Rod, options: &SolverOptions) -> Result<Self, ParameterError> {
         actuator.validate()?;
         // The upper bound keeps a typo (2e9 steps) from exhausting memory.
         if options.steps_per_span < 2 || options.steps_per_span % 2 != 0 || options.steps_per_span > MAX_STEPS_PER_SPAN {
@@ -465,7 +465,7 @@ impl Simulator {
     }
 
     /// The actuator this solver was built for.
-    pub fn actuator(&self) -> &Actuator {
+    pub fn actuator(&self) -> &Rod {
         &self.actuator
     }
 
@@ -881,7 +881,7 @@ fn resolution_advice(options: &SolverOptions, resolution: usize) -> String {
 /// routing's knot `knot_mm`, the cable's anchor and the body's breakpoints
 /// (so that every span's integrands are smooth); [0, knot, L] for the
 /// uniform rod.
-fn span_boundaries(a: &Actuator, body: Option<&Body>, knot_mm: f64) -> Vec<f64> {
+fn span_boundaries(a: &Rod, body: Option<&Body>, knot_mm: f64) -> Vec<f64> {
     let length = a.length_mm;
     let mut cuts = vec![0.0, knot_mm, a.cable_length_mm(), length];
     if let Some(b) = body {
@@ -943,7 +943,7 @@ pub enum SimulateError {
 /// Solves one actuator at `tension_n`, stepping up from a low tension by
 /// continuation so that large deformations start from a nearby solution.
 pub fn simulate(
-    actuator: &Actuator,
+    actuator: &Rod,
     options: &SolverOptions,
     routing: &Routing,
     tension_n: f64,
@@ -958,7 +958,7 @@ pub fn simulate(
 /// `hold.direction` (friction) and held for `hold.dwell_s` from a virgin
 /// rod (creep); the ladder below it is loaded without dwell.
 pub fn simulate_held(
-    actuator: &Actuator,
+    actuator: &Rod,
     options: &SolverOptions,
     routing: &Routing,
     tension_n: f64,
@@ -1040,9 +1040,9 @@ pub const MAX_AUTO_STEPS_PER_SPAN: usize = 6144;
 /// without gravity), a routing within ±0.8 r and a tension bending it by
 /// about 0.3–3 rad: the error estimates' test cases.
 #[cfg(test)]
-fn random_case(rng: &mut crate::calibrate::rng::Rng) -> (Actuator, Vec<f64>, f64) {
+fn random_case(rng: &mut crate::calibrate::rng::Rng) -> (Rod, Vec<f64>, f64) {
     let mut span = |lo: f64, hi: f64| lo * (hi / lo).powf(rng.uniform());
-    let mut a = Actuator::default();
+    let mut a = Rod::default();
     (a.length_mm, a.radius_mm, a.ei_n_mm2, a.ea_n, a.ga_n) = (span(30.0, 300.0), span(2.0, 8.0), span(20.0, 400.0), span(15.0, 60.0), span(1.0, 5.0));
     let tension = span(0.3, 3.0) * a.ei_n_mm2 / a.length_mm / a.radius_mm;
     a.gravity.enabled = rng.uniform() < 0.5;
@@ -1056,8 +1056,8 @@ mod tests {
 
     /// Thesis rod without gravity on a straight routing y_i = `d_mm`: the
     /// cable direction is α = 0 everywhere, so the effects have closed forms.
-    fn straight(effects: impl FnOnce(&mut Actuator), d_mm: f64) -> Simulator {
-        let mut a = Actuator::default();
+    fn straight(effects: impl FnOnce(&mut Rod), d_mm: f64) -> Simulator {
+        let mut a = Rod::default();
         a.gravity.enabled = false;
         effects(&mut a);
         let mut sim = Simulator::new(&a, &SolverOptions::default()).unwrap();
@@ -1078,7 +1078,7 @@ mod tests {
     /// a tension ladder up and down, with creep holds.
     #[test]
     fn collocation_agrees_with_rk4_for_every_effect() {
-        type Setup = fn(&mut Actuator);
+        type Setup = fn(&mut Rod);
         let cases: [(&str, Setup); 9] = [
             ("thesis", |_| {}),
             ("gravity scale", |a| a.gravity.scale = 2.5),
@@ -1095,7 +1095,7 @@ mod tests {
         ];
         let rk4 = SolverOptions { method: SolverMethod::Rk4, steps_per_span: 192, ..SolverOptions::default() };
         for (name, setup) in cases {
-            let mut a = Actuator::default();
+            let mut a = Rod::default();
             setup(&mut a);
             let mut sims = [Simulator::new(&a, &SolverOptions::default()).unwrap(), Simulator::new(&a, &rk4).unwrap()];
             for route in [[1.0, -2.0, 4.0, 4.0, -4.0], [-3.0, 1.0, -1.0, 0.0, -2.0]] {
@@ -1128,7 +1128,7 @@ mod tests {
 
     #[test]
     fn simulate_reports_its_own_errors_with_the_lower_layers_as_sources() {
-        let (a, options) = (Actuator::default(), SolverOptions::default());
+        let (a, options) = (Rod::default(), SolverOptions::default());
         let routing = Routing::new(&[1.0, -2.0, 4.0, 4.0, -4.0], a.length_mm, a.radius_mm).unwrap();
         let err = simulate(&a, &options, &routing, -1.0, 3, LengthBasis::Rest).unwrap_err();
         assert!(matches!(err, SimulateError::Solve(SolveFailure::InvalidTension(t)) if t == -1.0), "{err:?}");
@@ -1148,7 +1148,7 @@ mod tests {
         // ψ' = u = τ(s) d / EI and dτ/ds = −η μ τ ψ' (slip sign η) give
         // τ(s) = τ0 / (1 + η μ τ0 d s / EI), φ(L) = η ln(1 + η μ τ0 d L / EI) / μ.
         let (mu, tau, d) = (0.1, 2.0, 4.0);
-        let a = Actuator::default();
+        let a = Rod::default();
         for direction in [LoadDirection::Load, LoadDirection::Unload] {
             let slip = direction.slip_sign();
             let mut sim = straight(|a| a.effects.friction_mu = mu, d);
@@ -1169,7 +1169,7 @@ mod tests {
 
     #[test]
     fn friction_makes_a_hysteresis_loop_on_a_curved_routing_with_gravity() {
-        let mut a = Actuator::default();
+        let mut a = Rod::default();
         a.effects.friction_mu = 0.2;
         let mut sim = Simulator::new(&a, &SolverOptions::default()).unwrap();
         sim.set_routing_mm(&[1.0, -2.0, 4.0, 4.0, -4.0]).unwrap();
@@ -1185,7 +1185,7 @@ mod tests {
     #[test]
     fn creep_follows_the_standard_linear_solid() {
         let (f, t_s, tau, d) = (0.3, 10.0, 1.0, 3.0);
-        let a = Actuator::default();
+        let a = Rod::default();
         let mut sim = straight(
             |a| {
                 a.effects.creep_fraction = f;
@@ -1244,7 +1244,7 @@ mod tests {
         assert!((soft.tip_x_mm - (c * stiff.tip_x_mm - s * stiff.tip_y_mm)).abs() < 1e-9);
         assert!((soft.tip_y_mm - (s * stiff.tip_x_mm + c * stiff.tip_y_mm)).abs() < 1e-9);
         // No moment at the clamp (y_c(0) = 0, no gravity): no rotation.
-        let mut a = Actuator::default();
+        let mut a = Rod::default();
         a.gravity.enabled = false;
         let route = [0.0, 2.0, 3.0, 1.0, 2.0];
         let mut rigid = Simulator::new(&a, &SolverOptions::default()).unwrap();
@@ -1259,7 +1259,7 @@ mod tests {
     fn stiffening_and_channel_offset_follow_their_laws() {
         // Straight routing: constant moment τ d, curvature solves EI (u + α r² u³) = τ d.
         let (alpha, tau, d) = (2.0, 2.0, 3.0);
-        let a = Actuator::default();
+        let a = Rod::default();
         let pose = ladder(&mut straight(|a| a.effects.stiffening_alpha = alpha, d), tau);
         let u = pose.tip_angle_rad / a.length_mm;
         let m = a.ei_n_mm2 * (u + alpha * a.radius_mm.powi(2) * u.powi(3));
@@ -1274,7 +1274,7 @@ mod tests {
     fn hidden_rest_curvature_and_stiff_base_segment_follow_their_laws() {
         // Straight routing: u = τ d / EI_local + u₀, so φ(L) = ∫ u ds.
         let (tau, d, u0) = (1.5, 3.0, 0.004);
-        let a = Actuator::default();
+        let a = Rod::default();
         let curved = ladder(&mut straight(|a| a.effects.hidden.rest_curvature_per_mm = u0, d), tau);
         let want = tau * d * a.length_mm / a.ei_n_mm2 + u0 * a.length_mm;
         assert!((curved.tip_angle_rad - want).abs() < 1e-6, "{} vs {want}", curved.tip_angle_rad);
@@ -1348,8 +1348,8 @@ mod body_tests {
         (x, y, phi(cuts[cuts.len() - 1]))
     }
 
-    fn tapered_thesis_rod() -> Actuator {
-        let mut a = Actuator::default();
+    fn tapered_thesis_rod() -> Rod {
+        let mut a = Rod::default();
         a.radius_profile_mm = vec![(0.0, 6.0), (30.0, 5.0), (65.0, 4.0)];
         a
     }
@@ -1416,7 +1416,7 @@ mod body_tests {
     #[test]
     fn a_tapered_rod_under_its_weight_balances_the_base_moment() {
         for (profile, direction) in [(vec![(0.0, 7.0), (65.0, 3.0)], 1.0), (vec![(0.0, 6.0), (30.0, 5.0), (65.0, 4.0)], 0.4)] {
-            let mut a = Actuator::default();
+            let mut a = Rod::default();
             a.radius_profile_mm = profile;
             a.gravity.direction_rad = direction;
             a.gravity.scale = 20.0;
@@ -1452,7 +1452,7 @@ mod body_tests {
         // weight is summed differently, so rounding takes another path; the
         // sweeps stop at 1e-9 rad, about 1e-7 mm at the tip); an extra
         // breakpoint at 20 mm changes the discretisation, well below its error.
-        let mut flat = Actuator::default();
+        let mut flat = Rod::default();
         flat.radius_profile_mm = vec![(0.0, 5.0), (65.0, 5.0)];
         flat.segments = vec![Segment { end_mm: 65.0, ea_n: None, ga_n: None, ei_n_mm2: None, density_g_cm3: None }];
         flat.cable_anchor_mm = Some(65.0);
@@ -1460,7 +1460,7 @@ mod body_tests {
         split.radius_profile_mm = vec![(0.0, 5.0), (20.0, 5.0), (65.0, 5.0)];
         let route = [1.0, -2.0, 4.0, 4.0, -4.0];
         let mut poses = Vec::new();
-        for a in [Actuator::default(), flat, split] {
+        for a in [Rod::default(), flat, split] {
             let mut sim = Simulator::new(&a, &SolverOptions::default()).unwrap();
             sim.set_routing_mm(&route).unwrap();
             poses.push((1..=8).map(|k| sim.solve(0.25 * k as f64).unwrap()).collect::<Vec<_>>());
@@ -1474,7 +1474,7 @@ mod body_tests {
 
     #[test]
     fn rk4_agrees_with_collocation_on_a_cone_with_gravity() {
-        let mut a = Actuator::default();
+        let mut a = Rod::default();
         a.radius_profile_mm = vec![(0.0, 6.5), (65.0, 4.0)];
         a.effects.stiffness_gradient_beta = -0.5;
         let rk4 = SolverOptions { method: SolverMethod::Rk4, steps_per_span: 192, ..SolverOptions::default() };
@@ -1495,7 +1495,7 @@ mod body_tests {
     #[test]
     fn the_real_tentacle_solves_up_to_7_7_n() {
         // 360 mm, r 15.4 → 6.4 → 4.8 mm, tendon knotted at 305 mm, full gravity.
-        let mut a = Actuator { length_mm: 360.0, cable_anchor_mm: Some(305.0), ..Actuator::default() };
+        let mut a = Rod { length_mm: 360.0, cable_anchor_mm: Some(305.0), ..Rod::default() };
         a.radius_profile_mm = vec![(0.0, 15.4), (305.0, 6.4), (360.0, 4.8)];
         let mut sim = Simulator::new(&a, &SolverOptions::default()).unwrap();
         sim.set_routing_mm(&[4.0; 5]).unwrap();
@@ -1518,7 +1518,7 @@ mod anchor_edge_tests {
     fn an_anchor_merged_into_a_breakpoint_ends_the_cable_there() {
         let mut poses = Vec::new();
         for anchor in [50.0, 50.0 + 1e-12] {
-            let mut a = Actuator::default();
+            let mut a = Rod::default();
             a.gravity.enabled = false;
             a.radius_profile_mm = vec![(0.0, 6.0), (50.0, 5.0), (65.0, 4.0)];
             a.cable_anchor_mm = Some(anchor);

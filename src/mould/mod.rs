@@ -136,7 +136,7 @@ pub enum MouldError {
 
 /// Refuses a body the moulds cannot cast: a radius profile, segments or a
 /// cable knotted before the tip ([`MouldError::NonUniformBody`]).
-pub fn check_uniform_body(a: &crate::model::Actuator) -> Result<(), MouldError> {
+pub fn check_uniform_body(a: &crate::model::Rod) -> Result<(), MouldError> {
     let mut what = Vec::new();
     if !a.radius_profile_mm.is_empty() {
         what.push("a radius profile (radius_profile_mm)");

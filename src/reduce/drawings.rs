@@ -3,7 +3,7 @@
 //! (with the run's actuator and solver) for modes.png and index.html.
 
 use super::{Design, MapData};
-use crate::model::{Actuator, SolverOptions};
+use crate::model::{Rod, SolverOptions};
 use crate::plot::BodyDrawing;
 
 /// Why a representative could not be drawn.
@@ -39,7 +39,7 @@ pub struct ModeDrawings {
 
 impl ModeDrawings {
     /// Simulates every mode's representative of `map` again and draws it.
-    pub fn of_map(map: &MapData, actuator: &Actuator, solver: &SolverOptions) -> Self {
+    pub fn of_map(map: &MapData, actuator: &Rod, solver: &SolverOptions) -> Self {
         let mut drawings = Self::default();
         for m in &map.modes {
             let shape = m.representative.as_ref().map(|d| draw(m.mode, d, actuator, solver)).transpose();
@@ -65,7 +65,7 @@ impl ModeDrawings {
     }
 }
 
-fn draw(mode: usize, d: &Design, actuator: &Actuator, solver: &SolverOptions) -> Result<BodyDrawing, DrawingError> {
+fn draw(mode: usize, d: &Design, actuator: &Rod, solver: &SolverOptions) -> Result<BodyDrawing, DrawingError> {
     let routing = crate::model::Routing::for_actuator(d.routing_mm, actuator)
         .map_err(|source| DrawingError::Routing { mode, source })?;
     let sim = crate::model::simulate(actuator, solver, &routing, d.tension_n, 1, crate::shape::LengthBasis::default())

@@ -11,7 +11,7 @@
 
 use super::plots::Picture;
 use super::{MapData, ReduceError, MODES};
-use crate::model::Actuator;
+use crate::model::Rod;
 use crate::plot::BodyDrawing;
 use serde_json::{json, Value};
 use std::path::Path;
@@ -41,7 +41,7 @@ fn points(pts: &[(f64, f64)]) -> Value {
 }
 
 /// The data object the page reads.
-fn data(map: &MapData, actuator: &Actuator, shapes: &[Option<BodyDrawing>], pictures: &[Picture], written_utc: &str) -> Value {
+fn data(map: &MapData, actuator: &Rod, shapes: &[Option<BodyDrawing>], pictures: &[Picture], written_utc: &str) -> Value {
     let c = &map.cells;
     let nk = c.first().map_or(0, |c| c.coefficients.len());
     let stats: Vec<Value> = (0..nk)
@@ -117,7 +117,7 @@ fn data(map: &MapData, actuator: &Actuator, shapes: &[Option<BodyDrawing>], pict
 }
 
 /// The effects whose settings differ from the thesis model's (name, value).
-fn effects_in_use(actuator: &Actuator) -> Vec<(String, Value)> {
+fn effects_in_use(actuator: &Rod) -> Vec<(String, Value)> {
     let used = serde_json::to_value(&actuator.effects).expect("effects serialise");
     let default = serde_json::to_value(crate::model::Effects::default()).expect("effects serialise");
     let (Some(used), Some(default)) = (used.as_object(), default.as_object()) else { return Vec::new() };
@@ -147,7 +147,7 @@ pub fn utc_now() -> String {
 pub fn write_explorer(
     dir: &Path,
     map: &MapData,
-    actuator: &Actuator,
+    actuator: &Rod,
     shapes: &[Option<BodyDrawing>],
     pictures: &[Picture],
 ) -> Result<(), ReduceError> {

@@ -292,7 +292,7 @@ pub struct MapBody {
 
 impl MapBody {
     /// The body of `actuator`.
-    pub fn of(actuator: &crate::model::Actuator) -> Self {
+    pub fn of(actuator: &crate::model::Rod) -> Self {
         MapBody {
             radius_profile_mm: actuator.radius_profile_mm.clone(),
             segments: actuator.segments.clone(),
@@ -909,7 +909,7 @@ mod tests {
     #[test]
     fn a_representative_that_cannot_be_drawn_is_reported() {
         let mut map = run(&pseudo_rows(200), false, &ReduceOptions::default());
-        let actuator = crate::model::Actuator::default();
+        let actuator = crate::model::Rod::default();
         let m = map.modes.iter().position(|m| m.representative.is_some()).unwrap();
         // Outside the body: the routing is refused, and the drawing says so.
         map.modes[m].representative.as_mut().unwrap().routing_mm[2] = 2.0 * actuator.radius_mm;
@@ -925,14 +925,14 @@ mod tests {
 #[cfg(test)]
 mod picture_tests {
     use super::*;
-    use crate::model::{Actuator, Routing, Simulator, SolverOptions};
+    use crate::model::{Rod, Routing, Simulator, SolverOptions};
     use arrow::array::{ArrayRef, Float64Array, Int64Array, StringArray};
     use arrow::datatypes::{DataType, Field, Schema};
     use std::sync::Arc;
 
     /// A small real run: 3 levels per control point, 4 tensions, as one batch.
     fn small_run() -> RecordBatch {
-        let actuator = Actuator::default();
+        let actuator = Rod::default();
         let mut sim = Simulator::new(&actuator, &SolverOptions::default()).unwrap();
         let (mut ids, mut status, mut ys, mut t, mut out) = (vec![], vec![], vec![[0.0; 5]; 0], vec![], vec![]);
         for id in 0..243i64 {
@@ -987,7 +987,7 @@ mod picture_tests {
         let dir = std::env::var_os("CABLEMAP_KEEP_MAP").map(std::path::PathBuf::from);
         let tmp = tempfile::tempdir().unwrap();
         let dir = dir.unwrap_or_else(|| tmp.path().to_path_buf());
-        let pictures = write_map(&dir, &map, &Actuator::default(), &SolverOptions::default()).unwrap();
+        let pictures = write_map(&dir, &map, &Rod::default(), &SolverOptions::default()).unwrap();
         assert_eq!(pictures.len(), 1 + 3 * 3 + 1);
         for p in &pictures {
             let img = image::open(dir.join(&p.file)).unwrap().to_rgb8();

@@ -15,7 +15,7 @@ use std::path::Path;
 pub fn write_map_replacing(
     dir: &Path,
     map: &MapData,
-    actuator: &crate::model::Actuator,
+    actuator: &crate::model::Rod,
     solver: &crate::model::SolverOptions,
 ) -> Result<Vec<Picture>, ReduceError> {
     write_dir_replacing(dir, |staging| write_map(staging, map, actuator, solver))
@@ -102,7 +102,7 @@ fn holds_only_map_files(dir: &Path, depth: usize) -> bool {
 pub fn write_map(
     dir: &Path,
     map: &MapData,
-    actuator: &crate::model::Actuator,
+    actuator: &crate::model::Rod,
     solver: &crate::model::SolverOptions,
 ) -> Result<Vec<Picture>, ReduceError> {
     write_map_drawn(dir, map, actuator, &ModeDrawings::of_map(map, actuator, solver))
@@ -113,7 +113,7 @@ pub fn write_map(
 pub fn write_map_drawn(
     dir: &Path,
     map: &MapData,
-    actuator: &crate::model::Actuator,
+    actuator: &crate::model::Rod,
     drawings: &ModeDrawings,
 ) -> Result<Vec<Picture>, ReduceError> {
     std::fs::create_dir_all(dir).map_err(|source| ReduceError::CreateDir { path: dir.to_path_buf(), source })?;

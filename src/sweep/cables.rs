@@ -8,7 +8,7 @@
 //!
 //! ```toml
 //! gravity_direction = [1, 0, 0]   # optional, as in the actuator file
-//! [rod]                            # optional: model::Actuator
+//! [rod]                            # optional: model::Rod
 //! [solver]                         # optional: SpatialOptions
 //! [output]
 //! order = 3                        # a0…a3, a_bend_y0…, a_twist0…
@@ -37,8 +37,8 @@
 //! `output.chunk_routings` routings.
 
 use crate::model::routing::CONTROL_POINTS;
-use crate::model::spatial::{Cable, SpatialActuator, SpatialError, SpatialOptions, SpatialSolver};
-use crate::model::{Actuator, STATUS_OK};
+use crate::model::spatial::{Cable, Actuator, SpatialError, SpatialOptions, SpatialSolver};
+use crate::model::{Rod, STATUS_OK};
 use crate::shape::LengthBasis;
 use super::kind::{ChunkLayout, RunSpec};
 use super::SweepError;
@@ -78,7 +78,7 @@ pub enum CableSweepError {
 pub struct CableSweepSpec {
     /// Rod parameters (thesis defaults).
     #[serde(default)]
-    pub rod: Actuator,
+    pub rod: Rod,
     /// Torsional rigidity, N·mm² (default EI/1.5).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub gj_n_mm2: Option<f64>,
@@ -299,7 +299,7 @@ impl CableSweepSpec {
 
     /// The actuator of routing `id` (mixed radix over the dimensions, the
     /// first fastest), tensions at zero.
-    fn actuator_for(&self, id: u64, dims: &[Dimension]) -> SpatialActuator {
+    fn actuator_for(&self, id: u64, dims: &[Dimension]) -> Actuator {
         let mut cables: Vec<Cable> = self
             .cables
             .iter()
@@ -316,7 +316,7 @@ impl CableSweepSpec {
                 Axis::Z => c.z_mm[d.point] = level,
             }
         }
-        SpatialActuator { rod: self.rod.clone(), gj_n_mm2: self.gj_n_mm2, gravity_direction: self.gravity_direction, cables }
+        Actuator { rod: self.rod.clone(), gj_n_mm2: self.gj_n_mm2, gravity_direction: self.gravity_direction, cables }
     }
 }
 
@@ -436,7 +436,7 @@ impl CableSweepSpec {
     /// Routing `id` and the tensions of its `k`-th combination (grid order):
     /// the actuator of the row with `routing_id = id` at that combination,
     /// e.g. to solve it again.
-    pub fn actuator_at(&self, id: u64, k: usize) -> SpatialActuator {
+    pub fn actuator_at(&self, id: u64, k: usize) -> Actuator {
         let mut actuator = self.actuator_for(id, &self.dimensions());
         let grids = self.tension_grids();
         let mut rest = k;

@@ -3,7 +3,7 @@
 //! are rejected so that a typo never silently falls back to a default.
 //!
 //! ```toml
-//! [actuator]            # model::Actuator; omitted fields keep the thesis values
+//! [actuator]            # model::Rod; omitted fields keep the thesis values
 //! [actuator.gravity]
 //! enabled = true
 //! [solver]              # model::SolverOptions
@@ -24,7 +24,7 @@
 //! ```
 
 use super::SweepError;
-use crate::model::{Actuator, SolverOptions};
+use crate::model::{Rod, SolverOptions};
 use crate::shape::LengthBasis;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
@@ -64,8 +64,8 @@ const ROW_COPIES: u64 = 3;
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
 #[serde(deny_unknown_fields, default)]
 pub struct SweepSpec {
-    /// Actuator parameters and effects.
-    pub actuator: Actuator,
+    /// Rod parameters and effects.
+    pub actuator: Rod,
     /// Numerical settings of the solver.
     pub solver: SolverOptions,
     /// The grid of routings.
@@ -144,7 +144,7 @@ impl Default for OutputSpec {
 pub enum SpecError {
     /// The actuator's parameters.
     #[error("[actuator] {0}")]
-    Actuator(#[source] crate::model::ParameterError),
+    Rod(#[source] crate::model::ParameterError),
     /// Another setting, in its section.
     #[error("[{section}] {message}")]
     Setting {
@@ -190,7 +190,7 @@ impl SweepSpec {
 
     /// Checks every setting; the message names the field and what to do.
     pub fn validate(&self) -> Result<(), SpecError> {
-        self.actuator.validate().map_err(SpecError::Actuator)?;
+        self.actuator.validate().map_err(SpecError::Rod)?;
         // Sizes before anything is allocated for them.
         if self.solver.steps_per_span > MAX_STEPS_PER_SPAN {
             return Err(SpecError::setting("solver", format!("steps_per_span = {} is more than {MAX_STEPS_PER_SPAN}: the solver would need more memory than a \

@@ -4,7 +4,7 @@
 //! layout and writes the map tables (`docs/maps.md`).
 
 use arrow::array::{ArrayRef, Float64Array, Int64Array, RecordBatch, StringArray};
-use cablemap::model::{Actuator, Routing, Simulator, SolverOptions, STATUS_OK};
+use cablemap::model::{Rod, Routing, Simulator, SolverOptions, STATUS_OK};
 use cablemap::reduce::{reduce_batches, tables::write_tables, ReduceOptions, RunInfo};
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, OnceLock};
@@ -28,7 +28,7 @@ pub struct Row {
 
 /// Simulates the sweep: one routing of each mirror pair.
 pub fn simulate_rows() -> Vec<Row> {
-    let actuator = Actuator::default();
+    let actuator = Rod::default();
     let mut sim = Simulator::new(&actuator, &SolverOptions::default()).unwrap();
     let mut rows = Vec::new();
     for id in 0..LEVELS_MM.len().pow(5) {

@@ -1256,11 +1256,11 @@ impl Simulator {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::{Actuator, SolverOptions};
+    use crate::model::{Rod, SolverOptions};
 
     /// The tip, tip angle and a_0 … a_order of a ladder up to `tension` at
     /// `m` intervals, with the tip's and the coefficients' error estimates.
-    fn estimated(a: &Actuator, m: usize, y: &[f64], tension: f64, order: usize) -> Option<([f64; 3], Vec<f64>, f64, f64)> {
+    fn estimated(a: &Rod, m: usize, y: &[f64], tension: f64, order: usize) -> Option<([f64; 3], Vec<f64>, f64, f64)> {
         let mut sim = Simulator::new(a, &SolverOptions { nodes_per_span: m, ..SolverOptions::default() }).ok()?;
         sim.set_routing_mm(y).ok()?;
         let rungs = ((tension / 0.25).ceil() as usize).max(1);
@@ -1302,7 +1302,7 @@ mod tests {
         }
         assert!(checked >= 30, "only {checked} cases solved");
         for gravity in [true, false] {
-            let mut a = Actuator::default();
+            let mut a = Rod::default();
             a.gravity.enabled = gravity;
             for y in crate::bench::sample_thesis_routings(40, 5.0) {
                 let (_, _, tip_error, a_error) = estimated(&a, 10, &y.0, 2.0, 3).unwrap();

@@ -1,6 +1,6 @@
 //! Several cables with spatial routings (issue 16, the thesis's future work).
 //!
-//! An actuator here is the thesis's rod ([`Actuator`]) with 1–8 cables, each
+//! An actuator here is the thesis's rod ([`Rod`]) with 1–8 cables, each
 //! routed along r_c,i(s) = (0, y_i(s), z_i(s)) in the body frame, y and z
 //! each the thesis's five-point parametric B-spline ([`cable`]); torsion
 //! enters with GJ (default EI/1.5: ν = 0.5, incompressible silicone) and
@@ -9,21 +9,17 @@
 //! single-cable solver ([`crate::model::simulate`]) stays the fast path for
 //! planar single-cable work, and the two agree on planar cases.
 
-pub mod cable;
 pub mod record;
 pub mod solver;
 
-pub use cable::{Cable, MAX_CABLES};
+pub use crate::model::cable::{self, Cable, MAX_CABLES};
+pub use crate::model::actuator::{Actuator, EI_OVER_GJ};
 pub use solver::{check_order, SpatialFailure, SpatialNode, SpatialOptions, SpatialPose, SpatialSolver, MAX_SPATIAL_ORDER};
 
 use crate::model::routing::RoutingError;
-use crate::model::{Actuator, ParameterError};
+use crate::model::{Rod, ParameterError};
 use crate::shape::LengthBasis;
-use serde::{Deserialize, Serialize};
-
-/// GJ = EI / this factor when not given: for an isotropic material
-/// GJ/EI = G/E·(J/I) = 2/(2(1 + ν)) = 1/1.5 with ν = 0.5.
-pub const EI_OVER_GJ: f64 = 1.5;
+use serde::Serialize;
 
 /// Why a spatial actuator or solve was rejected.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -82,7 +78,7 @@ pub enum SpatialError {
 
 /// Checks that the 3-D solver models `rod`: valid parameters, a uniform
 /// body, and none of the planar solver's effects.
-fn check_rod(rod: &Actuator) -> Result<(), SpatialError> {
+pub(crate) fn check_rod(rod: &Rod) -> Result<(), SpatialError> {
     rod.validate()?;
     let e = &rod.effects;
     let d = crate::model::Effects::default();
@@ -104,87 +100,11 @@ fn check_rod(rod: &Actuator) -> Result<(), SpatialError> {
     Ok(())
 }
 
-/// A whole spatial actuator: rod, torsion, gravity direction and cables.
-/// This is the `--actuator FILE.toml` format (see docs/schema.md).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct SpatialActuator {
-    /// Rod parameters (thesis defaults); `rod.gravity.direction_rad` is
-    /// ignored when `gravity_direction` is given.
-    #[serde(default)]
-    pub rod: Actuator,
-    /// Torsional rigidity GJ, N·mm²; `None` is EI/1.5.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub gj_n_mm2: Option<f64>,
-    /// Gravity direction in the global frame (any length, normalised);
-    /// `None` takes the planar rod's in-plane direction (cos d, sin d, 0).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub gravity_direction: Option<[f64; 3]>,
-    /// The cables (TOML: `[[cable]]` tables).
-    #[serde(rename = "cable")]
-    pub cables: Vec<Cable>,
-}
-
-impl SpatialActuator {
-    /// The thesis rod with `cables`.
-    pub fn with_cables(rod: Actuator, cables: Vec<Cable>) -> Self {
-        Self { rod, gj_n_mm2: None, gravity_direction: None, cables }
-    }
-
-    /// GJ in use, N·mm².
-    pub fn torsional_rigidity_n_mm2(&self) -> f64 {
-        self.gj_n_mm2.unwrap_or(self.rod.ei_n_mm2 / EI_OVER_GJ)
-    }
-
-    /// Unit gravity direction (global).
-    pub fn gravity_unit(&self) -> Result<[f64; 3], SpatialError> {
-        let g = match self.gravity_direction {
-            Some(g) => g,
-            None => {
-                let d = self.rod.gravity.direction_rad;
-                [d.cos(), d.sin(), 0.0]
-            }
-        };
-        let n = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
-        if !(n.is_finite() && n > 0.0) {
-            return Err(SpatialError::GravityDirection(g));
-        }
-        Ok(g.map(|c| c / n))
-    }
-
-    /// Checks everything and builds the cables' channels.
-    pub fn validate(&self) -> Result<Vec<cable::Channel>, SpatialError> {
-        check_rod(&self.rod)?;
-        if let Some(gj) = self.gj_n_mm2 {
-            if !(gj.is_finite() && gj > 0.0) {
-                return Err(ParameterError::NotPositive { name: "gj_n_mm2", value: gj }.into());
-            }
-            crate::model::actuator::PLAUSIBLE_EI_N_MM2.check("gj_n_mm2", gj)?;
-        }
-        self.gravity_unit()?;
-        cable::validate(&self.rod, &self.cables)
-    }
-
-    /// Reads the TOML format (docs/schema.md); `source` names the file in errors.
-    pub fn from_toml(text: &str, source: &str) -> Result<Self, SpatialError> {
-        toml::from_str(text).map_err(|e| SpatialError::Toml { source_name: source.to_string(), message: e.to_string() })
-    }
-
-    /// Reads and validates an actuator file.
-    pub fn read(path: &std::path::Path) -> Result<Self, SpatialError> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| SpatialError::Read { path: path.display().to_string(), message: e.to_string() })?;
-        let a = Self::from_toml(&text, &path.display().to_string())?;
-        a.validate()?;
-        Ok(a)
-    }
-}
-
 /// Everything about one spatial solve (allocates; for single solves).
 #[derive(Debug, Clone, Serialize)]
 pub struct SpatialSimulation {
     /// The actuator solved (its tensions are the final ones).
-    pub actuator: SpatialActuator,
+    pub actuator: Actuator,
     /// Tip pose and length.
     pub pose: SpatialPose,
     /// Legendre coefficients of the twist u_1, a_0 … a_order, 1/mm.
@@ -233,7 +153,7 @@ impl SpatialSimulation {
 /// solve is refused as unresolved. A tip farther from the clamp than the
 /// stretched rod is long is refused too.
 pub fn simulate_spatial(
-    actuator: &SpatialActuator,
+    actuator: &Actuator,
     options: &SpatialOptions,
     order: usize,
     basis: LengthBasis,
@@ -307,7 +227,7 @@ fn unresolved_part(fine: &SpatialSimulation, coarse: &SpatialSimulation, steps: 
 
 /// One ladder of [`simulate_spatial`] at `options`' steps, without the
 /// resolution check (but refusing non-finite results).
-fn solve_ladder(actuator: &SpatialActuator, options: &SpatialOptions, order: usize, basis: LengthBasis) -> Result<SpatialSimulation, SpatialError> {
+fn solve_ladder(actuator: &Actuator, options: &SpatialOptions, order: usize, basis: LengthBasis) -> Result<SpatialSimulation, SpatialError> {
     let mut solver = SpatialSolver::new(actuator, options)?;
     let top = actuator.cables.iter().map(|c| c.tension_n).fold(0.0, f64::max);
     let rungs = ((top / 0.25).ceil() as usize).max(1);

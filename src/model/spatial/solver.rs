@@ -44,8 +44,8 @@
 //! series uses u_1, the torsion of the body frame.
 
 use super::cable::{Channel, ChannelPoint3};
-use super::{SpatialActuator, SpatialError};
-use crate::model::Actuator;
+use super::{Actuator, SpatialError};
+use crate::model::Rod;
 use crate::shape::LengthBasis;
 use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
 use serde::{Deserialize, Serialize};
@@ -233,7 +233,7 @@ struct Local {
 /// Reusable spatial solver for one actuator: set the cables, then solve.
 #[derive(Debug, Clone)]
 pub struct SpatialSolver {
-    rod: Actuator,
+    rod: Rod,
     stiff: [f64; 6],
     /// Weight per unit rest length along the gravity direction, N/mm (global vector).
     weight: V3,
@@ -270,7 +270,7 @@ pub struct SpatialSolver {
 
 impl SpatialSolver {
     /// A solver for `actuator` (its cables, rod, torsion and gravity).
-    pub fn new(actuator: &SpatialActuator, options: &SpatialOptions) -> Result<Self, SpatialError> {
+    pub fn new(actuator: &Actuator, options: &SpatialOptions) -> Result<Self, SpatialError> {
         let channels = actuator.validate()?;
         if options.steps_per_span < 2 {
             return Err(SpatialError::Option(format!("steps_per_span = {} must be at least 2", options.steps_per_span)));
@@ -340,7 +340,7 @@ impl SpatialSolver {
     }
 
     /// The rod parameters.
-    pub fn rod(&self) -> &Actuator {
+    pub fn rod(&self) -> &Rod {
         &self.rod
     }
 

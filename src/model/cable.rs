@@ -6,9 +6,9 @@
 //! is one parametric space curve r_c(s) = (0, y_c(s), z_c(s)) in the body
 //! frame. z ≡ 0 is today's planar routing.
 
-use super::SpatialError;
+use crate::model::spatial::SpatialError;
 use crate::model::routing::{ChannelPoint, Routing, CONTROL_POINTS};
-use crate::model::Actuator;
+use crate::model::Rod;
 use serde::{Deserialize, Serialize};
 
 /// Most cables an actuator may have.
@@ -103,7 +103,7 @@ impl Channel {
 /// coordinate, not the distance); an anchor outside (0, L]; two cables on
 /// the same path (identical control points: the spline is linear in them, so
 /// this is exactly "the same curve").
-pub fn validate(actuator: &Actuator, cables: &[Cable]) -> Result<Vec<Channel>, SpatialError> {
+pub fn validate(actuator: &Rod, cables: &[Cable]) -> Result<Vec<Channel>, SpatialError> {
     if cables.is_empty() || cables.len() > MAX_CABLES {
         return Err(SpatialError::CableCount(cables.len()));
     }
@@ -145,8 +145,8 @@ pub fn validate(actuator: &Actuator, cables: &[Cable]) -> Result<Vec<Channel>, S
 mod tests {
     use super::*;
 
-    fn rod() -> Actuator {
-        Actuator::default()
+    fn rod() -> Rod {
+        Rod::default()
     }
 
     #[test]
