@@ -386,6 +386,42 @@ pub fn legendre(i: usize, t: f64) -> f64 {
     p
 }
 
+/// The shifted Legendre polynomials P_i(2x − 1), i = 0 … `order`, in powers
+/// of x: row i holds the coefficients of x^0 … x^i. From the same
+/// three-term recurrence as [`legendre`], on coefficient vectors:
+/// (k + 1) P_{k+1} = (2k + 1)(2x − 1) P_k − k P_{k−1}. The coefficients are
+/// integers, (−1)^(i+j) C(i, j) C(i + j, j), and come out exact in f64
+/// (checked to order 20).
+/// For quadratures that accumulate ∫ x^j f before the interval's length is
+/// known (the 3-D solver's coefficient moments).
+pub fn shifted_legendre_powers(order: usize) -> Vec<Vec<f64>> {
+    let mut rows: Vec<Vec<f64>> = Vec::with_capacity(order + 1);
+    for i in 0..=order {
+        let row = match i {
+            0 => vec![1.0],
+            _ => {
+                let k = (i - 1) as f64;
+                let p = &rows[i - 1];
+                let mut next = vec![0.0; i + 1];
+                // (2k + 1)(2x − 1) P_k
+                for (j, &c) in p.iter().enumerate() {
+                    next[j + 1] += (2.0 * k + 1.0) * 2.0 * c;
+                    next[j] -= (2.0 * k + 1.0) * c;
+                }
+                if i >= 2 {
+                    for (n, &c) in next.iter_mut().zip(&rows[i - 2]) {
+                        *n -= k * c;
+                    }
+                }
+                next.iter_mut().for_each(|n| *n /= k + 1.0);
+                next
+            }
+        };
+        rows.push(row);
+    }
+    rows
+}
+
 /// Builds a centreline with curvature κ(t) = Σ a_i P_i(t) over length ℓ from
 /// base angle θ_0, sampled at `points` points evenly in arc length. Used to
 /// make known shapes (tests, synthetic data); positions are integrated with
@@ -432,6 +468,27 @@ pub fn centreline_from_coefficients(a: &[f64], length_mm: f64, base_angle_rad: f
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn shifted_legendre_powers_are_the_closed_form_and_the_polynomials() {
+        let binom = |n: usize, k: usize| (0..k).fold(1u128, |acc, m| acc * (n - m) as u128 / (m + 1) as u128);
+        let rows = shifted_legendre_powers(20);
+        assert_eq!(rows.len(), 21);
+        for (i, row) in rows.iter().enumerate() {
+            assert_eq!(row.len(), i + 1);
+            for (j, &c) in row.iter().enumerate() {
+                let magnitude = (binom(i, j) * binom(i + j, j)) as f64;
+                assert_eq!(c, if (i + j) % 2 == 0 { magnitude } else { -magnitude }, "P_{i}, x^{j}");
+            }
+            if i <= 8 {
+                for k in 0..=20 {
+                    let x = k as f64 / 20.0;
+                    let poly: f64 = row.iter().enumerate().map(|(j, c)| c * x.powi(j as i32)).sum();
+                    assert!((poly - legendre(i, 2.0 * x - 1.0)).abs() < 1e-9, "P_{i}({x})");
+                }
+            }
+        }
+    }
 
     #[test]
     fn rest_basis_is_the_default_and_scales_by_deformed_over_rest_length() {
