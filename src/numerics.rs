@@ -13,6 +13,13 @@
 /// Fractions c_i of the step at which the four stages are evaluated.
 const STAGE_FRACTIONS: [f64; 4] = [0.0, 0.5, 0.5, 1.0];
 
+/// The same in half steps, for callers that sample their data on a grid of
+/// half steps.
+const STAGE_HALF_STEPS: [usize; 4] = [0, 1, 1, 2];
+
+/// The stages' weights b_i in sixths.
+const STAGE_WEIGHTS_SIXTHS: [f64; 4] = [1.0, 2.0, 2.0, 1.0];
+
 /// One stage of a classical RK4 step, as the derivative closure sees it.
 #[derive(Debug)]
 pub struct Rk4Stage<'a, const N: usize> {
@@ -21,6 +28,11 @@ pub struct Rk4Stage<'a, const N: usize> {
     /// c_i h: the stage's distance from the start of the step, in the
     /// integration variable's unit (0, h/2, h/2, h).
     pub offset: f64,
+    /// The same in half steps (0, 1, 1, 2).
+    pub half_steps: usize,
+    /// The stage's weight b_i in sixths (1, 2, 2, 1): h/6 Σ weight·g(stage)
+    /// is the step's quadrature of a quantity g, consistent with the step.
+    pub weight_sixths: f64,
     /// The state at the stage: y + c_i h k_{i−1} (y itself at stage 0).
     pub state: &'a [f64; N],
     /// k_{i−1}, the derivative the stage state was stepped along (zeros at
@@ -71,10 +83,19 @@ pub fn rk4_step<const N: usize, E>(
                 *s = y0 + offset * d;
             }
         }
-        derivative(&Rk4Stage { index, offset, state: stage, slope }, &mut rest[0])?;
+        let stage = Rk4Stage {
+            index,
+            offset,
+            half_steps: STAGE_HALF_STEPS[index],
+            weight_sixths: STAGE_WEIGHTS_SIXTHS[index],
+            state: stage,
+            slope,
+        };
+        derivative(&stage, &mut rest[0])?;
     }
+    let w = STAGE_WEIGHTS_SIXTHS;
     for (j, value) in y.iter_mut().enumerate() {
-        *value += h / 6.0 * (k[0][j] + 2.0 * k[1][j] + 2.0 * k[2][j] + k[3][j]);
+        *value += h / 6.0 * (w[0] * k[0][j] + w[1] * k[1][j] + w[2] * k[2][j] + w[3] * k[3][j]);
     }
     Ok(())
 }
@@ -94,6 +115,8 @@ mod tests {
             for _ in 0..steps {
                 rk4_step(&mut y, h, &mut scratch, |stage, dy| {
                     assert_eq!(stage.offset, [0.0, 0.5, 0.5, 1.0][stage.index] * h);
+                    assert_eq!(stage.offset, stage.half_steps as f64 * 0.5 * h);
+                    assert_eq!(stage.weight_sixths, [1.0, 2.0, 2.0, 1.0][stage.index]);
                     if stage.index == 0 {
                         assert_eq!(stage.slope, &[0.0; 2]);
                     }

@@ -220,7 +220,7 @@ impl Simulator {
                 let trig = st.phi.sin_cos();
                 let mut y = st.to_array();
                 rk4_step(&mut y, h, &mut scratch, |stage, dy| {
-                    let point = k + stride * [0, 1, 1, 2][stage.index];
+                    let point = k + stride * stage.half_steps;
                     let stage_trig = if stage.index == 0 { trig } else { rotate_sin_cos(trig, stage.offset * stage.slope[PHI]) };
                     let stage_state = State::from_array(*stage.state);
                     let (d, e) = self.derivative(s + stage.offset, point, &stage_state, stage_trig, tension)?;

@@ -520,15 +520,15 @@ impl SpatialSolver {
                     rk4_step(&mut y, h, &mut scratch, |stage, dy| {
                         let i = stage.index;
                         let ys = stage.state;
-                        let (f, l) = self.deriv(seg, k0 + [0, 1, 1, 2][i], slot + i, ys)?;
+                        let (f, l) = self.deriv(seg, k0 + stage.half_steps, slot + i, ys)?;
                         if i == 0 {
                             self.record(s0, ys, &l.x);
                         }
                         if self.with_kappa {
                             // RK4 quadrature of the moments with the stage values.
-                            let (x, wgt) = (ys[10] / length, [1.0, 2.0, 2.0, 1.0][i]);
+                            let x = ys[10] / length;
                             for (series, kappa) in moments.iter_mut().zip([l.x[3], l.kappa[1], l.kappa[2]]) {
-                                let mut pw = wgt * h / 6.0 * kappa;
+                                let mut pw = stage.weight_sixths * h / 6.0 * kappa;
                                 for c in series.iter_mut() {
                                     *c += pw;
                                     pw *= x;
