@@ -146,18 +146,51 @@ impl ShapeCoefficients {
     }
 }
 
-/// Legendre polynomials P_0..P_{n−1} and their derivatives at `t`, by the
-/// three-term recurrence (and P'_{k+1} = P'_{k−1} + (2k+1) P_k).
-#[inline]
-fn legendre_with_derivative(t: f64, k: usize, p_prev: &mut f64, p: &mut f64, dp_prev: &mut f64, dp: &mut f64) {
-    // Advance (P_{k−1}, P_k) → (P_k, P_{k+1}), likewise for derivatives.
-    let kf = k as f64;
-    let p_next = ((2.0 * kf + 1.0) * t * *p - kf * *p_prev) / (kf + 1.0);
-    let dp_next = *dp_prev + (2.0 * kf + 1.0) * *p;
-    *p_prev = *p;
-    *p = p_next;
-    *dp_prev = *dp;
-    *dp = dp_next;
+/// Legendre polynomials P_0, P_1, … and their derivatives at one point t,
+/// one order after the other by the three-term recurrence
+/// (k + 1) P_{k+1} = (2k + 1) t P_k − k P_{k−1} and
+/// P'_{k+1} = P'_{k−1} + (2k + 1) P_k. The one Legendre recurrence of the
+/// crate: quadratures over all orders at a sample advance it in their loop
+/// over orders (no allocation), [`legendre`] runs it to one order.
+#[derive(Debug, Clone, Copy)]
+pub struct LegendreSeries {
+    t: f64,
+    /// The current order k.
+    order: usize,
+    p_prev: f64,
+    p: f64,
+    dp_prev: f64,
+    dp: f64,
+}
+
+impl LegendreSeries {
+    /// P_0(t) = 1, P_0'(t) = 0.
+    #[inline]
+    pub fn new(t: f64) -> Self {
+        Self { t, order: 0, p_prev: 0.0, p: 1.0, dp_prev: 0.0, dp: 0.0 }
+    }
+
+    /// Moves from order k to k + 1.
+    #[inline]
+    pub fn advance(&mut self) {
+        let kf = self.order as f64;
+        let p_next = ((2.0 * kf + 1.0) * self.t * self.p - kf * self.p_prev) / (kf + 1.0);
+        let dp_next = self.dp_prev + (2.0 * kf + 1.0) * self.p;
+        (self.p_prev, self.p, self.dp_prev, self.dp) = (self.p, p_next, self.dp, dp_next);
+        self.order += 1;
+    }
+
+    /// P_k(t) at the current order k.
+    #[inline]
+    pub fn value(&self) -> f64 {
+        self.p
+    }
+
+    /// P_k'(t) at the current order k.
+    #[inline]
+    pub fn derivative(&self) -> f64 {
+        self.dp
+    }
 }
 
 /// Composite Simpson weight of sample `i` of `n` (3/8 rule on the last three
@@ -202,12 +235,12 @@ pub fn legendre_from_tangent(theta: &[f64], sigma: &[f64], speed: &[f64], h: f64
     for k in 0..n {
         let t = 2.0 * (sigma[k] - sigma[0]) / length - 1.0;
         let weight = quadrature_weight(k, n) * h * theta[k] * 2.0 * speed[k] / length;
-        let (mut p_prev, mut p, mut dp_prev, mut dp) = (0.0, 1.0, 0.0, 0.0);
+        let mut legendre = LegendreSeries::new(t);
         for (i, a) in out.iter_mut().enumerate() {
             if i > 0 {
-                legendre_with_derivative(t, i - 1, &mut p_prev, &mut p, &mut dp_prev, &mut dp);
+                legendre.advance();
             }
-            *a += weight * dp;
+            *a += weight * legendre.derivative();
         }
     }
     let (theta0, theta_e) = (theta[0], theta[n - 1]);
@@ -376,14 +409,47 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 
 /// Legendre polynomial P_i(t).
 pub fn legendre(i: usize, t: f64) -> f64 {
-    let (mut p_prev, mut p) = (0.0, 1.0);
-    for k in 0..i {
-        let kf = k as f64;
-        let next = ((2.0 * kf + 1.0) * t * p - kf * p_prev) / (kf + 1.0);
-        p_prev = p;
-        p = next;
+    let mut series = LegendreSeries::new(t);
+    for _ in 0..i {
+        series.advance();
     }
-    p
+    series.value()
+}
+
+/// The shifted Legendre polynomials P_i(2x − 1), i = 0 … `order`, in powers
+/// of x: row i holds the coefficients of x^0 … x^i. From the same
+/// three-term recurrence as [`legendre`], on coefficient vectors:
+/// (k + 1) P_{k+1} = (2k + 1)(2x − 1) P_k − k P_{k−1}. The coefficients are
+/// integers, (−1)^(i+j) C(i, j) C(i + j, j), and come out exact in f64
+/// (checked to order 20).
+/// For quadratures that accumulate ∫ x^j f before the interval's length is
+/// known (the 3-D solver's coefficient moments).
+pub fn shifted_legendre_powers(order: usize) -> Vec<Vec<f64>> {
+    let mut rows: Vec<Vec<f64>> = Vec::with_capacity(order + 1);
+    for i in 0..=order {
+        let row = match i {
+            0 => vec![1.0],
+            _ => {
+                let k = (i - 1) as f64;
+                let p = &rows[i - 1];
+                let mut next = vec![0.0; i + 1];
+                // (2k + 1)(2x − 1) P_k
+                for (j, &c) in p.iter().enumerate() {
+                    next[j + 1] += (2.0 * k + 1.0) * 2.0 * c;
+                    next[j] -= (2.0 * k + 1.0) * c;
+                }
+                if i >= 2 {
+                    for (n, &c) in next.iter_mut().zip(&rows[i - 2]) {
+                        *n -= k * c;
+                    }
+                }
+                next.iter_mut().for_each(|n| *n /= k + 1.0);
+                next
+            }
+        };
+        rows.push(row);
+    }
+    rows
 }
 
 /// Builds a centreline with curvature κ(t) = Σ a_i P_i(t) over length ℓ from
@@ -432,6 +498,27 @@ pub fn centreline_from_coefficients(a: &[f64], length_mm: f64, base_angle_rad: f
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn shifted_legendre_powers_are_the_closed_form_and_the_polynomials() {
+        let binom = |n: usize, k: usize| (0..k).fold(1u128, |acc, m| acc * (n - m) as u128 / (m + 1) as u128);
+        let rows = shifted_legendre_powers(20);
+        assert_eq!(rows.len(), 21);
+        for (i, row) in rows.iter().enumerate() {
+            assert_eq!(row.len(), i + 1);
+            for (j, &c) in row.iter().enumerate() {
+                let magnitude = (binom(i, j) * binom(i + j, j)) as f64;
+                assert_eq!(c, if (i + j) % 2 == 0 { magnitude } else { -magnitude }, "P_{i}, x^{j}");
+            }
+            if i <= 8 {
+                for k in 0..=20 {
+                    let x = k as f64 / 20.0;
+                    let poly: f64 = row.iter().enumerate().map(|(j, c)| c * x.powi(j as i32)).sum();
+                    assert!((poly - legendre(i, 2.0 * x - 1.0)).abs() < 1e-9, "P_{i}({x})");
+                }
+            }
+        }
+    }
 
     #[test]
     fn rest_basis_is_the_default_and_scales_by_deformed_over_rest_length() {

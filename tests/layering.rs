@@ -76,3 +76,174 @@ fn only_the_top_returns_the_top_level_error() {
         assert!(!code.contains("crate::Error"), "src/{file} uses the top-level crate::Error: return the layer's own error enum");
     }
 }
+
+/// Every source file under src/ (the binary's too), test modules and
+/// `//` comments cut off, as (path from src/, code).
+fn code_without_comments() -> Vec<(String, String)> {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut files = Vec::new();
+    rust_files(&src, &mut files);
+    files
+        .into_iter()
+        .map(|p| {
+            let text = std::fs::read_to_string(&p).unwrap();
+            let text = match text.find("#[cfg(test)]") {
+                Some(i) => &text[..i],
+                None => &text[..],
+            };
+            let code: Vec<&str> = text.lines().map(|l| l.find("//").map_or(l, |i| &l[..i])).collect();
+            (p.strip_prefix(&src).unwrap().display().to_string(), code.join("\n"))
+        })
+        .collect()
+}
+
+/// The names the code defines: identifiers after `fn`, `struct`, `enum`,
+/// `type`, `trait`, `const`, `static` and `mod`.
+fn defined_names(code: &str) -> Vec<String> {
+    let words: Vec<&str> = code.split(|c: char| !(c.is_alphanumeric() || c == '_')).filter(|w| !w.is_empty()).collect();
+    words
+        .windows(2)
+        .filter(|w| ["fn", "struct", "enum", "type", "trait", "const", "static", "mod"].contains(&w[0]))
+        .map(|w| w[1].to_string())
+        .collect()
+}
+
+/// The words of an identifier, lowercase: `Lu6Factors` → lu, 6, factors;
+/// `lu_solve` → lu, solve.
+fn name_words(name: &str) -> Vec<String> {
+    let mut words = Vec::new();
+    let mut word = String::new();
+    let mut previous: Option<char> = None;
+    for c in name.chars() {
+        let boundary = c == '_'
+            || previous.is_some_and(|p| (p.is_lowercase() && c.is_uppercase()) || (p.is_ascii_digit() != c.is_ascii_digit()));
+        if boundary && !word.is_empty() {
+            words.push(std::mem::take(&mut word));
+        }
+        if c != '_' {
+            word.extend(c.to_lowercase());
+        }
+        previous = Some(c);
+    }
+    if !word.is_empty() {
+        words.push(word);
+    }
+    words
+}
+
+/// The code with all whitespace removed, so that a pattern matches however
+/// it is formatted.
+fn squeezed(code: &str) -> String {
+    code.chars().filter(|c| !c.is_whitespace()).collect()
+}
+
+/// `count` or more non-overlapping occurrences of `needle` in
+/// `text[at..at + window]` (clamped to char boundaries).
+fn occurs_near(text: &str, at: usize, window: usize, needle: &str, count: usize) -> bool {
+    let mut end = (at + window).min(text.len());
+    while !text.is_char_boundary(end) {
+        end -= 1;
+    }
+    text[at..end].matches(needle).count() >= count
+}
+
+#[test]
+fn the_rk4_step_is_written_once() {
+    // Owner: src/numerics.rs. The tableau's combination of the stages,
+    // h/6 (k1 + 2 k2 + 2 k3 + k4) or with weights 1/6, 1/3, in any layout.
+    let mut problems = Vec::new();
+    for (file, code) in code_without_comments() {
+        if file == "numerics.rs" {
+            continue;
+        }
+        let text = squeezed(&code);
+        for (at, _) in text.match_indices("/6.0") {
+            let mut from = at.saturating_sub(80);
+            while !text.is_char_boundary(from) {
+                from -= 1;
+            }
+            let weights = occurs_near(&text, from, 160, "+2.0*", 2) || occurs_near(&text, from, 160, "+2.0*(", 1);
+            let thirds = occurs_near(&text, from, 160, "1.0/3.0", 1) && occurs_near(&text, from, 160, "1.0/6.0", 1);
+            let mut to = (at + 80).min(text.len());
+            while !text.is_char_boundary(to) {
+                to -= 1;
+            }
+            if weights || thirds {
+                problems.push(format!(
+                    "src/{file} combines RK4 stages itself (near `{}`): step with crate::numerics::rk4_step",
+                    &text[from..to]
+                ));
+            }
+        }
+        for name in defined_names(&code) {
+            let words = name_words(&name);
+            let stepper = words.iter().any(|w| w == "runge" || w == "kutta")
+                || (words.iter().any(|w| w == "rk4" || w == "rk") && words.iter().any(|w| w == "step" || w == "stage" || w == "stages"));
+            if stepper {
+                problems.push(format!("src/{file} defines `{name}`: RK4 steps belong to crate::numerics (rk4_step)"));
+            }
+        }
+    }
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+}
+
+#[test]
+fn linear_systems_use_nalgebra_not_a_hand_written_lu() {
+    // Owner: nalgebra (`Matrix::lu`, `full_piv_lu`, `cholesky`, ...).
+    let mut problems = Vec::new();
+    for (file, code) in code_without_comments() {
+        for name in defined_names(&code) {
+            let words = name_words(&name);
+            let lu = words.iter().any(|w| ["lu", "lup", "plu", "gauss", "gaussian", "pivot", "pivots", "pivoting", "elimination", "eliminate"].contains(&w.as_str()));
+            if lu {
+                problems.push(format!("src/{file} defines `{name}`: factor matrices with nalgebra (`.lu()`, `.full_piv_lu()`), not by hand"));
+            }
+        }
+        let words: Vec<&str> = code.split(|c: char| !(c.is_alphanumeric() || c == '_')).collect();
+        for pivot in ["piv", "pivot", "pivots", "pivot_row", "ipiv"] {
+            if words.contains(&pivot) {
+                problems.push(format!(
+                    "src/{file} uses `{pivot}`: row pivoting means a hand-written LU; factor with nalgebra (`.lu()`) instead"
+                ));
+            }
+        }
+    }
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+}
+
+#[test]
+fn legendre_polynomials_are_written_once() {
+    // Owner: src/shape.rs (legendre, shifted_legendre_powers, ...).
+    let mut problems = Vec::new();
+    for (file, code) in code_without_comments() {
+        if file == "shape.rs" {
+            continue;
+        }
+        for name in defined_names(&code) {
+            if name.to_lowercase().contains("legendre") {
+                problems.push(format!(
+                    "src/{file} defines `{name}`: Legendre polynomials belong to src/shape.rs (legendre, shifted_legendre_powers)"
+                ));
+            }
+        }
+        // Bonnet's recurrence ((2k + 1) t P_k − k P_{k−1}) / (k + 1), in
+        // f64 or integer spelling.
+        let text = squeezed(&code);
+        for (at, _) in text.match_indices("(2.0*").chain(text.match_indices("(2*")) {
+            let rest = &text[at..];
+            let var: String = rest.split('*').nth(1).unwrap_or("").chars().take_while(|c| c.is_alphanumeric() || *c == '_').collect();
+            if var.is_empty() {
+                continue;
+            }
+            let division = [format!("/({var}+1.0)"), format!("/({var}+1)asf64"), format!("/(({var}+1)asf64)")];
+            let window: String = rest.chars().take(160).collect();
+            if division.iter().any(|d| window.contains(d.as_str())) {
+                problems.push(format!(
+                    "src/{file} has a three-term recurrence in `{var}` (near `{}`): Legendre polynomials belong to src/shape.rs",
+                    window.chars().take(80).collect::<String>()
+                ));
+            }
+        }
+    }
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+}

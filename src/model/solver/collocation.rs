@@ -1165,15 +1165,12 @@ impl Simulator {
                     *w = c.tail[r * np + j] * value;
                 }
                 let t = 2.0 * c.sigma[i] / ell - 1.0;
-                // P_n and P_n' by the three-term recurrence.
-                let (mut p_prev, mut p, mut dp_prev, mut dp) = (0.0, 1.0, 0.0, 0.0);
+                let mut legendre = crate::shape::LegendreSeries::new(t);
                 for (n, a) in out.iter_mut().enumerate() {
                     if n > 0 {
-                        let k = (n - 1) as f64;
-                        let p_next = ((2.0 * k + 1.0) * t * p - k * p_prev) / (k + 1.0);
-                        let dp_next = dp_prev + (2.0 * k + 1.0) * p;
-                        (p_prev, p, dp_prev, dp) = (p, p_next, dp, dp_next);
+                        legendre.advance();
                     }
+                    let dp = legendre.derivative();
                     match sums.get_mut(n) {
                         Some(sum) => sum.iter_mut().zip(&weights).for_each(|(acc, w)| *acc += w * dp),
                         None => *a += weights[0] * dp,

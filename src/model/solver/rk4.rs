@@ -10,8 +10,8 @@ use super::{
     bending_moment, friction, rotate, CentrelinePoint, ChannelSample, Routing, Simulator, SolveFailure, Strains, TipPose,
     CLAMP_MAX_ITERATIONS, CLAMP_TOLERANCE_RAD,
 };
+use crate::numerics::{rk4_step, Rk4Scratch};
 use crate::shape::{self, LengthBasis};
-
 
 /// Integration state: position, frame angle, gravity's distal moment, arc length.
 #[derive(Debug, Clone, Copy, Default)]
@@ -23,15 +23,19 @@ struct State {
     sigma: f64,
 }
 
+/// Position of φ in [`State::to_array`] (the stepper's state).
+const PHI: usize = 2;
+
 impl State {
-    fn axpy(self, h: f64, d: &State) -> State {
-        State {
-            x: self.x + h * d.x,
-            y: self.y + h * d.y,
-            phi: self.phi + h * d.phi,
-            moment: self.moment + h * d.moment,
-            sigma: self.sigma + h * d.sigma,
-        }
+    /// The state as the shared RK4 stepper's array: x, y, φ, moment, σ.
+    #[inline]
+    fn to_array(self) -> [f64; 5] {
+        [self.x, self.y, self.phi, self.moment, self.sigma]
+    }
+    /// The inverse of [`State::to_array`].
+    #[inline]
+    fn from_array([x, y, phi, moment, sigma]: [f64; 5]) -> State {
+        State { x, y, phi, moment, sigma }
     }
     fn is_finite(&self) -> bool {
         self.x.is_finite() && self.y.is_finite() && self.phi.is_finite() && self.moment.is_finite() && self.sigma.is_finite()
@@ -205,6 +209,7 @@ impl Simulator {
         let n = self.options.steps_per_span;
         let record = stride == 1;
         let mut st = State { phi: self.clamp_angle(moment0, tension)?, moment: moment0, ..State::default() };
+        let mut scratch = Rk4Scratch::default();
         for span in 0..2 {
             let h = self.rk4.step_mm[span] * stride as f64;
             let base = span * (2 * n + 1);
@@ -213,27 +218,25 @@ impl Simulator {
                 let k = base + 2 * stride * step;
                 // One sin/cos per step; the stages rotate it by small angles.
                 let trig = st.phi.sin_cos();
-                let (d1, e1) = self.derivative(s, k, &st, trig, tension)?;
-                if record {
-                    let node = span * n + step;
-                    self.rk4.nodes_state[node] = st;
-                    self.rk4.nodes_strain[node] = e1;
-                } else {
-                    self.rk4.record_coarse(span * (n / stride) + step, &st, &e1);
-                }
-                let s2 = st.axpy(0.5 * h, &d1);
-                let (d2, _) = self.derivative(s + 0.5 * h, k + stride, &s2, rotate_sin_cos(trig, 0.5 * h * d1.phi), tension)?;
-                let s3 = st.axpy(0.5 * h, &d2);
-                let (d3, _) = self.derivative(s + 0.5 * h, k + stride, &s3, rotate_sin_cos(trig, 0.5 * h * d2.phi), tension)?;
-                let s4 = st.axpy(h, &d3);
-                let (d4, _) = self.derivative(s + h, k + 2 * stride, &s4, rotate_sin_cos(trig, h * d3.phi), tension)?;
-                st = State {
-                    x: st.x + h / 6.0 * (d1.x + 2.0 * d2.x + 2.0 * d3.x + d4.x),
-                    y: st.y + h / 6.0 * (d1.y + 2.0 * d2.y + 2.0 * d3.y + d4.y),
-                    phi: st.phi + h / 6.0 * (d1.phi + 2.0 * d2.phi + 2.0 * d3.phi + d4.phi),
-                    moment: st.moment + h / 6.0 * (d1.moment + 2.0 * d2.moment + 2.0 * d3.moment + d4.moment),
-                    sigma: st.sigma + h / 6.0 * (d1.sigma + 2.0 * d2.sigma + 2.0 * d3.sigma + d4.sigma),
-                };
+                let mut y = st.to_array();
+                rk4_step(&mut y, h, &mut scratch, |stage, dy| {
+                    let point = k + stride * stage.half_steps;
+                    let stage_trig = if stage.index == 0 { trig } else { rotate_sin_cos(trig, stage.offset * stage.slope[PHI]) };
+                    let stage_state = State::from_array(*stage.state);
+                    let (d, e) = self.derivative(s + stage.offset, point, &stage_state, stage_trig, tension)?;
+                    if stage.index == 0 {
+                        if record {
+                            let node = span * n + step;
+                            self.rk4.nodes_state[node] = stage_state;
+                            self.rk4.nodes_strain[node] = e;
+                        } else {
+                            self.rk4.record_coarse(span * (n / stride) + step, &stage_state, &e);
+                        }
+                    }
+                    *dy = d.to_array();
+                    Ok(())
+                })?;
+                st = State::from_array(y);
                 if !st.is_finite() {
                     return Err(SolveFailure::NonFinite { s_mm: s + h });
                 }

@@ -46,12 +46,15 @@
 use super::cable::{Channel, ChannelPoint3};
 use super::{Actuator, SpatialError};
 use crate::model::Rod;
-use crate::shape::LengthBasis;
-use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
+use crate::numerics::{rk4_step, Rk4Scratch};
+use crate::shape::{self, LengthBasis};
+use nalgebra::{Matrix3, Matrix6, Quaternion, UnitQuaternion, Vector3, Vector6, LU, U6};
 use serde::{Deserialize, Serialize};
 
 type V3 = Vector3<f64>;
 type M3 = Matrix3<f64>;
+/// LU factors (partial pivoting) of a cut-equation Jacobian.
+type Factors = LU<f64, U6, U6>;
 
 /// A gravity pass started from a moment residual below this (N·mm) is
 /// expected to be the last (Broyden cuts the residual by 100× or more per
@@ -259,8 +262,9 @@ pub struct SpatialSolver {
     moments: [[f64; MAX_SPATIAL_ORDER + 1]; 3],
     /// Whether `moments` belong to the last solve.
     moments_valid: bool,
-    /// Newton's last factors per warm-start slot, for chord passes.
-    lus: Vec<Lu6>,
+    /// Newton's last factors per warm-start slot, for chord passes (`None`
+    /// until a Newton solve there, and after a failed solve).
+    lus: Vec<Option<Factors>>,
     /// This pass reuses `lus` (simplified Newton).
     chord: bool,
     /// This pass computes the curvature vector and the coefficient moments.
@@ -332,7 +336,7 @@ impl SpatialSolver {
             nodes: Vec::new(),
             moments: [[0.0; MAX_SPATIAL_ORDER + 1]; 3],
             moments_valid: false,
-            lus: vec![Lu6::default(); 4 * step0 + cuts.len()],
+            lus: vec![None; 4 * step0 + cuts.len()],
             chord: false,
             with_kappa: false,
             last: None,
@@ -373,7 +377,7 @@ impl SpatialSolver {
             self.history.clear();
             // A failed solve leaves no sensible warm start.
             self.warm.iter_mut().for_each(|w| *w = [1.0, 0.0, 0.0, 0.0, 0.0, 0.0]);
-            self.lus.iter_mut().for_each(|l| l.valid = false);
+            self.lus.iter_mut().for_each(|l| *l = None);
             self.chord = false;
             self.moments_valid = false;
             self.m0 = V3::zeros();
@@ -505,34 +509,35 @@ impl SpatialSolver {
         self.nodes.clear();
         let mut tip = [0.0; 6];
         let segments = std::mem::take(&mut self.segments);
+        let mut scratch = Rk4Scratch::default();
         let result = (|| {
             for (si, seg) in segments.iter().enumerate() {
                 let h = seg.h_mm;
                 for j in 0..seg.steps {
                     let k0 = seg.point0 + 2 * j;
                     let slot = 4 * (seg.step0 + j);
-                    let (f1, l1) = self.deriv(seg, k0, slot, &y)?;
-                    self.record(seg.start_mm + j as f64 * h, &y, &l1.x);
-                    let y2 = axpy(&y, 0.5 * h, &f1);
-                    let (f2, l2) = self.deriv(seg, k0 + 1, slot + 1, &y2)?;
-                    let y3 = axpy(&y, 0.5 * h, &f2);
-                    let (f3, l3) = self.deriv(seg, k0 + 1, slot + 2, &y3)?;
-                    let y4 = axpy(&y, h, &f3);
-                    let (f4, l4) = self.deriv(seg, k0 + 2, slot + 3, &y4)?;
-                    let stages = [(&y, &l1, 1.0), (&y2, &l2, 2.0), (&y3, &l3, 2.0), (&y4, &l4, 1.0)];
-                    for (ys, l, wgt) in stages.into_iter().filter(|_| self.with_kappa) {
-                        let x = ys[10] / length;
-                        for (series, kappa) in moments.iter_mut().zip([l.x[3], l.kappa[1], l.kappa[2]]) {
-                            let mut pw = wgt * h / 6.0 * kappa;
-                            for c in series.iter_mut() {
-                                *c += pw;
-                                pw *= x;
+                    let s0 = seg.start_mm + j as f64 * h;
+                    rk4_step(&mut y, h, &mut scratch, |stage, dy| {
+                        let i = stage.index;
+                        let ys = stage.state;
+                        let (f, l) = self.deriv(seg, k0 + stage.half_steps, slot + i, ys)?;
+                        if i == 0 {
+                            self.record(s0, ys, &l.x);
+                        }
+                        if self.with_kappa {
+                            // RK4 quadrature of the moments with the stage values.
+                            let x = ys[10] / length;
+                            for (series, kappa) in moments.iter_mut().zip([l.x[3], l.kappa[1], l.kappa[2]]) {
+                                let mut pw = stage.weight_sixths * h / 6.0 * kappa;
+                                for c in series.iter_mut() {
+                                    *c += pw;
+                                    pw *= x;
+                                }
                             }
                         }
-                    }
-                    for i in 0..11 {
-                        y[i] += h / 6.0 * (f1[i] + 2.0 * f2[i] + 2.0 * f3[i] + f4[i]);
-                    }
+                        *dy = f;
+                        Ok(())
+                    })?;
                     let norm = (y[3] * y[3] + y[4] * y[4] + y[5] * y[5] + y[6] * y[6]).sqrt();
                     y[3..7].iter_mut().for_each(|c| *c /= norm);
                 }
@@ -596,11 +601,12 @@ impl SpatialSolver {
         }
         let tensions = &taus[..self.cables];
         let mut x = self.warm[slot];
-        if self.chord && self.lus[slot].valid {
-            let lu = &self.lus[slot];
+        if let (true, Some(lu)) = (self.chord, &self.lus[slot]) {
             for _ in 0..4 {
-                let mut dx = self.residual_only(&x, chans, tensions, nw, mw).map(|v| -v);
-                lu.solve(&mut dx);
+                let mut dx = Vector6::from(self.residual_only(&x, chans, tensions, nw, mw).map(|v| -v));
+                if !lu.solve_mut(&mut dx) {
+                    break;
+                }
                 let mut big = 0.0f64;
                 for i in 0..6 {
                     x[i] += dx[i];
@@ -615,15 +621,16 @@ impl SpatialSolver {
             }
             x = self.warm[slot];
         }
-        let mut converged = false;
-        let mut lu = Lu6::default();
+        let mut converged = None;
         for _ in 0..100 {
             let (f, j) = self.residual_jacobian(&x, chans, tensions, nw, mw);
-            let mut dx = f.map(|v| -v);
-            if !lu.factor(j) {
+            let lu = j.lu();
+            let mut dx = Vector6::from(f.map(|v| -v));
+            // A singular Jacobian (or a non-finite one: NaN fills the step)
+            // ends Newton as not converged.
+            if !lu.solve_mut(&mut dx) || !dx.iter().all(|d| d.is_finite()) {
                 break;
             }
-            lu.solve(&mut dx);
             // Keep the axial stretch positive: a Newton step through v1 = 0
             // would fold the rod onto itself.
             let mut lambda = 1.0;
@@ -655,15 +662,15 @@ impl SpatialSolver {
             }
             // Quadratic convergence: after a step of 1e-8 the error is ~1e-16.
             if big < 1e-8 {
-                converged = true;
+                converged = Some(lu);
                 break;
             }
         }
-        if !converged {
+        let Some(lu) = converged else {
             return Err(SpatialFailure::Local { s_mm: self.points_s[k] });
-        }
+        };
         self.warm[slot] = x;
-        self.lus[slot] = lu;
+        self.lus[slot] = Some(lu);
         let kappa = if self.with_kappa { self.curvature(&x, chans, tensions, nw, mw, r, &lu, false) } else { V3::zeros() };
         Ok(Local { x, kappa })
     }
@@ -674,7 +681,7 @@ impl SpatialSolver {
     /// Jacobian within ~1e-4 of it; then one step of iterative refinement
     /// with the exact product J·x' brings x' to ~1e-8 relative.
     #[allow(clippy::too_many_arguments)]
-    fn curvature(&self, x: &[f64; 6], chans: &[Chan], tensions: &[f64], nw: V3, mw: V3, r: M3, lu: &Lu6, refine: bool) -> V3 {
+    fn curvature(&self, x: &[f64; 6], chans: &[Chan], tensions: &[f64], nw: V3, mw: V3, r: M3, lu: &Factors, refine: bool) -> V3 {
         let (v, u) = strains(x);
         // ∂G/∂s at fixed (v, u): the channel's motion, then the body-frame
         // change of the distal loads.
@@ -691,17 +698,16 @@ impl SpatialSolver {
         let mw_s = -u.cross(&mw) - v.cross(&nw);
         gs_f -= nw_s;
         gs_m -= mw_s;
-        let rhs = [-gs_f[0], -gs_f[1], -gs_f[2], -gs_m[0], -gs_m[1], -gs_m[2]];
+        let rhs = Vector6::new(-gs_f[0], -gs_f[1], -gs_f[2], -gs_m[0], -gs_m[1], -gs_m[2]);
+        // The factors were invertible when they were made: a solve cannot fail.
         let mut xs = rhs;
-        lu.solve(&mut xs);
+        lu.solve_mut(&mut xs);
         if refine {
             for _ in 0..1 {
-                let jx = self.jacobian_times(x, chans, tensions, &xs);
-                let mut d: [f64; 6] = std::array::from_fn(|i| rhs[i] - jx[i]);
-                lu.solve(&mut d);
-                for i in 0..6 {
-                    xs[i] += d[i];
-                }
+                let jx = self.jacobian_times(x, chans, tensions, &xs.into());
+                let mut d = rhs - Vector6::from(jx);
+                lu.solve_mut(&mut d);
+                xs += d;
             }
         }
         let vs = V3::new(xs[0], xs[1], xs[2]);
@@ -748,7 +754,7 @@ impl SpatialSolver {
     }
 
     /// Residual G(x) of the cut equations and its Jacobian.
-    fn residual_jacobian(&self, x: &[f64; 6], chans: &[Chan], tensions: &[f64], nw: V3, mw: V3) -> ([f64; 6], [[f64; 6]; 6]) {
+    fn residual_jacobian(&self, x: &[f64; 6], chans: &[Chan], tensions: &[f64], nw: V3, mw: V3) -> ([f64; 6], Matrix6<f64>) {
         let k = &self.stiff;
         let (v, u) = strains(x);
         let (mut ff, mut fm) = self.elastic_residual(x, nw, mw);
@@ -768,15 +774,11 @@ impl SpatialSolver {
             juv += sa;
             juu -= sa * sk;
         }
-        let mut j = [[0.0; 6]; 6];
-        for r in 0..3 {
-            for c in 0..3 {
-                j[r][c] = jvv[(r, c)];
-                j[r][c + 3] = jvu[(r, c)];
-                j[r + 3][c] = juv[(r, c)];
-                j[r + 3][c + 3] = juu[(r, c)];
-            }
-        }
+        let mut j = Matrix6::zeros();
+        j.fixed_view_mut::<3, 3>(0, 0).copy_from(&jvv);
+        j.fixed_view_mut::<3, 3>(0, 3).copy_from(&jvu);
+        j.fixed_view_mut::<3, 3>(3, 0).copy_from(&juv);
+        j.fixed_view_mut::<3, 3>(3, 3).copy_from(&juu);
         ([ff[0], ff[1], ff[2], fm[0], fm[1], fm[2]], j)
     }
 
@@ -827,13 +829,15 @@ impl SpatialSolver {
             LengthBasis::Rest => 1.0,
             LengthBasis::Deformed => ratio,
         };
+        // P_i(2σ/ℓ − 1) in powers of σ/ℓ = (σ/L)·(L/ℓ): the moments are in σ/L.
+        let powers = shape::shifted_legendre_powers(order);
         let out = std::array::from_fn(|k| {
             (0..=order)
                 .map(|i| {
                     let mut sum = 0.0;
                     let mut pw = 1.0;
-                    for (jj, c) in moments[k].iter().enumerate().take(i + 1) {
-                        sum += shifted_legendre_coefficient(i, jj) * pw * c;
+                    for (coefficient, c) in powers[i].iter().zip(&moments[k]) {
+                        sum += coefficient * pw * c;
                         pw *= ratio;
                     }
                     factor * (2 * i + 1) as f64 / length * sum
@@ -867,122 +871,4 @@ fn residual(end: &State) -> V3 {
 
 fn quat(y: &State) -> UnitQuaternion<f64> {
     UnitQuaternion::new_unchecked(Quaternion::new(y[3], y[4], y[5], y[6]))
-}
-
-fn axpy(y: &State, h: f64, f: &State) -> State {
-    std::array::from_fn(|i| y[i] + h * f[i])
-}
-
-/// Coefficient of x^j in the shifted Legendre polynomial P_i(2x − 1):
-/// (−1)^(i+j) C(i, j) C(i + j, j).
-fn shifted_legendre_coefficient(i: usize, j: usize) -> f64 {
-    let binom = |n: usize, k: usize| (0..k).fold(1.0, |acc, m| acc * (n - m) as f64 / (m + 1) as f64);
-    let sign = if (i + j).is_multiple_of(2) { 1.0 } else { -1.0 };
-    sign * binom(i, j) * binom(i + j, j)
-}
-
-/// LU factors of a 6×6 matrix (Gaussian elimination with partial pivoting).
-#[derive(Debug, Clone, Copy, Default)]
-struct Lu6 {
-    a: [[f64; 6]; 6],
-    /// Row swapped with row `col` at step `col`.
-    piv: [usize; 6],
-    /// 1 / U's diagonal (a division per row is the slow part of a solve).
-    inv_diag: [f64; 6],
-    valid: bool,
-}
-
-impl Lu6 {
-    /// Factors `a`; false if it is singular.
-    fn factor(&mut self, mut a: [[f64; 6]; 6]) -> bool {
-        let mut pivots = [0; 6];
-        let mut inv_diag = [0.0; 6];
-        for col in 0..6 {
-            let mut piv = col;
-            for r in col + 1..6 {
-                if a[r][col].abs() > a[piv][col].abs() {
-                    piv = r;
-                }
-            }
-            if a[piv][col].abs() < 1e-300 || !a[piv][col].is_finite() {
-                return false;
-            }
-            a.swap(col, piv);
-            pivots[col] = piv;
-            let d = 1.0 / a[col][col];
-            inv_diag[col] = d;
-            for r in col + 1..6 {
-                let f = a[r][col] * d;
-                a[r][col] = f;
-                if f != 0.0 {
-                    let pivot_row = a[col];
-                    for (x, p) in a[r][col + 1..].iter_mut().zip(&pivot_row[col + 1..]) {
-                        *x -= f * p;
-                    }
-                }
-            }
-        }
-        self.a = a;
-        self.piv = pivots;
-        self.inv_diag = inv_diag;
-        self.valid = true;
-        true
-    }
-
-    /// Solves A x = b in place with the factors.
-    fn solve(&self, b: &mut [f64; 6]) {
-        let a = &self.a;
-        let mut y = *b;
-        for (col, &p) in self.piv.iter().enumerate() {
-            y.swap(col, p.min(5));
-        }
-        for r in 1..6 {
-            for c in 0..r {
-                y[r] -= a[r][c] * y[c];
-            }
-        }
-        for r in (0..6).rev() {
-            for c in r + 1..6 {
-                y[r] -= a[r][c] * y[c];
-            }
-            y[r] *= self.inv_diag[r];
-        }
-        *b = y;
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn shifted_legendre_matches_the_recurrence() {
-        for i in 0..=MAX_SPATIAL_ORDER {
-            for k in 0..=20 {
-                let x = k as f64 / 20.0;
-                let poly: f64 = (0..=i).map(|j| shifted_legendre_coefficient(i, j) * x.powi(j as i32)).sum();
-                assert!((poly - crate::shape::legendre(i, 2.0 * x - 1.0)).abs() < 1e-9, "P_{i}({x})");
-            }
-        }
-    }
-
-    #[test]
-    fn lu6_solves() {
-        let a = [
-            [4.0, 1.0, 0.0, 0.0, 0.0, 2.0],
-            [1.0, 5.0, 1.0, 0.0, 0.0, 0.0],
-            [0.0, 1.0, 6.0, 1.0, 0.0, 0.0],
-            [0.0, 0.0, 1.0, 7.0, 1.0, 0.0],
-            [3.0, 0.0, 0.0, 1.0, 8.0, 1.0],
-            [0.0, 0.0, 0.0, 0.0, 1.0, 0.0],
-        ];
-        let x = [1.0, -2.0, 3.0, -4.0, 5.0, -6.0];
-        let mut b: [f64; 6] = std::array::from_fn(|r| (0..6).map(|c| a[r][c] * x[c]).sum());
-        let mut lu = Lu6::default();
-        assert!(lu.factor(a));
-        lu.solve(&mut b);
-        for i in 0..6 {
-            assert!((b[i] - x[i]).abs() < 1e-12);
-        }
-    }
 }
