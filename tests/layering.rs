@@ -76,3 +76,74 @@ fn only_the_top_returns_the_top_level_error() {
         assert!(!code.contains("crate::Error"), "src/{file} uses the top-level crate::Error: return the layer's own error enum");
     }
 }
+
+/// Every source file of `src/` (the binary's too) with its code: test
+/// modules cut off and `//` comments removed (a comment may name anything).
+fn all_code() -> Vec<(String, String)> {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut files = Vec::new();
+    rust_files(&src, &mut files);
+    files
+        .into_iter()
+        .map(|p| {
+            let text = std::fs::read_to_string(&p).unwrap();
+            let text = match text.find("#[cfg(test)]") {
+                Some(i) => &text[..i],
+                None => &text[..],
+            };
+            let code: Vec<&str> = text.lines().map(|l| l.find("//").map_or(l, |i| &l[..i])).collect();
+            (p.strip_prefix(&src).unwrap().display().to_string(), code.join("\n"))
+        })
+        .collect()
+}
+
+/// Where `word` occurs in `code` as a whole word other than as a field
+/// access (`.word`, checked by the compiler): line numbers.
+fn spelled(code: &str, word: &str) -> Vec<usize> {
+    let ident = |c: char| c.is_alphanumeric() || c == '_';
+    let mut lines = Vec::new();
+    for (n, line) in code.lines().enumerate() {
+        let mut from = 0;
+        while let Some(i) = line[from..].find(word).map(|i| i + from) {
+            let before = line[..i].chars().next_back();
+            let after = line[i + word.len()..].chars().next();
+            let whole = !before.is_some_and(ident) && !after.is_some_and(ident) && !before.is_some_and(|c| c == '-');
+            if whole && before != Some('.') {
+                lines.push(n + 1);
+            }
+            from = i + word.len();
+        }
+    }
+    lines
+}
+
+#[test]
+fn an_effects_spec_key_is_spelled_only_in_the_registry() {
+    // The `[effects]` keys (gravity's `scale` is too common a word to
+    // search for). Tests may use them; field accesses are the compiler's
+    // to check. The flag's kebab form counts as a spelling too.
+    let keys: Vec<&str> = cablemap::model::REGISTRY
+        .iter()
+        .filter(|e| e.section == cablemap::model::effects::Section::Effects)
+        .map(|e| e.key)
+        .collect();
+    assert!(keys.contains(&"friction_mu") && keys.contains(&"stiffening_alpha"), "{keys:?}");
+    let mut found = Vec::new();
+    for (file, code) in all_code() {
+        if file == "model/effects.rs" {
+            continue;
+        }
+        for key in &keys {
+            for word in [key.to_string(), key.replace('_', "-")] {
+                for line in spelled(&code, &word) {
+                    found.push(format!("src/{file}:{line} spells {word}"));
+                }
+            }
+        }
+    }
+    assert!(
+        found.is_empty(),
+        "effect keys are spelled outside the registry (src/model/effects.rs); take them from its entry (e.g. FRICTION.key, .flag, .path):\n{}",
+        found.join("\n")
+    );
+}
