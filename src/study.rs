@@ -20,7 +20,10 @@
 //! Axes: `length_mm`, `radius_mm`, `ei_n_mm2`, `ea_n`, `ga_n`,
 //! `density_g_cm3` (numbers, or `scale`), `tension_n` (pairs [min, max] in
 //! N), `effects` (tables of `[actuator.effects]` settings, laid over the
-//! base spec's). Variants are numbered with the first axis slowest.
+//! base spec's), and each effect parameter of the registry by its path
+//! (`effects.friction_mu`, `gravity.scale`: numbers; see
+//! [`crate::model::effects`]). Variants are numbered with the first axis
+//! slowest.
 //!
 //! A study directory holds `study.json` (the study and its variants),
 //! `v{i}/run` and `v{i}/map` per variant (each exactly what `cablemap map`
@@ -212,6 +215,8 @@ pub struct StudySpec {
 /// How one axis changes the spec (as JSON, the spec's canonical form).
 enum Change {
     Number { key: &'static str, value: f64 },
+    /// A registry effect parameter at `[actuator.SECTION] KEY`.
+    Effect { info: &'static crate::model::EffectInfo, value: f64 },
     Scale { key: &'static str, factor: f64 },
     Tension { min_n: f64, max_n: f64 },
     Effects(serde_json::Map<String, serde_json::Value>),
@@ -351,6 +356,23 @@ impl StudySpec {
                 (None, None) => Err("give values = [...] or scale = [...]".into()),
             };
         }
+        if let Some(info) = crate::model::REGISTRY.iter().copied().find(|e| e.path == a.name) {
+            let values = a
+                .values
+                .as_ref()
+                .filter(|_| a.scale.is_none())
+                .ok_or("give values = [...] (numbers; an effect parameter has no scale)")?;
+            return values
+                .iter()
+                .map(|v| {
+                    let x = v
+                        .as_float()
+                        .or_else(|| v.as_integer().map(|i| i as f64))
+                        .ok_or_else(|| format!("value {v} is not a number"))?;
+                    Ok((fmt(x), Change::Effect { info, value: x }))
+                })
+                .collect();
+        }
         match a.name.as_str() {
             "tension_n" => {
                 let values = a
@@ -401,8 +423,9 @@ impl StudySpec {
                     .collect()
             }
             other => Err(format!(
-                "unknown axis '{other}': use one of {}, tension_n, effects",
-                NUMBER_AXES.join(", ")
+                "unknown axis '{other}': use one of {}, tension_n, effects, or an effect parameter ({})",
+                NUMBER_AXES.join(", "),
+                crate::model::REGISTRY.iter().map(|e| e.path).collect::<Vec<_>>().join(", ")
             )),
         }
     }
@@ -478,6 +501,14 @@ fn apply(json: &mut serde_json::Value, change: &Change) {
         Change::Tension { min_n, max_n } => {
             json["tension"]["min_n"] = serde_json::json!(min_n);
             json["tension"]["max_n"] = serde_json::json!(max_n);
+        }
+        Change::Effect { info, value } => {
+            // Through the rod's own serde form, so that the parameter's
+            // field (an optional one: the clamp) is written as the rod writes it.
+            let mut rod: crate::model::Rod = serde_json::from_value(actuator.clone()).expect("the spec's actuator reads back");
+            (info.set)(&mut rod, *value);
+            let section = info.section.key();
+            actuator[section] = serde_json::to_value(rod).expect("a rod serialises")[section].take();
         }
         Change::Effects(settings) => {
             for (k, v) in settings {
@@ -888,6 +919,17 @@ mod tests {
         assert_eq!(s.variants[3].spec.actuator.effects.friction_mu, 0.1);
         assert_eq!(s.variants[2].spec.actuator.effects.friction_mu, 0.0);
         assert_eq!(s.variants[3].label(), "tension_n=1–3 N, effects={friction_mu:0.1}");
+    }
+
+    #[test]
+    fn every_registry_effect_parameter_is_an_axis() {
+        for info in crate::model::REGISTRY.iter() {
+            let v = if info.default == 0.0 { 0.25 } else if info.default.is_finite() { info.default * 0.5 } else { 40.0 };
+            // Without mirror_dedup: a tilt or an offset breaks the mirror symmetry.
+            let text = format!("[grid]\nmirror_dedup = false\n[study]\n[[study.axis]]\nname = \"{}\"\nvalues = [{v}]\n", info.path);
+            let s = StudySpec::from_toml(&text, "t").unwrap_or_else(|e| panic!("{}: {e}", info.path));
+            assert_eq!((info.get)(&s.variants[0].spec.actuator), v, "{}", info.path);
+        }
     }
 
     #[test]

@@ -77,9 +77,9 @@ fn only_the_top_returns_the_top_level_error() {
     }
 }
 
-/// Every source file under src/ (the binary's too), test modules and
-/// `//` comments cut off, as (path from src/, code).
-fn code_without_comments() -> Vec<(String, String)> {
+/// Every source file of `src/` (the binary's too) with its code: test
+/// modules cut off and `//` comments removed (a comment may name anything).
+fn all_code() -> Vec<(String, String)> {
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
     let mut files = Vec::new();
     rust_files(&src, &mut files);
@@ -152,7 +152,7 @@ fn the_rk4_step_is_written_once() {
     // Owner: src/numerics.rs. The tableau's combination of the stages,
     // h/6 (k1 + 2 k2 + 2 k3 + k4) or with weights 1/6, 1/3, in any layout.
     let mut problems = Vec::new();
-    for (file, code) in code_without_comments() {
+    for (file, code) in all_code() {
         if file == "numerics.rs" {
             continue;
         }
@@ -191,7 +191,7 @@ fn the_rk4_step_is_written_once() {
 fn linear_systems_use_nalgebra_not_a_hand_written_lu() {
     // Owner: nalgebra (`Matrix::lu`, `full_piv_lu`, `cholesky`, ...).
     let mut problems = Vec::new();
-    for (file, code) in code_without_comments() {
+    for (file, code) in all_code() {
         for name in defined_names(&code) {
             let words = name_words(&name);
             let lu = words.iter().any(|w| ["lu", "lup", "plu", "gauss", "gaussian", "pivot", "pivots", "pivoting", "elimination", "eliminate"].contains(&w.as_str()));
@@ -215,7 +215,7 @@ fn linear_systems_use_nalgebra_not_a_hand_written_lu() {
 fn legendre_polynomials_are_written_once() {
     // Owner: src/shape.rs (legendre, shifted_legendre_powers, ...).
     let mut problems = Vec::new();
-    for (file, code) in code_without_comments() {
+    for (file, code) in all_code() {
         if file == "shape.rs" {
             continue;
         }
@@ -246,4 +246,53 @@ fn legendre_polynomials_are_written_once() {
         }
     }
     assert!(problems.is_empty(), "{}", problems.join("\n"));
+/// Where `word` occurs in `code` as a whole word other than as a field
+/// access (`.word`, checked by the compiler): line numbers.
+fn spelled(code: &str, word: &str) -> Vec<usize> {
+    let ident = |c: char| c.is_alphanumeric() || c == '_';
+    let mut lines = Vec::new();
+    for (n, line) in code.lines().enumerate() {
+        let mut from = 0;
+        while let Some(i) = line[from..].find(word).map(|i| i + from) {
+            let before = line[..i].chars().next_back();
+            let after = line[i + word.len()..].chars().next();
+            let whole = !before.is_some_and(ident) && !after.is_some_and(ident) && !before.is_some_and(|c| c == '-');
+            if whole && before != Some('.') {
+                lines.push(n + 1);
+            }
+            from = i + word.len();
+        }
+    }
+    lines
+}
+
+#[test]
+fn an_effects_spec_key_is_spelled_only_in_the_registry() {
+    // The `[effects]` keys (gravity's `scale` is too common a word to
+    // search for). Tests may use them; field accesses are the compiler's
+    // to check. The flag's kebab form counts as a spelling too.
+    let keys: Vec<&str> = cablemap::model::REGISTRY
+        .iter()
+        .filter(|e| e.section == cablemap::model::effects::Section::Effects)
+        .map(|e| e.key)
+        .collect();
+    assert!(keys.contains(&"friction_mu") && keys.contains(&"stiffening_alpha"), "{keys:?}");
+    let mut found = Vec::new();
+    for (file, code) in all_code() {
+        if file == "model/effects.rs" {
+            continue;
+        }
+        for key in &keys {
+            for word in [key.to_string(), key.replace('_', "-")] {
+                for line in spelled(&code, &word) {
+                    found.push(format!("src/{file}:{line} spells {word}"));
+                }
+            }
+        }
+    }
+    assert!(
+        found.is_empty(),
+        "effect keys are spelled outside the registry (src/model/effects.rs); take them from its entry (e.g. FRICTION.key, .flag, .path):\n{}",
+        found.join("\n")
+    );
 }

@@ -14,6 +14,8 @@
 mod bodies;
 #[path = "calibrate.rs"]
 mod calibrate;
+#[path = "effects.rs"]
+mod effects;
 #[path = "feasible.rs"]
 mod feasible;
 #[path = "heavy_rod.rs"]

@@ -1,11 +1,16 @@
-//! The candidate effects of model-notes §6 as fit parameters: how each sets
-//! the actuator, how it is parameterised for the fit (positivity by logs,
-//! a fraction by a logit) and what values are physically plausible.
+//! The candidate effects of model-notes §6 as fit parameters: a view of the
+//! effect registry ([`crate::model::effects`]), whose entries with a
+//! [`Fit`] are the candidates. The registry says how each sets the
+//! actuator, how it is parameterised for the fit (positivity by logs, a
+//! fraction by a logit) and what values are physically plausible; this
+//! module adds only what separates two candidates.
 
+use crate::model::effects::{Domain, EffectInfo, Fit, REGISTRY};
 use crate::model::Rod;
 use serde::Serialize;
 
-/// An effect the thesis model leaves out, with one fitted parameter.
+/// An effect the thesis model leaves out, with one fitted parameter: one
+/// per registry entry with a [`Fit`], in registry order (a test checks it).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Effect {
@@ -26,7 +31,7 @@ pub enum Effect {
 }
 
 impl Effect {
-    /// Every candidate, in a fixed order.
+    /// Every candidate, in a fixed order (reports and fits list them so).
     pub const ALL: [Effect; 7] = [
         Effect::Friction,
         Effect::Gravity,
@@ -37,9 +42,10 @@ impl Effect {
         Effect::StiffnessGradient,
     ];
 
-    /// The name used in reports, JSON and on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
+    /// The candidate's registry entry.
+    pub fn info(self) -> &'static EffectInfo {
+        // The one place a candidate meets its entry: by the fit's name.
+        let name = match self {
             Effect::Friction => "friction",
             Effect::Gravity => "gravity",
             Effect::Stiffening => "stiffening",
@@ -47,7 +53,18 @@ impl Effect {
             Effect::ChannelOffset => "channel_offset",
             Effect::Creep => "creep",
             Effect::StiffnessGradient => "stiffness_gradient",
-        }
+        };
+        REGISTRY.iter().copied().find(|e| e.fit.is_some_and(|f| f.name == name)).expect("every candidate has a registry entry with a fit")
+    }
+
+    /// How the candidate is fitted.
+    pub fn fit(self) -> &'static Fit {
+        self.info().fit.as_ref().expect("a candidate's entry has a fit")
+    }
+
+    /// The name used in reports, JSON and on the command line.
+    pub fn name(self) -> &'static str {
+        self.fit().name
     }
 
     /// Parses a name of [`Effect::name`].
@@ -57,115 +74,67 @@ impl Effect {
 
     /// The parameter's name with its unit.
     pub fn parameter_name(self) -> &'static str {
-        match self {
-            Effect::Friction => "friction_mu",
-            Effect::Gravity => "gravity_scale",
-            Effect::Stiffening => "stiffening_alpha",
-            Effect::ClampCompliance => "clamp_stiffness_n_mm_per_rad",
-            Effect::ChannelOffset => "channel_offset_mm",
-            Effect::Creep => "creep_fraction",
-            Effect::StiffnessGradient => "stiffness_gradient_beta",
-        }
+        self.info().name
     }
 
-    /// Sets the effect's parameter on `a`.
+    /// Sets the effect's parameter on `a` (switching the effect on).
     pub fn apply(self, a: &mut Rod, value: f64) {
-        match self {
-            Effect::Friction => a.effects.friction_mu = value,
-            Effect::Gravity => {
-                a.gravity.enabled = true;
-                a.gravity.scale = value;
-            }
-            Effect::Stiffening => a.effects.stiffening_alpha = value,
-            Effect::ClampCompliance => a.effects.clamp_stiffness_n_mm_per_rad = Some(value),
-            Effect::ChannelOffset => a.effects.channel_offset_mm = value,
-            Effect::Creep => a.effects.creep_fraction = value,
-            Effect::StiffnessGradient => a.effects.stiffness_gradient_beta = value,
-        }
+        (self.fit().switch_on)(a);
+        (self.info().set)(a, value);
     }
 
-    /// The effect's value on `a` if it is switched on there (a fit then
-    /// starts from it), `None` if `a` has the thesis model's value.
+    /// The effect's value on `a` if it is switched on there and can start
+    /// a fit (a fit then starts from it), `None` if `a` has the thesis
+    /// model's value.
     pub fn current(self, a: &Rod) -> Option<f64> {
-        let v = match self {
-            Effect::Friction => a.effects.friction_mu,
-            Effect::Gravity => return (a.gravity.enabled && a.gravity.scale != 1.0 && a.gravity.scale > 0.0).then_some(a.gravity.scale),
-            Effect::Stiffening => a.effects.stiffening_alpha,
-            Effect::ClampCompliance => return a.effects.clamp_stiffness_n_mm_per_rad,
-            Effect::ChannelOffset => a.effects.channel_offset_mm,
-            Effect::Creep => a.effects.creep_fraction,
-            Effect::StiffnessGradient => a.effects.stiffness_gradient_beta,
-        };
-        (v != 0.0).then_some(v)
+        let (info, fit) = (self.info(), self.fit());
+        let v = (info.get)(a);
+        ((fit.switched_on)(a) && info.is_set(a) && fit.domain.contains(v)).then_some(v)
     }
 
     /// Starting value of the fit.
     pub fn start(self) -> f64 {
-        match self {
-            Effect::Friction => 0.02,
-            Effect::Gravity => 1.0,
-            Effect::Stiffening => 0.2,
-            Effect::ClampCompliance => 300.0,
-            Effect::ChannelOffset => 0.0,
-            Effect::Creep => 0.05,
-            Effect::StiffnessGradient => 0.0,
-        }
+        self.fit().start
     }
 
     /// Values a real rod, clamp and cable can have; a fit outside them
     /// points at another cause.
     pub fn plausible(self, value: f64) -> bool {
-        match self {
-            Effect::Friction => value > 0.0 && value <= 1.0,
-            Effect::Gravity => value > 0.0 && value <= 10.0,
-            Effect::Stiffening => value > 0.0 && value <= 100.0,
-            Effect::ClampCompliance => (1.0..=1e5).contains(&value),
-            Effect::ChannelOffset => value.abs() <= 2.0,
-            Effect::Creep => value > 0.0 && value <= 0.9,
-            Effect::StiffnessGradient => value.abs() <= 5.0,
-        }
+        self.fit().is_plausible(value)
     }
 
     /// The plausible range in words, for reports.
     pub fn plausible_text(self) -> &'static str {
-        match self {
-            Effect::Friction => "0 < μ ≤ 1",
-            Effect::Gravity => "0 < k ≤ 10",
-            Effect::Stiffening => "0 < α ≤ 100",
-            Effect::ClampCompliance => "1 ≤ k_θ ≤ 1e5 N·mm/rad",
-            Effect::ChannelOffset => "|δ| ≤ 2 mm",
-            Effect::Creep => "0 < f ≤ 0.9",
-            Effect::StiffnessGradient => "|β| ≤ 5 (EI(L)/EI(0) between 1/150 and 150)",
-        }
+        self.fit().plausible_text
     }
 
     /// Maps a parameter value to the fit's unconstrained coordinate.
     pub fn to_internal(self, value: f64) -> f64 {
-        match self {
-            Effect::ChannelOffset | Effect::StiffnessGradient => value,
-            Effect::Creep => (value / (1.0 - value)).ln(),
-            _ => value.ln(),
+        match self.fit().domain {
+            Domain::Signed => value,
+            Domain::Fraction => (value / (1.0 - value)).ln(),
+            Domain::Positive => value.ln(),
         }
     }
 
     /// Inverse of [`Effect::to_internal`].
     pub fn from_internal(self, x: f64) -> f64 {
-        match self {
-            Effect::ChannelOffset | Effect::StiffnessGradient => x,
-            Effect::Creep => 1.0 / (1.0 + (-x).exp()),
-            _ => x.exp(),
+        match self.fit().domain {
+            Domain::Signed => x,
+            Domain::Fraction => 1.0 / (1.0 + (-x).exp()),
+            Domain::Positive => x.exp(),
         }
     }
 
     /// d value / d internal coordinate at internal `x` (for standard errors).
     pub fn derivative(self, x: f64) -> f64 {
-        match self {
-            Effect::ChannelOffset | Effect::StiffnessGradient => 1.0,
-            Effect::Creep => {
+        match self.fit().domain {
+            Domain::Signed => 1.0,
+            Domain::Fraction => {
                 let f = self.from_internal(x);
                 f * (1.0 - f)
             }
-            _ => x.exp(),
+            Domain::Positive => x.exp(),
         }
     }
 
@@ -202,5 +171,25 @@ mod tests {
             assert!((fd - e.derivative(x)).abs() < 1e-6 * fd.abs().max(1.0));
             assert_eq!(Effect::parse(e.name()), Some(e));
         }
+    }
+
+    #[test]
+    fn the_candidates_are_the_registrys_fittable_entries_in_order() {
+        let fittable: Vec<&str> = crate::model::effects::fittable().map(|(e, _)| e.name).collect();
+        let candidates: Vec<&str> = Effect::ALL.iter().map(|e| e.parameter_name()).collect();
+        let mut sorted = candidates.clone();
+        sorted.sort_by_key(|k| fittable.iter().position(|f| f == k));
+        assert_eq!(sorted, fittable, "every fittable registry entry is a candidate, and only those");
+    }
+
+    #[test]
+    fn current_reads_a_switched_on_effect_only() {
+        let mut a = Rod::default();
+        assert!(Effect::ALL.iter().all(|e| e.current(&a).is_none()));
+        Effect::Gravity.apply(&mut a, 2.0);
+        Effect::ClampCompliance.apply(&mut a, 300.0);
+        assert_eq!((Effect::Gravity.current(&a), Effect::ClampCompliance.current(&a)), (Some(2.0), Some(300.0)));
+        a.gravity.enabled = false;
+        assert_eq!(Effect::Gravity.current(&a), None);
     }
 }

@@ -11,7 +11,108 @@ use super::predict::predict_group;
 use super::rng::Rng;
 use super::CalibrateError;
 use crate::model::routing::CONTROL_POINTS;
-use crate::model::{Rod, SolverOptions};
+use crate::model::{Rod, SolverOptions, Unmodelled};
+use super::Effect;
+
+/// Effects `synth` can hide that are deliberately not diagnosis candidates
+/// (nor registry entries), so that tests can check the diagnosis answers
+/// `unexplained` for them.
+pub const OUT_OF_LIBRARY: [&str; 2] = ["rest_curvature", "glue_joint"];
+
+/// Every effect `synth --effect` hides besides `none`: the calibration
+/// candidates (the registry's fittable entries), then [`OUT_OF_LIBRARY`].
+pub fn effect_names() -> Vec<&'static str> {
+    Effect::ALL.iter().map(|e| e.name()).chain(OUT_OF_LIBRARY).collect()
+}
+
+/// The effect hidden in synthetic data.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Planted {
+    /// The thesis model.
+    None,
+    /// A calibration candidate at a value of its parameter.
+    Candidate {
+        /// The effect.
+        effect: Effect,
+        /// Its parameter's value.
+        value: f64,
+    },
+    /// A rod cured bent (outside the library: no candidate names it).
+    RestCurvature {
+        /// The rest curvature, 1/mm.
+        per_mm: f64,
+    },
+    /// A stiff glue joint at the clamp (outside the library).
+    GlueJoint {
+        /// The joint's bending-rigidity factor.
+        ei_factor: f64,
+        /// Its length from the clamp, mm.
+        length_mm: f64,
+    },
+}
+
+/// Why the effect to hide was not understood.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PlantError {
+    /// No effect of that name.
+    #[error("--effect {name}: unknown effect; use none or one of {}", effect_names().join(", "))]
+    Unknown {
+        /// The name given.
+        name: String,
+    },
+    /// An effect without its size.
+    #[error("--effect {name} needs --magnitude ({what})")]
+    NoMagnitude {
+        /// The effect.
+        name: String,
+        /// What the magnitude is, in words.
+        what: String,
+    },
+    /// A size without an effect.
+    #[error("--magnitude needs --effect")]
+    NoEffect,
+}
+
+impl Planted {
+    /// The effect named `name` (`none`, a candidate or one of
+    /// [`OUT_OF_LIBRARY`]) of size `magnitude`; a glue joint is
+    /// `glue_length_mm` long.
+    pub fn parse(name: &str, magnitude: Option<f64>, glue_length_mm: f64) -> Result<Planted, PlantError> {
+        let needs = |what: String| PlantError::NoMagnitude { name: name.to_string(), what };
+        match name {
+            "none" => magnitude.map_or(Ok(Planted::None), |_| Err(PlantError::NoEffect)),
+            "rest_curvature" => {
+                let per_mm = magnitude.ok_or_else(|| needs("the rest curvature in 1/mm, e.g. 0.004".into()))?;
+                Ok(Planted::RestCurvature { per_mm })
+            }
+            "glue_joint" => {
+                let ei_factor = magnitude.ok_or_else(|| needs("the joint's EI factor, e.g. 5".into()))?;
+                Ok(Planted::GlueJoint { ei_factor, length_mm: glue_length_mm })
+            }
+            _ => {
+                let effect = Effect::parse(name).ok_or_else(|| PlantError::Unknown { name: name.to_string() })?;
+                let value = magnitude.ok_or_else(|| needs(format!("its parameter {}", effect.parameter_name())))?;
+                Ok(Planted::Candidate { effect, value })
+            }
+        }
+    }
+
+    /// Hides the effect in `rod`. The unmodelled ones go into the rod's
+    /// [`Unmodelled`] slot, which only this function sets and no file
+    /// carries.
+    pub fn plant(&self, rod: &mut Rod) {
+        match *self {
+            Planted::None => {}
+            Planted::Candidate { effect, value } => effect.apply(rod, value),
+            Planted::RestCurvature { per_mm } => {
+                rod.effects.hidden = Unmodelled { rest_curvature_per_mm: per_mm, ..Unmodelled::default() };
+            }
+            Planted::GlueJoint { ei_factor, length_mm } => {
+                rod.effects.hidden = Unmodelled { base_segment_ei_factor: ei_factor, base_segment_mm: length_mm, ..Unmodelled::default() };
+            }
+        }
+    }
+}
 
 /// What to generate.
 #[derive(Debug, Clone, PartialEq)]
@@ -272,6 +373,19 @@ pub fn resample(line: &[[f64; 2]], count: usize) -> Vec<[f64; 2]> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn every_candidate_and_unmodelled_effect_can_be_planted() {
+        for name in effect_names() {
+            let planted = Planted::parse(name, Some(0.3), 5.0).unwrap();
+            let mut rod = Rod::default();
+            planted.plant(&mut rod);
+            assert_ne!(rod, Rod::default(), "{name} changes the rod");
+            assert!(Planted::parse(name, None, 5.0).unwrap_err().to_string().contains("needs --magnitude"));
+        }
+        assert_eq!(Planted::parse("none", None, 5.0).unwrap(), Planted::None);
+        assert!(Planted::parse("bogus", Some(1.0), 5.0).unwrap_err().to_string().contains("stiffness_gradient, rest_curvature, glue_joint"));
+    }
 
     #[test]
     fn protocol_rests_loads_unloads_and_rests() {

@@ -14,7 +14,7 @@ pub mod study;
 pub mod sweep;
 pub mod synth;
 
-use cablemap::model::{Rod, SolverOptions};
+use cablemap::model::{EffectInfo, Rod, SolverOptions, REGISTRY};
 use cablemap::shape::LengthBasis;
 use clap::Args;
 
@@ -43,37 +43,10 @@ pub struct ActuatorArgs {
     /// Turn self-weight off (the thesis's rod hangs: gravity is on by default).
     #[arg(long)]
     pub no_gravity: bool,
-    /// Gravity direction from the clamp axis, rad (clamp tilt) [default: 0].
-    #[arg(long, value_name = "RAD", allow_hyphen_values = true)]
-    pub gravity_direction_rad: Option<f64>,
-    /// Scale on the nominal self-weight [default: 1].
-    #[arg(long, value_name = "K", allow_hyphen_values = true)]
-    pub gravity_scale: Option<f64>,
-    /// Material stiffening α: moment EI·u·(1 + α (r u)²) [default: 0].
-    #[arg(long, value_name = "ALPHA", allow_hyphen_values = true)]
-    pub stiffening_alpha: Option<f64>,
-    /// Clamp rotational stiffness k_θ, N·mm/rad: the effect `clamp_compliance`
-    /// (`--clamp-stiffness` is the old name) [default: rigid clamp].
-    #[arg(long = "clamp-stiffness-n-mm-per-rad", alias = "clamp-stiffness", value_name = "N_MM_PER_RAD", allow_hyphen_values = true)]
-    pub clamp_stiffness: Option<f64>,
-    /// Channel offset δ added to every y_i, mm [default: 0].
-    #[arg(long, value_name = "MM", allow_hyphen_values = true)]
-    pub channel_offset_mm: Option<f64>,
-    /// Stiffness gradient β: EI(s) = EI·exp(β (s/L − ½)), β = ln(EI(L)/EI(0)) [default: 0].
-    #[arg(long, value_name = "BETA", allow_hyphen_values = true)]
-    pub stiffness_gradient_beta: Option<f64>,
-    /// Cable–channel friction coefficient μ (capstan law) [default: 0].
-    #[arg(long, value_name = "MU", allow_hyphen_values = true)]
-    pub friction_mu: Option<f64>,
-    /// Creep: fraction f of the bending rigidity that relaxes (0 ≤ f < 1) [default: 0].
-    #[arg(long, value_name = "F", allow_hyphen_values = true)]
-    pub creep_fraction: Option<f64>,
-    /// Creep time constant T, s [default: 10].
-    #[arg(long, value_name = "S", allow_hyphen_values = true)]
-    pub creep_time_s: Option<f64>,
-    /// Creep: seconds each tension is held on a fresh rod in sweeps and design [default: 0].
-    #[arg(long, value_name = "S", allow_hyphen_values = true)]
-    pub creep_hold_s: Option<f64>,
+    /// The effect parameters' flags, one per registry entry
+    /// (`cablemap::model::effects::REGISTRY`).
+    #[command(flatten)]
+    pub effects: EffectArgs,
     /// Rod TOML file (the fields of a sweep spec's [actuator] section, docs/model.md); the
     /// flags above and below override it [default: the thesis's actuator].
     #[arg(long, value_name = "FILE")]
@@ -96,6 +69,61 @@ pub struct ActuatorArgs {
     /// (2·N + 1 points) [default: 24].
     #[arg(long, value_name = "N")]
     pub steps_per_span: Option<usize>,
+}
+
+/// The effect flags, generated from the effect registry: each entry's
+/// flag, value name, help and default, so that a new effect gets its flag
+/// by its entry alone.
+#[derive(Debug, Clone, Default)]
+pub struct EffectArgs {
+    /// The values given, by registry entry.
+    values: Vec<(&'static EffectInfo, f64)>,
+}
+
+impl EffectArgs {
+    /// Sets the given parameters on `rod`.
+    pub fn apply(&self, rod: &mut Rod) {
+        for (info, value) in &self.values {
+            (info.set)(rod, *value);
+        }
+    }
+}
+
+impl clap::FromArgMatches for EffectArgs {
+    fn from_arg_matches(matches: &clap::ArgMatches) -> Result<Self, clap::Error> {
+        let mut args = Self::default();
+        args.update_from_arg_matches(matches)?;
+        Ok(args)
+    }
+
+    fn update_from_arg_matches(&mut self, matches: &clap::ArgMatches) -> Result<(), clap::Error> {
+        for info in REGISTRY.iter() {
+            if let Some(&v) = matches.get_one::<f64>(info.name) {
+                self.values.retain(|(i, _)| i.name != info.name);
+                self.values.push((*info, v));
+            }
+        }
+        Ok(())
+    }
+}
+
+impl clap::Args for EffectArgs {
+    fn augment_args(cmd: clap::Command) -> clap::Command {
+        cmd.args(REGISTRY.iter().map(|info| {
+            let long = info.flag.trim_start_matches("--");
+            clap::Arg::new(info.name)
+                .long(long)
+                .aliases(info.flag_aliases.iter().map(|a| a.trim_start_matches("--")))
+                .value_name(info.value_name)
+                .allow_hyphen_values(true)
+                .value_parser(clap::value_parser!(f64))
+                .help(info.flag_help())
+        }))
+    }
+
+    fn augment_args_for_update(cmd: clap::Command) -> clap::Command {
+        Self::augment_args(cmd)
+    }
 }
 
 /// A radius profile given on the command line.
@@ -130,20 +158,9 @@ impl ActuatorArgs {
         set(&mut a.ga_n, self.ga_n);
         set(&mut a.ei_n_mm2, self.ei_n_mm2);
         set(&mut a.density_g_cm3, self.density_g_cm3);
-        set(&mut a.gravity.direction_rad, self.gravity_direction_rad);
-        set(&mut a.gravity.scale, self.gravity_scale);
-        set(&mut a.effects.stiffening_alpha, self.stiffening_alpha);
-        set(&mut a.effects.channel_offset_mm, self.channel_offset_mm);
-        set(&mut a.effects.friction_mu, self.friction_mu);
-        set(&mut a.effects.stiffness_gradient_beta, self.stiffness_gradient_beta);
-        set(&mut a.effects.creep_fraction, self.creep_fraction);
-        set(&mut a.effects.creep_time_s, self.creep_time_s);
-        set(&mut a.effects.creep_hold_s, self.creep_hold_s);
+        self.effects.apply(&mut a);
         if self.no_gravity {
             a.gravity.enabled = false;
-        }
-        if self.clamp_stiffness.is_some() {
-            a.effects.clamp_stiffness_n_mm_per_rad = self.clamp_stiffness;
         }
         if let Some(p) = &self.radius_profile_mm {
             a.radius_profile_mm = p.0.clone();

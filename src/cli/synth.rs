@@ -3,8 +3,7 @@
 
 use super::{parse_list, ActuatorArgs};
 use cablemap::calibrate::data::{centrelines_csv, markers_csv, measurements_csv};
-use cablemap::calibrate::synth::{default_routings, hidden_effect_size, synthesize_with_markers, SynthSpec, VISIBLE_NOISE_SDS};
-use cablemap::calibrate::Effect;
+use cablemap::calibrate::synth::{default_routings, hidden_effect_size, synthesize_with_markers, Planted, SynthSpec, VISIBLE_NOISE_SDS};
 use cablemap::model::routing::CONTROL_POINTS;
 use cablemap::model::SolverOptions;
 use anyhow::{bail, Context};
@@ -78,10 +77,6 @@ pub struct SynthArgs {
     pub actuator: ActuatorArgs,
 }
 
-/// Effects `synth` can hide that are deliberately not diagnosis candidates,
-/// so that tests can check the diagnosis answers `unexplained` for them.
-pub const OUT_OF_LIBRARY: [&str; 2] = ["rest_curvature", "glue_joint"];
-
 /// Routings parsed from `--routings`, with the per-routing clamp tilts.
 type ParsedRoutings = (Vec<(String, [f64; CONTROL_POINTS])>, BTreeMap<String, f64>);
 
@@ -135,29 +130,7 @@ pub fn run(args: &SynthArgs) -> anyhow::Result<()> {
     let mut actuator = args.actuator.resolve(None)?;
     // The actuator as it would be without the hidden effect, to size the effect against the noise.
     let without_effect = actuator.clone();
-    if let Some(hidden) = OUT_OF_LIBRARY.iter().find(|h| **h == args.effect) {
-        let Some(m) = args.magnitude else {
-            bail!("--effect {hidden} needs --magnitude ({})", if *hidden == "rest_curvature" { "the rest curvature in 1/mm, e.g. 0.004" } else { "the joint's EI factor, e.g. 5" });
-        };
-        let h = &mut actuator.effects.hidden;
-        if *hidden == "rest_curvature" {
-            h.rest_curvature_per_mm = m;
-        } else {
-            h.base_segment_ei_factor = m;
-            h.base_segment_mm = args.glue_length_mm;
-        }
-    } else if args.effect != "none" {
-        let Some(effect) = Effect::parse(&args.effect) else {
-            let names: Vec<&str> = Effect::ALL.iter().map(|e| e.name()).chain(OUT_OF_LIBRARY).collect();
-            bail!("--effect {}: unknown effect; use none or one of {}", args.effect, names.join(", "));
-        };
-        let Some(m) = args.magnitude else {
-            bail!("--effect {} needs --magnitude (its parameter {})", args.effect, effect.parameter_name());
-        };
-        effect.apply(&mut actuator, m);
-    } else if args.magnitude.is_some() {
-        bail!("--magnitude needs --effect");
-    }
+    Planted::parse(&args.effect, args.magnitude, args.glue_length_mm)?.plant(&mut actuator);
     actuator.validate().context("the true actuator")?;
     let (routings, routing_tilts_rad) = match &args.routings {
         Some(t) => parse_routings(t)?,

@@ -1,10 +1,12 @@
-//! The physical model: routing, actuator parameters and effects, and the
+//! The physical model: routing, actuator parameters and effects (with their
+//! registry, [`effects`]), and the
 //! static rod–cable solver.
 
 pub mod actuator;
 pub mod cable;
 pub mod rod;
 pub mod body;
+pub mod effects;
 pub mod record;
 pub mod routing;
 pub mod resolution;
@@ -14,6 +16,7 @@ pub mod spatial;
 pub use body::{Body, BodyError, Segment};
 pub use actuator::Actuator;
 pub use cable::{Cable, MAX_CABLES};
-pub use rod::{Rod, Effects, Gravity, LoadDirection, ParameterError};
+pub use rod::{Rod, Effects, Gravity, LoadDirection, ParameterError, Unmodelled};
+pub use effects::{BackendKind, EffectInfo, REGISTRY};
 pub use routing::{ControlPoints, Routing, RoutingError};
 pub use solver::{simulate, simulate_held, CentrelinePoint, Hold, SimulateError, Simulation, Simulator, SolveFailure, SolverMethod, SolverOptions, TipPose, Unresolved, STATUS_OK};

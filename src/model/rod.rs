@@ -4,15 +4,19 @@
 use super::body::{Body, Segment};
 use serde::{Deserialize, Serialize};
 
-/// Default creep time constant T, s.
-pub const DEFAULT_CREEP_TIME_S: f64 = 10.0;
+// The effects and their registry live in `effects`; re-exported here, where
+// the rod's other parameters are.
+pub use super::effects::{
+    Effects, LoadDirection, Unmodelled, DEFAULT_CREEP_TIME_S, PLAUSIBLE_CLAMP_STIFFNESS, PLAUSIBLE_FRICTION_MU,
+    PLAUSIBLE_GRAVITY_SCALE, PLAUSIBLE_STIFFENING_ALPHA,
+};
 
 /// Standard gravity, m/s².
 pub const STANDARD_GRAVITY_M_S2: f64 = 9.81;
 
 /// A plausible range of a parameter: far beyond any rod cablemap models,
 /// yet refusing values whose products in the solver overflow or vanish.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PlausibleRange {
     /// Smallest value accepted.
     pub min: f64,
@@ -51,18 +55,6 @@ pub const PLAUSIBLE_DENSITY_G_CM3: PlausibleRange =
 /// Acceleration of gravity, m/s².
 pub const PLAUSIBLE_G_M_S2: PlausibleRange =
     PlausibleRange { min: 0.0, max: 1e4, expected: "0, or an acceleration up to 1e4 m/s² (Earth: 9.81)" };
-/// Scale on the weight.
-pub const PLAUSIBLE_GRAVITY_SCALE: PlausibleRange =
-    PlausibleRange { min: 0.0, max: 1e6, expected: "0, or a scale up to 1e6 on the nominal weight (1 is the rod's own)" };
-/// Friction coefficient.
-pub const PLAUSIBLE_FRICTION_MU: PlausibleRange =
-    PlausibleRange { min: 0.0, max: 100.0, expected: "0, or a friction coefficient up to 100 (PTFE on silicone: about 0.1–0.5)" };
-/// Material stiffening α.
-pub const PLAUSIBLE_STIFFENING_ALPHA: PlausibleRange =
-    PlausibleRange { min: 0.0, max: 1e6, expected: "0, or a stiffening up to 1e6" };
-/// Clamp stiffness, N·mm/rad.
-pub const PLAUSIBLE_CLAMP_STIFFNESS: PlausibleRange =
-    PlausibleRange { min: 1e-9, max: 1e18, expected: "a clamp stiffness from 1e-9 to 1e18 N·mm/rad" };
 
 /// Why a parameter set was rejected.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -112,118 +104,6 @@ pub struct Gravity {
 impl Default for Gravity {
     fn default() -> Self {
         Self { enabled: true, direction_rad: 0.0, scale: 1.0, g_m_s2: STANDARD_GRAVITY_M_S2 }
-    }
-}
-
-/// Direction of the last tension change, which decides the sign of friction.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "lowercase")]
-pub enum LoadDirection {
-    /// Tension rising: friction opposes the cable sliding toward the base.
-    #[default]
-    Load,
-    /// Tension falling: friction acts the other way.
-    Unload,
-}
-
-impl LoadDirection {
-    /// The slip sign η in friction's capstan law dτ/ds = −η μ τ |ψ'|:
-    /// +1 loading, −1 unloading.
-    pub fn slip_sign(self) -> f64 {
-        match self {
-            LoadDirection::Load => 1.0,
-            LoadDirection::Unload => -1.0,
-        }
-    }
-}
-
-/// Physical effects beyond the thesis model, each with one parameter
-/// (model-notes §6). All default to "off" (the thesis model).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct Effects {
-    /// Cable–channel friction coefficient μ (capstan law along the channel).
-    pub friction_mu: f64,
-    /// Whether the tension was last rising or falling (sign of friction).
-    pub load_direction: LoadDirection,
-    /// Material stiffening α: bending moment EI·u·(1 + α (r u)²).
-    pub stiffening_alpha: f64,
-    /// Rotational stiffness of the clamp k_θ, N·mm/rad; `None` is a rigid clamp.
-    pub clamp_stiffness_n_mm_per_rad: Option<f64>,
-    /// Channel offset δ: the built channel sits at y_c + δ, mm.
-    pub channel_offset_mm: f64,
-    /// Viscoelastic creep in bending (standard linear solid): the fraction f
-    /// of the instantaneous bending rigidity that relaxes, 0 ≤ f < 1. Held
-    /// long enough at a moment m, the curvature creeps from m/EI to
-    /// m/(EI (1 − f)).
-    pub creep_fraction: f64,
-    /// Time constant T of the creep's dashpot, s (the curvature relaxes
-    /// like exp(−(1 − f) t / T) at a held moment).
-    pub creep_time_s: f64,
-    /// For solves outside a measured protocol (simulate, sweep, design):
-    /// how long each tension is held on a rod with no load history before
-    /// the shape is taken, s. 0 gives the instantaneous (elastic) shape.
-    pub creep_hold_s: f64,
-    /// Out-of-library effects, for synthetic test data only (they are not
-    /// diagnosis candidates): see [`Hidden`]. Not written when off, so
-    /// existing specs and metadata are unchanged.
-    #[serde(skip_serializing_if = "Hidden::is_off")]
-    pub hidden: Hidden,
-    /// Stiffness gradient β: EI(s) = EI·exp(β (s/L − ½)) with EA, GA
-    /// unchanged (uneven curing, an unmodelled taper); β = ln(EI(L)/EI(0)),
-    /// β < 0 is softer toward the tip. Not written when 0, so existing specs
-    /// and metadata are unchanged.
-    #[serde(skip_serializing_if = "is_zero")]
-    pub stiffness_gradient_beta: f64,
-}
-
-fn is_zero(v: &f64) -> bool {
-    *v == 0.0
-}
-
-/// Effects deliberately outside the diagnosis's candidate list, so that
-/// tests can check that the diagnosis says "unexplained" instead of naming
-/// a wrong effect (`cablemap synth --effect rest_curvature|glue_joint`).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct Hidden {
-    /// Rest (cured-in) curvature along the whole rod, 1/mm: the bending law
-    /// becomes m = EI (u − u₀).
-    pub rest_curvature_per_mm: f64,
-    /// Bending rigidity factor over `[0, base_segment_mm]` (a stiff glue
-    /// joint at the clamp); 1 is none.
-    pub base_segment_ei_factor: f64,
-    /// Length of the stiff base segment, mm.
-    pub base_segment_mm: f64,
-}
-
-impl Default for Hidden {
-    fn default() -> Self {
-        Self { rest_curvature_per_mm: 0.0, base_segment_ei_factor: 1.0, base_segment_mm: 0.0 }
-    }
-}
-
-impl Hidden {
-    /// Whether every hidden effect is off.
-    pub fn is_off(&self) -> bool {
-        *self == Hidden::default()
-    }
-}
-
-impl Default for Effects {
-    fn default() -> Self {
-        Self {
-            friction_mu: 0.0,
-            load_direction: LoadDirection::Load,
-            stiffening_alpha: 0.0,
-            clamp_stiffness_n_mm_per_rad: None,
-            channel_offset_mm: 0.0,
-            creep_fraction: 0.0,
-            creep_time_s: DEFAULT_CREEP_TIME_S,
-            creep_hold_s: 0.0,
-            hidden: Hidden::default(),
-            stiffness_gradient_beta: 0.0,
-        }
     }
 }
 
@@ -373,84 +253,18 @@ impl Rod {
         ] {
             range.check(name, value)?;
         }
-        let non_negative = [
+        for (name, value, range) in [
             ("density_g_cm3", self.density_g_cm3, PLAUSIBLE_DENSITY_G_CM3),
             ("gravity.g_m_s2", self.gravity.g_m_s2, PLAUSIBLE_G_M_S2),
-            ("gravity.scale", self.gravity.scale, PLAUSIBLE_GRAVITY_SCALE),
-            ("effects.friction_mu", self.effects.friction_mu, PLAUSIBLE_FRICTION_MU),
-            ("effects.stiffening_alpha", self.effects.stiffening_alpha, PLAUSIBLE_STIFFENING_ALPHA),
-        ];
-        for (name, value, range) in non_negative {
+        ] {
             if !(value.is_finite() && value >= 0.0) {
                 return Err(ParameterError::OutOfRange { name, value, expected: "a finite number ≥ 0" });
             }
             range.check(name, value)?;
         }
-        let tilt = self.gravity.direction_rad;
-        if !(tilt.is_finite() && tilt.abs() <= std::f64::consts::TAU) {
-            return Err(ParameterError::OutOfRange {
-                name: "gravity.direction_rad",
-                value: tilt,
-                expected: "an angle in rad with |θ| ≤ 2π (was it given in degrees?)",
-            });
-        }
-        if let Some(k) = self.effects.clamp_stiffness_n_mm_per_rad {
-            if !(k.is_finite() && k > 0.0) {
-                return Err(ParameterError::NotPositive { name: "effects.clamp_stiffness_n_mm_per_rad", value: k });
-            }
-            PLAUSIBLE_CLAMP_STIFFNESS.check("effects.clamp_stiffness_n_mm_per_rad", k)?;
-        }
-        let f = self.effects.creep_fraction;
-        if !(f.is_finite() && (0.0..1.0).contains(&f)) {
-            return Err(ParameterError::OutOfRange {
-                name: "effects.creep_fraction",
-                value: f,
-                expected: "0 ≤ f < 1 (the fraction of the bending rigidity that relaxes)",
-            });
-        }
-        let t = self.effects.creep_time_s;
-        if !(t.is_finite() && t > 0.0) {
-            return Err(ParameterError::NotPositive { name: "effects.creep_time_s", value: t });
-        }
-        let hold = self.effects.creep_hold_s;
-        if !(hold.is_finite() && hold >= 0.0) {
-            return Err(ParameterError::OutOfRange { name: "effects.creep_hold_s", value: hold, expected: "a finite time ≥ 0 s" });
-        }
-        let h = &self.effects.hidden;
-        if !h.rest_curvature_per_mm.is_finite() {
-            return Err(ParameterError::OutOfRange {
-                name: "effects.hidden.rest_curvature_per_mm",
-                value: h.rest_curvature_per_mm,
-                expected: "a finite curvature in 1/mm",
-            });
-        }
-        if !(h.base_segment_ei_factor.is_finite() && h.base_segment_ei_factor > 0.0) {
-            return Err(ParameterError::NotPositive { name: "effects.hidden.base_segment_ei_factor", value: h.base_segment_ei_factor });
-        }
-        if !(h.base_segment_mm.is_finite() && h.base_segment_mm >= 0.0) {
-            return Err(ParameterError::OutOfRange {
-                name: "effects.hidden.base_segment_mm",
-                value: h.base_segment_mm,
-                expected: "a finite length ≥ 0 mm",
-            });
-        }
-        let beta = self.effects.stiffness_gradient_beta;
-        if !(beta.is_finite() && beta.abs() <= 20.0) {
-            return Err(ParameterError::OutOfRange {
-                name: "effects.stiffness_gradient_beta",
-                value: beta,
-                expected: "|β| ≤ 20 (β = ln(EI(L)/EI(0)))",
-            });
-        }
+        // Every effect parameter by its registry entry.
+        super::effects::validate(self)?;
         Body::of(self)?;
-        let delta = self.effects.channel_offset_mm;
-        if !(delta.is_finite() && delta.abs() < self.radius_mm) {
-            return Err(ParameterError::OutOfRange {
-                name: "effects.channel_offset_mm",
-                value: delta,
-                expected: "|δ| below the radius",
-            });
-        }
         Ok(())
     }
 }

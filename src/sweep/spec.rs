@@ -216,16 +216,16 @@ impl SweepSpec {
         // A tapered body's levels are fractions of its narrowest radius along the cable.
         let r = self.actuator.channel_radius_mm();
         if (g.extent_r * r).abs() + delta.abs() >= r {
-            return Err(SpecError::setting("grid", format!("extent_r = {} with channel_offset_mm = {delta} puts the channel beyond ±r: reduce one of them",
-                g.extent_r
+            return Err(SpecError::setting("grid", format!("extent_r = {} with {} = {delta} puts the channel beyond ±r: reduce one of them",
+                g.extent_r, crate::model::effects::CHANNEL_OFFSET.key
             )));
         }
         if g.mirror_dedup {
             let gravity = &self.actuator.gravity;
             let tilted = gravity.enabled && gravity.scale != 0.0 && gravity.direction_rad.sin().abs() > 1e-12;
             if delta != 0.0 || tilted {
-                return Err(SpecError::setting("grid", "mirror_dedup = true needs a mirror-symmetric actuator (channel_offset_mm = 0 and \
-                            gravity along the clamp axis): set mirror_dedup = false"));
+                return Err(SpecError::setting("grid", format!("mirror_dedup = true needs a mirror-symmetric actuator ({} = 0 and \
+                            gravity along the clamp axis): set mirror_dedup = false", crate::model::effects::CHANNEL_OFFSET.key)));
             }
         }
         let t = &self.tension;

@@ -80,19 +80,11 @@ pub enum SpatialError {
 /// body, and none of the planar solver's effects.
 pub(crate) fn check_rod(rod: &Rod) -> Result<(), SpatialError> {
     rod.validate()?;
-    let e = &rod.effects;
-    let d = crate::model::Effects::default();
-    let unsupported = [
-        ("friction_mu", e.friction_mu != d.friction_mu),
-        ("stiffening_alpha", e.stiffening_alpha != d.stiffening_alpha),
-        ("clamp_stiffness_n_mm_per_rad", e.clamp_stiffness_n_mm_per_rad.is_some()),
-        ("channel_offset_mm", e.channel_offset_mm != d.channel_offset_mm),
-        ("creep_fraction", e.creep_fraction != d.creep_fraction),
-        ("hidden", e.hidden != d.hidden),
-        ("stiffness_gradient_beta", e.stiffness_gradient_beta != d.stiffness_gradient_beta),
-    ];
-    if let Some((name, _)) = unsupported.iter().find(|(_, on)| *on) {
-        return Err(SpatialError::UnsupportedEffect(name));
+    if let Some(effect) = crate::model::effects::unsupported_by(crate::model::effects::BackendKind::Spatial, rod) {
+        return Err(SpatialError::UnsupportedEffect(effect.key));
+    }
+    if !rod.effects.hidden.is_off() {
+        return Err(SpatialError::UnsupportedEffect("hidden"));
     }
     if !rod.is_uniform_body() {
         return Err(SpatialError::NonUniformRod);
