@@ -81,6 +81,10 @@ pub enum ParameterError {
     /// ([`crate::model::body::BodyError`]).
     #[error("{0}")]
     Body(String),
+    /// The solver backend asked for does not model this rod
+    /// ([`crate::model::solver::Backend::check`]).
+    #[error(transparent)]
+    Unsupported(#[from] crate::model::solver::Unsupported),
 }
 
 /// Why an actuator file could not be used.
@@ -207,6 +211,27 @@ impl Hidden {
     /// Whether every hidden effect is off.
     pub fn is_off(&self) -> bool {
         *self == Hidden::default()
+    }
+}
+
+impl Effects {
+    /// The names (spec keys under `[effects]`) of the effects that change the
+    /// model away from the thesis's rod, in one place: what a backend that
+    /// models no effects refuses ([`crate::model::solver::Backend::check`]).
+    /// The load direction, creep time and hold act only through friction
+    /// and creep, so they are not listed.
+    pub fn non_default(&self) -> Vec<&'static str> {
+        let d = Effects::default();
+        let on = [
+            ("friction_mu", self.friction_mu != d.friction_mu),
+            ("stiffening_alpha", self.stiffening_alpha != d.stiffening_alpha),
+            ("clamp_stiffness_n_mm_per_rad", self.clamp_stiffness_n_mm_per_rad.is_some()),
+            ("channel_offset_mm", self.channel_offset_mm != d.channel_offset_mm),
+            ("creep_fraction", self.creep_fraction != d.creep_fraction),
+            ("hidden", self.hidden != d.hidden),
+            ("stiffness_gradient_beta", self.stiffness_gradient_beta != d.stiffness_gradient_beta),
+        ];
+        on.into_iter().filter(|(_, on)| *on).map(|(name, _)| name).collect()
     }
 }
 
