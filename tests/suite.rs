@@ -10,6 +10,8 @@
 //! `tests/` that neither lists. One file's tests:
 //! `cargo test --release --test suite -- map::`.
 
+#[path = "backends.rs"]
+mod backends;
 #[path = "bodies.rs"]
 mod bodies;
 #[path = "calibrate.rs"]

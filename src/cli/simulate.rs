@@ -2,7 +2,7 @@
 
 use super::{parse_list, ActuatorArgs, LengthBasisArgs};
 use cablemap::model::record::{self, SimulationRecord};
-use cablemap::model::{simulate_held, Hold, LoadDirection, Routing, SimulateError, SolverOptions};
+use cablemap::model::{simulate_held, Backend, Given, Hold, LoadDirection, Routing, SimulateError, SolverOptions};
 use cablemap::plot::{draw_bodies, BodyDrawing};
 use anyhow::Context;
 use clap::Args;
@@ -97,6 +97,9 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     );
     let y = parse_list(routing_text, "--routing")?;
     let routing = Routing::for_actuator(&y, &actuator).context("--routing")?;
+    // The one check: a setting the planar backend of --method does not read is refused.
+    let one = cablemap::model::Actuator::with_cables(actuator.clone(), vec![cablemap::model::Cable::planar(routing.control_points_mm().0, tension)]);
+    Backend::planar(options.method).check(&one, &options, given_settings(args))?;
     let direction = if args.direction == "unload" { LoadDirection::Unload } else { LoadDirection::Load };
     let hold = Hold { direction, dwell_s: args.dwell_s.unwrap_or(actuator.effects.creep_hold_s) };
     // The thesis route computes its own coefficients from the centreline
@@ -165,17 +168,14 @@ fn report_png(args: &SimulateArgs) {
     }
 }
 
-/// Several or spatial cables: the 3-D solver (`model::spatial`).
+/// An actuator given by its cables (`--cable`, `--actuator`, or a routing
+/// with spatial flags): solved by the backend that serves it
+/// ([`cablemap::model::Backend::serving`]: the planar fast path for one
+/// in-plane cable with gravity in the plane, else the 3-D solver) and
+/// reported in the actuator's terms (the spatial record).
 fn run_spatial(args: &SimulateArgs) -> anyhow::Result<()> {
-    use cablemap::model::spatial::{record, Cable, Actuator, SpatialError, SpatialOptions};
-    let planar_only = [
-        (args.coefficients == CoefficientRoute::Thesis, "--coefficients thesis"),
-        (args.direction != "load", "--direction"),
-        (args.dwell_s.is_some(), "--dwell-s"),
-    ];
-    if let Some((_, flag)) = planar_only.iter().find(|(given, _)| *given) {
-        anyhow::bail!("{flag} applies to the planar single-cable solver (--routing/--tension) only; the 3-D solver models the thesis's rod");
-    }
+    use cablemap::model::spatial::{record, simulate_actuator, Actuator, Cable, SpatialOptions};
+    use cablemap::model::Hold;
     // The rod: the spatial file's [rod], else an --actuator-file, else the
     // thesis's; rod flags override either.
     let mut spatial = match &args.spatial_actuator {
@@ -207,15 +207,40 @@ fn run_spatial(args: &SimulateArgs) -> anyhow::Result<()> {
         let g: [f64; 3] = g.try_into().map_err(|g: Vec<f64>| anyhow::anyhow!("--gravity-direction needs 3 numbers X,Y,Z, got {}", g.len()))?;
         spatial.gravity_direction = Some(g);
     }
-    let mut options = SpatialOptions::default();
+    anyhow::ensure!(
+        args.n_d <= MAX_N_D,
+        "--n-d {} is more than {MAX_N_D} intervals (the thesis uses 40; the solver has only 2 × steps-per-span nodes to resample)",
+        args.n_d
+    );
+    let options = args.actuator.solver_options(&SolverOptions::default());
+    let mut spatial_options = SpatialOptions::default();
     if let Some(steps) = args.actuator.steps_per_span {
-        options.steps_per_span = steps;
+        spatial_options.steps_per_span = steps;
     }
-    let solved = cablemap::model::spatial::simulate_spatial(&spatial, &options, args.order, args.basis.length_basis);
-    if let (Err(SpatialError::Solve(failure)), true) = (&solved, args.json) {
-        print_failure_json(failure.status(), &failure.to_string())?;
+    let thesis = args.coefficients == CoefficientRoute::Thesis;
+    let given = given_settings(args);
+    // As the planar `--routing` path holds it.
+    let direction = if args.direction == "unload" { LoadDirection::Unload } else { LoadDirection::Load };
+    let hold = Hold { direction, dwell_s: args.dwell_s.unwrap_or(spatial.rod.effects.creep_hold_s) };
+    let order = if thesis { args.order.min(cablemap::model::resolution::max_order(&options)) } else { args.order };
+    let basis = args.basis.length_basis;
+    let solved = simulate_actuator(&spatial, &options, &spatial_options, given, Some(hold), order, basis);
+    if let (Err(e), true) = (&solved, args.json) {
+        if let Some(status) = e.failure_status() {
+            print_failure_json(status, &e.to_string())?;
+        }
     }
-    let sim = solved?;
+    let solved = solved?;
+    let mut sim = solved.spatial;
+    if let (true, Some(planar)) = (thesis, &solved.planar) {
+        let points: Vec<[f64; 2]> = planar.centreline.iter().map(|c| [c.x_mm, c.y_mm]).collect();
+        sim.a_bend_z = cablemap::shape::thesis_coefficients(&points, args.order, args.n_d)
+            .context("thesis coefficient route")?
+            .in_basis(basis, spatial.rod.length_mm)
+            .a;
+        sim.a_bend_y = vec![0.0; sim.a_bend_z.len()];
+        sim.a_twist = vec![0.0; sim.a_bend_z.len()];
+    }
     if let Some(path) = &args.csv {
         record::write_centreline_csv(path, &sim).with_context(|| format!("writing centreline CSV {}", path.display()))?;
     }
@@ -234,6 +259,18 @@ fn run_spatial(args: &SimulateArgs) -> anyhow::Result<()> {
     drop(out);
     report_png(args);
     Ok(())
+}
+
+/// The settings given by flags rather than left at their defaults: the
+/// backend serving the request must read each ([`Backend::check`]).
+fn given_settings(args: &SimulateArgs) -> Given {
+    Given {
+        method: args.actuator.method.is_some(),
+        nodes_per_span: args.actuator.nodes_per_span.is_some(),
+        steps_per_span: args.actuator.steps_per_span.is_some(),
+        hold: args.direction != "load" || args.dwell_s.is_some(),
+        thesis_coefficients: args.coefficients == CoefficientRoute::Thesis,
+    }
 }
 
 /// With `--json`, a failed solve is a record too: its status (the one a

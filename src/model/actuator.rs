@@ -5,7 +5,8 @@
 //! (docs/schema.md).
 
 use crate::model::cable::{self, Cable};
-use crate::model::spatial::{check_rod, SpatialError};
+use crate::model::spatial::SpatialError;
+use crate::model::{Backend, Given, SolverOptions};
 use crate::model::{ParameterError, Rod};
 use serde::{Deserialize, Serialize};
 
@@ -61,9 +62,20 @@ impl Actuator {
         Ok(g.map(|c| c / n))
     }
 
-    /// Checks everything and builds the cables' channels.
+    /// Checks everything for the spatial solver (the cable sweep's and
+    /// [`crate::model::spatial::SpatialSolver`]'s input): the actuator
+    /// ([`Actuator::channels`]) and that the spatial backend models it
+    /// ([`Backend::check`]); builds the cables' channels.
     pub fn validate(&self) -> Result<Vec<cable::Channel>, SpatialError> {
-        check_rod(&self.rod)?;
+        let channels = self.channels()?;
+        Backend::Spatial.check(self, &SolverOptions::default(), Given::default())?;
+        Ok(channels)
+    }
+
+    /// Checks the actuator itself, whichever backend solves it (the rod's
+    /// parameters, torsion, gravity and cables), and builds the cables' channels.
+    pub fn channels(&self) -> Result<Vec<cable::Channel>, SpatialError> {
+        self.rod.validate()?;
         if let Some(gj) = self.gj_n_mm2 {
             if !(gj.is_finite() && gj > 0.0) {
                 return Err(ParameterError::NotPositive { name: "gj_n_mm2", value: gj }.into());
@@ -79,12 +91,13 @@ impl Actuator {
         toml::from_str(text).map_err(|e| SpatialError::Toml { source_name: source.to_string(), message: e.to_string() })
     }
 
-    /// Reads and validates an actuator file.
+    /// Reads and checks an actuator file ([`Actuator::channels`]; which
+    /// backend serves it is decided when it is solved).
     pub fn read(path: &std::path::Path) -> Result<Self, SpatialError> {
         let text = std::fs::read_to_string(path)
             .map_err(|e| SpatialError::Read { path: path.display().to_string(), message: e.to_string() })?;
         let a = Self::from_toml(&text, &path.display().to_string())?;
-        a.validate()?;
+        a.channels()?;
         Ok(a)
     }
 }

@@ -29,7 +29,8 @@ pub struct Cable {
     /// Tension pulled at the base, N (≥ 0).
     pub tension_n: f64,
     /// Arc length s_k of the knot, mm (0 < s_k ≤ L); `None` is the tip.
-    /// Beyond s_k the cable is slack and carries no load.
+    /// The five control points span the cable, [0, s_k] (as the planar
+    /// `cable_anchor_mm`); beyond s_k the cable is slack and carries no load.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub anchor_mm: Option<f64>,
 }
@@ -114,15 +115,18 @@ pub fn validate(actuator: &Rod, cables: &[Cable]) -> Result<Vec<Channel>, Spatia
         if !(cable.tension_n.is_finite() && cable.tension_n >= 0.0) {
             return Err(SpatialError::Tension { cable: cable_no, tension_n: cable.tension_n });
         }
-        let y = Routing::new(&cable.y_mm, length, radius)
-            .map_err(|source| SpatialError::Routing { cable: cable_no, axis: 'y', source })?;
-        let z = Routing::new(&cable.z_mm, length, radius)
-            .map_err(|source| SpatialError::Routing { cable: cable_no, axis: 'z', source })?;
         if let Some(anchor) = cable.anchor_mm {
             if !(anchor.is_finite() && anchor > 0.0 && anchor <= length) {
                 return Err(SpatialError::Anchor { cable: cable_no, anchor_mm: anchor, length_mm: length });
             }
         }
+        // The control points span the cable, [0, anchor] (docs/model.md,
+        // "Cables"), as the planar solver's `cable_anchor_mm` does.
+        let span = cable.anchor_or_tip_mm(length);
+        let y = Routing::new(&cable.y_mm, span, radius)
+            .map_err(|source| SpatialError::Routing { cable: cable_no, axis: 'y', source })?;
+        let z = Routing::new(&cable.z_mm, span, radius)
+            .map_err(|source| SpatialError::Routing { cable: cable_no, axis: 'z', source })?;
         let channel = Channel { y, z };
         let n = 2 * RADIUS_CHECK_POINTS_PER_SPAN;
         for k in 0..=n {

@@ -166,32 +166,8 @@ impl Unmodelled {
     }
 }
 
-/// A solver backend, as far as effects are concerned: each registry entry
-/// lists the backends that model it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum BackendKind {
-    /// The planar solver by spectral collocation (the default).
-    PlanarCollocation,
-    /// The planar solver by RK4 with shooting (the reference method).
-    PlanarRk4,
-    /// The 3-D solver of several or out-of-plane cables.
-    Spatial,
-}
-
-impl BackendKind {
-    /// Every backend.
-    pub const ALL: [BackendKind; 3] = [BackendKind::PlanarCollocation, BackendKind::PlanarRk4, BackendKind::Spatial];
-
-    /// The backend's name in messages and docs.
-    pub fn name(self) -> &'static str {
-        match self {
-            BackendKind::PlanarCollocation => "planar collocation",
-            BackendKind::PlanarRk4 => "planar RK4",
-            BackendKind::Spatial => "spatial",
-        }
-    }
-}
+/// The solver backends each entry lists as modelling it.
+pub use crate::model::solver::Backend as BackendKind;
 
 /// The table of the rod a parameter sits in (`[actuator.effects]`,
 /// `[actuator.gravity]` in a sweep spec; `[rod.…]` in a cable spec).

@@ -73,6 +73,10 @@ pub enum ParameterError {
     /// ([`crate::model::body::BodyError`]).
     #[error("{0}")]
     Body(String),
+    /// The solver backend asked for does not model this rod
+    /// ([`crate::model::solver::Backend::check`]).
+    #[error(transparent)]
+    Unsupported(#[from] crate::model::solver::Unsupported),
 }
 
 /// Why an actuator file could not be used.

@@ -53,6 +53,7 @@ use super::routing::Routing;
 use crate::shape::LengthBasis;
 use serde::{Deserialize, Serialize};
 
+pub mod backend;
 mod collocation;
 mod continuation;
 mod creep;
@@ -60,6 +61,7 @@ mod friction;
 mod probe;
 mod rk4;
 
+pub use backend::{Backend, Given, Support, Unsupported};
 use creep::Creep;
 use friction::Friction;
 
@@ -414,11 +416,7 @@ impl Simulator {
             options.nodes_per_span
         };
         let body = Body::of(actuator)?;
-        if options.method == SolverMethod::Rk4 && !actuator.is_uniform_body() && actuator.cable_length_mm() < actuator.length_mm {
-            return Err(ParameterError::Body(
-                "the rk4 reference method knots the cable at the tip only: use the default collocation method for a cable anchored before the tip".into(),
-            ));
-        }
+        Backend::check_planar(actuator, options)?;
         let spans = span_boundaries(actuator, body.as_ref(), 0.5 * actuator.cable_length_mm()).len() - 1;
         // Per-point buffers: RK4 stage points, or collocation nodes.
         let points = match options.method {
@@ -930,7 +928,7 @@ pub struct Simulation {
 }
 
 /// Why [`simulate`] or [`simulate_held`] produced no result.
-#[derive(Debug, thiserror::Error)]
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SimulateError {
     /// The actuator, solver options, hold or coefficient order are invalid.
     #[error(transparent)]

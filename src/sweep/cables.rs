@@ -290,7 +290,7 @@ impl CableSweepSpec {
         let base = self.actuator_for(0, &self.dimensions());
         match base.validate() {
             Err(SpatialError::Parameter(e)) => return Err(bad(e.to_string())),
-            Err(e @ (SpatialError::UnsupportedEffect(_) | SpatialError::NonUniformRod)) => return Err(bad(format!("[rod] {e}"))),
+            Err(e @ SpatialError::Unsupported(_)) => return Err(bad(format!("[rod] {e}"))),
             Err(e @ SpatialError::GravityDirection(_)) => return Err(bad(e.to_string())),
             _ => {}
         }

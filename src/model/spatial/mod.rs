@@ -17,7 +17,7 @@ pub use crate::model::actuator::{Actuator, EI_OVER_GJ};
 pub use solver::{check_order, SpatialFailure, SpatialNode, SpatialOptions, SpatialPose, SpatialSolver, MAX_SPATIAL_ORDER};
 
 use crate::model::routing::RoutingError;
-use crate::model::{Rod, ParameterError};
+use crate::model::ParameterError;
 use crate::shape::LengthBasis;
 use serde::Serialize;
 
@@ -48,12 +48,13 @@ pub enum SpatialError {
     /// A rod parameter is bad.
     #[error(transparent)]
     Parameter(#[from] ParameterError),
-    /// The spatial solver models the thesis's rod only.
-    #[error("effects.{0} is not modelled by the spatial solver (it models the thesis's rod: no friction, stiffening, clamp compliance, channel offset or creep); leave it at its default")]
-    UnsupportedEffect(&'static str),
-    /// A tapered or segmented rod, or a rod-level cable anchor.
-    #[error("the spatial solver models a uniform rod: leave out radius_profile_mm and segments, and give each cable its own anchor (anchor=S) instead of cable_anchor_mm")]
-    NonUniformRod,
+    /// The solver serving the request does not model part of it
+    /// ([`crate::model::Backend::check`]).
+    #[error(transparent)]
+    Unsupported(#[from] crate::model::Unsupported),
+    /// A planar solve (the fast path of a one-cable in-plane actuator) failed.
+    #[error(transparent)]
+    Planar(#[from] crate::model::SimulateError),
     /// The `--cable` text could not be read.
     #[error("cable \"{text}\": {why} (expected \"y=Y0,Y1,Y2,Y3,Y4 z=Z0,Z1,Z2,Z3,Z4 tension=T\", z= optional, anchor=S optional)")]
     CableSpec { text: String, why: String },
@@ -74,22 +75,6 @@ pub enum SpatialError {
         /// The cause (as text: this error is cloned and compared).
         message: String,
     },
-}
-
-/// Checks that the 3-D solver models `rod`: valid parameters, a uniform
-/// body, and none of the planar solver's effects.
-pub(crate) fn check_rod(rod: &Rod) -> Result<(), SpatialError> {
-    rod.validate()?;
-    if let Some(effect) = crate::model::effects::unsupported_by(crate::model::effects::BackendKind::Spatial, rod) {
-        return Err(SpatialError::UnsupportedEffect(effect.key));
-    }
-    if !rod.effects.hidden.is_off() {
-        return Err(SpatialError::UnsupportedEffect("hidden"));
-    }
-    if !rod.is_uniform_body() {
-        return Err(SpatialError::NonUniformRod);
-    }
-    Ok(())
 }
 
 /// Everything about one spatial solve (allocates; for single solves).
@@ -115,7 +100,7 @@ pub struct SpatialSimulation {
 impl SpatialSimulation {
     /// Each cable's path in the global frame at the nodes, mm.
     pub fn cable_paths_mm(&self) -> Vec<Vec<[f64; 3]>> {
-        let channels = self.actuator.validate().expect("validated when solved");
+        let channels = self.actuator.channels().expect("validated when solved");
         channels
             .iter()
             .map(|c| {
@@ -243,4 +228,127 @@ fn solve_ladder(actuator: &Actuator, options: &SpatialOptions, order: usize, bas
         length_basis: basis,
         nodes: solver.nodes().to_vec(),
     })
+}
+
+/// What [`simulate_actuator`] solved: the planar result of the fast path
+/// (kept for what only it has, the planar centreline), and the one result
+/// type of an actuator, [`SpatialSimulation`] (the planar values as its
+/// in-plane special case).
+#[derive(Debug, Clone)]
+pub struct ActuatorSimulation {
+    /// The backend that solved it.
+    pub backend: crate::model::Backend,
+    /// The planar solve, when a planar backend served the request.
+    pub planar: Option<crate::model::Simulation>,
+    /// The result in the actuator's terms.
+    pub spatial: SpatialSimulation,
+}
+
+/// Solves `actuator` with the backend that serves it ([`crate::model::Backend::serving`]):
+/// one in-plane cable with gravity in the plane takes the planar fast path
+/// (`options`, and `hold` for the final tension), anything else the 3-D
+/// solver (`spatial_options`). `given` names the settings asked for
+/// explicitly; one a backend does not read is refused, not ignored.
+#[allow(clippy::too_many_arguments)]
+pub fn simulate_actuator(
+    actuator: &Actuator,
+    options: &crate::model::SolverOptions,
+    spatial_options: &SpatialOptions,
+    given: crate::model::Given,
+    hold: Option<crate::model::Hold>,
+    order: usize,
+    basis: LengthBasis,
+) -> Result<ActuatorSimulation, SpatialError> {
+    use crate::model::Backend;
+    actuator.channels()?;
+    let backend = Backend::serving(actuator, options, given)?;
+    if backend == Backend::Spatial {
+        let spatial = simulate_spatial(actuator, spatial_options, order, basis)?;
+        return Ok(ActuatorSimulation { backend, planar: None, spatial });
+    }
+    let (rod, routing) = planar_problem(actuator)?;
+    let cable = &actuator.cables[0];
+    let hold = hold.unwrap_or(crate::model::Hold { direction: rod.effects.load_direction, dwell_s: rod.effects.creep_hold_s });
+    let planar = crate::model::simulate_held(&rod, options, &routing, cable.tension_n, order, basis, hold)?;
+    let spatial = planar_as_spatial(actuator, &planar);
+    Ok(ActuatorSimulation { backend, planar: Some(planar), spatial })
+}
+
+/// The planar solver's input for a planar `actuator` (one cable, z ≡ 0,
+/// gravity in the x–y plane): the rod with the cable's anchor and gravity's
+/// in-plane direction, and the cable's routing over [0, anchor].
+pub fn planar_problem(actuator: &Actuator) -> Result<(crate::model::Rod, crate::model::Routing), SpatialError> {
+    let cable = &actuator.cables[0];
+    let mut rod = actuator.rod.clone();
+    if let Some(anchor) = cable.anchor_mm {
+        if rod.cable_anchor_mm.is_some_and(|k| k != anchor) {
+            return Err(SpatialError::Option(format!(
+                "cable 1 has anchor={} mm and the rod cable_anchor_mm = {} mm: give the anchor once",
+                crate::io::fmt_num(anchor),
+                crate::io::fmt_num(rod.cable_anchor_mm.unwrap_or(anchor))
+            )));
+        }
+        rod.cable_anchor_mm = Some(anchor);
+    }
+    if let (Some(g), true) = (actuator.gravity_direction, rod.gravity.enabled) {
+        rod.gravity.direction_rad = g[1].atan2(g[0]);
+    }
+    let routing = crate::model::Routing::for_actuator(cable.y_mm, &rod)
+        .map_err(|source| SpatialError::Routing { cable: 1, axis: 'y', source })?;
+    Ok((rod, routing))
+}
+
+/// A planar solve of `actuator` as its [`SpatialSimulation`]: the frame
+/// turns about z by φ, v = (v1, v2, 0), u = (0, 0, u), the in-plane series
+/// is the planar a_i and the out-of-plane and twist series are zero.
+pub fn planar_as_spatial(actuator: &Actuator, planar: &crate::model::Simulation) -> SpatialSimulation {
+    let p = &planar.pose;
+    let (st, ct) = p.tip_angle_rad.sin_cos();
+    let (sf, cf) = p.tip_frame_angle_rad.sin_cos();
+    let pose = SpatialPose {
+        tip_mm: [p.tip_x_mm, p.tip_y_mm, 0.0],
+        tip_tangent: [ct, st, 0.0],
+        tip_body_y_axis: [-sf, cf, 0.0],
+        // As the spatial solver measures it: the unsigned angle to +x.
+        tip_angle_rad: ct.clamp(-1.0, 1.0).acos(),
+        length_mm: p.length_mm,
+        passes: p.iterations,
+    };
+    let nodes = planar
+        .centreline
+        .iter()
+        .map(|c| {
+            let (s, co) = c.frame_angle_rad.sin_cos();
+            SpatialNode {
+                s_mm: c.s_mm,
+                p_mm: [c.x_mm, c.y_mm, 0.0],
+                rotation: [[co, -s, 0.0], [s, co, 0.0], [0.0, 0.0, 1.0]],
+                v: [c.v1, c.v2, 0.0],
+                u_per_mm: [0.0, 0.0, c.u_per_mm],
+                arc_length_mm: c.arc_length_mm,
+            }
+        })
+        .collect();
+    let zeros = vec![0.0; planar.a.len()];
+    SpatialSimulation {
+        actuator: actuator.clone(),
+        pose,
+        a_twist: zeros.clone(),
+        a_bend_y: zeros,
+        a_bend_z: planar.a.clone(),
+        length_basis: planar.length_basis,
+        nodes,
+    }
+}
+
+impl SpatialError {
+    /// The status a sweep stores for a failed solve (`unresolved`,
+    /// `non_finite`, …), whichever backend failed; `None` for bad input.
+    pub fn failure_status(&self) -> Option<&'static str> {
+        match self {
+            SpatialError::Solve(f) => Some(f.status()),
+            SpatialError::Planar(crate::model::SimulateError::Solve(f)) => Some(f.status()),
+            _ => None,
+        }
+    }
 }

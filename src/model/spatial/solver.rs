@@ -288,8 +288,10 @@ impl SpatialSolver {
         let g = actuator.gravity_unit()?;
         let weight = V3::from(g) * rod.weight_n_per_mm();
         let length = rod.length_mm;
-        // Breakpoints: clamp, knot, anchors, tip.
-        let mut cuts = vec![0.0, channels[0].knot_mm(), length];
+        // Breakpoints: clamp, every cable's knot (each channel spans its
+        // cable, [0, anchor]), anchors, tip.
+        let mut cuts = vec![0.0, length];
+        cuts.extend(channels.iter().map(Channel::knot_mm));
         cuts.extend(actuator.cables.iter().filter_map(|c| c.anchor_mm).filter(|&a| a < length));
         cuts.sort_by(f64::total_cmp);
         cuts.dedup_by(|a, b| (*a - *b).abs() < 1e-9);

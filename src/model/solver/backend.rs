@@ -1,0 +1,315 @@
+//! The solver interface: which backend solves an [`Actuator`], what each
+//! backend models, and the one check that refuses a request a backend
+//! cannot serve ([`Backend::check`]).
+//!
+//! Three backends solve the same actuator (a rod with 1–8 cables):
+//! - [`Backend::PlanarCollocation`], the fast path: spectral collocation of
+//!   the planar cut equations (`collocation`), whenever every cable lies in
+//!   one plane through the axis and gravity lies in it — today one cable
+//!   with z ≡ 0 — with every effect, tapered and segmented bodies and anchors;
+//! - [`Backend::PlanarRk4`], the planar reference: classical RK4 with
+//!   shooting (`rk4`), the same model with the cable knotted at the tip;
+//! - [`Backend::Spatial`], the 3-D solver (`crate::model::spatial`): several
+//!   cables, out-of-plane channels and gravity, on the thesis's uniform rod
+//!   without effects.
+//!
+//! What a request needs is listed once ([`needs`]) and what a backend
+//! models once ([`Backend::support`]); the check compares the two, so a
+//! new feature or backend is one line in each.
+
+use crate::model::{Actuator, Rod};
+use crate::model::solver::{SolverMethod, SolverOptions};
+
+/// A way to solve an actuator's statics.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Backend {
+    /// Planar spectral collocation: one cable in the plane of gravity (the default).
+    PlanarCollocation,
+    /// Planar classical RK4 with shooting (`--method rk4`), the reference.
+    PlanarRk4,
+    /// The 3-D solver: several and out-of-plane cables, gravity in any direction.
+    Spatial,
+}
+
+impl Backend {
+    /// The backend's name in messages and docs.
+    pub fn name(self) -> &'static str {
+        match self {
+            Backend::PlanarCollocation => "planar collocation",
+            Backend::PlanarRk4 => "planar RK4",
+            Backend::Spatial => "spatial",
+        }
+    }
+}
+
+impl std::fmt::Display for Backend {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// Settings of a request given explicitly (by a flag or a spec key) rather
+/// than left at their defaults: a backend that does not read one refuses
+/// it instead of ignoring it silently. Defaults every backend may ignore.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Given {
+    /// The method (`--method`).
+    pub method: bool,
+    /// Collocation intervals per span (`--nodes-per-span`).
+    pub nodes_per_span: bool,
+    /// RK4 steps per span (`--steps-per-span`).
+    pub steps_per_span: bool,
+    /// A load direction or dwell of the final tension (`--direction`, `--dwell-s`).
+    pub hold: bool,
+    /// The thesis's coefficient route from a planar centreline (`--coefficients thesis`).
+    pub thesis_coefficients: bool,
+}
+
+/// One thing a request needs of its backend.
+#[derive(Debug, Clone, Copy)]
+enum Need {
+    /// An effect away from its default: served where the registry says.
+    SeveralCables,
+    OutOfPlaneChannel,
+    GravityOutOfPlane,
+    NonUniformBody,
+    AnchorBeforeTip,
+    RodAnchor,
+    /// `synth`'s planted effects (planar only).
+    Unmodelled,
+    Effect(&'static crate::model::effects::EffectInfo),
+    Hold,
+    ThesisCoefficients,
+    Collocation,
+    Rk4,
+    NodesPerSpan,
+    StepsPerSpan,
+}
+
+/// What a backend models: the features of [`needs`] it serves.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Support {
+    /// More than one cable.
+    pub several_cables: bool,
+    /// A channel with z ≠ 0 (out of the x–y plane).
+    pub out_of_plane_channels: bool,
+    /// Gravity with a component out of the x–y plane.
+    pub gravity_out_of_plane: bool,
+    /// A tapered (radius_profile_mm) or segmented (segments) body.
+    pub non_uniform_body: bool,
+    /// A cable knotted before the tip.
+    pub anchors: bool,
+    /// The rod-level anchor `cable_anchor_mm` (the planar single cable's).
+    pub rod_anchor: bool,
+    /// A load direction and dwell of the final tension.
+    pub hold: bool,
+    /// `synth`'s planted, unmodelled effects.
+    pub unmodelled: bool,
+    /// The thesis's coefficient route (needs a planar centreline).
+    pub thesis_coefficients: bool,
+    /// The integration it is asked for by `method`.
+    pub method: SolverMethod,
+    /// Whether it reads `nodes_per_span` (collocation intervals).
+    pub nodes_per_span: bool,
+    /// Whether it reads `steps_per_span` (RK4 steps; collocation's centreline points).
+    pub steps_per_span: bool,
+}
+
+impl Backend {
+    /// Every backend, in the order a request is offered to them.
+    pub const ALL: [Backend; 3] = [Backend::PlanarCollocation, Backend::PlanarRk4, Backend::Spatial];
+
+    /// The planar backend of `method`.
+    pub fn planar(method: SolverMethod) -> Backend {
+        match method {
+            SolverMethod::Collocation => Backend::PlanarCollocation,
+            SolverMethod::Rk4 => Backend::PlanarRk4,
+        }
+    }
+
+    /// What this backend models.
+    pub fn support(self) -> Support {
+        let planar = Support {
+            several_cables: false,
+            out_of_plane_channels: false,
+            gravity_out_of_plane: false,
+            non_uniform_body: true,
+            anchors: true,
+            rod_anchor: true,
+            hold: true,
+            unmodelled: true,
+            thesis_coefficients: true,
+            method: SolverMethod::Collocation,
+            nodes_per_span: true,
+            steps_per_span: true,
+        };
+        match self {
+            Backend::PlanarCollocation => planar,
+            // RK4 integrates each knot span in equal steps from clamp to tip.
+            Backend::PlanarRk4 => Support { anchors: false, method: SolverMethod::Rk4, nodes_per_span: false, ..planar },
+            Backend::Spatial => Support {
+                several_cables: true,
+                out_of_plane_channels: true,
+                gravity_out_of_plane: true,
+                non_uniform_body: false,
+                anchors: true,
+                rod_anchor: false,
+                hold: false,
+                unmodelled: false,
+                thesis_coefficients: false,
+                // Its integrator is RK4: `--method rk4` is what it does.
+                method: SolverMethod::Rk4,
+                nodes_per_span: false,
+                steps_per_span: true,
+            },
+        }
+    }
+
+    /// Whether this backend serves `need`.
+    fn serves(self, need: Need) -> bool {
+        let s = self.support();
+        match need {
+            Need::SeveralCables => s.several_cables,
+            Need::OutOfPlaneChannel => s.out_of_plane_channels,
+            Need::GravityOutOfPlane => s.gravity_out_of_plane,
+            Need::NonUniformBody => s.non_uniform_body,
+            Need::AnchorBeforeTip => s.anchors,
+            Need::RodAnchor => s.rod_anchor,
+            Need::Effect(info) => info.supported_by(self),
+            Need::Unmodelled => s.unmodelled,
+            Need::Hold => s.hold,
+            Need::ThesisCoefficients => s.thesis_coefficients,
+            Need::Collocation => s.method == SolverMethod::Collocation,
+            Need::Rk4 => s.method == SolverMethod::Rk4,
+            Need::NodesPerSpan => s.nodes_per_span,
+            Need::StepsPerSpan => s.steps_per_span,
+        }
+    }
+
+    /// The one check: `Ok` if this backend serves `actuator` with `options`
+    /// (the settings in `given` asked for explicitly); otherwise what it does
+    /// not model and which backend would serve the whole request, if any.
+    pub fn check(self, actuator: &Actuator, options: &SolverOptions, given: Given) -> Result<(), Unsupported> {
+        let needs = needs(actuator, options, given);
+        let Some(&(need, ref what)) = needs.iter().find(|(need, _)| !self.serves(*need)) else {
+            return Ok(());
+        };
+        let others = || Backend::ALL.into_iter().filter(move |b| *b != self);
+        if let Some(b) = others().find(|b| needs.iter().all(|(n, _)| b.serves(*n))) {
+            return Err(Unsupported { backend: self, what: what.clone(), served_by: Some(b), but_not: None });
+        }
+        // None serves it all: name the one that models this part, and what
+        // else of the request it does not.
+        let partial = others().find(|b| b.serves(need));
+        let but_not = partial.and_then(|b| needs.iter().find(|(n, _)| !b.serves(*n)).map(|(_, w)| w.clone()));
+        Err(Unsupported { backend: self, what: what.clone(), served_by: partial, but_not })
+    }
+
+    /// The backend that serves `actuator`: the planar backend of `options.method`
+    /// when every cable lies in the x–y plane with gravity (the fast path),
+    /// else the spatial one; refused by [`Backend::check`] if that one cannot.
+    pub fn serving(actuator: &Actuator, options: &SolverOptions, given: Given) -> Result<Backend, Unsupported> {
+        let backend = if is_planar(actuator) { Backend::planar(options.method) } else { Backend::Spatial };
+        backend.check(actuator, options, given)?;
+        Ok(backend)
+    }
+
+    /// [`Backend::check`] of the planar backend of `options.method` for the
+    /// planar solver's own input: `rod` with its one in-plane cable.
+    pub fn check_planar(rod: &Rod, options: &SolverOptions) -> Result<(), Unsupported> {
+        let one = Actuator::with_cables(rod.clone(), vec![crate::model::Cable::planar([0.0; 5], 0.0)]);
+        Backend::planar(options.method).check(&one, options, Given::default())
+    }
+}
+
+/// Whether `actuator` is planar: one cable with z ≡ 0 and gravity (if on) in
+/// the x–y plane. (Several cables in one plane through the axis would be
+/// planar too; the planar backends take one cable today.)
+pub fn is_planar(actuator: &Actuator) -> bool {
+    let gravity_in_plane = !actuator.rod.gravity.enabled || actuator.gravity_direction.is_none_or(|g| g[2] == 0.0);
+    actuator.cables.len() == 1 && actuator.cables[0].is_planar() && gravity_in_plane
+}
+
+/// Everything `actuator` with `options` needs of a backend, each with the
+/// words that name it in a refusal.
+fn needs(actuator: &Actuator, options: &SolverOptions, given: Given) -> Vec<(Need, String)> {
+    let rod = &actuator.rod;
+    let mut needs = Vec::new();
+    let mut need = |n: Need, what: String| needs.push((n, what));
+    if actuator.cables.len() > 1 {
+        need(Need::SeveralCables, format!("{} cables (it takes one)", actuator.cables.len()));
+    }
+    if let Some(i) = actuator.cables.iter().position(|c| !c.is_planar()) {
+        need(Need::OutOfPlaneChannel, format!("an out-of-plane channel (cable {}: z ≠ 0)", i + 1));
+    }
+    if rod.gravity.enabled && actuator.gravity_direction.is_some_and(|g| g[2] != 0.0) {
+        need(Need::GravityOutOfPlane, "gravity out of the x–y plane (--gravity-direction with Z ≠ 0)".into());
+    }
+    if !rod.radius_profile_mm.is_empty() || !rod.segments.is_empty() {
+        need(Need::NonUniformBody, "a tapered or segmented body (radius_profile_mm, segments): it models a uniform rod".into());
+    }
+    if rod.cable_anchor_mm.is_some() {
+        need(Need::RodAnchor, "the rod-level cable_anchor_mm (--cable-anchor-mm): give each cable its own anchor (anchor=S); it models a uniform rod".into());
+    }
+    let length = rod.length_mm;
+    let anchored = rod.cable_anchor_mm.is_some_and(|k| k < length) || actuator.cables.iter().any(|c| c.anchor_mm.is_some_and(|k| k < length));
+    if anchored {
+        need(Need::AnchorBeforeTip, "a cable anchored before the tip (it knots the cable at the tip only)".into());
+    }
+    for info in crate::model::effects::REGISTRY.iter().copied().filter(|info| info.acts(rod)) {
+        need(Need::Effect(info), format!("effects.{} (leave it at its default)", info.key));
+    }
+    if !rod.effects.hidden.is_off() {
+        need(Need::Unmodelled, "synth's unmodelled effects".into());
+    }
+    if given.hold {
+        need(Need::Hold, "a load direction or dwell (--direction, --dwell-s)".into());
+    }
+    if given.thesis_coefficients {
+        need(Need::ThesisCoefficients, "--coefficients thesis (the thesis's route from a planar centreline)".into());
+    }
+    if given.method {
+        match options.method {
+            SolverMethod::Collocation => need(Need::Collocation, "--method collocation".into()),
+            SolverMethod::Rk4 => need(Need::Rk4, "--method rk4".into()),
+        }
+    }
+    if given.nodes_per_span {
+        need(Need::NodesPerSpan, "--nodes-per-span (collocation intervals; its resolution is --steps-per-span)".into());
+    }
+    if given.steps_per_span {
+        need(Need::StepsPerSpan, "--steps-per-span".into());
+    }
+    needs
+}
+
+/// A request a backend cannot serve: what it does not model, and the
+/// backend that would serve it.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("the {backend} solver does not model {what}; {}", advice(*served_by, but_not.as_deref()))]
+pub struct Unsupported {
+    /// The backend asked.
+    pub backend: Backend,
+    /// What it does not model, in the words of the flags and spec keys.
+    pub what: String,
+    /// The backend that serves the whole request; or, with `but_not`, the
+    /// one that models `what` but not the rest; `None` if no backend models `what`.
+    pub served_by: Option<Backend>,
+    /// What of the request `served_by` does not model (`None`: it serves all).
+    pub but_not: Option<String>,
+}
+
+/// The advice of an [`Unsupported`]: the backend to use, or why none serves.
+fn advice(served_by: Option<Backend>, but_not: Option<&str>) -> String {
+    let how = |b: Backend| match b {
+        Backend::PlanarCollocation => "the planar collocation solver (the default --method collocation)",
+        Backend::PlanarRk4 => "the planar rk4 solver (--method rk4)",
+        Backend::Spatial => "the spatial (3-D) solver",
+    };
+    match (served_by, but_not) {
+        (Some(b), None) => format!("{} serves this request", how(b)),
+        (Some(b), Some(rest)) => format!("{} models it, but not {rest}", how(b)),
+        (None, _) => "no solver models it".into(),
+    }
+}
