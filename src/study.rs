@@ -227,6 +227,11 @@ pub fn is_study_toml(text: &str) -> bool {
     text.parse::<toml::Table>().is_ok_and(|t| t.contains_key("study"))
 }
 
+/// An axis value as a number (TOML integers count).
+fn number(v: &toml::Value) -> Result<f64, String> {
+    v.as_float().or_else(|| v.as_integer().map(|i| i as f64)).ok_or_else(|| format!("value {v} is not a number"))
+}
+
 fn fmt(v: f64) -> String {
     crate::io::fmt_num(v)
 }
@@ -334,13 +339,7 @@ impl StudySpec {
             return match (&a.values, &a.scale) {
                 (Some(values), None) => values
                     .iter()
-                    .map(|v| {
-                        let x = v
-                            .as_float()
-                            .or_else(|| v.as_integer().map(|i| i as f64))
-                            .ok_or_else(|| format!("value {v} is not a number"))?;
-                        Ok((fmt(x), Change::Number { key, value: x }))
-                    })
+                    .map(|v| number(v).map(|x| (fmt(x), Change::Number { key, value: x })))
                     .collect(),
                 (None, Some(scale)) => scale
                     .iter()
@@ -364,13 +363,7 @@ impl StudySpec {
                 .ok_or("give values = [...] (numbers; an effect parameter has no scale)")?;
             return values
                 .iter()
-                .map(|v| {
-                    let x = v
-                        .as_float()
-                        .or_else(|| v.as_integer().map(|i| i as f64))
-                        .ok_or_else(|| format!("value {v} is not a number"))?;
-                    Ok((fmt(x), Change::Effect { info, value: x }))
-                })
+                .map(|v| number(v).map(|x| (fmt(x), Change::Effect { info, value: x })))
                 .collect();
         }
         match a.name.as_str() {

@@ -15,24 +15,27 @@ fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
     }
 }
 
-/// Library source files with their text, test modules cut off (tests may
-/// use anything).
-fn library_sources() -> Vec<(String, String)> {
+/// Every source file of `src/` (the binary's too), by its path below
+/// `src/`, with its text, test modules cut off (tests may use anything).
+fn all_sources() -> Vec<(String, String)> {
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
     let mut files = Vec::new();
     rust_files(&src, &mut files);
-    files
-        .into_iter()
-        .filter(|p| !p.starts_with(src.join("cli")) && p != &src.join("main.rs"))
-        .map(|p| {
-            let text = std::fs::read_to_string(&p).unwrap();
-            let code = match text.find("#[cfg(test)]") {
-                Some(i) => text[..i].to_string(),
-                None => text,
-            };
-            (p.strip_prefix(&src).unwrap().display().to_string(), code)
-        })
-        .collect()
+    files.into_iter().map(|p| (p.strip_prefix(&src).unwrap().display().to_string(), without_tests(&p))).collect()
+}
+
+/// Library source files with their text, test modules cut off.
+fn library_sources() -> Vec<(String, String)> {
+    all_sources().into_iter().filter(|(file, _)| !file.starts_with("cli/") && file != "main.rs").collect()
+}
+
+/// A source file's text with its test module cut off.
+fn without_tests(path: &Path) -> String {
+    let text = std::fs::read_to_string(path).unwrap();
+    match text.find("#[cfg(test)]") {
+        Some(i) => text[..i].to_string(),
+        None => text,
+    }
 }
 
 #[test]
@@ -77,22 +80,13 @@ fn only_the_top_returns_the_top_level_error() {
     }
 }
 
-/// Every source file of `src/` (the binary's too) with its code: test
-/// modules cut off and `//` comments removed (a comment may name anything).
+/// [`all_sources`] with `//` comments removed (a comment may name anything).
 fn all_code() -> Vec<(String, String)> {
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
-    let mut files = Vec::new();
-    rust_files(&src, &mut files);
-    files
+    all_sources()
         .into_iter()
-        .map(|p| {
-            let text = std::fs::read_to_string(&p).unwrap();
-            let text = match text.find("#[cfg(test)]") {
-                Some(i) => &text[..i],
-                None => &text[..],
-            };
+        .map(|(file, text)| {
             let code: Vec<&str> = text.lines().map(|l| l.find("//").map_or(l, |i| &l[..i])).collect();
-            (p.strip_prefix(&src).unwrap().display().to_string(), code.join("\n"))
+            (file, code.join("\n"))
         })
         .collect()
 }

@@ -259,6 +259,11 @@ pub struct Fit {
 }
 
 impl Fit {
+    /// A fit of an effect that is on wherever its parameter is set.
+    pub const fn new(name: &'static str, start: f64, domain: Domain, plausible: (f64, f64), plausible_text: &'static str) -> Fit {
+        Fit { name, start, domain, plausible, plausible_text, switched_on: always_on, switch_on: nothing_to_switch }
+    }
+
     /// Whether `value` is plausible for a real rod.
     pub fn is_plausible(&self, value: f64) -> bool {
         self.domain.contains(value) && (self.plausible.0..=self.plausible.1).contains(&value)
@@ -369,13 +374,10 @@ pub static GRAVITY_SCALE: EffectInfo = EffectInfo {
     value_name: "K",
     help: "Scale on the nominal self-weight",
     fit: Some(Fit {
-        name: "gravity",
-        start: 1.0,
-        domain: Domain::Positive,
-        plausible: (0.0, 10.0),
-        plausible_text: "0 < k ≤ 10",
+        // Gravity can be off whatever its scale: fitting its scale turns it on.
         switched_on: |a| a.gravity.enabled,
         switch_on: |a| a.gravity.enabled = true,
+        ..Fit::new("gravity", 1.0, Domain::Positive, (0.0, 10.0), "0 < k ≤ 10")
     }),
     backends: ALL_BACKENDS,
     qualifies: None,
@@ -400,15 +402,7 @@ pub static STIFFENING: EffectInfo = EffectInfo {
     flag_aliases: &[],
     value_name: "ALPHA",
     help: "Material stiffening α: moment EI·u·(1 + α (r u)²)",
-    fit: Some(Fit {
-        name: "stiffening",
-        start: 0.2,
-        domain: Domain::Positive,
-        plausible: (0.0, 100.0),
-        plausible_text: "0 < α ≤ 100",
-        switched_on: always_on,
-        switch_on: nothing_to_switch,
-    }),
+    fit: Some(Fit::new("stiffening", 0.2, Domain::Positive, (0.0, 100.0), "0 < α ≤ 100")),
     backends: PLANAR,
     qualifies: None,
     get: |a| a.effects.stiffening_alpha,
@@ -432,15 +426,7 @@ pub static CLAMP_COMPLIANCE: EffectInfo = EffectInfo {
     flag_aliases: &["--clamp-stiffness"],
     value_name: "N_MM_PER_RAD",
     help: "Clamp rotational stiffness k_θ, N·mm/rad: the effect `clamp_compliance` (`--clamp-stiffness` is the old name)",
-    fit: Some(Fit {
-        name: "clamp_compliance",
-        start: 300.0,
-        domain: Domain::Positive,
-        plausible: (1.0, 1e5),
-        plausible_text: "1 ≤ k_θ ≤ 1e5 N·mm/rad",
-        switched_on: always_on,
-        switch_on: nothing_to_switch,
-    }),
+    fit: Some(Fit::new("clamp_compliance", 300.0, Domain::Positive, (1.0, 1e5), "1 ≤ k_θ ≤ 1e5 N·mm/rad")),
     backends: PLANAR,
     qualifies: None,
     get: |a| a.effects.clamp_stiffness_n_mm_per_rad.unwrap_or(f64::INFINITY),
@@ -464,15 +450,7 @@ pub static CHANNEL_OFFSET: EffectInfo = EffectInfo {
     flag_aliases: &[],
     value_name: "MM",
     help: "Channel offset δ added to every y_i, mm",
-    fit: Some(Fit {
-        name: "channel_offset",
-        start: 0.0,
-        domain: Domain::Signed,
-        plausible: (-2.0, 2.0),
-        plausible_text: "|δ| ≤ 2 mm",
-        switched_on: always_on,
-        switch_on: nothing_to_switch,
-    }),
+    fit: Some(Fit::new("channel_offset", 0.0, Domain::Signed, (-2.0, 2.0), "|δ| ≤ 2 mm")),
     backends: PLANAR,
     qualifies: None,
     get: |a| a.effects.channel_offset_mm,
@@ -496,15 +474,7 @@ pub static STIFFNESS_GRADIENT: EffectInfo = EffectInfo {
     flag_aliases: &[],
     value_name: "BETA",
     help: "Stiffness gradient β: EI(s) = EI·exp(β (s/L − ½)), β = ln(EI(L)/EI(0))",
-    fit: Some(Fit {
-        name: "stiffness_gradient",
-        start: 0.0,
-        domain: Domain::Signed,
-        plausible: (-5.0, 5.0),
-        plausible_text: "|β| ≤ 5 (EI(L)/EI(0) between 1/150 and 150)",
-        switched_on: always_on,
-        switch_on: nothing_to_switch,
-    }),
+    fit: Some(Fit::new("stiffness_gradient", 0.0, Domain::Signed, (-5.0, 5.0), "|β| ≤ 5 (EI(L)/EI(0) between 1/150 and 150)")),
     backends: PLANAR,
     qualifies: None,
     get: |a| a.effects.stiffness_gradient_beta,
@@ -528,15 +498,7 @@ pub static FRICTION: EffectInfo = EffectInfo {
     flag_aliases: &[],
     value_name: "MU",
     help: "Cable–channel friction coefficient μ (capstan law)",
-    fit: Some(Fit {
-        name: "friction",
-        start: 0.02,
-        domain: Domain::Positive,
-        plausible: (0.0, 1.0),
-        plausible_text: "0 < μ ≤ 1",
-        switched_on: always_on,
-        switch_on: nothing_to_switch,
-    }),
+    fit: Some(Fit::new("friction", 0.02, Domain::Positive, (0.0, 1.0), "0 < μ ≤ 1")),
     backends: PLANAR,
     qualifies: None,
     get: |a| a.effects.friction_mu,
@@ -565,15 +527,7 @@ pub static CREEP_FRACTION: EffectInfo = EffectInfo {
     flag_aliases: &[],
     value_name: "F",
     help: "Creep: fraction f of the bending rigidity that relaxes (0 ≤ f < 1)",
-    fit: Some(Fit {
-        name: "creep",
-        start: 0.05,
-        domain: Domain::Fraction,
-        plausible: (0.0, 0.9),
-        plausible_text: "0 < f ≤ 0.9",
-        switched_on: always_on,
-        switch_on: nothing_to_switch,
-    }),
+    fit: Some(Fit::new("creep", 0.05, Domain::Fraction, (0.0, 0.9), "0 < f ≤ 0.9")),
     backends: PLANAR,
     qualifies: None,
     get: |a| a.effects.creep_fraction,
