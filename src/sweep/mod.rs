@@ -9,6 +9,7 @@
 //! - [`store`]: the run directory: manifest, atomic chunk files, checks.
 //! - [`run`]: the engine (parallel solving, resume, progress, summary).
 //! - [`status`]: done/total per shard, failures, completeness.
+//! - [`report`]: what `sweep` and `status` print, for every kind.
 //! - [`read`]: **the reader other stages use**: [`read::open_run`] checks a
 //!   run directory and streams its rows as Arrow record batches.
 
@@ -17,6 +18,7 @@ pub mod enumerate;
 pub mod kind;
 pub mod progress;
 pub mod read;
+pub mod report;
 pub mod run;
 pub mod schema;
 pub mod spec;
@@ -24,8 +26,9 @@ pub mod status;
 pub mod store;
 
 pub use enumerate::SweepPlan;
-pub use kind::{is_cable_spec_toml, run_kind, ChunkLayout, RunKind, RunSpec};
+pub use kind::{run_kind, ChunkLayout, InvalidSpec, RunKind, RunSpec};
 pub use read::{open_run, open_run_of, Completeness, SweepRun};
+pub use report::{StatusReport, SweepReport};
 pub use run::{run_sweep, run_sweep_of, SweepOptions, SweepSummary, MAX_SHARDS};
 pub use spec::SweepSpec;
 pub use status::{run_status, run_status_of, RunStatus};
@@ -154,6 +157,14 @@ pub enum SweepError {
     /// Arrow decoding.
     #[error("{context}: {source}")]
     Arrow { context: String, source: arrow::error::ArrowError },
+    /// Reading the run's state after its sweep.
+    #[error("checking {} after the sweep: {source}", dir.display())]
+    After {
+        /// The run directory.
+        dir: PathBuf,
+        /// Why it could not be read.
+        source: Box<SweepError>,
+    },
     /// A file operation.
     #[error("{context}: {source}")]
     Io { context: String, source: std::io::Error },
