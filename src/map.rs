@@ -256,6 +256,8 @@ impl fmt::Display for ReduceReport {
 pub trait MapKind: RunSpec {
     /// Reduces `request.run` (a run of this kind) into `request.out`.
     fn reduce(request: &ReduceRequest) -> Result<ReduceReport, MapError>;
+    /// Writes one part of the reduce of `part.run` (split for a cluster array).
+    fn reduce_part(part: &PartRequest) -> Result<PartWritten, MapError>;
 }
 
 impl MapKind for SweepSpec {
@@ -282,6 +284,13 @@ impl MapKind for SweepSpec {
             sparse_note,
         }))
     }
+
+    fn reduce_part(request: &PartRequest) -> Result<PartWritten, MapError> {
+        let PartRequest { run, out, shard, shards, .. } = request;
+        let start = Instant::now();
+        let part = crate::reduce::parts::write_part(run, out, *shard, *shards).map_err(|source| MapError::Reduce { run: run.clone(), source })?;
+        Ok(PartWritten { request: request.clone(), part, reduce_s: start.elapsed().as_secs_f64() })
+    }
 }
 
 impl MapKind for CableSweepSpec {
@@ -300,6 +309,10 @@ impl MapKind for CableSweepSpec {
             planar: map.planar.map(|(m, p)| (m.summary, p.into_iter().map(|p| p.file).collect())),
             total_s: start.elapsed().as_secs_f64(),
         }))
+    }
+
+    fn reduce_part(request: &PartRequest) -> Result<PartWritten, MapError> {
+        Err(MapError::CablesHaveNoParts { run: request.run.clone() })
     }
 }
 
@@ -352,9 +365,9 @@ pub fn reduce(request: &ReduceRequest) -> Result<ReduceReport, MapError> {
     on_kind(run_kind(&request.run).unwrap_or(RunKind::Planar), Reduce(request))
 }
 
-/// One part of a planar run's reduce written (`reduce --shard I --shards N`).
-#[derive(Debug, Clone)]
-pub struct PartWritten {
+/// One part of a planar run's reduce (`reduce --shard I --shards N`).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct PartRequest {
     /// The run directory.
     pub run: PathBuf,
     /// The map directory the parts are for.
@@ -365,35 +378,35 @@ pub struct PartWritten {
     pub shards: u64,
     /// Where the part's index came from (`--shard`, an environment variable).
     pub shard_source: String,
+}
+
+/// One part written.
+#[derive(Debug, Clone)]
+pub struct PartWritten {
+    /// What was asked.
+    pub request: PartRequest,
     /// What was written.
     pub part: PartReport,
     /// Seconds.
     pub reduce_s: f64,
 }
 
-/// Writes part `shard` of `shards` of the reduce of the planar run `run`
-/// into `out`'s parts directory.
-pub fn reduce_part(run: &Path, out: &Path, shard: u64, shards: u64, shard_source: &str) -> Result<PartWritten, MapError> {
-    if kind_of(run).is_ok_and(|k| k == RunKind::Cables) {
-        return Err(MapError::CablesHaveNoParts { run: run.to_path_buf() });
+/// Writes one part of the reduce of a run into its map's parts directory.
+pub fn reduce_part(request: &PartRequest) -> Result<PartWritten, MapError> {
+    struct Part<'a>(&'a PartRequest);
+    impl KindVisitor for Part<'_> {
+        type Output = Result<PartWritten, MapError>;
+        fn visit<S: MapKind>(self) -> Self::Output {
+            S::reduce_part(self.0)
+        }
     }
-    let start = Instant::now();
-    let part = crate::reduce::parts::write_part(run, out, shard, shards).map_err(|source| MapError::Reduce { run: run.to_path_buf(), source })?;
-    Ok(PartWritten {
-        run: run.to_path_buf(),
-        out: out.to_path_buf(),
-        shard,
-        shards,
-        shard_source: shard_source.to_string(),
-        part,
-        reduce_s: start.elapsed().as_secs_f64(),
-    })
+    on_kind(run_kind(&request.run).unwrap_or(RunKind::Planar), Part(request))
 }
 
 impl Serialize for PartWritten {
     fn serialize<Se: serde::Serializer>(&self, serializer: Se) -> Result<Se::Ok, Se::Error> {
         let r = &self.part;
-        serde_json::json!({ "part": self.shard, "parts": self.shards, "record": r.record, "chunks": r.chunks,
+        serde_json::json!({ "part": self.request.shard, "parts": self.request.shards, "record": r.record, "chunks": r.chunks,
             "rows": r.rows, "samples": r.samples, "reduce_s": self.reduce_s })
         .serialize(serializer)
     }
@@ -401,20 +414,20 @@ impl Serialize for PartWritten {
 
 impl fmt::Display for PartWritten {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let r = &self.part;
+        let (r, q) = (&self.part, &self.request);
         writeln!(
             f,
             "reduce part {} of {} ({}): {} chunk files, {} rows, {} converged samples in {:.2} s; written {}",
-            self.shard,
-            self.shards,
-            self.shard_source,
+            q.shard,
+            q.shards,
+            q.shard_source,
             r.chunks,
             r.rows,
             r.samples,
             self.reduce_s,
             r.record.display()
         )?;
-        writeln!(f, "when all {} parts are written: cablemap reduce {} --out {} --merge", self.shards, self.run.display(), self.out.display())
+        writeln!(f, "when all {} parts are written: cablemap reduce {} --out {} --merge", q.shards, q.run.display(), q.out.display())
     }
 }
 

@@ -18,21 +18,7 @@ fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
 /// Library source files with their text, test modules cut off (tests may
 /// use anything).
 fn library_sources() -> Vec<(String, String)> {
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
-    let mut files = Vec::new();
-    rust_files(&src, &mut files);
-    files
-        .into_iter()
-        .filter(|p| !p.starts_with(src.join("cli")) && p != &src.join("main.rs"))
-        .map(|p| {
-            let text = std::fs::read_to_string(&p).unwrap();
-            let code = match text.find("#[cfg(test)]") {
-                Some(i) => text[..i].to_string(),
-                None => text,
-            };
-            (p.strip_prefix(&src).unwrap().display().to_string(), code)
-        })
-        .collect()
+    all_sources().into_iter().filter(|(f, _)| !f.starts_with("cli/") && f != "main.rs").collect()
 }
 
 #[test]
@@ -75,4 +61,76 @@ fn only_the_top_returns_the_top_level_error() {
         }
         assert!(!code.contains("crate::Error"), "src/{file} uses the top-level crate::Error: return the layer's own error enum");
     }
+}
+
+/// Every source file under src/ (the binary's too) with its text, test
+/// modules cut off.
+fn all_sources() -> Vec<(String, String)> {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut files = Vec::new();
+    rust_files(&src, &mut files);
+    files
+        .into_iter()
+        .map(|p| {
+            let text = std::fs::read_to_string(&p).unwrap();
+            let code = match text.find("#[cfg(test)]") {
+                Some(i) => text[..i].to_string(),
+                None => text,
+            };
+            (p.strip_prefix(&src).unwrap().display().to_string(), code)
+        })
+        .collect()
+}
+
+#[test]
+fn no_two_files_of_a_folder_use_each_other() {
+    // A file's siblings are the files beside it; `super::NAME` names one.
+    let files = all_sources();
+    let sibling = |file: &str, name: &str| -> Option<String> {
+        let dir = Path::new(file).parent().map(|d| d.display().to_string()).unwrap_or_default();
+        let candidate = if dir.is_empty() { format!("{name}.rs") } else { format!("{dir}/{name}.rs") };
+        (Path::new(file).file_name().is_some_and(|n| n != "mod.rs") && files.iter().any(|(f, _)| *f == candidate)).then_some(candidate)
+    };
+    let uses = |file: &str, code: &str| -> Vec<String> {
+        let mut out: Vec<String> = code
+            .split("super::")
+            .skip(1)
+            .filter_map(|rest| {
+                let name: String = rest.chars().take_while(|c| c.is_alphanumeric() || *c == '_').collect();
+                sibling(file, &name)
+            })
+            .collect();
+        out.sort();
+        out.dedup();
+        out
+    };
+    for (a, code_a) in &files {
+        for b in uses(a, code_a) {
+            let code_b = &files.iter().find(|(f, _)| *f == b).unwrap().1;
+            assert!(!uses(&b, code_b).contains(a), "src/{a} and src/{b} use each other: move what both need into one of them (or a third file)");
+        }
+    }
+}
+
+#[test]
+fn the_library_returns_no_string_errors_but_where_listed() {
+    // Still to be typed by their layers' owners; nothing may be added.
+    let remaining = ["model/resolution.rs", "model/rod.rs", "io.rs", "sweep/cables.rs", "reduce/cables.rs"];
+    let re = |code: &str| code.lines().filter(|l| l.contains("Result<") && l.contains(", String>")).count();
+    for (file, code) in library_sources() {
+        if remaining.contains(&file.as_str()) {
+            continue;
+        }
+        assert_eq!(re(&code), 0, "src/{file} returns Result<_, String>: give it a thiserror enum naming the problem");
+    }
+}
+
+#[test]
+fn a_run_kind_picks_its_code_in_one_place() {
+    let matched: Vec<String> = all_sources()
+        .into_iter()
+        .filter(|(f, code)| f != "sweep/kind.rs" && code.contains("RunKind::Planar =>"))
+        .map(|(f, _)| f)
+        .collect();
+    assert_eq!(matched, ["map.rs"], "a run directory's kind picks its code in map::on_kind only");
 }

@@ -1,7 +1,7 @@
 //! `cablemap reduce` and `cablemap map` (sweep then reduce: the main job).
 
 use cablemap::job::{Job, JobSpec};
-use cablemap::map::{self, MapError, MapReport, MapRequest, MapSettings, ReduceReport, ReduceRequest, Source};
+use cablemap::map::{self, MapError, MapReport, MapRequest, MapSettings, PartRequest, ReduceReport, ReduceRequest, Source};
 use cablemap::reduce::{ModeBoundaries, ReduceError};
 use cablemap::study::StudyReport;
 use clap::Args;
@@ -152,7 +152,8 @@ pub fn run(args: &ReduceArgs) -> anyhow::Result<()> {
         anyhow::ensure!(shards >= 1, "--shards must be at least 1");
         let (shard, from) = super::sweep::shard_from_env(args.shard)?;
         anyhow::ensure!(shard < shards, "part {shard} (from {from}) is not below --shards {shards}: parts are numbered 0 to {}", shards - 1);
-        let written = map::reduce_part(&args.run, &args.out, shard, shards, from).map_err(|e| match e {
+        let part = PartRequest { run: args.run.clone(), out: args.out.clone(), shard, shards, shard_source: from.to_string() };
+        let written = map::reduce_part(&part).map_err(|e| match e {
             MapError::Reduce { source, .. } => {
                 flagged(source, &args.run, &args.out).context(format!("reducing part {shard} of {shards} of {}", args.run.display()))
             }

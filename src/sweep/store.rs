@@ -129,34 +129,57 @@ impl<S: RunSpec> Manifest<S> {
     /// hash of the spec it holds and the counts follow from that spec. A
     /// hand-edited field (a changed `tension.max_n`) fails here instead of
     /// silently changing what later stages report.
-    pub fn verify(&self) -> Result<(), String> {
-        self.spec.check().map_err(|e| format!("its spec is invalid ({e})"))?;
+    pub fn verify(&self) -> Result<(), ManifestMismatch> {
+        self.spec.check().map_err(ManifestMismatch::InvalidSpec)?;
         let hash = self.spec.hash_hex();
         if hash != self.spec_sha256 {
-            return Err(format!(
-                "its spec hashes to {hash}, not the recorded spec_sha256 {} (the file was edited or damaged)",
-                self.spec_sha256
-            ));
+            return Err(ManifestMismatch::Hash { hash, recorded: self.spec_sha256.clone() });
         }
         if self.shards == 0 || self.shards > super::MAX_SHARDS {
             // Status keeps a line per shard: an absurd count must not be allocated.
-            return Err(format!(
-                "shards = {} is not 1 … {} (the file was edited, or written with an absurd --shards)",
-                self.shards,
-                super::MAX_SHARDS
-            ));
+            return Err(ManifestMismatch::Shards { shards: self.shards });
         }
         let expected = Manifest { tool_version: self.tool_version.clone(), ..Manifest::new(&self.spec, self.shards) };
         if *self != expected {
-            return Err(format!(
-                "its counts do not follow from its spec (routings {} tensions {} chunk_routings {} chunks {} total_rows {}; \
-                 expected {} {} {} {} {}): the file was edited or damaged",
-                self.routings, self.tensions, self.chunk_routings, self.chunks, self.total_rows,
-                expected.routings, expected.tensions, expected.chunk_routings, expected.chunks, expected.total_rows
-            ));
+            let counts = |m: &Self| [m.routings, m.tensions, m.chunk_routings, m.chunks, m.total_rows];
+            return Err(ManifestMismatch::Counts { found: counts(self), expected: counts(&expected) });
         }
         Ok(())
     }
+}
+
+/// How a manifest disagrees with itself ([`Manifest::verify`]).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum ManifestMismatch {
+    /// The spec it holds is refused.
+    #[error("its spec is invalid ({0})")]
+    InvalidSpec(super::kind::InvalidSpec),
+    /// The spec does not hash to the recorded hash.
+    #[error("its spec hashes to {hash}, not the recorded spec_sha256 {recorded} (the file was edited or damaged)")]
+    Hash {
+        /// The spec's hash.
+        hash: String,
+        /// The recorded one.
+        recorded: String,
+    },
+    /// An absurd shard count.
+    #[error("shards = {shards} is not 1 … {} (the file was edited, or written with an absurd --shards)", super::MAX_SHARDS)]
+    Shards {
+        /// The recorded count.
+        shards: u64,
+    },
+    /// Counts that do not follow from the spec: routings, tensions, chunk_routings, chunks, total_rows.
+    #[error(
+        "its counts do not follow from its spec (routings {} tensions {} chunk_routings {} chunks {} total_rows {}; \
+         expected {} {} {} {} {}): the file was edited or damaged",
+        found[0], found[1], found[2], found[3], found[4], expected[0], expected[1], expected[2], expected[3], expected[4]
+    )]
+    Counts {
+        /// As recorded.
+        found: [u64; 5],
+        /// As the spec gives them.
+        expected: [u64; 5],
+    },
 }
 
 /// A chunk file that failed its check: bytes changed since it was
@@ -310,7 +333,7 @@ impl RunDir {
                 ),
             });
         }
-        manifest.verify().map_err(|message| SweepError::CorruptManifest { path, message })?;
+        manifest.verify().map_err(|e| SweepError::CorruptManifest { path, message: e.to_string() })?;
         Ok(Some(manifest))
     }
 
@@ -660,7 +683,7 @@ mod tests {
         assert!(Manifest::new(&spec, super::super::MAX_SHARDS).verify().is_ok());
         for shards in [0, super::super::MAX_SHARDS + 1, u64::MAX] {
             let e = Manifest::new(&spec, shards).verify().unwrap_err();
-            assert!(e.contains(&format!("shards = {shards} is not 1")), "{e}");
+            assert!(e.to_string().contains(&format!("shards = {shards} is not 1")), "{e}");
         }
     }
 
