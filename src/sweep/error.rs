@@ -133,7 +133,17 @@ pub enum SweepError {
         /// Why it could not be read.
         source: Box<SweepError>,
     },
+    /// A damaged chunk could not be moved aside.
+    #[error("moving damaged chunk {} to {}: {source}", from.display(), to.display())]
+    MoveAside {
+        /// The damaged chunk.
+        from: PathBuf,
+        /// Where it was to go.
+        to: PathBuf,
+        /// Why it could not.
+        source: std::io::Error,
+    },
     /// A file operation.
-    #[error("{context}: {source}")]
-    Io { context: String, source: std::io::Error },
+    #[error(transparent)]
+    File(#[from] crate::io::FileError),
 }

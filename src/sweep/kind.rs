@@ -138,7 +138,7 @@ pub fn run_kind(dir: &Path) -> Result<RunKind, SweepError> {
     let text = match crate::io::read_utf8(&path) {
         Ok(t) => t,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Err(SweepError::no_run(dir)),
-        Err(source) => return Err(SweepError::Io { context: format!("reading {}", path.display()), source }),
+        Err(source) => return Err(crate::io::FileError::new("reading", path, source).into()),
     };
     let value: serde_json::Value =
         serde_json::from_str(&text).map_err(|e| SweepError::CorruptManifest { path: path.clone(), message: e.to_string() })?;

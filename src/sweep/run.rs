@@ -201,7 +201,7 @@ pub fn run_sweep_of<S: RunSpec>(spec: &S, dir: &Path, options: &SweepOptions) ->
             match std::fs::remove_file(path) {
                 Ok(()) => partial_chunks_removed += 1,
                 Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
-                Err(source) => return Err(SweepError::Io { context: format!("removing {}", path.display()), source }),
+                Err(source) => return Err(crate::io::FileError::new("removing", path, source).into()),
             }
         }
     }
