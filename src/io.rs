@@ -272,21 +272,79 @@ pub fn enclosing_run_dir(path: &Path) -> Option<PathBuf> {
     resolved.ancestors().find(|d| is_run_dir(d)).map(Path::to_path_buf)
 }
 
+/// An output that is, or lies inside, a sweep run directory
+/// ([`check_not_in_run_dir`]).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error(
+    "{what} {} {} the sweep run directory {}; writing there would make the run unusable: give a path outside the run",
+    out.display(),
+    if *is_the_run { "is" } else { "is inside" },
+    run.display()
+)]
+pub struct InsideRunDir {
+    /// What the output is, for the message (e.g. "the map directory").
+    pub what: String,
+    /// The output asked for.
+    pub out: PathBuf,
+    /// The run directory it is or lies in.
+    pub run: PathBuf,
+    /// The output is the run directory itself.
+    pub is_the_run: bool,
+}
+
 /// Refuses an output (a directory or a file) that is a sweep run
 /// directory or lies inside one at any depth: the run would then hold
 /// files cablemap's checks reject, or lose its own, and be unusable until
 /// cleaned by hand. `what` names the output in the message (the command
 /// line adds its flag).
-pub fn check_not_in_run_dir(out: &Path, what: &str) -> Result<(), String> {
+pub fn check_outside_run_dir(out: &Path, what: &str) -> Result<(), InsideRunDir> {
     let Some(run) = enclosing_run_dir(out) else { return Ok(()) };
     let is_the_run = std::fs::canonicalize(out).is_ok_and(|o| o == run);
-    Err(format!(
-        "{what} {} {} the sweep run directory {}; writing there would make the run unusable: \
-         give a path outside the run",
-        out.display(),
-        if is_the_run { "is" } else { "is inside" },
-        run.display()
-    ))
+    Err(InsideRunDir { what: what.to_string(), out: out.to_path_buf(), run, is_the_run })
+}
+
+/// [`check_outside_run_dir`] with the message as text, for the layers whose
+/// error enums still hold it as a string (calibrate's report directory,
+/// reduce's map directory); new code takes [`InsideRunDir`].
+pub fn check_not_in_run_dir(out: &Path, what: &str) -> Result<(), String> {
+    check_outside_run_dir(out, what).map_err(|e| e.to_string())
+}
+
+/// A file operation that failed: which file, what was being done, and why.
+/// The one I/O error of every layer, so each names the path the same way
+/// (as a path, not a pre-formatted string) and keeps the cause.
+#[derive(Debug, thiserror::Error)]
+#[error("{op} {}: {source}", path.display())]
+pub struct FileError {
+    /// The file or directory.
+    pub path: PathBuf,
+    /// What was being done, as a verb phrase before the path ("reading", "writing", "creating").
+    pub op: &'static str,
+    /// The cause.
+    pub source: std::io::Error,
+}
+
+impl FileError {
+    /// The error of `op` on `path`.
+    pub fn new(op: &'static str, path: impl Into<PathBuf>, source: std::io::Error) -> Self {
+        Self { path: path.into(), op, source }
+    }
+
+    /// A closure for `map_err`: `std::fs::read(p).map_err(FileError::on("reading", p))`.
+    pub fn on(op: &'static str, path: &Path) -> impl FnOnce(std::io::Error) -> Self {
+        let path = path.to_path_buf();
+        move |source| Self { path, op, source }
+    }
+
+    /// Whether the cause is a missing file.
+    pub fn is_not_found(&self) -> bool {
+        self.source.kind() == std::io::ErrorKind::NotFound
+    }
+}
+
+/// [`read_utf8`] with the path in the error.
+pub fn read_text(path: &Path, op: &'static str) -> Result<String, FileError> {
+    read_utf8(path).map_err(FileError::on(op, path))
 }
 
 /// A number for a message: plain for ordinary magnitudes, scientific for

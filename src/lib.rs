@@ -2,12 +2,20 @@
 //!
 //! The pipeline runs one way: [`model`] (routing, rod, effects, solver) →
 //! [`shape`] (Legendre curvature coefficients) → [`sweep`] → reduce → design
-//! and calibrate. Each layer has its own error enum, joined here.
+//! and calibrate. Each layer has its own error enum, joined here in
+//! [`Error`].
+//!
+//! Workflows are requests in, reports out (each report serialises to the
+//! JSON `--json` prints and displays as the text the command prints):
+//! [`map::run`] (sweep and reduce of any [`job::Job`]), [`study::run`],
+//! [`design::run::run`], [`design::feasible::run`], [`synth::run`].
 
 pub mod bench;
 pub mod calibrate;
 pub mod design;
 pub mod io;
+pub mod job;
+pub mod map;
 pub mod model;
 pub mod mould;
 pub mod numerics;
@@ -16,6 +24,7 @@ pub mod reduce;
 pub mod shape;
 pub mod study;
 pub mod sweep;
+pub mod synth;
 
 /// Any error of the library, by layer.
 #[derive(Debug, thiserror::Error)]
@@ -59,7 +68,19 @@ pub enum Error {
     /// Building or writing moulds.
     #[error(transparent)]
     Mould(#[from] mould::MouldError),
+    /// A job spec.
+    #[error(transparent)]
+    Job(#[from] job::JobError),
+    /// A map of a job or a run.
+    #[error(transparent)]
+    Map(#[from] map::MapError),
+    /// A study.
+    #[error(transparent)]
+    Study(#[from] study::StudyError),
+    /// Synthetic measurements.
+    #[error(transparent)]
+    Synth(#[from] synth::SynthError),
     /// Reading or writing a file.
-    #[error("{context}: {source}")]
-    Io { context: String, source: std::io::Error },
+    #[error(transparent)]
+    File(#[from] io::FileError),
 }

@@ -31,6 +31,11 @@
 //! variant is mapped the comparison: `comparison.csv`, `comparison.json`
 //! and `index.html` (the variants' maps side by side).
 
+pub mod run;
+
+pub use run::{run, StudyProgress, StudyReport, StudyRequest, StudyTask};
+
+use crate::io::FileError;
 use crate::reduce::tables::{read_cells, read_summary};
 use crate::reduce::{CellStats, MapSummary, MODES};
 use crate::sweep::SweepSpec;
@@ -130,12 +135,31 @@ pub enum StudyError {
     #[error(transparent)]
     Plot(#[from] crate::plot::PlotError),
     /// A file operation.
-    #[error("{}: {source}", path.display())]
-    Io {
+    #[error(transparent)]
+    File(#[from] FileError),
+    /// `study.json` is not a study's record.
+    #[error("{}: not a study record: {message}", path.display())]
+    NotARecord {
         /// The file.
         path: PathBuf,
-        /// The error.
-        source: std::io::Error,
+        /// What is wrong.
+        message: String,
+    },
+    /// A task index outside the split.
+    #[error("task {shard} is not below the {shards} tasks of the split: tasks are numbered 0 to shards − 1 (shards ≥ 1)")]
+    BadTask {
+        /// The task asked for.
+        shard: u64,
+        /// Tasks in all.
+        shards: u64,
+    },
+    /// Running a variant of the study in a directory.
+    #[error("study {}: {source}", dir.display())]
+    In {
+        /// The study directory.
+        dir: PathBuf,
+        /// What went wrong.
+        source: Box<StudyError>,
     },
 }
 
@@ -222,11 +246,6 @@ enum Change {
     Effects(serde_json::Map<String, serde_json::Value>),
 }
 
-/// Whether a spec's text has a `[study]` section.
-pub fn is_study_toml(text: &str) -> bool {
-    text.parse::<toml::Table>().is_ok_and(|t| t.contains_key("study"))
-}
-
 /// An axis value as a number (TOML integers count).
 fn number(v: &toml::Value) -> Result<f64, String> {
     v.as_float().or_else(|| v.as_integer().map(|i| i as f64)).ok_or_else(|| format!("value {v} is not a number"))
@@ -239,10 +258,7 @@ fn fmt(v: f64) -> String {
 impl StudySpec {
     /// Reads a study spec file.
     pub fn load(path: &Path) -> Result<Self, StudyError> {
-        let text = crate::io::read_utf8(path).map_err(|source| StudyError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let text = crate::io::read_text(path, "reading")?;
         Self::from_toml(&text, &path.display().to_string())
     }
 
@@ -252,7 +268,17 @@ impl StudySpec {
             origin: origin.to_string(),
             message,
         };
-        let mut table: toml::Table = text.parse().map_err(|e: toml::de::Error| bad(e.to_string()))?;
+        let table: toml::Table = text.parse().map_err(|e: toml::de::Error| bad(e.to_string()))?;
+        Self::from_table(table, origin)
+    }
+
+    /// A study spec from its parsed TOML (see [`crate::job::Job::load`],
+    /// which parses a spec once to tell its kind); `origin` names it in errors.
+    pub fn from_table(mut table: toml::Table, origin: &str) -> Result<Self, StudyError> {
+        let bad = |message: String| StudyError::Spec {
+            origin: origin.to_string(),
+            message,
+        };
         let section = table
             .remove("study")
             .ok_or_else(|| bad("no [study] section: a study spec is a sweep spec with a [study] section naming its axes".into()))?;
@@ -439,11 +465,8 @@ impl StudySpec {
     /// Prepares the study directory `dir`: writes `study.json` and each
     /// variant's `spec.toml` (refusing a directory of another study).
     pub fn prepare(&self, dir: &Path) -> Result<(), StudyError> {
-        let io = |path: &Path| {
-            let path = path.to_path_buf();
-            move |source| StudyError::Io { path, source }
-        };
-        std::fs::create_dir_all(dir).map_err(io(dir))?;
+        let io = |op: &'static str, path: &Path| FileError::on(op, path);
+        std::fs::create_dir_all(dir).map_err(io("creating", dir))?;
         let path = dir.join(STUDY_FILE);
         let record = self.record();
         match std::fs::read(&path) {
@@ -456,13 +479,13 @@ impl StudySpec {
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
                 let mut text = serde_json::to_string_pretty(&record).expect("serializes");
                 text.push('\n');
-                crate::io::write_atomic(&path, text.as_bytes()).map_err(io(&path))?;
+                crate::io::write_atomic(&path, text.as_bytes()).map_err(io("writing", &path))?;
             }
-            Err(e) => return Err(StudyError::Io { path, source: e }),
+            Err(e) => return Err(FileError::new("reading", path, e).into()),
         }
         for v in &self.variants {
             let vdir = v.dir(dir);
-            std::fs::create_dir_all(&vdir).map_err(io(&vdir))?;
+            std::fs::create_dir_all(&vdir).map_err(io("creating", &vdir))?;
             let spec_path = vdir.join("spec.toml");
             let text = format!(
                 "# Variant {} of study '{}': {}\n# Written by `cablemap study`; `cablemap map` of this file gives the same run and map.\n{}",
@@ -471,7 +494,7 @@ impl StudySpec {
                 v.label(),
                 toml::to_string(&v.spec).expect("a sweep spec serializes as TOML")
             );
-            crate::io::write_atomic(&spec_path, text.as_bytes()).map_err(io(&spec_path))?;
+            crate::io::write_atomic(&spec_path, text.as_bytes()).map_err(io("writing", &spec_path))?;
         }
         Ok(())
     }
@@ -803,7 +826,7 @@ impl Comparison {
         let json = serde_json::to_string_pretty(self).expect("serializes") + "\n";
         for (file, text) in [(COMPARISON_CSV, self.csv()), (COMPARISON_JSON, json), (PAGE_FILE, self.html(&pictures))] {
             let path = dir.join(file);
-            crate::io::write_atomic(&path, text.as_bytes()).map_err(|source| StudyError::Io { path, source })?;
+            crate::io::write_atomic(&path, text.as_bytes()).map_err(FileError::on("writing", &path))?;
         }
         Ok(())
     }
@@ -855,12 +878,10 @@ pub fn mapped_variants(dir: &Path) -> Result<Vec<(usize, String, PathBuf)>, Stud
     let bytes = match std::fs::read(&path) {
         Ok(b) => b,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Err(StudyError::NoStudy { dir: dir.to_path_buf() }),
-        Err(source) => return Err(StudyError::Io { path, source }),
+        Err(source) => return Err(FileError::new("reading", path, source).into()),
     };
-    let v: serde_json::Value = serde_json::from_slice(&bytes).map_err(|e| StudyError::Io {
-        path: path.clone(),
-        source: std::io::Error::other(format!("not a study record: {e}")),
-    })?;
+    let v: serde_json::Value =
+        serde_json::from_slice(&bytes).map_err(|e| StudyError::NotARecord { path: path.clone(), message: e.to_string() })?;
     Ok(v["variants"]
         .as_array()
         .into_iter()

@@ -289,4 +289,63 @@ fn an_effects_spec_key_is_spelled_only_in_the_registry() {
         "effect keys are spelled outside the registry (src/model/effects.rs); take them from its entry (e.g. FRICTION.key, .flag, .path):\n{}",
         found.join("\n")
     );
+#[test]
+fn no_two_files_of_a_folder_use_each_other() {
+    // A file's siblings are the files beside it; `super::NAME` names one.
+    let files = all_sources();
+    let sibling = |file: &str, name: &str| -> Option<String> {
+        let dir = Path::new(file).parent().map(|d| d.display().to_string()).unwrap_or_default();
+        let candidate = if dir.is_empty() { format!("{name}.rs") } else { format!("{dir}/{name}.rs") };
+        (Path::new(file).file_name().is_some_and(|n| n != "mod.rs") && files.iter().any(|(f, _)| *f == candidate)).then_some(candidate)
+    };
+    let uses = |file: &str, code: &str| -> Vec<String> {
+        let mut out: Vec<String> = code
+            .split("super::")
+            .skip(1)
+            .filter_map(|rest| {
+                let name: String = rest.chars().take_while(|c| c.is_alphanumeric() || *c == '_').collect();
+                sibling(file, &name)
+            })
+            .collect();
+        out.sort();
+        out.dedup();
+        out
+    };
+    // Still to be untangled by their layer's owners; nothing may be added.
+    let known = [("model/body.rs", "model/rod.rs")];
+    let mut circles = Vec::new();
+    for (a, code_a) in &files {
+        for b in uses(a, code_a) {
+            let code_b = &files.iter().find(|(f, _)| *f == b).unwrap().1;
+            if a < &b && uses(&b, code_b).contains(a) && !known.contains(&(a.as_str(), b.as_str())) {
+                circles.push(format!("src/{a} and src/{b}"));
+            }
+        }
+    }
+    assert!(circles.is_empty(), "{} use each other: move what both need into one of them (or a third file)", circles.join("; "));
+}
+
+#[test]
+fn the_library_returns_no_string_errors_but_where_listed() {
+    // Still to be typed by their layers' owners; nothing may be added.
+    // (study.rs: the axis parser, beside the effects' patches being moved to the registry.)
+    let remaining =
+        ["model/body.rs", "model/resolution.rs", "model/rod.rs", "io.rs", "sweep/cables.rs", "reduce/cables.rs", "calibrate/data.rs", "study.rs"];
+    let re = |code: &str| code.lines().filter(|l| l.contains("Result<") && l.contains(", String>")).count();
+    for (file, code) in library_sources() {
+        if remaining.contains(&file.as_str()) {
+            continue;
+        }
+        assert_eq!(re(&code), 0, "src/{file} returns Result<_, String>: give it a thiserror enum naming the problem");
+    }
+}
+
+#[test]
+fn a_run_kind_picks_its_code_in_one_place() {
+    let matched: Vec<String> = all_sources()
+        .into_iter()
+        .filter(|(f, code)| f != "sweep/kind.rs" && code.contains("RunKind::Planar =>"))
+        .map(|(f, _)| f)
+        .collect();
+    assert_eq!(matched, ["map.rs"], "a run directory's kind picks its code in map::on_kind only");
 }

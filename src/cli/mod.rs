@@ -2,7 +2,6 @@
 //! run each command. `main.rs` only parses and dispatches.
 
 pub mod bench;
-pub mod cable_map;
 pub mod calibrate;
 pub mod design;
 pub mod diagnose;

@@ -1,12 +1,11 @@
 //! `cablemap reduce` and `cablemap map` (sweep then reduce: the main job).
 
-use cablemap::reduce::{reduce_run, write_map_replacing, MapData, ModeBoundaries, ReduceError, ReduceOptions};
-use anyhow::Context;
-use cablemap::sweep::progress::ProgressMode;
-use cablemap::sweep::SweepOptions;
+use cablemap::job::{Job, JobSpec};
+use cablemap::map::{self, MapError, MapReport, MapRequest, MapSettings, PartRequest, ReduceReport, ReduceRequest, Source};
+use cablemap::reduce::{ModeBoundaries, ReduceError};
+use cablemap::study::StudyReport;
 use clap::Args;
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 
 /// Map options shared by `reduce` and `map`.
 #[derive(Debug, Clone, Args)]
@@ -35,8 +34,8 @@ pub struct MapOptionArgs {
 }
 
 impl MapOptionArgs {
-    /// The reduce options these arguments give.
-    pub fn options(&self) -> anyhow::Result<ReduceOptions> {
+    /// The map settings these arguments give.
+    pub fn settings(&self) -> anyhow::Result<MapSettings> {
         let mode_boundaries = match (&self.a0_bounds, &self.a1_bounds) {
             (None, None) => None,
             (Some(a0), Some(a1)) => {
@@ -49,13 +48,7 @@ impl MapOptionArgs {
             _ => anyhow::bail!("give both --a0-bounds and --a1-bounds, or neither (quantiles of the data)"),
         };
         anyhow::ensure!(self.memory_samples >= 1, "--memory-samples must be at least 1");
-        Ok(ReduceOptions {
-            cell_mm: self.cell_mm.unwrap_or(1.0),
-            mode_boundaries,
-            designs_per_cell: self.designs_per_cell,
-            memory_samples: self.memory_samples,
-            scratch_dir: None,
-        })
+        Ok(MapSettings { cell_mm: self.cell_mm, mode_boundaries, designs_per_cell: self.designs_per_cell, memory_samples: self.memory_samples })
     }
 }
 
@@ -87,91 +80,51 @@ pub struct ReduceArgs {
     pub map: MapOptionArgs,
 }
 
-/// Reduces `run` (either kind of sweep) into `out` and prints a summary.
-pub fn reduce_any_into(run: &Path, out: &Path, partial: bool, args: &MapOptionArgs) -> anyhow::Result<()> {
-    match cablemap::sweep::run_kind(run)? {
-        cablemap::sweep::RunKind::Planar => reduce_into(run, out, partial, args).map(|_| ()),
-        cablemap::sweep::RunKind::Cables => super::cable_map::reduce_cables_into(run, out, partial, args.cell_mm, &args.options()?, args.json),
-    }
-}
-
-/// How `reduce_into` gets the map.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Source {
-    /// Reduce the run in this process (`partial`: an unfinished run).
-    Run {
-        /// Map only the complete chunks of an unfinished run.
-        partial: bool,
-    },
-    /// Merge the parts written by `--shard I --shards N`.
-    Parts,
-}
-
-/// Reduces `run` into `out` and prints a summary.
-pub fn reduce_into(run: &Path, out: &Path, partial: bool, args: &MapOptionArgs) -> anyhow::Result<MapData> {
-    reduce_from(run, out, Source::Run { partial }, args)
-}
-
-/// Reduces `run` (or merges its parts) into `out` and prints a summary.
-pub fn reduce_from(run: &Path, out: &Path, source: Source, args: &MapOptionArgs) -> anyhow::Result<MapData> {
-    let mut options = args.options()?;
-    cablemap::reduce::check_map_out(out)?;
-    // Scratch beside the map: on the same disk as the results, not in a
-    // RAM-backed /tmp.
-    options.scratch_dir = Some(out.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new(".")).to_path_buf());
-    let start = Instant::now();
-    let reduced = match source {
-        Source::Run { partial } => reduce_run(run, partial, &options),
-        Source::Parts => cablemap::reduce::parts::merge_parts(run, out, &options),
-    };
-    let (map, spec) = reduced.map_err(|e| with_flags(e, run, out)).with_context(|| format!("reducing {}", run.display()))?;
-    let reduced_s = start.elapsed().as_secs_f64();
-    let pictures = write_map_replacing(out, &map, &spec.actuator, &spec.solver)?;
-    let total_s = start.elapsed().as_secs_f64();
-    let s = &map.summary;
-    if args.json {
-        println!(
-            "{}",
-            serde_json::json!({ "summary": s, "map_dir": out, "pictures": pictures.iter().map(|p| &p.file).collect::<Vec<_>>(),
-                "reduce_s": reduced_s, "total_s": total_s })
-        );
-    } else {
-        println!(
-            "map {}: {} simulations ({} converged, {} failed{}) in {} cells of {} mm; modes by {}: a0 {}, a1 {} (mm⁻¹, {} basis)",
-            out.display(),
-            s.rows_total,
-            s.rows_converged,
-            s.rows_failed,
-            if s.mirrored { ", mirrored half restored" } else { "" },
-            s.cells,
-            s.cell_mm,
-            s.mode_boundaries_source,
-            boundaries_text(&s.mode_boundaries.a0),
-            boundaries_text(&s.mode_boundaries.a1),
-            s.length_basis
-        );
-        println!("reduced in {reduced_s:.2} s, tables and {} pictures written in {total_s:.2} s; open {}", pictures.len(), out.join("index.html").display());
-    }
-    // With --json on stderr: stdout stays the JSON object alone.
-    if let Some(note) = cablemap::reduce::plots::Density::sparse_note(s, &map.cells) {
-        if args.json {
+/// Prints a map's report: its text, or its JSON with the note on stderr
+/// (stdout then holds the JSON alone).
+fn print_map(report: &ReduceReport, json: bool) -> anyhow::Result<()> {
+    if json {
+        println!("{}", serde_json::to_value(report)?);
+        if let Some(note) = report.note() {
             eprintln!("{note}");
-        } else {
-            println!("{note}");
         }
+    } else {
+        print!("{report}");
     }
-    Ok(map)
+    Ok(())
 }
 
-/// Mode boundaries to 4 significant digits, `[-0.02, -0.0134, 0.0071]`:
-/// enough to tell the modes apart; summary.json keeps full precision.
-fn boundaries_text(bounds: &[f64]) -> String {
-    let values: Vec<String> = bounds.iter().map(|&b| cablemap::io::fmt_sig(b, 4)).collect();
-    format!("[{}]", values.join(", "))
+/// Prints a study's progress line: on stdout, on stderr beside `--json`
+/// (stdout then carries only the comparison).
+pub fn say(line: &dyn std::fmt::Display, json: bool) {
+    if json {
+        eprintln!("{line}");
+    } else {
+        println!("{line}");
+    }
+}
+
+/// Prints a study's report: the comparison (text, or JSON with `json`), or
+/// the command that finishes a split study.
+pub fn print_study(report: &StudyReport, json: bool) -> anyhow::Result<()> {
+    match report {
+        StudyReport::TaskDone { .. } => say(&report.to_string().trim_end(), json),
+        StudyReport::Compared { .. } if json => println!("{}", serde_json::to_string(report)?),
+        StudyReport::Compared { .. } => print!("{report}"),
+    }
+    Ok(())
 }
 
 /// The library's error, with the flag that fixes it where there is one.
-fn with_flags(e: ReduceError, run: &Path, out: &Path) -> anyhow::Error {
+fn with_flags(e: MapError, run: &Path, out: &Path) -> anyhow::Error {
+    match e {
+        MapError::Reduce { source, run: reduced } => flagged(source, run, out).context(format!("reducing {}", reduced.display())),
+        e => e.into(),
+    }
+}
+
+/// A reduce error, with the flag that fixes it where there is one.
+fn flagged(e: ReduceError, run: &Path, out: &Path) -> anyhow::Error {
     use cablemap::reduce::parts::PartsError;
     let part = |i: String, n: String| format!("cablemap reduce {} --out {} --shard {i} --shards {n}", run.display(), out.display());
     match &e {
@@ -195,44 +148,29 @@ fn with_flags(e: ReduceError, run: &Path, out: &Path) -> anyhow::Error {
 
 /// Runs `cablemap reduce`.
 pub fn run(args: &ReduceArgs) -> anyhow::Result<()> {
-    if matches!(cablemap::sweep::run_kind(&args.run), Ok(cablemap::sweep::RunKind::Cables)) {
-        anyhow::ensure!(
-            args.shards.is_none() && args.shard.is_none() && !args.merge,
-            "{} is a cable sweep: its reduce streams the chunks in one process and has no parts; drop --shard/--shards/--merge",
-            args.run.display()
-        );
-        return reduce_any_into(&args.run, &args.out, args.partial, &args.map);
-    }
     if let Some(shards) = args.shards {
         anyhow::ensure!(shards >= 1, "--shards must be at least 1");
         let (shard, from) = super::sweep::shard_from_env(args.shard)?;
         anyhow::ensure!(shard < shards, "part {shard} (from {from}) is not below --shards {shards}: parts are numbered 0 to {}", shards - 1);
-        let start = Instant::now();
-        let report = cablemap::reduce::parts::write_part(&args.run, &args.out, shard, shards)
-            .map_err(|e| with_flags(e, &args.run, &args.out))
-            .with_context(|| format!("reducing part {shard} of {shards} of {}", args.run.display()))?;
-        let s = start.elapsed().as_secs_f64();
+        let part = PartRequest { run: args.run.clone(), out: args.out.clone(), shard, shards, shard_source: from.to_string() };
+        let written = map::reduce_part(&part).map_err(|e| match e {
+            MapError::Reduce { source, .. } => {
+                flagged(source, &args.run, &args.out).context(format!("reducing part {shard} of {shards} of {}", args.run.display()))
+            }
+            e => e.into(),
+        })?;
         if args.map.json {
-            println!(
-                "{}",
-                serde_json::json!({ "part": shard, "parts": shards, "record": report.record, "chunks": report.chunks,
-                    "rows": report.rows, "samples": report.samples, "reduce_s": s })
-            );
+            println!("{}", serde_json::to_value(&written)?);
         } else {
-            println!(
-                "reduce part {shard} of {shards} ({from}): {} chunk files, {} rows, {} converged samples in {s:.2} s; written {}",
-                report.chunks,
-                report.rows,
-                report.samples,
-                report.record.display()
-            );
-            println!("when all {shards} parts are written: cablemap reduce {} --out {} --merge", args.run.display(), args.out.display());
+            print!("{written}");
         }
         return Ok(());
     }
     anyhow::ensure!(args.shard.is_none(), "--shard needs --shards N");
     let source = if args.merge { Source::Parts } else { Source::Run { partial: args.partial } };
-    reduce_from(&args.run, &args.out, source, &args.map).map(|_| ())
+    let request = ReduceRequest { run: args.run.clone(), out: args.out.clone(), source, settings: args.map.settings()? };
+    let report = map::reduce(&request).map_err(|e| with_flags(e, &args.run, &args.out))?;
+    print_map(&report, args.map.json)
 }
 
 /// Arguments of `cablemap map`.
@@ -254,20 +192,31 @@ pub struct MapArgs {
     pub map: MapOptionArgs,
 }
 
-/// Runs `cablemap map`: the sweep (resumable) then the reduction.
+/// Runs `cablemap map`: the sweep (resumable) then the reduction; a study
+/// spec's study.
 pub fn run_map(args: &MapArgs) -> anyhow::Result<()> {
-    if let Some(path) = args.spec.as_deref().filter(|p| std::fs::read_to_string(p).is_ok_and(|t| cablemap::study::is_study_toml(&t))) {
-        // A study spec: one sweep and map per variant, then the comparison.
-        let study = cablemap::study::StudySpec::load(path)?;
-        let threads = super::sweep::thread_count(args.threads)?;
-        return super::study::run_study(&study, path, &args.out, None, false, threads, args.allow_large, &args.map);
+    let job = Job::load_or_thesis(args.spec.as_deref())?;
+    if let Some(note) = job.note() {
+        eprintln!("{note}");
     }
-    let spec = super::sweep::load_any_spec(args.spec.as_deref())?;
-    let threads = super::sweep::thread_count(args.threads)?;
-    let options = SweepOptions { shard: 0, shards: 1, threads, progress: ProgressMode::Auto, allow_large: args.allow_large };
-    match &spec {
-        super::sweep::AnySpec::Planar(spec) => super::sweep::sweep_and_report(spec, &args.out.join("run"), &options, false)?,
-        super::sweep::AnySpec::Cables(spec) => super::sweep::sweep_and_report(spec, &args.out.join("run"), &options, false)?,
+    let request = MapRequest {
+        job,
+        out: args.out.clone(),
+        threads: super::sweep::thread_count(args.threads)?,
+        allow_large: args.allow_large,
+        settings: args.map.settings()?,
     };
-    reduce_any_into(&args.out.join("run"), &args.out.join("map"), false, &args.map)
+    let json = args.map.json;
+    if !matches!(request.job.spec, JobSpec::Study(_)) {
+        super::sweep::resume_hint_on_interrupt();
+    }
+    let report = map::run(&request, &mut |p| say(p, json)).map_err(|e| with_flags(e, &request.out.join("run"), &request.out.join("map")))?;
+    match &report {
+        // The sweep's lines stay text beside --json, as they always were.
+        MapReport::Swept { sweep, map } => {
+            print!("{sweep}");
+            print_map(map, json)
+        }
+        MapReport::Study(study) => print_study(study, json),
+    }
 }

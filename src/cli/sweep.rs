@@ -1,11 +1,10 @@
 //! `cablemap sweep` and `cablemap status`: front ends of [`cablemap::sweep`].
 
+use cablemap::job::Job;
 use cablemap::sweep::progress::ProgressMode;
-use cablemap::sweep::cables::CableSweepSpec;
-use cablemap::sweep::{run_kind, run_status_of, run_sweep_of, RunKind, RunSpec, RunStatus, SweepOptions, SweepSpec, SweepSummary};
-use anyhow::Context;
+use cablemap::sweep::SweepOptions;
 use clap::Args;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Duration;
 
 /// Arguments of `cablemap sweep`.
@@ -84,42 +83,6 @@ pub fn shard_from_env(shard: Option<u64>) -> anyhow::Result<(u64, &'static str)>
     Ok((0, "default"))
 }
 
-/// A job spec of either kind.
-pub enum AnySpec {
-    /// A planar single-cable sweep.
-    Planar(SweepSpec),
-    /// A sweep of several or spatial cables.
-    Cables(CableSweepSpec),
-}
-
-/// The spec at `path` (a cable sweep when it has `[[cable]]` tables), or
-/// the built-in thesis spec.
-pub fn load_any_spec(path: Option<&Path>) -> anyhow::Result<AnySpec> {
-    if let Some(path) = path {
-        if std::fs::read_to_string(path).is_ok_and(|t| cablemap::sweep::is_cable_spec_toml(&t)) {
-            return Ok(AnySpec::Cables(cablemap::sweep::cables::load_spec(path)?));
-        }
-    }
-    load_spec(path).map(AnySpec::Planar)
-}
-
-/// The sweep spec at `path`, or the built-in thesis spec.
-pub fn load_spec(path: Option<&Path>) -> anyhow::Result<SweepSpec> {
-    Ok(match path {
-        Some(path) => {
-            let spec = SweepSpec::load(path)?;
-            if std::fs::read_to_string(path).is_ok_and(|t| SweepSpec::is_blank_toml(&t)) {
-                eprintln!(
-                    "note: {} sets nothing: running the built-in thesis sweep (jobs/thesis.toml) with every default",
-                    path.display()
-                );
-            }
-            spec
-        }
-        None => SweepSpec::thesis(),
-    })
-}
-
 /// Worker threads: `threads`, else $SLURM_CPUS_PER_TASK, else one per core (None).
 pub fn thread_count(threads: Option<usize>) -> anyhow::Result<Option<usize>> {
     let (threads, source) = match threads {
@@ -130,28 +93,22 @@ pub fn thread_count(threads: Option<usize>) -> anyhow::Result<Option<usize>> {
     Ok(threads)
 }
 
-/// Runs one shard of `spec` into `out`, saying how to resume when
-/// interrupted, and prints the summary and the run's state. Returns whether
-/// the run is complete.
-pub fn sweep_and_report<S: RunSpec>(spec: &S, out: &Path, options: &SweepOptions, json: bool) -> anyhow::Result<bool> {
+/// Says, on Ctrl-C or SIGTERM, that the chunks written are kept and how to
+/// resume: this very command line again.
+pub fn resume_hint_on_interrupt() {
     let again: Vec<String> = std::env::args().collect();
     say_how_to_resume_on_interrupt(format!(
         "\ninterrupted: every chunk already written is kept; resume with the same command:\n  {}\n",
         again.join(" ")
     ));
-    let summary = run_sweep_of(spec, out, options)?;
-    let status = run_status_of::<S>(out).with_context(|| format!("checking {} after the sweep", out.display()))?;
-    if json {
-        println!("{}", serde_json::json!({ "summary": summary, "run": status.to_json_value() }));
-    } else {
-        print_summary(&summary, &status);
-    }
-    Ok(status.complete)
 }
 
 /// Runs `cablemap sweep`.
 pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
-    let spec = load_any_spec(args.spec.as_deref())?;
+    let job = Job::load_or_thesis(args.spec.as_deref())?;
+    if let Some(note) = job.note() {
+        eprintln!("{note}");
+    }
     let threads = thread_count(args.threads)?;
     let progress = if args.quiet {
         ProgressMode::Quiet
@@ -170,32 +127,18 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
         args.shards
     );
     let options = SweepOptions { shard, shards: args.shards, threads, progress, allow_large: args.allow_large };
-    let complete = match &spec {
-        AnySpec::Planar(spec) => sweep_and_report(spec, &args.out, &options, args.json)?,
-        AnySpec::Cables(spec) => sweep_and_report(spec, &args.out, &options, args.json)?,
-    };
-    // Only here: `map` reduces by itself, so the hint belongs to `sweep` alone.
-    if complete && !args.json {
-        println!("next: cablemap reduce {} --out MAP_DIR", args.out.display());
+    resume_hint_on_interrupt();
+    let report = job.sweep(&args.out, &options)?;
+    if args.json {
+        println!("{}", serde_json::to_value(&report)?);
+    } else {
+        print!("{report}");
+        // Only here: `map` reduces by itself, so the hint belongs to `sweep` alone.
+        if report.status.complete {
+            println!("next: cablemap reduce {} --out MAP_DIR", args.out.display());
+        }
     }
     Ok(())
-}
-
-/// The closing lines, each short enough for an 80-column terminal.
-fn print_summary<S: RunSpec>(s: &SweepSummary, status: &RunStatus<S>) {
-    println!("shard {}/{}: {} rows solved and written, {} already done", s.shard, s.shards, s.rows_written, s.rows_skipped);
-    if s.partial_chunks_removed + s.damaged_chunks_redone > 0 {
-        println!("  {} abandoned partial chunks removed, {} damaged chunks redone", s.partial_chunks_removed, s.damaged_chunks_redone);
-    }
-    println!("  {:.2} s wall, {:.0} solves/s, {} thread{}", s.wall_s, s.solves_per_s, s.threads, if s.threads == 1 { "" } else { "s" });
-    println!("shard {}/{} statuses: {}", s.shard, s.shards, fmt_counts(&s.status_counts));
-    println!(
-        "run {}: {}/{} rows, {}",
-        status.dir.display(),
-        status.rows_done,
-        status.rows_total,
-        if status.complete { "complete" } else { "partial (other shards not done yet)" }
-    );
 }
 
 /// On Ctrl-C (SIGINT) or SIGTERM: say what is kept and how to resume, then
@@ -225,116 +168,13 @@ fn say_how_to_resume_on_interrupt(resume: String) {
 #[cfg(not(unix))]
 fn say_how_to_resume_on_interrupt(_resume: String) {}
 
-/// The coefficients a run stores, as people write them: `a_0…a_3` (not the
-/// Rust range `0..=3`).
-fn coefficient_range(order: usize) -> String {
-    if order == 0 {
-        "a_0".into()
-    } else {
-        format!("a_0…a_{order}")
-    }
-}
-
-fn fmt_counts(counts: &std::collections::BTreeMap<String, u64>) -> String {
-    if counts.is_empty() {
-        return "(no rows)".into();
-    }
-    counts.iter().map(|(s, n)| format!("{s} {n}")).collect::<Vec<_>>().join(", ")
-}
-
 /// Runs `cablemap status`.
 pub fn run_status_command(args: &StatusArgs) -> anyhow::Result<()> {
-    // A map given for its run is named as such (the reduce layer knows maps).
-    let kind = run_kind(&args.dir)
-        .map_err(|e| cablemap::reduce::map_given_as_run(&e).map_or_else(|| anyhow::Error::from(e), anyhow::Error::from))?;
-    match kind {
-        RunKind::Planar => print_status(&run_status_of::<SweepSpec>(&args.dir)?, args.json),
-        RunKind::Cables => print_status(&run_status_of::<CableSweepSpec>(&args.dir)?, args.json),
+    let report = cablemap::map::status(&args.dir)?;
+    if args.json {
+        println!("{}", report.to_json_value());
+    } else {
+        print!("{report}");
     }
-}
-
-/// Most shards listed one per line by `status`; beyond, the table lists
-/// the unfinished ones up to this many and counts the rest (`--json` has
-/// every shard).
-const SHARD_LINES: usize = 32;
-
-/// The per-shard table of `status`: every shard for a few dozen, else a
-/// count of finished shards and the first unfinished ones.
-fn print_shard_table(shards: &[cablemap::sweep::status::ShardStatus]) {
-    let line = |sh: &cablemap::sweep::status::ShardStatus| {
-        println!(
-            "{:>6} {:>14} {:>22} {:>9}",
-            sh.shard,
-            format!("{}/{}", sh.chunks_done, sh.chunks_total),
-            format!("{}/{}", sh.rows_done, sh.rows_total),
-            sh.failures
-        )
-    };
-    println!("{:>6} {:>14} {:>22} {:>9}", "shard", "chunks", "rows", "failures");
-    if shards.len() <= SHARD_LINES {
-        shards.iter().for_each(line);
-        return;
-    }
-    let unfinished: Vec<_> = shards.iter().filter(|sh| sh.chunks_done < sh.chunks_total).collect();
-    unfinished.iter().take(SHARD_LINES).for_each(|sh| line(sh));
-    let finished = shards.len() - unfinished.len();
-    let more = unfinished.len().saturating_sub(SHARD_LINES);
-    println!(
-        "  ({} shards: {finished} finished{}; `status --json` lists every shard)",
-        shards.len(),
-        if more > 0 {
-            format!(", {} unfinished listed, {more} more unfinished", SHARD_LINES)
-        } else {
-            format!(", {} unfinished listed", unfinished.len())
-        }
-    );
-}
-
-fn print_status<S: RunSpec>(s: &RunStatus<S>, json: bool) -> anyhow::Result<()> {
-    if json {
-        println!("{}", s.to_json_value());
-        return Ok(());
-    }
-    let m = &s.manifest;
-    println!("run        {}", s.dir.display());
-    if S::FORMAT != SweepSpec::FORMAT {
-        println!("kind       {} ({})", S::KIND, S::FORMAT);
-    }
-    println!("spec       sha256 {} (cablemap {})", m.spec_sha256, m.tool_version);
-    println!(
-        "sweep      {} routings x {} {} = {} rows in {} chunks, {} shard(s)",
-        m.routings,
-        m.tensions,
-        if S::FORMAT == SweepSpec::FORMAT { "tensions" } else { "tension combinations" },
-        m.total_rows,
-        m.chunks,
-        m.shards
-    );
-    println!("a_i        {}, {}", coefficient_range(m.spec.order()), m.length_basis.describe());
-    print_shard_table(&s.shards);
-    println!("statuses   {}", fmt_counts(&s.status_counts));
-    for d in &s.damaged {
-        println!("damaged    {} ({}): rerun its shard's sweep command to move it aside and recompute it", d.path.display(), d.reason);
-    }
-    if s.chunks_in_progress > 0 {
-        println!("in flight  {} chunk(s) being written or left by an interrupted run (redone on resume)", s.chunks_in_progress);
-    }
-    println!(
-        "state      {}: {}/{} rows",
-        if s.complete { "complete" } else { "partial" },
-        s.rows_done,
-        s.rows_total
-    );
     Ok(())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::coefficient_range;
-
-    #[test]
-    fn coefficient_ranges_read_as_written_by_hand() {
-        assert_eq!(coefficient_range(0), "a_0");
-        assert_eq!(coefficient_range(3), "a_0…a_3");
-    }
 }

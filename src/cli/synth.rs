@@ -2,11 +2,11 @@
 //! hidden effect and noise.
 
 use super::{parse_list, ActuatorArgs};
-use cablemap::calibrate::data::{centrelines_csv, markers_csv, measurements_csv};
-use cablemap::calibrate::synth::{default_routings, hidden_effect_size, synthesize_with_markers, Planted, SynthSpec, VISIBLE_NOISE_SDS};
+use cablemap::calibrate::Effect;
 use cablemap::model::routing::CONTROL_POINTS;
 use cablemap::model::SolverOptions;
-use anyhow::{bail, Context};
+use cablemap::synth::{HiddenEffect, Markers, SynthRequest, OUT_OF_LIBRARY};
+use anyhow::bail;
 use clap::Args;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -125,32 +125,53 @@ fn parse_markers(text: &str) -> anyhow::Result<Vec<(f64, f64)>> {
     Ok(out)
 }
 
-/// Runs `cablemap synth`.
-pub fn run(args: &SynthArgs) -> anyhow::Result<()> {
-    let mut actuator = args.actuator.resolve(None)?;
-    // The actuator as it would be without the hidden effect, to size the effect against the noise.
-    let without_effect = actuator.clone();
-    Planted::parse(&args.effect, args.magnitude, args.glue_length_mm)?.plant(&mut actuator);
-    actuator.validate().context("the true actuator")?;
+/// The hidden effect `--effect` and `--magnitude` ask for.
+fn hidden_effect(args: &SynthArgs) -> anyhow::Result<HiddenEffect> {
+    if let Some(hidden) = OUT_OF_LIBRARY.iter().find(|h| **h == args.effect) {
+        let Some(m) = args.magnitude else {
+            bail!("--effect {hidden} needs --magnitude ({})", if *hidden == "rest_curvature" { "the rest curvature in 1/mm, e.g. 0.004" } else { "the joint's EI factor, e.g. 5" });
+        };
+        return Ok(if *hidden == "rest_curvature" {
+            HiddenEffect::RestCurvature { per_mm: m }
+        } else {
+            HiddenEffect::GlueJoint { ei_factor: m, length_mm: args.glue_length_mm }
+        });
+    }
+    if args.effect == "none" {
+        anyhow::ensure!(args.magnitude.is_none(), "--magnitude needs --effect");
+        return Ok(HiddenEffect::None);
+    }
+    let Some(effect) = Effect::parse(&args.effect) else {
+        let names: Vec<&str> = Effect::ALL.iter().map(|e| e.name()).chain(OUT_OF_LIBRARY).collect();
+        bail!("--effect {}: unknown effect; use none or one of {}", args.effect, names.join(", "));
+    };
+    let Some(magnitude) = args.magnitude else {
+        bail!("--effect {} needs --magnitude (its parameter {})", args.effect, effect.parameter_name());
+    };
+    Ok(HiddenEffect::Candidate { effect, magnitude })
+}
+
+/// The synth request the arguments describe.
+fn request(args: &SynthArgs) -> anyhow::Result<SynthRequest> {
+    let actuator = args.actuator.resolve(None)?;
+    let effect = hidden_effect(args)?;
     let (routings, routing_tilts_rad) = match &args.routings {
-        Some(t) => parse_routings(t)?,
-        None => (default_routings(), BTreeMap::new()),
-    };
-    let markers = match (&args.markers_out, &args.markers) {
-        (None, Some(_)) => bail!("--markers needs --markers-out FILE"),
-        (None, None) => Vec::new(),
-        (Some(_), Some(text)) => parse_markers(text)?,
-        (Some(_), None) => {
-            // On the surface: r(s) for a tapered body.
-            let l = actuator.length_mm;
-            let r = |f: f64| actuator.radius_at(f * l);
-            vec![(0.25 * l, r(0.25)), (0.5 * l, -r(0.5)), (0.75 * l, r(0.75)), (l, -r(1.0))]
+        Some(t) => {
+            let (r, tilts) = parse_routings(t)?;
+            (Some(r), tilts)
         }
+        None => (None, BTreeMap::new()),
     };
-    let spec = SynthSpec {
-        markers,
+    let markers_out = match (&args.markers_out, &args.markers) {
+        (None, Some(_)) => bail!("--markers needs --markers-out FILE"),
+        (None, None) => None,
+        (Some(path), Some(text)) => Some((path.clone(), Markers::At(parse_markers(text)?))),
+        (Some(path), None) => Some((path.clone(), Markers::Default)),
+    };
+    Ok(SynthRequest {
         actuator,
         options: args.actuator.solver_options(&SolverOptions::default()),
+        effect,
         routings,
         routing_tilts_rad,
         max_tension_n: args.max_tension,
@@ -161,49 +182,16 @@ pub fn run(args: &SynthArgs) -> anyhow::Result<()> {
         noise_mm: args.noise_mm,
         noise_deg: args.noise_deg,
         seed: args.seed,
-    };
-    for path in std::iter::once(&args.out).chain(&args.centreline_out).chain(&args.markers_out) {
-        anyhow::ensure!(
-            args.force || !path.exists(),
-            "{} exists: synth does not overwrite measurement files; give another --out, or --force to replace it",
-            path.display()
-        );
-    }
-    let points = if args.centreline_out.is_some() { args.centreline_points.max(2) } else { 0 };
-    let (mut data, centrelines, markers) = synthesize_with_markers(&spec, points)?;
-    if !spec.actuator.is_uniform_body() {
-        // The body goes into the file, so diagnose needs no geometry flags.
-        data.actuator = Some(spec.actuator.clone());
-    }
-    cablemap::io::write_atomic(&args.out, measurements_csv(&data).as_bytes())
-        .with_context(|| format!("writing {}", args.out.display()))?;
-    if let Some(path) = &args.centreline_out {
-        cablemap::io::write_atomic(path, centrelines_csv(&centrelines).as_bytes()).with_context(|| format!("writing {}", path.display()))?;
-    }
-    if let Some(path) = &args.markers_out {
-        cablemap::io::write_atomic(path, markers_csv(&markers).as_bytes()).with_context(|| format!("writing {}", path.display()))?;
-    }
-    eprintln!(
-        "wrote {} readings of {} routings to {} (hidden effect: {}{})",
-        data.rows.len(),
-        spec.routings.len(),
-        args.out.display(),
-        args.effect,
-        args.magnitude.map(|m| format!(" = {m}")).unwrap_or_default()
-    );
-    if args.effect != "none" {
-        let size = hidden_effect_size(&spec, &without_effect)?;
-        if size.hidden_by_noise(spec.noise_mm, spec.noise_deg) {
-            eprintln!(
-                "warning: the hidden effect moves the simulated tips by at most {} mm (in x or y) and {}°, less than \
-                 {VISIBLE_NOISE_SDS}× the noise (sd {} mm, {}°): the data cannot show it and a diagnosis will rightly answer \
-                 `none`; raise --magnitude or lower --noise-mm/--noise-deg",
-                cablemap::io::fmt_sig(size.max_tip_shift_mm, 2),
-                cablemap::io::fmt_sig(size.max_angle_shift_deg, 2),
-                spec.noise_mm,
-                spec.noise_deg
-            );
-        }
-    }
+        out: args.out.clone(),
+        centreline_out: args.centreline_out.clone().map(|p| (p, args.centreline_points)),
+        markers_out,
+        force: args.force,
+    })
+}
+
+/// Runs `cablemap synth`: what it wrote goes to stderr.
+pub fn run(args: &SynthArgs) -> anyhow::Result<()> {
+    let report = cablemap::synth::run(&request(args)?)?;
+    eprint!("{report}");
     Ok(())
 }

@@ -6,6 +6,7 @@ use super::objective::{Evaluation, Objective};
 use super::target::Component;
 use super::record::DesignRecord;
 use super::DesignError;
+use crate::io::FileError;
 use crate::model::{simulate, Routing};
 use crate::plot::{draw_bodies, BodyDrawing};
 use crate::shape::centreline_from_coefficients;
@@ -13,8 +14,9 @@ use plotters::style::full_palette::{BLUE_800, GREEN_700};
 use std::fmt::Write as _;
 use std::path::Path;
 
-fn io_error(context: String) -> impl FnOnce(std::io::Error) -> DesignError {
-    move |source| DesignError::Io { context, source }
+/// Refuses an export directory inside a sweep's run directory.
+pub fn check_export_dir(dir: &Path) -> Result<(), DesignError> {
+    Ok(crate::io::check_outside_run_dir(dir, "the export directory")?)
 }
 
 /// A 1:1 drawing of the straight body (L × 2r) with its channel, in mm
@@ -138,12 +140,12 @@ pub fn write_all(
     record: &DesignRecord,
     tube_diameter_mm: f64,
 ) -> Result<Vec<String>, DesignError> {
-    super::run::check_export_dir(dir)?;
-    std::fs::create_dir_all(dir).map_err(io_error(format!("creating {}", dir.display())))?;
+    check_export_dir(dir)?;
+    std::fs::create_dir_all(dir).map_err(FileError::on("creating", dir))?;
     let mut written = Vec::new();
     let mut write = |name: &str, bytes: &[u8]| {
         let p = dir.join(name);
-        crate::io::write_atomic(&p, bytes).map_err(io_error(format!("writing {}", p.display())))?;
+        crate::io::write_atomic(&p, bytes).map_err(FileError::on("writing", &p))?;
         written.push(name.to_string());
         Ok::<_, DesignError>(())
     };

@@ -8,6 +8,8 @@ use super::target::{Component, Target, Weights};
 use super::DesignError;
 use crate::shape::LengthBasis;
 use serde::Serialize;
+use std::fmt;
+use std::path::{Path, PathBuf};
 
 /// The three verdicts.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -257,4 +259,202 @@ fn mode_check(map: &MapDir, target: &Target, cell: Option<&Cell>) -> ModeCheck {
     };
     let count_in_cell = cell.map(|c| candidates.iter().map(|&m| c.modes[m]).sum());
     ModeCheck { mode, candidates, count_in_cell }
+}
+
+/// What `feasible` judges the target against.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum MapSource {
+    /// One feasibility map directory (`cablemap reduce` output).
+    Map(PathBuf),
+    /// A study directory (`cablemap study` output): every variant's map.
+    Study(PathBuf),
+}
+
+/// Everything a feasibility check needs.
+#[derive(Debug, Clone)]
+pub struct FeasibleRequest {
+    /// The map, or the study's maps.
+    pub source: MapSource,
+    /// The target.
+    pub target: Target,
+    /// Weights of the distance to the nearest designs (checked against the target here).
+    pub weights: Weights,
+    /// The length the target's coefficients are per unit of.
+    pub length_basis: LengthBasis,
+    /// Nearest simulated designs to list.
+    pub nearest: usize,
+}
+
+/// One study variant's verdict.
+#[derive(Debug, Clone)]
+pub struct VariantVerdict {
+    /// Variant number.
+    pub index: usize,
+    /// Its settings, `axis=value, …`.
+    pub label: String,
+    /// Its map's verdict.
+    pub report: FeasibilityReport,
+}
+
+/// The answer of `feasible`.
+#[derive(Debug, Clone)]
+pub enum FeasibleReport {
+    /// One map's verdict.
+    Map {
+        /// The verdict and its evidence.
+        report: FeasibilityReport,
+        /// The command that designs for the target with the map's designs as seeds.
+        next: String,
+    },
+    /// Every variant's verdict of a study.
+    Study {
+        /// The study directory.
+        dir: PathBuf,
+        /// One verdict per variant.
+        variants: Vec<VariantVerdict>,
+    },
+}
+
+impl FeasibleReport {
+    /// The variants of a study whose maps reach the target feasibly (`v0`, …).
+    pub fn feasible_variants(&self) -> Vec<String> {
+        match self {
+            FeasibleReport::Map { .. } => Vec::new(),
+            FeasibleReport::Study { variants, .. } => {
+                variants.iter().filter(|v| v.report.verdict == Verdict::Feasible).map(|v| format!("v{}", v.index)).collect()
+            }
+        }
+    }
+}
+
+impl Serialize for FeasibleReport {
+    /// The JSON `feasible --json` prints.
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        match self {
+            FeasibleReport::Map { report, .. } => report.serialize(serializer),
+            FeasibleReport::Study { dir, variants } => {
+                let rows: Vec<_> = variants
+                    .iter()
+                    .map(|v| serde_json::json!({ "variant": v.index, "label": v.label, "verdict": v.report.verdict, "report": v.report }))
+                    .collect();
+                serde_json::json!({ "study": dir, "feasible_variants": self.feasible_variants(), "variants": rows }).serialize(serializer)
+            }
+        }
+    }
+}
+
+impl fmt::Display for FeasibleReport {
+    /// The text `feasible` prints.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            FeasibleReport::Map { report, next } => {
+                write!(f, "{report}")?;
+                writeln!(f, "next      {next}")
+            }
+            FeasibleReport::Study { variants, .. } => {
+                for v in variants {
+                    let first = v.report.reasons.first().map_or(String::new(), |s| format!(": {s}"));
+                    writeln!(f, "v{:<3} {}: {}{first}", v.index, v.label, v.report.verdict.label())?;
+                }
+                let reach = self.feasible_variants();
+                if reach.is_empty() {
+                    writeln!(f, "no variant reaches the target feasibly (see the borderline ones, or widen the study)")
+                } else {
+                    writeln!(f, "reach the target: {} of {} variants ({})", reach.len(), variants.len(), reach.join(", "))
+                }
+            }
+        }
+    }
+}
+
+impl fmt::Display for FeasibilityReport {
+    /// The verdict, its reasons, the tip cell, the coefficients, the mode and the nearest designs.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let r = self;
+        writeln!(f, "verdict   {}", r.verdict.label())?;
+        for reason in &r.reasons {
+            writeln!(f, "          - {reason}")?;
+        }
+        let t = &r.tip_cell;
+        let idx = |v: Option<i32>| v.map_or("any".to_string(), |v| v.to_string());
+        writeln!(f, "tip cell  ix = {}, iy = {}: {} simulation(s) ({} with its neighbours)", idx(t.ix), idx(t.iy), t.count, t.neighbourhood_count)?;
+        if !r.coefficients.is_empty() {
+            writeln!(f, "basis     a_i in 1/mm, {} (the map's basis)", r.length_basis.describe())?;
+            writeln!(f, "{:<6}{:>12}{:>12}{:>12}{:>12}{:>12}", "", "target", "cell p10", "cell p90", "near min", "near max")?;
+            let v = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.5}"));
+            for c in &r.coefficients {
+                writeln!(
+                    f,
+                    "{:<6}{:>12.5}{:>12}{:>12}{:>12}{:>12}",
+                    c.component,
+                    c.target,
+                    v(c.cell_p10),
+                    v(c.cell_p90),
+                    v(c.neighbourhood_min),
+                    v(c.neighbourhood_max)
+                )?;
+            }
+        }
+        let m = &r.mode;
+        match (m.mode, m.count_in_cell) {
+            (Some(mode), Some(n)) => writeln!(f, "mode      {mode} (a0 range {}, a1 range {}); {n} simulations of the tip cell in it", mode / 3, mode % 3)?,
+            (Some(mode), None) => writeln!(f, "mode      {mode} (a0 range {}, a1 range {})", mode / 3, mode % 3)?,
+            (None, _) => writeln!(f, "mode      one of {:?} (give a0 and a1 to pin it down)", m.candidates)?,
+        }
+        writeln!(f, "nearest simulated designs (weighted distance):")?;
+        for near in &r.nearest {
+            let d = &near.design;
+            writeln!(
+                f,
+                "  y = [{}] mm, τ = {:.3} N → tip ({:.2}, {:.2}) mm, a = [{}]  (distance {:.4})",
+                d.routing_mm.iter().map(|v| format!("{v:.2}")).collect::<Vec<_>>().join(", "),
+                d.tension_n,
+                d.tip_x_mm,
+                d.tip_y_mm,
+                d.a.iter().map(|v| format!("{v:.4}")).collect::<Vec<_>>().join(", "),
+                near.distance
+            )?;
+        }
+        Ok(())
+    }
+}
+
+/// The command that designs for `target` with `map_dir`'s designs as seeds,
+/// ready to paste: `cablemap design --target x=…,a0=… --map MAP_DIR`.
+pub fn design_command(target: &Target, map_dir: &Path) -> String {
+    let components: Vec<String> = target.components.iter().map(|(c, v)| format!("{}={v}", c.key())).collect();
+    format!("cablemap design --target {} --map {}", components.join(","), shell_word(&map_dir.display().to_string()))
+}
+
+/// `text` as one shell word: as it is when it holds only characters no shell
+/// treats specially, else in single quotes.
+fn shell_word(text: &str) -> String {
+    let plain = |c: char| c.is_ascii_alphanumeric() || "-_./,:=+@%".contains(c);
+    if !text.is_empty() && text.chars().all(plain) {
+        text.to_string()
+    } else {
+        format!("'{}'", text.replace('\'', r"'\''"))
+    }
+}
+
+/// Runs `feasible`: the map's verdict on the target, or every study variant's.
+pub fn run(request: &FeasibleRequest) -> Result<FeasibleReport, DesignError> {
+    let FeasibleRequest { source, target, weights, length_basis, nearest } = request;
+    weights.check_against(target)?;
+    match source {
+        MapSource::Map(dir) => {
+            let map = MapDir::open(dir)?;
+            let report = check(&map, target, *length_basis, weights, *nearest)?;
+            Ok(FeasibleReport::Map { report, next: design_command(target, dir) })
+        }
+        MapSource::Study(dir) => {
+            let mut variants = Vec::new();
+            for (index, label, map_dir) in crate::study::mapped_variants(dir).map_err(Box::new)? {
+                let map = MapDir::open(&map_dir).map_err(|e| DesignError::Variant { index, label: label.clone(), source: Box::new(e) })?;
+                let report = check(&map, target, *length_basis, weights, *nearest)?;
+                variants.push(VariantVerdict { index, label, report });
+            }
+            Ok(FeasibleReport::Study { dir: dir.clone(), variants })
+        }
+    }
 }

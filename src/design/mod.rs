@@ -34,17 +34,18 @@ pub enum DesignError {
     /// A search setting is unusable (tolerance, number of starts).
     #[error("bad search setting: {0}")]
     BadSearch(String),
-    /// The export directory is unusable.
-    #[error("{message}")]
+    /// The export directory lies in a sweep's run directory.
+    #[error(transparent)]
     ExportDir {
-        /// Why.
-        message: String,
+        /// Where it lies.
+        #[from]
+        source: crate::io::InsideRunDir,
     },
     /// A design.json that cannot be read back.
-    #[error("{path} {message}; give a design.json written by `cablemap design --out`")]
+    #[error("{} {message}; give a design.json written by `cablemap design --out`", path.display())]
     DesignFile {
         /// The file.
-        path: String,
+        path: std::path::PathBuf,
         /// What is wrong with it.
         message: String,
     },
@@ -77,10 +78,23 @@ pub enum DesignError {
     /// A map table cannot be read.
     #[error(transparent)]
     MapTable(#[from] crate::reduce::tables::ReadError),
-    /// Writing an export.
-    #[error("{context}: {source}")]
-    Io { context: String, source: std::io::Error },
+    /// Reading a design or writing an export.
+    #[error(transparent)]
+    File(#[from] crate::io::FileError),
     /// Drawing a picture.
     #[error(transparent)]
     Plot(#[from] crate::plot::PlotError),
+    /// A study directory's record (`feasible --study`).
+    #[error(transparent)]
+    Study(#[from] Box<crate::study::StudyError>),
+    /// A study variant's map.
+    #[error("variant {index} ({label}): run the study to finish its map: {source}")]
+    Variant {
+        /// Variant number.
+        index: usize,
+        /// Its settings.
+        label: String,
+        /// Why its map cannot be read.
+        source: Box<DesignError>,
+    },
 }

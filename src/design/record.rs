@@ -142,9 +142,9 @@ pub struct DesignFile {
 
 /// Reads the routing and actuator of a design.json written by `design --out`.
 pub fn read_design_file(path: &Path) -> Result<DesignFile, DesignError> {
-    let bad = |message: String| DesignError::DesignFile { path: path.display().to_string(), message };
+    let bad = |message: String| DesignError::DesignFile { path: path.to_path_buf(), message };
     let text = std::fs::read_to_string(path)
-        .map_err(|source| DesignError::Io { context: format!("reading {}", path.display()), source })?;
+        .map_err(crate::io::FileError::on("reading", path))?;
     let v: serde_json::Value = serde_json::from_str(&text).map_err(|e| bad(format!("is not JSON ({e})")))?;
     let routing_mm: Vec<f64> = v
         .get("routing_mm")

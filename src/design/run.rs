@@ -12,7 +12,7 @@ use super::DesignError;
 use crate::model::{Rod, Routing, SolverOptions};
 use crate::mould::{MouldParams, MouldSet, MouldSummary};
 use crate::shape::LengthBasis;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// Tension bounds without a map, N (the thesis's design range, §5).
 pub const DEFAULT_TENSION_RANGE_N: [f64; 2] = [1.0, 2.0];
@@ -146,7 +146,7 @@ impl DesignRequest {
 pub fn run(request: &DesignRequest) -> Result<DesignRun, DesignError> {
     if let Some(dir) = &request.out {
         // Before the search, not after it.
-        check_export_dir(dir)?;
+        super::export::check_export_dir(dir)?;
     }
     request.check_moulds()?;
     let map = request.map.as_deref().map(MapDir::open).transpose()?;
@@ -176,11 +176,6 @@ pub fn run(request: &DesignRequest) -> Result<DesignRun, DesignError> {
         }
     }
     Ok(DesignRun { objective, outcome, results, feasibility, record, exported, moulds })
-}
-
-/// Refuses an export directory inside a sweep's run directory.
-pub fn check_export_dir(dir: &Path) -> Result<(), DesignError> {
-    crate::io::check_not_in_run_dir(dir, "the export directory").map_err(|message| DesignError::ExportDir { message })
 }
 
 #[cfg(test)]

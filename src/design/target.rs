@@ -88,9 +88,7 @@ impl Target {
     /// Parses `x=50,y=5,a0=-0.025,a1=-0.06,a2=0.015` (any subset, any order).
     pub fn parse(text: &str) -> Result<Self, DesignError> {
         let mut components = Vec::new();
-        for (key, component, value) in parse_pairs(text, "e.g. --target x=50,y=5,a0=-0.025,a1=-0.06,a2=0.015")
-            .map_err(DesignError::BadTarget)?
-        {
+        for (key, component, value) in parse_pairs(text, "e.g. --target x=50,y=5,a0=-0.025,a1=-0.06,a2=0.015", DesignError::BadTarget)? {
             if !value.is_finite() {
                 return Err(DesignError::BadTarget(format!("{key}: '{value}' is not a finite number")));
             }
@@ -143,7 +141,7 @@ impl Weights {
     pub fn parse(text: &str) -> Result<Self, DesignError> {
         let mut overrides: Vec<(Component, f64)> = Vec::new();
         for (key, component, value) in
-            parse_pairs(text, "e.g. --weights x=1,y=1,a0=100,a1=50,a2=25").map_err(DesignError::BadWeights)?
+            parse_pairs(text, "e.g. --weights x=1,y=1,a0=100,a1=50,a2=25", DesignError::BadWeights)?
         {
             if !(value.is_finite() && value >= 0.0) {
                 return Err(DesignError::BadWeights(format!("{key}: '{value}' is not a finite weight ≥ 0")));
@@ -179,22 +177,22 @@ impl Weights {
 }
 
 /// Splits `KEY=VALUE,…` into (key, component, number); `example` completes
-/// the error messages.
-fn parse_pairs(text: &str, example: &str) -> Result<Vec<(String, Component, f64)>, String> {
+/// the error messages, `error` says which kind of list is wrong.
+fn parse_pairs(text: &str, example: &str, error: fn(String) -> DesignError) -> Result<Vec<(String, Component, f64)>, DesignError> {
     text.split(',')
         .map(str::trim)
         .filter(|s| !s.is_empty())
         .map(|item| {
-            let (key, value) = item.split_once('=').ok_or_else(|| format!("'{item}' is not KEY=VALUE; write {example}"))?;
+            let (key, value) = item.split_once('=').ok_or_else(|| error(format!("'{item}' is not KEY=VALUE; write {example}")))?;
             let key = key.trim();
             let component = Component::parse(key).ok_or_else(|| {
-                format!("unknown component '{key}'; use x, y (tip, mm) or a0 … a{MAX_ORDER} (curvature coefficients, 1/mm)")
+                error(format!("unknown component '{key}'; use x, y (tip, mm) or a0 … a{MAX_ORDER} (curvature coefficients, 1/mm)"))
             })?;
             let number: f64 = value.trim().parse().map_err(|_| {
                 let value = value.trim();
                 // "x=50 y=5" or "x=50;y=5": another component written into this one's value.
                 let separator = if value.contains(['=', ' ', ';', '\t']) { "; separate components with commas, " } else { "; " };
-                format!("{key}: '{value}' is not a finite number{separator}{example}")
+                error(format!("{key}: '{value}' is not a finite number{separator}{example}"))
             })?;
             Ok((key.to_string(), component, number))
         })

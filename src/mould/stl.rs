@@ -50,15 +50,36 @@ pub fn write(mut w: impl Write, mesh: &Mesh, title: &str) -> io::Result<()> {
     w.write_all(&to_bytes(mesh, title))
 }
 
+/// Why bytes are not binary STL.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum StlError {
+    /// Fewer bytes than the header.
+    #[error("{bytes} bytes is too short for binary STL (84-byte header)")]
+    TooShort {
+        /// Bytes given.
+        bytes: usize,
+    },
+    /// The triangle count disagrees with the length.
+    #[error("header says {triangles} triangles ({expected} bytes) but the file has {bytes} bytes")]
+    WrongLength {
+        /// Triangles in the header.
+        triangles: usize,
+        /// Bytes that count needs.
+        expected: usize,
+        /// Bytes given.
+        bytes: usize,
+    },
+}
+
 /// Reads binary STL: the header text and the mesh, corners welded where
 /// they are bit-identical (as written).
-pub fn read(bytes: &[u8]) -> Result<(String, Mesh), String> {
+pub fn read(bytes: &[u8]) -> Result<(String, Mesh), StlError> {
     if bytes.len() < 84 {
-        return Err(format!("{} bytes is too short for binary STL (84-byte header)", bytes.len()));
+        return Err(StlError::TooShort { bytes: bytes.len() });
     }
     let count = u32::from_le_bytes(bytes[80..84].try_into().expect("4 bytes")) as usize;
     if bytes.len() != 84 + 50 * count {
-        return Err(format!("header says {count} triangles ({} bytes) but the file has {} bytes", 84 + 50 * count, bytes.len()));
+        return Err(StlError::WrongLength { triangles: count, expected: 84 + 50 * count, bytes: bytes.len() });
     }
     let title = String::from_utf8_lossy(&bytes[..80]).trim_end().to_string();
     let mut mesh = Mesh::default();

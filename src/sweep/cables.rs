@@ -465,10 +465,10 @@ impl RunSpec for CableSweepSpec {
     type Worker = CableWorker;
     type Solved = Vec<Row>;
 
-    fn check(&self) -> Result<(), String> {
+    fn check(&self) -> Result<(), super::kind::InvalidSpec> {
         self.validate("").map_err(|e| match e {
-            CableSweepError::BadSpec { message, .. } => message,
-            other => other.to_string(),
+            CableSweepError::BadSpec { message, .. } => super::kind::InvalidSpec(message),
+            other => super::kind::InvalidSpec(other.to_string()),
         })
     }
 

@@ -5,7 +5,8 @@
 //!
 //! - [`super::SweepSpec`]: one planar cable (`cablemap-sweep/2` runs).
 //! - [`super::cables::CableSweepSpec`]: several or spatial cables
-//!   (`cablemap-cables/1` runs), recognised by its `[[cable]]` tables.
+//!   (`cablemap-cables/1` runs), recognised by its `[[cable]]` tables
+//!   (`crate::job::Job::load` tells a spec file's kind).
 //!
 //! Chunks, shards and row counts follow from [`ChunkLayout`] alone, so
 //! sharding, resume, checksums and status are the same code for both.
@@ -87,7 +88,7 @@ pub trait RunSpec: Clone + PartialEq + std::fmt::Debug + serde::Serialize + serd
     type Solved: Send;
 
     /// Checks the spec; the message names the setting.
-    fn check(&self) -> Result<(), String>;
+    fn check(&self) -> Result<(), InvalidSpec>;
     /// Checks the whole sweep's size (refused above a bound unless `allow_large`).
     fn check_run_size(&self, allow_large: bool) -> Result<(), SweepError>;
     /// The spec with every default filled in, as compact JSON.
@@ -114,6 +115,12 @@ pub trait RunSpec: Clone + PartialEq + std::fmt::Debug + serde::Serialize + serd
     fn batch(&self, schema: &SchemaRef, solved: &[Self::Solved]) -> RecordBatch;
 }
 
+/// Why [`RunSpec::check`] refuses a spec: the setting and what to do, in
+/// the kind's own words (without the spec's origin, which the caller knows).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{0}")]
+pub struct InvalidSpec(pub String);
+
 /// The kind of sweep a run directory holds, from its manifest's format tag.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum RunKind {
@@ -131,7 +138,7 @@ pub fn run_kind(dir: &Path) -> Result<RunKind, SweepError> {
     let text = match crate::io::read_utf8(&path) {
         Ok(t) => t,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Err(SweepError::no_run(dir)),
-        Err(source) => return Err(SweepError::Io { context: format!("reading {}", path.display()), source }),
+        Err(source) => return Err(crate::io::FileError::new("reading", path, source).into()),
     };
     let value: serde_json::Value =
         serde_json::from_str(&text).map_err(|e| SweepError::CorruptManifest { path: path.clone(), message: e.to_string() })?;
@@ -139,13 +146,6 @@ pub fn run_kind(dir: &Path) -> Result<RunKind, SweepError> {
         Some(f) if f == <super::cables::CableSweepSpec as RunSpec>::FORMAT => RunKind::Cables,
         _ => RunKind::Planar,
     })
-}
-
-/// Whether the TOML text of a spec is a cable sweep: it has `[[cable]]`
-/// tables (a planar spec has none). Unparsable text is reported as planar,
-/// whose parser then names the problem.
-pub fn is_cable_spec_toml(text: &str) -> bool {
-    text.parse::<toml::Table>().is_ok_and(|t| t.contains_key("cable"))
 }
 
 #[cfg(test)]
@@ -167,12 +167,5 @@ mod tests {
         for format in [super::super::store::FORMAT, super::super::cables::CABLES_FORMAT] {
             assert!(crate::io::RUN_FORMAT_PREFIXES.iter().any(|p| format.starts_with(p)), "{format}");
         }
-    }
-
-    #[test]
-    fn cable_specs_are_told_by_their_cable_tables() {
-        assert!(is_cable_spec_toml("[[cable]]\ny_mm = [1, 1, 1, 1, 1]\n"));
-        assert!(!is_cable_spec_toml("[grid]\nlevels = 3\n"));
-        assert!(!is_cable_spec_toml("not toml ["));
     }
 }

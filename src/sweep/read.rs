@@ -213,7 +213,7 @@ fn open_chunk(
     expected: &SchemaRef,
     projection: Option<&[usize]>,
 ) -> Result<parquet::arrow::arrow_reader::ParquetRecordBatchReader, SweepError> {
-    let file = File::open(path).map_err(|source| SweepError::Io { context: format!("opening {}", path.display()), source })?;
+    let file = File::open(path).map_err(crate::io::FileError::on("opening", path))?;
     let corrupt = |message: String| SweepError::CorruptChunk { path: path.to_path_buf(), message };
     let builder = ParquetRecordBatchReaderBuilder::try_new(file).map_err(|e| corrupt(e.to_string()))?;
     let found = builder.schema();

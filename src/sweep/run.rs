@@ -160,7 +160,7 @@ pub fn run_sweep(spec: &SweepSpec, dir: &Path, options: &SweepOptions) -> Result
 /// ([`RunSpec`]: planar, or several/spatial cables) into `dir`.
 pub fn run_sweep_of<S: RunSpec>(spec: &S, dir: &Path, options: &SweepOptions) -> Result<SweepSummary, SweepError> {
     let started = Instant::now();
-    spec.check().map_err(|message| SweepError::InvalidSpec { origin: "(in memory)".into(), message })?;
+    spec.check().map_err(|e| SweepError::InvalidSpec { origin: "(in memory)".into(), message: e.0 })?;
     let (shard, shards) = (options.shard, options.shards);
     if shards == 0 || shard >= shards {
         return Err(SweepError::BadShard { shard, shards });
@@ -201,7 +201,7 @@ pub fn run_sweep_of<S: RunSpec>(spec: &S, dir: &Path, options: &SweepOptions) ->
             match std::fs::remove_file(path) {
                 Ok(()) => partial_chunks_removed += 1,
                 Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
-                Err(source) => return Err(SweepError::Io { context: format!("removing {}", path.display()), source }),
+                Err(source) => return Err(crate::io::FileError::new("removing", path, source).into()),
             }
         }
     }
@@ -308,8 +308,8 @@ impl RunSpec for SweepSpec {
     type Worker = Simulator;
     type Solved = SolvedRouting;
 
-    fn check(&self) -> Result<(), String> {
-        self.validate().map_err(|e| e.to_string())
+    fn check(&self) -> Result<(), super::kind::InvalidSpec> {
+        self.validate().map_err(|e| super::kind::InvalidSpec(e.to_string()))
     }
 
     fn check_run_size(&self, allow_large: bool) -> Result<(), SweepError> {

@@ -184,7 +184,7 @@ impl SweepSpec {
     /// Reads, parses and validates a spec file.
     pub fn load(path: &Path) -> Result<Self, SweepError> {
         let text = crate::io::read_utf8(path)
-            .map_err(|source| SweepError::Io { context: format!("reading spec {}", path.display()), source })?;
+            .map_err(crate::io::FileError::on("reading spec", path))?;
         Self::from_toml(&text, &path.display().to_string())
     }
 

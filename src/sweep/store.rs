@@ -27,6 +27,7 @@ use super::kind::RunSpec;
 use super::spec::SweepSpec;
 use crate::shape::LengthBasis;
 use super::SweepError;
+use crate::io::FileError;
 use arrow::record_batch::RecordBatch;
 use parquet::arrow::ArrowWriter;
 use parquet::basic::{Compression, ZstdLevel};
@@ -129,34 +130,57 @@ impl<S: RunSpec> Manifest<S> {
     /// hash of the spec it holds and the counts follow from that spec. A
     /// hand-edited field (a changed `tension.max_n`) fails here instead of
     /// silently changing what later stages report.
-    pub fn verify(&self) -> Result<(), String> {
-        self.spec.check().map_err(|e| format!("its spec is invalid ({e})"))?;
+    pub fn verify(&self) -> Result<(), ManifestMismatch> {
+        self.spec.check().map_err(ManifestMismatch::InvalidSpec)?;
         let hash = self.spec.hash_hex();
         if hash != self.spec_sha256 {
-            return Err(format!(
-                "its spec hashes to {hash}, not the recorded spec_sha256 {} (the file was edited or damaged)",
-                self.spec_sha256
-            ));
+            return Err(ManifestMismatch::Hash { hash, recorded: self.spec_sha256.clone() });
         }
         if self.shards == 0 || self.shards > super::MAX_SHARDS {
             // Status keeps a line per shard: an absurd count must not be allocated.
-            return Err(format!(
-                "shards = {} is not 1 … {} (the file was edited, or written with an absurd --shards)",
-                self.shards,
-                super::MAX_SHARDS
-            ));
+            return Err(ManifestMismatch::Shards { shards: self.shards });
         }
         let expected = Manifest { tool_version: self.tool_version.clone(), ..Manifest::new(&self.spec, self.shards) };
         if *self != expected {
-            return Err(format!(
-                "its counts do not follow from its spec (routings {} tensions {} chunk_routings {} chunks {} total_rows {}; \
-                 expected {} {} {} {} {}): the file was edited or damaged",
-                self.routings, self.tensions, self.chunk_routings, self.chunks, self.total_rows,
-                expected.routings, expected.tensions, expected.chunk_routings, expected.chunks, expected.total_rows
-            ));
+            let counts = |m: &Self| [m.routings, m.tensions, m.chunk_routings, m.chunks, m.total_rows];
+            return Err(ManifestMismatch::Counts { found: counts(self), expected: counts(&expected) });
         }
         Ok(())
     }
+}
+
+/// How a manifest disagrees with itself ([`Manifest::verify`]).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum ManifestMismatch {
+    /// The spec it holds is refused.
+    #[error("its spec is invalid ({0})")]
+    InvalidSpec(super::kind::InvalidSpec),
+    /// The spec does not hash to the recorded hash.
+    #[error("its spec hashes to {hash}, not the recorded spec_sha256 {recorded} (the file was edited or damaged)")]
+    Hash {
+        /// The spec's hash.
+        hash: String,
+        /// The recorded one.
+        recorded: String,
+    },
+    /// An absurd shard count.
+    #[error("shards = {shards} is not 1 … {} (the file was edited, or written with an absurd --shards)", super::MAX_SHARDS)]
+    Shards {
+        /// The recorded count.
+        shards: u64,
+    },
+    /// Counts that do not follow from the spec: routings, tensions, chunk_routings, chunks, total_rows.
+    #[error(
+        "its counts do not follow from its spec (routings {} tensions {} chunk_routings {} chunks {} total_rows {}; \
+         expected {} {} {} {} {}): the file was edited or damaged",
+        found[0], found[1], found[2], found[3], found[4], expected[0], expected[1], expected[2], expected[3], expected[4]
+    )]
+    Counts {
+        /// As recorded.
+        found: [u64; 5],
+        /// As the spec gives them.
+        expected: [u64; 5],
+    },
 }
 
 /// A chunk file that failed its check: bytes changed since it was
@@ -243,18 +267,17 @@ impl RunDir {
     /// is not an error. Returns where it went.
     pub fn move_aside(&self, damaged: &DamagedChunk) -> Result<Option<PathBuf>, SweepError> {
         let dir = self.root.join(DAMAGED_DIR);
-        let io = |what: String, source| SweepError::Io { context: what, source };
-        std::fs::create_dir_all(&dir).map_err(|e| io(format!("creating {}", dir.display()), e))?;
+        std::fs::create_dir_all(&dir).map_err(FileError::on("creating", &dir))?;
         let to = dir.join(format!("{}.{}", chunk_file_name(damaged.chunk), crate::io::unique_token()));
         let moved = match std::fs::rename(&damaged.path, &to) {
             Ok(()) => Some(to),
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => None,
-            Err(e) => return Err(io(format!("moving damaged chunk {} to {}", damaged.path.display(), to.display()), e)),
+            Err(source) => return Err(SweepError::MoveAside { from: damaged.path.clone(), to, source }),
         };
         match std::fs::remove_file(self.checksum_path(damaged.chunk)) {
             Ok(()) => {}
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
-            Err(e) => return Err(io(format!("removing {}", self.checksum_path(damaged.chunk).display()), e)),
+            Err(e) => return Err(FileError::new("removing", self.checksum_path(damaged.chunk), e).into()),
         }
         crate::io::sync_dir(&self.shards_dir());
         Ok(moved)
@@ -271,7 +294,7 @@ impl RunDir {
         let text = match crate::io::read_utf8(&path) {
             Ok(t) => t,
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
-            Err(source) => return Err(SweepError::Io { context: format!("reading {}", path.display()), source }),
+            Err(source) => return Err(FileError::new("reading", path, source).into()),
         };
         let manifest: Manifest<S> = match serde_json::from_str(&text) {
             Ok(m) => m,
@@ -310,7 +333,7 @@ impl RunDir {
                 ),
             });
         }
-        manifest.verify().map_err(|message| SweepError::CorruptManifest { path, message })?;
+        manifest.verify().map_err(|e| SweepError::CorruptManifest { path, message: e.to_string() })?;
         Ok(Some(manifest))
     }
 
@@ -318,7 +341,7 @@ impl RunDir {
     /// existing run is the same job (spec, tool version, shard count).
     /// Returns the manifest in force.
     pub fn create_or_check<S: RunSpec>(&self, spec: &S, shards: u64) -> Result<Manifest<S>, SweepError> {
-        let io = |what: &str, source| SweepError::Io { context: format!("{what} {}", self.root.display()), source };
+        let io = |op: &'static str, source| SweepError::from(FileError::new(op, &self.root, source));
         std::fs::create_dir_all(&self.root).map_err(|e| io("creating output directory", e))?;
         let wanted = Manifest::new(spec, shards);
         let existing = match self.read_manifest()? {
@@ -373,7 +396,7 @@ impl RunDir {
         let path = self.manifest_path();
         let tmp = crate::io::temp_path(&path);
         let text = serde_json::to_string_pretty(manifest).expect("manifest serialises") + "\n";
-        let io = |what: &str, source| SweepError::Io { context: format!("{what} {}", path.display()), source };
+        let io = |op: &'static str, source| SweepError::from(FileError::new(op, &path, source));
         let written = (|| {
             use std::io::Write;
             let mut f = File::create(&tmp)?;
@@ -410,7 +433,7 @@ impl RunDir {
         let shards_dir = self.shards_dir();
         let mut names = match list_dir(&shards_dir) {
             Ok(n) => n,
-            Err(SweepError::Io { source, .. }) if source.kind() == std::io::ErrorKind::NotFound => Vec::new(),
+            Err(SweepError::File(e)) if e.is_not_found() => Vec::new(),
             Err(e) => return Err(e),
         };
         names.sort();
@@ -467,10 +490,10 @@ impl RunDir {
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
                 return Err(corrupt(format!("no checksum recorded in {}", sum_path.display())))
             }
-            Err(e) => return Err(SweepError::Io { context: format!("reading {}", sum_path.display()), source: e }),
+            Err(e) => return Err(FileError::new("reading", sum_path, e).into()),
         };
         let actual = crate::io::sha256_file(path)
-            .map_err(|e| SweepError::Io { context: format!("reading {}", path.display()), source: e })?;
+            .map_err(FileError::on("reading", path))?;
         if actual != recorded {
             return Err(corrupt(format!("its SHA-256 is {actual}, not the {recorded} recorded when it was written")));
         }
@@ -482,7 +505,7 @@ impl RunDir {
     pub fn write_chunk<S: RunSpec>(&self, manifest: &Manifest<S>, chunk: u64, batch: &RecordBatch) -> Result<ChunkInfo, SweepError> {
         let path = self.chunk_path(chunk);
         let tmp = crate::io::temp_path(&path);
-        let io = |source| SweepError::Io { context: format!("writing {}", tmp.display()), source };
+        let io = |source| SweepError::from(FileError::new("writing", &tmp, source));
         let status_counts = count_statuses(batch);
         let kv = |k: &str, v: String| KeyValue::new(k.to_string(), v);
         let metadata = vec![
@@ -578,7 +601,7 @@ fn is_run_entry(name: &str) -> bool {
 }
 
 fn list_dir(dir: &Path) -> Result<Vec<std::ffi::OsString>, SweepError> {
-    let io = |source| SweepError::Io { context: format!("listing {}", dir.display()), source };
+    let io = |source| SweepError::from(FileError::new("listing", dir, source));
     std::fs::read_dir(dir).map_err(io)?.map(|e| e.map(|e| e.file_name()).map_err(io)).collect()
 }
 
@@ -586,7 +609,7 @@ fn list_dir(dir: &Path) -> Result<Vec<std::ffi::OsString>, SweepError> {
 /// with `rows` rows.
 pub fn check_chunk<S: RunSpec>(path: &Path, chunk: u64, manifest: &Manifest<S>, rows: u64) -> Result<ChunkInfo, SweepError> {
     let file =
-        File::open(path).map_err(|source| SweepError::Io { context: format!("opening {}", path.display()), source })?;
+        File::open(path).map_err(FileError::on("opening", path))?;
     let meta = ParquetMetaDataReader::new()
         .parse_and_finish(&file)
         .map_err(|e| SweepError::CorruptChunk { path: path.to_path_buf(), message: e.to_string() })?;
@@ -660,7 +683,7 @@ mod tests {
         assert!(Manifest::new(&spec, super::super::MAX_SHARDS).verify().is_ok());
         for shards in [0, super::super::MAX_SHARDS + 1, u64::MAX] {
             let e = Manifest::new(&spec, shards).verify().unwrap_err();
-            assert!(e.contains(&format!("shards = {shards} is not 1")), "{e}");
+            assert!(e.to_string().contains(&format!("shards = {shards} is not 1")), "{e}");
         }
     }
 

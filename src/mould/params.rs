@@ -1,0 +1,67 @@
+//! The moulds' parameters and the bodies they can cast.
+
+use super::MouldError;
+use serde::Serialize;
+
+/// Parameters of the moulds, mm.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct MouldParams {
+    /// Wall (and floor) thickness around the cavity, mm.
+    pub wall_mm: f64,
+    /// Outer diameter of the PTFE tube that forms the channel, mm (thesis: 1).
+    pub tube_diameter_mm: f64,
+    /// Play between mating printed features (pins, tube notches), mm.
+    pub clearance_mm: f64,
+    /// Length of the clamp block cast before the clamp face (x from −c to 0), mm.
+    pub clamp_mm: f64,
+    /// Least silicone between the channel and the body surface, mm.
+    pub min_skin_mm: f64,
+    /// Largest spacing of mesh stations along the channel, mm.
+    pub station_step_mm: f64,
+}
+
+impl Default for MouldParams {
+    fn default() -> Self {
+        Self { wall_mm: 3.0, tube_diameter_mm: 1.0, clearance_mm: 0.15, clamp_mm: 10.0, min_skin_mm: 0.3, station_step_mm: 0.5 }
+    }
+}
+
+impl MouldParams {
+    /// The largest channel offset |y_c| these moulds can cast in a body of
+    /// radius `radius_mm`: the tube's outer radius and `min_skin_mm` of
+    /// silicone must fit between the channel's centreline and the surface, mm.
+    /// [`Moulds::new`] refuses a channel beyond it; `design --moulds` bounds
+    /// its search by it.
+    pub fn max_channel_offset_mm(&self, radius_mm: f64) -> f64 {
+        radius_mm - self.tube_diameter_mm / 2.0 - self.min_skin_mm
+    }
+}
+
+/// Largest size accepted for any mould dimension (body length and radius,
+/// wall, clamp block, tube), mm.
+pub const MAX_SIZE_MM: f64 = 10_000.0;
+
+/// Most triangles of the three parts together (about 50 bytes each in the
+/// STL files, several times that in memory while they are built).
+pub const MAX_TRIANGLES: f64 = 4e6;
+
+/// Refuses a body the moulds cannot cast: a radius profile, segments or a
+/// cable knotted before the tip ([`MouldError::NonUniformBody`]).
+pub fn check_uniform_body(a: &crate::model::Rod) -> Result<(), MouldError> {
+    let mut what = Vec::new();
+    if !a.radius_profile_mm.is_empty() {
+        what.push("a radius profile (radius_profile_mm)");
+    }
+    if !a.segments.is_empty() {
+        what.push("segments of their own material");
+    }
+    if a.cable_length_mm() < a.length_mm {
+        what.push("a cable anchored before the tip (cable_anchor_mm)");
+    }
+    if what.is_empty() {
+        Ok(())
+    } else {
+        Err(MouldError::NonUniformBody(what.join(" and ")))
+    }
+}
+

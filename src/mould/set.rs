@@ -1,0 +1,213 @@
+//! The three parts built once, placed on print plates and written:
+//! mould1.stl, mould2.stl, previews and mould.json.
+
+use super::mesh::Mesh;
+use super::{preview, stl, volume_below_face_mm3, MouldError, MouldParams, Moulds, Part, PartKind, SUMMARY_FILE};
+use crate::io::FileError;
+use crate::model::Routing;
+use serde::Serialize;
+use std::path::Path;
+
+/// Gap between the two parts of one print plate, mm.
+const PLATE_GAP_MM: f64 = 6.0;
+
+/// The three parts of a routing's moulds, built once.
+#[derive(Debug, Clone)]
+pub struct MouldSet {
+    /// The geometry they were built from.
+    pub moulds: Moulds,
+    /// Lower half trough (both castings).
+    pub tray: Part,
+    /// Plate with the protrusion (mould 1).
+    pub lid: Part,
+    /// Upper half trough (mould 2).
+    pub cover: Part,
+}
+
+/// One part as placed in an STL file.
+#[derive(Debug, Clone, Serialize)]
+pub struct PlacedPart {
+    /// Part name (tray, lid, cover).
+    pub part: PartKind,
+    /// Engraved letter.
+    pub letter: &'static str,
+    /// Translation from the part's print frame to the file, mm.
+    pub offset_mm: [f64; 3],
+    /// Enclosed volume (print material), mm³.
+    pub volume_mm3: f64,
+    /// Triangles.
+    pub triangles: usize,
+    /// Closed, 2-manifold, consistently oriented, positive volume.
+    pub watertight: bool,
+}
+
+/// One STL file: its name and the parts on its plate.
+#[derive(Debug, Clone, Serialize)]
+pub struct MouldFile {
+    /// File name (mould1.stl, mould2.stl).
+    pub file: String,
+    /// The parts, in file order.
+    pub parts: Vec<PlacedPart>,
+}
+
+/// What `write_all` wrote (also saved as mould.json).
+#[derive(Debug, Clone, Serialize)]
+pub struct MouldSummary {
+    /// Control points y0..y4, mm.
+    pub routing_mm: crate::model::routing::ControlPoints,
+    /// Body length L and radius r, mm.
+    pub length_mm: f64,
+    /// Body radius r, mm.
+    pub radius_mm: f64,
+    /// Mould parameters.
+    pub params: MouldParams,
+    /// Channel length inside the body (clamp block + arc), mm.
+    pub channel_length_mm: f64,
+    /// The STL files with their parts.
+    pub files: Vec<MouldFile>,
+    /// Cavity of mould 1 measured on the meshes (half body minus half channel), mm³.
+    pub mould1_cavity_mm3: f64,
+    /// The half body with its groove, π r² (L + c)/2 − π ρ²/2 · channel length, mm³.
+    pub mould1_body_mm3: f64,
+    /// Cavity of mould 2 measured on the meshes, mm³.
+    pub mould2_cavity_mm3: f64,
+    /// The full body, π r² (L + c), mm³ (the tube takes π ρ² · channel length of it).
+    pub mould2_body_mm3: f64,
+}
+
+impl MouldSet {
+    /// Builds the tray, lid and cover.
+    pub fn build(moulds: Moulds) -> Self {
+        let tray = moulds.part(PartKind::Tray);
+        let lid = moulds.part(PartKind::Lid);
+        let cover = moulds.part(PartKind::Cover);
+        Self { moulds, tray, lid, cover }
+    }
+
+    /// Checks and builds the moulds of `routing` on a body of radius `radius_mm`.
+    pub fn new(routing: &Routing, radius_mm: f64, params: &MouldParams) -> Result<Self, MouldError> {
+        Ok(Self::build(Moulds::new(routing, radius_mm, params)?))
+    }
+
+    /// The part of a kind.
+    pub fn part(&self, kind: PartKind) -> &Part {
+        match kind {
+            PartKind::Tray => &self.tray,
+            PartKind::Lid => &self.lid,
+            PartKind::Cover => &self.cover,
+        }
+    }
+
+    /// The parts of mould 1 (tray, lid) or 2 (tray, cover).
+    pub fn kinds(number: u8) -> [PartKind; 2] {
+        if number == 1 {
+            [PartKind::Tray, PartKind::Lid]
+        } else {
+            [PartKind::Tray, PartKind::Cover]
+        }
+    }
+
+    /// The print plate of mould `number`: both parts on z = 0, side by side in y.
+    pub fn plate(&self, number: u8) -> (Mesh, Vec<PlacedPart>) {
+        let mut mesh = Mesh::default();
+        let mut placed = Vec::new();
+        for (k, kind) in Self::kinds(number).into_iter().enumerate() {
+            let m = &self.moulds;
+            let offset = [0.0, k as f64 * (2.0 * m.y_half_mm() + PLATE_GAP_MM), -m.z_bottom_mm(kind)];
+            let part = self.part(kind).mesh.translated(offset);
+            let report = part.check();
+            placed.push(PlacedPart {
+                part: kind,
+                letter: kind.letter(),
+                offset_mm: offset,
+                volume_mm3: report.volume_mm3,
+                triangles: report.triangles,
+                watertight: report.is_watertight(),
+            });
+            mesh.append(&part);
+        }
+        (mesh, placed)
+    }
+
+    /// Cavity volume of mould `number` measured on the part meshes, mm³.
+    pub fn cavity_volume_mm3(&self, number: u8) -> f64 {
+        let (x, r) = (self.moulds.cavity_x_mm(), self.moulds.radius_mm());
+        Self::kinds(number).iter().map(|k| volume_below_face_mm3(&self.part(*k).mesh, x, r)).sum()
+    }
+
+    /// The body volume the cavity of mould `number` should have, mm³.
+    pub fn body_volume_mm3(&self, number: u8) -> f64 {
+        let m = &self.moulds;
+        let [c0, c1] = m.cavity_x_mm();
+        let full = std::f64::consts::PI * m.radius_mm().powi(2) * (c1 - c0);
+        if number == 1 {
+            full / 2.0 - std::f64::consts::PI * m.tube_radius_mm.powi(2) / 2.0 * m.channel_length_mm()
+        } else {
+            full
+        }
+    }
+
+    /// Writes the mould directory `dir` as a whole: its files are written
+    /// into a staging directory beside it, which then replaces `dir`
+    /// ([`crate::io::write_dir_replacing`]), so a killed run leaves no
+    /// partial `dir` (and an earlier one whole). `dir` must be new, empty or
+    /// an earlier mould directory (it has [`SUMMARY_FILE`]).
+    pub fn write_dir(&self, dir: &Path) -> Result<MouldSummary, MouldError> {
+        let name = dir.file_name().map(|n| n.to_string_lossy().into_owned()).filter(|n| n != "." && n != "..");
+        let Some(name) = name else {
+            return Err(MouldError::OutUnnamed { path: dir.to_path_buf() });
+        };
+        let holds_files = std::fs::read_dir(dir).is_ok_and(|mut entries| entries.next().is_some());
+        if holds_files && !dir.join(SUMMARY_FILE).is_file() {
+            return Err(MouldError::NotAMouldDir { path: dir.to_path_buf() });
+        }
+        crate::io::write_dir_replacing(dir, &name, |staging| self.write_all(staging), |step, path, source| {
+            let what = match step {
+                crate::io::DirStep::Create => "creating",
+                crate::io::DirStep::Replace => "putting the new moulds in place at",
+            };
+            FileError::new(what, path, source).into()
+        })
+    }
+
+    /// Writes mould1.stl, mould2.stl, mould1.png, mould2.png, channel.csv and
+    /// mould.json into `dir` (created if missing), in place: [`MouldSet::write_dir`]
+    /// is what `cablemap mould` uses; `design --moulds` writes them among
+    /// its own files.
+    pub fn write_all(&self, dir: &Path) -> Result<MouldSummary, MouldError> {
+        std::fs::create_dir_all(dir).map_err(FileError::on("creating", dir))?;
+        let m = &self.moulds;
+        let routing = m.routing();
+        let ys = routing.control_points_mm().iter().map(|y| format!("{y:.3}")).collect::<Vec<_>>().join(",");
+        let mut files = Vec::new();
+        for number in [1u8, 2] {
+            let (mesh, placed) = self.plate(number);
+            let title = format!("cablemap mould{number}, units mm, L={} r={} y=[{ys}]", routing.length_mm(), m.radius_mm());
+            let name = format!("mould{number}.stl");
+            let path = dir.join(&name);
+            crate::io::write_atomic(&path, &stl::to_bytes(&mesh, &title)).map_err(FileError::on("writing", &path))?;
+            preview::write_png(&dir.join(format!("mould{number}.png")), self, number)?;
+            files.push(MouldFile { file: name, parts: placed });
+        }
+        let path = dir.join("channel.csv");
+        crate::io::write_atomic(&path, routing.channel_csv().as_bytes())
+            .map_err(FileError::on("writing", &path))?;
+        let summary = MouldSummary {
+            routing_mm: routing.control_points_mm(),
+            length_mm: routing.length_mm(),
+            radius_mm: m.radius_mm(),
+            params: m.params().clone(),
+            channel_length_mm: m.channel_length_mm(),
+            files,
+            mould1_cavity_mm3: self.cavity_volume_mm3(1),
+            mould1_body_mm3: self.body_volume_mm3(1),
+            mould2_cavity_mm3: self.cavity_volume_mm3(2),
+            mould2_body_mm3: self.body_volume_mm3(2),
+        };
+        let path = dir.join(SUMMARY_FILE);
+        let json = serde_json::to_string_pretty(&summary).expect("summary serialises") + "\n";
+        crate::io::write_atomic(&path, json.as_bytes()).map_err(FileError::on("writing", &path))?;
+        Ok(summary)
+    }
+}
+
