@@ -10,6 +10,7 @@ pub mod design;
 pub mod io;
 pub mod model;
 pub mod mould;
+pub mod numerics;
 pub mod plot;
 pub mod reduce;
 pub mod shape;
