@@ -685,6 +685,24 @@ pub fn centrelines_csv(points: &CentrelinePoints) -> String {
     out
 }
 
+/// Splits the routings into fitted and held-out ones.
+pub fn split_holdout(data: &Dataset, holdout: Option<&str>) -> Result<(Vec<RoutingGroup>, Option<RoutingGroup>), CalibrateError> {
+    let groups = data.groups();
+    let Some(id) = holdout else {
+        return Ok((groups, None));
+    };
+    let ids: Vec<&str> = groups.iter().map(|g| g.routing.as_str()).collect();
+    let Some(pos) = groups.iter().position(|g| g.routing == id) else {
+        return Err(CalibrateError::Holdout(format!("no routing '{id}' in the data to hold out (routings: {})", ids.join(", "))));
+    };
+    let mut train = groups;
+    let held = train.remove(pos);
+    if train.is_empty() {
+        return Err(CalibrateError::Holdout(format!("routing {id} is the only routing; holding it out would leave nothing to fit")));
+    }
+    Ok((train, Some(held)))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -72,7 +72,7 @@ impl Noise {
     pub fn validate(&self) -> Result<(), CalibrateError> {
         for (name, v) in [("noise_mm", self.mm), ("noise_deg", self.deg)] {
             if !(v.is_finite() && v > 0.0) {
-                return Err(CalibrateError::Invalid(format!("{name} = {v}: the measurement noise must be a standard deviation > 0")));
+                return Err(CalibrateError::Noise(format!("{name} = {v}: the measurement noise must be a standard deviation > 0")));
             }
         }
         Ok(())
@@ -203,18 +203,21 @@ pub struct RoutingRms {
     pub rms_angle_deg: f64,
 }
 
-/// The result of a fit.
-#[derive(Debug, Clone)]
+/// The result of a fit. It serialises to the fit's JSON object (without
+/// the actuator and the predictions).
+#[derive(Debug, Clone, Serialize)]
 pub struct FitResult {
     /// Effects that were fitted.
     pub effects: Vec<Effect>,
     /// The base actuator with the fitted values.
+    #[serde(skip)]
     pub actuator: Rod,
     /// EA, GA, EI, then each effect's parameter.
     pub parameters: Vec<FittedParameter>,
     /// Correlation matrix of the parameters (same order).
     pub correlation: Vec<Vec<f64>>,
     /// The minimised loss Σ ρ(z) of the whitened residuals.
+    #[serde(rename = "loss")]
     pub rss: f64,
     /// Number of residuals (3 per reading, 1 per centreline point, 2 per marker).
     pub n_residuals: usize,
@@ -245,6 +248,7 @@ pub struct FitResult {
     /// Jacobian could be evaluated at the optimum).
     pub converged: bool,
     /// Predictions at the optimum, indexed like the data's rows.
+    #[serde(skip)]
     pub predictions: Vec<Option<Prediction>>,
 }
 
@@ -863,7 +867,7 @@ pub fn apply_held(base: &Rod, held: &[(Held, f64)]) -> Result<(Rod, [bool; 3], V
     let mut effects = Vec::new();
     for &(h, v) in held {
         if !v.is_finite() {
-            return Err(CalibrateError::Invalid(format!("held value {v} is not a finite number")));
+            return Err(CalibrateError::Held(Box::new(CalibrateError::Invalid(format!("held value {v} is not a finite number")))));
         }
         match h {
             Held::Rigidity(k) => {
@@ -876,7 +880,7 @@ pub fn apply_held(base: &Rod, held: &[(Held, f64)]) -> Result<(Rod, [bool; 3], V
             }
         }
     }
-    a.validate()?;
+    a.validate().map_err(|e| CalibrateError::Held(Box::new(e.into())))?;
     Ok((a, fixed, effects))
 }
 
