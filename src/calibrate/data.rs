@@ -235,7 +235,7 @@ fn parse_csv(path: &Path, text: &str) -> Result<Table, CalibrateError> {
         return Err(CalibrateError::Empty { path: path.display().to_string() });
     };
     let header: Vec<String> = split_csv_line(head.trim_start_matches('\u{feff}'))
-        .map_err(|message| CalibrateError::Malformed { path: path.display().to_string(), row: 0, message })?
+        .map_err(|e| CalibrateError::Malformed { path: path.display().to_string(), row: 0, message: e.to_string() })?
         .into_iter()
         .map(|h| h.trim().to_string())
         .collect();
@@ -259,7 +259,7 @@ fn parse_csv(path: &Path, text: &str) -> Result<Table, CalibrateError> {
     for (data_row, (_, line)) in lines.enumerate() {
         let row = data_row + 1;
         let cells = split_csv_line(line)
-            .map_err(|message| CalibrateError::Malformed { path: path.display().to_string(), row, message })?;
+            .map_err(|e| CalibrateError::Malformed { path: path.display().to_string(), row, message: e.to_string() })?;
         if cells.len() != header.len() {
             return Err(CalibrateError::Malformed {
                 path: path.display().to_string(),
@@ -272,7 +272,18 @@ fn parse_csv(path: &Path, text: &str) -> Result<Table, CalibrateError> {
     Ok(Table { header, rows, front })
 }
 
-fn split_csv_line(line: &str) -> Result<Vec<String>, String> {
+/// Why a CSV line cannot be split into fields.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+enum CsvLineError {
+    /// `a"b`: a quote inside a field that did not start with one.
+    #[error("a quote in the middle of an unquoted field")]
+    StrayQuote,
+    /// `"a,b`: the line ends inside a quoted field.
+    #[error("a quoted field is not closed")]
+    Unclosed,
+}
+
+fn split_csv_line(line: &str) -> Result<Vec<String>, CsvLineError> {
     let mut cells = Vec::new();
     let mut cell = String::new();
     let mut chars = line.chars().peekable();
@@ -295,12 +306,12 @@ fn split_csv_line(line: &str) -> Result<Vec<String>, String> {
                 cells.push(std::mem::take(&mut cell));
                 was_quoted = false;
             }
-            (false, '"') => return Err("a quote in the middle of an unquoted field".into()),
+            (false, '"') => return Err(CsvLineError::StrayQuote),
             (false, _) => cell.push(c),
         }
     }
     if quoted {
-        return Err("a quoted field is not closed".into());
+        return Err(CsvLineError::Unclosed);
     }
     cells.push(cell);
     Ok(cells.into_iter().map(|c| c.trim().to_string()).collect())

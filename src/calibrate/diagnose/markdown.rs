@@ -574,6 +574,7 @@ fn shape_plot(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::calibrate::stats::p_text;
 
     fn fit_with_p(p_value: f64) -> FitResult {
         FitResult {
