@@ -235,7 +235,7 @@ fn parse_csv(path: &Path, text: &str) -> Result<Table, CalibrateError> {
         return Err(CalibrateError::Empty { path: path.display().to_string() });
     };
     let header: Vec<String> = split_csv_line(head.trim_start_matches('\u{feff}'))
-        .map_err(|message| CalibrateError::Malformed { path: path.display().to_string(), row: 0, message })?
+        .map_err(|e| CalibrateError::Malformed { path: path.display().to_string(), row: 0, message: e.to_string() })?
         .into_iter()
         .map(|h| h.trim().to_string())
         .collect();
@@ -259,7 +259,7 @@ fn parse_csv(path: &Path, text: &str) -> Result<Table, CalibrateError> {
     for (data_row, (_, line)) in lines.enumerate() {
         let row = data_row + 1;
         let cells = split_csv_line(line)
-            .map_err(|message| CalibrateError::Malformed { path: path.display().to_string(), row, message })?;
+            .map_err(|e| CalibrateError::Malformed { path: path.display().to_string(), row, message: e.to_string() })?;
         if cells.len() != header.len() {
             return Err(CalibrateError::Malformed {
                 path: path.display().to_string(),
@@ -272,7 +272,18 @@ fn parse_csv(path: &Path, text: &str) -> Result<Table, CalibrateError> {
     Ok(Table { header, rows, front })
 }
 
-fn split_csv_line(line: &str) -> Result<Vec<String>, String> {
+/// Why a CSV line cannot be split into fields.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+enum CsvLineError {
+    /// `a"b`: a quote inside a field that did not start with one.
+    #[error("a quote in the middle of an unquoted field")]
+    StrayQuote,
+    /// `"a,b`: the line ends inside a quoted field.
+    #[error("a quoted field is not closed")]
+    Unclosed,
+}
+
+fn split_csv_line(line: &str) -> Result<Vec<String>, CsvLineError> {
     let mut cells = Vec::new();
     let mut cell = String::new();
     let mut chars = line.chars().peekable();
@@ -295,12 +306,12 @@ fn split_csv_line(line: &str) -> Result<Vec<String>, String> {
                 cells.push(std::mem::take(&mut cell));
                 was_quoted = false;
             }
-            (false, '"') => return Err("a quote in the middle of an unquoted field".into()),
+            (false, '"') => return Err(CsvLineError::StrayQuote),
             (false, _) => cell.push(c),
         }
     }
     if quoted {
-        return Err("a quoted field is not closed".into());
+        return Err(CsvLineError::Unclosed);
     }
     cells.push(cell);
     Ok(cells.into_iter().map(|c| c.trim().to_string()).collect())
@@ -683,6 +694,24 @@ pub fn centrelines_csv(points: &CentrelinePoints) -> String {
         }
     }
     out
+}
+
+/// Splits the routings into fitted and held-out ones.
+pub fn split_holdout(data: &Dataset, holdout: Option<&str>) -> Result<(Vec<RoutingGroup>, Option<RoutingGroup>), CalibrateError> {
+    let groups = data.groups();
+    let Some(id) = holdout else {
+        return Ok((groups, None));
+    };
+    let ids: Vec<&str> = groups.iter().map(|g| g.routing.as_str()).collect();
+    let Some(pos) = groups.iter().position(|g| g.routing == id) else {
+        return Err(CalibrateError::Holdout(format!("no routing '{id}' in the data to hold out (routings: {})", ids.join(", "))));
+    };
+    let mut train = groups;
+    let held = train.remove(pos);
+    if train.is_empty() {
+        return Err(CalibrateError::Holdout(format!("routing {id} is the only routing; holding it out would leave nothing to fit")));
+    }
+    Ok((train, Some(held)))
 }
 
 #[cfg(test)]

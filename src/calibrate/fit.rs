@@ -24,10 +24,10 @@
 //! [`max_outliers`] readings), its degrees of freedom and the chance that
 //! noise alone gives a χ² as large ([`stats::chi2_p_value`]).
 //!
-//! The optimiser is written here (about fifty lines) rather than taken from
-//! the `levenberg-marquardt` crate because a trial step whose solve fails
-//! (a rod that collapses at absurd rigidities) must simply be rejected, and
-//! the noise-free tests need the stopping rule to run down to rounding.
+//! The optimiser is the library's one bounded Levenberg–Marquardt
+//! ([`crate::numerics::lm`], shared with design): a trial step whose solve
+//! fails (a rod that collapses at absurd rigidities) is simply rejected, and
+//! the stopping rule runs down to rounding for the noise-free tests.
 
 use super::data::{CentrelinePoints, Dataset, Marker, MarkerPoints, Measurement, RoutingGroup};
 use super::effect::Effect;
@@ -35,7 +35,8 @@ use super::predict::{predict, Prediction};
 use super::stats;
 use super::CalibrateError;
 use crate::model::{Rod, CentrelinePoint, SolverOptions};
-use nalgebra::{DMatrix, DVector};
+use crate::numerics::lm;
+use nalgebra::DMatrix;
 use rayon::prelude::*;
 use serde::Serialize;
 use std::sync::Arc;
@@ -71,7 +72,7 @@ impl Noise {
     pub fn validate(&self) -> Result<(), CalibrateError> {
         for (name, v) in [("noise_mm", self.mm), ("noise_deg", self.deg)] {
             if !(v.is_finite() && v > 0.0) {
-                return Err(CalibrateError::Invalid(format!("{name} = {v}: the measurement noise must be a standard deviation > 0")));
+                return Err(CalibrateError::Noise(format!("{name} = {v}: the measurement noise must be a standard deviation > 0")));
             }
         }
         Ok(())
@@ -202,18 +203,21 @@ pub struct RoutingRms {
     pub rms_angle_deg: f64,
 }
 
-/// The result of a fit.
-#[derive(Debug, Clone)]
+/// The result of a fit. It serialises to the fit's JSON object (without
+/// the actuator and the predictions).
+#[derive(Debug, Clone, Serialize)]
 pub struct FitResult {
     /// Effects that were fitted.
     pub effects: Vec<Effect>,
     /// The base actuator with the fitted values.
+    #[serde(skip)]
     pub actuator: Rod,
     /// EA, GA, EI, then each effect's parameter.
     pub parameters: Vec<FittedParameter>,
     /// Correlation matrix of the parameters (same order).
     pub correlation: Vec<Vec<f64>>,
     /// The minimised loss Σ ρ(z) of the whitened residuals.
+    #[serde(rename = "loss")]
     pub rss: f64,
     /// Number of residuals (3 per reading, 1 per centreline point, 2 per marker).
     pub n_residuals: usize,
@@ -244,6 +248,7 @@ pub struct FitResult {
     /// Jacobian could be evaluated at the optimum).
     pub converged: bool,
     /// Predictions at the optimum, indexed like the data's rows.
+    #[serde(skip)]
     pub predictions: Vec<Option<Prediction>>,
 }
 
@@ -541,7 +546,7 @@ impl Problem<'_> {
     }
 
     /// The residuals the solver squares: the loss's transform of z.
-    fn residuals(&self, x: &[f64]) -> Result<Vec<f64>, CalibrateError> {
+    fn transformed_residuals(&self, x: &[f64]) -> Result<Vec<f64>, CalibrateError> {
         self.evaluate(x).map(|(z, _)| z.into_iter().map(|v| self.spec.loss.transform(v)).collect())
     }
 
@@ -550,7 +555,7 @@ impl Problem<'_> {
     /// difference cannot be solved falls back to a one-sided difference,
     /// then to smaller steps; a column that fails every way is zero and
     /// reported by index.
-    fn jacobian(&self, x: &[f64], r: &[f64]) -> (DMatrix<f64>, Vec<usize>) {
+    fn differences(&self, x: &[f64], r: &[f64]) -> (DMatrix<f64>, Vec<usize>) {
         let n = r.len();
         let columns: Vec<Option<Vec<f64>>> = self
             .free
@@ -559,7 +564,7 @@ impl Problem<'_> {
                 let at = |h: f64| {
                     let mut xh = x.to_vec();
                     xh[j] += h;
-                    self.residuals(&xh).ok()
+                    self.transformed_residuals(&xh).ok()
                 };
                 let diff = |a: &[f64], b: &[f64], span: f64| a.iter().zip(b).map(|(p, m)| (p - m) / span).collect::<Vec<f64>>();
                 // One-sided differences: half the solves of central ones (the
@@ -582,6 +587,18 @@ impl Problem<'_> {
         let failed: Vec<usize> = self.free.iter().zip(&columns).filter(|(_, c)| c.is_none()).map(|(&j, _)| j).collect();
         let j = DMatrix::from_fn(n, self.free.len(), |i, k| columns[k].as_ref().map_or(0.0, |c| c[i]));
         (j, failed)
+    }
+}
+
+impl lm::Problem for Problem<'_> {
+    fn residuals(&mut self, x: &[f64]) -> Option<Vec<f64>> {
+        self.transformed_residuals(x).ok()
+    }
+
+    fn jacobian(&mut self, x: &[f64], r: &[f64], _free: &[usize]) -> Option<DMatrix<f64>> {
+        // Columns that cannot be differenced are zero here; at the optimum
+        // they are reported (see `fit_observed`).
+        Some(self.differences(x, r).0)
     }
 }
 
@@ -667,9 +684,9 @@ pub fn fit_observed(
         .enumerate()
         .map(|(k, &v)| if k < 3 { (v - RIGIDITY_RANGE.ln(), v + RIGIDITY_RANGE.ln()) } else { (-50.0, 50.0) })
         .collect();
-    let problem = Problem { base, options, data, groups, spec, slots, free };
+    let mut problem = Problem { base, options, data, groups, spec, slots, free };
     let p = problem.free.len();
-    let mut r = problem.residuals(&x)?;
+    let r = problem.transformed_residuals(&x)?;
     let n = r.len();
     if n <= p {
         return Err(CalibrateError::Invalid(format!(
@@ -677,7 +694,7 @@ pub fn fit_observed(
             data.rows.len()
         )));
     }
-    let mut cost: f64 = r.iter().map(|v| v * v).sum();
+    let cost: f64 = r.iter().map(|v| v * v).sum();
     // Residuals are in units of the noise (and the robust loss compresses
     // large ones): a trillion noise widths, or squares that overflow, is no
     // measurement of this actuator. No step can lower such a cost, and "no
@@ -693,80 +710,14 @@ pub fn fit_observed(
             crate::io::fmt_num(worst)
         )));
     }
-    let mut lambda = 1e-3;
-    let mut converged = false;
-    let mut iterations = 0;
-    if p == 0 {
-        // Everything held: the fit only evaluates the given model.
-        converged = true;
-    }
-    while p > 0 && iterations < spec.max_iterations {
-        iterations += 1;
-        let (j, _) = problem.jacobian(&x, &r);
-        let rv = DVector::from_column_slice(&r);
-        let mut a = j.transpose() * &j;
-        let mut g = j.transpose() * rv;
-        // A coordinate at its bound whose descent direction points outward
-        // is held this iteration (a projected step), so the others can settle.
-        for (k, &idx) in problem.free.iter().enumerate() {
-            let (lo, hi) = bounds[idx];
-            if (x[idx] <= lo + 1e-9 && g[k] > 0.0) || (x[idx] >= hi - 1e-9 && g[k] < 0.0) {
-                g[k] = 0.0;
-                for c in 0..p {
-                    a[(k, c)] = 0.0;
-                    a[(c, k)] = 0.0;
-                }
-                a[(k, k)] = 1.0;
-            }
-        }
-        let diag_floor = a.diagonal().max() * 1e-12 + 1e-300;
-        let mut accepted = None;
-        while lambda < 1e12 {
-            let mut m = a.clone();
-            for k in 0..p {
-                m[(k, k)] += lambda * a[(k, k)].max(diag_floor);
-            }
-            let Some(chol) = m.cholesky() else {
-                lambda *= 5.0;
-                continue;
-            };
-            let step = chol.solve(&(-&g));
-            let mut trial = x.clone();
-            for (k, &idx) in problem.free.iter().enumerate() {
-                trial[idx] = (x[idx] + step[k]).clamp(bounds[idx].0, bounds[idx].1);
-            }
-            let moved = trial.iter().zip(&x).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
-            match problem.residuals(&trial) {
-                Ok(rt) => {
-                    let ct: f64 = rt.iter().map(|v| v * v).sum();
-                    if ct < cost {
-                        accepted = Some((trial, rt, ct, moved));
-                        lambda = (lambda / 5.0).max(1e-12);
-                        break;
-                    }
-                    lambda *= 5.0;
-                }
-                // A trial the model cannot solve is simply a bad step.
-                Err(_) => lambda *= 5.0,
-            }
-        }
-        let Some((trial, rt, ct, step_size)) = accepted else {
-            // No step lowers the cost: a minimum to within rounding.
-            converged = true;
-            break;
-        };
-        let reduction = (cost - ct) / cost.max(1e-300);
-        x = trial;
-        r = rt;
-        cost = ct;
-        observe(FitProgress { iteration: iterations, rms_mm: (cost / n as f64).sqrt() });
-        if cost < 1e-24 * n as f64 || reduction < 1e-12 || step_size < 1e-11 {
-            converged = true;
-            break;
-        }
-    }
+    let settings = lm::Settings { bounds: bounds.clone(), free: problem.free.clone(), max_iterations: spec.max_iterations };
+    let outcome = lm::minimise(&mut problem, x, r, &settings, &mut |step| {
+        observe(FitProgress { iteration: step.iteration, rms_mm: (step.cost / step.residuals as f64).sqrt() })
+    });
+    let (x, r, cost, iterations) = (outcome.x, outcome.r, outcome.cost, outcome.iterations);
+    let mut converged = outcome.termination.converged();
     // Uncertainties from the Jacobian at the optimum.
-    let (j, failed_columns) = problem.jacobian(&x, &r);
+    let (j, failed_columns) = problem.differences(&x, &r);
     let jtj = j.transpose() * &j;
     // Residual kinds are measured by different means: each gets its own
     // variance from its residuals, and the covariance is the sandwich
@@ -916,7 +867,7 @@ pub fn apply_held(base: &Rod, held: &[(Held, f64)]) -> Result<(Rod, [bool; 3], V
     let mut effects = Vec::new();
     for &(h, v) in held {
         if !v.is_finite() {
-            return Err(CalibrateError::Invalid(format!("held value {v} is not a finite number")));
+            return Err(CalibrateError::Held(Box::new(CalibrateError::Invalid(format!("held value {v} is not a finite number")))));
         }
         match h {
             Held::Rigidity(k) => {
@@ -929,7 +880,7 @@ pub fn apply_held(base: &Rod, held: &[(Held, f64)]) -> Result<(Rod, [bool; 3], V
             }
         }
     }
-    a.validate()?;
+    a.validate().map_err(|e| CalibrateError::Held(Box::new(e.into())))?;
     Ok((a, fixed, effects))
 }
 

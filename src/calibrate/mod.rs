@@ -8,14 +8,15 @@ pub mod diagnose;
 pub mod effect;
 pub mod fit;
 pub mod predict;
-pub mod report;
 pub mod rng;
+pub mod run;
 pub mod stats;
 pub mod synth;
 
 pub use data::{read_measurements, Dataset, Direction, Measurement};
 pub use effect::Effect;
 pub use fit::{fit, FitResult, FitSpec};
+pub use run::{run, CalibrateReport, CalibrateRequest, FitSettings};
 
 /// Errors of the calibration layer.
 #[derive(Debug, thiserror::Error)]
@@ -56,6 +57,21 @@ pub enum CalibrateError {
     /// The request cannot be carried out on this data.
     #[error("{0}")]
     Invalid(String),
+    /// The routing to hold out is not one the data can spare.
+    #[error("{0}")]
+    Holdout(String),
+    /// The measurement noise is not a standard deviation > 0.
+    #[error("{0}")]
+    Noise(String),
+    /// A value to hold a parameter at is not valid.
+    #[error(transparent)]
+    Held(Box<CalibrateError>),
+    /// An effect is both fitted and held.
+    #[error("--effect {0} and --fix {1}=…: an effect is either fitted or held, not both", .effect.name(), .effect.parameter_name())]
+    FittedAndHeld { effect: Effect },
+    /// The report directory is inside a sweep's run directory.
+    #[error("{message}")]
+    ReportDir { message: String },
     /// Drawing a plot.
     #[error(transparent)]
     Plot(#[from] crate::plot::PlotError),

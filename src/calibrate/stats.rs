@@ -82,6 +82,29 @@ pub fn chi2_p_value(chi2: f64, dof: usize) -> f64 {
     gamma_q(0.5 * dof as f64, 0.5 * chi2.max(0.0))
 }
 
+/// A p-value in a table column headed p: `0.031`, `2.4e-7`, or `< 1e-99`
+/// below what the χ² tail resolves.
+pub fn p_cell(p: f64) -> String {
+    if !p.is_finite() {
+        "—".into()
+    } else if p < 1e-99 {
+        "< 1e-99".into()
+    } else {
+        crate::io::fmt_sig(p, 2)
+    }
+}
+
+/// A p-value in a sentence: `p = 0.031`, `p = 2.4e-7`, or `p < 1e-99`
+/// (never `p = < 1e-99`).
+pub fn p_text(p: f64) -> String {
+    let value = p_cell(p);
+    if value.starts_with('<') {
+        format!("p {value}")
+    } else {
+        format!("p = {value}")
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

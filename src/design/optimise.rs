@@ -1,13 +1,14 @@
 //! Minimising eq. 3.17: multi-start Levenberg–Marquardt over the routing
 //! y_0…y_4 and the tension τ, inside box bounds.
 //!
-//! Bounds by transformation: the solver works on unbounded z ∈ R⁶ with
-//! y_i = Y sin z_i and τ = τ_l + (τ_u − τ_l)(1 + sin w)/2, so every trial
-//! point is a valid design (the simulator rejects routings outside the body)
-//! and a bound-active optimum is a stationary point of the transformed
-//! problem (the thesis's Target II sits at τ ≈ τ_u). A sine rather than tanh
-//! keeps the map well conditioned near the bounds instead of flattening
-//! exponentially, so the solver can still leave a bound it touched.
+//! The search runs the library's one bounded Levenberg–Marquardt
+//! ([`crate::numerics::lm`]) on the design scaled into the unit box,
+//! u_i = y_i / Y ∈ [−1, 1] and v = (τ − τ_l)/(τ_u − τ_l) ∈ [0, 1], so that
+//! one finite-difference step and one stopping rule fit every variable. Its
+//! bounds are held by projection: every trial point is a valid design (the
+//! simulator rejects routings outside the body), and a bound-active optimum
+//! (the thesis's Target II sits at τ = τ_u) is reached exactly. A trial point
+//! the model cannot solve is a rejected step, not the end of the start.
 //!
 //! Starts come from a coarse grid of simulated designs of our own (5 levels
 //! per control point, 5 tensions; half the routings simulated, the rest
@@ -18,11 +19,10 @@ use super::objective::{Evaluation, Objective};
 use super::target::Component;
 use super::DesignError;
 use crate::model::{ControlPoints, Routing, Simulator, SolveFailure};
-use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
-use nalgebra::{DMatrix, DVector, Dyn, Owned};
+use crate::numerics::lm;
+use nalgebra::DMatrix;
 use rayon::prelude::*;
 use serde::Serialize;
-use std::cell::{Cell, RefCell};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
@@ -202,16 +202,13 @@ pub fn evaluate_seeds(objective: &Objective, seeds: &[Seed]) -> Vec<(f64, Seed)>
     out
 }
 
-/// The least-squares problem in transformed variables z (see module docs).
+/// The least-squares problem in the unit box (see module docs).
 struct Problem<'a> {
     objective: &'a Objective,
-    sim: RefCell<Simulator>,
-    z: DVector<f64>,
-    /// Residuals at `z`, filled on first use.
-    current: RefCell<Option<Option<DVector<f64>>>>,
-    /// Best design seen so far (LM may stop on a rejected trial point).
-    best: RefCell<Option<(f64, Evaluation)>>,
-    evaluations: Cell<usize>,
+    sim: Simulator,
+    /// Best design seen so far (a rejected trial point may be the best seen).
+    best: Option<(f64, Evaluation)>,
+    evaluations: usize,
     max_evaluations: usize,
     /// This start's place in its pass (the seeds' order).
     index: usize,
@@ -259,99 +256,95 @@ impl Default for ExactFit {
 /// the search (without it, a zero-residual problem keeps LM iterating).
 pub const COST_FLOOR: f64 = 1e-20;
 
-/// Finite-difference step in z (a few 1e-5 mm in y): large against the
-/// solver's convergence noise (~1e-10 in a_i), small against curvature.
+/// Finite-difference step in the unit box (1e-5 mm in y at the thesis's
+/// bounds): large against the solver's convergence noise (~1e-10 in a_i),
+/// small against curvature.
 const FD_STEP: f64 = 2e-6;
 
+/// Index of the tension among the design variables.
+const TENSION: usize = 5;
+
 impl Problem<'_> {
-    fn design_of(&self, z: &DVector<f64>) -> (ControlPoints, f64) {
+    /// The design at unit-box coordinates `u`.
+    fn design_of(&self, u: &[f64]) -> (ControlPoints, f64) {
         let b = self.objective.bounds;
-        let y = std::array::from_fn(|i| b.max_offset_mm * z[i].sin());
-        let tension = b.tension_min_n + (b.tension_max_n - b.tension_min_n) * 0.5 * (1.0 + z[5].sin());
+        let y = std::array::from_fn(|i| b.max_offset_mm * u[i]);
+        let tension = b.tension_min_n + (b.tension_max_n - b.tension_min_n) * u[TENSION];
         (y.into(), tension)
     }
 
-    fn z_of(&self, y: &ControlPoints, tension: f64) -> DVector<f64> {
+    /// The unit-box coordinates of a design inside the bounds.
+    fn unit_of(&self, y: &ControlPoints, tension: f64) -> Vec<f64> {
         let b = self.objective.bounds;
-        let mut z = DVector::zeros(6);
-        for i in 0..5 {
-            z[i] = (y[i] / b.max_offset_mm).clamp(-1.0, 1.0).asin();
-        }
+        let mut u: Vec<f64> = y.iter().map(|v| (v / b.max_offset_mm).clamp(-1.0, 1.0)).collect();
         let span = b.tension_max_n - b.tension_min_n;
-        z[5] = if span > 0.0 { (2.0 * (tension - b.tension_min_n) / span - 1.0).clamp(-1.0, 1.0).asin() } else { 0.0 };
-        z
+        u.push(if span > 0.0 { ((tension - b.tension_min_n) / span).clamp(0.0, 1.0) } else { 0.0 });
+        u
     }
 
-    fn residuals_at(&self, z: &DVector<f64>) -> Result<DVector<f64>, SolveFailure> {
-        self.evaluations.set(self.evaluations.get() + 1);
-        let (y, tension) = self.design_of(z);
-        let e = self.objective.evaluate(&mut self.sim.borrow_mut(), &y, tension)?;
-        let mut r = DVector::zeros(self.objective.residual_count());
-        self.objective.residuals_into(&e, r.as_mut_slice());
-        let cost = r.norm_squared();
-        let mut best = self.best.borrow_mut();
-        if best.as_ref().is_none_or(|(c, _)| cost < *c) {
-            *best = Some((cost, e));
+    /// The box bounds and the free variables: the tension is held when its
+    /// bounds coincide.
+    fn settings(&self) -> lm::Settings {
+        let b = self.objective.bounds;
+        let mut bounds = vec![(-1.0, 1.0); 5];
+        bounds.push((0.0, 1.0));
+        let free = if b.tension_max_n > b.tension_min_n { (0..6).collect() } else { (0..5).collect() };
+        // The evaluation budget ends a start, not an iteration count.
+        lm::Settings { bounds, free, max_iterations: usize::MAX }
+    }
+
+    fn residuals_at(&mut self, u: &[f64]) -> Result<Vec<f64>, SolveFailure> {
+        self.evaluations += 1;
+        let (y, tension) = self.design_of(u);
+        let e = self.objective.evaluate(&mut self.sim, &y, tension)?;
+        let mut r = vec![0.0; self.objective.residual_count()];
+        self.objective.residuals_into(&e, &mut r);
+        let cost = r.iter().map(|v| v * v).sum::<f64>();
+        if self.best.as_ref().is_none_or(|(c, _)| cost < *c) {
+            self.best = Some((cost, e));
         }
         Ok(r)
     }
 }
 
-impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
-    type ResidualStorage = Owned<f64, Dyn>;
-    type JacobianStorage = Owned<f64, Dyn, Dyn>;
-    type ParameterStorage = Owned<f64, Dyn>;
-
-    fn set_params(&mut self, z: &DVector<f64>) {
-        self.z.copy_from(z);
-        *self.current.borrow_mut() = None;
+impl lm::Problem for Problem<'_> {
+    fn residuals(&mut self, u: &[f64]) -> Option<Vec<f64>> {
+        self.residuals_at(u).ok()
     }
 
-    fn params(&self) -> DVector<f64> {
-        self.z.clone()
+    /// Forward differences, stepping inward at an upper bound (every point
+    /// evaluated stays a valid design), and the other way round when a point
+    /// cannot be solved.
+    fn jacobian(&mut self, u: &[f64], r: &[f64], free: &[usize]) -> Option<DMatrix<f64>> {
+        let mut jac = DMatrix::zeros(r.len(), free.len());
+        for (k, &j) in free.iter().enumerate() {
+            // Every variable's upper bound is 1.
+            let mut h = if u[j] + FD_STEP > 1.0 { -FD_STEP } else { FD_STEP };
+            let mut at = u.to_vec();
+            at[j] += h;
+            let rh = match self.residuals_at(&at) {
+                Ok(rh) => rh,
+                Err(_) => {
+                    h = -h;
+                    at[j] = u[j] + h;
+                    self.residuals_at(&at).ok()?
+                }
+            };
+            for (i, (a, b)) in rh.iter().zip(r).enumerate() {
+                jac[(i, k)] = (a - b) / h;
+            }
+        }
+        Some(jac)
     }
 
-    fn residuals(&self) -> Option<DVector<f64>> {
-        let exact = self.best.borrow().as_ref().is_some_and(|(c, _)| *c <= COST_FLOOR);
+    /// Exact fit here or in an earlier start, or out of budget: the best
+    /// design seen is kept.
+    fn stop(&mut self) -> bool {
+        let exact = self.best.as_ref().is_some_and(|(c, _)| *c <= COST_FLOOR);
         if exact {
             self.exact_fit.record(self.index);
         }
-        if exact || self.exact_fit.before(self.index) || self.evaluations.get() >= self.max_evaluations {
-            // Exact fit here or in an earlier start, or out of budget: returning no
-            // residuals stops the solver (the best design is kept).
-            return None;
-        }
-        if let Some(r) = self.current.borrow().as_ref() {
-            return r.clone();
-        }
-        let r = match self.residuals_at(&self.z) {
-            Ok(r) => Some(r),
-            // A trial point the model cannot solve: a huge residual makes LM
-            // reject the step and shrink its trust region instead of stopping.
-            Err(_) => Some(DVector::from_element(self.objective.residual_count(), 1e6)),
-        };
-        *self.current.borrow_mut() = Some(r.clone());
-        r
-    }
-
-    fn jacobian(&self) -> Option<DMatrix<f64>> {
-        let r0 = self.residuals()?;
-        let m = r0.len();
-        let mut jac = DMatrix::zeros(m, 6);
-        for j in 0..6 {
-            let mut z = self.z.clone();
-            z[j] += FD_STEP;
-            let column = match self.residuals_at(&z) {
-                Ok(r) => (r - &r0) / FD_STEP,
-                Err(_) => {
-                    // Forward point unsolvable: try the backward difference.
-                    z[j] -= 2.0 * FD_STEP;
-                    (&r0 - self.residuals_at(&z).ok()?) / FD_STEP
-                }
-            };
-            jac.set_column(j, &column);
-        }
-        Some(jac)
+        exact || self.exact_fit.before(self.index) || self.evaluations >= self.max_evaluations
     }
 }
 
@@ -367,45 +360,37 @@ pub fn refine(
     index: usize,
     exact_fit: &ExactFit,
 ) -> (Option<(f64, Evaluation)>, StartReport) {
-    let mut problem = Problem {
-        objective,
-        sim: RefCell::new(objective.simulator()),
-        z: DVector::zeros(6),
-        current: RefCell::new(None),
-        best: RefCell::new(None),
-        evaluations: Cell::new(0),
-        max_evaluations,
-        index,
-        exact_fit,
-    };
+    let mut problem = Problem { objective, sim: objective.simulator(), best: None, evaluations: 0, max_evaluations, index, exact_fit };
     let mut s = *seed;
     objective.bounds.clamp(&mut s.routing_mm, &mut s.tension_n);
-    problem.z = problem.z_of(&s.routing_mm, s.tension_n);
-    let seed_cost = problem.residuals().map_or(f64::INFINITY, |r| r.norm_squared());
-    let (problem, report) = LevenbergMarquardt::new()
-        .with_ftol(1e-14)
-        .with_xtol(1e-12)
-        .with_gtol(1e-14)
-        .with_patience(max_evaluations / 7 + 1)
-        .minimize(problem);
-    let best = problem.best.into_inner();
-    let start = StartReport {
+    let u = problem.unit_of(&s.routing_mm, s.tension_n);
+    let start = if lm::Problem::stop(&mut problem) { None } else { problem.residuals_at(&u).ok() };
+    let seed_cost = start.as_ref().map_or(f64::INFINITY, |r| r.iter().map(|v| v * v).sum());
+    let termination = match start {
+        Some(r) => {
+            let settings = problem.settings();
+            lm::minimise(&mut problem, u, r, &settings, &mut |_| {}).termination.to_string()
+        }
+        None => "the seed could not be simulated".to_string(),
+    };
+    let best = problem.best.take();
+    let report = StartReport {
         seed: s,
         seed_cost,
         cost: best.as_ref().map_or(f64::INFINITY, |b| b.0),
-        evaluations: problem.evaluations.get(),
-        // Our own stops surface from the solver as residual failures.
+        evaluations: problem.evaluations,
+        // Our own stops, named.
         termination: if best.as_ref().is_some_and(|(c, _)| *c <= COST_FLOOR) {
             "exact fit (objective at the noise floor)".to_string()
         } else if exact_fit.before(index) {
             "stopped: an earlier start fitted exactly".to_string()
-        } else if problem.evaluations.get() >= max_evaluations {
+        } else if problem.evaluations >= max_evaluations {
             "evaluation budget reached".to_string()
         } else {
-            format!("{:?}", report.termination)
+            termination
         },
     };
-    (best, start)
+    (best, report)
 }
 
 /// Picks up to `count` seeds from `ranked` (best first), skipping any within
@@ -599,28 +584,22 @@ mod tests {
     }
 
     #[test]
-    fn the_bounds_transformation_round_trips_and_stays_inside() {
+    fn the_unit_box_round_trips_and_stays_inside() {
         let obj = objective();
-        let p = Problem {
-            objective: &obj,
-            sim: RefCell::new(obj.simulator()),
-            z: DVector::zeros(6),
-            current: RefCell::new(None),
-            best: RefCell::new(None),
-            evaluations: Cell::new(0),
-            max_evaluations: 10,
-            index: 0,
-            exact_fit: &ExactFit::new(),
-        };
+        let exact_fit = ExactFit::new();
+        let p = Problem { objective: &obj, sim: obj.simulator(), best: None, evaluations: 0, max_evaluations: 10, index: 0, exact_fit: &exact_fit };
         let y = [4.99, -4.99, 0.0, 1.234, -3.0];
-        let (y2, t2) = p.design_of(&p.z_of(&y.into(), 1.7));
+        let (y2, t2) = p.design_of(&p.unit_of(&y.into(), 1.7));
         for (a, b) in y.iter().zip(&y2) {
             assert!((a - b).abs() < 1e-12);
         }
         assert!((t2 - 1.7).abs() < 1e-12);
-        for z in [-100.0, -1.6, 0.3, std::f64::consts::FRAC_PI_2, 7.0] {
-            let (y, t) = p.design_of(&DVector::from_element(6, z));
-            assert!(y.iter().all(|v| v.abs() <= obj.bounds.max_offset_mm) && (1.0..=2.0).contains(&t));
+        // The box's corners are the bounds' corners.
+        let s = p.settings();
+        for (corner, sign, tension) in [(s.bounds.iter().map(|b| b.0).collect::<Vec<_>>(), -1.0, 1.0), (s.bounds.iter().map(|b| b.1).collect(), 1.0, 2.0)] {
+            let (y, t) = p.design_of(&corner);
+            assert!(y.iter().all(|v| (v - sign * obj.bounds.max_offset_mm).abs() < 1e-12), "{y:?}");
+            assert!((t - tension).abs() < 1e-12);
         }
     }
 

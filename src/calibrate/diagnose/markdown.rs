@@ -2,11 +2,12 @@
 //! residual diagnostics, the fitted parameters and three PNG plots
 //! (residuals before/after, load/unload loops, measured vs simulated shapes).
 
-use super::data::{CentrelinePoints, Dataset, Direction, MarkerPoints, RoutingGroup};
-use super::diagnose::{Candidate, DiagnoseSpec, Diagnosis};
-use super::fit::{row_residual, FitResult};
-use super::predict::Prediction;
-use super::CalibrateError;
+use super::analysis::{Candidate, DiagnoseSpec, Diagnosis};
+use super::Verdict;
+use crate::calibrate::data::{CentrelinePoints, Dataset, Direction, MarkerPoints, RoutingGroup};
+use crate::calibrate::fit::{row_residual, FitResult};
+use crate::calibrate::predict::Prediction;
+use crate::calibrate::CalibrateError;
 use crate::plot::{register_fonts, PlotError, FONT};
 use plotters::prelude::*;
 use std::fmt::Write as _;
@@ -21,7 +22,7 @@ pub fn write_report(
     d: &Diagnosis,
     spec: &DiagnoseSpec,
 ) -> Result<PathBuf, CalibrateError> {
-    crate::io::check_not_in_run_dir(dir, "the report directory").map_err(CalibrateError::Invalid)?;
+    crate::io::check_not_in_run_dir(dir, "the report directory").map_err(|message| CalibrateError::ReportDir { message })?;
     std::fs::create_dir_all(dir)
         .map_err(|source| CalibrateError::Io { context: format!("creating report directory {}", dir.display()), source })?;
     let groups = data.groups();
@@ -82,42 +83,19 @@ fn candidate_table(out: &mut String, cands: &[Candidate]) {
             out,
             "| {} | {} | `{}` | {} ± {} | {} | {} | {} | {} | {} |",
             c.rank,
-            c.effect,
+            c.effect.name(),
             c.parameter_name,
             num(c.parameter),
             num(c.parameter_se),
             num(c.delta_bic),
             num(c.reduced_chi2),
-            pval(c.p_value),
+            crate::calibrate::stats::p_cell(c.p_value),
             num(c.rms_mm),
             match c.failure() {
                 None => "yes".to_string(),
                 Some(why) => format!("no: {}", why.replace('|', "/").replace('\n', " ")),
             }
         );
-    }
-}
-
-/// A p-value in a table column headed p: `0.031`, `2.4e-7`, or `< 1e-99`
-/// below what the χ² tail resolves.
-fn pval(p: f64) -> String {
-    if !p.is_finite() {
-        "—".into()
-    } else if p < 1e-99 {
-        "< 1e-99".into()
-    } else {
-        crate::io::fmt_sig(p, 2)
-    }
-}
-
-/// A p-value in a sentence: `p = 0.031`, `p = 2.4e-7`, or `p < 1e-99`
-/// (never `p = < 1e-99`).
-pub fn p_text(p: f64) -> String {
-    let value = pval(p);
-    if value.starts_with('<') {
-        format!("p {value}")
-    } else {
-        format!("p = {value}")
     }
 }
 
@@ -128,7 +106,7 @@ fn adequacy_line(f: &FitResult) -> String {
         num(f.chi2),
         f.dof,
         num(f.reduced_chi2),
-        p_text(f.p_value)
+        crate::calibrate::stats::p_text(f.p_value)
     );
     if !f.outliers.is_empty() {
         let _ = write!(line, "; readings set aside as outliers (measurement ids): {}", f.outliers.iter().map(|i| i.to_string()).collect::<Vec<_>>().join(", "));
@@ -183,20 +161,20 @@ fn markdown(data_path: &Path, data: &Dataset, d: &Diagnosis, after_label: Option
     let mut out = String::new();
     let _ = writeln!(out, "# Model-discrepancy diagnosis\n\nData: `{}` ({} rows, {} routings).\n", data_path.display(), data.rows.len(), data.groups().len());
     out.push_str("## Verdict\n\n");
-    match d.verdict.as_str() {
-        "none" => {
+    match d.verdict {
+        Verdict::Consistent => {
             let _ = writeln!(out, "**none**: {}.\n", d.reason);
         }
-        "inconclusive" => {
+        Verdict::Inconclusive => {
             let _ = writeln!(out, "**inconclusive**: {}.\n", d.reason);
         }
-        "unexplained" => {
+        Verdict::Unexplained => {
             let _ = writeln!(out, "**unexplained**: {}.\n", d.reason);
             for n in &d.partial_effects {
                 let _ = writeln!(
                     out,
                     "- {} helps (`{}` = {} ± {}, ΔBIC {}) but does not explain the data.",
-                    n.effect,
+                    n.effect.name(),
                     n.parameter_name,
                     num(n.parameter),
                     num(n.parameter_se),
@@ -219,19 +197,19 @@ fn markdown(data_path: &Path, data: &Dataset, d: &Diagnosis, after_label: Option
             }
             out.push('\n');
         }
-        "ambiguous" => {
+        Verdict::Ambiguous(..) => {
             let _ = writeln!(
                 out,
                 "**ambiguous**: the data cannot tell **{}** and **{}** apart ({}). To separate them: {}.\n",
-                d.ambiguous_between[0],
-                d.ambiguous_between[1],
+                d.ambiguous_between[0].name(),
+                d.ambiguous_between[1].name(),
                 d.reason,
                 d.separating_measurement.as_deref().unwrap_or("")
             );
         }
-        _ => {
+        Verdict::Named(_) => {
             for n in &d.named {
-                let _ = writeln!(out, "- **{}**: `{}` = {} ± {} (ΔBIC {})", n.effect, n.parameter_name, num(n.parameter), num(n.parameter_se), num(n.delta_bic));
+                let _ = writeln!(out, "- **{}**: `{}` = {} ± {} (ΔBIC {})", n.effect.name(), n.parameter_name, num(n.parameter), num(n.parameter_se), num(n.delta_bic));
             }
             let _ = writeln!(out, "\nWhy: {}.\n", d.reason);
         }
@@ -253,7 +231,7 @@ fn markdown(data_path: &Path, data: &Dataset, d: &Diagnosis, after_label: Option
     out.push_str("## Candidates (each refitted with EA, GA, EI)\n\n");
     candidate_table(&mut out, &d.candidates);
     if !d.second_round.is_empty() {
-        let first = d.named.first().or(d.partial_effects.first()).map_or_else(|| d.candidates.first().map_or("", |c| c.effect), |n| n.effect);
+        let first = d.named.first().or(d.partial_effects.first()).map_or_else(|| d.candidates.first().map_or("", |c| c.effect.name()), |n| n.effect.name());
         let _ = writeln!(out, "\nSecond round (given {first}):\n");
         candidate_table(&mut out, &d.second_round);
     }
@@ -301,8 +279,8 @@ pub fn shape_coefficients_rest_basis(points: &[[f64; 2]], rest_length_mm: f64, o
 /// `noise_mm` on x and y): how much of a measured a_i noise alone explains.
 fn coefficient_noise(prediction: &Option<Prediction>, count: usize, noise_mm: f64, length_mm: f64) -> Option<Vec<f64>> {
     let line: Vec<[f64; 2]> = prediction.as_ref()?.centreline.as_ref()?.iter().map(|c| [c.x_mm, c.y_mm]).collect();
-    let base = super::synth::resample(&line, count);
-    let mut rng = super::rng::Rng::new(0x5eed);
+    let base = crate::calibrate::synth::resample(&line, count);
+    let mut rng = crate::calibrate::rng::Rng::new(0x5eed);
     const DRAWS: usize = 40;
     let mut sum = [0.0; SHAPE_ORDER + 1];
     let mut sum2 = [0.0; SHAPE_ORDER + 1];
@@ -596,6 +574,7 @@ fn shape_plot(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::calibrate::stats::p_text;
 
     fn fit_with_p(p_value: f64) -> FitResult {
         FitResult {

@@ -20,11 +20,12 @@
 //! ([`Effect::plausible`]). Effects are added forward-stepwise by the same
 //! rule (at most `max_effects`).
 
-use super::data::{Dataset, Direction, RoutingGroup};
-use super::effect::Effect;
-use super::fit::{closest_on_centreline, fit, residuals, rms_per_routing, FitResult, FitSpec, RoutingRms};
-use super::predict::{predict, Prediction};
-use super::CalibrateError;
+use super::Verdict;
+use crate::calibrate::data::{split_holdout, Dataset, Direction, RoutingGroup};
+use crate::calibrate::effect::Effect;
+use crate::calibrate::fit::{closest_on_centreline, fit, residuals, rms_per_routing, FitResult, FitSpec, RoutingRms};
+use crate::calibrate::predict::{predict, Prediction};
+use crate::calibrate::{stats, CalibrateError};
 use crate::model::{Rod, SolverOptions};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -61,8 +62,8 @@ impl Default for DiagnoseSpec {
 pub struct Candidate {
     /// Rank (1 = lowest BIC).
     pub rank: usize,
-    /// Effect name.
-    pub effect: &'static str,
+    /// The effect.
+    pub effect: Effect,
     /// Parameter name with unit.
     pub parameter_name: &'static str,
     /// Fitted value (NaN if the fit failed).
@@ -165,8 +166,8 @@ pub struct Signature {
 /// A named effect of the final model.
 #[derive(Debug, Clone, Serialize)]
 pub struct NamedEffect {
-    /// Effect name.
-    pub effect: &'static str,
+    /// The effect.
+    pub effect: Effect,
     /// Parameter name.
     pub parameter_name: &'static str,
     /// Fitted value.
@@ -180,8 +181,8 @@ pub struct NamedEffect {
 /// The outcome of a diagnosis.
 #[derive(Debug, Clone)]
 pub struct Diagnosis {
-    /// `none`, an effect name, `ambiguous`, `unexplained` or `inconclusive`.
-    pub verdict: String,
+    /// The verdict.
+    pub verdict: Verdict,
     /// Why, in one sentence (states the test).
     pub reason: String,
     /// Effects of the final model, in the order they were added.
@@ -190,7 +191,7 @@ pub struct Diagnosis {
     /// fit above the noise.
     pub partial_effects: Vec<NamedEffect>,
     /// The two effects the data cannot tell apart, if ambiguous.
-    pub ambiguous_between: Vec<&'static str>,
+    pub ambiguous_between: Vec<Effect>,
     /// The measurement that would separate them.
     pub separating_measurement: Option<String>,
     /// Ranked candidates of the first round.
@@ -224,85 +225,13 @@ pub struct Diagnosis {
     pub alpha: f64,
 }
 
-impl Diagnosis {
-    /// The `--json` object.
-    pub fn to_json(&self) -> serde_json::Value {
-        let first = self.named.first();
-        serde_json::json!({
-            "verdict": self.verdict,
-            "reason": self.reason,
-            "parameter_name": first.map(|n| n.parameter_name),
-            "parameter": first.map(|n| n.parameter),
-            "parameter_se": first.map(|n| n.parameter_se),
-            "effects": self.named,
-            "partial_effects": self.partial_effects,
-            "ambiguous_between": self.ambiguous_between,
-            "separating_measurement": self.separating_measurement,
-            "candidates": self.candidates,
-            "second_round": self.second_round,
-            "criterion": self.criterion,
-            "alpha": self.alpha,
-            "baseline": fit_json(&self.baseline),
-            "extended": fit_json(&self.extended),
-            "best": fit_json(&self.best),
-            "signature": self.signature,
-            "diagnostics": self.diagnostics,
-            "holdout": self.holdout,
-            "holdout_rms_before": self.holdout_rms_before,
-            "holdout_rms_after": self.holdout_rms_after,
-            "not_identifiable": ["cable_stretch: under tension control the cable's stretch does not change the forces on the rod, so no tip reading can show it"],
-        })
-    }
-}
-
-/// A fit as JSON: parameters with SEs, correlations, χ², RMS per routing.
-pub fn fit_json(f: &FitResult) -> serde_json::Value {
-    serde_json::json!({
-        "effects": f.effects,
-        "parameters": f.parameters,
-        "correlation": f.correlation,
-        "loss": f.rss,
-        "n_residuals": f.n_residuals,
-        "bic": f.bic,
-        "chi2": f.chi2,
-        "dof": f.dof,
-        "reduced_chi2": f.reduced_chi2,
-        "p_value": f.p_value,
-        "outliers": f.outliers,
-        "flags": f.flags,
-        "implausible": f.implausible,
-        "rms_mm": f.rms_mm,
-        "per_routing": f.per_routing,
-        "iterations": f.iterations,
-        "converged": f.converged,
-    })
-}
-
-/// Splits the routings into fitted and held-out ones.
-pub fn split_holdout(data: &Dataset, holdout: Option<&str>) -> Result<(Vec<RoutingGroup>, Option<RoutingGroup>), CalibrateError> {
-    let groups = data.groups();
-    let Some(id) = holdout else {
-        return Ok((groups, None));
-    };
-    let ids: Vec<&str> = groups.iter().map(|g| g.routing.as_str()).collect();
-    let Some(pos) = groups.iter().position(|g| g.routing == id) else {
-        return Err(CalibrateError::Invalid(format!("no routing '{id}' in the data to hold out (routings: {})", ids.join(", "))));
-    };
-    let mut train = groups;
-    let held = train.remove(pos);
-    if train.is_empty() {
-        return Err(CalibrateError::Invalid(format!("routing {id} is the only routing; holding it out would leave nothing to fit")));
-    }
-    Ok((train, Some(held)))
-}
-
 fn candidate(effect: Effect, reference_bic: f64, result: &Result<FitResult, CalibrateError>) -> Candidate {
     match result {
         Ok(f) => {
             let p = f.effect_parameter(effect).expect("fitted effect");
             Candidate {
                 rank: 0,
-                effect: effect.name(),
+                effect,
                 parameter_name: effect.parameter_name(),
                 parameter: p.value,
                 parameter_se: p.se,
@@ -320,7 +249,7 @@ fn candidate(effect: Effect, reference_bic: f64, result: &Result<FitResult, Cali
         }
         Err(e) => Candidate {
             rank: 0,
-            effect: effect.name(),
+            effect,
             parameter_name: effect.parameter_name(),
             parameter: f64::NAN,
             parameter_se: f64::NAN,
@@ -351,10 +280,10 @@ fn decide(ranked: &[Candidate], spec: &DiagnoseSpec) -> Decision {
     if best.delta_bic > -spec.threshold {
         return Decision::None;
     }
-    let e = Effect::parse(best.effect).expect("known effect");
+    let e = best.effect;
     match ok.get(1) {
         Some(runner) if runner.delta_bic - best.delta_bic < spec.margin => {
-            Decision::Ambiguous(e, Effect::parse(runner.effect).expect("known effect"))
+            Decision::Ambiguous(e, runner.effect)
         }
         _ => Decision::Named(e),
     }
@@ -404,7 +333,7 @@ fn round(
 }
 
 fn named_effect(e: Effect, c: &Candidate) -> NamedEffect {
-    NamedEffect { effect: e.name(), parameter_name: e.parameter_name(), parameter: c.parameter, parameter_se: c.parameter_se, delta_bic: c.delta_bic }
+    NamedEffect { effect: e, parameter_name: e.parameter_name(), parameter: c.parameter, parameter_se: c.parameter_se, delta_bic: c.delta_bic }
 }
 
 fn fit_of(fits: &[(Effect, FitResult)], e: Effect) -> FitResult {
@@ -412,7 +341,7 @@ fn fit_of(fits: &[(Effect, FitResult)], e: Effect) -> FitResult {
 }
 
 fn chi2_text(f: &FitResult) -> String {
-    format!("χ² = {:.1} on {} dof, χ²/dof = {:.2}, {}", f.chi2, f.dof, f.reduced_chi2, super::report::p_text(f.p_value))
+    format!("χ² = {:.1} on {} dof, χ²/dof = {:.2}, {}", f.chi2, f.dof, f.reduced_chi2, stats::p_text(f.p_value))
 }
 
 /// Runs the whole workflow on `data` with `base` as the starting actuator.
@@ -434,21 +363,21 @@ pub fn diagnose(base: &Rod, options: &SolverOptions, data: &Dataset, spec: &Diag
     // The naming rule on the first round (and a second effect on top).
     let decision = decide(&candidates, spec);
     match decision {
-        Decision::None => verdict = "none".to_string(),
+        Decision::None => verdict = Verdict::Consistent,
         Decision::Ambiguous(a, b) => {
-            ambiguous_between = vec![a.name(), b.name()];
+            ambiguous_between = vec![a, b];
             separating_measurement = Some(a.separating_measurement(b).to_string());
-            verdict = "ambiguous".to_string();
+            verdict = Verdict::Ambiguous(a, b);
         }
         Decision::Named(e) => {
-            let c = candidates.iter().find(|c| c.effect == e.name()).expect("candidate");
+            let c = candidates.iter().find(|c| c.effect == e).expect("candidate");
             named.push(named_effect(e, c));
             extended = fit_of(&fits, e);
             if spec.max_effects > 1 {
                 let (cands2, fits2) = round(base, options, data, &train, spec, &[e], &extended);
                 if let Decision::Named(e2) = decide(&cands2, spec) {
                     let f2 = fit_of(&fits2, e2);
-                    let c2 = cands2.iter().find(|c| c.effect == e2.name()).expect("candidate");
+                    let c2 = cands2.iter().find(|c| c.effect == e2).expect("candidate");
                     // The first effect's value is re-estimated with the second.
                     if let Some(p1) = f2.effect_parameter(e) {
                         named[0].parameter = p1.value;
@@ -459,7 +388,7 @@ pub fn diagnose(base: &Rod, options: &SolverOptions, data: &Dataset, spec: &Diag
                 }
                 second_round = cands2;
             }
-            verdict = e.name().to_string();
+            verdict = Verdict::Named(e);
         }
     }
     // The model judged against the noise: the named one, or for an
@@ -472,7 +401,7 @@ pub fn diagnose(base: &Rod, options: &SolverOptions, data: &Dataset, spec: &Diag
     let mut partial_effects = Vec::new();
     let reason;
     if !baseline.converged {
-        verdict = "inconclusive".into();
+        verdict = Verdict::Inconclusive;
         named.clear();
         extended = baseline.clone();
         reason = format!(
@@ -481,12 +410,12 @@ pub fn diagnose(base: &Rod, options: &SolverOptions, data: &Dataset, spec: &Diag
             if baseline.flags.is_empty() { String::new() } else { format!("; {}", baseline.flags.join("; ")) }
         );
     } else if judged.consistent_with_noise(spec.alpha) {
-        reason = match verdict.as_str() {
-            "none" if !any_counts => {
-                verdict = "inconclusive".into();
+        reason = match verdict {
+            Verdict::Consistent if !any_counts => {
+                verdict = Verdict::Inconclusive;
                 "the thesis model is consistent with the noise, but no candidate fit converged to a plausible value, so no effect can be ruled out".to_string()
             }
-            "none" => format!(
+            Verdict::Consistent => format!(
                 "{} explains the data to within the stated noise ({}) and no candidate effect is warranted",
                 if spec.held_effects.is_empty() {
                     "the thesis model".to_string()
@@ -496,7 +425,7 @@ pub fn diagnose(base: &Rod, options: &SolverOptions, data: &Dataset, spec: &Diag
                 },
                 chi2_text(&baseline)
             ),
-            "ambiguous" => format!("two effects fit equally well and the better one is consistent with the noise ({})", chi2_text(&judged)),
+            Verdict::Ambiguous(..) => format!("two effects fit equally well and the better one is consistent with the noise ({})", chi2_text(&judged)),
             _ => format!("the model {} explains the data to within the stated noise ({})", model_name(&extended), chi2_text(&extended)),
         };
     } else {
@@ -504,12 +433,12 @@ pub fn diagnose(base: &Rod, options: &SolverOptions, data: &Dataset, spec: &Diag
         let mut best_pair: Option<(Effect, Effect, FitResult, Candidate, Candidate)> = None;
         if !matches!(decision, Decision::Named(_)) && spec.max_effects > 1 {
             if let Some(c1) = candidates.iter().find(|c| c.counts()) {
-                let e1 = Effect::parse(c1.effect).expect("known effect");
+                let e1 = c1.effect;
                 let f1 = fit_of(&fits, e1);
                 let (cands2, fits2) = round(base, options, data, &train, spec, &[e1], &f1);
                 if let Decision::Named(e2) = decide(&cands2, spec) {
                     let f2 = fit_of(&fits2, e2);
-                    let c2 = cands2.iter().find(|c| c.effect == e2.name()).expect("candidate").clone();
+                    let c2 = cands2.iter().find(|c| c.effect == e2).expect("candidate").clone();
                     best_pair = Some((e1, e2, f2, c1.clone(), c2));
                 }
                 second_round = cands2;
@@ -529,7 +458,7 @@ pub fn diagnose(base: &Rod, options: &SolverOptions, data: &Dataset, spec: &Diag
                 ambiguous_between.clear();
                 separating_measurement = None;
                 extended = f2;
-                verdict = e1.name().to_string();
+                verdict = Verdict::Named(e1);
                 reason = format!("the model {} explains the data to within the stated noise ({})", model_name(&extended), chi2_text(&extended));
             }
             pair => {
@@ -545,13 +474,13 @@ pub fn diagnose(base: &Rod, options: &SolverOptions, data: &Dataset, spec: &Diag
                 partial_effects = std::mem::take(&mut named);
                 if partial_effects.is_empty() {
                     if let Some(c) = candidates.iter().find(|c| c.counts() && c.delta_bic <= -spec.threshold) {
-                        partial_effects.push(named_effect(Effect::parse(c.effect).expect("known"), c));
+                        partial_effects.push(named_effect(c.effect, c));
                     }
                 }
                 ambiguous_between.clear();
                 separating_measurement = None;
                 extended = baseline.clone();
-                verdict = "unexplained".into();
+                verdict = Verdict::Unexplained;
                 reason = format!(
                     "even the best model tried ({}) stays above the stated noise: {}, below {:.0e} (chi-square test of the noise-whitened residuals); the data show something no candidate effect describes, or the noise is larger than stated",
                     model_name(&judged),
@@ -562,7 +491,7 @@ pub fn diagnose(base: &Rod, options: &SolverOptions, data: &Dataset, spec: &Diag
         }
     }
     let best = if judged.chi2 <= extended.chi2 { judged } else { extended.clone() };
-    let signature = (verdict == "unexplained").then(|| signature(data, &train, &best, &spec.fit));
+    let signature = (verdict == Verdict::Unexplained).then(|| signature(data, &train, &best, &spec.fit));
     // Predict every row (the held-out routing too) with both models.
     let all = data.groups();
     let keep = true;
@@ -583,7 +512,7 @@ pub fn diagnose(base: &Rod, options: &SolverOptions, data: &Dataset, spec: &Diag
          (n ln(Σρ/n) + p ln n) by at least {} against the model without it, leads the runner-up by at least {} and has physically plausible values; \
          effects are added forward-stepwise by the same rule (at most {}); only converged fits count",
         spec.fit.loss.describe(),
-        super::fit::OUTLIER_Z,
+        crate::calibrate::fit::OUTLIER_Z,
         spec.alpha,
         spec.alpha,
         spec.threshold,
@@ -671,7 +600,7 @@ pub fn signature(data: &Dataset, groups: &[RoutingGroup], f: &FitResult, spec: &
             add(s_mm, dist * dist);
         }
         for m in spec.shapes.markers.get(&id).into_iter().flatten() {
-            let q = super::fit::simulated_marker(m, line);
+            let q = crate::calibrate::fit::simulated_marker(m, line);
             add(m.s_mm, (q[0] - m.x_mm).powi(2) + (q[1] - m.y_mm).powi(2));
         }
     }
@@ -780,7 +709,7 @@ mod tests {
     fn cand(effect: Effect, delta_bic: f64, plausible: bool) -> Candidate {
         Candidate {
             rank: 0,
-            effect: effect.name(),
+            effect,
             parameter_name: effect.parameter_name(),
             parameter: 1.0,
             parameter_se: 0.1,

@@ -1,0 +1,20 @@
+//! The model-discrepancy workflow behind `cablemap diagnose`: fit the thesis
+//! model, judge it against the noise, refit with each candidate effect, name
+//! the effect the data call for (or none, or the two it cannot tell apart,
+//! or that no library effect explains the data), and write the report.
+//!
+//! [`run`] takes a [`DiagnoseRequest`] and returns a [`DiagnoseReport`],
+//! which serialises itself (the `--json` object) and displays itself (the
+//! summary). The criterion is in [`analysis`], the Markdown report and its
+//! plots in [`markdown`].
+
+pub mod analysis;
+pub mod markdown;
+pub mod report;
+pub mod run;
+pub mod verdict;
+
+pub use analysis::{diagnose, model_name, Candidate, DiagnoseSpec, Diagnosis, NamedEffect};
+pub use report::DiagnoseReport;
+pub use run::{run, DiagnoseRequest};
+pub use verdict::Verdict;
