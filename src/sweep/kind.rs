@@ -163,13 +163,6 @@ mod tests {
     }
 
     #[test]
-    fn every_run_format_is_one_io_recognises_as_a_run() {
-        for format in [super::super::store::FORMAT, super::super::cables::CABLES_FORMAT] {
-            assert!(crate::io::RUN_FORMAT_PREFIXES.iter().any(|p| format.starts_with(p)), "{format}");
-        }
-    }
-
-    #[test]
     fn cable_specs_are_told_by_their_cable_tables() {
         assert!(is_cable_spec_toml("[[cable]]\ny_mm = [1, 1, 1, 1, 1]\n"));
         assert!(!is_cable_spec_toml("[grid]\nlevels = 3\n"));
