@@ -53,7 +53,7 @@ pub fn run(args: &FeasibleArgs) -> anyhow::Result<()> {
     if args.json {
         writeln!(out, "{}", serde_json::to_value(&report)?)?;
     } else {
-        write!(out, "{}", text(&report))?;
+        write!(out, "{}", text(&report, cablemap::reduce::MapCables::open(map_dir)?.as_ref()))?;
         writeln!(out, "next      {}", design_command(&target, map_dir))?;
     }
     Ok(())
@@ -109,8 +109,9 @@ fn run_study(dir: &std::path::Path, target: &Target, weights: &Weights, args: &F
     Ok(())
 }
 
-/// The text report.
-pub fn text(r: &FeasibilityReport) -> String {
+/// The text report; a map of several cables (`cables`) lists every cable
+/// of each design and the command that solves it again.
+pub fn text(r: &FeasibilityReport, cables: Option<&cablemap::reduce::MapCables>) -> String {
     let mut s = format!("verdict   {}\n", r.verdict.label());
     for reason in &r.reasons {
         s.push_str(&format!("          - {reason}\n"));
@@ -150,14 +151,16 @@ pub fn text(r: &FeasibilityReport) -> String {
     for near in &r.nearest {
         let d = &near.design;
         s.push_str(&format!(
-            "  y = [{}] mm, τ = {:.3} N → tip ({:.2}, {:.2}) mm, a = [{}]  (distance {:.4})\n",
-            d.routing_mm.iter().map(|v| format!("{v:.2}")).collect::<Vec<_>>().join(", "),
-            d.tension_n,
+            "  {} → tip ({:.2}, {:.2}) mm, a = [{}]  (distance {:.4})\n",
+            cablemap::reduce::design_actuation(cables, d.routing_id, &d.routing_mm, d.tension_n),
             d.tip_x_mm,
             d.tip_y_mm,
             d.a.iter().map(|v| format!("{v:.4}")).collect::<Vec<_>>().join(", "),
             near.distance
         ));
+        if let Some(cables) = cables {
+            s.push_str(&format!("    {}\n", cables.command(d.routing_id).text));
+        }
     }
     s
 }
