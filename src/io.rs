@@ -240,17 +240,64 @@ pub fn sync_dir(dir: &Path) {
     }
 }
 
-/// Beginnings of the format tags of sweep manifests: `cablemap-sweep/N`
-/// (planar runs) and `cablemap-cables/N` (cable runs). The sweep layer's
-/// tags are checked against these by its tests.
-pub const RUN_FORMAT_PREFIXES: [&str; 2] = ["cablemap-sweep/", "cablemap-cables/"];
+/// What marks a directory as a sweep run: its manifest's file name and
+/// each kind's format tag. The one owner of these markers: the sweep engine
+/// writes them from here ([`crate::sweep::store`], [`crate::sweep::cables`])
+/// and [`is_run_dir`] recognises them from here, so a new kind of run is
+/// protected from stray outputs as soon as its tag is added.
+pub mod run_markers {
+    /// Manifest file name in a run directory.
+    pub const MANIFEST: &str = "manifest.json";
+    /// Format tag of planar single-cable sweep runs. Version 2: the a_i
+    /// columns are in the basis the manifest names (`length_basis`, the
+    /// thesis's rest-length basis by default); version 1 runs had
+    /// deformed-length a_i and no such field.
+    pub const PLANAR_FORMAT: &str = "cablemap-sweep/2";
+    /// Format tag of sweeps of several or spatial cables.
+    pub const CABLES_FORMAT: &str = "cablemap-cables/1";
+    /// Every kind's current tag.
+    pub const FORMATS: [&str; 2] = [PLANAR_FORMAT, CABLES_FORMAT];
 
-/// Whether `dir` is a sweep run directory of either kind: it has a
-/// cablemap sweep manifest (even a damaged one, as long as it names the
-/// format).
+    /// The family of a format tag: its text up to and including the `/`
+    /// before the version (`cablemap-sweep/`), so runs of every version of
+    /// a kind are recognised.
+    pub fn family(format: &str) -> &str {
+        format.find('/').map_or(format, |k| &format[..=k])
+    }
+}
+
+/// Bytes of a manifest read to find its format tag: the tag is its first
+/// key, so a user's huge file named `manifest.json` is never read whole.
+const MANIFEST_HEAD_BYTES: u64 = 64 << 10;
+
+/// Whether `dir` is a sweep run directory of any kind: its manifest's
+/// `format` names a run kind of [`run_markers::FORMATS`] (any version).
+/// The tag is found in the text rather than by parsing the JSON, so a
+/// damaged (truncated) manifest still marks the run; a `manifest.json` of
+/// something else that only mentions a tag elsewhere does not.
 pub fn is_run_dir(dir: &Path) -> bool {
-    std::fs::read(dir.join("manifest.json"))
-        .is_ok_and(|b| RUN_FORMAT_PREFIXES.iter().any(|p| b.windows(p.len()).any(|w| w == p.as_bytes())))
+    use std::io::Read;
+    let Ok(file) = File::open(dir.join(run_markers::MANIFEST)) else { return false };
+    let mut head = Vec::new();
+    if file.take(MANIFEST_HEAD_BYTES).read_to_end(&mut head).is_err() {
+        return false;
+    }
+    manifest_format(&String::from_utf8_lossy(&head)).is_some_and(|format| {
+        run_markers::FORMATS.iter().any(|kind| format.starts_with(run_markers::family(kind)))
+    })
+}
+
+/// The string value of the first `"format"` key of a JSON text
+/// (`"format": "cablemap-sweep/2"` → `cablemap-sweep/2`), whatever follows.
+fn manifest_format(text: &str) -> Option<&str> {
+    let mut rest = text;
+    while let Some(k) = rest.find("\"format\"") {
+        rest = rest[k + "\"format\"".len()..].trim_start();
+        if let Some(value) = rest.strip_prefix(':').map(str::trim_start).and_then(|v| v.strip_prefix('"')) {
+            return value.find('"').map(|end| &value[..end]);
+        }
+    }
+    None
 }
 
 /// The sweep run directory that `path` is, or lies inside at any depth,
@@ -653,7 +700,7 @@ mod tests {
     #[test]
     fn run_directories_of_either_kind_are_found_at_any_depth() {
         let dir = tempfile::tempdir().unwrap();
-        for (name, format) in [("planar", "cablemap-sweep/2"), ("cables", "cablemap-cables/1")] {
+        for (name, format) in [("planar", run_markers::PLANAR_FORMAT), ("cables", run_markers::CABLES_FORMAT)] {
             let run = dir.path().join(name);
             std::fs::create_dir_all(run.join("shards")).unwrap();
             std::fs::write(run.join("manifest.json"), format!("{{\"format\": \"{format}\"}}")).unwrap();
@@ -672,6 +719,26 @@ mod tests {
         }
         assert_eq!(enclosing_run_dir(&dir.path().join("elsewhere/map")), None);
         assert!(check_not_in_run_dir(Path::new("relative/new/map"), "x").is_ok());
+    }
+
+    /// A run is told by its manifest's `format`, of any version and even
+    /// when the manifest is cut short; a `manifest.json` of something else
+    /// is not a run for mentioning a tag in another field.
+    #[test]
+    fn a_run_is_told_by_its_manifests_format_key() {
+        let dir = tempfile::tempdir().unwrap();
+        for (manifest, is_run) in [
+            (r#"{"format": "cablemap-cables/1", "tool_version": "0.1.0"}"#, true),
+            ("{\n  \"format\" : \"cablemap-sweep/1\",\n  \"spec\": {", true),
+            (r#"{"format":"cablemap-cables/7"}"#, true),
+            (r#"{"format": "cablemap-map/1"}"#, false),
+            (r#"{"format": "photos/3", "note": "made from cablemap-sweep/2 and cablemap-cables/1 runs"}"#, false),
+            (r#"{"name": "cablemap-cables/1"}"#, false),
+            ("", false),
+        ] {
+            std::fs::write(dir.path().join(run_markers::MANIFEST), manifest).unwrap();
+            assert_eq!(is_run_dir(dir.path()), is_run, "{manifest}");
+        }
     }
 
     #[test]

@@ -232,6 +232,113 @@ fn planar_pair_mode_pictures_are_drawn_from_a_solve_of_all_cables() {
     assert!(png.width() > 1000);
 }
 
+/// The words of a command line as a POSIX shell splits it (the commands
+/// cablemap prints quote with double quotes only).
+fn shell_words(line: &str) -> Vec<String> {
+    assert!(!line.contains(['\'', '\\', '$', '`']), "{line}");
+    let (mut words, mut word, mut quoted, mut started) = (Vec::new(), String::new(), false, false);
+    for ch in line.chars() {
+        match ch {
+            '"' => (quoted, started) = (!quoted, true),
+            c if c.is_whitespace() && !quoted => {
+                if started {
+                    words.push(std::mem::take(&mut word));
+                }
+                started = false;
+            }
+            c => (word, started) = (word + &c.to_string(), true),
+        }
+    }
+    assert!(!quoted, "unbalanced quotes: {line}");
+    if started {
+        words.push(word);
+    }
+    words
+}
+
+/// Runs a printed `cablemap simulate …` command with `--json`: its tip (x, y), mm.
+fn tip_of_command(command: &str) -> (f64, f64) {
+    let words = shell_words(command);
+    assert_eq!(words[..2], ["cablemap", "simulate"], "{command}");
+    let mut args: Vec<&str> = words[1..].iter().map(String::as_str).collect();
+    args.push("--json");
+    let (ok, stdout, stderr) = run(&args);
+    assert!(ok, "{command}: {stderr}");
+    let v: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    (v["tip_x_mm"].as_f64().unwrap(), v["tip_y_mm"].as_f64().unwrap())
+}
+
+#[test]
+fn a_shown_design_of_a_two_cable_map_pasted_gives_the_maps_tip() {
+    // An antagonistic pair on a rod other than the thesis's, cable 2 knotted
+    // short of the tip: the commands must carry the rod and every cable.
+    let spec_text = r#"
+[rod]
+ei_n_mm2 = 100.5
+[rod.gravity]
+scale = 1.5
+[[cable]]
+y_mm = [3, 3, 3, 3, 3]
+tension_n = { min = 0.0, max = 2.0, count = 5 }
+[[cable.sweep]]
+axis = "y"
+points = [2]
+levels_mm = [1.0, 4.0]
+[[cable]]
+y_mm = [-3, -3, -3, -3, -3]
+anchor_mm = 50
+tension_n = { min = 0.0, max = 2.0, count = 5 }
+"#;
+    let dir = tempfile::tempdir().unwrap();
+    let spec = dir.path().join("pair.toml");
+    std::fs::write(&spec, spec_text).unwrap();
+    let out = dir.path().join("out");
+    let (ok, _, stderr) = run(&["map", s(&spec), "--out", s(&out)]);
+    assert!(ok, "{stderr}");
+    let planar = out.join("map/planar");
+    let designs = read(&planar.join("designs.parquet"));
+    let (xs, ys) = (f64s(&designs, "tip_x_mm"), f64s(&designs, "tip_y_mm"));
+    // The explorer: its header names both cables, each row shows both and a command.
+    let script = std::fs::read_to_string(planar.join("explorer-data.js")).unwrap();
+    let json = script.split_once("window.CABLEMAP_MAP = ").unwrap().1.trim_end().trim_end_matches(';');
+    let data: serde_json::Value = serde_json::from_str(json).unwrap();
+    assert_eq!(data["cables"]["count"], 2, "the page's header says the actuator has two cables");
+    assert!(data["cables"]["describe"][1].as_str().unwrap().contains("knotted at s = 50 mm"), "{}", data["cables"]);
+    let commands = data["designs"]["command"].as_array().expect("every design has its command");
+    assert_eq!(commands.len(), designs.num_rows());
+    let mut moved = 0;
+    for (k, command) in commands.iter().enumerate().step_by(3) {
+        let command = command.as_str().unwrap();
+        assert!(command.contains("--ei-n-mm2 100.5") && command.contains("--gravity-scale 1.5"), "{command}");
+        assert_eq!(command.matches("--cable ").count(), 2, "{command}");
+        assert_eq!(data["designs"]["cables"][k].as_array().unwrap().len(), 2);
+        let (x, y) = tip_of_command(command);
+        let gap = (x - xs[k].unwrap()).hypot(y - ys[k].unwrap());
+        assert!(gap < 1e-3, "design {k}: `{command}` ends at ({x}, {y}) mm, {gap} mm from the map's tip");
+        moved += usize::from(data["designs"]["cables"][k][1]["tension_n"].as_f64().unwrap() > 0.0);
+    }
+    assert!(moved > 0, "some checked design pulls cable 2 too");
+    // The modes' representatives (modes.png's captions, the page's panels) carry every cable too.
+    for m in data["modes"].as_array().unwrap().iter().filter(|m| !m["rep"].is_null()) {
+        assert_eq!(m["rep"]["cables"].as_array().unwrap().len(), 2, "{}", m["rep"]["command"]);
+    }
+    // `feasible`: each nearest design is listed with both cables and the command that solves it.
+    let target = format!("x={},y={}", xs[0].unwrap(), ys[0].unwrap());
+    let (ok, text, stderr) = run(&["feasible", "--map", s(&planar), "--target", &target, "--nearest", "4"]);
+    assert!(ok, "{stderr}");
+    let (ok, json, stderr) = run(&["feasible", "--map", s(&planar), "--target", &target, "--nearest", "4", "--json"]);
+    assert!(ok, "{stderr}");
+    let nearest: serde_json::Value = serde_json::from_str(&json).unwrap();
+    let shown: Vec<&str> = text.lines().filter_map(|l| l.trim_start().strip_prefix("cablemap simulate").map(|_| l.trim())).collect();
+    assert_eq!(shown.len(), 4, "{text}");
+    assert_eq!(text.matches("cable 2 y = [").count(), 4, "{text}");
+    for (command, near) in shown.iter().zip(nearest["nearest"].as_array().unwrap()) {
+        let (x, y) = tip_of_command(command);
+        let gap = (x - near["tip_x_mm"].as_f64().unwrap()).hypot(y - near["tip_y_mm"].as_f64().unwrap());
+        assert!(gap < 1e-3, "`{command}` ends {gap} mm from the map's tip");
+    }
+}
+
 /// A cable spec of many small chunks, slow enough that kills land mid-run.
 const KILL_SPEC: &str = r#"
 gravity_direction = [1, 0, 0]

@@ -117,6 +117,10 @@ pub struct FeasibilityReport {
     pub nearest: Vec<NearDesign>,
     /// The length the coefficients (target, map, designs) are per unit of.
     pub length_basis: LengthBasis,
+    /// A several-cable map's cables, so that each design lists every cable
+    /// and the command that solves it again (`None`: one planar cable).
+    #[serde(skip)]
+    pub cables: Option<crate::reduce::MapCables>,
 }
 
 /// Judges `target` against `map`; `nearest` designs are listed. The
@@ -242,6 +246,7 @@ pub fn check(map: &MapDir, target: &Target, basis: LengthBasis, weights: &Weight
         mode,
         nearest: map.nearest_designs(target, weights, nearest)?,
         length_basis: map.summary.length_basis,
+        cables: crate::reduce::MapCables::open(&map.path)?,
     })
 }
 
@@ -406,14 +411,16 @@ impl fmt::Display for FeasibilityReport {
             let d = &near.design;
             writeln!(
                 f,
-                "  y = [{}] mm, τ = {:.3} N → tip ({:.2}, {:.2}) mm, a = [{}]  (distance {:.4})",
-                d.routing_mm.iter().map(|v| format!("{v:.2}")).collect::<Vec<_>>().join(", "),
-                d.tension_n,
+                "  {} → tip ({:.2}, {:.2}) mm, a = [{}]  (distance {:.4})",
+                crate::reduce::design_actuation(r.cables.as_ref(), d.routing_id, &d.routing_mm, d.tension_n),
                 d.tip_x_mm,
                 d.tip_y_mm,
                 d.a.iter().map(|v| format!("{v:.4}")).collect::<Vec<_>>().join(", "),
                 near.distance
             )?;
+            if let Some(cables) = &r.cables {
+                writeln!(f, "    {}", cables.command(d.routing_id).text)?;
+            }
         }
         Ok(())
     }

@@ -139,7 +139,8 @@ pub fn reduce_cable_run(
         crate::io::write_atomic(&path, json.as_bytes()).map_err(|e| write_err(format!("writing {}", path.display()), e.to_string()))?;
         planar_map
             .map(|(map, drawings)| {
-                let pictures = write_map_drawn(&dir.join(PLANAR_MAP_DIR), &map, &spec.rod, &drawings)?;
+                let cables = super::MapCables::of_spec(&spec);
+                let pictures = write_map_drawn(&dir.join(PLANAR_MAP_DIR), &map, &spec.rod, &drawings, Some(&cables))?;
                 Ok::<_, ReduceError>((map, pictures))
             })
             .transpose()

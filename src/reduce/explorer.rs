@@ -10,7 +10,7 @@
 //! enough for every value a person reads off the page (the tables keep all).
 
 use super::plots::Picture;
-use super::{MapData, ReduceError, MODES};
+use super::{MapCables, MapData, ReduceError, MODES};
 use crate::model::Rod;
 use crate::plot::BodyDrawing;
 use serde_json::{json, Value};
@@ -40,8 +40,26 @@ fn points(pts: &[(f64, f64)]) -> Value {
     Value::Array(pts.iter().map(|&(x, y)| json!([num(x), num(y)])).collect())
 }
 
-/// The data object the page reads.
-fn data(map: &MapData, actuator: &Rod, shapes: &[Option<BodyDrawing>], pictures: &[Picture], written_utc: &str) -> Value {
+/// Every cable of a design of a several-cable map: `[{y, tension_n, anchor_mm}, …]`.
+fn design_cables(cables: &MapCables, routing_id: i64) -> Value {
+    let actuator = cables.actuator(routing_id);
+    Value::Array(
+        actuator.cables.iter().map(|c| json!({ "y": nums(c.y_mm), "tension_n": num(c.tension_n), "anchor_mm": c.anchor_mm })).collect(),
+    )
+}
+
+/// The data object the page reads. A map of several cables (`cables`) adds
+/// `cables` (their count, one sentence each, what the commands cannot
+/// give) and, per design and mode representative, every cable's routing
+/// and tension and the `cablemap simulate` command that solves it again.
+fn data(
+    map: &MapData,
+    actuator: &Rod,
+    shapes: &[Option<BodyDrawing>],
+    pictures: &[Picture],
+    written_utc: &str,
+    cables: Option<&MapCables>,
+) -> Value {
     let c = &map.cells;
     let nk = c.first().map_or(0, |c| c.coefficients.len());
     let stats: Vec<Value> = (0..nk)
@@ -75,6 +93,10 @@ fn data(map: &MapData, actuator: &Rod, shapes: &[Option<BodyDrawing>], pictures:
                 if !shape.further_cables.is_empty() {
                     rep["further_cables"] = shape.further_cables.iter().map(|c| points(c)).collect();
                 }
+                if let Some(cables) = cables {
+                    rep["cables"] = design_cables(cables, r.routing_id);
+                    rep["command"] = json!(cables.command(r.routing_id).text);
+                }
                 rep
             });
             json!({
@@ -87,7 +109,7 @@ fn data(map: &MapData, actuator: &Rod, shapes: &[Option<BodyDrawing>], pictures:
             })
         })
         .collect();
-    json!({
+    let mut value = json!({
         "summary": map.summary,
         "length_basis_description": map.summary.length_basis.describe(),
         "sparse_note": super::plots::Density::sparse_note(&map.summary, &map.cells),
@@ -113,7 +135,16 @@ fn data(map: &MapData, actuator: &Rod, shapes: &[Option<BodyDrawing>], pictures:
         },
         "modes": modes,
         "mode_count": MODES,
-    })
+    });
+    if let Some(cables) = cables {
+        // The rod and solver are the same for every design: what no flag
+        // gives is said once.
+        let missing = d.first().map(|d| cables.command(d.routing_id).missing).unwrap_or_default();
+        value["cables"] = json!({ "count": cables.count(), "describe": cables.describe(), "command_missing": missing });
+        value["designs"]["cables"] = d.iter().map(|d| design_cables(cables, d.routing_id)).collect();
+        value["designs"]["command"] = d.iter().map(|d| json!(cables.command(d.routing_id).text)).collect();
+    }
+    value
 }
 
 /// The effects whose settings differ from the thesis model's (name, value).
@@ -143,16 +174,17 @@ pub fn utc_now() -> String {
 
 /// Writes `index.html` and `explorer-data.js` into `dir` (each atomically).
 /// `shapes` are the modes' representative bodies (index = mode), `pictures`
-/// the PNGs the page links to.
+/// the PNGs the page links to; `cables` those of a map of several cables.
 pub fn write_explorer(
     dir: &Path,
     map: &MapData,
     actuator: &Rod,
     shapes: &[Option<BodyDrawing>],
     pictures: &[Picture],
+    cables: Option<&MapCables>,
 ) -> Result<(), ReduceError> {
     let write = |name: &str, bytes: &[u8]| super::tables::write_file(&dir.join(name), bytes);
-    let value = data(map, actuator, shapes, pictures, &utc_now());
+    let value = data(map, actuator, shapes, pictures, &utc_now(), cables);
     let script = format!("// Written by `cablemap reduce`: the map explorer's data (index.html).\nwindow.CABLEMAP_MAP = {value};\n");
     write(DATA_FILE, script.as_bytes())?;
     write("index.html", PAGE.as_bytes())

@@ -29,6 +29,7 @@ pub mod drawings;
 pub mod explorer;
 mod fetch;
 mod grid;
+pub mod map_cables;
 mod mirror;
 mod modes;
 pub mod output;
@@ -48,6 +49,7 @@ use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
+pub use map_cables::{design_actuation, MapCables};
 pub use output::{check_map_out, write_map, write_map_replacing};
 
 /// Number of characteristic modes: a_0 in 4 ranges × a_1 in 3.
@@ -249,6 +251,17 @@ pub enum ReduceError {
     /// The parts of a split reduction do not make one map.
     #[error("{0}")]
     Parts(#[from] parts::PartsError),
+    /// A several-cable map's cable spec ([`map_cables::CABLES_FILE`]) cannot be read.
+    #[error(
+        "reading {}: {source} (`cablemap reduce` writes it beside the tables of a map of several cables: reduce the run again)",
+        path.display()
+    )]
+    CablesFile {
+        /// The file.
+        path: PathBuf,
+        /// Why it cannot be read or parsed.
+        source: Box<dyn std::error::Error + Send + Sync>,
+    },
 }
 
 /// What the reducer needs to know about the run it reads.

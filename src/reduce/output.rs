@@ -3,7 +3,7 @@
 
 use super::drawings::ModeDrawings;
 use super::plots::{self, draw_heatmap, Picture, Scale};
-use super::{explorer, tables, CoefficientStats, MapData, ReduceError, COEFFICIENT_UNIT};
+use super::{explorer, tables, CoefficientStats, MapCables, MapData, ReduceError, COEFFICIENT_UNIT};
 use std::path::Path;
 
 /// Writes the map directory `dir` as a whole: everything is written into a
@@ -105,21 +105,27 @@ pub fn write_map(
     actuator: &crate::model::Rod,
     solver: &crate::model::SolverOptions,
 ) -> Result<Vec<Picture>, ReduceError> {
-    write_map_drawn(dir, map, actuator, &ModeDrawings::of_map(map, actuator, solver))
+    write_map_drawn(dir, map, actuator, &ModeDrawings::of_map(map, actuator, solver), None)
 }
 
 /// [`write_map`] with the mode representatives' bodies already drawn (a
-/// cable sweep draws them with the solver of several cables).
+/// cable sweep draws them with the solver of several cables). A map of
+/// several cables (`cables`) also gets their spec ([`MapCables`]), and its
+/// captions, page and designs show every cable.
 pub fn write_map_drawn(
     dir: &Path,
     map: &MapData,
     actuator: &crate::model::Rod,
     drawings: &ModeDrawings,
+    cables: Option<&MapCables>,
 ) -> Result<Vec<Picture>, ReduceError> {
     std::fs::create_dir_all(dir).map_err(|source| ReduceError::CreateDir { path: dir.to_path_buf(), source })?;
     tables::write_tables(dir, map)?;
+    if let Some(cables) = cables {
+        cables.write(dir)?;
+    }
     let mut pictures = coefficient_pictures(dir, map)?;
-    plots::draw_modes(&dir.join("modes.png"), map, &drawings.shapes)?;
+    plots::draw_modes(&dir.join("modes.png"), map, &drawings.shapes, cables)?;
     pictures.push(Picture {
         file: "modes.png".into(),
         title: "Characteristic modes (thesis Fig. 4.4)".into(),
@@ -129,7 +135,7 @@ pub fn write_map_drawn(
             drawings.failure_note()
         ),
     });
-    explorer::write_explorer(dir, map, actuator, &drawings.shapes, &pictures)?;
+    explorer::write_explorer(dir, map, actuator, &drawings.shapes, &pictures, cables)?;
     Ok(pictures)
 }
 

@@ -502,8 +502,15 @@ impl ModesLayout {
 /// colour scale. Each mode's representative shape is drawn as a thumbnail
 /// beside its map, on its own mm axes: drawn over the map it would hide
 /// the very cells it explains (its tip lies in them, and a long body such
-/// as the tentacle crosses much of its reach). Returns the image size.
-pub fn draw_modes(path: &Path, map: &MapData, shapes: &[Option<BodyDrawing>]) -> Result<(u32, u32), PlotError> {
+/// as the tentacle crosses much of its reach). A map of several cables
+/// (`cables`) captions each shape with every cable's tension. Returns the
+/// image size.
+pub fn draw_modes(
+    path: &Path,
+    map: &MapData,
+    shapes: &[Option<BodyDrawing>],
+    cables: Option<&super::MapCables>,
+) -> Result<(u32, u32), PlotError> {
     register_fonts();
     let layout = ModesLayout::of(&map.summary);
     let frame = MapFrame::of(&map.summary);
@@ -542,7 +549,10 @@ pub fn draw_modes(path: &Path, map: &MapData, shapes: &[Option<BodyDrawing>]) ->
         title
             .draw(&Text::new(format!("mode {m}  (n = {})", mode.count), (10, 4), (FONT, 17)))
             .map_err(|e| PlotError::new(path, e))?;
-        let tension = mode.representative.as_ref().map_or(String::new(), |r| format!(", shape at τ = {:.2} N", r.tension_n));
+        let tension = mode.representative.as_ref().map_or(String::new(), |r| {
+            let tensions = cables.map_or_else(|| format!("{:.2} N", r.tension_n), |c| c.tensions_text(r.routing_id));
+            format!(", shape at τ = {tensions}")
+        });
         title
             .draw(&Text::new(format!("a0 {}, a1 {}{tension}", fmt(mode.a0_bounds), fmt(mode.a1_bounds)), (10, 25), (FONT, 13)))
             .map_err(|e| PlotError::new(path, e))?;
@@ -678,7 +688,7 @@ pub(crate) mod tests {
         shapes[0] = Some(crate::plot::tests::hanging(Vec::new(), body_colour));
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("modes.png");
-        draw_modes(&path, &map, &shapes).unwrap();
+        draw_modes(&path, &map, &shapes, None).unwrap();
         let img = image::open(&path).unwrap().to_rgb8();
         let cell_colour = colour(2f64.log10(), (0.0, 2f64.log10()), Scale::Log);
         let ((x0, x1), (y0, y1)) = bounding_box(&pixels_of(&img, cell_colour, MODES_BAR_H));

@@ -53,8 +53,9 @@ use sha2::{Digest, Sha256};
 use std::path::Path;
 use std::sync::Arc;
 
-/// Format tag of cable sweep runs (manifest and chunk footers).
-pub const CABLES_FORMAT: &str = "cablemap-cables/1";
+/// Format tag of cable sweep runs (manifest and chunk footers;
+/// [`crate::io::run_markers::CABLES_FORMAT`], where every run kind's tag is kept).
+pub const CABLES_FORMAT: &str = crate::io::run_markers::CABLES_FORMAT;
 /// Most values in one tension grid.
 pub const MAX_TENSION_COUNT: u32 = 10_000;
 /// Status of rows whose routing was rejected (e.g. two cables on one path).

@@ -38,14 +38,13 @@ use std::collections::BTreeMap;
 use std::fs::File;
 use std::path::{Path, PathBuf};
 
-/// Format tag of manifests and chunk files. Version 2: the a_i columns are
-/// in the basis the manifest names (`length_basis`, the thesis's rest-length
-/// basis by default); version 1 runs had deformed-length a_i and no such field.
-pub const FORMAT: &str = "cablemap-sweep/2";
+/// Format tag of planar manifests and chunk files
+/// ([`crate::io::run_markers::PLANAR_FORMAT`], where every run kind's tag is kept).
+pub const FORMAT: &str = crate::io::run_markers::PLANAR_FORMAT;
 /// Version of the tool writing the files.
 pub const TOOL_VERSION: &str = env!("CARGO_PKG_VERSION");
-/// Manifest file name in DIR.
-pub const MANIFEST: &str = "manifest.json";
+/// Manifest file name in DIR ([`crate::io::run_markers::MANIFEST`]).
+pub const MANIFEST: &str = crate::io::run_markers::MANIFEST;
 /// Folder of chunk files in DIR (only Parquet chunks live there, so any
 /// Parquet reader can read the folder as one dataset).
 pub const SHARDS_DIR: &str = "shards";
@@ -305,7 +304,7 @@ impl RunDir {
                     .ok()
                     .and_then(|v| v.get("format").and_then(|f| f.as_str()).map(str::to_string));
                 return Err(match format {
-                    Some(f) if f != S::FORMAT && [FORMAT, super::cables::CABLES_FORMAT].contains(&f.as_str()) => {
+                    Some(f) if f != S::FORMAT && crate::io::run_markers::FORMATS.contains(&f.as_str()) => {
                         SweepError::OtherKind { dir: self.root.clone(), found: f, wanted: S::FORMAT.into() }
                     }
                     _ => SweepError::CorruptManifest { path, message: e.to_string() },

@@ -9,7 +9,9 @@ failure.
 """
 
 import json
+import math
 import re
+import shlex
 import subprocess
 import sys
 import tempfile
@@ -30,6 +32,12 @@ screenshot = Path(sys.argv[3])
 
 cells = pd.read_parquet(map_dir / "cells.parquet")
 designs = pd.read_parquet(map_dir / "designs.parquet")
+# The planar map of a cable sweep sits in the cable map's folder, whose
+# summary says how many cables the actuator has: its page shows every cable.
+parent_summary = map_dir.parent / "summary.json"
+cable_map = json.loads(parent_summary.read_text()) if parent_summary.exists() else {}
+several = cable_map.get("kind") == "cables"
+n_cables = cable_map.get("cables", 1)
 
 options = webdriver.ChromeOptions()
 options.binary_location = "/usr/bin/chromium"
@@ -65,6 +73,9 @@ def check_loads():
     assert "L = 65 mm" in header and "EI = 115.117" in header, header
     assert "per unit rest length" in header, header
     assert f"{summary['tension_range_n'][0]}" in header
+    if several:
+        assert f"{n_cables} cables, each with its own routing and tension" in header, header
+        assert "cable 2:" in header, header
     # Equal aspect: the main map's drawn height over width equals the mm extents'.
     ratio = driver.execute_script(
         "const c = document.getElementById('map-main'); return [c.clientWidth, c.clientHeight];")
@@ -102,9 +113,25 @@ def check_click():
         assert int(driver.find_element(By.ID, "designs-count").text) == len(want) > 0
         rows = driver.find_elements(By.CSS_SELECTOR, "#designs tr.design-row")
         assert len(rows) == len(want)
-        # Routings are shown as pasteable --routing arguments.
-        first = rows[0].find_elements(By.TAG_NAME, "td")[1].text
-        assert first.startswith("--routing ") and len(first.split()[1].split(",")) == 5, first
+        if not several:
+            # Routings are shown as pasteable --routing arguments.
+            first = rows[0].find_elements(By.TAG_NAME, "td")[1].text
+            assert first.startswith("--routing ") and len(first.split()[1].split(",")) == 5, first
+            continue
+        # Every cable's routing and tension, and a command that solves the row again to its tip.
+        cells_of_first = rows[0].find_elements(By.TAG_NAME, "td")
+        assert len(cells_of_first) == 1 + 2 * n_cables + 1 + len([c for c in designs.columns if re.fullmatch(r"a\d+", c)])
+        for k in range(n_cables):
+            assert len(cells_of_first[1 + 2 * k].text.split(",")) == 5, cells_of_first[1 + 2 * k].text
+        commands = driver.find_elements(By.CSS_SELECTOR, "#designs tr.design-command code.command")
+        assert len(commands) == len(want)
+        for command, (_, design) in list(zip(commands, want.iterrows()))[:2]:
+            words = shlex.split(command.text)
+            assert words[:2] == ["cablemap", "simulate"] and words.count("--cable") == n_cables, words
+            out = subprocess.run([binary] + words[1:] + ["--json"], check=True, capture_output=True, text=True)
+            tip = json.loads(out.stdout)
+            gap = math.hypot(tip["tip_x_mm"] - design["tip_x_mm"], tip["tip_y_mm"] - design["tip_y_mm"])
+            assert gap < 1e-3, (command.text, gap)
 
 
 def feasible_cli(target):

@@ -1,8 +1,9 @@
 //! What a spatial simulation writes: the `--cable` text form of a cable, the
-//! JSON record, the text report and the 3-D centreline CSV (this module owns
-//! those formats; docs/schema.md describes them).
+//! `cablemap simulate` command of an actuator, the JSON record, the text
+//! report and the 3-D centreline CSV (this module owns those formats;
+//! docs/schema.md describes them).
 
-use super::{Cable, SpatialError, SpatialSimulation};
+use super::{Actuator, Cable, SpatialError, SpatialOptions, SpatialSimulation};
 use crate::model::routing::CONTROL_POINTS;
 use crate::model::STATUS_OK;
 use serde_json::json;
@@ -54,6 +55,91 @@ impl std::str::FromStr for Cable {
         let tension_n = tension.ok_or_else(|| bad("tension= is missing".into()))?;
         Ok(Cable { y_mm, z_mm: z.unwrap_or([0.0; CONTROL_POINTS]), tension_n, anchor_mm: anchor })
     }
+}
+
+/// The `--cable` form that [`Cable`]'s `FromStr` reads back to the same
+/// cable bit for bit: `y=…` always, `z=…` only when out of plane, then
+/// `tension=…` and `anchor=…` when knotted before the tip. Numbers are
+/// Rust's shortest round-trip form.
+impl std::fmt::Display for Cable {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let list = |v: &[f64]| v.iter().map(|x| format!("{x}")).collect::<Vec<_>>().join(",");
+        write!(f, "y={}", list(&self.y_mm))?;
+        if !self.is_planar() {
+            write!(f, " z={}", list(&self.z_mm))?;
+        }
+        write!(f, " tension={}", self.tension_n)?;
+        if let Some(anchor) = self.anchor_mm {
+            write!(f, " anchor={anchor}")?;
+        }
+        Ok(())
+    }
+}
+
+/// A `cablemap simulate` command line that solves an actuator again, and
+/// what of it no flag can give.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SimulateCommand {
+    /// `cablemap simulate [rod flags] --cable "…" …`, ready to paste into a
+    /// POSIX shell.
+    pub text: String,
+    /// Settings of the actuator or solver that differ from the defaults but
+    /// have no flag (`gj_n_mm2 = 80`, …): the command solves with the default
+    /// instead. Empty when the command reproduces the actuator exactly.
+    pub missing: Vec<String>,
+}
+
+/// The `cablemap simulate` command of `actuator` solved with `options`:
+/// a flag for each rod parameter that differs from the thesis's rod (the
+/// defaults of `simulate`), `--gravity-direction`, `--steps-per-span`, and one
+/// `--cable` per cable. Only what the 3-D solver models is written: it
+/// refuses the planar solver's effects and bodies, so they are never set on
+/// an actuator it solved.
+pub fn simulate_command(actuator: &Actuator, options: &SpatialOptions) -> SimulateCommand {
+    let rod = &actuator.rod;
+    let thesis = crate::model::Rod::default();
+    let mut flags: Vec<String> = Vec::new();
+    let mut missing = Vec::new();
+    for (flag, value, default) in [
+        ("--length-mm", rod.length_mm, thesis.length_mm),
+        ("--radius-mm", rod.radius_mm, thesis.radius_mm),
+        ("--ea-n", rod.ea_n, thesis.ea_n),
+        ("--ga-n", rod.ga_n, thesis.ga_n),
+        ("--ei-n-mm2", rod.ei_n_mm2, thesis.ei_n_mm2),
+        ("--density-g-cm3", rod.density_g_cm3, thesis.density_g_cm3),
+        ("--gravity-direction-rad", rod.gravity.direction_rad, thesis.gravity.direction_rad),
+        ("--gravity-scale", rod.gravity.scale, thesis.gravity.scale),
+    ] {
+        if value != default {
+            flags.push(format!("{flag} {value}"));
+        }
+    }
+    if !rod.gravity.enabled {
+        flags.push("--no-gravity".into());
+    }
+    if rod.gravity.g_m_s2 != thesis.gravity.g_m_s2 {
+        missing.push(format!("gravity.g_m_s2 = {}", rod.gravity.g_m_s2));
+    }
+    if let Some(gj) = actuator.gj_n_mm2 {
+        missing.push(format!("gj_n_mm2 = {gj}"));
+    }
+    if let Some(g) = actuator.gravity_direction {
+        flags.push(format!("--gravity-direction {},{},{}", g[0], g[1], g[2]));
+    }
+    let solver = SpatialOptions::default();
+    if options.steps_per_span != solver.steps_per_span {
+        flags.push(format!("--steps-per-span {}", options.steps_per_span));
+    }
+    if options.moment_tolerance_n_mm != solver.moment_tolerance_n_mm {
+        missing.push(format!("solver.moment_tolerance_n_mm = {}", options.moment_tolerance_n_mm));
+    }
+    if options.max_passes != solver.max_passes {
+        missing.push(format!("solver.max_passes = {}", options.max_passes));
+    }
+    // The cable text holds only digits, signs, '.', ',', '=', 'e' and spaces:
+    // double quotes keep it one shell word.
+    flags.extend(actuator.cables.iter().map(|c| format!("--cable \"{c}\"")));
+    SimulateCommand { text: format!("cablemap simulate {}", flags.join(" ")), missing }
 }
 
 /// The JSON object of a spatial simulation (names in docs/schema.md). Keys
@@ -198,5 +284,31 @@ mod tests {
             assert!(e.contains(needle), "{text}: {e}");
             assert!(e.contains("cable \""), "{e}");
         }
+    }
+
+    #[test]
+    fn a_cables_text_form_reads_back_to_the_same_cable() {
+        for c in [
+            Cable::planar([3.0, 1.0, 2.5, 1.0, 3.0], 1.8000000000000003),
+            Cable { y_mm: [0.1, -0.2, 0.3, 1e-7, 4.0], z_mm: [0.0, 1.0, -1.5, 0.0, 2.0], tension_n: 0.6, anchor_mm: Some(40.25) },
+        ] {
+            assert_eq!(c.to_string().parse::<Cable>().unwrap(), c, "{c}");
+        }
+        assert_eq!(Cable::planar([3.0, 1.0, 1.0, 1.0, 3.0], 1.8).to_string(), "y=3,1,1,1,3 tension=1.8");
+    }
+
+    #[test]
+    fn the_simulate_command_gives_what_differs_from_the_thesis_rod() {
+        let mut a = Actuator::with_cables(crate::model::Rod::default(), vec![Cable::planar([3.0; 5], 1.0), Cable::planar([-3.0; 5], 0.5)]);
+        let plain = simulate_command(&a, &SpatialOptions::default());
+        assert_eq!(plain.text, r#"cablemap simulate --cable "y=3,3,3,3,3 tension=1" --cable "y=-3,-3,-3,-3,-3 tension=0.5""#);
+        assert!(plain.missing.is_empty());
+        a.rod.ei_n_mm2 = 90.5;
+        a.rod.gravity.enabled = false;
+        a.gj_n_mm2 = Some(80.0);
+        let options = SpatialOptions { steps_per_span: 16, ..SpatialOptions::default() };
+        let c = simulate_command(&a, &options);
+        assert!(c.text.starts_with("cablemap simulate --ei-n-mm2 90.5 --no-gravity --steps-per-span 16 --cable "), "{}", c.text);
+        assert_eq!(c.missing, ["gj_n_mm2 = 80"]);
     }
 }
