@@ -50,6 +50,11 @@ pub struct DiagnoseArgs {
 
 /// Runs `cablemap diagnose`.
 pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
+    // A report directory inside a run is refused before the data are read.
+    if let (false, Some(out)) = (args.no_report, &args.out) {
+        cablemap::io::check_not_in_run_dir(out, "the report directory")
+            .map_err(|message| anyhow::Error::new(CalibrateError::ReportDir { message }).context("--out"))?;
+    }
     let data = read_measurements(&args.data)?;
     let request = DiagnoseRequest {
         data_path: args.data.clone(),

@@ -246,7 +246,8 @@ pub fn check(map: &MapDir, target: &Target, basis: LengthBasis, weights: &Weight
         mode,
         nearest: map.nearest_designs(target, weights, nearest)?,
         length_basis: map.summary.length_basis,
-        cables: crate::reduce::MapCables::open(&map.path)?,
+        cables: crate::reduce::MapCables::open(&map.path)
+            .map_err(|e| DesignError::Map { path: map.path.display().to_string(), message: e.to_string() })?,
     })
 }
 

@@ -1,4 +1,10 @@
-//! Numerical methods shared by several layers: the bounded
-//! Levenberg–Marquardt minimiser of calibrate's fits and design's search.
+//! Numerical methods shared by several layers: the one classical RK4 step
+//! of the integrators along the rod ([`rk4`]) and the bounded
+//! Levenberg–Marquardt minimiser of calibrate's fits and design's search
+//! ([`lm`]). Linear algebra is nalgebra's and Legendre polynomials are
+//! [`crate::shape`]'s.
 
 pub mod lm;
+pub mod rk4;
+
+pub use rk4::{rk4_step, Rk4Scratch};

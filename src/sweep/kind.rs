@@ -162,10 +162,4 @@ mod tests {
         assert_eq!(l.shard_chunks(1, 2).collect::<Vec<_>>(), vec![1]);
     }
 
-    #[test]
-    fn every_run_format_is_one_io_recognises_as_a_run() {
-        for format in [super::super::store::FORMAT, super::super::cables::CABLES_FORMAT] {
-            assert!(crate::io::RUN_FORMAT_PREFIXES.iter().any(|p| format.starts_with(p)), "{format}");
-        }
-    }
 }

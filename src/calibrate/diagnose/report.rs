@@ -219,24 +219,13 @@ pub fn next_step(fit: &FitResult) -> String {
     }
     let mut effects = String::new();
     for e in &fit.effects {
-        let fx = &a.effects;
-        // (flag, spec key, value); gravity's scale lives in [actuator.gravity].
-        let (flag, key, value) = match e {
-            Effect::Friction => ("--friction-mu", "friction_mu", fx.friction_mu),
-            Effect::Gravity => ("--gravity-scale", "scale", a.gravity.scale),
-            Effect::Stiffening => ("--stiffening-alpha", "stiffening_alpha", fx.stiffening_alpha),
-            Effect::ClampCompliance => {
-                ("--clamp-stiffness-n-mm-per-rad", "clamp_stiffness_n_mm_per_rad", fx.clamp_stiffness_n_mm_per_rad.unwrap_or(f64::INFINITY))
-            }
-            Effect::ChannelOffset => ("--channel-offset-mm", "channel_offset_mm", fx.channel_offset_mm),
-            Effect::Creep => ("--creep-fraction", "creep_fraction", fx.creep_fraction),
-            Effect::StiffnessGradient => ("--stiffness-gradient-beta", "stiffness_gradient_beta", fx.stiffness_gradient_beta),
-        };
-        flags.push(format!("{flag} {}", sig5(value)));
-        if *e == Effect::Gravity {
-            toml.push_str(&format!("[actuator.gravity]\n{key} = {}\n", sig5(value)));
-        } else {
-            effects.push_str(&format!("{key} = {}\n", sig5(value)));
+        // The flag, spec key and table from the effect's registry entry.
+        let info = e.info();
+        let value = (info.get)(a);
+        flags.push(format!("{} {}", info.flag, sig5(value)));
+        match info.section {
+            crate::model::effects::Section::Effects => effects.push_str(&format!("{} = {}\n", info.key, sig5(value))),
+            section => toml.push_str(&format!("[actuator.{}]\n{} = {}\n", section.key(), info.key, sig5(value))),
         }
     }
     if !effects.is_empty() {
