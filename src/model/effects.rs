@@ -166,8 +166,7 @@ impl Unmodelled {
     }
 }
 
-/// The solver backends each entry lists as modelling it.
-pub use crate::model::solver::Backend as BackendKind;
+use crate::model::solver::Backend;
 
 /// The table of the rod a parameter sits in (`[actuator.effects]`,
 /// `[actuator.gravity]` in a sweep spec; `[rod.…]` in a cable spec).
@@ -309,7 +308,7 @@ pub struct EffectInfo {
     /// How calibrate and diagnose fit it; `None`: not a fit candidate.
     pub fit: Option<Fit>,
     /// The backends that model it.
-    pub backends: &'static [BackendKind],
+    pub backends: &'static [Backend],
     /// The parameter it qualifies (creep's time constant acts only when
     /// creep's fraction does); `None` for a main parameter.
     pub qualifies: Option<&'static EffectInfo>,
@@ -319,8 +318,8 @@ pub struct EffectInfo {
     pub set: fn(&mut Rod, f64),
 }
 
-const ALL_BACKENDS: &[BackendKind] = &BackendKind::ALL;
-const PLANAR: &[BackendKind] = &[BackendKind::PlanarCollocation, BackendKind::PlanarRk4];
+const ALL_BACKENDS: &[Backend] = &Backend::ALL;
+const PLANAR: &[Backend] = &[Backend::PlanarCollocation, Backend::PlanarRk4];
 
 fn always_on(_: &Rod) -> bool {
     true
@@ -616,7 +615,7 @@ impl EffectInfo {
     }
 
     /// Whether `backend` models the parameter.
-    pub fn supported_by(&self, backend: BackendKind) -> bool {
+    pub fn supported_by(&self, backend: Backend) -> bool {
         self.backends.contains(&backend)
     }
 
@@ -679,7 +678,7 @@ pub fn fittable() -> impl Iterator<Item = (&'static EffectInfo, &'static Fit)> {
 /// The first effect acting on `rod` that `backend` does not model, `None`
 /// when it models all of them: the solvers' one capability check for
 /// effects. [`EffectInfo::backends`] names the backends that would serve it.
-pub fn unsupported_by(backend: BackendKind, rod: &Rod) -> Option<&'static EffectInfo> {
+pub fn unsupported_by(backend: Backend, rod: &Rod) -> Option<&'static EffectInfo> {
     REGISTRY.iter().copied().find(|e| !e.supported_by(backend) && e.acts(rod))
 }
 
@@ -722,19 +721,19 @@ mod tests {
     #[test]
     fn the_spatial_backend_refuses_each_planar_effect_and_a_qualifier_alone_does_not_act() {
         let mut a = Rod::default();
-        assert!(BackendKind::ALL.iter().all(|&b| unsupported_by(b, &a).is_none()));
+        assert!(Backend::ALL.iter().all(|&b| unsupported_by(b, &a).is_none()));
         a.effects.creep_time_s = 3.0;
         a.effects.creep_hold_s = 5.0;
-        assert!(unsupported_by(BackendKind::Spatial, &a).is_none(), "creep's time and hold act only with a creep fraction");
+        assert!(unsupported_by(Backend::Spatial, &a).is_none(), "creep's time and hold act only with a creep fraction");
         a.effects.creep_fraction = 0.2;
-        assert_eq!(unsupported_by(BackendKind::Spatial, &a).map(|e| e.key), Some("creep_fraction"));
-        assert!(unsupported_by(BackendKind::PlanarRk4, &a).is_none());
+        assert_eq!(unsupported_by(Backend::Spatial, &a).map(|e| e.key), Some("creep_fraction"));
+        assert!(unsupported_by(Backend::PlanarRk4, &a).is_none());
         let mut b = Rod::default();
         b.effects.clamp_stiffness_n_mm_per_rad = Some(40.0);
-        assert_eq!(unsupported_by(BackendKind::Spatial, &b).map(|e| e.key), Some("clamp_stiffness_n_mm_per_rad"));
+        assert_eq!(unsupported_by(Backend::Spatial, &b).map(|e| e.key), Some("clamp_stiffness_n_mm_per_rad"));
         b = Rod::default();
         b.gravity.scale = 2.0;
-        assert!(unsupported_by(BackendKind::Spatial, &b).is_none());
+        assert!(unsupported_by(Backend::Spatial, &b).is_none());
     }
 
     #[test]

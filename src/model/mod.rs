@@ -17,7 +17,7 @@ pub use body::{Body, BodyError, Segment};
 pub use actuator::Actuator;
 pub use cable::{Cable, MAX_CABLES};
 pub use rod::{Rod, Effects, Gravity, LoadDirection, ParameterError, Unmodelled};
-pub use effects::{BackendKind, EffectInfo, REGISTRY};
+pub use effects::{EffectInfo, REGISTRY};
 pub use routing::{ControlPoints, Routing, RoutingError};
 pub use solver::{Backend, Given, Unsupported};
 pub use solver::{simulate, simulate_held, CentrelinePoint, Hold, SimulateError, Simulation, Simulator, SolveFailure, SolverMethod, SolverOptions, TipPose, Unresolved, STATUS_OK};
