@@ -62,13 +62,18 @@ impl Actuator {
         Ok(g.map(|c| c / n))
     }
 
-    /// Checks everything for the spatial solver (the cable sweep's and
-    /// [`crate::model::spatial::SpatialSolver`]'s input): the actuator
-    /// ([`Actuator::channels`]) and that the spatial backend models it
-    /// ([`Backend::check`]); builds the cables' channels.
+    /// [`Actuator::validate_for`] the 3-D solver (collocation), which serves
+    /// every actuator the spatial RK4 reference does and more.
     pub fn validate(&self) -> Result<Vec<cable::Channel>, SpatialError> {
+        self.validate_for(Backend::Spatial)
+    }
+
+    /// Checks everything for a 3-D solver: the actuator
+    /// ([`Actuator::channels`]) and that `backend` models it
+    /// ([`Backend::check`]); builds the cables' channels.
+    pub fn validate_for(&self, backend: Backend) -> Result<Vec<cable::Channel>, SpatialError> {
         let channels = self.channels()?;
-        Backend::Spatial.check(self, &SolverOptions::default(), Given::default())?;
+        backend.check(self, &SolverOptions::default(), Given::default())?;
         Ok(channels)
     }
 

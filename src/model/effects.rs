@@ -319,7 +319,9 @@ pub struct EffectInfo {
 }
 
 const ALL_BACKENDS: &[Backend] = &Backend::ALL;
-const PLANAR: &[Backend] = &[Backend::PlanarCollocation, Backend::PlanarRk4];
+/// The collocation and planar backends: every effect's term is in each of
+/// them; the 3-D RK4 reference models the thesis's rod without effects.
+const MODELLING_EFFECTS: &[Backend] = &[Backend::PlanarCollocation, Backend::PlanarRk4, Backend::Spatial];
 
 fn always_on(_: &Rod) -> bool {
     true
@@ -402,7 +404,7 @@ pub static STIFFENING: EffectInfo = EffectInfo {
     value_name: "ALPHA",
     help: "Material stiffening α: moment EI·u·(1 + α (r u)²)",
     fit: Some(Fit::new("stiffening", 0.2, Domain::Positive, (0.0, 100.0), "0 < α ≤ 100")),
-    backends: PLANAR,
+    backends: MODELLING_EFFECTS,
     qualifies: None,
     get: |a| a.effects.stiffening_alpha,
     set: |a, v| a.effects.stiffening_alpha = v,
@@ -426,7 +428,7 @@ pub static CLAMP_COMPLIANCE: EffectInfo = EffectInfo {
     value_name: "N_MM_PER_RAD",
     help: "Clamp rotational stiffness k_θ, N·mm/rad: the effect `clamp_compliance` (`--clamp-stiffness` is the old name)",
     fit: Some(Fit::new("clamp_compliance", 300.0, Domain::Positive, (1.0, 1e5), "1 ≤ k_θ ≤ 1e5 N·mm/rad")),
-    backends: PLANAR,
+    backends: MODELLING_EFFECTS,
     qualifies: None,
     get: |a| a.effects.clamp_stiffness_n_mm_per_rad.unwrap_or(f64::INFINITY),
     set: |a, v| a.effects.clamp_stiffness_n_mm_per_rad = (v != f64::INFINITY).then_some(v),
@@ -450,7 +452,7 @@ pub static CHANNEL_OFFSET: EffectInfo = EffectInfo {
     value_name: "MM",
     help: "Channel offset δ added to every y_i, mm",
     fit: Some(Fit::new("channel_offset", 0.0, Domain::Signed, (-2.0, 2.0), "|δ| ≤ 2 mm")),
-    backends: PLANAR,
+    backends: MODELLING_EFFECTS,
     qualifies: None,
     get: |a| a.effects.channel_offset_mm,
     set: |a, v| a.effects.channel_offset_mm = v,
@@ -474,7 +476,7 @@ pub static STIFFNESS_GRADIENT: EffectInfo = EffectInfo {
     value_name: "BETA",
     help: "Stiffness gradient β: EI(s) = EI·exp(β (s/L − ½)), β = ln(EI(L)/EI(0))",
     fit: Some(Fit::new("stiffness_gradient", 0.0, Domain::Signed, (-5.0, 5.0), "|β| ≤ 5 (EI(L)/EI(0) between 1/150 and 150)")),
-    backends: PLANAR,
+    backends: MODELLING_EFFECTS,
     qualifies: None,
     get: |a| a.effects.stiffness_gradient_beta,
     set: |a, v| a.effects.stiffness_gradient_beta = v,
@@ -498,7 +500,7 @@ pub static FRICTION: EffectInfo = EffectInfo {
     value_name: "MU",
     help: "Cable–channel friction coefficient μ (capstan law)",
     fit: Some(Fit::new("friction", 0.02, Domain::Positive, (0.0, 1.0), "0 < μ ≤ 1")),
-    backends: PLANAR,
+    backends: MODELLING_EFFECTS,
     qualifies: None,
     get: |a| a.effects.friction_mu,
     set: |a, v| a.effects.friction_mu = v,
@@ -527,7 +529,7 @@ pub static CREEP_FRACTION: EffectInfo = EffectInfo {
     value_name: "F",
     help: "Creep: fraction f of the bending rigidity that relaxes (0 ≤ f < 1)",
     fit: Some(Fit::new("creep", 0.05, Domain::Fraction, (0.0, 0.9), "0 < f ≤ 0.9")),
-    backends: PLANAR,
+    backends: MODELLING_EFFECTS,
     qualifies: None,
     get: |a| a.effects.creep_fraction,
     set: |a, v| a.effects.creep_fraction = v,
@@ -551,7 +553,7 @@ pub static CREEP_TIME: EffectInfo = EffectInfo {
     value_name: "S",
     help: "Creep time constant T, s",
     fit: None,
-    backends: PLANAR,
+    backends: MODELLING_EFFECTS,
     qualifies: Some(&CREEP_FRACTION),
     get: |a| a.effects.creep_time_s,
     set: |a, v| a.effects.creep_time_s = v,
@@ -575,7 +577,7 @@ pub static CREEP_HOLD: EffectInfo = EffectInfo {
     value_name: "S",
     help: "Creep: seconds each tension is held on a fresh rod in sweeps and design",
     fit: None,
-    backends: PLANAR,
+    backends: MODELLING_EFFECTS,
     qualifies: Some(&CREEP_FRACTION),
     get: |a| a.effects.creep_hold_s,
     set: |a, v| a.effects.creep_hold_s = v,
@@ -719,21 +721,23 @@ mod tests {
     }
 
     #[test]
-    fn the_spatial_backend_refuses_each_planar_effect_and_a_qualifier_alone_does_not_act() {
+    fn the_spatial_rk4_reference_refuses_each_effect_and_a_qualifier_alone_does_not_act() {
         let mut a = Rod::default();
         assert!(Backend::ALL.iter().all(|&b| unsupported_by(b, &a).is_none()));
         a.effects.creep_time_s = 3.0;
         a.effects.creep_hold_s = 5.0;
-        assert!(unsupported_by(Backend::Spatial, &a).is_none(), "creep's time and hold act only with a creep fraction");
+        assert!(unsupported_by(Backend::SpatialRk4, &a).is_none(), "creep's time and hold act only with a creep fraction");
         a.effects.creep_fraction = 0.2;
-        assert_eq!(unsupported_by(Backend::Spatial, &a).map(|e| e.key), Some("creep_fraction"));
+        assert_eq!(unsupported_by(Backend::SpatialRk4, &a).map(|e| e.key), Some("creep_fraction"));
         assert!(unsupported_by(Backend::PlanarRk4, &a).is_none());
+        assert!(unsupported_by(Backend::Spatial, &a).is_none());
         let mut b = Rod::default();
         b.effects.clamp_stiffness_n_mm_per_rad = Some(40.0);
-        assert_eq!(unsupported_by(Backend::Spatial, &b).map(|e| e.key), Some("clamp_stiffness_n_mm_per_rad"));
+        assert_eq!(unsupported_by(Backend::SpatialRk4, &b).map(|e| e.key), Some("clamp_stiffness_n_mm_per_rad"));
+        assert!(unsupported_by(Backend::Spatial, &b).is_none());
         b = Rod::default();
         b.gravity.scale = 2.0;
-        assert!(unsupported_by(Backend::Spatial, &b).is_none());
+        assert!(unsupported_by(Backend::SpatialRk4, &b).is_none());
     }
 
     #[test]

@@ -54,10 +54,10 @@ use crate::shape::LengthBasis;
 use serde::{Deserialize, Serialize};
 
 pub mod backend;
-mod collocation;
+pub(crate) mod collocation;
 mod continuation;
-mod creep;
-mod friction;
+pub(crate) mod creep;
+pub(crate) mod friction;
 mod probe;
 mod rk4;
 

@@ -9,9 +9,12 @@
 //!   with z ≡ 0 — with every effect, tapered and segmented bodies and anchors;
 //! - [`Backend::PlanarRk4`], the planar reference: classical RK4 with
 //!   shooting (`rk4`), the same model with the cable knotted at the tip;
-//! - [`Backend::Spatial`], the 3-D solver (`crate::model::spatial`): several
-//!   cables, out-of-plane channels and gravity, on the thesis's uniform rod
-//!   without effects.
+//! - [`Backend::Spatial`], the 3-D solver (`crate::model::spatial::collocation`):
+//!   several cables, out-of-plane channels and gravity, spectral collocation
+//!   with every effect, tapered and segmented bodies and anchors;
+//! - [`Backend::SpatialRk4`], the 3-D reference: RK4 along s with Broyden on
+//!   gravity's moment (`crate::model::spatial::solver`), the thesis's uniform
+//!   rod without effects (`--method rk4` with several or spatial cables).
 //!
 //! What a request needs is listed once ([`needs`]) and what a backend
 //! models once ([`Backend::support`]); the check compares the two, so a
@@ -28,8 +31,11 @@ pub enum Backend {
     PlanarCollocation,
     /// Planar classical RK4 with shooting (`--method rk4`), the reference.
     PlanarRk4,
-    /// The 3-D solver: several and out-of-plane cables, gravity in any direction.
+    /// The 3-D solver: several and out-of-plane cables, gravity in any
+    /// direction, by spectral collocation (the default for such actuators).
     Spatial,
+    /// The 3-D reference: RK4 along s (`--method rk4`), uniform rods without effects.
+    SpatialRk4,
 }
 
 impl Backend {
@@ -39,6 +45,7 @@ impl Backend {
             Backend::PlanarCollocation => "planar collocation",
             Backend::PlanarRk4 => "planar RK4",
             Backend::Spatial => "spatial",
+            Backend::SpatialRk4 => "spatial RK4",
         }
     }
 }
@@ -118,13 +125,21 @@ pub struct Support {
 
 impl Backend {
     /// Every backend, in the order a request is offered to them.
-    pub const ALL: [Backend; 3] = [Backend::PlanarCollocation, Backend::PlanarRk4, Backend::Spatial];
+    pub const ALL: [Backend; 4] = [Backend::PlanarCollocation, Backend::PlanarRk4, Backend::Spatial, Backend::SpatialRk4];
 
     /// The planar backend of `method`.
     pub fn planar(method: SolverMethod) -> Backend {
         match method {
             SolverMethod::Collocation => Backend::PlanarCollocation,
             SolverMethod::Rk4 => Backend::PlanarRk4,
+        }
+    }
+
+    /// The spatial backend of `method`.
+    pub fn spatial(method: SolverMethod) -> Backend {
+        match method {
+            SolverMethod::Collocation => Backend::Spatial,
+            SolverMethod::Rk4 => Backend::SpatialRk4,
         }
     }
 
@@ -152,13 +167,27 @@ impl Backend {
                 several_cables: true,
                 out_of_plane_channels: true,
                 gravity_out_of_plane: true,
+                non_uniform_body: true,
+                anchors: true,
+                rod_anchor: false,
+                hold: true,
+                unmodelled: true,
+                thesis_coefficients: false,
+                method: SolverMethod::Collocation,
+                nodes_per_span: true,
+                // The centreline's points.
+                steps_per_span: true,
+            },
+            Backend::SpatialRk4 => Support {
+                several_cables: true,
+                out_of_plane_channels: true,
+                gravity_out_of_plane: true,
                 non_uniform_body: false,
                 anchors: true,
                 rod_anchor: false,
                 hold: false,
                 unmodelled: false,
                 thesis_coefficients: false,
-                // Its integrator is RK4: `--method rk4` is what it does.
                 method: SolverMethod::Rk4,
                 nodes_per_span: false,
                 steps_per_span: true,
@@ -210,7 +239,7 @@ impl Backend {
     /// when every cable lies in the x–y plane with gravity (the fast path),
     /// else the spatial one; refused by [`Backend::check`] if that one cannot.
     pub fn serving(actuator: &Actuator, options: &SolverOptions, given: Given) -> Result<Backend, Unsupported> {
-        let backend = if is_planar(actuator) { Backend::planar(options.method) } else { Backend::Spatial };
+        let backend = if is_planar(actuator) { Backend::planar(options.method) } else { Backend::spatial(options.method) };
         backend.check(actuator, options, given)?;
         Ok(backend)
     }
@@ -306,6 +335,7 @@ fn advice(served_by: Option<Backend>, but_not: Option<&str>) -> String {
         Backend::PlanarCollocation => "the planar collocation solver (the default --method collocation)",
         Backend::PlanarRk4 => "the planar rk4 solver (--method rk4)",
         Backend::Spatial => "the spatial (3-D) solver",
+        Backend::SpatialRk4 => "the spatial rk4 solver (--method rk4 with several or spatial cables)",
     };
     match (served_by, but_not) {
         (Some(b), None) => format!("{} serves this request", how(b)),

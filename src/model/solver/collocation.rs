@@ -23,6 +23,8 @@
 use super::friction::{MAX_PASSES as FRICTION_MAX_PASSES, TOLERANCE as FRICTION_TOLERANCE};
 use super::{bending_moment, CentrelinePoint, ChannelSample, Simulator, SolveFailure, Strains, TipPose};
 use crate::shape::LengthBasis;
+use crate::numerics::anderson::Anderson;
+use crate::numerics::chebyshev::{self, next_coefficient, ESTIMATE_SAFETY, TAIL_COEFFICIENTS};
 use nalgebra::{DMatrix, DVector};
 
 /// Most fixed-point sweeps before Newton takes over.
@@ -123,10 +125,10 @@ impl Colloc {
     pub(super) fn new(m: usize, spans: usize) -> Self {
         let np = m + 1;
         let nn = spans * np;
-        let x: Vec<f64> = (0..np).map(|j| -(std::f64::consts::PI * j as f64 / m as f64).cos()).collect();
+        let x = chebyshev::lobatto_nodes(m);
         let mut c = Self {
             m,
-            q: integration_matrix(m),
+            q: chebyshev::integration_matrix(m),
             x,
             s: vec![0.0; nn],
             half: vec![0.0; spans],
@@ -146,7 +148,7 @@ impl Colloc {
             dmom: vec![0.0; nn],
             scratch: vec![0.0; nn],
             qb: {
-                let q = integration_matrix(m);
+                let q = chebyshev::integration_matrix(m);
                 let mut qb = vec![0.0; np * np];
                 for j in 0..np {
                     for k in 0..np {
@@ -156,7 +158,7 @@ impl Colloc {
                 qb
             },
             fine: Vec::new(),
-            tail: tail_rows(m),
+            tail: chebyshev::tail_rows(m),
             anderson: Anderson::new(3 * nn),
             hist_t: [0.0; 3],
             hist_phi: std::array::from_fn(|_| vec![0.0; nn]),
@@ -218,16 +220,7 @@ impl Colloc {
     /// (`fs`, the span's slices), in one pass over the transform's rows.
     #[inline]
     fn tails_of<const K: usize>(&self, fs: [&[f64]; K]) -> [[f64; TAIL_COEFFICIENTS]; K] {
-        let np = self.np();
-        let mut out = [[0.0; TAIL_COEFFICIENTS]; K];
-        for (r, row) in self.tail.chunks_exact(np).enumerate() {
-            for (j, w) in row.iter().enumerate() {
-                for (o, f) in out.iter_mut().zip(&fs) {
-                    o[r] += w * f[j];
-                }
-            }
-        }
-        out
+        chebyshev::tails_of(&self.tail, self.np(), fs)
     }
 
     /// Σ_k q[j][k] f[k] over one span's values `f`.
@@ -327,10 +320,11 @@ impl Colloc {
     fn accelerate(&mut self, scale: f64, ratio: &mut [f64]) {
         let nn = self.phi.len();
         let a = &mut self.anderson;
+        let g = a.output_mut();
         for i in 0..nn {
-            a.g[i] = self.phi[i];
-            a.g[nn + i] = self.mom[i] * scale;
-            a.g[2 * nn + i] = ratio[i];
+            g[i] = self.phi[i];
+            g[nn + i] = self.mom[i] * scale;
+            g[2 * nn + i] = ratio[i];
         }
         let Some(next) = a.step() else { return };
         for i in 0..nn {
@@ -342,24 +336,21 @@ impl Colloc {
         }
     }
 
+    /// Records the input z = (φ, M·scale, τ(s)/τ(0)) of the next sweep for Anderson.
+    fn begin_sweep(&mut self, ratio: &[f64], scale: f64) {
+        let nn = self.phi.len();
+        let z = self.anderson.input_mut();
+        for i in 0..nn {
+            z[i] = self.phi[i];
+            z[nn + i] = self.mom[i] * scale;
+            z[2 * nn + i] = ratio[i];
+        }
+    }
+
     /// Barycentric interpolation of node values `f` (one span) at unit
     /// coordinate `x` ∈ [−1, 1].
     fn interpolate(&self, f: &[f64], x: f64) -> f64 {
-        let np = self.np();
-        let (mut num, mut den) = (0.0, 0.0);
-        for j in 0..np {
-            let d = x - self.x[j];
-            if d == 0.0 {
-                return f[j];
-            }
-            let mut w = if j % 2 == 0 { 1.0 } else { -1.0 };
-            if j == 0 || j == np - 1 {
-                w *= 0.5;
-            }
-            num += w / d * f[j];
-            den += w / d;
-        }
-        num / den
+        chebyshev::interpolate(&self.x, f, x)
     }
 }
 
@@ -373,194 +364,6 @@ fn turn((sn, cs): (f64, f64), delta: f64, phi: f64) -> (f64, f64) {
     } else {
         phi.sin_cos()
     }
-}
-
-/// Anderson acceleration (type II, depth 2) of a fixed point z = G(z):
-/// z_next = G_k − Σ γ_i ΔG_i with γ minimising |f_k − Σ γ_i Δf_i|,
-/// f = G(z) − z, over the differences of the last three sweeps.
-#[derive(Debug, Clone)]
-struct Anderson {
-    /// Input z of the current sweep, and its output G(z).
-    z: Vec<f64>,
-    g: Vec<f64>,
-    /// Previous f and G.
-    f_prev: Vec<f64>,
-    g_prev: Vec<f64>,
-    /// Differences Δf, ΔG of the last two steps, newest first.
-    df: [Vec<f64>; 2],
-    dg: [Vec<f64>; 2],
-    count: usize,
-    /// Difference pairs held (0–2).
-    pairs: usize,
-    next: Vec<f64>,
-}
-
-impl Anderson {
-    fn new(n: usize) -> Self {
-        Self {
-            z: vec![0.0; n],
-            g: vec![0.0; n],
-            f_prev: vec![0.0; n],
-            g_prev: vec![0.0; n],
-            df: [vec![0.0; n], vec![0.0; n]],
-            dg: [vec![0.0; n], vec![0.0; n]],
-            count: 0,
-            pairs: 0,
-            next: vec![0.0; n],
-        }
-    }
-
-    /// Forgets everything (new routing or a failed solve).
-    fn clear(&mut self) {
-        self.count = 0;
-        self.pairs = 0;
-    }
-
-    /// Starts a new solve: the difference pairs of the previous tension are
-    /// kept (the map's Jacobian drifts slowly with tension, so they
-    /// accelerate the first sweep already); the last f, G are not.
-    fn restart(&mut self) {
-        self.count = 0;
-    }
-
-    /// Records the input of the next sweep.
-    fn begin(&mut self, phi: &[f64], mom: &[f64], ratio: &[f64], scale: f64) {
-        let nn = phi.len();
-        for i in 0..nn {
-            self.z[i] = phi[i];
-            self.z[nn + i] = mom[i] * scale;
-            self.z[2 * nn + i] = ratio[i];
-        }
-    }
-
-    /// With G(z) in `g`: the accelerated next input, or `None` for plain G(z).
-    fn step(&mut self) -> Option<&[f64]> {
-        let n = self.z.len();
-        if self.count > 0 {
-            self.df.swap(0, 1);
-            self.dg.swap(0, 1);
-            for i in 0..n {
-                let f = self.g[i] - self.z[i];
-                self.df[0][i] = f - self.f_prev[i];
-                self.dg[0][i] = self.g[i] - self.g_prev[i];
-            }
-            self.pairs = (self.pairs + 1).min(2);
-        }
-        for i in 0..n {
-            self.f_prev[i] = self.g[i] - self.z[i];
-            self.g_prev[i] = self.g[i];
-        }
-        self.count += 1;
-        if self.pairs == 0 {
-            return None;
-        }
-        let depth = self.pairs;
-        let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
-        let f = &self.f_prev;
-        let (a00, b0) = (dot(&self.df[0], &self.df[0]), dot(&self.df[0], f));
-        let mut gamma = [0.0; 2];
-        if a00 <= 0.0 {
-            return None;
-        }
-        if depth == 2 {
-            let (a01, a11, b1) = (dot(&self.df[0], &self.df[1]), dot(&self.df[1], &self.df[1]), dot(&self.df[1], f));
-            let det = a00 * a11 - a01 * a01;
-            if det > 1e-10 * a00 * a11 {
-                gamma = [(b0 * a11 - b1 * a01) / det, (a00 * b1 - a01 * b0) / det];
-            } else {
-                gamma[0] = b0 / a00;
-            }
-        } else {
-            gamma[0] = b0 / a00;
-        }
-        if !gamma.iter().all(|g| g.is_finite()) {
-            return None;
-        }
-        for i in 0..n {
-            self.next[i] = self.g[i] - gamma[0] * self.dg[0][i] - gamma[1] * self.dg[1][i];
-        }
-        Some(&self.next)
-    }
-}
-
-/// How many of the highest Chebyshev coefficients the error estimate reads:
-/// more than one, so that a function whose samples alias onto a low mode
-/// (an under-resolved oscillation) is not taken for a resolved one.
-const TAIL_COEFFICIENTS: usize = 4;
-
-/// The size of the first Chebyshev coefficient past a span's highest,
-/// extrapolated from its highest four `tail` (c_{m−3} … c_m): the last
-/// pair's size times their decay per degree, measured against the pair
-/// before (pairs, because an even or odd function has every other
-/// coefficient zero). A tail that does not decay is taken as it is.
-fn next_coefficient(tail: [f64; TAIL_COEFFICIENTS]) -> f64 {
-    let last = tail[2].abs().max(tail[3].abs());
-    let before = tail[0].abs().max(tail[1].abs());
-    let decay = if before > 0.0 { (last / before).sqrt().min(1.0) } else { 1.0 };
-    last * decay
-}
-
-/// The interpolants' error at the nodes, integrated over a span, is about
-/// the span's length times the first coefficient past the last over m²
-/// (measured: on 150 random bodies, routings and tensions at 6–16
-/// intervals against 64, the estimate of the tip, and of a_k up to the
-/// highest order the table allows at m, was at least 2.3 times the error,
-/// and 40–130 times it at the median); this factor adds half again.
-const ESTIMATE_SAFETY: f64 = 1.5;
-
-
-/// The rows of [`Colloc::tail`]: c_n = (2/m) Σ''_j f_j T_n(x_j) for the
-/// highest [`TAIL_COEFFICIENTS`] n (Σ'' halves the end terms; c_m is halved).
-fn tail_rows(m: usize) -> Vec<f64> {
-    let np = m + 1;
-    let mf = m as f64;
-    let mut rows = Vec::with_capacity(TAIL_COEFFICIENTS * np);
-    for n in m + 1 - TAIL_COEFFICIENTS.min(m)..=m {
-        let scale = if n == m { 1.0 / mf } else { 2.0 / mf };
-        for j in 0..np {
-            let end = if j == 0 || j == m { 0.5 } else { 1.0 };
-            // x_j = −cos(π j/m) = cos(π (m − j)/m), so T_n(x_j) = cos(n π (m − j)/m).
-            rows.push(scale * end * (n as f64 * std::f64::consts::PI * (m - j) as f64 / mf).cos());
-        }
-    }
-    rows
-}
-
-/// ∫_{−1}^{x_j} ℓ_k(x) dx for the Lagrange basis ℓ_k on the Chebyshev–Lobatto
-/// nodes x_j = −cos(π j/m), via the discrete Chebyshev expansion of ℓ_k.
-fn integration_matrix(m: usize) -> Vec<f64> {
-    let np = m + 1;
-    let mf = m as f64;
-    let theta = |j: usize| std::f64::consts::PI * (m - j) as f64 / mf; // x_j = cos θ_j
-    let cheb = |n: usize, j: usize| (n as f64 * theta(j)).cos();
-    let gamma = |i: usize| if i == 0 || i == m { 2.0 } else { 1.0 };
-    // ∫_{−1}^{x_j} T_n.
-    let int_t = |n: usize, j: usize| -> f64 {
-        let x = theta(j).cos();
-        match n {
-            0 => x + 1.0,
-            1 => (x * x - 1.0) / 2.0,
-            _ => {
-                let nf = n as f64;
-                let at = |t_next: f64, t_prev: f64| t_next / (2.0 * (nf + 1.0)) - t_prev / (2.0 * (nf - 1.0));
-                let sign = |p: usize| if p % 2 == 0 { 1.0 } else { -1.0 };
-                at(cheb(n + 1, j), cheb(n - 1, j)) - at(sign(n + 1), sign(n - 1))
-            }
-        }
-    };
-    let mut q = vec![0.0; np * np];
-    for j in 0..np {
-        for k in 0..np {
-            let mut v = 0.0;
-            for n in 0..np {
-                v += 2.0 / (mf * gamma(k) * gamma(n)) * cheb(n, k) * int_t(n, j);
-            }
-            q[j * np + k] = v;
-        }
-    }
-    // Row 0 integrates over an empty interval.
-    q[..np].iter_mut().for_each(|v| *v = 0.0);
-    q
 }
 
 impl Simulator {
@@ -635,7 +438,7 @@ impl Simulator {
         let scale = self.actuator.length_mm / self.actuator.ei_n_mm2;
         c.anderson.restart();
         let outcome = loop {
-            c.anderson.begin(&c.phi, &c.mom, self.friction.ratios(), scale);
+            c.begin_sweep(self.friction.ratios(), scale);
             let (dphi, dmom) = match self.colloc_sweep(c, tension) {
                 Ok(change) => change,
                 Err(e) => break Err(e),
@@ -1351,4 +1154,4 @@ mod tests {
 
 /// Points between consecutive nodes at which friction's turning angle is
 /// summed (the cable angle is interpolated there).
-const FRICTION_SUBSTEPS: usize = 8;
+pub(crate) const FRICTION_SUBSTEPS: usize = 8;

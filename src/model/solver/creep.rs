@@ -15,7 +15,7 @@ use super::super::rod::Effects;
 /// The creep state of a simulator: the material law, the current hold and
 /// the history q(s) at every point of the integrator.
 #[derive(Debug, Clone)]
-pub(super) struct Creep {
+pub(crate) struct Creep {
     /// Creep fraction f (0: no creep).
     fraction: f64,
     /// Creep time T, s.
@@ -43,7 +43,7 @@ pub(super) struct Creep {
 impl Creep {
     /// A virgin rod at each of `points` points, every solve held from it
     /// with no dwell until [`Creep::set_dwell`].
-    pub(super) fn new(effects: &Effects, ei_n_mm2: f64, points: usize) -> Self {
+    pub(crate) fn new(effects: &Effects, ei_n_mm2: f64, points: usize) -> Self {
         Self {
             fraction: effects.creep_fraction,
             time_s: effects.creep_time_s,
@@ -59,12 +59,12 @@ impl Creep {
 
     /// Whether the actuator creeps at all.
     #[inline]
-    pub(super) fn is_on(&self) -> bool {
+    pub(crate) fn is_on(&self) -> bool {
         self.fraction > 0.0
     }
 
     /// Sets the dwell `dwell_s` (s, checked by the caller) of the next solves.
-    pub(super) fn set_dwell(&mut self, dwell_s: f64) {
+    pub(crate) fn set_dwell(&mut self, dwell_s: f64) {
         self.dwell_s = dwell_s;
         let f = self.fraction;
         if f > 0.0 {
@@ -77,12 +77,12 @@ impl Creep {
     }
 
     /// From now on the history carries over from solve to solve.
-    pub(super) fn follow_protocol(&mut self) {
+    pub(crate) fn follow_protocol(&mut self) {
         self.virgin_holds = false;
     }
 
     /// Before a solve: outside a protocol the rod starts as new.
-    pub(super) fn begin_solve(&mut self) {
+    pub(crate) fn begin_solve(&mut self) {
         if self.virgin_holds && self.fraction > 0.0 {
             self.forget();
         }
@@ -91,7 +91,7 @@ impl Creep {
     /// After a successful solve: advances q over the hold just solved,
     /// q ← q∞ + (q − q∞) E with q∞ = m/(EI (1 − f)) (only in a protocol:
     /// a virgin hold leaves no history to keep).
-    pub(super) fn end_solve(&mut self) {
+    pub(crate) fn end_solve(&mut self) {
         if self.fraction > 0.0 && self.dwell_s > 0.0 && !self.virgin_holds {
             let f = self.fraction;
             let e = self.decay;
@@ -104,14 +104,14 @@ impl Creep {
     }
 
     /// Forgets the load history: the material is as new, unloaded.
-    pub(super) fn forget(&mut self) {
+    pub(crate) fn forget(&mut self) {
         self.q.iter_mut().for_each(|q| *q = 0.0);
     }
 
     /// du/dm added to the elastic compliance over the hold at a point of
     /// bending rigidity `ei_n_mm2`, f (1 − E)/((1 − f) EI), 1/(N·mm²).
     #[inline]
-    pub(super) fn gain(&self, ei_n_mm2: f64) -> f64 {
+    pub(crate) fn gain(&self, ei_n_mm2: f64) -> f64 {
         let f = self.fraction;
         if f > 0.0 {
             self.gain_times_ei / ((1.0 - f) * ei_n_mm2)
@@ -122,7 +122,7 @@ impl Creep {
 
     /// The held curvature f E q₀ at point `k`, 1/mm.
     #[inline]
-    pub(super) fn offset(&self, k: usize) -> f64 {
+    pub(crate) fn offset(&self, k: usize) -> f64 {
         let f = self.fraction;
         if f == 0.0 {
             0.0
@@ -134,7 +134,7 @@ impl Creep {
     /// Records the bending moment `m` (N·mm) and the bending rigidity
     /// `ei_n_mm2` at point `k` in this pass.
     #[inline]
-    pub(super) fn record_moment(&mut self, k: usize, m: f64, ei_n_mm2: f64) {
+    pub(crate) fn record_moment(&mut self, k: usize, m: f64, ei_n_mm2: f64) {
         self.moment[k] = m;
         self.ei_n_mm2[k] = ei_n_mm2;
     }

@@ -13,9 +13,9 @@
 use super::SolveFailure;
 
 /// Most re-integrations while the friction tension profile settles.
-pub(super) const MAX_PASSES: usize = 60;
+pub(crate) const MAX_PASSES: usize = 60;
 /// Largest change of τ(s)/τ(0) accepted as settled.
-pub(super) const TOLERANCE: f64 = 1e-10;
+pub(crate) const TOLERANCE: f64 = 1e-10;
 
 /// The friction state of a simulator: coefficient, slip sign and the
 /// tension profile at every point of the integrator.

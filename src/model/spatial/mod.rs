@@ -9,12 +9,14 @@
 //! single-cable solver ([`crate::model::simulate`]) stays the fast path for
 //! planar single-cable work, and the two agree on planar cases.
 
+pub mod collocation;
 pub mod record;
 pub mod solver;
 
 pub use crate::model::cable::{self, Cable, MAX_CABLES};
 pub use crate::model::actuator::{Actuator, EI_OVER_GJ};
-pub use solver::{check_order, SpatialFailure, SpatialNode, SpatialOptions, SpatialPose, SpatialSolver, MAX_SPATIAL_ORDER};
+pub use collocation::SpatialSolver;
+pub use solver::{check_order, SpatialFailure, SpatialNode, SpatialOptions, SpatialPose, SpatialRk4Solver, MAX_SPATIAL_ORDER};
 
 use crate::model::routing::RoutingError;
 use crate::model::ParameterError;
@@ -119,25 +121,65 @@ impl SpatialSimulation {
 /// Solves `actuator` at its cables' tensions, stepping all tensions up
 /// together from zero (rungs of at most 0.25 N on the largest) so that large
 /// deformations start from a nearby solution, and computes the coefficients
-/// a_0 … a_order in `basis`.
+/// a_0 … a_order in `basis`, by `options.method`:
 ///
-/// The result is checked against the same solve at half the steps (RK4's
-/// error falls as h⁴, so their difference is well above the finer one's
-/// error): the tip within [`crate::model::solver::tip_tolerance_mm`], every
-/// coefficient within [`crate::model::resolution::ORDER_TOLERANCE_PER_MM`].
-/// Where they differ by more, the steps are doubled (the last solve is the
-/// next comparison), up to [`MAX_AUTO_SPATIAL_STEPS_PER_SPAN`]; beyond, the
-/// solve is refused as unresolved. A tip farther from the clamp than the
-/// stretched rod is long is refused too.
+/// - collocation (the default, [`SpatialSolver`]): every solve estimates its
+///   own error (the tip within [`crate::model::solver::tip_tolerance_mm`],
+///   every coefficient within [`crate::model::resolution::ORDER_TOLERANCE_PER_MM`]);
+///   where it is above, the ladder is solved again at twice the intervals,
+///   up to [`crate::model::solver::MAX_NODES_PER_SPAN`], beyond which the
+///   solve is refused as unresolved;
+/// - RK4 (the reference, [`SpatialRk4Solver`]): the result is checked against
+///   the same solve at half the steps (RK4's error falls as h⁴, so their
+///   difference is well above the finer one's error), doubling the steps
+///   up to [`MAX_AUTO_SPATIAL_STEPS_PER_SPAN`].
+///
+/// A tip farther from the clamp than the stretched rod is long is refused too.
 pub fn simulate_spatial(
     actuator: &Actuator,
     options: &SpatialOptions,
     order: usize,
     basis: LengthBasis,
 ) -> Result<SpatialSimulation, SpatialError> {
-    solver::check_order(order, options)?;
     let top = actuator.cables.iter().map(|c| c.tension_n).fold(0.0, f64::max);
     crate::model::solver::check_ladder_tension("cable tension_n", top)?;
+    if options.method == crate::model::SolverMethod::Rk4 {
+        return simulate_spatial_rk4(actuator, options, order, basis);
+    }
+    if order > MAX_SPATIAL_ORDER {
+        return Err(SpatialError::Option(format!("order {order} is above the spatial solver's highest order {MAX_SPATIAL_ORDER}")));
+    }
+    let mut options = options.clone();
+    loop {
+        match solve_collocation_ladder(actuator, &options, order, basis) {
+            Err(SpatialError::Solve(SpatialFailure::Unresolved(_))) if options.nodes_per_span < crate::model::solver::MAX_NODES_PER_SPAN => {
+                options.nodes_per_span = (2 * options.nodes_per_span).min(crate::model::solver::MAX_NODES_PER_SPAN);
+            }
+            result => return result,
+        }
+    }
+}
+
+/// One ladder of the collocation solver at `options`, with its checks.
+fn solve_collocation_ladder(actuator: &Actuator, options: &SpatialOptions, order: usize, basis: LengthBasis) -> Result<SpatialSimulation, SpatialError> {
+    let mut solver = SpatialSolver::new(actuator, options)?;
+    let top = actuator.cables.iter().map(|c| c.tension_n).fold(0.0, f64::max);
+    let rungs = ((top / 0.25).ceil() as usize).max(1);
+    let mut pose = None;
+    for k in 1..=rungs {
+        pose = Some(solver.solve_scaled(k as f64 / rungs as f64)?);
+    }
+    let pose = pose.expect("at least one rung");
+    let [a_twist, a_bend_y, a_bend_z] = solver.coefficients(order, basis)?;
+    if !a_twist.iter().chain(&a_bend_y).chain(&a_bend_z).all(|v| v.is_finite()) {
+        return Err(SpatialFailure::NonFinite.into());
+    }
+    Ok(SpatialSimulation { actuator: actuator.clone(), pose, a_twist, a_bend_y, a_bend_z, length_basis: basis, nodes: solver.centreline() })
+}
+
+/// [`simulate_spatial`] by the RK4 reference, refining by comparison with half the steps.
+fn simulate_spatial_rk4(actuator: &Actuator, options: &SpatialOptions, order: usize, basis: LengthBasis) -> Result<SpatialSimulation, SpatialError> {
+    solver::check_order(order, options)?;
     let half = SpatialOptions { steps_per_span: (options.steps_per_span / 2).max(2), ..options.clone() };
     // A coarse solve that fails says nothing about the fine one: the
     // comparison then moves one level up.
@@ -202,10 +244,10 @@ fn unresolved_part(fine: &SpatialSimulation, coarse: &SpatialSimulation, steps: 
     None
 }
 
-/// One ladder of [`simulate_spatial`] at `options`' steps, without the
+/// One ladder of [`simulate_spatial_rk4`] at `options`' steps, without the
 /// resolution check (but refusing non-finite results).
 fn solve_ladder(actuator: &Actuator, options: &SpatialOptions, order: usize, basis: LengthBasis) -> Result<SpatialSimulation, SpatialError> {
-    let mut solver = SpatialSolver::new(actuator, options)?;
+    let mut solver = SpatialRk4Solver::new(actuator, options)?;
     let top = actuator.cables.iter().map(|c| c.tension_n).fold(0.0, f64::max);
     let rungs = ((top / 0.25).ceil() as usize).max(1);
     let mut pose = None;
@@ -262,8 +304,10 @@ pub fn simulate_actuator(
     use crate::model::Backend;
     actuator.channels()?;
     let backend = Backend::serving(actuator, options, given)?;
-    if backend == Backend::Spatial {
-        let spatial = simulate_spatial(actuator, spatial_options, order, basis)?;
+    if matches!(backend, Backend::Spatial | Backend::SpatialRk4) {
+        let method = if backend == Backend::Spatial { crate::model::SolverMethod::Collocation } else { crate::model::SolverMethod::Rk4 };
+        let spatial_options = SpatialOptions { method, ..spatial_options.clone() };
+        let spatial = simulate_spatial(actuator, &spatial_options, order, basis)?;
         return Ok(ActuatorSimulation { backend, planar: None, spatial });
     }
     let (rod, routing) = planar_problem(actuator)?;

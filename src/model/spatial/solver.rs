@@ -59,7 +59,7 @@ type Factors = LU<f64, U6, U6>;
 /// A gravity pass started from a moment residual below this (N·mm) is
 /// expected to be the last (Broyden cuts the residual by 100× or more per
 /// pass), so it also computes the coefficients; if it is not the last,
-/// [`SpatialSolver::coefficients`] runs one more pass.
+/// [`SpatialRk4Solver::coefficients`] runs one more pass.
 const LAST_PASS_RESIDUAL_N_MM: f64 = 1e-5;
 
 /// Highest coefficient order the spatial solver reports.
@@ -86,11 +86,36 @@ pub struct SpatialOptions {
     pub moment_tolerance_n_mm: f64,
     /// Most integration passes per solve (gravity's Broyden iteration).
     pub max_passes: u32,
+    /// Collocation intervals per span of the 3-D collocation (4 … 64).
+    pub nodes_per_span: usize,
+    /// The 3-D method: spectral collocation (the default,
+    /// [`crate::model::spatial::collocation`]) or the RK4 reference (`rk4`).
+    pub method: crate::model::SolverMethod,
 }
 
 impl Default for SpatialOptions {
     fn default() -> Self {
-        Self { steps_per_span: 10, moment_tolerance_n_mm: 1e-7, max_passes: 40 }
+        Self { steps_per_span: 10, moment_tolerance_n_mm: 1e-7, max_passes: 40, nodes_per_span: 10, method: crate::model::SolverMethod::Collocation }
+    }
+}
+
+impl SpatialOptions {
+    /// Checks the settings (the message names the setting and its range).
+    pub fn check(&self) -> Result<(), SpatialError> {
+        if self.steps_per_span < 2 {
+            return Err(SpatialError::Option(format!("steps_per_span = {} must be at least 2", self.steps_per_span)));
+        }
+        if !(4..=crate::model::solver::MAX_NODES_PER_SPAN).contains(&self.nodes_per_span) {
+            return Err(SpatialError::Option(format!(
+                "nodes_per_span = {} must be between 4 and {}",
+                self.nodes_per_span,
+                crate::model::solver::MAX_NODES_PER_SPAN
+            )));
+        }
+        if !(self.moment_tolerance_n_mm.is_finite() && self.moment_tolerance_n_mm > 0.0) {
+            return Err(SpatialError::Option("moment_tolerance_n_mm must be a positive number".into()));
+        }
+        Ok(())
     }
 }
 
@@ -145,6 +170,9 @@ pub enum SpatialFailure {
     /// Gravity's moment iteration did not converge.
     #[error("gravity's moment did not converge in {passes} passes (residual {residual_n_mm:.3e} N·mm); the rod may be too heavy for its stiffness")]
     Gravity { passes: u32, residual_n_mm: f64 },
+    /// The cables' tension profiles with friction did not settle.
+    #[error("the cable tension profiles with friction did not converge; try smaller tension steps or a smaller friction coefficient")]
+    Friction,
     /// A number of the result is not finite.
     #[error("the solve gave a non-finite tip or coefficient; check the rod's parameters (rigidities, length, density) for absurd values")]
     NonFinite,
@@ -164,6 +192,7 @@ impl SpatialFailure {
             SpatialFailure::Local { .. } => "cut_equations_not_converged",
             SpatialFailure::Gravity { .. } => "gravity_not_converged",
             SpatialFailure::NonFinite => "non_finite",
+            SpatialFailure::Friction => "friction_not_converged",
             SpatialFailure::Unresolved(_) => "unresolved",
         }
     }
@@ -235,7 +264,7 @@ struct Local {
 
 /// Reusable spatial solver for one actuator: set the cables, then solve.
 #[derive(Debug, Clone)]
-pub struct SpatialSolver {
+pub struct SpatialRk4Solver {
     rod: Rod,
     stiff: [f64; 6],
     /// Weight per unit rest length along the gravity direction, N/mm (global vector).
@@ -272,10 +301,10 @@ pub struct SpatialSolver {
     last: Option<SpatialPose>,
 }
 
-impl SpatialSolver {
+impl SpatialRk4Solver {
     /// A solver for `actuator` (its cables, rod, torsion and gravity).
     pub fn new(actuator: &Actuator, options: &SpatialOptions) -> Result<Self, SpatialError> {
-        let channels = actuator.validate()?;
+        let channels = actuator.validate_for(crate::model::Backend::SpatialRk4)?;
         if options.steps_per_span < 2 {
             return Err(SpatialError::Option(format!("steps_per_span = {} must be at least 2", options.steps_per_span)));
         }
@@ -819,7 +848,7 @@ impl SpatialSolver {
         Ok(())
     }
 
-    /// [`SpatialSolver::coefficients`] of the last solve without the
+    /// [`SpatialRk4Solver::coefficients`] of the last solve without the
     /// order check (the error estimate's coarse solve computes the same
     /// orders at half the steps); needs valid moments.
     pub(super) fn coefficients_unchecked(&self, order: usize, basis: LengthBasis) -> [Vec<f64>; 3] {

@@ -1,0 +1,1790 @@
+//! The 3-D solver by spectral collocation per knot span: the planar
+//! collocation ([`crate::model::solver`]) generalised to several cables,
+//! spatial channels, torsion and gravity in any direction.
+//!
+//! Cutting the rod at s and taking the distal part, rod and cables together,
+//! as a free body gives, in the body frame (model-notes §3b),
+//!
+//! ```text
+//! v = v* + K_se⁻¹ n,   n = Rᵀ W(s) − Σ τ_i(s) t_i            K_se = diag(EA, GA, GA)
+//! u = c(m),            m = Rᵀ M_W(s) − Σ τ_i(s) r_i × t_i     c: the bending and torsion law
+//! t_i = q_i / |q_i|,   q_i = v + u × r_i + r_i'
+//! ```
+//!
+//! with W(s) the distal weight (closed form for every body) and M_W(s) its
+//! moment about p(s), M_W' = −p' × W, M_W(L) = 0. Cable i pulls only where
+//! s < s_k,i (its anchor). At each node this is a local 6×6 system in
+//! x = (v, u), solved by Newton with the exact Jacobian.
+//!
+//! **Collocation.** The channels are cubic in their parameter on each knot
+//! span, so every integrand is analytic on the spans between the
+//! breakpoints (the channels' knots, anchors, the body's breakpoints). On
+//! each span the local equations are solved at m + 1 Chebyshev–Lobatto
+//! nodes and every integral along the span is the exact integral of the
+//! degree-m interpolant ([`crate::numerics::chebyshev`]): the error falls
+//! geometrically with m.
+//!
+//! - The frames follow from u by a sixth-order Magnus step between
+//!   consecutive nodes whose first term is the exact integral of u's
+//!   interpolant: R_j = R_{j−1} exp(∫u + commutators of u at the interval's
+//!   Gauss points). For a planar rod the commutators vanish and the frame
+//!   angle is exactly the planar solver's φ = ∫ u.
+//! - The positions, deformed arc length and gravity's moment are spectral
+//!   quadratures of R v, |v| and p' × W.
+//!
+//! The unknowns are the clamp's rotation θ₀ (clamp compliance), u and M_W at
+//! the nodes. Without distributed loads and friction the strains do not
+//! depend on them: one sweep (local solves → frames → positions) is the
+//! solution, no shooting. With gravity or friction the sweep is a fixed-point
+//! map, accelerated by Anderson's method ([`crate::numerics::anderson`]);
+//! where it does not contract (heavy rods), Newton's method on the whole
+//! collocation system takes over, continued in the weight from a weightless
+//! rod if it fails from the warm start.
+//!
+//! **Coefficients.** The bending curvature of the centreline is the rotation
+//! rate of its unit tangent, κ = u − (u·v̂) v̂ + v̂ × v̂' in the body frame
+//! (v̂' by spectral differentiation on each span), plus the tangent's jump
+//! where v jumps (an anchor, a change of material). Each series is
+//! a_i = (2i + 1)/L ∫ P_i(2σ/ℓ − 1) κ_k ds (the thesis's basis) with κ_k
+//! the component about body z (in the x–y plane: the planar a_i), about
+//! body y, and the torsion u_1 (twist).
+
+use super::cable::Channel;
+use super::solver::{SpatialFailure, SpatialNode, SpatialOptions, SpatialPose, MAX_SPATIAL_ORDER};
+use super::{Actuator, SpatialError};
+use crate::model::solver::collocation::FRICTION_SUBSTEPS;
+use crate::model::solver::creep::Creep;
+use crate::model::solver::friction::{MAX_PASSES as FRICTION_MAX_PASSES, TOLERANCE as FRICTION_TOLERANCE};
+use crate::model::{Body, Hold, Rod};
+use crate::numerics::anderson::Anderson;
+use crate::numerics::chebyshev::{self, next_coefficient, ESTIMATE_SAFETY};
+use crate::shape::{LegendreSeries, LengthBasis};
+use nalgebra::{DMatrix, DVector, Matrix3, Matrix6, Quaternion, Rotation3, UnitQuaternion, Vector3, Vector6};
+
+type V3 = Vector3<f64>;
+type M3 = Matrix3<f64>;
+
+/// Most fixed-point sweeps before Newton takes over.
+const MAX_SWEEPS: u32 = 40;
+/// Change of the frames between sweeps accepted as settled, rad.
+const SWEEP_ANGLE_TOLERANCE_RAD: f64 = 1e-9;
+/// Newton on the whole system: scaled residual (rad) accepted as converged.
+const NEWTON_TOLERANCE: f64 = 1e-11;
+/// Newton iterations per solve before giving up.
+const NEWTON_MAX_ITERATIONS: u32 = 40;
+/// Newton: the backtracking's sufficient decrease (Armijo) factor.
+const NEWTON_SUFFICIENT_DECREASE: f64 = 1e-4;
+/// Newton: smallest damping factor tried before giving up.
+const NEWTON_MIN_DAMPING: f64 = 1.0 / 1024.0;
+/// Weight continuation: first and largest steps, smallest step (fractions of the weight).
+const FIRST_WEIGHT_STEP: f64 = 0.25;
+const MAX_WEIGHT_STEP: f64 = 0.5;
+const MIN_WEIGHT_STEP: f64 = 1.0 / 1024.0;
+/// The local Newton's step (in v and u) below which it has converged:
+/// quadratic convergence leaves an error of about its square.
+const LOCAL_STEP_TOLERANCE: f64 = 1e-9;
+/// Local Newton: a chord step whose size is not below this fraction of the
+/// previous step's takes a fresh Jacobian next.
+const CHORD_CONTRACTION: f64 = 0.25;
+/// Local Newton: most steps.
+const LOCAL_MAX_ITERATIONS: usize = 100;
+/// Material stiffening's law: Newton's tolerance and iteration cap.
+const STIFFENING_TOLERANCE: f64 = 1e-15;
+const STIFFENING_MAX_ITERATIONS: usize = 50;
+/// Nodes at least with material stiffening (its law has complex branch
+/// points near the real axis, which slows the spectral convergence).
+const MIN_NODES_WITH_STIFFENING: usize = 16;
+/// Most collocation intervals per span (the buffers of a span are this + 1 long).
+const MAX_NODES: usize = crate::model::solver::MAX_NODES_PER_SPAN;
+
+/// The cross-section at a node.
+#[derive(Debug, Clone, Copy)]
+struct Section {
+    ea: f64,
+    ga: f64,
+    gj: f64,
+    ei: f64,
+    radius: f64,
+}
+
+/// A cable's channel at a node, body frame.
+#[derive(Debug, Clone, Copy, Default)]
+struct Chan {
+    r: V3,
+    dr: V3,
+    d2r: V3,
+}
+
+/// What the solver keeps of a converged solve, to extrapolate the next.
+#[derive(Debug, Clone)]
+struct Solved {
+    tensions: Vec<f64>,
+    state: Vec<f64>,
+    local: Vec<[f64; 6]>,
+}
+
+/// The 3-D collocation solver for one actuator: set tensions, then solve
+/// (in a ladder, for the best warm starts).
+#[derive(Debug, Clone)]
+pub struct SpatialSolver {
+    rod: Rod,
+    options: SpatialOptions,
+    cables: usize,
+    /// Tensions of the actuator's cables (scaled by `scale` in a solve), N.
+    base_tension_n: Vec<f64>,
+    scale: f64,
+    /// Unit gravity direction (global) and the fraction of the weight on
+    /// (1, or less during the weight continuation).
+    gravity_unit: V3,
+    weight_fraction: f64,
+    has_weight: bool,
+    clamp_stiffness: Option<f64>,
+    stiffening_alpha: f64,
+    /// Cable–channel friction: on, and μ η (η the slip sign: +1 loading).
+    friction: bool,
+    signed_mu: f64,
+    /// Where the friction profiles τ_c(s)/τ_c(0) start in the state (nn × cables, node-major).
+    ratio_at: usize,
+    /// Interpolation rows onto the friction grid of each interval
+    /// ((m) × (FRICTION_SUBSTEPS − 1) rows of np).
+    fine: Vec<f64>,
+    /// The cables' global directions at the nodes (node-major), scratch.
+    global_dir: Vec<V3>,
+    /// Viscoelastic creep in bending: two components (about body y and z) per node.
+    creep: Creep,
+    hold: Hold,
+    // The collocation grid.
+    m: usize,
+    np: usize,
+    xn: Vec<f64>,
+    q: Vec<f64>,
+    diff: Vec<f64>,
+    tail: Vec<f64>,
+    /// Per interval, the rows of its Magnus step (4 m rows of np; [`SpatialSolver::new`]).
+    magnus: Vec<f64>,
+    start: Vec<f64>,
+    half: Vec<f64>,
+    // Per node.
+    s: Vec<f64>,
+    section: Vec<Section>,
+    /// The weight beyond the cut (all of it), N.
+    distal_weight: Vec<f64>,
+    /// Channels, node-major (nn × cables).
+    chan: Vec<Chan>,
+    /// Whether each cable pulls at each node (node-major).
+    active: Vec<bool>,
+    // The state: θ₀ (3), u (3 per node), M_W (3 per node) in `state`, with
+    // u scaled by L and M_W by L/EI (angle units).
+    state: Vec<f64>,
+    next: Vec<f64>,
+    /// Local solutions (warm starts) and their factors.
+    local: Vec<[f64; 6]>,
+    /// The inverse local Jacobian of the last fresh Newton step per node (chord steps).
+    inverse: Vec<Option<Matrix6<f64>>>,
+    /// Frames of the solution, and scratch frames of a sweep's input and of
+    /// a finite-difference sweep.
+    rot: Vec<M3>,
+    rot_in: Vec<M3>,
+    rot_alt: Vec<M3>,
+    /// A sweep's u, v and M_W at the nodes.
+    ubuf: Vec<V3>,
+    vbuf: Vec<V3>,
+    mbuf: Vec<V3>,
+    pos: Vec<V3>,
+    sigma: Vec<f64>,
+    dp: Vec<V3>,
+    /// |v| at the nodes (σ' of the solution).
+    speed: Vec<f64>,
+    dmom: Vec<V3>,
+    anderson: Anderson,
+    /// The last three converged solves, newest first (`solved` of them valid).
+    history: Vec<Solved>,
+    solved: usize,
+    passes: u32,
+    last: Option<SpatialPose>,
+    u_scale: f64,
+    m_scale: f64,
+}
+
+impl SpatialSolver {
+    /// A solver for `actuator` (its cables, rod, body, torsion and gravity).
+    pub fn new(actuator: &Actuator, options: &SpatialOptions) -> Result<Self, SpatialError> {
+        let channels = actuator.validate_for(crate::model::Backend::Spatial)?;
+        options.check()?;
+        let rod = actuator.rod.clone();
+        let body = Body::of(&rod).map_err(|e| SpatialError::Option(e.to_string()))?;
+        let length = rod.length_mm;
+        let m = if rod.effects.stiffening_alpha > 0.0 { options.nodes_per_span.max(MIN_NODES_WITH_STIFFENING) } else { options.nodes_per_span };
+        let np = m + 1;
+        // Breakpoints: clamp, tip, every channel's knot, anchors, the body's breakpoints.
+        let mut cuts = vec![0.0, length];
+        cuts.extend(channels.iter().map(Channel::knot_mm));
+        cuts.extend(actuator.cables.iter().filter_map(|c| c.anchor_mm).filter(|&a| a < length));
+        if let Some(b) = &body {
+            cuts.extend(b.breakpoints_mm());
+        }
+        let cuts = crate::model::body::merge_sorted(cuts, length);
+        let spans = cuts.len() - 1;
+        let xn = chebyshev::lobatto_nodes(m);
+        let nn = spans * np;
+        let nc = channels.len();
+        let gj_uniform = actuator.torsional_rigidity_n_mm2();
+        let gj_over_ei = gj_uniform / rod.ei_n_mm2;
+        let beta = rod.effects.stiffness_gradient_beta;
+        let delta = rod.effects.channel_offset_mm;
+        let weight_factor = match &body {
+            None => rod.weight_n_per_mm(),
+            Some(_) if !rod.gravity.enabled => 0.0,
+            Some(_) => rod.gravity.scale * 1e-6 * std::f64::consts::PI * rod.gravity.g_m_s2,
+        };
+        let mut s = Vec::with_capacity(nn);
+        let mut section = Vec::with_capacity(nn);
+        let mut distal_weight = Vec::with_capacity(nn);
+        let mut chan = Vec::with_capacity(nn * nc);
+        let mut active = Vec::with_capacity(nn * nc);
+        let (mut start, mut half) = (Vec::with_capacity(spans), Vec::with_capacity(spans));
+        for w in cuts.windows(2) {
+            let (a, b) = (w[0], w[1]);
+            start.push(a);
+            half.push(0.5 * (b - a));
+            let mid = 0.5 * (a + b);
+            for j in 0..np {
+                // Exact end points, so breakpoints are hit exactly.
+                let sj = match j {
+                    0 => a,
+                    _ if j == m => b,
+                    _ => a + 0.5 * (b - a) * (1.0 + xn[j]),
+                };
+                let left = j == m;
+                s.push(sj);
+                let (ea, ga, ei, radius) = match &body {
+                    None => (rod.ea_n, rod.ga_n, rod.ei_n_mm2, rod.radius_mm),
+                    Some(b) => {
+                        let x = b.section_at_side(sj, left);
+                        (x.ea_n, x.ga_n, x.ei_n_mm2, x.radius_mm)
+                    }
+                };
+                let mut ei = ei;
+                let hidden = &rod.effects.hidden;
+                if sj < hidden.base_segment_mm || (left && sj == hidden.base_segment_mm) {
+                    ei *= hidden.base_segment_ei_factor;
+                }
+                // GJ scales with the section as EI does; the stiffness
+                // gradient (a material gradient) scales both.
+                let mut gj = gj_over_ei * ei;
+                if beta != 0.0 {
+                    let f = (beta * (sj / length - 0.5)).exp();
+                    ei *= f;
+                    gj *= f;
+                }
+                section.push(Section { ea, ga, gj, ei, radius });
+                distal_weight.push(match &body {
+                    None => weight_factor * (length - sj),
+                    Some(b) => weight_factor * b.distal_density_area(sj),
+                });
+                for (c, cable) in channels.iter().zip(&actuator.cables) {
+                    let anchor = cable.anchor_or_tip_mm(length);
+                    let on = mid < anchor;
+                    active.push(on);
+                    chan.push(if on {
+                        let p = c.at(sj.min(anchor));
+                        Chan {
+                            r: V3::new(0.0, p.r_mm[0] + delta, p.r_mm[1]),
+                            dr: V3::new(0.0, p.dr_ds[0], p.dr_ds[1]),
+                            d2r: V3::new(0.0, p.d2r_ds2[0], p.d2r_ds2[1]),
+                        }
+                    } else {
+                        Chan::default()
+                    });
+                }
+            }
+        }
+        if let Some(b) = &body {
+            check_channels_inside(actuator, &channels, b, delta)?;
+        }
+        let q = chebyshev::integration_matrix(m);
+        // Per interval [x_{j−1}, x_j], the rows the Magnus step reads: the
+        // exact integral of the interpolant over the interval, and at its
+        // Gauss points c = ½ − √15/10, ½, ½ + √15/10 the combinations
+        // u(c₂), u(c₃) − u(c₁), u(c₃) − 2u(c₂) + u(c₁).
+        let mut magnus = Vec::with_capacity(4 * m * np);
+        let mut g = [vec![0.0; np], vec![0.0; np], vec![0.0; np]];
+        let mut row = vec![0.0; np];
+        for j in 1..np {
+            for (row, c) in g.iter_mut().zip([0.5 - 15f64.sqrt() / 10.0, 0.5, 0.5 + 15f64.sqrt() / 10.0]) {
+                chebyshev::interpolation_weights(&xn, xn[j - 1] + c * (xn[j] - xn[j - 1]), row);
+            }
+            magnus.extend((0..np).map(|k| q[j * np + k] - q[(j - 1) * np + k]));
+            magnus.extend_from_slice(&g[1]);
+            magnus.extend((0..np).map(|k| g[2][k] - g[0][k]));
+            magnus.extend((0..np).map(|k| g[2][k] - 2.0 * g[1][k] + g[0][k]));
+        }
+        let gravity_unit = V3::from(actuator.gravity_unit()?);
+        let has_weight = weight_factor != 0.0;
+        let ei0 = section[0].ei;
+        let friction = rod.effects.friction_mu > 0.0;
+        let n_state = 3 + 6 * nn + if friction { nn * nc } else { 0 };
+        let mut fine = Vec::with_capacity(m * (FRICTION_SUBSTEPS - 1) * np);
+        if friction {
+            for j in 1..np {
+                for k in 1..FRICTION_SUBSTEPS {
+                    chebyshev::interpolation_weights(&xn, xn[j - 1] + (xn[j] - xn[j - 1]) * k as f64 / FRICTION_SUBSTEPS as f64, &mut row);
+                    fine.extend_from_slice(&row);
+                }
+            }
+        }
+        let hold = Hold { direction: rod.effects.load_direction, dwell_s: rod.effects.creep_hold_s };
+        let mut creep = Creep::new(&rod.effects, rod.ei_n_mm2, 2 * nn);
+        creep.set_dwell(hold.dwell_s);
+        let straight = [1.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+        Ok(Self {
+            options: options.clone(),
+            cables: nc,
+            base_tension_n: actuator.cables.iter().map(|c| c.tension_n).collect(),
+            scale: 1.0,
+            gravity_unit,
+            weight_fraction: 1.0,
+            has_weight,
+            clamp_stiffness: rod.effects.clamp_stiffness_n_mm_per_rad,
+            stiffening_alpha: rod.effects.stiffening_alpha,
+            friction,
+            signed_mu: rod.effects.friction_mu * rod.effects.load_direction.slip_sign(),
+            ratio_at: 3 + 6 * nn,
+            fine,
+            global_dir: vec![V3::x(); nn * nc],
+            creep,
+            hold,
+            m,
+            np,
+            xn,
+            diff: chebyshev::differentiation_matrix(m),
+            tail: chebyshev::tail_rows(m),
+            q,
+            magnus,
+            start,
+            half,
+            s,
+            section,
+            distal_weight,
+            chan,
+            active,
+            state: {
+                let mut z = vec![0.0; n_state];
+                z[3 + 6 * nn..].iter_mut().for_each(|r| *r = 1.0);
+                z
+            },
+            next: vec![0.0; n_state],
+            local: vec![straight; nn],
+            inverse: vec![None; nn],
+            rot: vec![M3::identity(); nn],
+            rot_in: vec![M3::identity(); nn],
+            rot_alt: vec![M3::identity(); nn],
+            ubuf: vec![V3::zeros(); nn],
+            vbuf: vec![V3::zeros(); nn],
+            mbuf: vec![V3::zeros(); nn],
+            pos: vec![V3::zeros(); nn],
+            sigma: vec![0.0; nn],
+            dp: vec![V3::zeros(); nn],
+            speed: vec![1.0; nn],
+            dmom: vec![V3::zeros(); nn],
+            anderson: Anderson::new(n_state),
+            history: Vec::with_capacity(3),
+            solved: 0,
+            passes: 0,
+            last: None,
+            u_scale: length,
+            m_scale: length / ei0,
+            rod,
+        })
+    }
+
+    fn nodes_count(&self) -> usize {
+        self.s.len()
+    }
+
+    fn spans(&self) -> usize {
+        self.half.len()
+    }
+
+    /// The rod parameters.
+    pub fn rod(&self) -> &Rod {
+        &self.rod
+    }
+
+    /// Number of cables.
+    pub fn cable_count(&self) -> usize {
+        self.cables
+    }
+
+    /// Collocation intervals per span in use.
+    pub fn intervals(&self) -> usize {
+        self.m
+    }
+
+    /// Tension of every cable in the last solve, N.
+    pub fn tensions_n(&self) -> Vec<f64> {
+        self.base_tension_n.iter().map(|t| t * self.scale).collect()
+    }
+
+    /// Sets every cable's tension (N, one per cable, each ≥ 0) and solves.
+    pub fn solve(&mut self, tensions_n: &[f64]) -> Result<SpatialPose, SpatialError> {
+        if tensions_n.len() != self.cables {
+            return Err(SpatialError::Option(format!("{} tensions given for {} cables", tensions_n.len(), self.cables)));
+        }
+        for (i, &t) in tensions_n.iter().enumerate() {
+            if !(t.is_finite() && t >= 0.0) {
+                return Err(SpatialError::Tension { cable: i + 1, tension_n: t });
+            }
+        }
+        self.base_tension_n.copy_from_slice(tensions_n);
+        self.solve_scaled(1.0)
+    }
+
+    /// Solves with every cable's tension scaled by `scale` (1 = the
+    /// actuator's tensions; continuation ladders step it from 0 to 1),
+    /// warm-started from the previous solves.
+    pub fn solve_scaled(&mut self, scale: f64) -> Result<SpatialPose, SpatialError> {
+        if !(scale.is_finite() && scale >= 0.0) {
+            return Err(SpatialError::Option(format!("tension scale {scale} must be finite and ≥ 0")));
+        }
+        self.scale = scale;
+        self.last = None;
+        let tensions = self.tensions_n();
+        self.predict(&tensions);
+        self.creep.begin_solve();
+        match self.solve_inner(&tensions) {
+            Ok(passes) => {
+                self.creep.end_solve();
+                self.passes = passes;
+                let pose = self.pose_of_state(passes);
+                if !pose.tip_mm.iter().chain(&[pose.length_mm, pose.tip_angle_rad]).all(|v| v.is_finite()) {
+                    self.forget();
+                    return Err(SpatialFailure::NonFinite.into());
+                }
+                if let Err(e) = self.check_resolved(&pose) {
+                    self.forget();
+                    return Err(SpatialFailure::Unresolved(e).into());
+                }
+                self.remember(&tensions);
+                self.last = Some(pose);
+                Ok(pose)
+            }
+            Err(e) => {
+                self.forget();
+                Err(e.into())
+            }
+        }
+    }
+
+    /// Sets how the next solves are held: the load direction (friction's
+    /// slip sign) and the dwell before the reading (creep). From then on the
+    /// solves follow a protocol: creep's history carries over from solve to
+    /// solve. Without this call every solve is held `effects.creep_hold_s`
+    /// on a rod with no load history, in `effects.load_direction`.
+    pub fn set_hold(&mut self, hold: Hold) -> Result<(), SpatialError> {
+        if !(hold.dwell_s.is_finite() && hold.dwell_s >= 0.0) {
+            return Err(SpatialError::Option(format!("dwell_s = {} must be a finite time ≥ 0 s", hold.dwell_s)));
+        }
+        self.creep.follow_protocol();
+        self.creep.set_dwell(hold.dwell_s);
+        self.signed_mu = self.rod.effects.friction_mu * hold.direction.slip_sign();
+        self.hold = hold;
+        Ok(())
+    }
+
+    /// The hold of the next solves.
+    pub fn hold(&self) -> Hold {
+        self.hold
+    }
+
+    /// Keeps the converged state of `tensions` as the newest of the last
+    /// three solves (ring buffers: no allocation after the first three).
+    fn remember(&mut self, tensions: &[f64]) {
+        if self.history.len() < 3 {
+            self.history.push(Solved { tensions: tensions.to_vec(), state: self.state.clone(), local: self.local.clone() });
+            self.history.rotate_right(1);
+        } else {
+            self.history.rotate_right(1);
+            let h = &mut self.history[0];
+            h.tensions.copy_from_slice(tensions);
+            h.state.copy_from_slice(&self.state);
+            h.local.copy_from_slice(&self.local);
+        }
+        self.solved = (self.solved + 1).min(3);
+    }
+
+    /// Forgets the warm start (after a failed solve).
+    fn forget(&mut self) {
+        self.solved = 0;
+        self.anderson.clear();
+        let ratio_at = self.ratio_at;
+        self.state.iter_mut().enumerate().for_each(|(i, v)| *v = if i >= ratio_at { 1.0 } else { 0.0 });
+        self.local.iter_mut().for_each(|l| *l = [1.0, 0.0, 0.0, 0.0, 0.0, 0.0]);
+        self.inverse.iter_mut().for_each(|f| *f = None);
+    }
+
+    /// Predicts the state for `tensions` from the previous solves: Lagrange
+    /// extrapolation along the line of the last tension steps when they are
+    /// collinear (a ladder), the newest solve otherwise.
+    fn predict(&mut self, tensions: &[f64]) {
+        if self.solved == 0 {
+            return;
+        }
+        let newest = &self.history[0];
+        let origin = &newest.tensions;
+        let step: Vec<f64> = tensions.iter().zip(origin).map(|(a, b)| a - b).collect();
+        let norm = step.iter().map(|d| d * d).sum::<f64>().sqrt();
+        // Parameter λ along `step` of each earlier solve, if it lies on the line.
+        let mut params = vec![0.0];
+        if norm > 0.0 {
+            for h in &self.history[1..self.solved] {
+                let d: Vec<f64> = h.tensions.iter().zip(origin).map(|(a, b)| a - b).collect();
+                let lambda = d.iter().zip(&step).map(|(a, b)| a * b).sum::<f64>() / (norm * norm);
+                let off = d.iter().zip(&step).map(|(a, b)| (a - lambda * b).powi(2)).sum::<f64>().sqrt();
+                if off > 1e-9 * (1.0 + norm) || params.iter().any(|p: &f64| (p - lambda).abs() < 1e-12) {
+                    break;
+                }
+                params.push(lambda);
+            }
+        }
+        let k = params.len();
+        let mut w = [0.0; 3];
+        for i in 0..k {
+            let mut weight = 1.0;
+            for j in 0..k {
+                if i != j {
+                    weight *= (1.0 - params[j]) / (params[i] - params[j]);
+                }
+            }
+            w[i] = weight;
+        }
+        if !w.iter().all(|v| v.is_finite()) {
+            w = [1.0, 0.0, 0.0];
+        }
+        for (i, v) in self.state.iter_mut().enumerate() {
+            *v = (0..k).map(|h| w[h] * self.history[h].state[i]).sum();
+        }
+        for (i, l) in self.local.iter_mut().enumerate() {
+            *l = std::array::from_fn(|c| (0..k).map(|h| w[h] * self.history[h].local[i][c]).sum());
+        }
+    }
+
+    fn solve_inner(&mut self, tensions: &[f64]) -> Result<u32, SpatialFailure> {
+        let has_weight = self.has_weight && self.weight_fraction > 0.0;
+        let has_friction = self.friction && tensions.iter().any(|&t| t > 0.0);
+        if !has_weight && !has_friction {
+            self.sweep(tensions, true)?;
+            std::mem::swap(&mut self.state, &mut self.next);
+            return Ok(1);
+        }
+        let mut passes = 0u32;
+        let mut previous = f64::INFINITY;
+        self.anderson.restart();
+        let outcome = loop {
+            self.anderson.input_mut().copy_from_slice(&self.state);
+            let change = match self.sweep(tensions, true) {
+                Ok(c) => c,
+                Err(e) => break Err(e),
+            };
+            passes += 1;
+            let settled = change.0 <= SWEEP_ANGLE_TOLERANCE_RAD && change.1 <= self.options.moment_tolerance_n_mm * self.m_scale && change.2 < FRICTION_TOLERANCE;
+            let change = change.0.max(change.1).max(change.2);
+            if settled && (passes == 1 || change <= 0.5 * previous || !has_weight) {
+                std::mem::swap(&mut self.state, &mut self.next);
+                break Ok(());
+            }
+            let most = if has_weight { MAX_SWEEPS } else { FRICTION_MAX_PASSES as u32 };
+            if !has_weight && passes >= most {
+                break Err(SpatialFailure::Friction);
+            }
+            if passes >= most || (has_weight && passes >= 3 && change > 0.5 * previous) {
+                break Err(SpatialFailure::Gravity { passes, residual_n_mm: change / self.m_scale });
+            }
+            previous = change;
+            self.anderson.output_mut().copy_from_slice(&self.next);
+            match self.anderson.step() {
+                Some(z) => self.state.copy_from_slice(z),
+                None => std::mem::swap(&mut self.state, &mut self.next),
+            }
+        };
+        match outcome {
+            Ok(()) => Ok(passes),
+            Err(SpatialFailure::Friction) => Err(SpatialFailure::Friction),
+            Err(_) => {
+                self.anderson.clear();
+                Ok(passes + self.newton_continued(tensions)?)
+            }
+        }
+    }
+
+    /// Newton from the current state; if it fails, continuation in the
+    /// weight from a weightless rod. Returns the Newton iterations.
+    fn newton_continued(&mut self, tensions: &[f64]) -> Result<u32, SpatialFailure> {
+        let saved = self.state.clone();
+        let saved_local = self.local.clone();
+        if let Ok(n) = self.newton(tensions) {
+            return Ok(n);
+        }
+        self.state.copy_from_slice(&saved);
+        self.local.copy_from_slice(&saved_local);
+        let full = self.weight_fraction;
+        self.weight_fraction = 0.0;
+        let mut iterations = 0;
+        let result = (|| -> Result<(), SpatialFailure> {
+            // Weightless: one sweep from any start.
+            self.sweep(tensions, true)?;
+            std::mem::swap(&mut self.state, &mut self.next);
+            let (mut reached, mut step) = (0.0f64, FIRST_WEIGHT_STEP);
+            while reached < 1.0 {
+                let next = (reached + step).min(1.0);
+                let (state, local) = (self.state.clone(), self.local.clone());
+                self.weight_fraction = full * next;
+                match self.newton(tensions) {
+                    Ok(n) => {
+                        iterations += n;
+                        reached = next;
+                        step = (step * 2.0).min(MAX_WEIGHT_STEP);
+                    }
+                    Err(_) => {
+                        self.state.copy_from_slice(&state);
+                        self.local.copy_from_slice(&local);
+                        step /= 2.0;
+                        if step < MIN_WEIGHT_STEP {
+                            return Err(SpatialFailure::Gravity { passes: iterations, residual_n_mm: f64::NAN });
+                        }
+                    }
+                }
+            }
+            Ok(())
+        })();
+        self.weight_fraction = full;
+        if let Err(e) = result {
+            self.state.copy_from_slice(&saved);
+            self.local.copy_from_slice(&saved_local);
+            return Err(e);
+        }
+        Ok(iterations)
+    }
+
+    /// Newton's method on F(z) = z − G(z) (G: one sweep), with the Jacobian
+    /// by finite differences of sweeps and backtracking on |F|.
+    fn newton(&mut self, tensions: &[f64]) -> Result<u32, SpatialFailure> {
+        let n = self.state.len();
+        let residual = |this: &mut Self, commit: bool| -> Result<DVector<f64>, SpatialFailure> {
+            this.sweep(tensions, commit)?;
+            Ok(DVector::from_iterator(n, this.state.iter().zip(&this.next).map(|(z, g)| z - g)))
+        };
+        let mut f = residual(self, true)?;
+        let mut norm = f.amax();
+        let mut jac = DMatrix::<f64>::zeros(n, n);
+        for it in 0..NEWTON_MAX_ITERATIONS {
+            if norm <= NEWTON_TOLERANCE {
+                return Ok(it);
+            }
+            let base = self.state.clone();
+            let g0 = self.next.clone();
+            for k in 0..n {
+                let eps = 1e-7 * (1.0 + base[k].abs());
+                self.state[k] = base[k] + eps;
+                self.sweep(tensions, false)?;
+                for i in 0..n {
+                    let fi = (self.state[i] - self.next[i]) - (base[i] - g0[i]);
+                    jac[(i, k)] = fi / eps;
+                }
+                self.state[k] = base[k];
+            }
+            let delta = jac.clone().lu().solve(&(-&f)).ok_or(SpatialFailure::Gravity { passes: it, residual_n_mm: norm })?;
+            let mut lambda = 1.0;
+            loop {
+                for i in 0..n {
+                    self.state[i] = base[i] + lambda * delta[i];
+                }
+                match residual(self, true) {
+                    Ok(fn_) if fn_.amax().is_finite() && fn_.amax() < (1.0 - NEWTON_SUFFICIENT_DECREASE * lambda) * norm => {
+                        norm = fn_.amax();
+                        f = fn_;
+                        break;
+                    }
+                    _ => {
+                        lambda /= 2.0;
+                        if lambda < NEWTON_MIN_DAMPING {
+                            self.state.copy_from_slice(&base);
+                            return Err(SpatialFailure::Gravity { passes: it, residual_n_mm: norm });
+                        }
+                    }
+                }
+            }
+        }
+        if norm <= 1e3 * NEWTON_TOLERANCE {
+            return Ok(NEWTON_MAX_ITERATIONS);
+        }
+        Err(SpatialFailure::Gravity { passes: NEWTON_MAX_ITERATIONS, residual_n_mm: norm })
+    }
+
+    /// The tension of cable `c` at node `i`, N.
+    #[inline]
+    fn tension_at(&self, tensions: &[f64], i: usize, c: usize) -> f64 {
+        let k = i * self.cables + c;
+        if !self.active[k] {
+            0.0
+        } else if self.friction {
+            tensions[c] * self.state[self.ratio_at + k]
+        } else {
+            tensions[c]
+        }
+    }
+
+    /// One sweep G(z) of the state in `self.state` into `self.next`:
+    /// frames from u (and θ₀), local solves with those frames and M_W,
+    /// then θ₀, frames, positions and M_W from the new strains. With
+    /// `commit` the local solutions, frames and positions become the
+    /// solver's (a finite-difference sweep of Newton's Jacobian leaves them).
+    /// Returns the largest changes of the frames (rad), of M_W (in angle
+    /// units, M_W·L/EI) and of the friction profiles.
+    fn sweep(&mut self, tensions: &[f64], commit: bool) -> Result<(f64, f64, f64), SpatialFailure> {
+        let nn = self.nodes_count();
+        let theta0 = V3::new(self.state[0], self.state[1], self.state[2]);
+        let mut ubuf = std::mem::take(&mut self.ubuf);
+        for i in 0..nn {
+            ubuf[i] = self.state_u(&self.state, i);
+        }
+        // Local solves (the frames of the input state matter only under a weight).
+        let w_scale = if self.has_weight { self.weight_fraction } else { 0.0 };
+        let mut rot_in = std::mem::take(&mut self.rot_in);
+        if w_scale > 0.0 {
+            self.frames(&ubuf, exp_so3(&theta0), &mut rot_in);
+        }
+        let mut clamp_moment = V3::zeros();
+        let mut failed = None;
+        for i in 0..nn {
+            let (nw, mw) = if w_scale > 0.0 {
+                let rt = rot_in[i].transpose();
+                (rt * (self.gravity_unit * (self.distal_weight[i] * w_scale)), rt * self.state_m(&self.state, i))
+            } else {
+                (V3::zeros(), V3::zeros())
+            };
+            match self.local_solve(i, tensions, nw, mw, commit) {
+                Ok(x) => {
+                    ubuf[i] = V3::new(x[3], x[4], x[5]);
+                    self.vbuf[i] = V3::new(x[0], x[1], x[2]);
+                    if i == 0 {
+                        clamp_moment = self.moment_of_curvature(&ubuf[0], 0);
+                    }
+                    if commit {
+                        self.local[i] = x;
+                    }
+                }
+                Err(e) => {
+                    failed = Some(e);
+                    break;
+                }
+            }
+        }
+        self.rot_in = rot_in;
+        if let Some(e) = failed {
+            self.ubuf = ubuf;
+            return Err(e);
+        }
+        // θ₀ from the clamp's moment (a rotational spring about both bending axes).
+        let theta0_out = match self.clamp_stiffness {
+            Some(k) => V3::new(0.0, clamp_moment[1] / k, clamp_moment[2] / k),
+            None => V3::zeros(),
+        };
+        let mut change = (theta0_out - theta0).amax();
+        let mut rot_out = if commit { std::mem::take(&mut self.rot) } else { std::mem::take(&mut self.rot_alt) };
+        self.frames(&ubuf, exp_so3(&theta0_out), &mut rot_out);
+        for i in 0..nn {
+            self.dp[i] = rot_out[i] * self.vbuf[i];
+        }
+        if commit {
+            for i in 0..nn {
+                self.speed[i] = self.vbuf[i].norm();
+            }
+        }
+        if commit {
+            self.rot = rot_out;
+        } else {
+            self.rot_alt = rot_out;
+        }
+        // M_W from the new frames and strains.
+        let mut mom = std::mem::take(&mut self.mbuf);
+        if w_scale > 0.0 {
+            for i in 0..nn {
+                self.dmom[i] = -self.dp[i].cross(&(self.gravity_unit * (self.distal_weight[i] * w_scale)));
+            }
+            self.integrate_backward(&mut mom);
+        } else {
+            mom.iter_mut().for_each(|m| *m = V3::zeros());
+        }
+        self.next[0..3].copy_from_slice(theta0_out.as_slice());
+        let mut change_m = 0.0f64;
+        // The frames' change (as the planar solver's change of φ): under a
+        // weight, between the input's and the output's frames; without one
+        // a single sweep is the solution.
+        if w_scale > 0.0 {
+            let out = if commit { &self.rot } else { &self.rot_alt };
+            for (a, b) in self.rot_in.iter().zip(out) {
+                let d = a.transpose() * b;
+                let skew = V3::new(d[(2, 1)] - d[(1, 2)], d[(0, 2)] - d[(2, 0)], d[(1, 0)] - d[(0, 1)]);
+                change = change.max(0.5 * skew.amax());
+            }
+        }
+        for i in 0..nn {
+            let uo = ubuf[i] * self.u_scale;
+            self.next[3 + 3 * i..6 + 3 * i].copy_from_slice(uo.as_slice());
+            let at = 3 + 3 * nn + 3 * i;
+            let mo = mom[i] * self.m_scale;
+            change_m = change_m.max((mo - V3::new(self.state[at], self.state[at + 1], self.state[at + 2])).amax());
+            self.next[at..at + 3].copy_from_slice(mo.as_slice());
+        }
+        self.ubuf = ubuf;
+        self.mbuf = mom;
+        let change_ratio = if self.friction { self.friction_profiles(commit) } else { 0.0 };
+        if commit {
+            self.positions();
+            if self.creep.is_on() {
+                for i in 0..nn {
+                    let x = self.local[i];
+                    let m = self.moment_of_curvature(&V3::new(x[3], x[4], x[5]), i);
+                    let ei = self.section[i].ei;
+                    self.creep.record_moment(2 * i, m[1], ei);
+                    self.creep.record_moment(2 * i + 1, m[2], ei);
+                }
+            }
+        }
+        if !(change + change_m + change_ratio).is_finite() {
+            return Err(SpatialFailure::NonFinite);
+        }
+        Ok((change, change_m, change_ratio))
+    }
+
+    #[inline]
+    fn state_u(&self, state: &[f64], i: usize) -> V3 {
+        V3::new(state[3 + 3 * i], state[4 + 3 * i], state[5 + 3 * i]) / self.u_scale
+    }
+
+    #[inline]
+    fn state_m(&self, state: &[f64], i: usize) -> V3 {
+        let at = 3 + 3 * self.nodes_count() + 3 * i;
+        V3::new(state[at], state[at + 1], state[at + 2]) / self.m_scale
+    }
+
+    /// Frames at the nodes from the curvatures `u` and the clamp frame `r0`:
+    /// sixth-order Magnus steps between nodes (Blanes, Casas & Ros, with
+    /// u at the interval's three Gauss points) whose first term, ∫u, is the
+    /// exact integral of u's interpolant.
+    fn frames(&self, u: &[V3], r0: M3, out: &mut [M3]) {
+        let np = self.np;
+        let sqrt15 = 15f64.sqrt();
+        let mut r = r0;
+        // One span's u by component (contiguous rows for the dot products).
+        let mut comp = [[0.0f64; MAX_NODES + 1]; 3];
+        for span in 0..self.spans() {
+            let base = span * np;
+            let h = self.half[span];
+            out[base] = r;
+            for (k, uk) in u[base..base + np].iter().enumerate() {
+                comp[0][k] = uk[0];
+                comp[1][k] = uk[1];
+                comp[2][k] = uk[2];
+            }
+            for j in 1..np {
+                let rows = &self.magnus[4 * (j - 1) * np..4 * j * np];
+                let mut g = [V3::zeros(); 4];
+                for (c, gc) in g.iter_mut().enumerate() {
+                    let row = &rows[c * np..(c + 1) * np];
+                    *gc = V3::new(dot(row, &comp[0][..np]), dot(row, &comp[1][..np]), dot(row, &comp[2][..np]));
+                }
+                let step = h * (self.xn[j] - self.xn[j - 1]);
+                let integral = g[0] * h;
+                let a1 = g[1] * step;
+                let a2 = g[2] * (sqrt15 * step / 3.0);
+                let a3 = g[3] * (10.0 * step / 3.0);
+                let c1 = a1.cross(&a2);
+                let c2 = a1.cross(&(c1 - a3 * 2.0)) / 60.0;
+                let omega = integral + (a1 * 20.0 + a3 + c1).cross(&(a2 - c2)) / 240.0;
+                r *= exp_so3(&omega);
+                out[base + j] = r;
+            }
+        }
+    }
+
+    /// Positions and deformed arc length from `self.dp` and the local v.
+    fn positions(&mut self) {
+        let np = self.np;
+        let (mut p0, mut s0) = (V3::zeros(), 0.0);
+        for span in 0..self.spans() {
+            let base = span * np;
+            let h = self.half[span];
+            for j in 0..np {
+                let row = &self.q[j * np..(j + 1) * np];
+                let (mut ap, mut asg) = (V3::zeros(), 0.0);
+                for k in 0..np {
+                    ap += self.dp[base + k] * row[k];
+                    asg += row[k] * self.speed[base + k];
+                }
+                self.pos[base + j] = p0 + ap * h;
+                self.sigma[base + j] = s0 + h * asg;
+            }
+            p0 = self.pos[base + np - 1];
+            s0 = self.sigma[base + np - 1];
+        }
+    }
+
+    /// M_W at the nodes from its rate in `self.dmom`, backward from M_W(L) = 0.
+    fn integrate_backward(&self, out: &mut [V3]) {
+        let np = self.np;
+        let mut end = V3::zeros();
+        for span in (0..self.spans()).rev() {
+            let base = span * np;
+            let h = self.half[span];
+            let last = &self.q[(np - 1) * np..np * np];
+            for j in 0..np {
+                let row = &self.q[j * np..(j + 1) * np];
+                let mut acc = V3::zeros();
+                for k in 0..np {
+                    acc += self.dmom[base + k] * (last[k] - row[k]);
+                }
+                out[base + j] = end - acc * h;
+            }
+            end = out[base];
+        }
+    }
+
+    /// Newton on the cut equations at node `i` (body-frame distal loads
+    /// `nw`, `mw`), warm-started from the last (or predicted) local
+    /// solution there. Steps use the inverse Jacobian kept from an earlier
+    /// solve (chord steps) while they contract fast, and a fresh one
+    /// otherwise; a step below [`LOCAL_STEP_TOLERANCE`] ends it (what is
+    /// left is about the contraction factor times that step).
+    fn local_solve(&mut self, i: usize, tensions: &[f64], nw: V3, mw: V3, commit: bool) -> Result<[f64; 6], SpatialFailure> {
+        let mut x = self.local[i];
+        let mut inverse = self.inverse[i];
+        let mut previous = f64::INFINITY;
+        // The last step taken and the residual before it (Broyden's update).
+        let mut last: Option<(Vector6<f64>, Vector6<f64>)> = None;
+        for _ in 0..LOCAL_MAX_ITERATIONS {
+            let fresh = inverse.is_none();
+            let (f, jacobian) = self.residual(i, tensions, &x, nw, mw, fresh);
+            let f = Vector6::from(f);
+            if let Some(j) = jacobian {
+                inverse = j.try_inverse();
+                if inverse.is_none() {
+                    break;
+                }
+            } else if let (Some((step, f_old)), Some(h)) = (last, inverse.as_mut()) {
+                // Broyden's ("good") update of the inverse Jacobian with the
+                // step just taken: chord steps then converge superlinearly,
+                // and the kept inverse follows the Jacobian from solve to solve.
+                let df = f - f_old;
+                let h_df = *h * df;
+                let denominator = step.dot(&h_df);
+                if denominator.abs() > 1e-300 {
+                    *h += (step - h_df) * (step.transpose() * *h) / denominator;
+                }
+            }
+            let inv = inverse.expect("set above");
+            let dx = -(inv * f);
+            let big = dx.amax();
+            if !big.is_finite() {
+                if fresh {
+                    break;
+                }
+                inverse = None;
+                last = None;
+                continue;
+            }
+            // Keep the axial stretch positive: a step through v1 = 0 would
+            // fold the rod onto itself.
+            let mut lambda = 1.0;
+            while x[0] + lambda * dx[0] < 0.05 && lambda > 1e-3 {
+                lambda *= 0.5;
+            }
+            // Far from the solution (a cold start, a large tension step),
+            // backtrack until the residual falls, so that Newton cannot
+            // jump to another branch of t = q/|q|.
+            if big > 0.02 {
+                let f0 = f.norm_squared();
+                while lambda > 1e-3 {
+                    let trial: [f64; 6] = std::array::from_fn(|k| x[k] + lambda * dx[k]);
+                    let (ft, _) = self.residual(i, tensions, &trial, nw, mw, false);
+                    let ft = Vector6::from(ft).norm_squared();
+                    if ft.is_finite() && ft < f0 {
+                        break;
+                    }
+                    lambda *= 0.5;
+                }
+            }
+            for k in 0..6 {
+                x[k] += lambda * dx[k];
+            }
+            if big < LOCAL_STEP_TOLERANCE && lambda == 1.0 && x[0] > 0.0 {
+                if commit {
+                    self.inverse[i] = inverse;
+                }
+                return Ok(x);
+            }
+            last = Some((dx * lambda, f));
+            // Steps that contract slowly: take a fresh Jacobian.
+            if !fresh && big > CHORD_CONTRACTION * previous {
+                inverse = None;
+                last = None;
+            }
+            previous = big;
+        }
+        if commit {
+            self.inverse[i] = None;
+        }
+        Err(SpatialFailure::Local { s_mm: self.s[i] })
+    }
+
+    /// The residual F(x) = x − x* − C(f(x)) of the cut equations at node `i`
+    /// (compliance form: f the internal force and moment, C the
+    /// constitutive law) and, when asked, its Jacobian.
+    fn residual(&self, i: usize, tensions: &[f64], x: &[f64; 6], nw: V3, mw: V3, jacobian: bool) -> ([f64; 6], Option<Matrix6<f64>>) {
+        let sec = self.section[i];
+        let v = V3::new(x[0], x[1], x[2]);
+        let u = V3::new(x[3], x[4], x[5]);
+        let mut n = nw;
+        let mut m = mw;
+        let (mut svv, mut svu, mut suv, mut suu) = (M3::zeros(), M3::zeros(), M3::zeros(), M3::zeros());
+        let nc = self.cables;
+        for c in 0..nc {
+            let tau = self.tension_at(tensions, i, c);
+            if tau == 0.0 {
+                continue;
+            }
+            let ch = self.chan[i * nc + c];
+            let q = v + u.cross(&ch.r) + ch.dr;
+            let len = q.norm();
+            let t = q / len;
+            n -= t * tau;
+            m -= ch.r.cross(&t) * tau;
+            if jacobian {
+                let p = (M3::identity() - t * t.transpose()) * (tau / len);
+                let rh = ch.r.cross_matrix();
+                let rp = rh * p;
+                svv += p;
+                svu -= p * rh;
+                suv += rp;
+                suu -= rp * rh;
+            }
+        }
+        // The constitutive law: v − v* = K_se⁻¹ n; u = c(m).
+        let fv = V3::new(v[0] - 1.0 - n[0] / sec.ea, v[1] - n[1] / sec.ga, v[2] - n[2] / sec.ga);
+        let (u_law, c_prime) = self.curvature_law(i, &m, &sec, jacobian);
+        let fu = u - u_law;
+        let f = [fv[0], fv[1], fv[2], fu[0], fu[1], fu[2]];
+        let jac = jacobian.then(|| {
+            let kv = M3::from_diagonal(&V3::new(1.0 / sec.ea, 1.0 / sec.ga, 1.0 / sec.ga));
+            let mut j = Matrix6::identity();
+            let jvv = M3::identity() + kv * svv;
+            let jvu = kv * svu;
+            let juv = c_prime * suv;
+            let juu = M3::identity() + c_prime * suu;
+            j.fixed_view_mut::<3, 3>(0, 0).copy_from(&jvv);
+            j.fixed_view_mut::<3, 3>(0, 3).copy_from(&jvu);
+            j.fixed_view_mut::<3, 3>(3, 0).copy_from(&juv);
+            j.fixed_view_mut::<3, 3>(3, 3).copy_from(&juu);
+            j
+        });
+        (f, jac)
+    }
+
+    /// The curvature u from the internal moment `m` (body frame) and, when
+    /// asked, du/dm: torsion u₁ = m₁/GJ; bending linear, m_b = EI u_b, or
+    /// with material stiffening m_b = EI u_b (1 + α r² |u_b|²) (isotropic:
+    /// u_b along m_b).
+    #[inline]
+    fn curvature_law(&self, i: usize, m: &V3, sec: &Section, derivative: bool) -> (V3, M3) {
+        let alpha = self.stiffening_alpha;
+        let hidden = self.rod.effects.hidden.rest_curvature_per_mm;
+        let (gain, off) = self.creep_terms(i, sec);
+        if alpha == 0.0 {
+            let b = 1.0 / sec.ei + gain;
+            let u = V3::new(m[0] / sec.gj, m[1] * b + off[1], m[2] * b + hidden + off[2]);
+            let d = if derivative { M3::from_diagonal(&V3::new(1.0 / sec.gj, b, b)) } else { M3::zeros() };
+            return (u, d);
+        }
+        let mb = (m[1] * m[1] + m[2] * m[2]).sqrt();
+        let c = alpha * sec.radius * sec.radius;
+        // Monotone cubic EI (k + c k³) = |m_b| for the bending magnitude k.
+        let mut k = mb / sec.ei;
+        for _ in 0..STIFFENING_MAX_ITERATIONS {
+            let f = sec.ei * (k + c * k * k * k) - mb;
+            let step = f / (sec.ei * (1.0 + 3.0 * c * k * k));
+            k -= step;
+            if step.abs() <= STIFFENING_TOLERANCE * (1.0 + k.abs()) {
+                break;
+            }
+        }
+        let ratio = if mb > 0.0 { k / mb } else { 1.0 / sec.ei };
+        let u = V3::new(m[0] / sec.gj, m[1] * (ratio + gain) + off[1], m[2] * (ratio + gain) + hidden + off[2]);
+        let mut d = M3::zeros();
+        if derivative {
+            d[(0, 0)] = 1.0 / sec.gj;
+            let dk = 1.0 / (sec.ei * (1.0 + 3.0 * c * k * k));
+            if mb > 0.0 {
+                let (e1, e2) = (m[1] / mb, m[2] / mb);
+                // d(k m̂) = dk/d|m| m̂ m̂ᵀ + k/|m| (I − m̂ m̂ᵀ).
+                d[(1, 1)] = dk * e1 * e1 + ratio * (1.0 - e1 * e1);
+                d[(1, 2)] = dk * e1 * e2 - ratio * e1 * e2;
+                d[(2, 1)] = d[(1, 2)];
+                d[(2, 2)] = dk * e2 * e2 + ratio * (1.0 - e2 * e2);
+            } else {
+                d[(1, 1)] = dk;
+                d[(2, 2)] = dk;
+            }
+            d[(1, 1)] += gain;
+            d[(2, 2)] += gain;
+        }
+        (u, d)
+    }
+
+    /// The internal moment (body frame, N·mm) whose curvature by the law
+    /// of [`SpatialSolver::curvature_law`] at node `i` is `u`: the
+    /// law's inverse (bending: m_b ∥ u_b − offset, its size from a scalar
+    /// cubic with stiffening and creep).
+    fn moment_of_curvature(&self, u: &V3, i: usize) -> V3 {
+        let sec = &self.section[i];
+        let hidden = self.rod.effects.hidden.rest_curvature_per_mm;
+        let (gain, off) = self.creep_terms(i, sec);
+        let ub = V3::new(0.0, u[1] - off[1], u[2] - hidden - off[2]);
+        let size = ub.norm();
+        let c = self.stiffening_alpha * sec.radius * sec.radius;
+        let ge = gain * sec.ei;
+        // The elastic law's curvature k, with k + g EI (k + c k³) = |u_b|
+        // (explicit without creep); then m_b = EI (k + c k³).
+        let mut k = size / (1.0 + ge);
+        if c > 0.0 && ge > 0.0 {
+            for _ in 0..STIFFENING_MAX_ITERATIONS {
+                let f = (1.0 + ge) * k + ge * c * k * k * k - size;
+                let step = f / (1.0 + ge + 3.0 * ge * c * k * k);
+                k -= step;
+                if step.abs() <= STIFFENING_TOLERANCE * (1.0 + k.abs()) {
+                    break;
+                }
+            }
+        }
+        let mb = sec.ei * (k + c * k * k * k);
+        let scale = if size > 0.0 { mb / size } else { 0.0 };
+        V3::new(sec.gj * u[0], ub[1] * scale, ub[2] * scale)
+    }
+
+    /// Creep's extra compliance over the hold and its held curvature at
+    /// node `i` (components about body y and z in 1 and 2).
+    #[inline]
+    fn creep_terms(&self, i: usize, sec: &Section) -> (f64, V3) {
+        if !self.creep.is_on() {
+            return (0.0, V3::zeros());
+        }
+        (self.creep.gain(sec.ei), V3::new(0.0, self.creep.offset(2 * i), self.creep.offset(2 * i + 1)))
+    }
+
+    /// Friction: each cable's tension profile τ_c(s)/τ_c(0) = exp(−μ η Θ_c(s))
+    /// from the turning Θ_c of its global direction R t_c, summed over a
+    /// fine grid of the direction's interpolant (exact where it turns in a
+    /// plane between grid points); written into the next state. Returns
+    /// the largest change.
+    fn friction_profiles(&mut self, commit: bool) -> f64 {
+        let np = self.np;
+        let nc = self.cables;
+        let nn = self.nodes_count();
+        let rot = if commit { &self.rot } else { &self.rot_alt };
+        for i in 0..nn {
+            let v = self.vbuf[i];
+            let u = self.next_u(i);
+            for c in 0..nc {
+                let ch = &self.chan[i * nc + c];
+                let q = v + u.cross(&ch.r) + ch.dr;
+                self.global_dir[i * nc + c] = rot[i] * q.normalize();
+            }
+        }
+        let mut change = 0.0f64;
+        for c in 0..nc {
+            let mut turning = 0.0;
+            for span in 0..self.spans() {
+                let base = span * np;
+                for j in 0..np {
+                    let i = base + j;
+                    if j > 0 && self.active[i * nc + c] {
+                        let mut prev = self.global_dir[(i - 1) * nc + c];
+                        for k in 1..=FRICTION_SUBSTEPS {
+                            let g = if k == FRICTION_SUBSTEPS {
+                                self.global_dir[i * nc + c]
+                            } else {
+                                let row = &self.fine[((j - 1) * (FRICTION_SUBSTEPS - 1) + (k - 1)) * np..][..np];
+                                let mut g = V3::zeros();
+                                for (w, jj) in row.iter().zip(0..np) {
+                                    g += self.global_dir[(base + jj) * nc + c] * *w;
+                                }
+                                g
+                            };
+                            turning += prev.cross(&g).norm().atan2(prev.dot(&g));
+                            prev = g;
+                        }
+                    }
+                    let at = self.ratio_at + i * nc + c;
+                    let ratio = (-self.signed_mu * turning).exp();
+                    change = change.max((ratio - self.state[at]).abs());
+                    self.next[at] = ratio;
+                }
+            }
+        }
+        change
+    }
+
+    /// u at node `i` of the sweep's output (in `self.next`).
+    #[inline]
+    fn next_u(&self, i: usize) -> V3 {
+        V3::new(self.next[3 + 3 * i], self.next[4 + 3 * i], self.next[5 + 3 * i]) / self.u_scale
+    }
+
+    /// The pose of the converged state.
+    fn pose_of_state(&self, passes: u32) -> SpatialPose {
+        let tip = self.nodes_count() - 1;
+        let r = &self.rot[tip];
+        let x = &self.local[tip];
+        let t = (r * V3::new(x[0], x[1], x[2])).normalize();
+        SpatialPose {
+            tip_mm: [self.pos[tip][0], self.pos[tip][1], self.pos[tip][2]],
+            tip_tangent: [t[0], t[1], t[2]],
+            tip_body_y_axis: [r[(0, 1)], r[(1, 1)], r[(2, 1)]],
+            tip_angle_rad: t[0].clamp(-1.0, 1.0).acos(),
+            length_mm: self.sigma[tip],
+            passes,
+        }
+    }
+
+    /// Refuses a pose whose estimated tip error is above
+    /// [`crate::model::solver::tip_tolerance_mm`], or whose tip lies farther
+    /// from the clamp than the stretched rod is long (no curve can).
+    fn check_resolved(&self, pose: &SpatialPose) -> Result<(), crate::model::solver::Unresolved> {
+        let tolerance = crate::model::solver::tip_tolerance_mm(self.rod.length_mm);
+        let [x, y, z] = pose.tip_mm;
+        let reach = (x * x + y * y + z * z).sqrt();
+        if reach > pose.length_mm + tolerance {
+            let what = format!(
+                "the tip (|tip| = {} mm is more than the stretched length ℓ = {} mm)",
+                crate::io::fmt_num(reach),
+                crate::io::fmt_num(pose.length_mm)
+            );
+            return Err(self.unresolved(what, reach - pose.length_mm, tolerance, "mm"));
+        }
+        let (_, tip_error) = self.error_estimate();
+        if !(tip_error <= tolerance) {
+            return Err(self.unresolved("the tip position".into(), tip_error, tolerance, "mm"));
+        }
+        Ok(())
+    }
+
+    /// The centreline of the last solve at 2·steps_per_span + 1 evenly
+    /// spaced points (the option's centreline resolution) and at every
+    /// span boundary.
+    pub fn centreline(&self) -> Vec<SpatialNode> {
+        self.nodes(2 * self.options.steps_per_span + 1)
+    }
+
+    /// The pose of the last successful solve.
+    pub fn pose(&self) -> Option<SpatialPose> {
+        self.last
+    }
+
+    /// The tangent angle's and the tip's estimated errors of the last
+    /// solve (rad, mm): what the interpolants of u, p' and M_W' miss on each
+    /// span, about the size of their highest Chebyshev coefficients.
+    pub fn error_estimate(&self) -> (f64, f64) {
+        let np = self.np;
+        let (mut angle, mut moment, mut position) = (0.0, 0.0, 0.0);
+        let mut comps = [0.0; 9 * (MAX_NODES + 1)];
+        for span in 0..self.spans() {
+            let base = span * np;
+            let length = 2.0 * self.half[span];
+            for j in 0..np {
+                let x = &self.local[base + j];
+                let dp = self.dp[base + j];
+                let dm = if self.has_weight { -dp.cross(&(self.gravity_unit * self.distal_weight[base + j])) } else { V3::zeros() };
+                for c in 0..3 {
+                    comps[c * np + j] = x[3 + c];
+                    comps[(3 + c) * np + j] = dp[c];
+                    comps[(6 + c) * np + j] = dm[c];
+                }
+            }
+            let slice = |k: usize| &comps[k * np..(k + 1) * np];
+            let tails = chebyshev::tails_of(&self.tail, np, [slice(0), slice(1), slice(2), slice(3), slice(4), slice(5), slice(6), slice(7), slice(8)]);
+            let next = tails.map(next_coefficient);
+            angle += length * next[0].max(next[1]).max(next[2]);
+            position += length * next[3].max(next[4]).max(next[5]);
+            moment += length * next[6].max(next[7]).max(next[8]);
+        }
+        let ei_min = self.section.iter().map(|s| s.ei.min(s.gj)).fold(f64::INFINITY, f64::min);
+        let scale = ESTIMATE_SAFETY / (self.m * self.m) as f64;
+        let theta = scale * (angle + moment * self.rod.length_mm / ei_min);
+        let ell = self.sigma[self.nodes_count() - 1];
+        (theta, scale * position + ell * theta)
+    }
+
+    /// Legendre coefficients of the last solve, order `order`, in `basis`:
+    /// `[twist, bending about body y, bending about body z]`, each
+    /// a_0 … a_order in 1/mm (see the module comment). Refused as unresolved
+    /// when their estimated error is above
+    /// [`crate::model::resolution::ORDER_TOLERANCE_PER_MM`] (the message
+    /// names the setting to raise).
+    pub fn coefficients(&self, order: usize, basis: LengthBasis) -> Result<[Vec<f64>; 3], SpatialError> {
+        let (a, error) = self.coefficients_with_error(order, basis)?;
+        let tolerance = crate::model::resolution::ORDER_TOLERANCE_PER_MM;
+        if !(error <= tolerance) {
+            return Err(SpatialFailure::Unresolved(self.unresolved(format!("a_0 … a_{order}"), error, tolerance, "mm⁻¹")).into());
+        }
+        Ok(a)
+    }
+
+    /// [`SpatialSolver::unresolved`]'s failure at this solver's resolution.
+    fn unresolved(&self, what: String, estimate: f64, tolerance: f64, unit: &'static str) -> crate::model::solver::Unresolved {
+        let advice = format!(
+            "raise --nodes-per-span above {} (spec: [solver] nodes_per_span; at most {}), or lower the tensions",
+            self.m,
+            crate::model::solver::MAX_NODES_PER_SPAN
+        );
+        crate::model::solver::Unresolved { what, estimate, tolerance, unit, advice }
+    }
+
+    /// [`SpatialSolver::coefficients`] without the check, with the estimated
+    /// error of the largest coefficient, 1/mm.
+    pub fn coefficients_with_error(&self, order: usize, basis: LengthBasis) -> Result<([Vec<f64>; 3], f64), SpatialError> {
+        if order > MAX_SPATIAL_ORDER {
+            return Err(SpatialError::Option(format!("order {order} is above the spatial solver's highest order {MAX_SPATIAL_ORDER}")));
+        }
+        assert!(self.last.is_some(), "coefficients needs a successful solve");
+        let np = self.np;
+        let nn = self.nodes_count();
+        let length = self.rod.length_mm;
+        let ell = self.sigma[nn - 1];
+        let (theta_error, _) = self.error_estimate();
+        // κ at the nodes (body frame): u − (u·v̂) v̂ + v̂ × v̂'.
+        let mut kappa = vec![V3::zeros(); nn];
+        let mut vhat = vec![V3::zeros(); nn];
+        for i in 0..nn {
+            let x = &self.local[i];
+            vhat[i] = V3::new(x[0], x[1], x[2]).normalize();
+        }
+        for span in 0..self.spans() {
+            let base = span * np;
+            for j in 0..np {
+                let row = &self.diff[j * np..(j + 1) * np];
+                let mut d = V3::zeros();
+                for k in 0..np {
+                    d += vhat[base + k] * row[k];
+                }
+                let dv = d / self.half[span];
+                let x = &self.local[base + j];
+                let u = V3::new(x[3], x[4], x[5]);
+                let vh = vhat[base + j];
+                let mut k = u - vh * u.dot(&vh) + vh.cross(&dv);
+                k[0] = u[0];
+                kappa[base + j] = k;
+            }
+        }
+        let mut out: [Vec<f64>; 3] = std::array::from_fn(|_| vec![0.0; order + 1]);
+        let mut quadrature_error = vec![0.0f64; order + 1];
+        let mut values = vec![0.0; (order + 1) * 3 * np];
+        for span in 0..self.spans() {
+            let base = span * np;
+            let h = self.half[span];
+            for j in 0..np {
+                let i = base + j;
+                let t = 2.0 * self.sigma[i] / ell - 1.0;
+                let mut legendre = LegendreSeries::new(t);
+                let w = h * self.q[(np - 1) * np + j];
+                for n in 0..=order {
+                    if n > 0 {
+                        legendre.advance();
+                    }
+                    let p = legendre.value();
+                    for k in 0..3 {
+                        out[k][n] += w * p * kappa[i][k];
+                        values[(n * 3 + k) * np + j] = p * kappa[i][k];
+                    }
+                }
+            }
+            for n in 0..=order {
+                let worst = (0..3)
+                    .map(|k| {
+                        let [tail] = chebyshev::tails_of(&self.tail, np, [&values[(n * 3 + k) * np..(n * 3 + k + 1) * np]]);
+                        next_coefficient(tail)
+                    })
+                    .fold(0.0, f64::max);
+                quadrature_error[n] += 2.0 * h * worst;
+            }
+            // The tangent's jump to the next span (where v jumps).
+            if span + 1 < self.spans() {
+                let (a, b) = (vhat[base + np - 1], vhat[base + np]);
+                let axis = a.cross(&b);
+                let sin = axis.norm();
+                if sin > 0.0 {
+                    let jump = axis * (sin.atan2(a.dot(&b)) / sin);
+                    let t = 2.0 * self.sigma[base + np - 1] / ell - 1.0;
+                    let mut legendre = LegendreSeries::new(t);
+                    for n in 0..=order {
+                        if n > 0 {
+                            legendre.advance();
+                        }
+                        for k in 1..3 {
+                            out[k][n] += legendre.value() * jump[k];
+                        }
+                    }
+                }
+            }
+        }
+        let factor = match basis {
+            LengthBasis::Rest => 1.0,
+            LengthBasis::Deformed => length / ell,
+        };
+        for series in out.iter_mut() {
+            for (n, a) in series.iter_mut().enumerate() {
+                *a *= factor * (2 * n + 1) as f64 / length;
+            }
+        }
+        let scale = ESTIMATE_SAFETY / (self.m * self.m) as f64;
+        let error = (0..=order)
+            .map(|n| {
+                let nf = n as f64;
+                let angles = theta_error * (2.0 + (2.0 * nf * (nf + 1.0)).sqrt());
+                factor * (2.0 * nf + 1.0) / length * (scale * quadrature_error[n] + angles)
+            })
+            .fold(0.0, f64::max);
+        Ok((out, error))
+    }
+
+    /// The centreline of the last solve at `count` evenly spaced points
+    /// (and at each anchor before the tip), interpolated from the nodes.
+    pub fn nodes(&self, count: usize) -> Vec<SpatialNode> {
+        assert!(self.last.is_some(), "nodes needs a successful solve");
+        let np = self.np;
+        let nn = self.nodes_count();
+        let length = self.rod.length_mm;
+        let count = count.max(2);
+        let mut samples: Vec<f64> = (0..count).map(|k| length * k as f64 / (count - 1) as f64).collect();
+        for &b in &self.start[1..] {
+            if !samples.contains(&b) {
+                samples.insert(samples.partition_point(|&s| s < b), b);
+            }
+        }
+        // Quaternions of the node frames, sign-continuous.
+        let mut quats: Vec<[f64; 4]> = Vec::with_capacity(nn);
+        let mut prev: Option<UnitQuaternion<f64>> = None;
+        for r in &self.rot {
+            let mut q = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(*r));
+            if let Some(p) = prev {
+                if p.coords.dot(&q.coords) < 0.0 {
+                    q = UnitQuaternion::new_unchecked(-q.into_inner());
+                }
+            }
+            prev = Some(q);
+            quats.push([q.w, q.i, q.j, q.k]);
+        }
+        samples
+            .into_iter()
+            .map(|s| {
+                let span = self.start[1..].iter().take_while(|&&b| s > b).count().min(self.spans() - 1);
+                let x = ((s - self.start[span]) / self.half[span] - 1.0).clamp(-1.0, 1.0);
+                let base = span * np;
+                let at = |f: &dyn Fn(usize) -> f64| {
+                    let vals: Vec<f64> = (0..np).map(|j| f(base + j)).collect();
+                    chebyshev::interpolate(&self.xn, &vals, x)
+                };
+                let p = [at(&|i| self.pos[i][0]), at(&|i| self.pos[i][1]), at(&|i| self.pos[i][2])];
+                let qv: [f64; 4] = std::array::from_fn(|c| at(&|i| quats[i][c]));
+                let q = UnitQuaternion::from_quaternion(Quaternion::new(qv[0], qv[1], qv[2], qv[3]));
+                let r = q.to_rotation_matrix().into_inner();
+                SpatialNode {
+                    s_mm: s,
+                    p_mm: p,
+                    rotation: std::array::from_fn(|a| std::array::from_fn(|b| r[(a, b)])),
+                    v: std::array::from_fn(|c| at(&|i| self.local[i][c])),
+                    u_per_mm: std::array::from_fn(|c| at(&|i| self.local[i][3 + c])),
+                    arc_length_mm: at(&|i| self.sigma[i]),
+                }
+            })
+            .collect()
+    }
+
+    /// Each cable's deformed path length from the clamp to its anchor, mm
+    /// (∫ |q_i| ds over the nodes where it pulls, by the span quadrature).
+    pub fn cable_path_lengths_mm(&self) -> Vec<f64> {
+        let np = self.np;
+        let nc = self.cables;
+        let mut out = vec![0.0; nc];
+        for span in 0..self.spans() {
+            let base = span * np;
+            let h = self.half[span];
+            for c in 0..nc {
+                if !self.active[base * nc + c] {
+                    continue;
+                }
+                for j in 0..np {
+                    let x = &self.local[base + j];
+                    let ch = &self.chan[(base + j) * nc + c];
+                    let q = V3::new(x[0], x[1], x[2]) + V3::new(x[3], x[4], x[5]).cross(&ch.r) + ch.dr;
+                    out[c] += h * self.q[(np - 1) * np + j] * q.norm();
+                }
+            }
+        }
+        out
+    }
+}
+
+/// Σ a_k b_k, with four partial sums (instruction-level parallelism).
+#[inline]
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let mut acc = [0.0; 4];
+    let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
+    let (ra, rb) = (ca.remainder(), cb.remainder());
+    for (x, y) in ca.zip(cb) {
+        for k in 0..4 {
+            acc[k] += x[k] * y[k];
+        }
+    }
+    let mut sum = (acc[0] + acc[1]) + (acc[2] + acc[3]);
+    for (x, y) in ra.iter().zip(rb) {
+        sum += x * y;
+    }
+    sum
+}
+
+/// exp of the skew matrix of `w` (Rodrigues).
+#[inline]
+fn exp_so3(w: &V3) -> M3 {
+    let theta2 = w.norm_squared();
+    let k = w.cross_matrix();
+    let (a, b) = if theta2 < 1e-12 {
+        (1.0 - theta2 / 6.0, 0.5 - theta2 / 24.0)
+    } else {
+        let theta = theta2.sqrt();
+        (theta.sin() / theta, (1.0 - theta.cos()) / theta2)
+    };
+    M3::identity() + k * a + k * k * b
+}
+
+/// Checks every cable's channel against the body's radius r(s) along s:
+/// |r_c(s)| < r(s) (the uniform rod's check is in [`super::cable::validate`]).
+fn check_channels_inside(actuator: &Actuator, channels: &[Channel], body: &Body, offset_y_mm: f64) -> Result<(), SpatialError> {
+    let length = actuator.rod.length_mm;
+    for (index, (channel, cable)) in channels.iter().zip(&actuator.cables).enumerate() {
+        let anchor = cable.anchor_or_tip_mm(length);
+        let n = 2048;
+        for k in 0..=n {
+            let s = anchor * k as f64 / n as f64;
+            let p = channel.at(s);
+            let distance = (p.r_mm[0] + offset_y_mm).hypot(p.r_mm[1]);
+            let radius = body.radius_at(s);
+            if distance >= radius {
+                return Err(SpatialError::OutsideBody { cable: index + 1, s_mm: s, distance_mm: distance, radius_mm: radius });
+            }
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::spatial::Cable;
+    use serde_json::Value;
+
+    fn cases() -> Vec<Value> {
+        let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/reference/multi-cable.json");
+        let v: Value = serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+        v["cases"].as_array().unwrap().clone()
+    }
+
+    fn arr<const N: usize>(v: &Value) -> [f64; N] {
+        let xs: Vec<f64> = v.as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
+        xs.try_into().unwrap()
+    }
+
+    fn actuator_for(case: &Value) -> Actuator {
+        let mut rod = Rod::default();
+        let g: [f64; 3] = arr(&case["gravity_N_per_mm"]);
+        let w = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
+        rod.gravity.enabled = w > 0.0;
+        let cables = case["cables"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| Cable::spatial(arr(&c["routing_y_mm"]), arr(&c["routing_z_mm"]), c["tension_N"].as_f64().unwrap()))
+            .collect();
+        let mut a = Actuator::with_cables(rod, cables);
+        if w > 0.0 {
+            a.gravity_direction = Some(g);
+        }
+        a
+    }
+
+    fn ladder(a: &Actuator, options: &SpatialOptions) -> Result<(SpatialSolver, SpatialPose), SpatialError> {
+        let mut sim = SpatialSolver::new(a, options)?;
+        let top = a.cables.iter().map(|c| c.tension_n).fold(0.0, f64::max);
+        let rungs = ((top / 0.25).ceil() as usize).max(1);
+        let mut pose = None;
+        for k in 1..=rungs {
+            pose = Some(sim.solve_scaled(k as f64 / rungs as f64)?);
+        }
+        Ok((sim, pose.unwrap()))
+    }
+
+    fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
+        ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+    }
+
+    /// A one-cable in-plane actuator (`rod`, routing `y`, tension `tau`,
+    /// anchor `anchor`) by the planar collocation solver and by this one:
+    /// tip distance (mm), tip angle difference (rad) and largest a_k
+    /// difference (1/mm).
+    fn planar_against_spatial(rod: &Rod, y: [f64; 5], tau: f64, anchor: Option<f64>) -> (f64, f64, f64) {
+        let mut planar_rod = rod.clone();
+        planar_rod.cable_anchor_mm = anchor;
+        let routing = crate::model::Routing::for_actuator(y, &planar_rod).unwrap();
+        let options = crate::model::SolverOptions { nodes_per_span: 24, ..Default::default() };
+        let p = crate::model::simulate(&planar_rod, &options, &routing, tau, 3, LengthBasis::Rest).unwrap();
+        let mut cable = Cable::planar(y, tau);
+        cable.anchor_mm = anchor;
+        let a = Actuator::with_cables(rod.clone(), vec![cable]);
+        let options = SpatialOptions { nodes_per_span: 24, ..Default::default() };
+        let sp = crate::model::spatial::simulate_spatial(&a, &options, 3, LengthBasis::Rest).unwrap();
+        let tip = dist(sp.pose.tip_mm, [p.pose.tip_x_mm, p.pose.tip_y_mm, 0.0]);
+        let angle = (sp.pose.tip_tangent[1].atan2(sp.pose.tip_tangent[0]) - p.pose.tip_angle_rad).abs();
+        let da = sp.a_bend_z.iter().zip(&p.a).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+        (tip, angle, da)
+    }
+
+    #[test]
+    fn in_plane_it_agrees_with_the_planar_solver_for_every_body_and_effect() {
+        let y = [3.0, -1.0, 2.5, 1.0, -2.0];
+        let taper = |r: &mut Rod| r.radius_profile_mm = vec![(0.0, 5.0), (40.0, 4.5), (65.0, 4.0)];
+        let segments = |r: &mut Rod| {
+            r.segments = vec![
+                crate::model::Segment { end_mm: 30.0, ea_n: None, ga_n: None, ei_n_mm2: Some(160.0), density_g_cm3: Some(1.2) },
+                crate::model::Segment { end_mm: 65.0, ea_n: None, ga_n: None, ei_n_mm2: None, density_g_cm3: None },
+            ]
+        };
+        type Case = (&'static str, fn(&mut Rod), Option<f64>);
+        let cases: Vec<Case> = vec![
+            ("uniform", |_| {}, None),
+            ("sideways gravity", |r| r.gravity.direction_rad = 1.2, None),
+            ("tapered", |r| r.radius_profile_mm = vec![(0.0, 5.0), (40.0, 4.5), (65.0, 4.0)], None),
+            ("segments", |r| {
+                r.segments = vec![
+                    crate::model::Segment { end_mm: 30.0, ea_n: None, ga_n: None, ei_n_mm2: Some(160.0), density_g_cm3: Some(1.2) },
+                    crate::model::Segment { end_mm: 65.0, ea_n: None, ga_n: None, ei_n_mm2: None, density_g_cm3: None },
+                ]
+            }, None),
+            ("anchored", |_| {}, Some(45.0)),
+            ("tapered and anchored", |r| r.radius_profile_mm = vec![(0.0, 5.0), (40.0, 4.5), (65.0, 4.0)], Some(50.0)),
+            ("friction, loading", |r| r.effects.friction_mu = 0.2, None),
+            ("friction, unloading", |r| {
+                r.effects.friction_mu = 0.2;
+                r.effects.load_direction = crate::model::LoadDirection::Unload;
+            }, None),
+            ("clamp compliance", |r| r.effects.clamp_stiffness_n_mm_per_rad = Some(300.0), None),
+            ("channel offset", |r| r.effects.channel_offset_mm = 0.4, None),
+            ("stiffening", |r| r.effects.stiffening_alpha = 2.0, None),
+            ("stiffness gradient", |r| r.effects.stiffness_gradient_beta = -0.8, None),
+            ("creep", |r| {
+                r.effects.creep_fraction = 0.3;
+                r.effects.creep_hold_s = 20.0;
+            }, None),
+        ];
+        let _ = (taper, segments);
+        let mut worst = (0.0f64, 0.0f64, 0.0f64);
+        for (name, set, anchor) in cases {
+            let mut rod = Rod::default();
+            set(&mut rod);
+            let (tip, angle, da) = planar_against_spatial(&rod, y, 1.6, anchor);
+            eprintln!("{name}: tip {tip:.1e} mm, angle {angle:.1e} rad, a {da:.1e} /mm");
+            assert!(tip < 1e-6 && angle < 1e-7 && da < 1e-7, "{name}: tip {tip:e} mm, angle {angle:e} rad, a_k {da:e} /mm");
+            worst = (worst.0.max(tip), worst.1.max(angle), worst.2.max(da));
+        }
+        eprintln!("worst: {worst:?}");
+    }
+
+    #[test]
+    fn every_reference_case_agrees_tightly() {
+        let mut worst = 0.0f64;
+        for case in cases() {
+            let a = actuator_for(&case);
+            let (sim, p) = ladder(&a, &SpatialOptions::default()).unwrap();
+            let tip = dist(p.tip_mm, arr(&case["tip_mm"]));
+            let t: [f64; 3] = arr(&case["tip_tangent"]);
+            let dot = (0..3).map(|i| t[i] * p.tip_tangent[i]).sum::<f64>().min(1.0);
+            let (theta, tip_err) = sim.error_estimate();
+            eprintln!("{}: tip off {tip:.2e} mm, tangent {:.2e} rad, length {:.2e}; estimate {tip_err:.1e} mm, {theta:.1e} rad; {} passes", case["name"], dot.acos(), (p.length_mm - case["deformed_length_mm"].as_f64().unwrap()).abs(), p.passes);
+            worst = worst.max(tip);
+        }
+        assert!(worst < 1e-4, "worst {worst:e}");
+    }
+}
+
+#[cfg(test)]
+mod timing {
+    use super::*;
+    use crate::model::spatial::SpatialRk4Solver;
+    use std::time::Instant;
+
+    /// Not a check: prints µs per solve of both 3-D solvers and the planar
+    /// one on the bench's cases (`cargo test --release -- --ignored timing --nocapture`).
+    #[test]
+    #[ignore]
+    fn print_timings() {
+        let pairs = crate::bench::sample_spatial_pairs(200, 5.0);
+        for gravity in [None, Some([1.0, 0.0, 0.0])] {
+            let mut rod = Rod::default();
+            rod.gravity.enabled = gravity.is_some();
+            let (mut t_col, mut t_rk4, mut n) = (0.0, 0.0, 0);
+            let mut passes = 0u64;
+            let mut worst = 0.0f64;
+            for pair in &pairs {
+                let mut a = Actuator::with_cables(rod.clone(), pair.to_vec());
+                a.gravity_direction = gravity;
+                let start = Instant::now();
+                let mut col = SpatialSolver::new(&a, &SpatialOptions::default()).unwrap();
+                let mut last = None;
+                for k in 0..21 {
+                    let t = 1.0 + k as f64 / 20.0;
+                    let p = col.solve(&[t, 0.5 * t]).unwrap();
+                    passes += p.passes as u64;
+                    let c = col.coefficients(3, LengthBasis::Rest).unwrap();
+                    std::hint::black_box(c);
+                    last = Some(p);
+                }
+                t_col += start.elapsed().as_secs_f64();
+                let start = Instant::now();
+                let mut rk = SpatialRk4Solver::new(&a, &SpatialOptions::default()).unwrap();
+                let mut last_rk = None;
+                for k in 0..21 {
+                    let t = 1.0 + k as f64 / 20.0;
+                    last_rk = Some(rk.solve(&[t, 0.5 * t]).unwrap());
+                    std::hint::black_box(rk.coefficients(3, LengthBasis::Rest).unwrap());
+                }
+                t_rk4 += start.elapsed().as_secs_f64();
+                let (p, q) = (last.unwrap(), last_rk.unwrap());
+                worst = worst.max((0..3).map(|i| (p.tip_mm[i] - q.tip_mm[i]).abs()).fold(0.0, f64::max));
+                n += 21;
+            }
+            eprintln!("passes per solve {:.2}", passes as f64 / n as f64);
+            eprintln!("gravity {gravity:?}: collocation {:.2} µs, rk4 {:.2} µs per solve; tips differ ≤ {worst:.1e} mm", t_col / n as f64 * 1e6, t_rk4 / n as f64 * 1e6);
+            let mut sim = crate::model::Simulator::new(&rod, &crate::model::SolverOptions::default()).unwrap();
+            let routings = crate::bench::sample_thesis_routings(200, 5.0);
+            let start = Instant::now();
+            let mut a = [0.0; 4];
+            for y in &routings {
+                sim.set_routing_mm(&y.0).unwrap();
+                for k in 0..21 {
+                    sim.solve(1.0 + k as f64 / 20.0).unwrap();
+                    sim.coefficients_into(LengthBasis::Rest, &mut a);
+                }
+            }
+            eprintln!("   planar {:.2} µs per solve", start.elapsed().as_secs_f64() / (21 * routings.len()) as f64 * 1e6);
+        }
+    }
+}
+
