@@ -23,8 +23,8 @@ pub enum SweepError {
         /// What is wrong.
         source: kind::InvalidSpec,
     },
-    /// A spec of another kind than planar (a cable sweep) is refused by the
-    /// engine: invalid, or larger than a sweep may be by default.
+    /// A spec the engine refuses ([`super::RunSpec::check`] of an in-memory
+    /// spec of any kind), or a cable sweep larger than a sweep may be by default.
     #[error("bad sweep spec {origin}: {message}")]
     InvalidSpec {
         /// The spec file, or where an in-memory spec came from.
