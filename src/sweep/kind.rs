@@ -1,9 +1,9 @@
 //! What a kind of sweep is to the engine: a spec that enumerates routings
 //! (ids 0..routings, each with the same number of rows) and solves one
 //! routing into rows of a fixed Arrow schema ([`RunSpec`]). The one engine
-//! (`sweep::run`) and the one run directory (`sweep::store`) serve every
-//! kind; each spec declares its kind once, in its `impl RunSpec`
-//! (`sweep::spec::planar`, `sweep::spec::cables`).
+//! ([`crate::sweep::run`]) and the one run directory ([`crate::sweep::store`])
+//! serve every kind; each spec declares its kind once, in its `impl RunSpec`
+//! ([`crate::sweep::spec::planar`], [`crate::sweep::spec::cables`]).
 //!
 //! Chunks, shards and row counts follow from [`ChunkLayout`] alone, so
 //! sharding, resume, checksums and status are the same code for every kind,
@@ -126,12 +126,12 @@ pub trait RunSpec: Clone + PartialEq + std::fmt::Debug + serde::Serialize + serd
 pub struct InvalidSpec(pub String);
 
 /// The kind of sweep a run directory holds, from its manifest's format tag
-/// (`sweep::store::run_kind` reads it).
+/// ([`crate::sweep::store::run_kind`] reads it).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum RunKind {
-    /// A planar single-cable sweep (`sweep::SweepSpec`).
+    /// A planar single-cable sweep ([`crate::sweep::SweepSpec`]).
     Planar,
-    /// A sweep of several or spatial cables (`sweep::CableSweepSpec`).
+    /// A sweep of several or spatial cables ([`crate::sweep::CableSweepSpec`]).
     Cables,
 }
 
