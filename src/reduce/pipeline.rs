@@ -3,7 +3,7 @@
 //! scratch samples, modes, grid, partitioned cells, pass 2 for the kept
 //! designs); [`reduce_run`] maps a planar sweep, and [`reduce_cable_run`] a
 //! cable sweep: its reach and, for a planar run, its feasibility map by the
-//! same stages ([`PlanarSource`] lays its rows out as planar rows).
+//! same stages (`source::PlanarSource` lays its rows out as planar rows).
 
 use super::drawings::ModeDrawings;
 use super::grid;

@@ -65,7 +65,7 @@ fn planar_row(sim: &mut Simulator, tension_n: f64, stored: Stored) -> SolvedRow 
 }
 
 /// A routing's tension grids, per cable (N), and their combinations in the
-/// order they are solved ([`snake`]). Computed once per worker.
+/// order they are solved (snake order). Computed once per worker.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TensionCombinations {
     /// Each cable's tension grid, N.
