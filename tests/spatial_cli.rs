@@ -162,12 +162,13 @@ fn bad_input_is_refused_with_a_clear_message() {
         (&["simulate", "--cable", "y=1,1,1,1,1 tension=1", "--gravity-direction", "0,0,0"], "non-zero"),
         (&["simulate", "--cable", "y=1,1,1,1,1 tension=1", "--gravity-direction", "0,1"], "3 numbers"),
         (&["simulate", "--cable", "y=1,1,1,1,1 z=0,1,1,1,0 tension=1", "--coefficients", "thesis"], "--coefficients thesis"),
-        (&["simulate", "--cable", "y=1,1,1,1,1 z=0,1,1,1,0 tension=1", "--friction-mu", "0.1"], "friction_mu"),
-        (&["simulate", "--cable", "y=1,1,1,1,1 z=0,1,1,1,0 tension=1", "--order", "7"], "--steps-per-span"),
+        (&["simulate", "--cable", "y=1,1,1,1,1 z=0,1,1,1,0 tension=1", "--method", "rk4", "--friction-mu", "0.1"], "friction_mu"),
+        (&["simulate", "--cable", "y=1,1,1,1,1 z=0,1,1,1,0 tension=1", "--method", "rk4", "--order", "7"], "--steps-per-span"),
+        (&["simulate", "--cable", "y=1,1,1,1,1 z=0,1,1,1,0 tension=1", "--order", "9"], "highest order 8"),
         (&["simulate", "--actuator", "/nonexistent/a.toml"], "/nonexistent/a.toml"),
-        (&["simulate", "--cable", "y=1,1,1,1,1 z=0,1,1,1,0 tension=1", "--radius-profile-mm", "0:5,65:3"], "uniform rod"),
-        (&["simulate", "--cable", "y=1,1,1,1,1 z=0,1,1,1,0 tension=1", "--cable-anchor-mm", "40"], "uniform rod"),
-        (&["simulate", "--cable", "y=1,1,1,1,1 z=0,1,1,1,0 tension=1", "--stiffness-gradient-beta", "-0.5"], "stiffness_gradient_beta"),
+        (&["simulate", "--cable", "y=1,1,1,1,1 z=0,1,1,1,0 tension=1", "--method", "rk4", "--radius-profile-mm", "0:5,65:3"], "uniform rod"),
+        (&["simulate", "--cable", "y=1,1,1,1,1 z=0,1,1,1,0 tension=1", "--cable-anchor-mm", "40"], "anchor=S"),
+        (&["simulate", "--cable", "y=1,1,1,1,1 z=0,1,1,1,0 tension=1", "--method", "rk4", "--stiffness-gradient-beta", "-0.5"], "stiffness_gradient_beta"),
         (&["simulate"], "--cable"),
     ];
     for (args, needle) in cases {

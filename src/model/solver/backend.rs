@@ -279,7 +279,7 @@ fn needs(actuator: &Actuator, options: &SolverOptions, given: Given) -> Vec<(Nee
         need(Need::NonUniformBody, "a tapered or segmented body (radius_profile_mm, segments): it models a uniform rod".into());
     }
     if rod.cable_anchor_mm.is_some() {
-        need(Need::RodAnchor, "the rod-level cable_anchor_mm (--cable-anchor-mm): give each cable its own anchor (anchor=S); it models a uniform rod".into());
+        need(Need::RodAnchor, "the rod-level cable_anchor_mm (--cable-anchor-mm): give each cable its own anchor (anchor=S)".into());
     }
     let length = rod.length_mm;
     let anchored = rod.cable_anchor_mm.is_some_and(|k| k < length) || actuator.cables.iter().any(|c| c.anchor_mm.is_some_and(|k| k < length));

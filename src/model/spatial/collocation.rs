@@ -112,7 +112,6 @@ struct Section {
 struct Chan {
     r: V3,
     dr: V3,
-    d2r: V3,
 }
 
 /// What the solver keeps of a converged solve, to extrapolate the next.
@@ -139,7 +138,8 @@ pub struct SpatialSolver {
     weight_fraction: f64,
     has_weight: bool,
     clamp_stiffness: Option<f64>,
-    stiffening_alpha: f64,
+    /// Material stiffening's α.
+    stiffening: f64,
     /// Cable–channel friction: on, and μ η (η the slip sign: +1 loading).
     friction: bool,
     signed_mu: f64,
@@ -291,7 +291,6 @@ impl SpatialSolver {
                         Chan {
                             r: V3::new(0.0, p.r_mm[0] + delta, p.r_mm[1]),
                             dr: V3::new(0.0, p.dr_ds[0], p.dr_ds[1]),
-                            d2r: V3::new(0.0, p.d2r_ds2[0], p.d2r_ds2[1]),
                         }
                     } else {
                         Chan::default()
@@ -346,7 +345,7 @@ impl SpatialSolver {
             weight_fraction: 1.0,
             has_weight,
             clamp_stiffness: rod.effects.clamp_stiffness_n_mm_per_rad,
-            stiffening_alpha: rod.effects.stiffening_alpha,
+            stiffening: rod.effects.stiffening_alpha,
             friction,
             signed_mu: rod.effects.friction_mu * rod.effects.load_direction.slip_sign(),
             ratio_at: 3 + 6 * nn,
@@ -1097,7 +1096,7 @@ impl SpatialSolver {
     /// u_b along m_b).
     #[inline]
     fn curvature_law(&self, i: usize, m: &V3, sec: &Section, derivative: bool) -> (V3, M3) {
-        let alpha = self.stiffening_alpha;
+        let alpha = self.stiffening;
         let hidden = self.rod.effects.hidden.rest_curvature_per_mm;
         let (gain, off) = self.creep_terms(i, sec);
         if alpha == 0.0 {
@@ -1151,7 +1150,7 @@ impl SpatialSolver {
         let (gain, off) = self.creep_terms(i, sec);
         let ub = V3::new(0.0, u[1] - off[1], u[2] - hidden - off[2]);
         let size = ub.norm();
-        let c = self.stiffening_alpha * sec.radius * sec.radius;
+        let c = self.stiffening * sec.radius * sec.radius;
         let ge = gain * sec.ei;
         // The elastic law's curvature k, with k + g EI (k + c k³) = |u_b|
         // (explicit without creep); then m_b = EI (k + c k³).

@@ -141,6 +141,21 @@ pub fn simulate_spatial(
     order: usize,
     basis: LengthBasis,
 ) -> Result<SpatialSimulation, SpatialError> {
+    simulate_spatial_held(actuator, options, order, basis, None)
+}
+
+/// [`simulate_spatial`] with the final tensions reached in direction
+/// `hold.direction` (friction) and held for `hold.dwell_s` from a virgin rod
+/// (creep); the ladder below is loaded as the effects say. `None` holds
+/// every rung as the actuator's effects say (collocation only: the RK4
+/// reference models no effect with a hold).
+pub fn simulate_spatial_held(
+    actuator: &Actuator,
+    options: &SpatialOptions,
+    order: usize,
+    basis: LengthBasis,
+    hold: Option<crate::model::Hold>,
+) -> Result<SpatialSimulation, SpatialError> {
     let top = actuator.cables.iter().map(|c| c.tension_n).fold(0.0, f64::max);
     crate::model::solver::check_ladder_tension("cable tension_n", top)?;
     if options.method == crate::model::SolverMethod::Rk4 {
@@ -151,7 +166,7 @@ pub fn simulate_spatial(
     }
     let mut options = options.clone();
     loop {
-        match solve_collocation_ladder(actuator, &options, order, basis) {
+        match solve_collocation_ladder(actuator, &options, order, basis, hold) {
             Err(SpatialError::Solve(SpatialFailure::Unresolved(_))) if options.nodes_per_span < crate::model::solver::MAX_NODES_PER_SPAN => {
                 options.nodes_per_span = (2 * options.nodes_per_span).min(crate::model::solver::MAX_NODES_PER_SPAN);
             }
@@ -161,12 +176,21 @@ pub fn simulate_spatial(
 }
 
 /// One ladder of the collocation solver at `options`, with its checks.
-fn solve_collocation_ladder(actuator: &Actuator, options: &SpatialOptions, order: usize, basis: LengthBasis) -> Result<SpatialSimulation, SpatialError> {
+fn solve_collocation_ladder(
+    actuator: &Actuator,
+    options: &SpatialOptions,
+    order: usize,
+    basis: LengthBasis,
+    hold: Option<crate::model::Hold>,
+) -> Result<SpatialSimulation, SpatialError> {
     let mut solver = SpatialSolver::new(actuator, options)?;
     let top = actuator.cables.iter().map(|c| c.tension_n).fold(0.0, f64::max);
     let rungs = ((top / 0.25).ceil() as usize).max(1);
     let mut pose = None;
     for k in 1..=rungs {
+        if let (true, Some(h)) = (k == rungs, hold) {
+            solver.set_hold(h)?;
+        }
         pose = Some(solver.solve_scaled(k as f64 / rungs as f64)?);
     }
     let pose = pose.expect("at least one rung");
@@ -305,9 +329,11 @@ pub fn simulate_actuator(
     actuator.channels()?;
     let backend = Backend::serving(actuator, options, given)?;
     if matches!(backend, Backend::Spatial | Backend::SpatialRk4) {
+        // One set of settings: the method picked the backend, and the
+        // collocation's intervals are the planar solver's option.
         let method = if backend == Backend::Spatial { crate::model::SolverMethod::Collocation } else { crate::model::SolverMethod::Rk4 };
-        let spatial_options = SpatialOptions { method, ..spatial_options.clone() };
-        let spatial = simulate_spatial(actuator, &spatial_options, order, basis)?;
+        let spatial_options = SpatialOptions { method, nodes_per_span: options.nodes_per_span, ..spatial_options.clone() };
+        let spatial = simulate_spatial_held(actuator, &spatial_options, order, basis, hold)?;
         return Ok(ActuatorSimulation { backend, planar: None, spatial });
     }
     let (rod, routing) = planar_problem(actuator)?;

@@ -879,12 +879,18 @@ impl SpatialRk4Solver {
     }
 }
 
-/// Checks that `order` is resolved with `options` (the message names the fix).
+/// Checks that `order` is resolved with `options` (the message names the
+/// fix): the collocation estimates its coefficients' error at every solve
+/// (up to [`MAX_SPATIAL_ORDER`]); the RK4 reference needs the steps of
+/// [`REQUIRED_SPATIAL_STEPS_PER_SPAN`].
 pub fn check_order(order: usize, options: &SpatialOptions) -> Result<(), SpatialError> {
     if order > MAX_SPATIAL_ORDER {
         return Err(SpatialError::Option(format!(
             "order {order} is above the spatial solver's highest order {MAX_SPATIAL_ORDER}"
         )));
+    }
+    if options.method == crate::model::SolverMethod::Collocation {
+        return Ok(());
     }
     let need = REQUIRED_SPATIAL_STEPS_PER_SPAN[order];
     if options.steps_per_span < need {

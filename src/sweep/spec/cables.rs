@@ -314,7 +314,7 @@ impl CableSweepSpec {
         // The base actuator (swept points at their first level) must be a
         // rod the 3-D solver models; a routing's own faults are its rows' status.
         let base = self.actuator_for(0, &self.dimensions());
-        match base.validate() {
+        match base.validate_for(crate::model::Backend::spatial(self.solver.method)) {
             Err(SpatialError::Parameter(e)) => return Err(bad(e.to_string())),
             Err(e @ SpatialError::Unsupported(_)) => return Err(bad(format!("[rod] {e}"))),
             Err(e @ SpatialError::GravityDirection(_)) => return Err(bad(e.to_string())),
@@ -542,8 +542,9 @@ levels_mm = [0.0, 1.5, -1.5]
             (SPEC.replace("count = 3", "count = 0"), "count = 0"),
             (SPEC.replace("min = 0.5", "min = -0.5"), "0 ≤ min"),
             (SPEC.replace("levels_mm = [1.0, 3.0]", "levels_mm = []"), "levels_mm"),
-            (SPEC.replace("[rod.gravity]", "[rod.effects]\nfriction_mu = 0.1\n[rod.gravity]"), "friction_mu"),
-            (format!("{SPEC}\n[output]\norder = 7\n"), "steps_per_span"),
+            (format!("{}\n[solver]\nmethod = \"rk4\"\n", SPEC.replace("[rod.gravity]", "[rod.effects]\nfriction_mu = 0.1\n[rod.gravity]")), "friction_mu"),
+            (format!("{SPEC}\n[output]\norder = 7\n[solver]\nmethod = \"rk4\"\n"), "steps_per_span"),
+            (format!("{SPEC}\n[output]\norder = 9\n"), "highest order 8"),
             (SPEC.replace("axis = \"z\"", "axis = \"x\""), "unknown variant"),
             (
                 SPEC.replace("y_mm = [2, 2, 2, 2, 2]", "y_mm = [2, 2, 2, 2, 2]\nanchor_mm = -1"),
