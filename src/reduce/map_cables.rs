@@ -11,7 +11,7 @@
 use super::cables::row_of_key;
 use super::ReduceError;
 use crate::model::routing::CONTROL_POINTS;
-use crate::model::spatial::record::{simulate_command, SimulateCommand};
+use crate::model::record::{simulate_command, SimulateCommand};
 use crate::model::spatial::Actuator;
 use crate::sweep::cables::{Axis, CableSweepSpec};
 use serde::{Deserialize, Serialize};

@@ -335,7 +335,7 @@ pub struct Row {
     /// Solver passes (0 when not solved).
     pub passes: i32,
     /// The pose of a solved row.
-    pub pose: Option<crate::model::spatial::SpatialPose>,
+    pub pose: Option<crate::model::TipPose>,
     /// Twist, out-of-plane and in-plane coefficient series of a solved row.
     pub a: Option<[Vec<f64>; 3]>,
 }
@@ -395,7 +395,7 @@ fn solve_routing(spec: &CableSweepSpec, id: u64, dims: &[Dimension], grids: &[Ve
         let t = tensions_of(combo);
         let solved = match solver.solve(&t) {
             Ok(pose) => match solver.coefficients(spec.output.order, spec.output.length_basis) {
-                Ok(a) if finite_row(&pose, &a) => row(combo, STATUS_OK, pose.passes as i32, Some(pose), Some(a)),
+                Ok(a) if finite_row(&pose, &a) => row(combo, STATUS_OK, pose.iterations as i32, Some(pose), Some(a)),
                 _ => row(combo, STATUS_FAILED, 0, None, None),
             },
             Err(_) => row(combo, STATUS_FAILED, 0, None, None),
@@ -408,9 +408,9 @@ fn solve_routing(spec: &CableSweepSpec, id: u64, dims: &[Dimension], grids: &[Ve
 
 /// A solve whose outputs are all finite (others are stored as failures, so
 /// that no output is NaN).
-fn finite_row(pose: &crate::model::spatial::SpatialPose, a: &[Vec<f64>; 3]) -> bool {
+fn finite_row(pose: &crate::model::TipPose, a: &[Vec<f64>; 3]) -> bool {
     let p = pose;
-    p.tip_mm.iter().chain(&p.tip_tangent).chain(&p.tip_body_y_axis).chain([&p.tip_angle_rad, &p.length_mm]).all(|v| v.is_finite())
+    p.tip_mm().iter().chain(&p.tip_tangent()).chain(&p.tip_body_y_axis()).chain([&p.angle_from_clamp_axis_rad(), &p.length_mm]).all(|v| v.is_finite())
         && a.iter().flatten().all(|v| v.is_finite())
 }
 
@@ -606,10 +606,11 @@ pub fn rows_batch(schema: &SchemaRef, rows: &[&Row], n_cables: usize, order: usi
     columns.push(Arc::new(Int32Array::from_iter_values(rows.iter().map(|r| r.passes))));
     let pose_value = |r: &Row, k: usize| {
         r.pose.map(|p| match k {
-            0..=2 => p.tip_mm[k],
-            3..=5 => p.tip_tangent[k - 3],
-            6..=8 => p.tip_body_y_axis[k - 6],
-            9 => p.tip_angle_rad,
+            0..=2 => p.tip_mm()[k],
+            3..=5 => p.tip_tangent()[k - 3],
+            6..=8 => p.tip_body_y_axis()[k - 6],
+            // The cable sweep's tip_angle_rad: unsigned, from the clamp axis.
+            9 => p.angle_from_clamp_axis_rad(),
             _ => p.length_mm,
         })
     };

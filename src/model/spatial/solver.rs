@@ -45,6 +45,7 @@
 
 use super::cable::{Channel, ChannelPoint3};
 use super::{Actuator, SpatialError};
+use crate::model::solver::result::{CableAtNode, CentrelinePoint, PerCable, TipFrame, TipPose};
 use crate::model::Rod;
 use crate::numerics::{rk4_step, Rk4Scratch};
 use crate::shape::{self, LengthBasis};
@@ -61,6 +62,10 @@ type Factors = LU<f64, U6, U6>;
 /// pass), so it also computes the coefficients; if it is not the last,
 /// [`SpatialSolver::coefficients`] runs one more pass.
 const LAST_PASS_RESIDUAL_N_MM: f64 = 1e-5;
+
+/// Breakpoints closer than this are one (mm): an anchor this close to a
+/// knot ends its cable at the knot.
+const ANCHOR_TOLERANCE_MM: f64 = 1e-9;
 
 /// Highest coefficient order the spatial solver reports.
 pub const MAX_SPATIAL_ORDER: usize = 8;
@@ -94,46 +99,24 @@ impl Default for SpatialOptions {
     }
 }
 
-/// The tip of one solve.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct SpatialPose {
-    /// Tip position (x, y, z), mm.
-    pub tip_mm: [f64; 3],
-    /// Unit tangent of the centreline at the tip, R v/|v|.
-    pub tip_tangent: [f64; 3],
-    /// The tip cross-section's body y-axis in the global frame (column 2 of R).
-    pub tip_body_y_axis: [f64; 3],
-    /// Angle between the tip tangent and the clamp axis (+x), rad.
-    pub tip_angle_rad: f64,
-    /// Deformed centreline length ℓ, mm.
-    pub length_mm: f64,
-    /// Integration passes the solve took.
-    pub passes: u32,
-}
-
-/// One point of the solved rod.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct SpatialNode {
+/// What a pass records at one step point of the rod (the centreline's
+/// nodes are made from these when asked for, [`SpatialSolver::centreline`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct NodeRecord {
+    /// Index of the half-step point (its channels in `chan`).
+    point: usize,
     /// Rest arc length s, mm.
-    pub s_mm: f64,
+    s_mm: f64,
     /// Centreline position, mm.
-    pub p_mm: [f64; 3],
-    /// Body frame: rows of R (`R[i][j]`; its columns are the body axes, global).
-    pub rotation: [[f64; 3]; 3],
+    p_mm: [f64; 3],
+    /// Body frame: rows of R.
+    rotation: [[f64; 3]; 3],
     /// Strain v (body frame).
-    pub v: [f64; 3],
+    v: [f64; 3],
     /// Curvature u (body frame), 1/mm.
-    pub u_per_mm: [f64; 3],
+    u_per_mm: [f64; 3],
     /// Deformed arc length σ, mm.
-    pub arc_length_mm: f64,
-}
-
-impl SpatialNode {
-    /// Global position of a point at body offset (0, y, z), mm.
-    pub fn body_point_mm(&self, y_mm: f64, z_mm: f64) -> [f64; 3] {
-        let r = &self.rotation;
-        std::array::from_fn(|i| self.p_mm[i] + r[i][1] * y_mm + r[i][2] * z_mm)
-    }
+    arc_length_mm: f64,
 }
 
 /// Why a spatial solve produced no result.
@@ -257,7 +240,11 @@ pub struct SpatialSolver {
     /// Tensions of the last two successful solves (newest first), N.
     history: Vec<Vec<f64>>,
     binv: M3,
-    nodes: Vec<SpatialNode>,
+    nodes: Vec<NodeRecord>,
+    /// Each cable's anchor (or the tip), mm.
+    anchors_mm: Vec<f64>,
+    /// The rod's rest curvature about body z, 1/mm ([`Rod::rest_curvature_per_mm`]).
+    rest_u3_per_mm: f64,
     /// ∫ (σ/L)^j κ_k ds of the last full pass, k = twist, about y, about z.
     moments: [[f64; MAX_SPATIAL_ORDER + 1]; 3],
     /// Whether `moments` belong to the last solve.
@@ -269,7 +256,7 @@ pub struct SpatialSolver {
     chord: bool,
     /// This pass computes the curvature vector and the coefficient moments.
     with_kappa: bool,
-    last: Option<SpatialPose>,
+    last: Option<TipPose>,
 }
 
 impl SpatialSolver {
@@ -294,7 +281,7 @@ impl SpatialSolver {
         cuts.extend(channels.iter().map(Channel::knot_mm));
         cuts.extend(actuator.cables.iter().filter_map(|c| c.anchor_mm).filter(|&a| a < length));
         cuts.sort_by(f64::total_cmp);
-        cuts.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
+        cuts.dedup_by(|a, b| (*a - *b).abs() < ANCHOR_TOLERANCE_MM);
         let span = length / 2.0;
         let mut segments = Vec::new();
         let (mut point0, mut step0) = (0, 0);
@@ -336,6 +323,8 @@ impl SpatialSolver {
             history: Vec::new(),
             binv: M3::identity(),
             nodes: Vec::new(),
+            anchors_mm: actuator.cables.iter().map(|c| c.anchor_or_tip_mm(length)).collect(),
+            rest_u3_per_mm: actuator.rod.rest_curvature_per_mm,
             moments: [[0.0; MAX_SPATIAL_ORDER + 1]; 3],
             moments_valid: false,
             lus: vec![None; 4 * step0 + cuts.len()],
@@ -363,7 +352,7 @@ impl SpatialSolver {
     /// Solves with every cable's tension scaled by `scale` (1 = the
     /// actuator's tensions; continuation ladders step it from 0 to 1),
     /// warm-started from the previous solve.
-    pub fn solve_scaled(&mut self, scale: f64) -> Result<SpatialPose, SpatialError> {
+    pub fn solve_scaled(&mut self, scale: f64) -> Result<TipPose, SpatialError> {
         if !(scale.is_finite() && scale >= 0.0) {
             return Err(SpatialError::Option(format!("tension scale {scale} must be finite and ≥ 0")));
         }
@@ -389,7 +378,7 @@ impl SpatialSolver {
     }
 
     /// Sets every cable's tension (N, one per cable, each ≥ 0) and solves.
-    pub fn solve(&mut self, tensions_n: &[f64]) -> Result<SpatialPose, SpatialError> {
+    pub fn solve(&mut self, tensions_n: &[f64]) -> Result<TipPose, SpatialError> {
         if tensions_n.len() != self.cables {
             return Err(SpatialError::Option(format!("{} tensions given for {} cables", tensions_n.len(), self.cables)));
         }
@@ -438,7 +427,7 @@ impl SpatialSolver {
         }
     }
 
-    fn solve_inner(&mut self) -> Result<SpatialPose, SpatialFailure> {
+    fn solve_inner(&mut self) -> Result<TipPose, SpatialFailure> {
         let gravity = self.weight.norm() > 0.0;
         let mut passes = 1;
         // The first pass of a solve refactors everything (the tensions
@@ -485,13 +474,23 @@ impl SpatialSolver {
         let r = q.to_rotation_matrix().into_inner();
         let v = V3::new(tip[0], tip[1], tip[2]);
         let t = (r * v).normalize();
-        let pose = SpatialPose {
-            tip_mm: [end[0], end[1], end[2]],
-            tip_tangent: [t[0], t[1], t[2]],
-            tip_body_y_axis: [r[(0, 1)], r[(1, 1)], r[(2, 1)]],
-            tip_angle_rad: t[0].clamp(-1.0, 1.0).acos(),
+        // At the clamp R = I: the base tangent is v(0)'s direction.
+        let base_v = self.nodes.first().map_or([1.0, 0.0, 0.0], |n| n.v);
+        let mut tensions_n = PerCable::filled(self.cables, 0.0);
+        for (out, t) in tensions_n.iter_mut().zip(&self.base_tension_n) {
+            *out = t * self.scale;
+        }
+        let pose = TipPose {
+            tensions_n,
+            tip_x_mm: end[0],
+            tip_y_mm: end[1],
+            tip_z_mm: end[2],
+            tip_angle_rad: t[1].atan2(t[0]),
+            tip_frame_angle_rad: r[(1, 0)].atan2(r[(0, 0)]),
+            base_angle_rad: base_v[1].atan2(base_v[0]),
             length_mm: end[10],
-            passes,
+            iterations: passes,
+            frame_3d: Some(TipFrame { tangent: [t[0], t[1], t[2]], body_y_axis: [r[(0, 1)], r[(1, 1)], r[(2, 1)]] }),
         };
         self.last = Some(pose);
         Ok(pose)
@@ -512,6 +511,11 @@ impl SpatialSolver {
         let mut tip = [0.0; 6];
         let segments = std::mem::take(&mut self.segments);
         let mut scratch = Rk4Scratch::default();
+        // Where a cable ends (its anchor) the strains jump, and so does the
+        // tangent: the curvature has a Dirac part there, the rotation from
+        // the tangent before to the one after. `ending` holds v just before
+        // such a point until the next segment's first stage gives v after it.
+        let mut ending: Option<V3> = None;
         let result = (|| {
             for (si, seg) in segments.iter().enumerate() {
                 let h = seg.h_mm;
@@ -524,7 +528,7 @@ impl SpatialSolver {
                         let ys = stage.state;
                         let (f, l) = self.deriv(seg, k0 + stage.half_steps, slot + i, ys)?;
                         if i == 0 {
-                            self.record(s0, ys, &l.x);
+                            self.record(k0, s0, ys, &l.x);
                         }
                         if self.with_kappa {
                             // RK4 quadrature of the moments with the stage values.
@@ -536,6 +540,16 @@ impl SpatialSolver {
                                     pw *= x;
                                 }
                             }
+                            if let Some(before) = ending.take() {
+                                let jump = tangent_turn(&before, &V3::new(l.x[0], l.x[1], l.x[2]));
+                                for (series, kappa) in moments[1..].iter_mut().zip([jump[1], jump[2]]) {
+                                    let mut pw = kappa;
+                                    for c in series.iter_mut() {
+                                        *c += pw;
+                                        pw *= x;
+                                    }
+                                }
+                            }
                         }
                         *dy = f;
                         Ok(())
@@ -543,12 +557,22 @@ impl SpatialSolver {
                     let norm = (y[3] * y[3] + y[4] * y[4] + y[5] * y[5] + y[6] * y[6]).sqrt();
                     y[3..7].iter_mut().for_each(|c| *c /= norm);
                 }
+                let k = seg.point0 + 2 * seg.steps;
                 if si + 1 == segments.len() {
-                    let k = seg.point0 + 2 * seg.steps;
                     let slot = self.warm.len() - 1;
                     let (_, l) = self.deriv(seg, k, slot, &y)?;
                     tip = l.x;
-                    self.record(length, &y, &l.x);
+                    self.record(k, length, &y, &l.x);
+                } else if self.with_kappa && seg.active != segments[si + 1].active {
+                    // The local solution just before the segment's end, in a
+                    // slot of its own (one per segment end), warm-started
+                    // from the last stage's.
+                    let slot = self.warm.len() - segments.len() - 1 + si;
+                    if self.lus[slot].is_none() {
+                        self.warm[slot] = self.warm[4 * (seg.step0 + seg.steps) - 1];
+                    }
+                    let (_, l) = self.deriv(seg, k, slot, &y)?;
+                    ending = Some(V3::new(l.x[0], l.x[1], l.x[2]));
                 }
             }
             Ok(())
@@ -560,9 +584,10 @@ impl SpatialSolver {
         result.map(|()| (y, tip))
     }
 
-    fn record(&mut self, s_mm: f64, y: &State, x: &[f64; 6]) {
+    fn record(&mut self, point: usize, s_mm: f64, y: &State, x: &[f64; 6]) {
         let r = quat(y).to_rotation_matrix().into_inner();
-        self.nodes.push(SpatialNode {
+        self.nodes.push(NodeRecord {
+            point,
             s_mm,
             p_mm: [y[0], y[1], y[2]],
             rotation: std::array::from_fn(|i| std::array::from_fn(|j| r[(i, j)])),
@@ -736,11 +761,15 @@ impl SpatialSolver {
         [jf[0], jf[1], jf[2], jm[0], jm[1], jm[2]]
     }
 
-    /// The rod's part of the residual: K_se (v − v*) − Rᵀ W and K_bt u − Rᵀ M_W.
+    /// The rod's part of the residual: K_se (v − v*) − Rᵀ W and
+    /// K_bt (u − u*) − Rᵀ M_W (u* = (0, 0, rest curvature)).
     #[inline]
     fn elastic_residual(&self, x: &[f64; 6], nw: V3, mw: V3) -> (V3, V3) {
         let k = &self.stiff;
-        (V3::new(k[0] * (x[0] - 1.0), k[1] * x[1], k[2] * x[2]) - nw, V3::new(k[3] * x[3], k[4] * x[4], k[5] * x[5]) - mw)
+        (
+            V3::new(k[0] * (x[0] - 1.0), k[1] * x[1], k[2] * x[2]) - nw,
+            V3::new(k[3] * x[3], k[4] * x[4], k[5] * (x[5] - self.rest_u3_per_mm)) - mw,
+        )
     }
 
     /// Residual G(x) of the cut equations (chord iterations).
@@ -785,14 +814,46 @@ impl SpatialSolver {
     }
 
     /// The pose of the last successful solve.
-    pub fn pose(&self) -> Option<SpatialPose> {
+    pub fn pose(&self) -> Option<TipPose> {
         self.last
     }
 
-    /// The nodes (step points, clamp to tip) of the last successful solve.
-    pub fn nodes(&self) -> &[SpatialNode] {
-        assert!(self.last.is_some(), "nodes needs a successful solve");
-        &self.nodes
+    /// The centreline of the last successful solve at the step points,
+    /// clamp to tip, with every cable's channel, path and tension (none
+    /// beyond a cable's anchor; a node lies exactly at each anchor).
+    pub fn centreline(&self) -> Vec<CentrelinePoint> {
+        assert!(self.last.is_some(), "centreline needs a successful solve");
+        self.nodes
+            .iter()
+            .map(|n| {
+                let mut node = CentrelinePoint {
+                    s_mm: n.s_mm,
+                    x_mm: n.p_mm[0],
+                    y_mm: n.p_mm[1],
+                    z_mm: n.p_mm[2],
+                    rotation: n.rotation,
+                    // The body x axis and the tangent R v, projected on the x–y plane.
+                    frame_angle_rad: n.rotation[1][0].atan2(n.rotation[0][0]),
+                    tangent_angle_rad: (0..3).map(|j| n.rotation[1][j] * n.v[j]).sum::<f64>().atan2((0..3).map(|j| n.rotation[0][j] * n.v[j]).sum::<f64>()),
+                    arc_length_mm: n.arc_length_mm,
+                    v: n.v,
+                    u_per_mm: n.u_per_mm,
+                    cables: PerCable::filled(self.cables, CableAtNode::NONE),
+                };
+                let chans = &self.chan[n.point * self.cables..(n.point + 1) * self.cables];
+                for (i, (c, &anchor)) in chans.iter().zip(&self.anchors_mm).enumerate() {
+                    // Up to the node at the anchor, where the cable ends.
+                    if n.s_mm <= anchor + ANCHOR_TOLERANCE_MM {
+                        node.cables[i] = CableAtNode {
+                            channel_mm: [c.r[1], c.r[2]],
+                            position_mm: node.body_point_mm(c.r[1], c.r[2]),
+                            tension_n: self.base_tension_n[i] * self.scale,
+                        };
+                    }
+                }
+                node
+            })
+            .collect()
     }
 
     /// Legendre coefficients of the last solve, order `order`, in `basis`:
@@ -806,7 +867,7 @@ impl SpatialSolver {
     }
 
     /// Makes the coefficient moments those of the last solve.
-    pub(super) fn settle_moments(&mut self) -> Result<(), SpatialError> {
+    pub(crate) fn settle_moments(&mut self) -> Result<(), SpatialError> {
         assert!(self.last.is_some(), "coefficients needs a successful solve");
         if !self.moments_valid {
             // The converged pass was a chord pass: one full pass at the
@@ -822,7 +883,7 @@ impl SpatialSolver {
     /// [`SpatialSolver::coefficients`] of the last solve without the
     /// order check (the error estimate's coarse solve computes the same
     /// orders at half the steps); needs valid moments.
-    pub(super) fn coefficients_unchecked(&self, order: usize, basis: LengthBasis) -> [Vec<f64>; 3] {
+    pub(crate) fn coefficients_unchecked(&self, order: usize, basis: LengthBasis) -> [Vec<f64>; 3] {
         let moments = &self.moments;
         let length = self.rod.length_mm;
         let ell = self.last.expect("checked").length_mm;
@@ -865,6 +926,18 @@ pub fn check_order(order: usize, options: &SpatialOptions) -> Result<(), Spatial
         )));
     }
     Ok(())
+}
+
+/// The rotation vector turning the direction of `before` into that of
+/// `after` (both in the body frame): its axis times its angle.
+fn tangent_turn(before: &V3, after: &V3) -> V3 {
+    let (a, b) = (before.normalize(), after.normalize());
+    let axis = a.cross(&b);
+    let sin = axis.norm();
+    if sin == 0.0 {
+        return V3::zeros();
+    }
+    axis * (sin.atan2(a.dot(&b)) / sin)
 }
 
 fn residual(end: &State) -> V3 {
