@@ -315,6 +315,47 @@ fn an_anchor_before_the_tip_leaves_the_distal_part_straight() {
     }
 }
 
+/// The spatial solve of a planar actuator against the planar one (fine on
+/// both): tip, in-plane series and no out-of-plane or twist series.
+fn assert_planar_agreement(rod: &Rod, cable: Cable, what: &str) {
+    let mut planar_rod = rod.clone();
+    planar_rod.cable_anchor_mm = cable.anchor_mm;
+    let routing = Routing::for_actuator(cable.y_mm, &planar_rod).unwrap();
+    let fine = SolverOptions { nodes_per_span: 32, ..SolverOptions::default() };
+    let planar = simulate(&planar_rod, &fine, &routing, cable.tension_n, 3, LengthBasis::Rest).unwrap();
+    let a = Actuator::with_cables(rod.clone(), vec![cable]);
+    let s = simulate_spatial(&a, &SpatialOptions { steps_per_span: 128, ..SpatialOptions::default() }, 3, LengthBasis::Rest).unwrap();
+    let d = dist(s.pose.tip_mm(), [planar.pose.tip_x_mm, planar.pose.tip_y_mm, 0.0]);
+    assert!(d < 1e-6, "{what}: tip off by {d:.2e} mm");
+    for i in 0..4 {
+        let (p, q) = (planar.a_bend_z[i], s.a_bend_z[i]);
+        assert!((p - q).abs() < 1e-7, "{what}: a_{i} planar {p} vs spatial {q}");
+        assert!(s.a_bend_y[i].abs() < 1e-12 && s.a_twist[i].abs() < 1e-12, "{what}");
+    }
+}
+
+#[test]
+fn an_anchored_cable_turns_the_tangent_where_it_ends_in_both_solvers() {
+    // The tension stops at the anchor, so the shear and stretch jump and the
+    // tangent turns there: both series include the turn.
+    for gravity in [false, true] {
+        let mut rod = Rod::default();
+        rod.gravity.enabled = gravity;
+        let cable = Cable { anchor_mm: Some(40.0), ..Cable::planar([0.0, 1.0, 2.0, 3.0, 4.0], 1.2) };
+        assert_planar_agreement(&rod, cable, &format!("anchored, gravity {gravity}"));
+    }
+}
+
+#[test]
+fn a_rod_cured_bent_bends_alike_in_both_solvers() {
+    for (gravity, tension) in [(false, 0.0), (true, 0.8), (false, 1.5)] {
+        let mut rod = Rod::default();
+        rod.gravity.enabled = gravity;
+        rod.rest_curvature_per_mm = 0.004;
+        assert_planar_agreement(&rod, Cable::planar([1.0, -2.0, 3.0, 1.5, -1.0], tension), &format!("rest curvature, {tension} N"));
+    }
+}
+
 mod properties {
     use super::*;
     use proptest::prelude::*;

@@ -296,7 +296,8 @@ pub struct Simulator {
     channel: Vec<ChannelSample>,
     /// Cable direction (cos α, sin α) at each stage point, kept as the Newton start.
     cable_dir: Vec<(f64, f64)>,
-    last: Option<TipPose>,
+    /// The tension of the last successful solve, N (`None` after a failure).
+    last_tension_n: Option<f64>,
     /// Cable–channel friction: slip sign and tension profile per point.
     friction: Friction,
     /// Creep: the hold and the load history per point.
@@ -393,7 +394,7 @@ impl Simulator {
             routing: None,
             channel: vec![ChannelSample::default(); points],
             cable_dir: vec![(1.0, 0.0); points],
-            last: None,
+            last_tension_n: None,
             friction: Friction::new(actuator.effects.friction_mu, actuator.effects.load_direction.slip_sign(), points),
             creep: Creep::new(&actuator.effects, actuator.ei_n_mm2, points),
             col,
@@ -446,7 +447,7 @@ impl Simulator {
         }
         self.reset_warm_start();
         self.reset_history();
-        self.last = None;
+        self.last_tension_n = None;
     }
 
     /// Forgets the warm start (the next solve starts cold). The creep
@@ -656,9 +657,9 @@ impl Simulator {
         }
         let result = self.solve_inner(tension_n);
         match &result {
-            Ok(pose) => self.last = Some(*pose),
+            Ok(pose) => self.last_tension_n = Some(pose.tension_n()),
             Err(_) => {
-                self.last = None;
+                self.last_tension_n = None;
                 self.reset_warm_start();
             }
         }
@@ -746,7 +747,7 @@ impl Simulator {
     /// [`Simulator::coefficients_checked`] refuses coefficients the
     /// discretisation does not resolve.
     pub fn coefficients_into(&mut self, basis: LengthBasis, out: &mut [f64]) {
-        assert!(self.last.is_some(), "coefficients_into needs a successful solve");
+        assert!(self.last_tension_n.is_some(), "coefficients_into needs a successful solve");
         let estimate = if self.col.is_some() { self.colloc_coefficients(basis, out) } else { self.rk4_coefficients(basis, out) };
         self.coefficient_error = if estimate.0 <= super::resolution::ORDER_TOLERANCE_PER_MM || self.is_probe {
             estimate
@@ -781,7 +782,7 @@ impl Simulator {
 
     /// The centreline of the last successful solve, clamp to tip.
     pub fn centreline(&self) -> Vec<CentrelinePoint> {
-        assert!(self.last.is_some(), "centreline needs a successful solve");
+        assert!(self.last_tension_n.is_some(), "centreline needs a successful solve");
         if self.col.is_some() {
             return self.colloc_centreline();
         }

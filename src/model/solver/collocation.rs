@@ -1209,7 +1209,7 @@ impl Simulator {
         let routing = self.routing.as_ref().expect("routing");
         let np = c.np();
         let count = 2 * self.options.steps_per_span + 1;
-        let tension = self.last.map_or(0.0, |p| p.tension_n());
+        let tension = self.last_tension_n.unwrap_or(0.0);
         let length = self.actuator.length_mm;
         let v1: Vec<f64> = c.strain.iter().map(|e| e.v1).collect();
         let v2: Vec<f64> = c.strain.iter().map(|e| e.v2).collect();

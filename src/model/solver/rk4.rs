@@ -381,7 +381,7 @@ impl Simulator {
     /// The centreline of the last solve at the nodes.
     pub(super) fn rk4_centreline(&self) -> Vec<CentrelinePoint> {
         let n = self.options.steps_per_span;
-        let tension = self.last.map_or(0.0, |p| p.tension_n());
+        let tension = self.last_tension_n.unwrap_or(0.0);
         (0..self.rk4.nodes_state.len())
             .map(|i| {
                 let (span, j) = if i < n { (0, i) } else { (1, i - n) };
@@ -434,7 +434,7 @@ mod tests {
                     let t = tension * k as f64 / rungs as f64;
                     let Ok(passes) = sim.rk4_solve(t) else { break };
                     solved = (k == rungs).then(|| sim.rk4_pose(t, passes));
-                    sim.last = Some(sim.rk4_pose(t, passes));
+                    sim.last_tension_n = Some(t);
                 }
                 let Some(pose) = solved else { continue };
                 let (_, tip_error) = sim.rk4_error_estimate(tension).unwrap();

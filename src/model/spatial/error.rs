@@ -1,6 +1,6 @@
-//! Why an actuator or a spatial solve was rejected.
+//! Why an actuator or a spatial solve was rejected ([`SpatialError`]), and
+//! why the spatial solver found no solution ([`SpatialFailure`]).
 
-use super::solver::SpatialFailure;
 use crate::model::cable::MAX_CABLES;
 use crate::model::routing::RoutingError;
 use crate::model::ParameterError;
@@ -69,6 +69,39 @@ impl SpatialError {
             SpatialError::Solve(f) => Some(f.status()),
             SpatialError::Planar(crate::model::SimulateError::Solve(f)) => Some(f.status()),
             _ => None,
+        }
+    }
+}
+
+/// Why a spatial solve produced no result.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SpatialFailure {
+    /// The local equations at a point did not converge.
+    #[error("the cut equations did not converge at s = {s_mm:.3} mm (tension too high for this routing, or a cable pulls straight through the axis); lower the tension or raise --steps-per-span")]
+    Local { s_mm: f64 },
+    /// Gravity's moment iteration did not converge.
+    #[error("gravity's moment did not converge in {passes} passes (residual {residual_n_mm:.3e} N·mm); the rod may be too heavy for its stiffness")]
+    Gravity { passes: u32, residual_n_mm: f64 },
+    /// A number of the result is not finite.
+    #[error("the solve gave a non-finite tip or coefficient; check the rod's parameters (rigidities, length, density) for absurd values")]
+    NonFinite,
+    /// The steps do not resolve the solution: its difference to the same
+    /// solve at half the steps is above the tolerance, up to the most steps
+    /// tried ([`crate::model::simulate_spatial`]), or the tip lies farther from the
+    /// clamp than the stretched rod is long.
+    #[error(transparent)]
+    Unresolved(crate::model::solver::Unresolved),
+}
+
+impl SpatialFailure {
+    /// Short machine-readable status (as the planar solver's
+    /// [`crate::model::SolveFailure::status`]).
+    pub fn status(&self) -> &'static str {
+        match self {
+            SpatialFailure::Local { .. } => "cut_equations_not_converged",
+            SpatialFailure::Gravity { .. } => "gravity_not_converged",
+            SpatialFailure::NonFinite => "non_finite",
+            SpatialFailure::Unresolved(_) => "unresolved",
         }
     }
 }

@@ -14,5 +14,5 @@ pub mod solver;
 pub use crate::model::actuator::{Actuator, EI_OVER_GJ};
 pub use crate::model::cable::{self, Cable, MAX_CABLES};
 pub use crate::model::solver::simulate_spatial;
-pub use error::SpatialError;
-pub use solver::{check_order, SpatialFailure, SpatialOptions, SpatialSolver, MAX_SPATIAL_ORDER};
+pub use error::{SpatialError, SpatialFailure};
+pub use solver::{check_order, SpatialOptions, SpatialSolver, MAX_SPATIAL_ORDER};
