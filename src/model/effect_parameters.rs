@@ -1,6 +1,6 @@
 //! The effect parameters a rod carries (its `[effects]` table,
 //! model-notes §6): the values only. What each parameter means, its bounds,
-//! flag and fit are the registry's ([`super::effects`]), which reads and
+//! flag and fit are the registry's ([`crate::model::effects`]), which reads and
 //! sets these fields; this file and the registry are the only places the
 //! `[effects]` keys are spelled (tests/layering.rs).
 

@@ -41,7 +41,11 @@
 //! angle, so the in-plane series is the planar solver's a_i (model-notes §4).
 //! Each series is a_i = (2i + 1)/L ∫ P_i(2σ/ℓ − 1) κ ds over the rest length
 //! (σ the deformed arc length, ℓ its total), the thesis's basis; the twist
-//! series uses u_1, the torsion of the body frame.
+//! series uses u_1, the torsion of the body frame. Where a cable ends
+//! before the tip, v jumps (its tension stops) and the tangent turns at a
+//! point: κ has a Dirac part there, the rotation vector from v̂ just before
+//! the anchor to v̂ just after it, which the bending series add at that σ
+//! (the planar a_i count the same jump of θ).
 
 use super::cable::{Channel, ChannelPoint3};
 use super::error::{SpatialError, SpatialFailure};
