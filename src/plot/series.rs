@@ -191,8 +191,20 @@ pub fn hanging_chart<'a, 'b>(
     lateral_mm: (f64, f64),
     page_vertical_mm: (f64, f64),
 ) -> Result<PageChart<'a, 'b>, PlotError> {
+    page_chart(root, path, (title, 22), ("y (mm, lateral)", lateral_mm), page_vertical_mm)
+}
+
+/// [`hanging_chart`] with its caption `(text, size in px)` and its lateral
+/// axis `(label, range in mm)`.
+pub(super) fn page_chart<'a, 'b>(
+    root: &'a DrawingArea<BitMapBackend<'b>, plotters::coord::Shift>,
+    path: &Path,
+    (caption, caption_px): (&str, u32),
+    (lateral_label, lateral_mm): (&str, (f64, f64)),
+    page_vertical_mm: (f64, f64),
+) -> Result<PageChart<'a, 'b>, PlotError> {
     let mut chart = ChartBuilder::on(root)
-        .caption(title, (FONT, 22))
+        .caption(caption, (FONT, caption_px))
         .margin(15)
         .x_label_area_size(45)
         .y_label_area_size(55)
@@ -200,7 +212,7 @@ pub fn hanging_chart<'a, 'b>(
         .map_err(|e| PlotError::new(path, e))?;
     chart
         .configure_mesh()
-        .x_desc("y (mm, lateral)")
+        .x_desc(lateral_label)
         .y_desc("x (mm, along the clamp axis, downward)")
         .y_label_formatter(&|v| format!("{:.0}", -v + 0.0))
         .label_style((FONT, 14))

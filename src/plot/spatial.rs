@@ -4,7 +4,7 @@
 //! it is knotted) and the tip.
 
 use super::canvas::{png_backend, register_fonts, PlotError, FONT};
-use super::series::{clamp_series, draw_legend, draw_series_on, legend_size, Mark, PictureSeries};
+use super::series::{clamp_series, draw_legend, draw_series_on, legend_size, page_chart, Mark, PictureSeries};
 use crate::model::Simulation;
 use plotters::prelude::*;
 use plotters::style::full_palette::{BLUE_800, BROWN, ORANGE, PURPLE};
@@ -44,22 +44,9 @@ pub fn draw_spatial(path: &Path, title: &str, sim: &Simulation) -> Result<(), Pl
     let x_range = (cx - span / 2.0, cx + span / 2.0);
     let lat_range = (cl - span / 2.0, cl + span / 2.0);
     for (panel, view) in panels.iter().zip([View { axis: 1, name: "y" }, View { axis: 2, name: "z" }]) {
-        let mut chart = ChartBuilder::on(panel)
-            .caption(format!("x–{} view (looking along {})", view.name, if view.axis == 1 { "z" } else { "y" }), (FONT, 18))
-            .margin(15)
-            .x_label_area_size(45)
-            .y_label_area_size(55)
-            .build_cartesian_2d(lat_range.0..lat_range.1, -x_range.1..-x_range.0)
-            .map_err(|e| PlotError::new(path, e))?;
-        chart
-            .configure_mesh()
-            .x_desc(format!("{} (mm)", view.name))
-            .y_desc("x (mm, along the clamp axis, downward)")
-            .y_label_formatter(&|v| format!("{:.0}", -v + 0.0))
-            .label_style((FONT, 14))
-            .axis_desc_style((FONT, 16))
-            .draw()
-            .map_err(|e| PlotError::new(path, e))?;
+        let caption = format!("x–{} view (looking along {})", view.name, if view.axis == 1 { "z" } else { "y" });
+        let lateral = format!("{} (mm)", view.name);
+        let mut chart = page_chart(panel, path, (&caption, 18), (&lateral, lat_range), (-x_range.1, -x_range.0))?;
         let a = view.axis;
         // Series in the view's body frame (x, lateral), as the planar pictures.
         let in_view = |p: [f64; 3]| (p[0], p[a]);
