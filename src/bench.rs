@@ -203,7 +203,7 @@ pub fn bench_spatial(
                 Ok(pose) => {
                     let a = solver.coefficients(3, crate::shape::LengthBasis::default())?;
                     sink += a[2][0];
-                    passes += u64::from(pose.passes);
+                    passes += u64::from(pose.iterations);
                     solves += 1;
                 }
                 Err(_) => failures += 1,

@@ -5,7 +5,7 @@
 //! says whether the noise hides the effect). Request in, report out.
 
 use crate::calibrate::data::{centrelines_csv, markers_csv, measurements_csv};
-use crate::calibrate::synth::{default_routings, hidden_effect_size, synthesize_with_markers, SynthSpec, VISIBLE_NOISE_SDS};
+use crate::calibrate::synth::{default_routings, hidden_effect_size, synthesize_with_markers, Planted, SynthSpec, VISIBLE_NOISE_SDS};
 use crate::calibrate::{CalibrateError, Effect};
 use crate::io::FileError;
 use crate::model::routing::CONTROL_POINTS;
@@ -67,18 +67,16 @@ impl HiddenEffect {
         }
     }
 
-    /// `actuator` with the effect in it.
+    /// `actuator` with the effect in it ([`Planted::plant`]).
     pub fn apply(&self, actuator: &Rod) -> Rod {
+        let planted = match *self {
+            HiddenEffect::None => Planted::None,
+            HiddenEffect::Candidate { effect, magnitude } => Planted::Candidate { effect, value: magnitude },
+            HiddenEffect::RestCurvature { per_mm } => Planted::RestCurvature { per_mm },
+            HiddenEffect::GlueJoint { ei_factor, length_mm } => Planted::GlueJoint { ei_factor, length_mm },
+        };
         let mut a = actuator.clone();
-        match *self {
-            HiddenEffect::None => {}
-            HiddenEffect::Candidate { effect, magnitude } => effect.apply(&mut a, magnitude),
-            HiddenEffect::RestCurvature { per_mm } => a.effects.hidden.rest_curvature_per_mm = per_mm,
-            HiddenEffect::GlueJoint { ei_factor, length_mm } => {
-                a.effects.hidden.base_segment_ei_factor = ei_factor;
-                a.effects.hidden.base_segment_mm = length_mm;
-            }
-        }
+        planted.plant(&mut a);
         a
     }
 }
@@ -251,9 +249,10 @@ pub fn run(request: &SynthRequest) -> Result<SynthReport, SynthError> {
     }
     let points = centreline.map_or(0, |(_, n)| (*n).max(2));
     let (mut data, centrelines, marker_points) = synthesize_with_markers(&spec, points)?;
-    if !spec.actuator.is_uniform_body() {
-        // The body goes into the file, so diagnose needs no geometry flags.
-        data.actuator = Some(spec.actuator.clone());
+    if !request.actuator.is_uniform_body() {
+        // The body goes into the file, so diagnose needs no geometry flags:
+        // the rod's without the hidden effect (a glue joint is a segment).
+        data.actuator = Some(request.actuator.clone());
     }
     let write = |path: &PathBuf, text: String| crate::io::write_atomic(path, text.as_bytes()).map_err(FileError::on("writing", path));
     write(&request.out, measurements_csv(&data))?;

@@ -31,12 +31,16 @@ fn every_effects_field_is_a_registry_entry_and_back() {
     assert!(!json.as_object().unwrap().contains_key("hidden"), "the unmodelled effects are not part of the file format");
 }
 
-/// A spec's `[effects.hidden]` table is refused: no file carries the
-/// unmodelled effects only `synth` plants.
+/// A spec's `[effects.hidden]` table is refused: the effects `synth`
+/// plants outside the library are no effects but the body's (a rest
+/// curvature, a stiff segment), read where the body is.
 #[test]
-fn the_unmodelled_effects_have_no_file_format() {
-    let e = Rod::from_toml_str("[effects.hidden]\nrest_curvature_per_mm = 0.01\n").unwrap_err();
+fn synths_out_of_library_effects_are_the_bodys_not_effects() {
+    let e = Rod::from_toml_str("[effects.hidden]\nrest_curvature_per_mm = 0.01\n").unwrap_err().to_string();
     assert!(e.contains("hidden"), "{e}");
+    let curved = Rod::from_toml_str("rest_curvature_per_mm = 0.01\n").unwrap();
+    assert_eq!(curved.rest_curvature_per_mm, 0.01);
+    assert!(!toml::to_string(&Rod::default()).unwrap().contains("rest_curvature"), "not written when 0: files are unchanged");
 }
 
 /// `cablemap simulate --help` shows each registry flag with its value name

@@ -43,7 +43,7 @@ fn heavy_rods_converge_and_refinement_agrees() {
                 let (p, q) = (coarse.pose, refined.pose);
                 let tip = (p.tip_x_mm - q.tip_x_mm).hypot(p.tip_y_mm - q.tip_y_mm);
                 let angle = (p.tip_angle_rad - q.tip_angle_rad).abs();
-                let a_err = (0..4).map(|i| (coarse.a[i] - refined.a[i]).abs()).fold(0.0, f64::max);
+                let a_err = (0..4).map(|i| (coarse.a_bend_z[i] - refined.a_bend_z[i]).abs()).fold(0.0, f64::max);
                 worst = worst.max(tip);
                 assert!(tip < 1e-6 && angle < 1e-8 && a_err < 1e-8, "EI {ei} EA {ea} {t} N: tip {tip} angle {angle} a {a_err}");
                 // The weight bends the rod down toward the clamp axis: the
@@ -92,7 +92,7 @@ fn heavy_rod_shape_is_in_equilibrium() {
                 let d = |f: &dyn Fn(usize) -> f64| (f(k + 1) - f(k - 1)) / (2.0 * h);
                 let u = d(&|i| line[i].frame_angle_rad);
                 let (dx, dy) = (d(&|i| line[i].x_mm), d(&|i| line[i].y_mm));
-                let (cx, cy) = (d(&|i| line[i].cable_x_mm), d(&|i| line[i].cable_y_mm));
+                let (cx, cy) = (d(&|i| line[i].cables[0].position_mm[0]), d(&|i| line[i].cables[0].position_mm[1]));
                 let (sp, cp) = p.frame_angle_rad.sin_cos();
                 // Cable direction in the body frame, from the cable's path.
                 let norm = cx.hypot(cy);
@@ -100,7 +100,7 @@ fn heavy_rod_shape_is_in_equilibrium() {
                 // Gravity along +x: moment of the distal weight about the cut.
                 let m_w = -w * distal(k, &|i| line[i].y_mm - p.y_mm);
                 let moment = ei * u;
-                let expected = t * p.channel_y_mm * tc1 + m_w;
+                let expected = t * p.cables[0].channel_mm[0] * tc1 + m_w;
                 worst_m = worst_m.max((moment - expected).abs());
                 scale_m = scale_m.max(moment.abs());
                 let v1 = dx * cp + dy * sp;

@@ -51,7 +51,7 @@ fn check_file(name: &str) {
         // deformed basis is the option.
         let (a_thesis, a_deformed) = (list("a_thesis_per_mm"), list("a_per_mm"));
         let a_err = (0..4)
-            .map(|i| (sim.a[i] - a_thesis[i]).abs().max((deformed.a[i] - a_deformed[i]).abs()))
+            .map(|i| (sim.a_bend_z[i] - a_thesis[i]).abs().max((deformed.a_bend_z[i] - a_deformed[i]).abs()))
             .fold(0.0, f64::max);
         worst = [worst[0].max(tip_err), worst[1].max(angle_err), worst[2].max(a_err), worst[3].max(len_err)];
         let ctx = format!("{name}: routing {y:?}, tension {tension}");
@@ -96,12 +96,12 @@ fn straight_routing_matches_the_analytic_arc() {
         let (x, y) = (v1 * (kappa * l).sin() / kappa, v1 * (1.0 - (kappa * l).cos()) / kappa);
         assert!((sim.pose.tip_x_mm - x).abs() < 1e-6 && (sim.pose.tip_y_mm - y).abs() < 1e-6, "d={d}: {:?} vs ({x},{y})", sim.pose);
         // Constant curvature per deformed length, κ/v1: a_0 has it, the rest vanish.
-        assert!((sim.a[0] - kappa / v1).abs() < 1e-9, "a0 {} vs {}", sim.a[0], kappa / v1);
-        assert!(sim.a[1..].iter().all(|v| v.abs() < 1e-9), "{:?}", sim.a);
+        assert!((sim.a_bend_z[0] - kappa / v1).abs() < 1e-9, "a0 {} vs {}", sim.a_bend_z[0], kappa / v1);
+        assert!(sim.a_bend_z[1..].iter().all(|v| v.abs() < 1e-9), "{:?}", sim.a_bend_z);
         // Per unit rest length (the thesis's basis): the turning angle κL over L.
         let rest = simulate(&a, &SolverOptions::default(), &routing, tau, 3, LengthBasis::Rest).unwrap();
-        assert!((rest.a[0] - kappa).abs() < 1e-9, "rest a0 {} vs {kappa}", rest.a[0]);
-        assert!(rest.a[1..].iter().all(|v| v.abs() < 1e-9), "{:?}", rest.a);
+        assert!((rest.a_bend_z[0] - kappa).abs() < 1e-9, "rest a0 {} vs {kappa}", rest.a_bend_z[0]);
+        assert!(rest.a_bend_z[1..].iter().all(|v| v.abs() < 1e-9), "{:?}", rest.a_bend_z);
     }
     // The number model-notes §3 quotes.
     let routing = Routing::new(&[4.0; 5], 65.0, 5.0).unwrap();
@@ -115,7 +115,7 @@ fn zero_tension_gives_the_straight_rod() {
     let routing = Routing::new(&[1.0, -3.0, 2.0, 4.0, -4.0], 65.0, 5.0).unwrap();
     let sim = simulate(&a, &SolverOptions::default(), &routing, 0.0, 3, LengthBasis::Deformed).unwrap();
     assert!((sim.pose.tip_x_mm - 65.0).abs() < 1e-12 && sim.pose.tip_y_mm.abs() < 1e-12);
-    assert!(sim.a.iter().all(|v| v.abs() < 1e-12));
+    assert!(sim.a_bend_z.iter().all(|v| v.abs() < 1e-12));
     // With gravity the hanging rod only stretches under its own weight.
     let sim = simulate(&Rod::default(), &SolverOptions::default(), &routing, 0.0, 3, LengthBasis::Rest).unwrap();
     let w = Rod::default().weight_n_per_mm();
@@ -143,7 +143,7 @@ proptest! {
         prop_assert!((m.pose.tip_angle_rad + n.pose.tip_angle_rad).abs() < 1e-9);
         prop_assert!((m.pose.base_angle_rad + n.pose.base_angle_rad).abs() < 1e-9);
         for i in 0..4 {
-            prop_assert!((m.a[i] + n.a[i]).abs() < 1e-10);
+            prop_assert!((m.a_bend_z[i] + n.a_bend_z[i]).abs() < 1e-10);
         }
     }
 }

@@ -194,7 +194,7 @@ fn actuator_of_front_matter(path: &Path, front: &str) -> Result<Option<crate::mo
         merged.insert(k, v);
     }
     let text = toml::to_string(&merged).map_err(|e| bad(e.to_string()))?;
-    Rod::from_toml_str(&text).map(Some).map_err(bad)
+    Rod::from_toml_str(&text).map(Some).map_err(|e| bad(e.to_string()))
 }
 
 fn read_table(path: &Path) -> Result<Table, CalibrateError> {

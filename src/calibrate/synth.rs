@@ -11,7 +11,7 @@ use super::predict::predict_group;
 use super::rng::Rng;
 use super::CalibrateError;
 use crate::model::routing::CONTROL_POINTS;
-use crate::model::{Rod, SolverOptions, Unmodelled};
+use crate::model::{Rod, Segment, SolverOptions};
 use super::Effect;
 
 /// Effects `synth` can hide that are deliberately not diagnosis candidates
@@ -97,21 +97,36 @@ impl Planted {
         }
     }
 
-    /// Hides the effect in `rod`. The unmodelled ones go into the rod's
-    /// [`Unmodelled`] slot, which only this function sets and no file
-    /// carries.
+    /// Hides the effect in `rod`. The ones outside the library are built
+    /// into the body: a rest curvature, or a segment of stiffer material
+    /// at the clamp. The measurement file's header takes the geometry of
+    /// the rod without the effect, so that no file carries them.
     pub fn plant(&self, rod: &mut Rod) {
         match *self {
             Planted::None => {}
             Planted::Candidate { effect, value } => effect.apply(rod, value),
-            Planted::RestCurvature { per_mm } => {
-                rod.effects.hidden = Unmodelled { rest_curvature_per_mm: per_mm, ..Unmodelled::default() };
-            }
-            Planted::GlueJoint { ei_factor, length_mm } => {
-                rod.effects.hidden = Unmodelled { base_segment_ei_factor: ei_factor, base_segment_mm: length_mm, ..Unmodelled::default() };
-            }
+            Planted::RestCurvature { per_mm } => rod.rest_curvature_per_mm = per_mm,
+            Planted::GlueJoint { ei_factor, length_mm } => stiffen_base(rod, ei_factor, length_mm),
         }
     }
+}
+
+/// Makes the bending rigidity of `rod` `ei_factor` times stiffer over
+/// [0, `length_mm`] (a glue joint at the clamp): its segments there take
+/// the factor, the segment across `length_mm` is split there.
+fn stiffen_base(rod: &mut Rod, ei_factor: f64, length_mm: f64) {
+    let whole = Segment { end_mm: rod.length_mm, ea_n: None, ga_n: None, ei_n_mm2: None, density_g_cm3: None };
+    let mut segments = if rod.segments.is_empty() { vec![whole] } else { rod.segments.clone() };
+    if let Some(k) = segments.iter().position(|g| g.end_mm > length_mm) {
+        if length_mm > 0.0 && (k == 0 || segments[k - 1].end_mm < length_mm) {
+            let first = Segment { end_mm: length_mm, ..segments[k].clone() };
+            segments.insert(k, first);
+        }
+    }
+    for g in segments.iter_mut().filter(|g| g.end_mm <= length_mm) {
+        g.ei_n_mm2 = Some(g.ei_n_mm2.unwrap_or(rod.ei_n_mm2) * ei_factor);
+    }
+    rod.segments = segments;
 }
 
 /// What to generate.

@@ -130,7 +130,7 @@ impl clap::Args for EffectArgs {
 pub struct RadiusProfileArg(pub Vec<(f64, f64)>);
 
 fn parse_radius_profile_arg(text: &str) -> Result<RadiusProfileArg, String> {
-    cablemap::model::body::parse_radius_profile(text).map(RadiusProfileArg)
+    cablemap::model::body::parse_radius_profile(text).map(RadiusProfileArg).map_err(|e| e.to_string())
 }
 
 /// Solver method on the command line.

@@ -117,13 +117,13 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     let mut sim = solved.with_context(|| format!("simulating routing {y:?} at {} N", cablemap::io::fmt_num(tension)))?;
     if args.coefficients == CoefficientRoute::Thesis {
         let points: Vec<[f64; 2]> = sim.centreline.iter().map(|c| [c.x_mm, c.y_mm]).collect();
-        sim.a = cablemap::shape::thesis_coefficients(&points, args.order, args.n_d)
+        sim.a_bend_z = cablemap::shape::thesis_coefficients(&points, args.order, args.n_d)
             .context("thesis coefficient route")?
             .in_basis(basis, actuator.length_mm)
             .a;
     }
     if let Some(path) = &args.csv {
-        record::write_centreline_csv(path, &sim).with_context(|| format!("writing centreline CSV {}", path.display()))?;
+        record::write_planar_centreline_csv(path, &sim).with_context(|| format!("writing centreline CSV {}", path.display()))?;
     }
     if let Some(path) = &args.png {
         let title = format!("routing [{}] mm, tension {:.3} N", fmt_list(&y), tension);
@@ -139,13 +139,13 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     }
     let p = &sim.pose;
     writeln!(out, "routing        [{}] mm", fmt_list(&y))?;
-    writeln!(out, "tension        {:.6} N   (gravity {})", p.tension_n, if actuator.gravity.enabled { "on" } else { "off" })?;
+    writeln!(out, "tension        {:.6} N   (gravity {})", p.tension_n(), if actuator.gravity.enabled { "on" } else { "off" })?;
     writeln!(out, "tip            x = {:.6} mm, y = {:.6} mm", p.tip_x_mm, p.tip_y_mm)?;
     writeln!(out, "tip angle      {:.8} rad ({:.4}°)", p.tip_angle_rad, p.tip_angle_rad.to_degrees())?;
     writeln!(out, "base angle     {:.8} rad ({:.4}°)", p.base_angle_rad, p.base_angle_rad.to_degrees())?;
     writeln!(out, "length ℓ       {:.6} mm", p.length_mm)?;
     writeln!(out, "coefficients   a_i {}", basis.describe())?;
-    for (i, a) in sim.a.iter().enumerate() {
+    for (i, a) in sim.a_bend_z.iter().enumerate() {
         writeln!(out, "a_{i:<12} {a:.8e} mm^-1")?;
     }
     writeln!(out, "iterations     {} integration pass(es)", p.iterations)?;
@@ -174,7 +174,8 @@ fn report_png(args: &SimulateArgs) {
 /// in-plane cable with gravity in the plane, else the 3-D solver) and
 /// reported in the actuator's terms (the spatial record).
 fn run_spatial(args: &SimulateArgs) -> anyhow::Result<()> {
-    use cablemap::model::spatial::{record, simulate_actuator, Actuator, Cable, SpatialOptions};
+    use cablemap::model::spatial::SpatialOptions;
+    use cablemap::model::{record, simulate_actuator, Actuator, Cable};
     use cablemap::model::Hold;
     // The rod: the spatial file's [rod], else an --actuator-file, else the
     // thesis's; rod flags override either.
@@ -230,10 +231,10 @@ fn run_spatial(args: &SimulateArgs) -> anyhow::Result<()> {
             print_failure_json(status, &e.to_string())?;
         }
     }
-    let solved = solved?;
-    let mut sim = solved.spatial;
-    if let (true, Some(planar)) = (thesis, &solved.planar) {
-        let points: Vec<[f64; 2]> = planar.centreline.iter().map(|c| [c.x_mm, c.y_mm]).collect();
+    let mut sim = solved?;
+    // The thesis route needs a planar centreline: the one check refused it otherwise.
+    if thesis && sim.backend != Backend::Spatial {
+        let points: Vec<[f64; 2]> = sim.centreline.iter().map(|c| [c.x_mm, c.y_mm]).collect();
         sim.a_bend_z = cablemap::shape::thesis_coefficients(&points, args.order, args.n_d)
             .context("thesis coefficient route")?
             .in_basis(basis, spatial.rod.length_mm)
@@ -242,7 +243,7 @@ fn run_spatial(args: &SimulateArgs) -> anyhow::Result<()> {
         sim.a_twist = vec![0.0; sim.a_bend_z.len()];
     }
     if let Some(path) = &args.csv {
-        record::write_centreline_csv(path, &sim).with_context(|| format!("writing centreline CSV {}", path.display()))?;
+        record::write_actuator_centreline_csv(path, &sim).with_context(|| format!("writing centreline CSV {}", path.display()))?;
     }
     if let Some(path) = &args.png {
         let tensions: Vec<String> = spatial.cables.iter().map(|c| format!("{:.3}", c.tension_n)).collect();

@@ -233,10 +233,10 @@ mod tests {
         let sim = simulate(&act, &Default::default(), &routing, 1.5, 2, crate::shape::LengthBasis::Rest).unwrap();
         let drawing = BodyDrawing::of_body(&sim, &act, "body".into(), BLUE_800);
         let knot = sim.centreline.iter().find(|c| c.s_mm == anchor_mm).expect("a centreline point at the anchor");
-        assert_eq!(drawing.cable.last(), Some(&(knot.cable_x_mm, knot.cable_y_mm)));
+        assert_eq!(drawing.cable.last(), Some(&(knot.cables[0].position_mm[0], knot.cables[0].position_mm[1])));
         assert_eq!(drawing.cable.len(), sim.centreline.iter().filter(|c| c.s_mm <= anchor_mm).count());
         // The channel's offset there (y_4 = 4 mm at the anchor): the path does not fall back onto the centreline.
-        assert!((knot.channel_y_mm - 4.0).abs() < 1e-9, "{knot:?}");
+        assert!((knot.cables[0].channel_mm[0] - 4.0).abs() < 1e-9, "{knot:?}");
         assert!(drawing.cable.iter().all(|p| p.0.is_finite() && p.1.is_finite()));
     }
 

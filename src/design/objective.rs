@@ -113,7 +113,7 @@ impl Objective {
         // The solver settings and the target's coefficient order, before any
         // search: every a_k compared must be resolved by the steps.
         Simulator::new(&actuator, &options)?;
-        crate::model::resolution::check_order(target.order(), &options).map_err(DesignError::BadTarget)?;
+        crate::model::resolution::check_order(target.order(), &options).map_err(|e| DesignError::BadTarget(e.to_string()))?;
         weights.check_against(&target)?;
         bounds.validate(actuator.channel_radius_mm())?;
         Ok(Self { actuator, options, target, weights, bounds, length_basis: LengthBasis::default() })

@@ -11,7 +11,6 @@
 //! cut, ∫_s^L ρ r² dσ, has a closed form; the collocation puts span
 //! boundaries at the breakpoints so each span's integrands stay smooth.
 
-use super::rod::{Rod, ParameterError};
 use serde::{Deserialize, Serialize};
 
 /// One segment of the body with its own material, from the previous
@@ -54,21 +53,21 @@ pub enum BodyError {
     /// The profile has fewer than two points.
     #[error("a radius profile needs at least two points s:r (a cone is two), got {0}")]
     ProfileTooShort(usize),
-    /// Segment ends must rise strictly and the last must be L.
-    #[error("segment {index} ends at s = {} mm, {problem}", crate::io::fmt_num(*end_mm))]
-    BadSegment { index: usize, end_mm: f64, problem: String },
+    /// Segment ends must rise strictly.
+    #[error(
+        "segment {index} ends at s = {} mm, not after the previous end (s = {previous_mm} mm): give segments from the clamp to the tip, each ending after the last",
+        crate::io::fmt_num(*end_mm)
+    )]
+    SegmentOutOfOrder { index: usize, end_mm: f64, previous_mm: f64 },
+    /// The last segment must end at L.
+    #[error("segment {index} ends at s = {} mm, but the last segment must end at the tip, L = {length_mm} mm", crate::io::fmt_num(*end_mm))]
+    LastSegmentShort { index: usize, end_mm: f64, length_mm: f64 },
     /// A segment's material value is not positive.
     #[error("segment {index}: {name} = {} must be a positive, finite number (density ≥ 0)", crate::io::fmt_num(*value))]
     BadSegmentMaterial { index: usize, name: &'static str, value: f64 },
     /// The cable anchor lies outside the rod.
     #[error("the cable anchor s_k = {} mm is outside the rod: give 0 < s_k ≤ L = {} mm (omit it to knot the cable at the tip)", crate::io::fmt_num(*anchor_mm), crate::io::fmt_num(*length_mm))]
     AnchorOutside { anchor_mm: f64, length_mm: f64 },
-}
-
-impl From<BodyError> for ParameterError {
-    fn from(e: BodyError) -> Self {
-        ParameterError::Body(e.to_string())
-    }
 }
 
 /// One piece between consecutive breakpoints: the radius at both ends
@@ -117,7 +116,32 @@ pub struct BodySection {
     pub radius_mm: f64,
 }
 
-/// A non-uniform body, resolved from an [`Rod`]: pieces between the
+/// What a body is made of: the rod's length, its uniform section (radius
+/// and material) and what varies along s ([`crate::model::Rod`] holds
+/// these; `Rod::body` resolves them).
+#[derive(Debug, Clone, Copy)]
+pub struct BodyParts<'a> {
+    /// Rod length L, mm.
+    pub length_mm: f64,
+    /// The radius the rigidities are given for, mm.
+    pub radius_mm: f64,
+    /// Axial rigidity EA, N.
+    pub ea_n: f64,
+    /// Shear rigidity GA, N.
+    pub ga_n: f64,
+    /// Bending rigidity EI, N·mm².
+    pub ei_n_mm2: f64,
+    /// Density, g/cm³.
+    pub density_g_cm3: f64,
+    /// Radius profile points (s, r), mm; empty: uniform.
+    pub radius_profile_mm: &'a [(f64, f64)],
+    /// Segments of their own material; empty: one material.
+    pub segments: &'a [Segment],
+    /// The cable's anchor, mm; `None`: the tip.
+    pub cable_anchor_mm: Option<f64>,
+}
+
+/// A non-uniform body, resolved from a rod's [`BodyParts`]: pieces between the
 /// breakpoints and the closed-form weight beyond each breakpoint.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Body {
@@ -134,14 +158,14 @@ pub(crate) const MERGE_TOLERANCE: f64 = 1e-9;
 impl Body {
     /// Resolves and checks the body of `a`; `None` for the uniform cylinder
     /// (no profile, no segments), which the solver handles on its fast path.
-    pub fn of(a: &Rod) -> Result<Option<Body>, BodyError> {
+    pub fn new(a: &BodyParts) -> Result<Option<Body>, BodyError> {
         check_anchor(a)?;
         if a.radius_profile_mm.is_empty() && a.segments.is_empty() {
             return Ok(None);
         }
         let length = a.length_mm;
         let profile: Vec<(f64, f64)> =
-            if a.radius_profile_mm.is_empty() { vec![(0.0, a.radius_mm), (length, a.radius_mm)] } else { a.radius_profile_mm.clone() };
+            if a.radius_profile_mm.is_empty() { vec![(0.0, a.radius_mm), (length, a.radius_mm)] } else { a.radius_profile_mm.to_vec() };
         check_profile(&profile, length)?;
         check_segments(a)?;
         // Breakpoints: the profile's interior points and the segments' ends.
@@ -266,7 +290,7 @@ pub(crate) fn merge_sorted(mut cuts: Vec<f64>, length_mm: f64) -> Vec<f64> {
     out
 }
 
-fn check_anchor(a: &Rod) -> Result<(), BodyError> {
+fn check_anchor(a: &BodyParts) -> Result<(), BodyError> {
     if let Some(k) = a.cable_anchor_mm {
         if !(k.is_finite() && k > 0.0 && k <= a.length_mm) {
             return Err(BodyError::AnchorOutside { anchor_mm: k, length_mm: a.length_mm });
@@ -298,7 +322,7 @@ fn check_profile(profile: &[(f64, f64)], length_mm: f64) -> Result<(), BodyError
     Ok(())
 }
 
-fn check_segments(a: &Rod) -> Result<(), BodyError> {
+fn check_segments(a: &BodyParts) -> Result<(), BodyError> {
     let n = a.segments.len();
     let mut previous = 0.0;
     for (index, g) in a.segments.iter().enumerate() {
@@ -306,18 +330,10 @@ fn check_segments(a: &Rod) -> Result<(), BodyError> {
             return Err(BodyError::NotFinite { what: "segment end", index });
         }
         if g.end_mm <= previous {
-            return Err(BodyError::BadSegment {
-                index,
-                end_mm: g.end_mm,
-                problem: format!("not after the previous end (s = {previous} mm): give segments from the clamp to the tip, each ending after the last"),
-            });
+            return Err(BodyError::SegmentOutOfOrder { index, end_mm: g.end_mm, previous_mm: previous });
         }
         if index + 1 == n && (g.end_mm - a.length_mm).abs() > MERGE_TOLERANCE * a.length_mm {
-            return Err(BodyError::BadSegment {
-                index,
-                end_mm: g.end_mm,
-                problem: format!("but the last segment must end at the tip, L = {} mm", a.length_mm),
-            });
+            return Err(BodyError::LastSegmentShort { index, end_mm: g.end_mm, length_mm: a.length_mm });
         }
         previous = g.end_mm;
         for (name, value, positive) in
@@ -333,18 +349,44 @@ fn check_segments(a: &Rod) -> Result<(), BodyError> {
     Ok(())
 }
 
+/// Why a radius profile given as text could not be read.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ProfileTextError {
+    /// A point is not `s:r`.
+    #[error("radius profile point {index} \"{item}\" is not s:r (two numbers in mm, e.g. \"0:15.4,305:6.4,360:4.8\")")]
+    NotAPair {
+        /// The point's index.
+        index: usize,
+        /// The text of the point.
+        item: String,
+    },
+    /// A coordinate is not a number.
+    #[error("radius profile point {index} \"{item}\": \"{number}\" is not a number")]
+    NotANumber {
+        /// The point's index.
+        index: usize,
+        /// The text of the point.
+        item: String,
+        /// The text that is not a number.
+        number: String,
+    },
+    /// No points at all.
+    #[error("the radius profile is empty: give points s:r in mm, e.g. \"0:15.4,305:6.4,360:4.8\"")]
+    Empty,
+}
+
 /// Parses a radius profile "s:r,s:r,…" (mm), as on the command line.
-pub fn parse_radius_profile(text: &str) -> Result<Vec<(f64, f64)>, String> {
+pub fn parse_radius_profile(text: &str) -> Result<Vec<(f64, f64)>, ProfileTextError> {
     let mut out = Vec::new();
-    for (i, item) in text.split(',').map(str::trim).filter(|t| !t.is_empty()).enumerate() {
-        let (s, r) = item
-            .split_once(':')
-            .ok_or_else(|| format!("radius profile point {i} \"{item}\" is not s:r (two numbers in mm, e.g. \"0:15.4,305:6.4,360:4.8\")"))?;
-        let num = |t: &str| t.trim().parse::<f64>().map_err(|_| format!("radius profile point {i} \"{item}\": \"{}\" is not a number", t.trim()));
+    for (index, item) in text.split(',').map(str::trim).filter(|t| !t.is_empty()).enumerate() {
+        let (s, r) = item.split_once(':').ok_or_else(|| ProfileTextError::NotAPair { index, item: item.to_string() })?;
+        let num = |t: &str| {
+            t.trim().parse::<f64>().map_err(|_| ProfileTextError::NotANumber { index, item: item.to_string(), number: t.trim().to_string() })
+        };
         out.push((num(s)?, num(r)?));
     }
     if out.is_empty() {
-        return Err("the radius profile is empty: give points s:r in mm, e.g. \"0:15.4,305:6.4,360:4.8\"".into());
+        return Err(ProfileTextError::Empty);
     }
     Ok(out)
 }
@@ -352,6 +394,7 @@ pub fn parse_radius_profile(text: &str) -> Result<Vec<(f64, f64)>, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::Rod;
 
     fn tapered() -> Rod {
         Rod { length_mm: 360.0, radius_mm: 15.4, radius_profile_mm: vec![(0.0, 15.4), (305.0, 6.4), (360.0, 4.8)], ..Rod::default() }
@@ -364,7 +407,7 @@ mod tests {
             Segment { end_mm: 100.0, ea_n: None, ga_n: None, ei_n_mm2: Some(500.0), density_g_cm3: Some(1.2) },
             Segment { end_mm: 360.0, ea_n: None, ga_n: None, ei_n_mm2: None, density_g_cm3: None },
         ];
-        let b = Body::of(&a).unwrap().unwrap();
+        let b = a.body().unwrap().unwrap();
         assert_eq!(b.breakpoints_mm(), vec![100.0, 305.0]);
         // Midpoint rule on a fine grid.
         for s in [0.0, 50.0, 100.0, 200.0, 305.0, 330.0, 360.0] {
@@ -387,20 +430,20 @@ mod tests {
     fn bad_bodies_name_where_and_what() {
         let mut a = tapered();
         a.radius_profile_mm = vec![(0.0, 15.4), (305.0, 6.4), (300.0, 4.8)];
-        let e = Body::of(&a).unwrap_err().to_string();
+        let e = a.body().unwrap_err().to_string();
         assert!(e.contains("point 2") && e.contains("increasing s"), "{e}");
         a.radius_profile_mm = vec![(0.0, 15.4), (305.0, 0.0), (360.0, 4.8)];
-        let e = Body::of(&a).unwrap_err().to_string();
+        let e = a.body().unwrap_err().to_string();
         assert!(e.contains("s = 305 mm") && e.contains("> 0"), "{e}");
         a.radius_profile_mm = vec![(0.0, 15.4), (300.0, 4.8)];
-        let e = Body::of(&a).unwrap_err().to_string();
+        let e = a.body().unwrap_err().to_string();
         assert!(e.contains("L = 360 mm"), "{e}");
         let mut a = tapered();
         a.cable_anchor_mm = Some(400.0);
-        let e = Body::of(&a).unwrap_err().to_string();
+        let e = a.body().unwrap_err().to_string();
         assert!(e.contains("anchor") && e.contains("400"), "{e}");
-        assert!(Body::of(&Rod::default()).unwrap().is_none());
+        assert!(Rod::default().body().unwrap().is_none());
         assert!(parse_radius_profile("0:15.4,305:6.4,360:4.8").unwrap().len() == 3);
-        assert!(parse_radius_profile("0:15.4,305").unwrap_err().contains("s:r"));
+        assert!(parse_radius_profile("0:15.4,305").unwrap_err().to_string().contains("s:r"));
     }
 }

@@ -1,5 +1,5 @@
-//! Cables of a spatial actuator: routing (y and z channels), tension and
-//! anchor, checked against the body.
+//! Cables of an actuator: routing (y and z channels), tension and anchor,
+//! checked against the body; a cable's `--cable` text form.
 //!
 //! Each coordinate of the channel is the thesis's parametric cubic B-spline
 //! ([`Routing`], model-notes §2): y_c(s) and z_c(s) share s(ζ), so the pair
@@ -145,6 +145,73 @@ pub fn validate(actuator: &Rod, cables: &[Cable]) -> Result<Vec<Channel>, Spatia
     Ok(channels)
 }
 
+/// Parses the `--cable` form: `y=Y0,Y1,Y2,Y3,Y4 z=Z0,Z1,Z2,Z3,Z4 tension=T`
+/// (whitespace-separated `key=value` fields; `z=` may be left out for a
+/// planar cable; `anchor=S` knots it at s = S mm instead of the tip).
+impl std::str::FromStr for Cable {
+    type Err = SpatialError;
+
+    fn from_str(text: &str) -> Result<Self, Self::Err> {
+        let bad = |why: String| SpatialError::CableSpec { text: text.to_string(), why };
+        let points = |key: &str, value: &str| -> Result<[f64; CONTROL_POINTS], SpatialError> {
+            let v: Vec<f64> = value
+                .split(',')
+                .map(|x| x.trim().parse::<f64>().map_err(|_| bad(format!("{key}: '{}' is not a number", x.trim()))))
+                .collect::<Result<_, _>>()?;
+            v.try_into().map_err(|v: Vec<f64>| bad(format!("{key} needs {CONTROL_POINTS} control points, got {}", v.len())))
+        };
+        let number = |key: &str, value: &str| -> Result<f64, SpatialError> {
+            value.trim().parse::<f64>().map_err(|_| bad(format!("{key}: '{value}' is not a number")))
+        };
+        let (mut y, mut z, mut tension, mut anchor) = (None, None, None, None);
+        for field in text.split_whitespace() {
+            let (key, value) = field.split_once('=').ok_or_else(|| bad(format!("'{field}' is not key=value")))?;
+            let slot_taken = |taken: bool| if taken { Err(bad(format!("{key}= is given twice"))) } else { Ok(()) };
+            match key {
+                "y" => {
+                    slot_taken(y.is_some())?;
+                    y = Some(points(key, value)?);
+                }
+                "z" => {
+                    slot_taken(z.is_some())?;
+                    z = Some(points(key, value)?);
+                }
+                "tension" => {
+                    slot_taken(tension.is_some())?;
+                    tension = Some(number(key, value)?);
+                }
+                "anchor" => {
+                    slot_taken(anchor.is_some())?;
+                    anchor = Some(number(key, value)?);
+                }
+                other => return Err(bad(format!("unknown field '{other}' (fields: y, z, tension, anchor)"))),
+            }
+        }
+        let y_mm = y.ok_or_else(|| bad("y= is missing".into()))?;
+        let tension_n = tension.ok_or_else(|| bad("tension= is missing".into()))?;
+        Ok(Cable { y_mm, z_mm: z.unwrap_or([0.0; CONTROL_POINTS]), tension_n, anchor_mm: anchor })
+    }
+}
+
+/// The `--cable` form that [`Cable`]'s `FromStr` reads back to the same
+/// cable bit for bit: `y=…` always, `z=…` only when out of plane, then
+/// `tension=…` and `anchor=…` when knotted before the tip. Numbers are
+/// Rust's shortest round-trip form.
+impl std::fmt::Display for Cable {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let list = |v: &[f64]| v.iter().map(|x| format!("{x}")).collect::<Vec<_>>().join(",");
+        write!(f, "y={}", list(&self.y_mm))?;
+        if !self.is_planar() {
+            write!(f, " z={}", list(&self.z_mm))?;
+        }
+        write!(f, " tension={}", self.tension_n)?;
+        if let Some(anchor) = self.anchor_mm {
+            write!(f, " anchor={anchor}")?;
+        }
+        Ok(())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -191,5 +258,41 @@ mod tests {
         anchored.anchor_mm = Some(70.0);
         let e = validate(&rod(), &[anchored]).unwrap_err();
         assert!(matches!(e, SpatialError::Anchor { cable: 1, .. }), "{e}");
+    }
+
+    #[test]
+    fn cable_text_form_parses_and_names_its_problems() {
+        let c: Cable = "y=1,2,3,2,1 z=0,-1,-2,-1,0 tension=1.5".parse().unwrap();
+        assert_eq!(c.y_mm, [1.0, 2.0, 3.0, 2.0, 1.0]);
+        assert_eq!(c.z_mm, [0.0, -1.0, -2.0, -1.0, 0.0]);
+        assert_eq!(c.tension_n, 1.5);
+        assert_eq!(c.anchor_mm, None);
+        let planar: Cable = "tension=2 y=-1,-1,-1,-1,-1 anchor=40".parse().unwrap();
+        assert!(planar.is_planar());
+        assert_eq!(planar.anchor_mm, Some(40.0));
+        for (text, needle) in [
+            ("y=1,2,3 tension=1", "5 control points, got 3"),
+            ("y=1,2,3,4,5", "tension= is missing"),
+            ("z=1,2,3,4,5 tension=1", "y= is missing"),
+            ("y=1,2,x,4,5 tension=1", "'x' is not a number"),
+            ("y=1,2,3,4,5 tension=1 colour=red", "unknown field 'colour'"),
+            ("y=1,2,3,4,5 tension=1 tension=2", "given twice"),
+            ("y=1,2,3,4,5 tension", "not key=value"),
+        ] {
+            let e = text.parse::<Cable>().unwrap_err().to_string();
+            assert!(e.contains(needle), "{text}: {e}");
+            assert!(e.contains("cable \""), "{e}");
+        }
+    }
+
+    #[test]
+    fn a_cables_text_form_reads_back_to_the_same_cable() {
+        for c in [
+            Cable::planar([3.0, 1.0, 2.5, 1.0, 3.0], 1.8000000000000003),
+            Cable { y_mm: [0.1, -0.2, 0.3, 1e-7, 4.0], z_mm: [0.0, 1.0, -1.5, 0.0, 2.0], tension_n: 0.6, anchor_mm: Some(40.25) },
+        ] {
+            assert_eq!(c.to_string().parse::<Cable>().unwrap(), c, "{c}");
+        }
+        assert_eq!(Cable::planar([3.0, 1.0, 1.0, 1.0, 3.0], 1.8).to_string(), "y=3,1,1,1,3 tension=1.8");
     }
 }

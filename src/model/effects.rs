@@ -9,17 +9,19 @@
 //! (`calibrate::Effect`) are a view of the entries with a [`Fit`], the
 //! solvers ask [`unsupported_by`] what they cannot serve, and tests check
 //! docs/model.md's effects table against it. The spec keys are spelled
-//! here and in the [`Effects`] struct only (tests/layering.rs checks it).
+//! here and in the [`Effects`] struct only (`effect_parameters.rs`;
+//! tests/layering.rs checks it).
 //!
 //! To add an effect: a field in [`Effects`] (or a parameter of the rod), an
 //! entry in [`REGISTRY`] and a row in docs/model.md's table; then its term
 //! in the solvers that model it.
 
-use super::rod::{ParameterError, PlausibleRange, Rod};
-use serde::{Deserialize, Serialize};
-
-/// Default creep time constant T, s.
-pub const DEFAULT_CREEP_TIME_S: f64 = 10.0;
+use super::effect_parameters::DEFAULT_CREEP_TIME_S;
+use super::parameter::{ParameterError, PlausibleRange};
+use super::rod::Rod;
+use crate::model::solver::Backend;
+#[cfg(doc)]
+use super::Effects;
 
 /// Scale on the weight.
 pub const PLAUSIBLE_GRAVITY_SCALE: PlausibleRange =
@@ -33,140 +35,6 @@ pub const PLAUSIBLE_STIFFENING_ALPHA: PlausibleRange =
 /// Clamp stiffness, N·mm/rad.
 pub const PLAUSIBLE_CLAMP_STIFFNESS: PlausibleRange =
     PlausibleRange { min: 1e-9, max: 1e18, expected: "a clamp stiffness from 1e-9 to 1e18 N·mm/rad" };
-
-/// Direction of the last tension change, which decides the sign of friction.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "lowercase")]
-pub enum LoadDirection {
-    /// Tension rising: friction opposes the cable sliding toward the base.
-    #[default]
-    Load,
-    /// Tension falling: friction acts the other way.
-    Unload,
-}
-
-impl LoadDirection {
-    /// The slip sign η in friction's capstan law dτ/ds = −η μ τ |ψ'|:
-    /// +1 loading, −1 unloading.
-    pub fn slip_sign(self) -> f64 {
-        match self {
-            LoadDirection::Load => 1.0,
-            LoadDirection::Unload => -1.0,
-        }
-    }
-}
-
-/// Physical effects beyond the thesis model, each with one parameter
-/// (model-notes §6; described in [`REGISTRY`]). All default to "off" (the
-/// thesis model).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct Effects {
-    /// Cable–channel friction coefficient μ (capstan law along the channel).
-    pub friction_mu: f64,
-    /// Whether the tension was last rising or falling (sign of friction).
-    pub load_direction: LoadDirection,
-    /// Material stiffening α: bending moment EI·u·(1 + α (r u)²).
-    pub stiffening_alpha: f64,
-    /// Rotational stiffness of the clamp k_θ, N·mm/rad; `None` is a rigid clamp.
-    pub clamp_stiffness_n_mm_per_rad: Option<f64>,
-    /// Channel offset δ: the built channel sits at y_c + δ, mm.
-    pub channel_offset_mm: f64,
-    /// Viscoelastic creep in bending (standard linear solid): the fraction f
-    /// of the instantaneous bending rigidity that relaxes, 0 ≤ f < 1. Held
-    /// long enough at a moment m, the curvature creeps from m/EI to
-    /// m/(EI (1 − f)).
-    pub creep_fraction: f64,
-    /// Time constant T of the creep's dashpot, s (the curvature relaxes
-    /// like exp(−(1 − f) t / T) at a held moment).
-    pub creep_time_s: f64,
-    /// For solves outside a measured protocol (simulate, sweep, design):
-    /// how long each tension is held on a rod with no load history before
-    /// the shape is taken, s. 0 gives the instantaneous (elastic) shape.
-    pub creep_hold_s: f64,
-    /// Out-of-library effects planted by `calibrate::synth` only (see
-    /// [`Unmodelled`]). Never read from or written to a file: no spec,
-    /// actuator file or record carries them, and only synth sets them.
-    #[serde(skip)]
-    pub hidden: Unmodelled,
-    /// Stiffness gradient β: EI(s) = EI·exp(β (s/L − ½)) with EA, GA
-    /// unchanged (uneven curing, an unmodelled taper); β = ln(EI(L)/EI(0)),
-    /// β < 0 is softer toward the tip. Not written when 0, so existing specs
-    /// and metadata are unchanged.
-    #[serde(skip_serializing_if = "is_zero")]
-    pub stiffness_gradient_beta: f64,
-}
-
-fn is_zero(v: &f64) -> bool {
-    *v == 0.0
-}
-
-impl Default for Effects {
-    fn default() -> Self {
-        Self {
-            friction_mu: 0.0,
-            load_direction: LoadDirection::Load,
-            stiffening_alpha: 0.0,
-            clamp_stiffness_n_mm_per_rad: None,
-            channel_offset_mm: 0.0,
-            creep_fraction: 0.0,
-            creep_time_s: DEFAULT_CREEP_TIME_S,
-            creep_hold_s: 0.0,
-            hidden: Unmodelled::default(),
-            stiffness_gradient_beta: 0.0,
-        }
-    }
-}
-
-/// Effects deliberately outside the registry and the diagnosis's candidate
-/// list, so that tests can check that the diagnosis says "unexplained"
-/// instead of naming a wrong effect (`cablemap synth --effect
-/// rest_curvature|glue_joint`). Only `calibrate::synth` plants them; they
-/// have no spec key, flag or file format.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Unmodelled {
-    /// Rest (cured-in) curvature along the whole rod, 1/mm: the bending law
-    /// becomes m = EI (u − u₀).
-    pub rest_curvature_per_mm: f64,
-    /// Bending rigidity factor over `[0, base_segment_mm]` (a stiff glue
-    /// joint at the clamp); 1 is none.
-    pub base_segment_ei_factor: f64,
-    /// Length of the stiff base segment, mm.
-    pub base_segment_mm: f64,
-}
-
-impl Default for Unmodelled {
-    fn default() -> Self {
-        Self { rest_curvature_per_mm: 0.0, base_segment_ei_factor: 1.0, base_segment_mm: 0.0 }
-    }
-}
-
-impl Unmodelled {
-    /// Whether every unmodelled effect is off.
-    pub fn is_off(&self) -> bool {
-        *self == Unmodelled::default()
-    }
-
-    /// Refuses values the solver cannot use (checked with the rod).
-    pub fn validate(&self) -> Result<(), ParameterError> {
-        if !self.rest_curvature_per_mm.is_finite() {
-            return Err(ParameterError::OutOfRange {
-                name: "rest_curvature_per_mm",
-                value: self.rest_curvature_per_mm,
-                expected: "a finite curvature in 1/mm",
-            });
-        }
-        if !(self.base_segment_ei_factor.is_finite() && self.base_segment_ei_factor > 0.0) {
-            return Err(ParameterError::NotPositive { name: "base_segment_ei_factor", value: self.base_segment_ei_factor });
-        }
-        if !(self.base_segment_mm.is_finite() && self.base_segment_mm >= 0.0) {
-            return Err(ParameterError::OutOfRange { name: "base_segment_mm", value: self.base_segment_mm, expected: "a finite length ≥ 0 mm" });
-        }
-        Ok(())
-    }
-}
-
-use crate::model::solver::Backend;
 
 /// The table of the rod a parameter sits in (`[actuator.effects]`,
 /// `[actuator.gravity]` in a sweep spec; `[rod.…]` in a cable spec).
@@ -686,8 +554,7 @@ pub fn unsupported_by(backend: Backend, rod: &Rod) -> Option<&'static EffectInfo
 
 /// Checks every effect parameter of `rod` against its bounds.
 pub fn validate(rod: &Rod) -> Result<(), ParameterError> {
-    REGISTRY.iter().try_for_each(|e| e.check(rod))?;
-    rod.effects.hidden.validate()
+    REGISTRY.iter().try_for_each(|e| e.check(rod))
 }
 
 #[cfg(test)]

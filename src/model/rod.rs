@@ -1,41 +1,16 @@
-//! Rod parameters (thesis Table 2.1, model-notes §1) and the optional
-//! physical effects the thesis model leaves out (model-notes §6).
+//! Rod parameters (thesis Table 2.1, model-notes §1): geometry, rigidities,
+//! density, gravity, the effects it carries, the body along s (radius
+//! profile, segments, rest curvature) and the cable's anchor; the actuator
+//! file format. Checking a rod is [`Rod::validate`] (`validation.rs`).
 
-use super::body::{Body, Segment};
+use super::body::{Body, BodyError, BodyParts, Segment};
+use super::parameter::{ParameterError, PlausibleRange};
 use serde::{Deserialize, Serialize};
 
-// The effects and their registry live in `effects`; re-exported here, where
-// the rod's other parameters are.
-pub use super::effects::{
-    Effects, LoadDirection, Unmodelled, DEFAULT_CREEP_TIME_S, PLAUSIBLE_CLAMP_STIFFNESS, PLAUSIBLE_FRICTION_MU,
-    PLAUSIBLE_GRAVITY_SCALE, PLAUSIBLE_STIFFENING_ALPHA,
-};
+pub use super::effect_parameters::{Effects, LoadDirection, DEFAULT_CREEP_TIME_S};
 
 /// Standard gravity, m/s².
 pub const STANDARD_GRAVITY_M_S2: f64 = 9.81;
-
-/// A plausible range of a parameter: far beyond any rod cablemap models,
-/// yet refusing values whose products in the solver overflow or vanish.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct PlausibleRange {
-    /// Smallest value accepted.
-    pub min: f64,
-    /// Largest value accepted.
-    pub max: f64,
-    /// The range and an example in words, for the error.
-    pub expected: &'static str,
-}
-
-impl PlausibleRange {
-    /// Refuses `value` of parameter `name` outside the range.
-    pub fn check(&self, name: &'static str, value: f64) -> Result<(), ParameterError> {
-        if (self.min..=self.max).contains(&value) {
-            Ok(())
-        } else {
-            Err(ParameterError::OutOfRange { name, value, expected: self.expected })
-        }
-    }
-}
 
 /// Rod length, mm.
 pub const PLAUSIBLE_LENGTH_MM: PlausibleRange =
@@ -56,37 +31,28 @@ pub const PLAUSIBLE_DENSITY_G_CM3: PlausibleRange =
 pub const PLAUSIBLE_G_M_S2: PlausibleRange =
     PlausibleRange { min: 0.0, max: 1e4, expected: "0, or an acceleration up to 1e4 m/s² (Earth: 9.81)" };
 
-/// Why a parameter set was rejected.
+/// What is wrong with an actuator's TOML text.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum ParameterError {
-    /// A parameter that must be positive and finite is not.
-    #[error("parameter {name} = {} must be a positive, finite number", crate::io::fmt_num(*value))]
-    NotPositive { name: &'static str, value: f64 },
-    /// A parameter that must be finite is not, or lies outside its range.
-    #[error("parameter {name} = {} is out of range: {expected}", crate::io::fmt_num(*value))]
-    OutOfRange { name: &'static str, value: f64, expected: &'static str },
-    /// A coefficient order the discretisation does not resolve
-    /// ([`crate::model::resolution`]).
+pub enum RodTextError {
+    /// The file could not be read (the cause as text: this error is cloned and compared).
     #[error("{0}")]
-    Unresolved(String),
-    /// The body along s (radius profile, segments, cable anchor) is invalid
-    /// ([`crate::model::body::BodyError`]).
+    Read(String),
+    /// Not TOML, or a field unknown or of the wrong type (the parser's message).
     #[error("{0}")]
-    Body(String),
-    /// The solver backend asked for does not model this rod
-    /// ([`crate::model::solver::Backend::check`]).
+    Toml(String),
+    /// A parameter is invalid.
     #[error(transparent)]
-    Unsupported(#[from] crate::model::solver::Unsupported),
+    Parameter(#[from] ParameterError),
 }
 
 /// Why an actuator file could not be used.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("actuator file {path}: {message} (an actuator file holds the [actuator] fields of docs/model.md: length_mm, radius_mm, radius_profile_mm, segments, cable_anchor_mm, ...)")]
+#[error("actuator file {path}: {problem} (an actuator file holds the [actuator] fields of docs/model.md: length_mm, radius_mm, radius_profile_mm, segments, cable_anchor_mm, ...)")]
 pub struct ActuatorFileError {
     /// The file.
     pub path: String,
     /// What is wrong.
-    pub message: String,
+    pub problem: RodTextError,
 }
 
 /// Self-weight of the rod.
@@ -148,6 +114,17 @@ pub struct Rod {
     /// carries no cable load, only its weight.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub cable_anchor_mm: Option<f64>,
+    /// Rest curvature u* of a rod cured bent, 1/mm: the curvature of the
+    /// unloaded rod in the x–y plane (about the body z axis), constant
+    /// along s; the bending law is m = EI (u − u*) (Rucker–Webster's u*).
+    /// A body property calibrate does not fit. Not written when 0, so
+    /// existing files are unchanged.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub rest_curvature_per_mm: f64,
+}
+
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
 }
 
 impl Default for Rod {
@@ -164,6 +141,7 @@ impl Default for Rod {
             radius_profile_mm: Vec::new(),
             segments: Vec::new(),
             cable_anchor_mm: None,
+            rest_curvature_per_mm: 0.0,
         }
     }
 }
@@ -191,9 +169,25 @@ impl Rod {
         self.cable_anchor_mm.unwrap_or(self.length_mm)
     }
 
+    /// The body along s (radius profile, segments), resolved and checked;
+    /// `None` for the uniform cylinder, solved on the fast path.
+    pub fn body(&self) -> Result<Option<Body>, BodyError> {
+        Body::new(&BodyParts {
+            length_mm: self.length_mm,
+            radius_mm: self.radius_mm,
+            ea_n: self.ea_n,
+            ga_n: self.ga_n,
+            ei_n_mm2: self.ei_n_mm2,
+            density_g_cm3: self.density_g_cm3,
+            radius_profile_mm: &self.radius_profile_mm,
+            segments: &self.segments,
+            cable_anchor_mm: self.cable_anchor_mm,
+        })
+    }
+
     /// Radius r(s), mm (the profile's, or `radius_mm`). Assumes a valid body.
     pub fn radius_at(&self, s_mm: f64) -> f64 {
-        match Body::of(self) {
+        match self.body() {
             Ok(Some(b)) => b.radius_at(s_mm),
             _ => self.radius_mm,
         }
@@ -204,7 +198,7 @@ impl Rod {
     /// spline stays in its control polygon's hull). `radius_mm` for the
     /// uniform cylinder.
     pub fn channel_radius_mm(&self) -> f64 {
-        match Body::of(self) {
+        match self.body() {
             Ok(Some(b)) => b.min_radius_mm(0.0, self.cable_length_mm()),
             _ => self.radius_mm,
         }
@@ -219,57 +213,16 @@ impl Rod {
     /// spec's `[actuator]` section; missing fields are the thesis's), checked
     /// with [`Rod::validate`]. This module owns the actuator file format.
     pub fn from_toml_file(path: &std::path::Path) -> Result<Rod, ActuatorFileError> {
-        let text = std::fs::read_to_string(path).map_err(|e| ActuatorFileError { path: path.display().to_string(), message: e.to_string() })?;
-        Rod::from_toml_str(&text).map_err(|message| ActuatorFileError { path: path.display().to_string(), message })
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| ActuatorFileError { path: path.display().to_string(), problem: RodTextError::Read(e.to_string()) })?;
+        Rod::from_toml_str(&text).map_err(|problem| ActuatorFileError { path: path.display().to_string(), problem })
     }
 
     /// Parses actuator TOML text (see [`Rod::from_toml_file`]).
-    pub fn from_toml_str(text: &str) -> Result<Rod, String> {
-        let a: Rod = toml::from_str(text).map_err(|e| e.to_string().trim_end().to_string())?;
-        a.validate().map_err(|e| e.to_string())?;
+    pub fn from_toml_str(text: &str) -> Result<Rod, RodTextError> {
+        let a: Rod = toml::from_str(text).map_err(|e| RodTextError::Toml(e.to_string().trim_end().to_string()))?;
+        a.validate()?;
         Ok(a)
-    }
-
-    /// Checks every parameter; the solver calls this before it starts.
-    pub fn validate(&self) -> Result<(), ParameterError> {
-        let positive = [
-            ("length_mm", self.length_mm),
-            ("radius_mm", self.radius_mm),
-            ("ea_n", self.ea_n),
-            ("ga_n", self.ga_n),
-            ("ei_n_mm2", self.ei_n_mm2),
-        ];
-        for (name, value) in positive {
-            if !(value.is_finite() && value > 0.0) {
-                return Err(ParameterError::NotPositive { name, value });
-            }
-        }
-        // Absurd sizes (a subnormal rigidity, a kilometre-long rod) are
-        // refused here with a plausible range: the solver's products of them
-        // would overflow or vanish into non-finite results. Within these
-        // ranges every product the solver forms stays finite.
-        for (name, value, range) in [
-            ("length_mm", self.length_mm, PLAUSIBLE_LENGTH_MM),
-            ("radius_mm", self.radius_mm, PLAUSIBLE_RADIUS_MM),
-            ("ea_n", self.ea_n, PLAUSIBLE_FORCE_N),
-            ("ga_n", self.ga_n, PLAUSIBLE_FORCE_N),
-            ("ei_n_mm2", self.ei_n_mm2, PLAUSIBLE_EI_N_MM2),
-        ] {
-            range.check(name, value)?;
-        }
-        for (name, value, range) in [
-            ("density_g_cm3", self.density_g_cm3, PLAUSIBLE_DENSITY_G_CM3),
-            ("gravity.g_m_s2", self.gravity.g_m_s2, PLAUSIBLE_G_M_S2),
-        ] {
-            if !(value.is_finite() && value >= 0.0) {
-                return Err(ParameterError::OutOfRange { name, value, expected: "a finite number ≥ 0" });
-            }
-            range.check(name, value)?;
-        }
-        // Every effect parameter by its registry entry.
-        super::effects::validate(self)?;
-        Body::of(self)?;
-        Ok(())
     }
 }
 

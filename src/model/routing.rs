@@ -102,8 +102,8 @@ pub enum RoutingError {
     #[error("the channel at s = {s_mm:.2} mm is at y_c = {y_mm:.3} mm, outside the body (radius r(s) = {radius_mm:.3} mm there): move the control points nearer the axis, or widen the radius profile there")]
     ChannelOutsideBody { s_mm: f64, y_mm: f64, radius_mm: f64 },
     /// The actuator's body (profile, segments, anchor) is invalid.
-    #[error("{0}")]
-    Body(String),
+    #[error(transparent)]
+    Body(#[from] super::body::BodyError),
     /// Rod length or radius is not positive and finite.
     #[error("rod length ({} mm) and radius ({} mm) must be positive and finite", crate::io::fmt_num(*length_mm), crate::io::fmt_num(*radius_mm))]
     BadGeometry { length_mm: f64, radius_mm: f64 },
@@ -220,7 +220,7 @@ impl Routing {
     /// for a non-uniform body. For the uniform body this is
     /// [`Routing::new`] with the actuator's length and radius.
     pub fn for_actuator(y_mm: impl AsRef<[f64]>, a: &super::Rod) -> Result<Self, RoutingError> {
-        let body = super::body::Body::of(a).map_err(|e| RoutingError::Body(e.to_string()))?;
+        let body = a.body()?;
         let Some(body) = body else {
             if a.is_uniform_body() {
                 return Routing::new(y_mm, a.length_mm, a.radius_mm);

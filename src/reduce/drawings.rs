@@ -74,34 +74,17 @@ impl ModeDrawings {
                 // The sweep reached the row along its tension path; a solve from
                 // zero could in principle land on another equilibrium: then the
                 // drawing would not be the row's, and is not made.
-                Ok(sim) if tip_gap_mm(&sim.pose.tip_mm, d) > REDRAW_TOLERANCE_MM => {
+                Ok(sim) if tip_gap_mm(&sim.pose.tip_mm(), d) > REDRAW_TOLERANCE_MM => {
                     drawings.shapes.push(None);
                     let message = format!(
                         "the solve from zero ends at ({:.3}, {:.3}) mm, not at the row's tip ({:.3}, {:.3}) mm",
-                        sim.pose.tip_mm[0], sim.pose.tip_mm[1], d.tip_x_mm, d.tip_y_mm
+                        sim.pose.tip_x_mm, sim.pose.tip_y_mm, d.tip_x_mm, d.tip_y_mm
                     );
                     drawings.failures.push(DrawingError::Simulation { mode: m.mode, source: message.into() });
                 }
                 Ok(sim) => {
-                    let centreline = sim.nodes.iter().map(|n| (n.p_mm[0], n.p_mm[1])).collect();
-                    // The body x-axis (first column of R) in the x–y plane.
-                    let frame_angle_rad = sim.nodes.iter().map(|n| n.rotation[1][0].atan2(n.rotation[0][0])).collect();
-                    let mut paths = sim.cable_paths_mm().into_iter().map(|p| p.iter().map(|q| (q[0], q[1])).collect::<Vec<_>>());
-                    let cable = paths.next().unwrap_or_default();
-                    let further_cables = paths.collect();
-                    drawings.shapes.push(Some(BodyDrawing {
-                        centreline,
-                        frame_angle_rad,
-                        cable,
-                        further_cables,
-                        radius_mm: rod.radius_mm,
-                        radii_mm: match crate::model::Body::of(rod) {
-                            Ok(Some(body)) => sim.nodes.iter().map(|n| body.radius_at(n.s_mm)).collect(),
-                            _ => Vec::new(),
-                        },
-                        label: format!("mode {}", m.mode),
-                        colour: plotters::style::full_palette::BLUE_800,
-                    }));
+                    let label = format!("mode {}", m.mode);
+                    drawings.shapes.push(Some(BodyDrawing::of_body(&sim, rod, label, plotters::style::full_palette::BLUE_800)));
                 }
                 Err(e) => {
                     drawings.shapes.push(None);

@@ -8,7 +8,7 @@ use super::reach::{Reach, PLANES};
 use super::tables::PLANAR_MAP_DIR;
 use super::{explorer, tables, CableMapSummary, CoefficientStats, MapCables, MapData, ReduceError, COEFFICIENT_UNIT};
 use crate::model::Rod;
-use crate::plot::spatial::{draw_reach_maps, ReachPlane};
+use crate::plot::{draw_reach_maps, ReachPlane};
 use std::path::Path;
 
 /// The picture of a cable sweep's reach: the three planes side by side.

@@ -13,7 +13,6 @@
 //! NaN), and `status` says why.
 
 use crate::model::routing::{ControlPoints, CONTROL_POINTS};
-use crate::model::spatial::SpatialPose;
 use crate::model::TipPose;
 use arrow::array::{ArrayRef, Float64Array, Float64Builder, Int32Array, Int32Builder, Int64Array, Int64Builder, ListBuilder, StringArray, StringBuilder};
 use arrow::datatypes::{DataType, Field, Schema, SchemaRef};
@@ -234,7 +233,7 @@ pub struct CableRow {
     /// Solver passes (0 when not solved).
     pub passes: i32,
     /// The pose of a solved row.
-    pub pose: Option<SpatialPose>,
+    pub pose: Option<TipPose>,
     /// Twist, out-of-plane and in-plane coefficient series of a solved row.
     pub a: Option<[Vec<f64>; 3]>,
 }
@@ -277,10 +276,11 @@ pub fn cable_batch(schema: &SchemaRef, rows: &[&CableRow], n_cables: usize, orde
     columns.push(Arc::new(Int32Array::from_iter_values(rows.iter().map(|r| r.passes))));
     let pose_value = |r: &CableRow, k: usize| {
         r.pose.map(|p| match k {
-            0..=2 => p.tip_mm[k],
-            3..=5 => p.tip_tangent[k - 3],
-            6..=8 => p.tip_body_y_axis[k - 6],
-            9 => p.tip_angle_rad,
+            0..=2 => p.tip_mm()[k],
+            3..=5 => p.tip_tangent()[k - 3],
+            6..=8 => p.tip_body_y_axis()[k - 6],
+            // The cable sweep's tip_angle_rad: unsigned, from the clamp axis.
+            9 => p.angle_from_clamp_axis_rad(),
             _ => p.length_mm,
         })
     };

@@ -7,8 +7,8 @@
 
 use super::schema::{CableRow, SolvedRouting, SolvedRow, STATUS_FAILED, STATUS_INVALID_ROUTING};
 use crate::model::routing::ControlPoints;
-use crate::model::spatial::{Actuator, SpatialOptions, SpatialPose, SpatialSolver};
-use crate::model::{Routing, Simulator, SolveFailure, STATUS_OK};
+use crate::model::spatial::{Actuator, SpatialOptions, SpatialSolver};
+use crate::model::{Routing, Simulator, SolveFailure, TipPose, STATUS_OK};
 use crate::shape::LengthBasis;
 
 /// What each solve of a sweep stores besides its pose: a_0 … a_`order` per
@@ -151,7 +151,7 @@ pub fn cable_routing(id: u64, mut actuator: Actuator, options: &SpatialOptions, 
         let t = combinations.tensions_n(combo);
         let solved = match solver.solve(&t) {
             Ok(pose) => match solver.coefficients(stored.order, stored.length_basis) {
-                Ok(a) if finite_cable_row(&pose, &a) => row(combo, STATUS_OK, pose.passes as i32, Some(pose), Some(a)),
+                Ok(a) if finite_cable_row(&pose, &a) => row(combo, STATUS_OK, pose.iterations as i32, Some(pose), Some(a)),
                 _ => row(combo, STATUS_FAILED, 0, None, None),
             },
             Err(_) => row(combo, STATUS_FAILED, 0, None, None),
@@ -164,9 +164,9 @@ pub fn cable_routing(id: u64, mut actuator: Actuator, options: &SpatialOptions, 
 
 /// A solve whose outputs are all finite (others are stored as failures, so
 /// that no output is NaN).
-fn finite_cable_row(pose: &SpatialPose, a: &[Vec<f64>; 3]) -> bool {
+fn finite_cable_row(pose: &TipPose, a: &[Vec<f64>; 3]) -> bool {
     let p = pose;
-    p.tip_mm.iter().chain(&p.tip_tangent).chain(&p.tip_body_y_axis).chain([&p.tip_angle_rad, &p.length_mm]).all(|v| v.is_finite())
+    p.tip_mm().iter().chain(&p.tip_tangent()).chain(&p.tip_body_y_axis()).chain([&p.angle_from_clamp_axis_rad(), &p.length_mm]).all(|v| v.is_finite())
         && a.iter().flatten().all(|v| v.is_finite())
 }
 

@@ -83,8 +83,6 @@ enum Need {
     NonUniformBody,
     AnchorBeforeTip,
     RodAnchor,
-    /// `synth`'s planted effects (planar only).
-    Unmodelled,
     Effect(&'static crate::model::effects::EffectInfo),
     Hold,
     ThesisCoefficients,
@@ -111,8 +109,6 @@ pub struct Support {
     pub rod_anchor: bool,
     /// A load direction and dwell of the final tension.
     pub hold: bool,
-    /// `synth`'s planted, unmodelled effects.
-    pub unmodelled: bool,
     /// The thesis's coefficient route (needs a planar centreline).
     pub thesis_coefficients: bool,
     /// The integration it is asked for by `method`.
@@ -153,7 +149,6 @@ impl Backend {
             anchors: true,
             rod_anchor: true,
             hold: true,
-            unmodelled: true,
             thesis_coefficients: true,
             method: SolverMethod::Collocation,
             nodes_per_span: true,
@@ -171,7 +166,6 @@ impl Backend {
                 anchors: true,
                 rod_anchor: false,
                 hold: true,
-                unmodelled: true,
                 thesis_coefficients: false,
                 method: SolverMethod::Collocation,
                 nodes_per_span: true,
@@ -186,7 +180,6 @@ impl Backend {
                 anchors: true,
                 rod_anchor: false,
                 hold: false,
-                unmodelled: false,
                 thesis_coefficients: false,
                 method: SolverMethod::Rk4,
                 nodes_per_span: false,
@@ -206,7 +199,6 @@ impl Backend {
             Need::AnchorBeforeTip => s.anchors,
             Need::RodAnchor => s.rod_anchor,
             Need::Effect(info) => info.supported_by(self),
-            Need::Unmodelled => s.unmodelled,
             Need::Hold => s.hold,
             Need::ThesisCoefficients => s.thesis_coefficients,
             Need::Collocation => s.method == SolverMethod::Collocation,
@@ -288,9 +280,6 @@ fn needs(actuator: &Actuator, options: &SolverOptions, given: Given) -> Vec<(Nee
     }
     for info in crate::model::effects::REGISTRY.iter().copied().filter(|info| info.acts(rod)) {
         need(Need::Effect(info), format!("effects.{} (leave it at its default)", info.key));
-    }
-    if !rod.effects.hidden.is_off() {
-        need(Need::Unmodelled, "synth's unmodelled effects".into());
     }
     if given.hold {
         need(Need::Hold, "a load direction or dwell (--direction, --dwell-s)".into());

@@ -21,6 +21,7 @@
 //! continued in the weight from a weightless rod.
 
 use super::friction::{MAX_PASSES as FRICTION_MAX_PASSES, TOLERANCE as FRICTION_TOLERANCE};
+use super::result::{PerCable, PlanarPoint};
 use super::{bending_moment, CentrelinePoint, ChannelSample, Simulator, SolveFailure, Strains, TipPose};
 use crate::shape::LengthBasis;
 use crate::numerics::anderson::Anderson;
@@ -921,7 +922,7 @@ impl Simulator {
         let tip = c.s.len() - 1;
         let (et, e0) = (c.strain[tip], c.strain[0]);
         TipPose {
-            tension_n: tension,
+            tensions_n: PerCable::one(tension),
             tip_x_mm: c.px[tip],
             tip_y_mm: c.py[tip],
             tip_angle_rad: c.phi[tip] + et.v2.atan2(et.v1),
@@ -929,6 +930,8 @@ impl Simulator {
             base_angle_rad: c.phi[0] + e0.v2.atan2(e0.v1),
             length_mm: c.sigma[tip],
             iterations: passes,
+            tip_z_mm: 0.0,
+            frame_3d: None,
         }
     }
 
@@ -1009,7 +1012,7 @@ impl Simulator {
         let routing = self.routing.as_ref().expect("routing");
         let np = c.np();
         let count = 2 * self.options.steps_per_span + 1;
-        let tension = self.last.map_or(0.0, |p| p.tension_n);
+        let tension = self.last_tension_n.unwrap_or(0.0);
         let length = self.actuator.length_mm;
         let v1: Vec<f64> = c.strain.iter().map(|e| e.v1).collect();
         let v2: Vec<f64> = c.strain.iter().map(|e| e.v2).collect();
@@ -1032,22 +1035,20 @@ impl Simulator {
                 let cable = anchor >= length || s <= anchor;
                 // No channel and no cable beyond the anchor.
                 let yc = if cable { routing.channel_at(s).y_mm } else { f64::NAN };
-                let (sp, cp) = phi.sin_cos();
-                CentrelinePoint {
+                CentrelinePoint::from(PlanarPoint {
                     s_mm: s,
                     x_mm: px,
                     y_mm: py,
                     frame_angle_rad: phi,
+                    frame_sin_cos: phi.sin_cos(),
                     tangent_angle_rad: phi + v2.atan2(v1),
                     arc_length_mm: at(&c.sigma),
                     v1,
                     v2,
                     u_per_mm: u,
                     channel_y_mm: yc,
-                    cable_x_mm: px - sp * yc,
-                    cable_y_mm: py + cp * yc,
                     cable_tension_n: if cable { tension * at(self.friction.ratios()) } else { 0.0 },
-                }
+                })
             })
             .collect()
     }

@@ -75,7 +75,7 @@ impl Simulator {
     /// solve (in `basis`) and the probe's, and its index; `None` where no
     /// probe can be made or its solve failed.
     pub(super) fn probe_coefficient_difference(&mut self, basis: LengthBasis, a: &[f64]) -> Option<(f64, usize)> {
-        let tension = self.last?.tension_n;
+        let tension = self.last_tension_n?;
         if a.len() > ESTIMATED_ORDERS {
             return None;
         }

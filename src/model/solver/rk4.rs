@@ -6,6 +6,7 @@
 //! 2n + 1 per span of n steps (the knot appears in both spans).
 
 use super::continuation::Continuation;
+use super::result::{PerCable, PlanarPoint};
 use super::{
     bending_moment, friction, rotate, CentrelinePoint, ChannelSample, Routing, Simulator, SolveFailure, Strains, TipPose,
     CLAMP_MAX_ITERATIONS, CLAMP_TOLERANCE_RAD,
@@ -336,7 +337,7 @@ impl Simulator {
         let tip = self.rk4.nodes_state[n_nodes - 1];
         let (e0, et) = (self.rk4.nodes_strain[0], self.rk4.nodes_strain[n_nodes - 1]);
         TipPose {
-            tension_n: tension,
+            tensions_n: PerCable::one(tension),
             tip_x_mm: tip.x,
             tip_y_mm: tip.y,
             tip_angle_rad: tip.phi + et.v2.atan2(et.v1),
@@ -344,6 +345,8 @@ impl Simulator {
             base_angle_rad: base.phi + e0.v2.atan2(e0.v1),
             length_mm: tip.sigma,
             iterations: passes,
+            tip_z_mm: 0.0,
+            frame_3d: None,
         }
     }
 
@@ -378,7 +381,7 @@ impl Simulator {
     /// The centreline of the last solve at the nodes.
     pub(super) fn rk4_centreline(&self) -> Vec<CentrelinePoint> {
         let n = self.options.steps_per_span;
-        let tension = self.last.map_or(0.0, |p| p.tension_n);
+        let tension = self.last_tension_n.unwrap_or(0.0);
         (0..self.rk4.nodes_state.len())
             .map(|i| {
                 let (span, j) = if i < n { (0, i) } else { (1, i - n) };
@@ -387,22 +390,20 @@ impl Simulator {
                 let st = self.rk4.nodes_state[i];
                 let e = self.rk4.nodes_strain[i];
                 let yc = self.channel[k].y;
-                let (sp, cp) = st.phi.sin_cos();
-                CentrelinePoint {
+                CentrelinePoint::from(PlanarPoint {
                     s_mm: s,
                     x_mm: st.x,
                     y_mm: st.y,
                     frame_angle_rad: st.phi,
+                    frame_sin_cos: st.phi.sin_cos(),
                     tangent_angle_rad: st.phi + e.v2.atan2(e.v1),
                     arc_length_mm: st.sigma,
                     v1: e.v1,
                     v2: e.v2,
                     u_per_mm: e.u,
                     channel_y_mm: yc,
-                    cable_x_mm: st.x - sp * yc,
-                    cable_y_mm: st.y + cp * yc,
                     cable_tension_n: tension * self.friction.ratio(k),
-                }
+                })
             })
             .collect()
     }
@@ -433,7 +434,7 @@ mod tests {
                     let t = tension * k as f64 / rungs as f64;
                     let Ok(passes) = sim.rk4_solve(t) else { break };
                     solved = (k == rungs).then(|| sim.rk4_pose(t, passes));
-                    sim.last = Some(sim.rk4_pose(t, passes));
+                    sim.last_tension_n = Some(t);
                 }
                 let Some(pose) = solved else { continue };
                 let (_, tip_error) = sim.rk4_error_estimate(tension).unwrap();
@@ -442,7 +443,7 @@ mod tests {
                 let off = (pose.tip_x_mm - reference.pose.tip_x_mm).hypot(pose.tip_y_mm - reference.pose.tip_y_mm);
                 assert!(off <= tip_error + 1e-7, "{n} steps: tip off by {off:e} mm, estimated {tip_error:e}");
                 for k in 0..6 {
-                    assert!((c[k] - reference.a[k]).abs() <= a_error + 1e-9, "{n} steps: a_{k} off by {:e}, estimated {a_error:e}", (c[k] - reference.a[k]).abs());
+                    assert!((c[k] - reference.a_bend_z[k]).abs() <= a_error + 1e-9, "{n} steps: a_{k} off by {:e}, estimated {a_error:e}", (c[k] - reference.a_bend_z[k]).abs());
                 }
                 checked += 1;
             }

@@ -50,8 +50,9 @@
 //! body y, and the torsion u_1 (twist).
 
 use super::cable::Channel;
-use super::solver::{SpatialFailure, SpatialNode, SpatialOptions, SpatialPose, MAX_SPATIAL_ORDER};
-use super::{Actuator, SpatialError};
+use super::solver::{SpatialOptions, MAX_SPATIAL_ORDER};
+use super::{Actuator, SpatialError, SpatialFailure};
+use crate::model::solver::result::{CableAtNode, CentrelinePoint, PerCable, TipFrame, TipPose};
 use crate::model::solver::collocation::FRICTION_SUBSTEPS;
 use crate::model::solver::creep::Creep;
 use crate::model::solver::friction::{MAX_PASSES as FRICTION_MAX_PASSES, TOLERANCE as FRICTION_TOLERANCE};
@@ -173,6 +174,8 @@ pub struct SpatialSolver {
     chan: Vec<Chan>,
     /// Whether each cable pulls at each node (node-major).
     active: Vec<bool>,
+    /// The cables' channels (for the centreline's cable paths).
+    channels: Vec<Channel>,
     // The state: θ₀ (3), u (3 per node), M_W (3 per node) in `state`, with
     // u scaled by L and M_W by L/EI (angle units).
     state: Vec<f64>,
@@ -201,7 +204,7 @@ pub struct SpatialSolver {
     history: Vec<Solved>,
     solved: usize,
     passes: u32,
-    last: Option<SpatialPose>,
+    last: Option<TipPose>,
     u_scale: f64,
     m_scale: f64,
 }
@@ -212,7 +215,7 @@ impl SpatialSolver {
         let channels = actuator.validate_for(crate::model::Backend::Spatial)?;
         options.check()?;
         let rod = actuator.rod.clone();
-        let body = Body::of(&rod).map_err(|e| SpatialError::Option(e.to_string()))?;
+        let body = rod.body().map_err(|e| SpatialError::Option(e.to_string()))?;
         let length = rod.length_mm;
         let m = if rod.effects.stiffening_alpha > 0.0 { options.nodes_per_span.max(MIN_NODES_WITH_STIFFENING) } else { options.nodes_per_span };
         let np = m + 1;
@@ -265,10 +268,6 @@ impl SpatialSolver {
                     }
                 };
                 let mut ei = ei;
-                let hidden = &rod.effects.hidden;
-                if sj < hidden.base_segment_mm || (left && sj == hidden.base_segment_mm) {
-                    ei *= hidden.base_segment_ei_factor;
-                }
                 // GJ scales with the section as EI does; the stiffness
                 // gradient (a material gradient) scales both.
                 let mut gj = gj_over_ei * ei;
@@ -367,6 +366,7 @@ impl SpatialSolver {
             distal_weight,
             chan,
             active,
+            channels,
             state: {
                 let mut z = vec![0.0; n_state];
                 z[3 + 6 * nn..].iter_mut().for_each(|r| *r = 1.0);
@@ -426,7 +426,7 @@ impl SpatialSolver {
     }
 
     /// Sets every cable's tension (N, one per cable, each ≥ 0) and solves.
-    pub fn solve(&mut self, tensions_n: &[f64]) -> Result<SpatialPose, SpatialError> {
+    pub fn solve(&mut self, tensions_n: &[f64]) -> Result<TipPose, SpatialError> {
         if tensions_n.len() != self.cables {
             return Err(SpatialError::Option(format!("{} tensions given for {} cables", tensions_n.len(), self.cables)));
         }
@@ -442,7 +442,7 @@ impl SpatialSolver {
     /// Solves with every cable's tension scaled by `scale` (1 = the
     /// actuator's tensions; continuation ladders step it from 0 to 1),
     /// warm-started from the previous solves.
-    pub fn solve_scaled(&mut self, scale: f64) -> Result<SpatialPose, SpatialError> {
+    pub fn solve_scaled(&mut self, scale: f64) -> Result<TipPose, SpatialError> {
         if !(scale.is_finite() && scale >= 0.0) {
             return Err(SpatialError::Option(format!("tension scale {scale} must be finite and ≥ 0")));
         }
@@ -455,8 +455,8 @@ impl SpatialSolver {
             Ok(passes) => {
                 self.creep.end_solve();
                 self.passes = passes;
-                let pose = self.pose_of_state(passes);
-                if !pose.tip_mm.iter().chain(&[pose.length_mm, pose.tip_angle_rad]).all(|v| v.is_finite()) {
+                let pose = self.pose_of_state(passes, &tensions);
+                if !pose.tip_mm().iter().chain(&[pose.length_mm, pose.tip_angle_rad]).all(|v| v.is_finite()) {
                     self.forget();
                     return Err(SpatialFailure::NonFinite.into());
                 }
@@ -1097,11 +1097,11 @@ impl SpatialSolver {
     #[inline]
     fn curvature_law(&self, i: usize, m: &V3, sec: &Section, derivative: bool) -> (V3, M3) {
         let alpha = self.stiffening;
-        let hidden = self.rod.effects.hidden.rest_curvature_per_mm;
+        let rest = self.rod.rest_curvature_per_mm;
         let (gain, off) = self.creep_terms(i, sec);
         if alpha == 0.0 {
             let b = 1.0 / sec.ei + gain;
-            let u = V3::new(m[0] / sec.gj, m[1] * b + off[1], m[2] * b + hidden + off[2]);
+            let u = V3::new(m[0] / sec.gj, m[1] * b + off[1], m[2] * b + rest + off[2]);
             let d = if derivative { M3::from_diagonal(&V3::new(1.0 / sec.gj, b, b)) } else { M3::zeros() };
             return (u, d);
         }
@@ -1118,7 +1118,7 @@ impl SpatialSolver {
             }
         }
         let ratio = if mb > 0.0 { k / mb } else { 1.0 / sec.ei };
-        let u = V3::new(m[0] / sec.gj, m[1] * (ratio + gain) + off[1], m[2] * (ratio + gain) + hidden + off[2]);
+        let u = V3::new(m[0] / sec.gj, m[1] * (ratio + gain) + off[1], m[2] * (ratio + gain) + rest + off[2]);
         let mut d = M3::zeros();
         if derivative {
             d[(0, 0)] = 1.0 / sec.gj;
@@ -1146,9 +1146,9 @@ impl SpatialSolver {
     /// cubic with stiffening and creep).
     fn moment_of_curvature(&self, u: &V3, i: usize) -> V3 {
         let sec = &self.section[i];
-        let hidden = self.rod.effects.hidden.rest_curvature_per_mm;
+        let rest = self.rod.rest_curvature_per_mm;
         let (gain, off) = self.creep_terms(i, sec);
-        let ub = V3::new(0.0, u[1] - off[1], u[2] - hidden - off[2]);
+        let ub = V3::new(0.0, u[1] - off[1], u[2] - rest - off[2]);
         let size = ub.norm();
         let c = self.stiffening * sec.radius * sec.radius;
         let ge = gain * sec.ei;
@@ -1240,27 +1240,35 @@ impl SpatialSolver {
     }
 
     /// The pose of the converged state.
-    fn pose_of_state(&self, passes: u32) -> SpatialPose {
+    fn pose_of_state(&self, passes: u32, tensions: &[f64]) -> TipPose {
         let tip = self.nodes_count() - 1;
         let r = &self.rot[tip];
         let x = &self.local[tip];
         let t = (r * V3::new(x[0], x[1], x[2])).normalize();
-        SpatialPose {
-            tip_mm: [self.pos[tip][0], self.pos[tip][1], self.pos[tip][2]],
-            tip_tangent: [t[0], t[1], t[2]],
-            tip_body_y_axis: [r[(0, 1)], r[(1, 1)], r[(2, 1)]],
-            tip_angle_rad: t[0].clamp(-1.0, 1.0).acos(),
+        let base_v = self.rot[0] * V3::new(self.local[0][0], self.local[0][1], self.local[0][2]);
+        let mut tensions_n = PerCable::filled(self.cables, 0.0);
+        tensions_n.copy_from_slice(tensions);
+        TipPose {
+            tensions_n,
+            tip_x_mm: self.pos[tip][0],
+            tip_y_mm: self.pos[tip][1],
+            tip_z_mm: self.pos[tip][2],
+            // The angles of the projections on the x–y plane.
+            tip_angle_rad: t[1].atan2(t[0]),
+            tip_frame_angle_rad: r[(1, 0)].atan2(r[(0, 0)]),
+            base_angle_rad: base_v[1].atan2(base_v[0]),
             length_mm: self.sigma[tip],
-            passes,
+            iterations: passes,
+            frame_3d: Some(TipFrame { tangent: [t[0], t[1], t[2]], body_y_axis: [r[(0, 1)], r[(1, 1)], r[(2, 1)]] }),
         }
     }
 
     /// Refuses a pose whose estimated tip error is above
     /// [`crate::model::solver::tip_tolerance_mm`], or whose tip lies farther
     /// from the clamp than the stretched rod is long (no curve can).
-    fn check_resolved(&self, pose: &SpatialPose) -> Result<(), crate::model::solver::Unresolved> {
+    fn check_resolved(&self, pose: &TipPose) -> Result<(), crate::model::solver::Unresolved> {
         let tolerance = crate::model::solver::tip_tolerance_mm(self.rod.length_mm);
-        let [x, y, z] = pose.tip_mm;
+        let [x, y, z] = pose.tip_mm();
         let reach = (x * x + y * y + z * z).sqrt();
         if reach > pose.length_mm + tolerance {
             let what = format!(
@@ -1279,13 +1287,13 @@ impl SpatialSolver {
 
     /// The centreline of the last solve at 2·steps_per_span + 1 evenly
     /// spaced points (the option's centreline resolution) and at every
-    /// span boundary.
-    pub fn centreline(&self) -> Vec<SpatialNode> {
+    /// span boundary (each anchor among them, where its cable ends).
+    pub fn centreline(&self) -> Vec<CentrelinePoint> {
         self.nodes(2 * self.options.steps_per_span + 1)
     }
 
     /// The pose of the last successful solve.
-    pub fn pose(&self) -> Option<SpatialPose> {
+    pub fn pose(&self) -> Option<TipPose> {
         self.last
     }
 
@@ -1456,11 +1464,13 @@ impl SpatialSolver {
     }
 
     /// The centreline of the last solve at `count` evenly spaced points
-    /// (and at each anchor before the tip), interpolated from the nodes.
-    pub fn nodes(&self, count: usize) -> Vec<SpatialNode> {
+    /// and at each span boundary, interpolated from the nodes (spectrally
+    /// accurate on each span); a boundary's point is taken from the span
+    /// before it, so that a cable anchored there still runs through it.
+    pub fn nodes(&self, count: usize) -> Vec<CentrelinePoint> {
         assert!(self.last.is_some(), "nodes needs a successful solve");
         let np = self.np;
-        let nn = self.nodes_count();
+        let nc = self.cables;
         let length = self.rod.length_mm;
         let count = count.max(2);
         let mut samples: Vec<f64> = (0..count).map(|k| length * k as f64 / (count - 1) as f64).collect();
@@ -1470,7 +1480,7 @@ impl SpatialSolver {
             }
         }
         // Quaternions of the node frames, sign-continuous.
-        let mut quats: Vec<[f64; 4]> = Vec::with_capacity(nn);
+        let mut quats: Vec<[f64; 4]> = Vec::with_capacity(self.rot.len());
         let mut prev: Option<UnitQuaternion<f64>> = None;
         for r in &self.rot {
             let mut q = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(*r));
@@ -1482,28 +1492,50 @@ impl SpatialSolver {
             prev = Some(q);
             quats.push([q.w, q.i, q.j, q.k]);
         }
+        let tensions = self.tensions_n();
         samples
             .into_iter()
             .map(|s| {
                 let span = self.start[1..].iter().take_while(|&&b| s > b).count().min(self.spans() - 1);
                 let x = ((s - self.start[span]) / self.half[span] - 1.0).clamp(-1.0, 1.0);
                 let base = span * np;
-                let at = |f: &dyn Fn(usize) -> f64| {
-                    let vals: Vec<f64> = (0..np).map(|j| f(base + j)).collect();
-                    chebyshev::interpolate(&self.xn, &vals, x)
+                let mut vals = [0.0; MAX_NODES + 1];
+                let mut at = |f: &dyn Fn(usize) -> f64| {
+                    for (j, v) in vals[..np].iter_mut().enumerate() {
+                        *v = f(base + j);
+                    }
+                    chebyshev::interpolate(&self.xn, &vals[..np], x)
                 };
                 let p = [at(&|i| self.pos[i][0]), at(&|i| self.pos[i][1]), at(&|i| self.pos[i][2])];
                 let qv: [f64; 4] = std::array::from_fn(|c| at(&|i| quats[i][c]));
-                let q = UnitQuaternion::from_quaternion(Quaternion::new(qv[0], qv[1], qv[2], qv[3]));
-                let r = q.to_rotation_matrix().into_inner();
-                SpatialNode {
+                let r = UnitQuaternion::from_quaternion(Quaternion::new(qv[0], qv[1], qv[2], qv[3])).to_rotation_matrix().into_inner();
+                let v: [f64; 3] = std::array::from_fn(|c| at(&|i| self.local[i][c]));
+                let u: [f64; 3] = std::array::from_fn(|c| at(&|i| self.local[i][3 + c]));
+                let sigma = at(&|i| self.sigma[i]);
+                let ratios: Vec<f64> = (0..nc).map(|c| if self.friction { at(&|i| self.state[self.ratio_at + i * nc + c]) } else { 1.0 }).collect();
+                let tangent = r * V3::new(v[0], v[1], v[2]);
+                let mut node = CentrelinePoint {
                     s_mm: s,
-                    p_mm: p,
+                    x_mm: p[0],
+                    y_mm: p[1],
+                    z_mm: p[2],
                     rotation: std::array::from_fn(|a| std::array::from_fn(|b| r[(a, b)])),
-                    v: std::array::from_fn(|c| at(&|i| self.local[i][c])),
-                    u_per_mm: std::array::from_fn(|c| at(&|i| self.local[i][3 + c])),
-                    arc_length_mm: at(&|i| self.sigma[i]),
+                    frame_angle_rad: r[(1, 0)].atan2(r[(0, 0)]),
+                    tangent_angle_rad: tangent[1].atan2(tangent[0]),
+                    arc_length_mm: sigma,
+                    v,
+                    u_per_mm: u,
+                    cables: PerCable::filled(nc, CableAtNode::NONE),
+                };
+                for c in 0..nc {
+                    // The cable runs through the nodes of the spans it pulls in.
+                    if self.active[base * nc + c] {
+                        let ch = self.channels[c].at(s);
+                        let (y, z) = (ch.r_mm[0] + self.rod.effects.channel_offset_mm, ch.r_mm[1]);
+                        node.cables[c] = CableAtNode { channel_mm: [y, z], position_mm: node.body_point_mm(y, z), tension_n: tensions[c] * ratios[c] };
+                    }
                 }
+                node
             })
             .collect()
     }
@@ -1620,7 +1652,7 @@ mod tests {
         a
     }
 
-    fn ladder(a: &Actuator, options: &SpatialOptions) -> Result<(SpatialSolver, SpatialPose), SpatialError> {
+    fn ladder(a: &Actuator, options: &SpatialOptions) -> Result<(SpatialSolver, TipPose), SpatialError> {
         let mut sim = SpatialSolver::new(a, options)?;
         let top = a.cables.iter().map(|c| c.tension_n).fold(0.0, f64::max);
         let rungs = ((top / 0.25).ceil() as usize).max(1);
@@ -1650,9 +1682,9 @@ mod tests {
         let a = Actuator::with_cables(rod.clone(), vec![cable]);
         let options = SpatialOptions { nodes_per_span: 24, ..Default::default() };
         let sp = crate::model::spatial::simulate_spatial(&a, &options, 3, LengthBasis::Rest).unwrap();
-        let tip = dist(sp.pose.tip_mm, [p.pose.tip_x_mm, p.pose.tip_y_mm, 0.0]);
-        let angle = (sp.pose.tip_tangent[1].atan2(sp.pose.tip_tangent[0]) - p.pose.tip_angle_rad).abs();
-        let da = sp.a_bend_z.iter().zip(&p.a).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+        let tip = dist(sp.pose.tip_mm(), [p.pose.tip_x_mm, p.pose.tip_y_mm, 0.0]);
+        let angle = (sp.pose.tip_angle_rad - p.pose.tip_angle_rad).abs();
+        let da = sp.a_bend_z.iter().zip(&p.a_bend_z).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
         (tip, angle, da)
     }
 
@@ -1712,11 +1744,11 @@ mod tests {
         for case in cases() {
             let a = actuator_for(&case);
             let (sim, p) = ladder(&a, &SpatialOptions::default()).unwrap();
-            let tip = dist(p.tip_mm, arr(&case["tip_mm"]));
+            let tip = dist(p.tip_mm(), arr(&case["tip_mm"]));
             let t: [f64; 3] = arr(&case["tip_tangent"]);
-            let dot = (0..3).map(|i| t[i] * p.tip_tangent[i]).sum::<f64>().min(1.0);
+            let dot = (0..3).map(|i| t[i] * p.tip_tangent()[i]).sum::<f64>().min(1.0);
             let (theta, tip_err) = sim.error_estimate();
-            eprintln!("{}: tip off {tip:.2e} mm, tangent {:.2e} rad, length {:.2e}; estimate {tip_err:.1e} mm, {theta:.1e} rad; {} passes", case["name"], dot.acos(), (p.length_mm - case["deformed_length_mm"].as_f64().unwrap()).abs(), p.passes);
+            eprintln!("{}: tip off {tip:.2e} mm, tangent {:.2e} rad, length {:.2e}; estimate {tip_err:.1e} mm, {theta:.1e} rad; {} passes", case["name"], dot.acos(), (p.length_mm - case["deformed_length_mm"].as_f64().unwrap()).abs(), p.iterations);
             worst = worst.max(tip);
         }
         assert!(worst < 1e-4, "worst {worst:e}");
@@ -1750,7 +1782,7 @@ mod timing {
                 for k in 0..21 {
                     let t = 1.0 + k as f64 / 20.0;
                     let p = col.solve(&[t, 0.5 * t]).unwrap();
-                    passes += p.passes as u64;
+                    passes += p.iterations as u64;
                     let c = col.coefficients(3, LengthBasis::Rest).unwrap();
                     std::hint::black_box(c);
                     last = Some(p);
@@ -1766,7 +1798,7 @@ mod timing {
                 }
                 t_rk4 += start.elapsed().as_secs_f64();
                 let (p, q) = (last.unwrap(), last_rk.unwrap());
-                worst = worst.max((0..3).map(|i| (p.tip_mm[i] - q.tip_mm[i]).abs()).fold(0.0, f64::max));
+                worst = worst.max((0..3).map(|i| (p.tip_mm()[i] - q.tip_mm()[i]).abs()).fold(0.0, f64::max));
                 n += 21;
             }
             eprintln!("passes per solve {:.2}", passes as f64 / n as f64);

@@ -41,10 +41,16 @@
 //! angle, so the in-plane series is the planar solver's a_i (model-notes §4).
 //! Each series is a_i = (2i + 1)/L ∫ P_i(2σ/ℓ − 1) κ ds over the rest length
 //! (σ the deformed arc length, ℓ its total), the thesis's basis; the twist
-//! series uses u_1, the torsion of the body frame.
+//! series uses u_1, the torsion of the body frame. Where a cable ends
+//! before the tip, v jumps (its tension stops) and the tangent turns at a
+//! point: κ has a Dirac part there, the rotation vector from v̂ just before
+//! the anchor to v̂ just after it, which the bending series add at that σ
+//! (the planar a_i count the same jump of θ).
 
 use super::cable::{Channel, ChannelPoint3};
-use super::{Actuator, SpatialError};
+use super::error::{SpatialError, SpatialFailure};
+use super::Actuator;
+use crate::model::solver::result::{CableAtNode, CentrelinePoint, PerCable, TipFrame, TipPose};
 use crate::model::Rod;
 use crate::numerics::{rk4_step, Rk4Scratch};
 use crate::shape::{self, LengthBasis};
@@ -61,6 +67,10 @@ type Factors = LU<f64, U6, U6>;
 /// pass), so it also computes the coefficients; if it is not the last,
 /// [`SpatialRk4Solver::coefficients`] runs one more pass.
 const LAST_PASS_RESIDUAL_N_MM: f64 = 1e-5;
+
+/// Breakpoints closer than this are one (mm): an anchor this close to a
+/// knot ends its cable at the knot.
+const ANCHOR_TOLERANCE_MM: f64 = 1e-9;
 
 /// Highest coefficient order the spatial solver reports.
 pub const MAX_SPATIAL_ORDER: usize = 8;
@@ -119,83 +129,24 @@ impl SpatialOptions {
     }
 }
 
-/// The tip of one solve.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct SpatialPose {
-    /// Tip position (x, y, z), mm.
-    pub tip_mm: [f64; 3],
-    /// Unit tangent of the centreline at the tip, R v/|v|.
-    pub tip_tangent: [f64; 3],
-    /// The tip cross-section's body y-axis in the global frame (column 2 of R).
-    pub tip_body_y_axis: [f64; 3],
-    /// Angle between the tip tangent and the clamp axis (+x), rad.
-    pub tip_angle_rad: f64,
-    /// Deformed centreline length ℓ, mm.
-    pub length_mm: f64,
-    /// Integration passes the solve took.
-    pub passes: u32,
-}
-
-/// One point of the solved rod.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct SpatialNode {
+/// What a pass records at one step point of the rod (the centreline's
+/// nodes are made from these when asked for, [`SpatialRk4Solver::centreline`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct NodeRecord {
+    /// Index of the half-step point (its channels in `chan`).
+    point: usize,
     /// Rest arc length s, mm.
-    pub s_mm: f64,
+    s_mm: f64,
     /// Centreline position, mm.
-    pub p_mm: [f64; 3],
-    /// Body frame: rows of R (`R[i][j]`; its columns are the body axes, global).
-    pub rotation: [[f64; 3]; 3],
+    p_mm: [f64; 3],
+    /// Body frame: rows of R.
+    rotation: [[f64; 3]; 3],
     /// Strain v (body frame).
-    pub v: [f64; 3],
+    v: [f64; 3],
     /// Curvature u (body frame), 1/mm.
-    pub u_per_mm: [f64; 3],
+    u_per_mm: [f64; 3],
     /// Deformed arc length σ, mm.
-    pub arc_length_mm: f64,
-}
-
-impl SpatialNode {
-    /// Global position of a point at body offset (0, y, z), mm.
-    pub fn body_point_mm(&self, y_mm: f64, z_mm: f64) -> [f64; 3] {
-        let r = &self.rotation;
-        std::array::from_fn(|i| self.p_mm[i] + r[i][1] * y_mm + r[i][2] * z_mm)
-    }
-}
-
-/// Why a spatial solve produced no result.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum SpatialFailure {
-    /// The local equations at a point did not converge.
-    #[error("the cut equations did not converge at s = {s_mm:.3} mm (tension too high for this routing, or a cable pulls straight through the axis); lower the tension or raise --steps-per-span")]
-    Local { s_mm: f64 },
-    /// Gravity's moment iteration did not converge.
-    #[error("gravity's moment did not converge in {passes} passes (residual {residual_n_mm:.3e} N·mm); the rod may be too heavy for its stiffness")]
-    Gravity { passes: u32, residual_n_mm: f64 },
-    /// The cables' tension profiles with friction did not settle.
-    #[error("the cable tension profiles with friction did not converge; try smaller tension steps or a smaller friction coefficient")]
-    Friction,
-    /// A number of the result is not finite.
-    #[error("the solve gave a non-finite tip or coefficient; check the rod's parameters (rigidities, length, density) for absurd values")]
-    NonFinite,
-    /// The steps do not resolve the solution: its difference to the same
-    /// solve at half the steps is above the tolerance, up to the most steps
-    /// tried ([`super::simulate_spatial`]), or the tip lies farther from the
-    /// clamp than the stretched rod is long.
-    #[error(transparent)]
-    Unresolved(crate::model::solver::Unresolved),
-}
-
-impl SpatialFailure {
-    /// Short machine-readable status (as the planar solver's
-    /// [`crate::model::SolveFailure::status`]).
-    pub fn status(&self) -> &'static str {
-        match self {
-            SpatialFailure::Local { .. } => "cut_equations_not_converged",
-            SpatialFailure::Gravity { .. } => "gravity_not_converged",
-            SpatialFailure::NonFinite => "non_finite",
-            SpatialFailure::Friction => "friction_not_converged",
-            SpatialFailure::Unresolved(_) => "unresolved",
-        }
-    }
+    arc_length_mm: f64,
 }
 
 /// Per-point, per-cable channel data in body coordinates.
@@ -286,7 +237,11 @@ pub struct SpatialRk4Solver {
     /// Tensions of the last two successful solves (newest first), N.
     history: Vec<Vec<f64>>,
     binv: M3,
-    nodes: Vec<SpatialNode>,
+    nodes: Vec<NodeRecord>,
+    /// Each cable's anchor (or the tip), mm.
+    anchors_mm: Vec<f64>,
+    /// The rod's rest curvature about body z, 1/mm ([`Rod::rest_curvature_per_mm`]).
+    rest_u3_per_mm: f64,
     /// ∫ (σ/L)^j κ_k ds of the last full pass, k = twist, about y, about z.
     moments: [[f64; MAX_SPATIAL_ORDER + 1]; 3],
     /// Whether `moments` belong to the last solve.
@@ -298,7 +253,7 @@ pub struct SpatialRk4Solver {
     chord: bool,
     /// This pass computes the curvature vector and the coefficient moments.
     with_kappa: bool,
-    last: Option<SpatialPose>,
+    last: Option<TipPose>,
 }
 
 impl SpatialRk4Solver {
@@ -323,7 +278,7 @@ impl SpatialRk4Solver {
         cuts.extend(channels.iter().map(Channel::knot_mm));
         cuts.extend(actuator.cables.iter().filter_map(|c| c.anchor_mm).filter(|&a| a < length));
         cuts.sort_by(f64::total_cmp);
-        cuts.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
+        cuts.dedup_by(|a, b| (*a - *b).abs() < ANCHOR_TOLERANCE_MM);
         let span = length / 2.0;
         let mut segments = Vec::new();
         let (mut point0, mut step0) = (0, 0);
@@ -365,6 +320,8 @@ impl SpatialRk4Solver {
             history: Vec::new(),
             binv: M3::identity(),
             nodes: Vec::new(),
+            anchors_mm: actuator.cables.iter().map(|c| c.anchor_or_tip_mm(length)).collect(),
+            rest_u3_per_mm: actuator.rod.rest_curvature_per_mm,
             moments: [[0.0; MAX_SPATIAL_ORDER + 1]; 3],
             moments_valid: false,
             lus: vec![None; 4 * step0 + cuts.len()],
@@ -392,7 +349,7 @@ impl SpatialRk4Solver {
     /// Solves with every cable's tension scaled by `scale` (1 = the
     /// actuator's tensions; continuation ladders step it from 0 to 1),
     /// warm-started from the previous solve.
-    pub fn solve_scaled(&mut self, scale: f64) -> Result<SpatialPose, SpatialError> {
+    pub fn solve_scaled(&mut self, scale: f64) -> Result<TipPose, SpatialError> {
         if !(scale.is_finite() && scale >= 0.0) {
             return Err(SpatialError::Option(format!("tension scale {scale} must be finite and ≥ 0")));
         }
@@ -418,7 +375,7 @@ impl SpatialRk4Solver {
     }
 
     /// Sets every cable's tension (N, one per cable, each ≥ 0) and solves.
-    pub fn solve(&mut self, tensions_n: &[f64]) -> Result<SpatialPose, SpatialError> {
+    pub fn solve(&mut self, tensions_n: &[f64]) -> Result<TipPose, SpatialError> {
         if tensions_n.len() != self.cables {
             return Err(SpatialError::Option(format!("{} tensions given for {} cables", tensions_n.len(), self.cables)));
         }
@@ -467,7 +424,7 @@ impl SpatialRk4Solver {
         }
     }
 
-    fn solve_inner(&mut self) -> Result<SpatialPose, SpatialFailure> {
+    fn solve_inner(&mut self) -> Result<TipPose, SpatialFailure> {
         let gravity = self.weight.norm() > 0.0;
         let mut passes = 1;
         // The first pass of a solve refactors everything (the tensions
@@ -514,13 +471,23 @@ impl SpatialRk4Solver {
         let r = q.to_rotation_matrix().into_inner();
         let v = V3::new(tip[0], tip[1], tip[2]);
         let t = (r * v).normalize();
-        let pose = SpatialPose {
-            tip_mm: [end[0], end[1], end[2]],
-            tip_tangent: [t[0], t[1], t[2]],
-            tip_body_y_axis: [r[(0, 1)], r[(1, 1)], r[(2, 1)]],
-            tip_angle_rad: t[0].clamp(-1.0, 1.0).acos(),
+        // At the clamp R = I: the base tangent is v(0)'s direction.
+        let base_v = self.nodes.first().map_or([1.0, 0.0, 0.0], |n| n.v);
+        let mut tensions_n = PerCable::filled(self.cables, 0.0);
+        for (out, t) in tensions_n.iter_mut().zip(&self.base_tension_n) {
+            *out = t * self.scale;
+        }
+        let pose = TipPose {
+            tensions_n,
+            tip_x_mm: end[0],
+            tip_y_mm: end[1],
+            tip_z_mm: end[2],
+            tip_angle_rad: t[1].atan2(t[0]),
+            tip_frame_angle_rad: r[(1, 0)].atan2(r[(0, 0)]),
+            base_angle_rad: base_v[1].atan2(base_v[0]),
             length_mm: end[10],
-            passes,
+            iterations: passes,
+            frame_3d: Some(TipFrame { tangent: [t[0], t[1], t[2]], body_y_axis: [r[(0, 1)], r[(1, 1)], r[(2, 1)]] }),
         };
         self.last = Some(pose);
         Ok(pose)
@@ -541,6 +508,11 @@ impl SpatialRk4Solver {
         let mut tip = [0.0; 6];
         let segments = std::mem::take(&mut self.segments);
         let mut scratch = Rk4Scratch::default();
+        // Where a cable ends (its anchor) the strains jump, and so does the
+        // tangent: the curvature has a Dirac part there, the rotation from
+        // the tangent before to the one after. `ending` holds v just before
+        // such a point until the next segment's first stage gives v after it.
+        let mut ending: Option<V3> = None;
         let result = (|| {
             for (si, seg) in segments.iter().enumerate() {
                 let h = seg.h_mm;
@@ -553,7 +525,7 @@ impl SpatialRk4Solver {
                         let ys = stage.state;
                         let (f, l) = self.deriv(seg, k0 + stage.half_steps, slot + i, ys)?;
                         if i == 0 {
-                            self.record(s0, ys, &l.x);
+                            self.record(k0, s0, ys, &l.x);
                         }
                         if self.with_kappa {
                             // RK4 quadrature of the moments with the stage values.
@@ -565,6 +537,16 @@ impl SpatialRk4Solver {
                                     pw *= x;
                                 }
                             }
+                            if let Some(before) = ending.take() {
+                                let jump = tangent_turn(&before, &V3::new(l.x[0], l.x[1], l.x[2]));
+                                for (series, kappa) in moments[1..].iter_mut().zip([jump[1], jump[2]]) {
+                                    let mut pw = kappa;
+                                    for c in series.iter_mut() {
+                                        *c += pw;
+                                        pw *= x;
+                                    }
+                                }
+                            }
                         }
                         *dy = f;
                         Ok(())
@@ -572,12 +554,22 @@ impl SpatialRk4Solver {
                     let norm = (y[3] * y[3] + y[4] * y[4] + y[5] * y[5] + y[6] * y[6]).sqrt();
                     y[3..7].iter_mut().for_each(|c| *c /= norm);
                 }
+                let k = seg.point0 + 2 * seg.steps;
                 if si + 1 == segments.len() {
-                    let k = seg.point0 + 2 * seg.steps;
                     let slot = self.warm.len() - 1;
                     let (_, l) = self.deriv(seg, k, slot, &y)?;
                     tip = l.x;
-                    self.record(length, &y, &l.x);
+                    self.record(k, length, &y, &l.x);
+                } else if self.with_kappa && seg.active != segments[si + 1].active {
+                    // The local solution just before the segment's end, in a
+                    // slot of its own (one per segment end), warm-started
+                    // from the last stage's.
+                    let slot = self.warm.len() - segments.len() - 1 + si;
+                    if self.lus[slot].is_none() {
+                        self.warm[slot] = self.warm[4 * (seg.step0 + seg.steps) - 1];
+                    }
+                    let (_, l) = self.deriv(seg, k, slot, &y)?;
+                    ending = Some(V3::new(l.x[0], l.x[1], l.x[2]));
                 }
             }
             Ok(())
@@ -589,9 +581,10 @@ impl SpatialRk4Solver {
         result.map(|()| (y, tip))
     }
 
-    fn record(&mut self, s_mm: f64, y: &State, x: &[f64; 6]) {
+    fn record(&mut self, point: usize, s_mm: f64, y: &State, x: &[f64; 6]) {
         let r = quat(y).to_rotation_matrix().into_inner();
-        self.nodes.push(SpatialNode {
+        self.nodes.push(NodeRecord {
+            point,
             s_mm,
             p_mm: [y[0], y[1], y[2]],
             rotation: std::array::from_fn(|i| std::array::from_fn(|j| r[(i, j)])),
@@ -765,11 +758,15 @@ impl SpatialRk4Solver {
         [jf[0], jf[1], jf[2], jm[0], jm[1], jm[2]]
     }
 
-    /// The rod's part of the residual: K_se (v − v*) − Rᵀ W and K_bt u − Rᵀ M_W.
+    /// The rod's part of the residual: K_se (v − v*) − Rᵀ W and
+    /// K_bt (u − u*) − Rᵀ M_W (u* = (0, 0, rest curvature)).
     #[inline]
     fn elastic_residual(&self, x: &[f64; 6], nw: V3, mw: V3) -> (V3, V3) {
         let k = &self.stiff;
-        (V3::new(k[0] * (x[0] - 1.0), k[1] * x[1], k[2] * x[2]) - nw, V3::new(k[3] * x[3], k[4] * x[4], k[5] * x[5]) - mw)
+        (
+            V3::new(k[0] * (x[0] - 1.0), k[1] * x[1], k[2] * x[2]) - nw,
+            V3::new(k[3] * x[3], k[4] * x[4], k[5] * (x[5] - self.rest_u3_per_mm)) - mw,
+        )
     }
 
     /// Residual G(x) of the cut equations (chord iterations).
@@ -814,14 +811,46 @@ impl SpatialRk4Solver {
     }
 
     /// The pose of the last successful solve.
-    pub fn pose(&self) -> Option<SpatialPose> {
+    pub fn pose(&self) -> Option<TipPose> {
         self.last
     }
 
-    /// The nodes (step points, clamp to tip) of the last successful solve.
-    pub fn nodes(&self) -> &[SpatialNode] {
-        assert!(self.last.is_some(), "nodes needs a successful solve");
-        &self.nodes
+    /// The centreline of the last successful solve at the step points,
+    /// clamp to tip, with every cable's channel, path and tension (none
+    /// beyond a cable's anchor; a node lies exactly at each anchor).
+    pub fn centreline(&self) -> Vec<CentrelinePoint> {
+        assert!(self.last.is_some(), "centreline needs a successful solve");
+        self.nodes
+            .iter()
+            .map(|n| {
+                let mut node = CentrelinePoint {
+                    s_mm: n.s_mm,
+                    x_mm: n.p_mm[0],
+                    y_mm: n.p_mm[1],
+                    z_mm: n.p_mm[2],
+                    rotation: n.rotation,
+                    // The body x axis and the tangent R v, projected on the x–y plane.
+                    frame_angle_rad: n.rotation[1][0].atan2(n.rotation[0][0]),
+                    tangent_angle_rad: (0..3).map(|j| n.rotation[1][j] * n.v[j]).sum::<f64>().atan2((0..3).map(|j| n.rotation[0][j] * n.v[j]).sum::<f64>()),
+                    arc_length_mm: n.arc_length_mm,
+                    v: n.v,
+                    u_per_mm: n.u_per_mm,
+                    cables: PerCable::filled(self.cables, CableAtNode::NONE),
+                };
+                let chans = &self.chan[n.point * self.cables..(n.point + 1) * self.cables];
+                for (i, (c, &anchor)) in chans.iter().zip(&self.anchors_mm).enumerate() {
+                    // Up to the node at the anchor, where the cable ends.
+                    if n.s_mm <= anchor + ANCHOR_TOLERANCE_MM {
+                        node.cables[i] = CableAtNode {
+                            channel_mm: [c.r[1], c.r[2]],
+                            position_mm: node.body_point_mm(c.r[1], c.r[2]),
+                            tension_n: self.base_tension_n[i] * self.scale,
+                        };
+                    }
+                }
+                node
+            })
+            .collect()
     }
 
     /// Legendre coefficients of the last solve, order `order`, in `basis`:
@@ -835,7 +864,7 @@ impl SpatialRk4Solver {
     }
 
     /// Makes the coefficient moments those of the last solve.
-    pub(super) fn settle_moments(&mut self) -> Result<(), SpatialError> {
+    pub(crate) fn settle_moments(&mut self) -> Result<(), SpatialError> {
         assert!(self.last.is_some(), "coefficients needs a successful solve");
         if !self.moments_valid {
             // The converged pass was a chord pass: one full pass at the
@@ -851,7 +880,7 @@ impl SpatialRk4Solver {
     /// [`SpatialRk4Solver::coefficients`] of the last solve without the
     /// order check (the error estimate's coarse solve computes the same
     /// orders at half the steps); needs valid moments.
-    pub(super) fn coefficients_unchecked(&self, order: usize, basis: LengthBasis) -> [Vec<f64>; 3] {
+    pub(crate) fn coefficients_unchecked(&self, order: usize, basis: LengthBasis) -> [Vec<f64>; 3] {
         let moments = &self.moments;
         let length = self.rod.length_mm;
         let ell = self.last.expect("checked").length_mm;
@@ -900,6 +929,18 @@ pub fn check_order(order: usize, options: &SpatialOptions) -> Result<(), Spatial
         )));
     }
     Ok(())
+}
+
+/// The rotation vector turning the direction of `before` into that of
+/// `after` (both in the body frame): its axis times its angle.
+fn tangent_turn(before: &V3, after: &V3) -> V3 {
+    let (a, b) = (before.normalize(), after.normalize());
+    let axis = a.cross(&b);
+    let sin = axis.norm();
+    if sin == 0.0 {
+        return V3::zeros();
+    }
+    axis * (sin.atan2(a.dot(&b)) / sin)
 }
 
 fn residual(end: &State) -> V3 {

@@ -250,7 +250,7 @@ impl SweepSpec {
         if o.order > MAX_ORDER {
             return Err(SpecError::setting("output", format!("order = {} is above the supported {MAX_ORDER}", o.order)));
         }
-        crate::model::resolution::check_order(o.order, &self.solver).map_err(|e| SpecError::setting("output", e))?;
+        crate::model::resolution::check_order(o.order, &self.solver).map_err(|e| SpecError::setting("output", e.to_string()))?;
         if o.chunk_routings == 0 {
             return Err(SpecError::setting("output", "chunk_routings = 0: a chunk needs at least one routing"));
         }

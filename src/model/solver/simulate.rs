@@ -1,0 +1,346 @@
+//! Single solves of an actuator, whichever backend serves it
+//! ([`simulate_actuator`]): a ladder of tensions from zero (continuation, so
+//! that large deformations start from a nearby solution), then the
+//! coefficients, repeated at a finer discretisation until it resolves the
+//! result. [`simulate`] is the planar backends' ladder, [`simulate_spatial`]
+//! the spatial one's; both return the one [`Simulation`].
+
+use super::result::Simulation;
+use super::{tip_tolerance_mm, Backend, Given, Hold, SolveFailure, SolverMethod, SolverOptions, Simulator, Unresolved, MAX_NODES_PER_SPAN};
+use crate::model::parameter::ParameterError;
+use crate::model::spatial::{check_order, SpatialError, SpatialFailure, SpatialOptions, SpatialRk4Solver, SpatialSolver};
+use crate::model::{Actuator, Cable, Rod, Routing};
+use crate::shape::LengthBasis;
+
+/// Why [`simulate`] or [`simulate_held`] produced no result.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SimulateError {
+    /// The actuator, solver options, hold or coefficient order are invalid.
+    #[error(transparent)]
+    Parameter(#[from] ParameterError),
+    /// A solve of the tension ladder failed.
+    #[error(transparent)]
+    Solve(#[from] SolveFailure),
+}
+
+/// Solves one actuator at `tension_n`, stepping up from a low tension by
+/// continuation so that large deformations start from a nearby solution.
+pub fn simulate(
+    actuator: &Rod,
+    options: &SolverOptions,
+    routing: &Routing,
+    tension_n: f64,
+    order: usize,
+    basis: LengthBasis,
+) -> Result<Simulation, SimulateError> {
+    let hold = Hold { direction: actuator.effects.load_direction, dwell_s: actuator.effects.creep_hold_s };
+    simulate_held(actuator, options, routing, tension_n, order, basis, hold)
+}
+
+/// Like [`simulate`], with the final tension reached in direction
+/// `hold.direction` (friction) and held for `hold.dwell_s` from a virgin
+/// rod (creep); the ladder below it is loaded without dwell.
+pub fn simulate_held(
+    actuator: &Rod,
+    options: &SolverOptions,
+    routing: &Routing,
+    tension_n: f64,
+    order: usize,
+    basis: LengthBasis,
+    hold: Hold,
+) -> Result<Simulation, SimulateError> {
+    crate::model::resolution::check_order(order, options).map_err(ParameterError::from)?;
+    check_ladder_tension("tension_n", tension_n)?;
+    // A solve the discretisation does not resolve is repeated, from the
+    // bottom of the ladder, at a finer one, up to the most there is.
+    let attempt = |options: &SolverOptions| -> Result<Simulation, SimulateError> {
+        let mut sim = Simulator::new(actuator, options)?;
+        sim.set_routing(routing);
+        // A ladder of tensions: cheap, and it keeps Newton and the shooting in
+        // their basin for curled-up shapes.
+        let rungs = if tension_n.is_finite() { ((tension_n / 0.25).ceil() as usize).max(1) } else { 1 };
+        let mut pose = None;
+        for k in 1..=rungs {
+            let t = tension_n * k as f64 / rungs as f64;
+            if k == rungs {
+                sim.set_hold(hold)?;
+            }
+            pose = Some(sim.solve(t)?);
+        }
+        let pose = pose.expect("at least one rung");
+        let mut a = vec![0.0; order + 1];
+        sim.coefficients_checked(basis, &mut a)?;
+        Ok(Simulation {
+            actuator: Actuator::with_cables(actuator.clone(), vec![Cable::planar(routing.control_points_mm().0, tension_n)]),
+            backend: Backend::planar(options.method),
+            pose,
+            a_bend_z: a,
+            a_bend_y: vec![0.0; order + 1],
+            a_twist: vec![0.0; order + 1],
+            length_basis: basis,
+            centreline: sim.centreline(),
+        })
+    };
+    let mut options = options.clone();
+    loop {
+        match attempt(&options) {
+            Err(SimulateError::Solve(SolveFailure::Unresolved(_))) if refined(&mut options) => continue,
+            result => return result,
+        }
+    }
+}
+
+/// Highest tension the continuation ladders of [`simulate`] and
+/// [`simulate_spatial`] climb to, N: 10⁵ rungs of 0.25 N
+/// (a few seconds); an absurd tension is refused rather than climbed for hours.
+pub const MAX_LADDER_TENSION_N: f64 = 25_000.0;
+
+/// Refuses a tension above [`MAX_LADDER_TENSION_N`] (parameter `name`).
+pub fn check_ladder_tension(name: &'static str, tension_n: f64) -> Result<(), ParameterError> {
+    if tension_n > MAX_LADDER_TENSION_N {
+        return Err(ParameterError::OutOfRange {
+            name,
+            value: tension_n,
+            expected: "a tension of at most 25000 N (solves climb to it in steps of 0.25 N; the thesis's cable pulls up to 2 N)",
+        });
+    }
+    Ok(())
+}
+
+/// Raises `options`' resolution one step for an unresolved solve (1.5×
+/// the collocation intervals, up to [`MAX_NODES_PER_SPAN`]; 2× the RK4
+/// steps, up to [`MAX_AUTO_STEPS_PER_SPAN`]); false at the most.
+fn refined(options: &mut SolverOptions) -> bool {
+    match options.method {
+        SolverMethod::Collocation if options.nodes_per_span < MAX_NODES_PER_SPAN => {
+            options.nodes_per_span = (options.nodes_per_span * 3 / 2).clamp(options.nodes_per_span + 2, MAX_NODES_PER_SPAN);
+            true
+        }
+        SolverMethod::Rk4 if options.steps_per_span < MAX_AUTO_STEPS_PER_SPAN => {
+            options.steps_per_span = (2 * options.steps_per_span).min(MAX_AUTO_STEPS_PER_SPAN);
+            true
+        }
+        _ => false,
+    }
+}
+
+/// Most RK4 steps per span [`simulate`] refines to by itself (a solve
+/// there takes tens of milliseconds; more must be asked for).
+pub const MAX_AUTO_STEPS_PER_SPAN: usize = 6144;
+
+/// Solves `actuator` at its cables' tensions, stepping all tensions up
+/// together from zero (rungs of at most 0.25 N on the largest) so that large
+/// deformations start from a nearby solution, and computes the coefficients
+/// a_0 … a_order in `basis`, by `options.method`:
+///
+/// - collocation (the default, [`SpatialSolver`]): every solve estimates its
+///   own error (the tip within [`tip_tolerance_mm`], every coefficient within
+///   [`crate::model::resolution::ORDER_TOLERANCE_PER_MM`]); where it is above,
+///   the ladder is solved again at twice the intervals, up to
+///   [`MAX_NODES_PER_SPAN`], beyond which the solve is refused as unresolved;
+/// - RK4 (the reference, [`SpatialRk4Solver`]): the result is checked against
+///   the same solve at half the steps (RK4's error falls as h⁴, so their
+///   difference is well above the finer one's error), doubling the steps up
+///   to [`MAX_AUTO_SPATIAL_STEPS_PER_SPAN`].
+///
+/// A tip farther from the clamp than the stretched rod is long is refused too.
+pub fn simulate_spatial(
+    actuator: &Actuator,
+    options: &SpatialOptions,
+    order: usize,
+    basis: LengthBasis,
+) -> Result<Simulation, SpatialError> {
+    simulate_spatial_held(actuator, options, order, basis, None)
+}
+
+/// [`simulate_spatial`] with the final tensions reached in direction
+/// `hold.direction` (friction) and held for `hold.dwell_s` from a virgin rod
+/// (creep); `None` holds every rung as the actuator's effects say. (The RK4
+/// reference models no effect a hold acts on.)
+pub fn simulate_spatial_held(
+    actuator: &Actuator,
+    options: &SpatialOptions,
+    order: usize,
+    basis: LengthBasis,
+    hold: Option<Hold>,
+) -> Result<Simulation, SpatialError> {
+    check_order(order, options)?;
+    let top = actuator.cables.iter().map(|c| c.tension_n).fold(0.0, f64::max);
+    check_ladder_tension("cable tension_n", top)?;
+    if options.method == SolverMethod::Rk4 {
+        return simulate_spatial_rk4(actuator, options, order, basis);
+    }
+    let mut options = options.clone();
+    loop {
+        match solve_collocation_ladder(actuator, &options, order, basis, hold) {
+            Err(SpatialError::Solve(SpatialFailure::Unresolved(_))) if options.nodes_per_span < MAX_NODES_PER_SPAN => {
+                options.nodes_per_span = (2 * options.nodes_per_span).min(MAX_NODES_PER_SPAN);
+            }
+            result => return result,
+        }
+    }
+}
+
+/// One ladder of the collocation solver at `options`, with its checks.
+fn solve_collocation_ladder(actuator: &Actuator, options: &SpatialOptions, order: usize, basis: LengthBasis, hold: Option<Hold>) -> Result<Simulation, SpatialError> {
+    let mut solver = SpatialSolver::new(actuator, options)?;
+    let top = actuator.cables.iter().map(|c| c.tension_n).fold(0.0, f64::max);
+    let rungs = ((top / 0.25).ceil() as usize).max(1);
+    let mut pose = None;
+    for k in 1..=rungs {
+        if let (true, Some(h)) = (k == rungs, hold) {
+            solver.set_hold(h)?;
+        }
+        pose = Some(solver.solve_scaled(k as f64 / rungs as f64)?);
+    }
+    let pose = pose.expect("at least one rung");
+    let [a_twist, a_bend_y, a_bend_z] = solver.coefficients(order, basis)?;
+    if !a_twist.iter().chain(&a_bend_y).chain(&a_bend_z).all(|v| v.is_finite()) {
+        return Err(SpatialFailure::NonFinite.into());
+    }
+    Ok(Simulation { actuator: actuator.clone(), backend: Backend::Spatial, pose, a_bend_z, a_bend_y, a_twist, length_basis: basis, centreline: solver.centreline() })
+}
+
+/// [`simulate_spatial`] by the RK4 reference, refining by comparison with half the steps.
+fn simulate_spatial_rk4(actuator: &Actuator, options: &SpatialOptions, order: usize, basis: LengthBasis) -> Result<Simulation, SpatialError> {
+    let half = SpatialOptions { steps_per_span: (options.steps_per_span / 2).max(2), ..options.clone() };
+    // A coarse solve that fails says nothing about the fine one: the
+    // comparison then moves one level up.
+    let mut coarse = solve_ladder(actuator, &half, order, basis).ok();
+    let mut options = options.clone();
+    loop {
+        let fine = solve_ladder(actuator, &options, order, basis)?;
+        let steps = options.steps_per_span;
+        let failure = match &coarse {
+            Some(c) => unresolved_part(&fine, c, steps),
+            None => Some(unresolved("the tip position".into(), f64::INFINITY, 0.0, "mm", steps)),
+        };
+        let Some(failure) = failure else {
+            return Ok(fine);
+        };
+        if steps >= MAX_AUTO_SPATIAL_STEPS_PER_SPAN {
+            return Err(failure.into());
+        }
+        options.steps_per_span = (2 * steps).min(MAX_AUTO_SPATIAL_STEPS_PER_SPAN);
+        coarse = Some(fine);
+    }
+}
+
+/// Most RK4 steps per span [`simulate_spatial`] refines to by itself.
+pub const MAX_AUTO_SPATIAL_STEPS_PER_SPAN: usize = 2560;
+
+/// [`SpatialFailure::Unresolved`] for `what` at `steps` per span.
+fn unresolved(what: String, estimate: f64, tolerance: f64, unit: &'static str, steps: usize) -> SpatialFailure {
+    let advice = format!("raise --steps-per-span above {steps} (sweep spec: [solver] steps_per_span), or lower the tensions");
+    SpatialFailure::Unresolved(Unresolved { what, estimate, tolerance, unit, advice })
+}
+
+/// What of `fine` (at `steps` per span) is not resolved, judged against
+/// `coarse` (at fewer steps): the tip or a coefficient further off than
+/// its tolerance, or a tip beyond the stretched length. `None` if all is.
+fn unresolved_part(fine: &Simulation, coarse: &Simulation, steps: usize) -> Option<SpatialFailure> {
+    let unresolved = |what: String, estimate: f64, tolerance: f64, unit| Some(unresolved(what, estimate, tolerance, unit, steps));
+    let tolerance = tip_tolerance_mm(fine.actuator.rod.length_mm);
+    let [x, y, z] = fine.pose.tip_mm();
+    let reach = (x * x + y * y + z * z).sqrt();
+    if reach > fine.pose.length_mm + tolerance {
+        let what = format!(
+            "the tip (|tip| = {} mm is more than the stretched length ℓ = {} mm)",
+            crate::io::fmt_num(reach),
+            crate::io::fmt_num(fine.pose.length_mm)
+        );
+        return unresolved(what, reach - fine.pose.length_mm, tolerance, "mm");
+    }
+    let (f, c) = (fine.pose.tip_mm(), coarse.pose.tip_mm());
+    let tip_difference = (0..3).map(|i| (f[i] - c[i]).powi(2)).sum::<f64>().sqrt();
+    if !(tip_difference <= tolerance) {
+        return unresolved("the tip position".into(), tip_difference, tolerance, "mm");
+    }
+    let series = [("a_twist", &fine.a_twist, &coarse.a_twist), ("a_bend_y", &fine.a_bend_y, &coarse.a_bend_y), ("a_bend_z", &fine.a_bend_z, &coarse.a_bend_z)];
+    let a_tolerance = crate::model::resolution::ORDER_TOLERANCE_PER_MM;
+    for (name, f, c) in series {
+        for (k, (p, q)) in f.iter().zip(c.iter()).enumerate() {
+            if !((p - q).abs() <= a_tolerance) {
+                return unresolved(format!("{name}[{k}]"), (p - q).abs(), a_tolerance, "mm⁻¹");
+            }
+        }
+    }
+    None
+}
+
+/// One ladder of [`simulate_spatial_rk4`] at `options`' steps, without the
+/// resolution check (but refusing non-finite results).
+fn solve_ladder(actuator: &Actuator, options: &SpatialOptions, order: usize, basis: LengthBasis) -> Result<Simulation, SpatialError> {
+    let mut solver = SpatialRk4Solver::new(actuator, options)?;
+    let top = actuator.cables.iter().map(|c| c.tension_n).fold(0.0, f64::max);
+    let rungs = ((top / 0.25).ceil() as usize).max(1);
+    let mut pose = None;
+    for k in 1..=rungs {
+        pose = Some(solver.solve_scaled(k as f64 / rungs as f64)?);
+    }
+    let pose = pose.expect("at least one rung");
+    solver.settle_moments()?;
+    let [a_twist, a_bend_y, a_bend_z] = solver.coefficients_unchecked(order, basis);
+    let finite = pose.tip_mm().iter().chain(&[pose.length_mm, pose.angle_from_clamp_axis_rad()]).chain(&a_twist).chain(&a_bend_y).chain(&a_bend_z).all(|v| v.is_finite());
+    if !finite {
+        return Err(SpatialFailure::NonFinite.into());
+    }
+    Ok(Simulation { actuator: actuator.clone(), backend: Backend::SpatialRk4, pose, a_bend_z, a_bend_y, a_twist, length_basis: basis, centreline: solver.centreline() })
+}
+
+/// Solves `actuator` with the backend that serves it ([`Backend::serving`]):
+/// one in-plane cable with gravity in the plane takes the planar fast path
+/// (`options`, and `hold` for the final tension), anything else the 3-D
+/// solver (`spatial_options`). `given` names the settings asked for
+/// explicitly; one a backend does not read is refused, not ignored. The
+/// result holds `actuator` as given.
+#[allow(clippy::too_many_arguments)]
+pub fn simulate_actuator(
+    actuator: &Actuator,
+    options: &SolverOptions,
+    spatial_options: &SpatialOptions,
+    given: Given,
+    hold: Option<Hold>,
+    order: usize,
+    basis: LengthBasis,
+) -> Result<Simulation, SpatialError> {
+    actuator.channels()?;
+    let backend = Backend::serving(actuator, options, given)?;
+    if matches!(backend, Backend::Spatial | Backend::SpatialRk4) {
+        // One set of settings: the method picked the backend, and the
+        // collocation's intervals are the planar solver's option.
+        let method = if backend == Backend::Spatial { SolverMethod::Collocation } else { SolverMethod::Rk4 };
+        let spatial_options = SpatialOptions { method, nodes_per_span: options.nodes_per_span, ..spatial_options.clone() };
+        return simulate_spatial_held(actuator, &spatial_options, order, basis, hold);
+    }
+    let (rod, routing) = planar_problem(actuator)?;
+    let cable = &actuator.cables[0];
+    let hold = hold.unwrap_or(Hold { direction: rod.effects.load_direction, dwell_s: rod.effects.creep_hold_s });
+    let mut sim = simulate_held(&rod, options, &routing, cable.tension_n, order, basis, hold)?;
+    sim.actuator = actuator.clone();
+    Ok(sim)
+}
+
+/// The planar solver's input for a planar `actuator` (one cable, z ≡ 0,
+/// gravity in the x–y plane): the rod with the cable's anchor and gravity's
+/// in-plane direction, and the cable's routing over [0, anchor].
+pub fn planar_problem(actuator: &Actuator) -> Result<(Rod, Routing), SpatialError> {
+    let cable = &actuator.cables[0];
+    let mut rod = actuator.rod.clone();
+    if let Some(anchor) = cable.anchor_mm {
+        if rod.cable_anchor_mm.is_some_and(|k| k != anchor) {
+            return Err(SpatialError::Option(format!(
+                "cable 1 has anchor={} mm and the rod cable_anchor_mm = {} mm: give the anchor once",
+                crate::io::fmt_num(anchor),
+                crate::io::fmt_num(rod.cable_anchor_mm.unwrap_or(anchor))
+            )));
+        }
+        rod.cable_anchor_mm = Some(anchor);
+    }
+    if let (Some(g), true) = (actuator.gravity_direction, rod.gravity.enabled) {
+        rod.gravity.direction_rad = g[1].atan2(g[0]);
+    }
+    let routing = Routing::for_actuator(cable.y_mm, &rod)
+        .map_err(|source| SpatialError::Routing { cable: 1, axis: 'y', source })?;
+    Ok((rod, routing))
+}
