@@ -42,6 +42,8 @@ mod study;
 mod sweep;
 #[path = "sweep_cables.rs"]
 mod sweep_cables;
+#[path = "tentacle.rs"]
+mod tentacle;
 #[path = "test_script.rs"]
 mod test_script;
 

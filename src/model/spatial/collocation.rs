@@ -200,6 +200,11 @@ pub struct SpatialSolver {
     speed: Vec<f64>,
     dmom: Vec<V3>,
     anderson: Anderson,
+    /// Newton's Jacobian factors on the whole system, kept for chord steps.
+    newton_factors: Option<nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>>,
+    /// Whether the last solve's sweeps stalled (a heavy rod): the next
+    /// solve goes to Newton at once.
+    sweeps_stall: bool,
     /// The last three converged solves, newest first (`solved` of them valid).
     history: Vec<Solved>,
     solved: usize,
@@ -387,6 +392,8 @@ impl SpatialSolver {
             speed: vec![1.0; nn],
             dmom: vec![V3::zeros(); nn],
             anderson: Anderson::new(n_state),
+            newton_factors: None,
+            sweeps_stall: false,
             history: Vec::with_capacity(3),
             solved: 0,
             passes: 0,
@@ -515,6 +522,7 @@ impl SpatialSolver {
     /// Forgets the warm start (after a failed solve).
     fn forget(&mut self) {
         self.solved = 0;
+        self.newton_factors = None;
         self.anderson.clear();
         let ratio_at = self.ratio_at;
         self.state.iter_mut().enumerate().for_each(|(i, v)| *v = if i >= ratio_at { 1.0 } else { 0.0 });
@@ -579,7 +587,12 @@ impl SpatialSolver {
         let mut passes = 0u32;
         let mut previous = f64::INFINITY;
         self.anderson.restart();
-        let outcome = loop {
+        // The prediction, for Newton to start from if the sweeps stall.
+        let predicted = (self.state.clone(), self.local.clone());
+        let outcome = if self.sweeps_stall && has_weight {
+            Err(SpatialFailure::Gravity { passes: 0, residual_n_mm: f64::NAN })
+        } else {
+            loop {
             self.anderson.input_mut().copy_from_slice(&self.state);
             let change = match self.sweep(tensions, true) {
                 Ok(c) => c,
@@ -605,12 +618,19 @@ impl SpatialSolver {
                 Some(z) => self.state.copy_from_slice(z),
                 None => std::mem::swap(&mut self.state, &mut self.next),
             }
+            }
         };
         match outcome {
-            Ok(()) => Ok(passes),
+            Ok(()) => {
+                self.sweeps_stall = false;
+                Ok(passes)
+            }
             Err(SpatialFailure::Friction) => Err(SpatialFailure::Friction),
             Err(_) => {
                 self.anderson.clear();
+                self.sweeps_stall = true;
+                self.state.copy_from_slice(&predicted.0);
+                self.local.copy_from_slice(&predicted.1);
                 Ok(passes + self.newton_continued(tensions)?)
             }
         }
@@ -666,58 +686,100 @@ impl SpatialSolver {
     }
 
     /// Newton's method on F(z) = z − G(z) (G: one sweep), with the Jacobian
-    /// by finite differences of sweeps and backtracking on |F|.
+    /// by finite differences of sweeps and backtracking on |F|. The
+    /// Jacobian's factors are kept across iterations and solves (chord
+    /// steps: a heavy rod's Jacobian changes slowly along a tension ladder)
+    /// and made afresh when a chord step contracts by less than half.
     fn newton(&mut self, tensions: &[f64]) -> Result<u32, SpatialFailure> {
         let n = self.state.len();
-        let residual = |this: &mut Self, commit: bool| -> Result<DVector<f64>, SpatialFailure> {
-            this.sweep(tensions, commit)?;
+        let residual = |this: &mut Self| -> Result<DVector<f64>, SpatialFailure> {
+            this.sweep(tensions, true)?;
             Ok(DVector::from_iterator(n, this.state.iter().zip(&this.next).map(|(z, g)| z - g)))
         };
-        let mut f = residual(self, true)?;
+        let mut f = residual(self)?;
         let mut norm = f.amax();
-        let mut jac = DMatrix::<f64>::zeros(n, n);
+        let mut factors = self.newton_factors.take();
         for it in 0..NEWTON_MAX_ITERATIONS {
             if norm <= NEWTON_TOLERANCE {
+                self.newton_factors = factors;
                 return Ok(it);
             }
-            let base = self.state.clone();
-            let g0 = self.next.clone();
-            for k in 0..n {
-                let eps = 1e-7 * (1.0 + base[k].abs());
-                self.state[k] = base[k] + eps;
-                self.sweep(tensions, false)?;
-                for i in 0..n {
-                    let fi = (self.state[i] - self.next[i]) - (base[i] - g0[i]);
-                    jac[(i, k)] = fi / eps;
-                }
-                self.state[k] = base[k];
+            let fresh = factors.is_none();
+            if fresh {
+                factors = Some(self.jacobian(tensions)?.lu());
             }
-            let delta = jac.clone().lu().solve(&(-&f)).ok_or(SpatialFailure::Gravity { passes: it, residual_n_mm: norm })?;
+            let base = self.state.clone();
+            let failed = SpatialFailure::Gravity { passes: it, residual_n_mm: norm / self.m_scale };
+            let Some(delta) = factors.as_ref().and_then(|lu| lu.solve(&(-&f))) else {
+                if fresh {
+                    return Err(failed);
+                }
+                factors = None;
+                continue;
+            };
             let mut lambda = 1.0;
-            loop {
+            let accepted = loop {
                 for i in 0..n {
                     self.state[i] = base[i] + lambda * delta[i];
                 }
-                match residual(self, true) {
-                    Ok(fn_) if fn_.amax().is_finite() && fn_.amax() < (1.0 - NEWTON_SUFFICIENT_DECREASE * lambda) * norm => {
-                        norm = fn_.amax();
-                        f = fn_;
-                        break;
-                    }
+                match residual(self) {
+                    Ok(trial) if trial.amax().is_finite() && trial.amax() < (1.0 - NEWTON_SUFFICIENT_DECREASE * lambda) * norm => break Some(trial),
                     _ => {
                         lambda /= 2.0;
-                        if lambda < NEWTON_MIN_DAMPING {
-                            self.state.copy_from_slice(&base);
-                            return Err(SpatialFailure::Gravity { passes: it, residual_n_mm: norm });
+                        if lambda < NEWTON_MIN_DAMPING || (!fresh && lambda < 0.25) {
+                            break None;
                         }
                     }
+                }
+            };
+            match accepted {
+                Some(trial) => {
+                    let contraction = trial.amax() / norm;
+                    norm = trial.amax();
+                    f = trial;
+                    if !fresh && contraction > 0.5 {
+                        factors = None;
+                    }
+                }
+                None => {
+                    self.state.copy_from_slice(&base);
+                    if fresh {
+                        return Err(failed);
+                    }
+                    factors = None;
+                    f = residual(self)?;
+                    norm = f.amax();
                 }
             }
         }
         if norm <= 1e3 * NEWTON_TOLERANCE {
+            self.newton_factors = factors;
             return Ok(NEWTON_MAX_ITERATIONS);
         }
-        Err(SpatialFailure::Gravity { passes: NEWTON_MAX_ITERATIONS, residual_n_mm: norm })
+        Err(SpatialFailure::Gravity { passes: NEWTON_MAX_ITERATIONS, residual_n_mm: norm / self.m_scale })
+    }
+
+    /// The Jacobian of F(z) = z − G(z) at the current state by forward
+    /// differences of sweeps (each from the committed local solutions).
+    fn jacobian(&mut self, tensions: &[f64]) -> Result<DMatrix<f64>, SpatialFailure> {
+        let n = self.state.len();
+        let base = self.state.clone();
+        let g0 = self.next.clone();
+        let mut jac = DMatrix::<f64>::zeros(n, n);
+        for k in 0..n {
+            let eps = 1e-7 * (1.0 + base[k].abs());
+            self.state[k] = base[k] + eps;
+            let result = self.sweep(tensions, false);
+            if result.is_ok() {
+                for i in 0..n {
+                    jac[(i, k)] = ((self.state[i] - self.next[i]) - (base[i] - g0[i])) / eps;
+                }
+            }
+            self.state[k] = base[k];
+            result?;
+        }
+        self.next.copy_from_slice(&g0);
+        Ok(jac)
     }
 
     /// The tension of cable `c` at node `i`, N.
