@@ -174,10 +174,11 @@ pub fn sample_spatial_pairs(count: usize, radius_mm: f64) -> Vec<[crate::model::
         .collect()
 }
 
-/// Times the 3-D solver on two-cable spatial actuators: per actuator, a
-/// ladder of `tensions` steps with τ_1 = t and τ_2 = t/2, t from 1.0 to
-/// 2.0 N (continuation, as a sweep would step it), coefficients a_0 … a_3 of
-/// all three series included. `gravity` is the direction (None: off).
+/// Times a 3-D solver (`options.method`: the collocation, or the RK4
+/// reference) on two-cable spatial actuators: per actuator, a ladder of
+/// `tensions` steps with τ_1 = t and τ_2 = t/2, t from 1.0 to 2.0 N
+/// (continuation, as a sweep would step it), coefficients a_0 … a_3 of all
+/// three series included. `gravity` is the direction (None: off).
 pub fn bench_spatial(
     rod: &Rod,
     options: &crate::model::spatial::SpatialOptions,
@@ -186,32 +187,57 @@ pub fn bench_spatial(
     gravity: Option<[f64; 3]>,
     label: &str,
 ) -> Result<BenchFigures, crate::Error> {
-    use crate::model::spatial::{Actuator, SpatialSolver};
+    use crate::model::spatial::{Actuator, SpatialRk4Solver, SpatialSolver};
+    use crate::model::SolverMethod;
     let mut rod = rod.clone();
     rod.gravity.enabled = gravity.is_some();
     let mut per_solve = Vec::with_capacity(pairs.len());
     let (mut passes, mut solves, mut failures) = (0u64, 0u64, 0usize);
     let mut sink = 0.0;
+    let basis = crate::shape::LengthBasis::default();
     for pair in pairs {
         let mut actuator = Actuator::with_cables(rod.clone(), pair.to_vec());
         actuator.gravity_direction = gravity;
         let start = Instant::now();
-        let mut solver = SpatialSolver::new(&actuator, options)?;
-        for k in 0..tensions {
+        let ladder = |k: usize| {
             let t = 1.0 + k as f64 / (tensions.max(2) - 1) as f64;
-            match solver.solve(&[t, 0.5 * t]) {
-                Ok(pose) => {
-                    let a = solver.coefficients(3, crate::shape::LengthBasis::default())?;
-                    sink += a[2][0];
-                    passes += u64::from(pose.iterations);
-                    solves += 1;
+            [t, 0.5 * t]
+        };
+        match options.method {
+            SolverMethod::Collocation => {
+                let mut solver = SpatialSolver::new(&actuator, options)?;
+                for k in 0..tensions {
+                    match solver.solve(&ladder(k)).and_then(|pose| Ok((pose, solver.coefficients(3, basis)?))) {
+                        Ok((pose, a)) => {
+                            sink += a[2][0];
+                            passes += u64::from(pose.iterations);
+                            solves += 1;
+                        }
+                        Err(_) => failures += 1,
+                    }
                 }
-                Err(_) => failures += 1,
+            }
+            SolverMethod::Rk4 => {
+                let mut solver = SpatialRk4Solver::new(&actuator, options)?;
+                for k in 0..tensions {
+                    match solver.solve(&ladder(k)) {
+                        Ok(pose) => {
+                            let a = solver.coefficients(3, basis)?;
+                            sink += a[2][0];
+                            passes += u64::from(pose.iterations);
+                            solves += 1;
+                        }
+                        Err(_) => failures += 1,
+                    }
+                }
             }
         }
         per_solve.push(start.elapsed().as_secs_f64() * 1e6 / tensions as f64);
     }
     std::hint::black_box(sink);
-    let method = format!("spatial-rk4-{}", options.steps_per_span);
+    let method = match options.method {
+        crate::model::SolverMethod::Collocation => format!("spatial-collocation-{}", options.nodes_per_span),
+        crate::model::SolverMethod::Rk4 => format!("spatial-rk4-{}", options.steps_per_span),
+    };
     Ok(figures(label, per_solve, tensions, passes as f64 / solves.max(1) as f64, failures, method))
 }

@@ -53,22 +53,39 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
             );
         }
     }
-    // The 3-D solver (issue 16): two spatial cables, in the table only (the
-    // JSON array keeps its two planar rows).
-    let spatial_options = cablemap::model::spatial::SpatialOptions::default();
+    // The 3-D solver: two spatial cables, in the table only (the JSON
+    // array keeps its two planar rows), with its RK4 reference unless
+    // --no-reference, and its ratio to the planar single-cable solve of this run.
+    let spatial_options = cablemap::model::spatial::SpatialOptions { nodes_per_span: options.nodes_per_span, ..Default::default() };
+    let rk4_options = cablemap::model::spatial::SpatialOptions { method: cablemap::model::SolverMethod::Rk4, ..Default::default() };
     let pairs = cablemap::bench::sample_spatial_pairs(args.routings.div_ceil(4), base.radius_mm);
     println!(
         "3-D solver, {} two-cable spatial actuators x 21 tensions (tau1 1.0..2.0 N, tau2 = tau1/2, continuation), twist and both bending series a_0..a_3 included",
         pairs.len()
     );
-    println!("{:<22} {:<16} {:>10} {:>8} {:>8} {:>8} {:>9}", "case", "method", "median µs", "p10 µs", "p90 µs", "passes", "failures");
+    println!("{:<22} {:<24} {:>10} {:>8} {:>8} {:>8} {:>9}", "case", "method", "median µs", "p10 µs", "p90 µs", "passes", "failures");
     let cases = [(Some([1.0, 0.0, 0.0]), "gravity +x (hanging)"), (Some([0.0, 0.6, 0.8]), "gravity (0, .6, .8)"), (None, "gravity off")];
+    let mut ratios = Vec::new();
     for (gravity, label) in cases {
-        let f = cablemap::bench::bench_spatial(&base, &spatial_options, &pairs, 21, gravity, label)?;
-        println!(
-            "{:<22} {:<16} {:>10.2} {:>8.2} {:>8.2} {:>8.2} {:>9}",
-            f.label, f.method, f.median_us_per_solve, f.p10_us_per_solve, f.p90_us_per_solve, f.mean_passes, f.failures
-        );
+        let mut methods = vec![&spatial_options];
+        if !args.no_reference {
+            methods.push(&rk4_options);
+        }
+        for (k, o) in methods.into_iter().enumerate() {
+            let f = cablemap::bench::bench_spatial(&base, o, &pairs, 21, gravity, label)?;
+            println!(
+                "{:<22} {:<24} {:>10.2} {:>8.2} {:>8.2} {:>8.2} {:>9}",
+                f.label, f.method, f.median_us_per_solve, f.p10_us_per_solve, f.p90_us_per_solve, f.mean_passes, f.failures
+            );
+            // The planar row of the same gravity (on: the first; off: the second).
+            let planar = if gravity.is_some() { rows.first() } else { rows.get(1) };
+            if let (0, Some(p)) = (k, planar) {
+                ratios.push(format!("{label}: two-cable 3-D {:.2} µs = {:.2}x the planar single-cable {:.2} µs", f.median_us_per_solve, f.median_us_per_solve / p.median_us_per_solve, p.median_us_per_solve));
+            }
+        }
+    }
+    for r in ratios {
+        println!("{r} (medians, same run)");
     }
     for r in &rows {
         if let (Some(s), Some(reference)) = (r.speedup, r.reference.as_deref()) {
