@@ -17,33 +17,105 @@ pub const MAX_CABLES: usize = 8;
 /// Points per knot span at which the channel is checked against the radius.
 const RADIUS_CHECK_POINTS_PER_SPAN: usize = 512;
 
-/// One cable: its channel's control points, its tension and where it is knotted.
+/// One cable: its channel's control points, its actuation (a tension, or a
+/// displacement), its stiffness and where it is knotted.
+///
+/// In a file (TOML `[[cable]]`) a cable gives exactly one of `tension_n`
+/// and `displacement_mm`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(try_from = "CableFile", into = "CableFile")]
 pub struct Cable {
     /// Lateral (body y) control points y_0 … y_4, mm.
     pub y_mm: [f64; CONTROL_POINTS],
     /// Out-of-plane (body z) control points z_0 … z_4, mm; all zero for a planar cable.
-    #[serde(default)]
     pub z_mm: [f64; CONTROL_POINTS],
-    /// Tension pulled at the base, N (≥ 0).
+    /// Tension pulled at the base, N (≥ 0): the actuation of a
+    /// tension-driven cable; of a displacement-driven one, the tension the
+    /// solve found (the start of the next solve).
     pub tension_n: f64,
+    /// The displacement Δℓ pulled in at the base, mm, when the cable is
+    /// driven by displacement (a motor's position) rather than by tension:
+    /// the change of its path length from the straight, unloaded rod's, plus
+    /// its own stretch under tension ([`Cable::cable_ea_n`]). A cable pulled
+    /// in less than its path needs carries no tension (slack).
+    pub displacement_mm: Option<f64>,
+    /// The cable's axial stiffness EA, N (its stretch under tension τ is
+    /// τ/EA per unit length); `None` is inextensible.
+    pub cable_ea_n: Option<f64>,
     /// Arc length s_k of the knot, mm (0 < s_k ≤ L); `None` is the tip.
     /// The five control points span the cable, [0, s_k] (as the planar
     /// `cable_anchor_mm`); beyond s_k the cable is slack and carries no load.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub anchor_mm: Option<f64>,
+}
+
+/// A cable as the actuator file writes it (exactly one actuation).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CableFile {
+    y_mm: [f64; CONTROL_POINTS],
+    #[serde(default)]
+    z_mm: [f64; CONTROL_POINTS],
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    tension_n: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    displacement_mm: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    cable_ea_n: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    anchor_mm: Option<f64>,
+}
+
+/// A `[[cable]]` table without exactly one actuation.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ActuationError {
+    /// Neither a tension nor a displacement.
+    #[error("a cable needs its actuation: tension_n = … (N) or displacement_mm = … (mm)")]
+    Missing,
+    /// Both.
+    #[error("a cable is driven either by tension_n or by displacement_mm, not both: give one")]
+    Both,
+}
+
+impl TryFrom<CableFile> for Cable {
+    type Error = ActuationError;
+    fn try_from(f: CableFile) -> Result<Self, ActuationError> {
+        let tension_n = match (f.tension_n, f.displacement_mm) {
+            (Some(_), Some(_)) => return Err(ActuationError::Both),
+            (None, None) => return Err(ActuationError::Missing),
+            (t, _) => t.unwrap_or(0.0),
+        };
+        Ok(Cable { y_mm: f.y_mm, z_mm: f.z_mm, tension_n, displacement_mm: f.displacement_mm, cable_ea_n: f.cable_ea_n, anchor_mm: f.anchor_mm })
+    }
+}
+
+impl From<Cable> for CableFile {
+    fn from(c: Cable) -> Self {
+        let driven = c.displacement_mm.is_some();
+        CableFile {
+            y_mm: c.y_mm,
+            z_mm: c.z_mm,
+            tension_n: (!driven).then_some(c.tension_n),
+            displacement_mm: c.displacement_mm,
+            cable_ea_n: c.cable_ea_n,
+            anchor_mm: c.anchor_mm,
+        }
+    }
 }
 
 impl Cable {
     /// A planar cable (z ≡ 0) knotted at the tip.
     pub fn planar(y_mm: [f64; CONTROL_POINTS], tension_n: f64) -> Self {
-        Self { y_mm, z_mm: [0.0; CONTROL_POINTS], tension_n, anchor_mm: None }
+        Self::spatial(y_mm, [0.0; CONTROL_POINTS], tension_n)
     }
 
     /// A spatial cable knotted at the tip.
     pub fn spatial(y_mm: [f64; CONTROL_POINTS], z_mm: [f64; CONTROL_POINTS], tension_n: f64) -> Self {
-        Self { y_mm, z_mm, tension_n, anchor_mm: None }
+        Self { y_mm, z_mm, tension_n, displacement_mm: None, cable_ea_n: None, anchor_mm: None }
+    }
+
+    /// Whether the cable is driven by its displacement (else by its tension).
+    pub fn is_displacement_driven(&self) -> bool {
+        self.displacement_mm.is_some()
     }
 
     /// Whether the channel lies in the body's x–y plane (every z_i = 0).
@@ -88,6 +160,19 @@ impl Channel {
     }
 
     /// The channel's distance from the rod axis at parameter ζ, mm.
+    /// The channel's length in the straight, unloaded rod, ∫ √(1 + y'² + z'²) ds
+    /// over [0, `end_mm`], mm (Simpson's rule on 1024 intervals; the bound
+    /// of a displacement).
+    pub fn rest_length_mm(&self, end_mm: f64) -> f64 {
+        let n = 1024;
+        let h = end_mm / n as f64;
+        let f = |s: f64| {
+            let p = self.at(s);
+            (1.0 + p.dr_ds[0] * p.dr_ds[0] + p.dr_ds[1] * p.dr_ds[1]).sqrt()
+        };
+        (0..=n).map(|k| f(k as f64 * h) * if k == 0 || k == n { 1.0 } else if k % 2 == 1 { 4.0 } else { 2.0 }).sum::<f64>() * h / 3.0
+    }
+
     fn radius_at_parameter(&self, zeta: f64) -> (f64, f64) {
         let (s, y) = self.y.at_parameter(zeta);
         let (_, z) = self.z.at_parameter(zeta);
@@ -135,6 +220,27 @@ pub fn validate(actuator: &Rod, cables: &[Cable]) -> Result<Vec<Channel>, Spatia
                 return Err(SpatialError::OutsideBody { cable: cable_no, s_mm: s, distance_mm: dist, radius_mm: radius });
             }
         }
+        if let Some(ea) = cable.cable_ea_n {
+            if !(ea.is_finite() && ea > 0.0) {
+                return Err(SpatialError::CableStiffness { cable: cable_no, cable_ea_n: ea });
+            }
+        }
+        if let Some(d) = cable.displacement_mm {
+            let bad = |why: String| Err(SpatialError::Displacement { cable: cable_no, displacement_mm: d, why });
+            if !d.is_finite() {
+                return bad("give a finite pulled-in length, mm".into());
+            }
+            if d < 0.0 {
+                return bad("a cable pulls: a negative displacement would push it; give the pulled-in length ≥ 0 mm".into());
+            }
+            let rest = channel.rest_length_mm(span);
+            if d >= rest {
+                return bad(format!(
+                    "the cable is only {} mm long in the unloaded rod; it cannot be pulled in by that much",
+                    crate::io::fmt_num((rest * 1e3).round() / 1e3)
+                ));
+            }
+        }
         for (other, earlier) in cables[..index].iter().enumerate() {
             if earlier.y_mm == cable.y_mm && earlier.z_mm == cable.z_mm {
                 return Err(SpatialError::SamePath { first: other + 1, second: cable_no });
@@ -163,7 +269,7 @@ impl std::str::FromStr for Cable {
         let number = |key: &str, value: &str| -> Result<f64, SpatialError> {
             value.trim().parse::<f64>().map_err(|_| bad(format!("{key}: '{value}' is not a number")))
         };
-        let (mut y, mut z, mut tension, mut anchor) = (None, None, None, None);
+        let (mut y, mut z, mut tension, mut anchor, mut displacement, mut ea) = (None, None, None, None, None, None);
         for field in text.split_whitespace() {
             let (key, value) = field.split_once('=').ok_or_else(|| bad(format!("'{field}' is not key=value")))?;
             let slot_taken = |taken: bool| if taken { Err(bad(format!("{key}= is given twice"))) } else { Ok(()) };
@@ -184,12 +290,24 @@ impl std::str::FromStr for Cable {
                     slot_taken(anchor.is_some())?;
                     anchor = Some(number(key, value)?);
                 }
-                other => return Err(bad(format!("unknown field '{other}' (fields: y, z, tension, anchor)"))),
+                "displacement" => {
+                    slot_taken(displacement.is_some())?;
+                    displacement = Some(number(key, value)?);
+                }
+                "ea" => {
+                    slot_taken(ea.is_some())?;
+                    ea = Some(number(key, value)?);
+                }
+                other => return Err(bad(format!("unknown field '{other}' (fields: y, z, tension, displacement, ea, anchor)"))),
             }
         }
         let y_mm = y.ok_or_else(|| bad("y= is missing".into()))?;
-        let tension_n = tension.ok_or_else(|| bad("tension= is missing".into()))?;
-        Ok(Cable { y_mm, z_mm: z.unwrap_or([0.0; CONTROL_POINTS]), tension_n, anchor_mm: anchor })
+        let tension_n = match (tension, displacement) {
+            (Some(_), Some(_)) => return Err(bad("give tension= or displacement=, not both".into())),
+            (None, None) => return Err(bad("tension= (N) or displacement= (mm) is missing".into())),
+            (t, _) => t.unwrap_or(0.0),
+        };
+        Ok(Cable { y_mm, z_mm: z.unwrap_or([0.0; CONTROL_POINTS]), tension_n, displacement_mm: displacement, cable_ea_n: ea, anchor_mm: anchor })
     }
 }
 
@@ -204,7 +322,13 @@ impl std::fmt::Display for Cable {
         if !self.is_planar() {
             write!(f, " z={}", list(&self.z_mm))?;
         }
-        write!(f, " tension={}", self.tension_n)?;
+        match self.displacement_mm {
+            Some(d) => write!(f, " displacement={d}")?,
+            None => write!(f, " tension={}", self.tension_n)?,
+        }
+        if let Some(ea) = self.cable_ea_n {
+            write!(f, " ea={ea}")?;
+        }
         if let Some(anchor) = self.anchor_mm {
             write!(f, " anchor={anchor}")?;
         }
@@ -289,7 +413,8 @@ mod tests {
     fn a_cables_text_form_reads_back_to_the_same_cable() {
         for c in [
             Cable::planar([3.0, 1.0, 2.5, 1.0, 3.0], 1.8000000000000003),
-            Cable { y_mm: [0.1, -0.2, 0.3, 1e-7, 4.0], z_mm: [0.0, 1.0, -1.5, 0.0, 2.0], tension_n: 0.6, anchor_mm: Some(40.25) },
+            Cable { y_mm: [0.1, -0.2, 0.3, 1e-7, 4.0], z_mm: [0.0, 1.0, -1.5, 0.0, 2.0], tension_n: 0.6, displacement_mm: None, cable_ea_n: None, anchor_mm: Some(40.25) },
+            Cable { y_mm: [0.1, -0.2, 0.3, 1e-7, 4.0], z_mm: [0.0; 5], tension_n: 0.0, displacement_mm: Some(1.25), cable_ea_n: Some(800.0), anchor_mm: None },
         ] {
             assert_eq!(c.to_string().parse::<Cable>().unwrap(), c, "{c}");
         }

@@ -54,6 +54,7 @@ use super::routing::Routing;
 use crate::shape::LengthBasis;
 use serde::{Deserialize, Serialize};
 
+pub mod actuation;
 pub mod backend;
 pub(crate) mod collocation;
 mod continuation;
@@ -109,6 +110,9 @@ pub enum SolveFailure {
     /// the tip lies farther from the clamp than the stretched rod is long).
     #[error(transparent)]
     Unresolved(Unresolved),
+    /// A displacement-driven cable's displacement was not met.
+    #[error(transparent)]
+    DisplacementNotMet(actuation::DisplacementNotMet),
 }
 
 /// What a solve does not resolve, by how much, and what to raise (the
@@ -147,6 +151,7 @@ impl SolveFailure {
             SolveFailure::FrictionNotConverged => "friction_not_converged",
             SolveFailure::WeightNotConverged { .. } => "weight_not_converged",
             SolveFailure::Unresolved(_) => "unresolved",
+            SolveFailure::DisplacementNotMet(_) => "displacement_not_met",
         }
     }
 }
@@ -313,6 +318,11 @@ pub struct Simulator {
     /// points when the cable is knotted at the tip): from there on the cut
     /// carries no cable load.
     cable_end: usize,
+    /// The cable's path length in the straight, unloaded rod, mm (collocation).
+    cable_rest_length_mm: f64,
+    /// The cable's axial stiffness EA, N (`None`: inextensible), for its
+    /// displacement's stretch.
+    cable_ea_n: Option<f64>,
     /// The estimated error of the tangent angle along the last solve, rad
     /// (the coefficients' error estimate starts from it).
     theta_error_rad: f64,
@@ -401,6 +411,8 @@ impl Simulator {
             rk4: rk4::Rk4::new(n),
             body,
             cable_end: points,
+            cable_rest_length_mm: 0.0,
+            cable_ea_n: None,
             theta_error_rad: 0.0,
             coefficient_error: (0.0, 0),
             given_routing: None,
@@ -448,6 +460,13 @@ impl Simulator {
         self.reset_warm_start();
         self.reset_history();
         self.last_tension_n = None;
+    }
+
+    /// Sets the cable's axial stiffness EA, N (`None`: inextensible), which
+    /// the pose's displacement adds the cable's stretch with (collocation;
+    /// RK4 reports no displacement).
+    pub fn set_cable_stiffness(&mut self, cable_ea_n: Option<f64>) {
+        self.cable_ea_n = cable_ea_n;
     }
 
     /// Forgets the warm start (the next solve starts cold). The creep
@@ -1353,3 +1372,14 @@ mod anchor_edge_tests {
 }
 
 
+
+/// The planar solver of one cable as a [`actuation::TensionSolve`].
+impl actuation::TensionSolve for Simulator {
+    type Error = SolveFailure;
+    fn solve_tensions(&mut self, tensions_n: &[f64]) -> Result<TipPose, SolveFailure> {
+        self.solve(tensions_n[0])
+    }
+    fn not_met(e: actuation::DisplacementNotMet) -> SolveFailure {
+        SolveFailure::DisplacementNotMet(e)
+    }
+}

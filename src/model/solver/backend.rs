@@ -82,6 +82,8 @@ enum Need {
     GravityOutOfPlane,
     NonUniformBody,
     AnchorBeforeTip,
+    /// A cable driven by its displacement.
+    Displacement,
     RodAnchor,
     Effect(&'static crate::model::effects::EffectInfo),
     Hold,
@@ -107,6 +109,8 @@ pub struct Support {
     pub anchors: bool,
     /// The rod-level anchor `cable_anchor_mm` (the planar single cable's).
     pub rod_anchor: bool,
+    /// Cables driven by their displacement (the solver integrates their paths).
+    pub displacement: bool,
     /// A load direction and dwell of the final tension.
     pub hold: bool,
     /// The thesis's coefficient route (needs a planar centreline).
@@ -148,6 +152,7 @@ impl Backend {
             non_uniform_body: true,
             anchors: true,
             rod_anchor: true,
+            displacement: true,
             hold: true,
             thesis_coefficients: true,
             method: SolverMethod::Collocation,
@@ -157,7 +162,7 @@ impl Backend {
         match self {
             Backend::PlanarCollocation => planar,
             // RK4 integrates each knot span in equal steps from clamp to tip.
-            Backend::PlanarRk4 => Support { anchors: false, method: SolverMethod::Rk4, nodes_per_span: false, ..planar },
+            Backend::PlanarRk4 => Support { anchors: false, displacement: false, method: SolverMethod::Rk4, nodes_per_span: false, ..planar },
             Backend::Spatial => Support {
                 several_cables: true,
                 out_of_plane_channels: true,
@@ -165,6 +170,7 @@ impl Backend {
                 non_uniform_body: true,
                 anchors: true,
                 rod_anchor: false,
+                displacement: true,
                 hold: true,
                 thesis_coefficients: false,
                 method: SolverMethod::Collocation,
@@ -179,6 +185,7 @@ impl Backend {
                 non_uniform_body: false,
                 anchors: true,
                 rod_anchor: false,
+                displacement: false,
                 hold: false,
                 thesis_coefficients: false,
                 method: SolverMethod::Rk4,
@@ -198,6 +205,7 @@ impl Backend {
             Need::NonUniformBody => s.non_uniform_body,
             Need::AnchorBeforeTip => s.anchors,
             Need::RodAnchor => s.rod_anchor,
+            Need::Displacement => s.displacement,
             Need::Effect(info) => info.supported_by(self),
             Need::Hold => s.hold,
             Need::ThesisCoefficients => s.thesis_coefficients,
@@ -269,6 +277,9 @@ fn needs(actuator: &Actuator, options: &SolverOptions, given: Given) -> Vec<(Nee
     }
     if !rod.radius_profile_mm.is_empty() || !rod.segments.is_empty() {
         need(Need::NonUniformBody, "a tapered or segmented body (radius_profile_mm, segments): it models a uniform rod".into());
+    }
+    if let Some(i) = actuator.cables.iter().position(|c| c.is_displacement_driven()) {
+        need(Need::Displacement, format!("a cable driven by its displacement (cable {}: displacement_mm; the RK4 methods do not integrate the cables' paths)", i + 1));
     }
     if rod.cable_anchor_mm.is_some() {
         need(Need::RodAnchor, "the rod-level cable_anchor_mm (--cable-anchor-mm): give each cable its own anchor (anchor=S)".into());

@@ -409,6 +409,17 @@ impl Simulator {
                 };
             }
         }
+        // The cable's path in the straight, unloaded rod, by the same quadrature.
+        let mut rest = 0.0;
+        for span in 0..c.spans() {
+            if span * np >= self.cable_end {
+                break;
+            }
+            for j in 0..np {
+                rest += c.half[span] * c.q[(np - 1) * np + j] * self.channel[span * np + j].dy.hypot(1.0);
+            }
+        }
+        self.cable_rest_length_mm = rest;
         self.col = Some(c);
     }
 
@@ -916,6 +927,31 @@ impl Simulator {
         (theta_error, tip_error)
     }
 
+    /// The cable's displacement at the base, mm: the rest path length
+    /// (kept at [`Simulator::colloc_set_routing`]) less the deformed one,
+    /// ∫ |(v1 − u y_c, v2 + y_c')| ds over the spans the cable runs in (the
+    /// same span quadrature), plus its stretch ∫ τ(s)/EA dℓ.
+    fn colloc_displacement_mm(&self, c: &Colloc, tension: f64) -> f64 {
+        let np = c.np();
+        let (mut path, mut pulled) = (0.0, 0.0);
+        for span in 0..c.spans() {
+            if span * np >= self.cable_end {
+                break;
+            }
+            let h = c.half[span];
+            for j in 0..np {
+                let i = span * np + j;
+                let (e, ch) = (c.strain[i], self.channel[i]);
+                let dl = (e.v1 - e.u * ch.y).hypot(e.v2 + ch.dy);
+                let w = h * c.q[(np - 1) * np + j];
+                path += w * dl;
+                pulled += w * dl * self.tension_at(i, tension);
+            }
+        }
+        let stretch = self.cable_ea_n.map_or(0.0, |ea| pulled / ea);
+        self.cable_rest_length_mm - path + stretch
+    }
+
     /// The pose of the converged state.
     pub(super) fn colloc_pose(&self, tension: f64, passes: u32) -> TipPose {
         let c = self.col.as_ref().expect("collocation state");
@@ -923,6 +959,7 @@ impl Simulator {
         let (et, e0) = (c.strain[tip], c.strain[0]);
         TipPose {
             tensions_n: PerCable::one(tension),
+            displacements_mm: PerCable::one(self.colloc_displacement_mm(c, tension)),
             tip_x_mm: c.px[tip],
             tip_y_mm: c.py[tip],
             tip_angle_rad: c.phi[tip] + et.v2.atan2(et.v1),

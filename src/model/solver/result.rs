@@ -70,6 +70,11 @@ pub struct TipFrame {
 pub struct TipPose {
     /// Each cable's tension at the base, N.
     pub tensions_n: PerCable<f64>,
+    /// Each cable's displacement Δℓ at the base, mm: its path's shortening
+    /// from the straight, unloaded rod's plus its own stretch ∫ τ(s)/EA dℓ
+    /// (the length a motor pulled in); NaN from the RK4 references, which
+    /// do not integrate the cables' paths.
+    pub displacements_mm: PerCable<f64>,
     /// Tip position along the clamp axis, mm.
     pub tip_x_mm: f64,
     /// Tip position across the clamp axis, in the plane of a planar cable, mm.
@@ -96,6 +101,11 @@ impl TipPose {
     /// Cable 1's tension, N: the planar solve's one tension.
     pub fn tension_n(&self) -> f64 {
         self.tensions_n[0]
+    }
+
+    /// Cable 1's displacement, mm: the planar solve's one cable's.
+    pub fn displacement_mm(&self) -> f64 {
+        self.displacements_mm[0]
     }
 
     /// Tip position (x, y, z), mm.

@@ -338,6 +338,7 @@ impl Simulator {
         let (e0, et) = (self.rk4.nodes_strain[0], self.rk4.nodes_strain[n_nodes - 1]);
         TipPose {
             tensions_n: PerCable::one(tension),
+            displacements_mm: PerCable::one(f64::NAN),
             tip_x_mm: tip.x,
             tip_y_mm: tip.y,
             tip_angle_rad: tip.phi + et.v2.atan2(et.v1),

@@ -5,6 +5,7 @@
 //! result. [`simulate`] is the planar backends' ladder, [`simulate_spatial`]
 //! the spatial one's; both return the one [`Simulation`].
 
+use super::actuation;
 use super::result::Simulation;
 use super::{tip_tolerance_mm, Backend, Given, Hold, SolveFailure, SolverMethod, SolverOptions, Simulator, Unresolved, MAX_NODES_PER_SPAN};
 use crate::model::parameter::ParameterError;
@@ -49,29 +50,73 @@ pub fn simulate_held(
     basis: LengthBasis,
     hold: Hold,
 ) -> Result<Simulation, SimulateError> {
-    crate::model::resolution::check_order(order, options).map_err(ParameterError::from)?;
     check_ladder_tension("tension_n", tension_n)?;
+    simulate_planar_cable(actuator, options, &Cable::planar(routing.control_points_mm().0, tension_n), routing, order, basis, hold)
+}
+
+/// Like [`simulate_held`] for a cable driven by its displacement: the
+/// cable is pulled in by `displacement_mm` (its stiffness `cable_ea_n`,
+/// `None` inextensible) in rungs of at most [`DISPLACEMENT_RUNG_MM`], each
+/// rung's tension found by [`actuation::meet_displacements`]; the result's
+/// cable carries the tension found.
+#[allow(clippy::too_many_arguments)]
+pub fn simulate_displaced(
+    actuator: &Rod,
+    options: &SolverOptions,
+    routing: &Routing,
+    displacement_mm: f64,
+    cable_ea_n: Option<f64>,
+    order: usize,
+    basis: LengthBasis,
+    hold: Hold,
+) -> Result<Simulation, SimulateError> {
+    let cable = Cable { displacement_mm: Some(displacement_mm), cable_ea_n, ..Cable::planar(routing.control_points_mm().0, 0.0) };
+    simulate_planar_cable(actuator, options, &cable, routing, order, basis, hold)
+}
+
+/// The planar ladder of one `cable` (its routing `routing`, built for the
+/// rod): up its tension, or its displacement; then the coefficients.
+fn simulate_planar_cable(
+    actuator: &Rod,
+    options: &SolverOptions,
+    cable: &Cable,
+    routing: &Routing,
+    order: usize,
+    basis: LengthBasis,
+    hold: Hold,
+) -> Result<Simulation, SimulateError> {
+    crate::model::resolution::check_order(order, options).map_err(ParameterError::from)?;
     // A solve the discretisation does not resolve is repeated, from the
     // bottom of the ladder, at a finer one, up to the most there is.
     let attempt = |options: &SolverOptions| -> Result<Simulation, SimulateError> {
         let mut sim = Simulator::new(actuator, options)?;
         sim.set_routing(routing);
-        // A ladder of tensions: cheap, and it keeps Newton and the shooting in
-        // their basin for curled-up shapes.
-        let rungs = if tension_n.is_finite() { ((tension_n / 0.25).ceil() as usize).max(1) } else { 1 };
+        sim.set_cable_stiffness(cable.cable_ea_n);
+        // A ladder: cheap, and it keeps Newton and the shooting in their
+        // basin for curled-up shapes.
+        let rungs = match cable.displacement_mm {
+            Some(d) => displacement_rungs(d),
+            None if cable.tension_n.is_finite() => ((cable.tension_n / 0.25).ceil() as usize).max(1),
+            None => 1,
+        };
+        let mut tension = [0.0];
         let mut pose = None;
         for k in 1..=rungs {
-            let t = tension_n * k as f64 / rungs as f64;
             if k == rungs {
                 sim.set_hold(hold)?;
             }
-            pose = Some(sim.solve(t)?);
+            let f = k as f64 / rungs as f64;
+            pose = Some(match cable.displacement_mm {
+                Some(d) => actuation::meet_displacements(&mut sim, &[Some(d * f)], &mut tension)?,
+                None => sim.solve(cable.tension_n * f)?,
+            });
         }
         let pose = pose.expect("at least one rung");
         let mut a = vec![0.0; order + 1];
         sim.coefficients_checked(basis, &mut a)?;
+        let cable = Cable { tension_n: pose.tension_n(), ..cable.clone() };
         Ok(Simulation {
-            actuator: Actuator::with_cables(actuator.clone(), vec![Cable::planar(routing.control_points_mm().0, tension_n)]),
+            actuator: Actuator::with_cables(actuator.clone(), vec![cable]),
             backend: Backend::planar(options.method),
             pose,
             a_bend_z: a,
@@ -88,6 +133,15 @@ pub fn simulate_held(
             result => return result,
         }
     }
+}
+
+/// Largest displacement step of a displacement ladder, mm (at the thesis
+/// rod's ≈ 2.5 mm/N about a 0.25 N tension rung).
+pub const DISPLACEMENT_RUNG_MM: f64 = 0.5;
+
+/// The rungs of a ladder up to `displacement_mm`.
+fn displacement_rungs(displacement_mm: f64) -> usize {
+    ((displacement_mm / DISPLACEMENT_RUNG_MM).ceil() as usize).max(1)
 }
 
 /// Highest tension the continuation ladders of [`simulate`] and
@@ -184,21 +238,41 @@ pub fn simulate_spatial_held(
 /// One ladder of the collocation solver at `options`, with its checks.
 fn solve_collocation_ladder(actuator: &Actuator, options: &SpatialOptions, order: usize, basis: LengthBasis, hold: Option<Hold>) -> Result<Simulation, SpatialError> {
     let mut solver = SpatialSolver::new(actuator, options)?;
-    let top = actuator.cables.iter().map(|c| c.tension_n).fold(0.0, f64::max);
-    let rungs = ((top / 0.25).ceil() as usize).max(1);
+    // One ladder for both actuations: the tensions of tension-driven cables
+    // and the displacements of the others climb together.
+    let top = actuator.cables.iter().filter(|c| !c.is_displacement_driven()).map(|c| c.tension_n).fold(0.0, f64::max);
+    let pull = actuator.cables.iter().filter_map(|c| c.displacement_mm).fold(0.0, f64::max);
+    let rungs = ((top / 0.25).ceil() as usize).max(displacement_rungs(pull));
+    let displaced = actuator.cables.iter().any(|c| c.is_displacement_driven());
+    let mut tensions: Vec<f64> = actuator.cables.iter().map(|c| if c.is_displacement_driven() { 0.0 } else { c.tension_n }).collect();
     let mut pose = None;
     for k in 1..=rungs {
         if let (true, Some(h)) = (k == rungs, hold) {
             solver.set_hold(h)?;
         }
-        pose = Some(solver.solve_scaled(k as f64 / rungs as f64)?);
+        let f = k as f64 / rungs as f64;
+        pose = Some(if displaced {
+            let targets: Vec<Option<f64>> = actuator.cables.iter().map(|c| c.displacement_mm.map(|d| d * f)).collect();
+            for (t, c) in tensions.iter_mut().zip(&actuator.cables) {
+                if !c.is_displacement_driven() {
+                    *t = c.tension_n * f;
+                }
+            }
+            actuation::meet_displacements(&mut solver, &targets, &mut tensions)?
+        } else {
+            solver.solve_scaled(f)?
+        });
     }
     let pose = pose.expect("at least one rung");
+    let mut actuator = actuator.clone();
+    for (c, t) in actuator.cables.iter_mut().zip(pose.tensions_n.iter()) {
+        c.tension_n = *t;
+    }
     let [a_twist, a_bend_y, a_bend_z] = solver.coefficients(order, basis)?;
     if !a_twist.iter().chain(&a_bend_y).chain(&a_bend_z).all(|v| v.is_finite()) {
         return Err(SpatialFailure::NonFinite.into());
     }
-    Ok(Simulation { actuator: actuator.clone(), backend: Backend::Spatial, pose, a_bend_z, a_bend_y, a_twist, length_basis: basis, centreline: solver.centreline() })
+    Ok(Simulation { actuator, backend: Backend::Spatial, pose, a_bend_z, a_bend_y, a_twist, length_basis: basis, centreline: solver.centreline() })
 }
 
 /// [`simulate_spatial`] by the RK4 reference, refining by comparison with half the steps.
@@ -316,8 +390,13 @@ pub fn simulate_actuator(
     let (rod, routing) = planar_problem(actuator)?;
     let cable = &actuator.cables[0];
     let hold = hold.unwrap_or(Hold { direction: rod.effects.load_direction, dwell_s: rod.effects.creep_hold_s });
-    let mut sim = simulate_held(&rod, options, &routing, cable.tension_n, order, basis, hold)?;
+    if cable.displacement_mm.is_none() {
+        check_ladder_tension("tension_n", cable.tension_n)?;
+    }
+    let mut sim = simulate_planar_cable(&rod, options, cable, &routing, order, basis, hold)?;
+    let tension = sim.pose.tension_n();
     sim.actuator = actuator.clone();
+    sim.actuator.cables[0].tension_n = tension;
     Ok(sim)
 }
 

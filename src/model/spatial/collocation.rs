@@ -87,6 +87,10 @@ const LOCAL_STEP_TOLERANCE: f64 = 1e-9;
 /// Local Newton: a chord step whose size is not below this fraction of the
 /// previous step's takes a fresh Jacobian next.
 const CHORD_CONTRACTION: f64 = 0.25;
+/// The tolerances' factor when a cable is driven by displacement: its
+/// tension comes from differences of displacements, so each solve is
+/// converged past the discretisation's noise (≈ 1e-13 mm in a path length).
+const PRECISE_TOLERANCE_SCALE: f64 = 1e-3;
 /// Local Newton: most steps.
 const LOCAL_MAX_ITERATIONS: usize = 100;
 /// Material stiffening's law: Newton's tolerance and iteration cap.
@@ -176,6 +180,10 @@ pub struct SpatialSolver {
     active: Vec<bool>,
     /// The cables' channels (for the centreline's cable paths).
     channels: Vec<Channel>,
+    /// Each cable's path length in the straight, unloaded rod, mm (the
+    /// span quadrature of |e₁ + r'|), and its axial stiffness EA, N.
+    rest_length_mm: Vec<f64>,
+    cable_ea_n: Vec<Option<f64>>,
     // The state: θ₀ (3), u (3 per node), M_W (3 per node) in `state`, with
     // u scaled by L and M_W by L/EI (angle units).
     state: Vec<f64>,
@@ -202,6 +210,10 @@ pub struct SpatialSolver {
     anderson: Anderson,
     /// Newton's Jacobian factors on the whole system, kept for chord steps.
     newton_factors: Option<nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>>,
+    /// A factor on the sweeps' and the local Newton's tolerances (1; below
+    /// for displacement-driven cables, whose tensions are found by
+    /// differences of solves).
+    tolerance_scale: f64,
     /// Whether the last solve's sweeps stalled (a heavy rod): the next
     /// solve goes to Newton at once.
     sweeps_stall: bool,
@@ -322,6 +334,18 @@ impl SpatialSolver {
             magnus.extend((0..np).map(|k| g[2][k] - g[0][k]));
             magnus.extend((0..np).map(|k| g[2][k] - 2.0 * g[1][k] + g[0][k]));
         }
+        // Each cable's rest path, by the span quadrature the deformed one takes.
+        let mut rest_length_mm = vec![0.0; nc];
+        for (span, &h) in half.iter().enumerate() {
+            for j in 0..np {
+                let i = span * np + j;
+                for (c, r) in rest_length_mm.iter_mut().enumerate() {
+                    if active[i * nc + c] {
+                        *r += h * q[(np - 1) * np + j] * (V3::x() + chan[i * nc + c].dr).norm();
+                    }
+                }
+            }
+        }
         let gravity_unit = V3::from(actuator.gravity_unit()?);
         let has_weight = weight_factor != 0.0;
         let ei0 = section[0].ei;
@@ -369,6 +393,8 @@ impl SpatialSolver {
             s,
             section,
             distal_weight,
+            rest_length_mm,
+            cable_ea_n: actuator.cables.iter().map(|c| c.cable_ea_n).collect(),
             chan,
             active,
             channels,
@@ -393,6 +419,7 @@ impl SpatialSolver {
             dmom: vec![V3::zeros(); nn],
             anderson: Anderson::new(n_state),
             newton_factors: None,
+            tolerance_scale: if actuator.cables.iter().any(|c| c.is_displacement_driven()) { PRECISE_TOLERANCE_SCALE } else { 1.0 },
             sweeps_stall: false,
             history: Vec::with_capacity(3),
             solved: 0,
@@ -599,7 +626,8 @@ impl SpatialSolver {
                 Err(e) => break Err(e),
             };
             passes += 1;
-            let settled = change.0 <= SWEEP_ANGLE_TOLERANCE_RAD && change.1 <= self.options.moment_tolerance_n_mm * self.m_scale && change.2 < FRICTION_TOLERANCE;
+            let k = self.tolerance_scale;
+            let settled = change.0 <= k * SWEEP_ANGLE_TOLERANCE_RAD && change.1 <= k * self.options.moment_tolerance_n_mm * self.m_scale && change.2 < k * FRICTION_TOLERANCE;
             let change = change.0.max(change.1).max(change.2);
             if settled && (passes == 1 || change <= 0.5 * previous || !has_weight) {
                 std::mem::swap(&mut self.state, &mut self.next);
@@ -1087,7 +1115,7 @@ impl SpatialSolver {
             for k in 0..6 {
                 x[k] += lambda * dx[k];
             }
-            if big < LOCAL_STEP_TOLERANCE && lambda == 1.0 && x[0] > 0.0 {
+            if big < self.tolerance_scale * LOCAL_STEP_TOLERANCE && lambda == 1.0 && x[0] > 0.0 {
                 if commit {
                     self.inverse[i] = inverse;
                 }
@@ -1318,8 +1346,11 @@ impl SpatialSolver {
         let base_v = self.rot[0] * V3::new(self.local[0][0], self.local[0][1], self.local[0][2]);
         let mut tensions_n = PerCable::filled(self.cables, 0.0);
         tensions_n.copy_from_slice(tensions);
+        let mut displacements_mm = PerCable::filled(self.cables, 0.0);
+        self.displacements_into(tensions, &mut displacements_mm);
         TipPose {
             tensions_n,
+            displacements_mm,
             tip_x_mm: self.pos[tip][0],
             tip_y_mm: self.pos[tip][1],
             tip_z_mm: self.pos[tip][2],
@@ -1610,6 +1641,34 @@ impl SpatialSolver {
             .collect()
     }
 
+    /// Each cable's displacement at the base, mm: its rest path length less
+    /// the deformed one, ∫ |q| ds by the span quadrature, plus its stretch
+    /// ∫ τ(s)/EA |q| ds (`tensions`: at the base; friction's profile from
+    /// the state).
+    fn displacements_into(&self, tensions: &[f64], out: &mut [f64]) {
+        let np = self.np;
+        let nc = self.cables;
+        for (c, d) in out.iter_mut().enumerate() {
+            let (mut path, mut pulled) = (0.0, 0.0);
+            for span in 0..self.spans() {
+                let base = span * np;
+                if !self.active[base * nc + c] {
+                    continue;
+                }
+                for j in 0..np {
+                    let i = base + j;
+                    let x = &self.local[i];
+                    let ch = &self.chan[i * nc + c];
+                    let dl = (V3::new(x[0], x[1], x[2]) + V3::new(x[3], x[4], x[5]).cross(&ch.r) + ch.dr).norm();
+                    let w = self.half[span] * self.q[(np - 1) * np + j];
+                    path += w * dl;
+                    pulled += w * dl * self.tension_at(tensions, i, c);
+                }
+            }
+            *d = self.rest_length_mm[c] - path + self.cable_ea_n[c].map_or(0.0, |ea| pulled / ea);
+        }
+    }
+
     /// Each cable's deformed path length from the clamp to its anchor, mm
     /// (∫ |q_i| ds over the nodes where it pulls, by the span quadrature).
     pub fn cable_path_lengths_mm(&self) -> Vec<f64> {
@@ -1635,22 +1694,15 @@ impl SpatialSolver {
     }
 }
 
-/// Σ a_k b_k, with four partial sums (instruction-level parallelism).
-#[inline]
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    let mut acc = [0.0; 4];
-    let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
-    let (ra, rb) = (ca.remainder(), cb.remainder());
-    for (x, y) in ca.zip(cb) {
-        for k in 0..4 {
-            acc[k] += x[k] * y[k];
-        }
+/// The 3-D solver as a [`crate::model::solver::actuation::TensionSolve`].
+impl crate::model::solver::actuation::TensionSolve for SpatialSolver {
+    type Error = SpatialError;
+    fn solve_tensions(&mut self, tensions_n: &[f64]) -> Result<TipPose, SpatialError> {
+        self.solve(tensions_n)
     }
-    let mut sum = (acc[0] + acc[1]) + (acc[2] + acc[3]);
-    for (x, y) in ra.iter().zip(rb) {
-        sum += x * y;
+    fn not_met(e: crate::model::solver::actuation::DisplacementNotMet) -> SpatialError {
+        SpatialFailure::DisplacementNotMet(e).into()
     }
-    sum
 }
 
 /// exp of the skew matrix of `w` (Rodrigues). Below 0.5 rad, as a Magnus
@@ -1811,6 +1863,92 @@ mod tests {
             worst = (worst.0.max(tip), worst.1.max(angle), worst.2.max(da));
         }
         eprintln!("worst: {worst:?}");
+    }
+
+    fn simulate(a: &Actuator) -> crate::model::Simulation {
+        let options = crate::model::SolverOptions::default();
+        crate::model::simulate_actuator(a, &options, &SpatialOptions::default(), Default::default(), None, 3, LengthBasis::Rest).unwrap()
+    }
+
+    fn same_shape(p: &crate::model::Simulation, q: &crate::model::Simulation) -> f64 {
+        p.centreline.iter().zip(&q.centreline).map(|(a, b)| dist(a.position_mm(), b.position_mm())).fold(0.0, f64::max)
+    }
+
+    #[test]
+    fn a_displacement_gives_back_the_shape_of_the_tension_that_produced_it() {
+        // Planar fast path, spatial pair, and a pair with one cable of each kind;
+        // gravity on, a stretchy cable for the second.
+        let mut rod = Rod::default();
+        rod.gravity.enabled = true;
+        let y = [3.0, -1.0, 2.5, 1.0, -2.0];
+        let one = Actuator::with_cables(rod.clone(), vec![Cable::planar(y, 1.6)]);
+        let mut second = Cable::spatial([-1.0, 1.0, 2.0, 0.5, -1.0], [1.0, -1.5, 0.5, 2.0, 1.0], 0.9);
+        second.cable_ea_n = Some(40.0);
+        let pair = Actuator::with_cables(rod.clone(), vec![Cable::spatial(y, [0.5, 1.0, -1.0, 0.0, 0.5], 1.3), second]);
+        for (name, a, driven) in [("planar", &one, vec![0]), ("pair", &pair, vec![0, 1]), ("mixed", &pair, vec![1])] {
+            let by_tension = simulate(a);
+            let mut b = a.clone();
+            for &i in &driven {
+                b.cables[i].displacement_mm = Some(by_tension.pose.displacements_mm[i]);
+                b.cables[i].tension_n = 0.0;
+            }
+            let by_displacement = simulate(&b);
+            let shape = same_shape(&by_tension, &by_displacement);
+            let tension = by_tension.pose.tensions_n.iter().zip(by_displacement.pose.tensions_n.iter()).map(|(p, q)| (p - q).abs()).fold(0.0, f64::max);
+            eprintln!("{name}: displacements {:?} mm, shape {shape:.1e} mm, tensions {tension:.1e} N", &by_tension.pose.displacements_mm[..]);
+            assert!(shape < 1e-9 && tension < 1e-9, "{name}: shape {shape:e} mm, tension {tension:e} N");
+            assert!(by_tension.pose.displacements_mm.iter().all(|d| d.is_finite() && *d > 0.0));
+            for &i in &driven {
+                assert!((by_displacement.actuator.cables[i].tension_n - by_tension.pose.tensions_n[i]).abs() < 1e-9);
+            }
+        }
+    }
+
+    #[test]
+    fn a_cable_pulled_in_less_than_its_path_needs_is_slack() {
+        // Gravity across the rod sags it toward +y: a cable at +y is on the
+        // inside of the bend and its path shortens, so a cable pulled in by
+        // nothing is slack, and the shape is the weight's alone.
+        let mut rod = Rod::default();
+        rod.gravity.enabled = true;
+        rod.gravity.direction_rad = std::f64::consts::FRAC_PI_2;
+        let y = [3.0; 5];
+        let weight = simulate(&Actuator::with_cables(rod.clone(), vec![Cable::planar(y, 0.0)]));
+        assert!(weight.pose.displacements_mm[0] > 0.0, "the sagging rod's inner path shortens: {:?}", weight.pose.displacements_mm);
+        let slack = Cable { displacement_mm: Some(0.0), ..Cable::planar(y, 0.0) };
+        for cables in [vec![slack.clone()], vec![Cable { z_mm: [0.0, 1.0, 1.0, 1.0, 0.0], ..slack.clone() }, Cable::planar([-3.0; 5], 0.0)]] {
+            let sim = simulate(&Actuator::with_cables(rod.clone(), cables.clone()));
+            assert_eq!(sim.pose.tensions_n[0], 0.0, "{cables:?}");
+            if cables.len() == 1 {
+                assert!(same_shape(&sim, &weight) < 1e-12);
+            }
+        }
+        // Pulled in a little more than the sag gives: taut, with a small tension.
+        let taut = Cable { displacement_mm: Some(weight.pose.displacements_mm[0] + 0.05), ..Cable::planar(y, 0.0) };
+        let sim = simulate(&Actuator::with_cables(rod, vec![taut]));
+        assert!(sim.pose.tensions_n[0] > 0.0 && sim.pose.tensions_n[0] < 0.2, "{:?}", &sim.pose.tensions_n[..]);
+    }
+
+    #[test]
+    fn bad_displacements_and_stiffnesses_are_refused_by_name() {
+        let y = [1.0; 5];
+        for (d, ea, needle) in [(-1.0, None, "negative"), (f64::NAN, None, "finite"), (80.0, None, "cannot be pulled in"), (1.0, Some(0.0), "cable_ea_n")] {
+            let cable = Cable { displacement_mm: Some(d), cable_ea_n: ea, ..Cable::planar(y, 0.0) };
+            let a = Actuator::with_cables(Rod::default(), vec![cable]);
+            let e = crate::model::simulate_actuator(&a, &Default::default(), &SpatialOptions::default(), Default::default(), None, 3, LengthBasis::Rest).unwrap_err();
+            assert!(e.to_string().contains(needle) && e.to_string().contains("cable 1"), "{e}");
+        }
+        // The RK4 references do not integrate the cables' paths.
+        let cable = Cable { displacement_mm: Some(1.0), ..Cable::planar(y, 0.0) };
+        let a = Actuator::with_cables(Rod::default(), vec![cable]);
+        let rk4 = crate::model::SolverOptions { method: crate::model::SolverMethod::Rk4, ..Default::default() };
+        let e = crate::model::simulate_actuator(&a, &rk4, &SpatialOptions::default(), Default::default(), None, 3, LengthBasis::Rest).unwrap_err();
+        assert!(e.to_string().contains("displacement"), "{e}");
+        // A file gives one actuation.
+        let both = "[[cable]]\ny_mm = [1, 1, 1, 1, 1]\ntension_n = 1\ndisplacement_mm = 1\n";
+        assert!(Actuator::from_toml(both, "a.toml").unwrap_err().to_string().contains("not both"));
+        let none = "[[cable]]\ny_mm = [1, 1, 1, 1, 1]\n";
+        assert!(Actuator::from_toml(none, "a.toml").unwrap_err().to_string().contains("displacement_mm"));
     }
 
     #[test]

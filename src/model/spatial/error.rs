@@ -14,6 +14,12 @@ pub enum SpatialError {
     /// A tension is negative or not finite.
     #[error("cable {cable}: tension {} N is invalid: a cable pulls with a finite tension ≥ 0 N", crate::io::fmt_num(*tension_n))]
     Tension { cable: usize, tension_n: f64 },
+    /// A displacement is negative, not finite, or longer than the cable.
+    #[error("cable {cable}: displacement_mm = {} mm is invalid: {why}", crate::io::fmt_num(*displacement_mm))]
+    Displacement { cable: usize, displacement_mm: f64, why: String },
+    /// A cable stiffness is not a positive number.
+    #[error("cable {cable}: cable_ea_n = {} N must be a finite stiffness > 0 N (leave it out for an inextensible cable)", crate::io::fmt_num(*cable_ea_n))]
+    CableStiffness { cable: usize, cable_ea_n: f64 },
     /// A control point is bad.
     #[error("cable {cable}, {axis} control points: {source}")]
     Routing { cable: usize, axis: char, source: RoutingError },
@@ -85,6 +91,9 @@ pub enum SpatialFailure {
     /// A number of the result is not finite.
     #[error("the solve gave a non-finite tip or coefficient; check the rod's parameters (rigidities, length, density) for absurd values")]
     NonFinite,
+    /// A displacement-driven cable's displacement was not met.
+    #[error(transparent)]
+    DisplacementNotMet(crate::model::solver::actuation::DisplacementNotMet),
     /// The cables' tension profiles with friction did not settle.
     #[error("the cable tension profiles with friction did not converge; try smaller tension steps or a smaller friction coefficient")]
     Friction,
@@ -105,7 +114,9 @@ impl SpatialFailure {
             SpatialFailure::Gravity { .. } => "gravity_not_converged",
             SpatialFailure::NonFinite => "non_finite",
             SpatialFailure::Friction => "friction_not_converged",
+            SpatialFailure::DisplacementNotMet(_) => "displacement_not_met",
             SpatialFailure::Unresolved(_) => "unresolved",
         }
     }
 }
+

@@ -479,6 +479,7 @@ impl SpatialRk4Solver {
         }
         let pose = TipPose {
             tensions_n,
+            displacements_mm: PerCable::filled(self.cables, f64::NAN),
             tip_x_mm: end[0],
             tip_y_mm: end[1],
             tip_z_mm: end[2],

@@ -181,7 +181,7 @@ impl From<SpecFile> for CableSweepSpec {
             .into_iter()
             .map(|c| {
                 let CableFile { y_mm, z_mm, anchor_mm, tension_n, sweeps } = c;
-                (Cable { y_mm, z_mm, tension_n: 0.0, anchor_mm }, CableGrid { tension_n, sweeps })
+                (Cable { anchor_mm, ..Cable::spatial(y_mm, z_mm, 0.0) }, CableGrid { tension_n, sweeps })
             })
             .unzip();
         Self { actuator: Actuator { rod, gj_n_mm2, gravity_direction, cables }, grids, solver, output }
@@ -197,7 +197,7 @@ impl From<CableSweepSpec> for SpecFile {
             .zip(grids)
             .map(|(cable, grid)| {
                 // The tension is the grid's; the actuator's is always 0.
-                let Cable { y_mm, z_mm, tension_n: _, anchor_mm } = cable;
+                let Cable { y_mm, z_mm, anchor_mm, .. } = cable;
                 CableFile { y_mm, z_mm, anchor_mm, tension_n: grid.tension_n, sweeps: grid.sweeps }
             })
             .collect();
