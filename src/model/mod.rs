@@ -5,6 +5,7 @@
 pub mod actuator;
 pub mod cable;
 pub mod rod;
+pub mod rod_overrides;
 pub mod body;
 pub mod effects;
 pub mod record;
@@ -17,6 +18,7 @@ pub use body::{Body, BodyError, Segment};
 pub use actuator::Actuator;
 pub use cable::{Cable, MAX_CABLES};
 pub use rod::{Rod, Effects, Gravity, LoadDirection, ParameterError, Unmodelled};
+pub use rod_overrides::RodOverrides;
 pub use effects::{EffectInfo, REGISTRY};
 pub use routing::{ControlPoints, Routing, RoutingError};
 pub use solver::{Backend, Given, Unsupported};
