@@ -2,7 +2,7 @@
 //! indexed by position, its simulated designs and, for a map of several
 //! cables, their cables. The files are read by the map format's owners,
 //! [`crate::reduce::tables`] and [`crate::reduce::MapCables`]; what a
-//! target makes of them is [`super::feasible`]'s.
+//! target makes of them is [`crate::design::feasible`]'s.
 
 use super::DesignError;
 use crate::model::Rod;
