@@ -98,8 +98,7 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     let y = parse_list(routing_text, "--routing")?;
     let routing = Routing::for_actuator(&y, &actuator).context("--routing")?;
     // The one check: a setting the planar backend of --method does not read is refused.
-    let one = cablemap::model::Actuator::with_cables(actuator.clone(), vec![cablemap::model::Cable::planar(routing.control_points_mm().0, tension)]);
-    Backend::planar(options.method).check(&one, &options, given_settings(args))?;
+    Backend::check_planar(&actuator, &options, given_settings(args))?;
     let direction = if args.direction == "unload" { LoadDirection::Unload } else { LoadDirection::Load };
     let hold = Hold { direction, dwell_s: args.dwell_s.unwrap_or(actuator.effects.creep_hold_s) };
     // The thesis route computes its own coefficients from the centreline
