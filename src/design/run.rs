@@ -85,9 +85,13 @@ const MOULD_ROUNDING_MM: f64 = 1e-9;
 
 impl DesignRequest {
     /// The objective, with bounds from the request, else the map's tension
-    /// range, else the defaults.
+    /// range, else the defaults; a map made for another actuator is refused
+    /// ([`MapDir::check_actuator`]).
     pub fn objective(&self, map: Option<&MapDir>) -> Result<Objective, DesignError> {
         self.actuator.validate()?;
+        if let Some(m) = map {
+            m.check_actuator(&self.actuator)?;
+        }
         if !(self.tolerance_pct.is_finite() && self.tolerance_pct >= 0.0) {
             return Err(DesignError::BadSearch(format!("the tolerance must be a finite number ≥ 0 %, got {}", self.tolerance_pct)));
         }
@@ -153,9 +157,6 @@ pub fn run(request: &DesignRequest) -> Result<DesignRun, DesignError> {
     }
     request.check_moulds()?;
     let map = request.map.as_deref().map(MapDir::open).transpose()?;
-    if let Some(m) = &map {
-        m.check_actuator(&request.actuator)?;
-    }
     let objective = request.objective(map.as_ref())?;
     let feasibility = match &map {
         Some(m) => Some(feasible::check(m, &objective.target, objective.length_basis, &objective.weights, 2 * request.search.starts)?),
