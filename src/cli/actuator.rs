@@ -145,10 +145,11 @@ impl ActuatorArgs {
         self.overrides().apply(base)
     }
 
-    /// The actuator: `--actuator-file` if given, else `from_data` (the one a
-    /// measurement file gives), else the thesis's; with the flags applied.
-    pub fn resolve(&self, from_data: Option<&Rod>) -> anyhow::Result<Rod> {
-        self.overrides().resolve(from_data).map_err(|e| anyhow::Error::new(e).context("--actuator-file"))
+    /// The actuator: `--actuator-file` if given, else the thesis's; with the
+    /// flags applied. (A workflow that reads measurements takes the
+    /// [`ActuatorArgs::overrides`] and resolves them on the data's rod.)
+    pub fn resolve(&self) -> anyhow::Result<Rod> {
+        self.overrides().resolve(None).map_err(|e| anyhow::Error::new(e).context("--actuator-file"))
     }
 
     /// Solver options with the step override.

@@ -69,7 +69,7 @@ fn request(args: &DesignArgs) -> anyhow::Result<DesignRequest> {
         None => Weights::default(),
     };
     Ok(DesignRequest {
-        actuator: args.actuator.resolve(None)?,
+        actuator: args.actuator.resolve()?,
         options: args.actuator.solver_options(&SolverOptions::default()),
         target: Target::parse(&args.target).context("--target")?,
         weights,

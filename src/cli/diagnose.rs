@@ -64,7 +64,6 @@ pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
     };
     let report = diagnose::run(&request).map_err(|e| match e {
         CalibrateError::ReportDir(_) => anyhow::Error::new(e).context("--out"),
-        CalibrateError::ActuatorFile(_) => anyhow::Error::new(e).context("--actuator-file"),
         e => with_flag(e, false),
     })?;
     let stdout = std::io::stdout();

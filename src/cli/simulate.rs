@@ -87,7 +87,7 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
             "say what to simulate: --routing Y0,..,Y4 --tension-n T (one planar cable), --cable \"y=.. z=.. tension=T\" (repeatable), or --actuator FILE.toml"
         );
     };
-    let actuator = args.actuator.resolve(None)?;
+    let actuator = args.actuator.resolve()?;
     actuator.validate()?;
     let options = args.actuator.solver_options(&SolverOptions::default());
     anyhow::ensure!(
@@ -187,7 +187,7 @@ fn run_spatial(args: &SimulateArgs) -> anyhow::Result<()> {
             spatial.rod = args.actuator.apply(&spatial.rod);
             spatial
         }
-        None => Actuator::with_cables(args.actuator.resolve(None)?, Vec::new()),
+        None => Actuator::with_cables(args.actuator.resolve()?, Vec::new()),
     };
     if !args.cable.is_empty() {
         spatial.cables = args.cable.iter().map(|c| c.parse::<Cable>()).collect::<Result<_, _>>().context("--cable")?;
