@@ -7,9 +7,8 @@
 
 use crate::io::FileError;
 use crate::study::{StudyError, StudySpec};
-use crate::sweep::cables::{CableSweepError, CableSweepSpec};
 use crate::sweep::report::SweepReport;
-use crate::sweep::{run_status_of, run_sweep_of, RunSpec, SweepError, SweepOptions, SweepSpec};
+use crate::sweep::{run_status_of, run_sweep_of, CableSweepSpec, RunSpec, SweepError, SweepOptions, SweepSpec};
 use std::path::{Path, PathBuf};
 
 /// Top-level tables of a planar sweep spec (docs/schema.md).
@@ -79,12 +78,9 @@ pub enum JobError {
         /// The file.
         path: PathBuf,
     },
-    /// A planar spec is malformed, invalid, or its sweep failed.
+    /// A sweep spec is malformed, invalid, or its sweep failed.
     #[error(transparent)]
     Sweep(#[from] SweepError),
-    /// A cable sweep spec is malformed or invalid.
-    #[error(transparent)]
-    Cables(#[from] CableSweepError),
     /// A study spec is malformed or invalid.
     #[error(transparent)]
     Study(#[from] StudyError),

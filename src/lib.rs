@@ -62,9 +62,6 @@ pub enum Error {
     /// Running, checking or reading a sweep.
     #[error(transparent)]
     Sweep(#[from] sweep::SweepError),
-    /// A sweep of several or spatial cables.
-    #[error(transparent)]
-    CableSweep(#[from] sweep::cables::CableSweepError),
     /// Building or writing moulds.
     #[error(transparent)]
     Mould(#[from] mould::MouldError),

@@ -9,13 +9,14 @@
 //! [`on_kind`]; each kind says how it is reduced ([`MapKind`]).
 
 use crate::job::{Job, JobError, JobSpec};
-use crate::reduce::cables::{reduce_cable_run, CableMapSummary, PLANAR_MAP_DIR};
 use crate::reduce::parts::PartReport;
-use crate::reduce::{reduce_run, write_map_replacing, MapSummary, ModeBoundaries, ReduceError, ReduceOptions};
+use crate::reduce::tables::PLANAR_MAP_DIR;
+use crate::reduce::{reduce_cable_run, reduce_run, write_map_replacing, CableMapSummary, MapSummary, ModeBoundaries, ReduceError, ReduceOptions};
 use crate::study::{StudyError, StudyProgress, StudyReport, StudyRequest};
-use crate::sweep::cables::CableSweepSpec;
 use crate::sweep::progress::ProgressMode;
-use crate::sweep::{run_kind, run_status_of, RunKind, RunSpec, StatusReport, SweepError, SweepOptions, SweepReport, SweepSpec};
+use crate::sweep::{
+    run_kind, run_status_of, CableSweepSpec, RunKind, RunSpec, StatusReport, SweepError, SweepOptions, SweepReport, SweepSpec,
+};
 use serde::Serialize;
 use std::fmt;
 use std::path::{Path, PathBuf};

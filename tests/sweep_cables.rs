@@ -9,7 +9,7 @@ mod process;
 use arrow::array::{Array, Float64Array, Int64Array, StringArray};
 use arrow::record_batch::RecordBatch;
 use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
-use cablemap::sweep::cables::CableSweepSpec;
+use cablemap::sweep::CableSweepSpec;
 use cablemap::sweep::{open_run_of, Completeness};
 use std::collections::BTreeMap;
 use std::path::Path;

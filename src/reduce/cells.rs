@@ -3,7 +3,7 @@
 //! own samples, so cells can be computed range by range.
 
 use super::grid::Grid;
-use super::samples::{RowRef, Sample};
+use super::sample::{RowRef, Sample};
 use super::stats::quantile_sorted;
 use super::{CellStats, CoefficientStats, ModeBoundaries, MODES};
 

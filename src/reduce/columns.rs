@@ -1,12 +1,22 @@
-//! Typed access to the sweep's row columns (docs/schema.md) in Arrow batches.
+//! The reducer's reader of run rows (docs/schema.md; names from
+//! `sweep::schema`): typed access to the planar row columns in Arrow
+//! batches ([`RowColumns`]), and a cable sweep's rows laid out as planar
+//! rows ([`cable_planar_batch`]), so one pipeline maps both kinds.
 
-use crate::model::routing::{ControlPoints, CONTROL_POINTS};
+use super::map_cables::row_key;
 use super::{Design, ReduceError};
-use crate::sweep::schema::{coefficient_column, ROUTING_ID, STATUS, TENSION_N, TIP_ANGLE_RAD, TIP_X_MM, TIP_Y_MM, Y_MM};
-use arrow::array::{Array, AsArray, Float64Array, Int64Array, StringArray};
+use crate::model::routing::{ControlPoints, CONTROL_POINTS};
+use crate::shape::LengthBasis;
+use crate::sweep::schema::{
+    coefficient_column, control_point_column, tension_column, Axis, LENGTH_MM, ROUTING_ID, STATUS, TENSION_N, TIP_ANGLE_RAD,
+    TIP_TANGENT_X, TIP_TANGENT_Y, TIP_X_MM, TIP_Y_MM, Y_MM,
+};
+use crate::sweep::CableSweepSpec;
+use arrow::array::{Array, ArrayRef, AsArray, Float64Array, Int64Array, StringArray};
 use arrow::compute::cast;
-use arrow::datatypes::DataType;
+use arrow::datatypes::{DataType, Field, Float64Type, Int64Type, Schema};
 use arrow::record_batch::RecordBatch;
+use std::sync::Arc;
 
 /// The columns of one sweep batch that the reducer reads, as plain arrays.
 pub struct RowColumns {
@@ -107,4 +117,76 @@ impl RowColumns {
             self.status.value(i)
         }
     }
+}
+
+/// The columns of a cable sweep's rows that [`cable_planar_batch`] reads:
+/// give them to the run's projected reader.
+pub(crate) fn cable_planar_columns(spec: &CableSweepSpec) -> Vec<String> {
+    let mut names: Vec<String> = vec![ROUTING_ID.into(), STATUS.into()];
+    names.extend((0..CONTROL_POINTS).map(|p| control_point_column(1, Axis::Y, p)));
+    names.extend((1..=spec.actuator.cables.len()).map(tension_column));
+    names.extend([TIP_X_MM, TIP_Y_MM, TIP_TANGENT_X, TIP_TANGENT_Y, LENGTH_MM].map(String::from));
+    names.extend((0..=spec.output.order).map(coefficient_column));
+    names
+}
+
+/// One batch of a planar cable run's rows ([`cable_planar_columns`]) in the
+/// planar reducer's row layout: `routing_id` = the row's [`row_key`] (where
+/// every cable's routing and tension are), `y0_mm`…`y4_mm` and `tension_n`
+/// = cable 1's, and `tip_angle_rad` = the signed in-plane tangent angle,
+/// continuous from the clamp. No mirror images are added (a pair's mirror
+/// is another routing of the spec, if swept).
+pub(crate) fn cable_planar_batch(spec: &CableSweepSpec, batch: &RecordBatch) -> Result<RecordBatch, ReduceError> {
+    let grids = spec.tension_grids();
+    let f = |name: &str| batch.column_by_name(name).expect("projected").as_primitive::<Float64Type>().clone();
+    let ids = batch.column_by_name(ROUTING_ID).expect("projected").as_primitive::<Int64Type>().clone();
+    let tensions: Vec<Float64Array> = (1..=grids.len()).map(|c| f(&tension_column(c))).collect();
+    let combinations: u64 = grids.iter().map(|g| g.len() as u64).product();
+    let n = batch.num_rows();
+    let mut keys = Vec::with_capacity(n);
+    for i in 0..n {
+        // Stored tensions are the grid's values bit for bit: find their indices.
+        let mut k = 0u64;
+        for (c, g) in grids.iter().enumerate() {
+            let t = tensions[c].value(i);
+            let j = g.iter().position(|&v| v == t).ok_or(ReduceError::TensionOffGrid { cable: c + 1, tension_n: t })?;
+            k = k * g.len() as u64 + j as u64;
+        }
+        keys.push(row_key(ids.value(i) as u64, k, combinations) as i64);
+    }
+    let mut fields = vec![Field::new(ROUTING_ID, DataType::Int64, false), Field::new(STATUS, DataType::Utf8, false)];
+    let mut columns: Vec<ArrayRef> = vec![Arc::new(Int64Array::from(keys)), batch.column_by_name(STATUS).expect("projected").clone()];
+    let mut push = |name: &str, column: ArrayRef| {
+        fields.push(Field::new(name, DataType::Float64, true));
+        columns.push(column);
+    };
+    for (p, name) in Y_MM.iter().enumerate() {
+        push(name, batch.column_by_name(&control_point_column(1, Axis::Y, p)).expect("projected").clone());
+    }
+    push(TENSION_N, Arc::new(tensions[0].clone()));
+    push(TIP_X_MM, batch.column_by_name(TIP_X_MM).expect("projected").clone());
+    push(TIP_Y_MM, batch.column_by_name(TIP_Y_MM).expect("projected").clone());
+    // The planar sweep's tip angle is continuous from the clamp, not wrapped:
+    // unwrap atan2 toward θ_e − θ_0 = a_0·L (rest basis; a_0·ℓ deformed),
+    // the clamp's shear angle θ_0 being far below π.
+    let (tx, ty, len, a0) = (f(TIP_TANGENT_X), f(TIP_TANGENT_Y), f(LENGTH_MM), f(&coefficient_column(0)));
+    let rest = spec.output.length_basis == LengthBasis::Rest;
+    let length_mm = spec.actuator.rod.length_mm;
+    let angle: Float64Array = (0..n)
+        .map(|i| {
+            if tx.is_null(i) || ty.is_null(i) || a0.is_null(i) || len.is_null(i) {
+                return None;
+            }
+            let wrapped = ty.value(i).atan2(tx.value(i));
+            let turn = a0.value(i) * if rest { length_mm } else { len.value(i) };
+            let tau = std::f64::consts::TAU;
+            Some(wrapped + tau * ((turn - wrapped) / tau).round())
+        })
+        .collect();
+    push(TIP_ANGLE_RAD, Arc::new(angle));
+    for i in 0..=spec.output.order {
+        let name = coefficient_column(i);
+        push(&name, batch.column_by_name(&name).expect("projected").clone());
+    }
+    RecordBatch::try_new(Arc::new(Schema::new(fields)), columns).map_err(ReduceError::PlanarRows)
 }

@@ -1,8 +1,11 @@
 //! The drawings of the modes' representative bodies: the map stores only a
 //! representative's routing and tension, so its body is simulated again
-//! (with the run's actuator and solver) for modes.png and index.html.
+//! (with the run's actuator and solver) for modes.png and index.html; a
+//! several-cable map's representative with all its cables
+//! ([`ModeDrawings::of_cables`]).
 
-use super::{Design, MapData};
+use super::{Design, MapCables, MapData};
+use crate::model::spatial::simulate_spatial;
 use crate::model::{Rod, SolverOptions};
 use crate::plot::BodyDrawing;
 
@@ -54,6 +57,61 @@ impl ModeDrawings {
         drawings
     }
 
+    /// Solves every mode's representative of the map of a cable sweep
+    /// again with all the cables of its row (its `routing_id` is the row
+    /// key, [`MapCables::actuator`]) and draws it in the x–y plane with
+    /// every cable's path.
+    pub fn of_cables(map: &MapData, cables: &MapCables) -> Self {
+        let spec = cables.spec();
+        let rod = &spec.actuator.rod;
+        let mut drawings = Self::default();
+        for m in &map.modes {
+            let Some(d) = &m.representative else {
+                drawings.shapes.push(None);
+                continue;
+            };
+            match simulate_spatial(&cables.actuator(d.routing_id), &spec.solver, 1, spec.output.length_basis) {
+                // The sweep reached the row along its tension path; a solve from
+                // zero could in principle land on another equilibrium: then the
+                // drawing would not be the row's, and is not made.
+                Ok(sim) if tip_gap_mm(&sim.pose.tip_mm, d) > REDRAW_TOLERANCE_MM => {
+                    drawings.shapes.push(None);
+                    let message = format!(
+                        "the solve from zero ends at ({:.3}, {:.3}) mm, not at the row's tip ({:.3}, {:.3}) mm",
+                        sim.pose.tip_mm[0], sim.pose.tip_mm[1], d.tip_x_mm, d.tip_y_mm
+                    );
+                    drawings.failures.push(DrawingError::Simulation { mode: m.mode, source: message.into() });
+                }
+                Ok(sim) => {
+                    let centreline = sim.nodes.iter().map(|n| (n.p_mm[0], n.p_mm[1])).collect();
+                    // The body x-axis (first column of R) in the x–y plane.
+                    let frame_angle_rad = sim.nodes.iter().map(|n| n.rotation[1][0].atan2(n.rotation[0][0])).collect();
+                    let mut paths = sim.cable_paths_mm().into_iter().map(|p| p.iter().map(|q| (q[0], q[1])).collect::<Vec<_>>());
+                    let cable = paths.next().unwrap_or_default();
+                    let further_cables = paths.collect();
+                    drawings.shapes.push(Some(BodyDrawing {
+                        centreline,
+                        frame_angle_rad,
+                        cable,
+                        further_cables,
+                        radius_mm: rod.radius_mm,
+                        radii_mm: match crate::model::Body::of(rod) {
+                            Ok(Some(body)) => sim.nodes.iter().map(|n| body.radius_at(n.s_mm)).collect(),
+                            _ => Vec::new(),
+                        },
+                        label: format!("mode {}", m.mode),
+                        colour: plotters::style::full_palette::BLUE_800,
+                    }));
+                }
+                Err(e) => {
+                    drawings.shapes.push(None);
+                    drawings.failures.push(DrawingError::Simulation { mode: m.mode, source: Box::new(e) });
+                }
+            }
+        }
+        drawings
+    }
+
     /// A sentence naming the representatives that could not be drawn (empty
     /// when all were).
     pub fn failure_note(&self) -> String {
@@ -71,4 +129,13 @@ fn draw(mode: usize, d: &Design, actuator: &Rod, solver: &SolverOptions) -> Resu
     let sim = crate::model::simulate(actuator, solver, &routing, d.tension_n, 1, crate::shape::LengthBasis::default())
         .map_err(|e| DrawingError::Simulation { mode, source: Box::new(e) })?;
     Ok(BodyDrawing::of_body(&sim, actuator, format!("mode {mode}"), plotters::style::full_palette::BLUE_800))
+}
+
+/// Largest distance, mm, between a representative's stored tip and the tip
+/// of its solve again for drawing.
+const REDRAW_TOLERANCE_MM: f64 = 1e-3;
+
+/// In-plane distance between a solved tip and a design's, mm.
+fn tip_gap_mm(tip: &[f64; 3], d: &Design) -> f64 {
+    (tip[0] - d.tip_x_mm).hypot(tip[1] - d.tip_y_mm)
 }

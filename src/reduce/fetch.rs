@@ -3,7 +3,7 @@
 
 use super::columns::RowColumns;
 use super::mirror::Mirror;
-use super::samples::RowRef;
+use super::sample::RowRef;
 use super::{Design, ReduceError};
 use arrow::record_batch::RecordBatch;
 use std::collections::HashMap;

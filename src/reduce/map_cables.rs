@@ -1,21 +1,33 @@
 //! Every cable of a several-cable map's designs. The planar reducer stores
 //! a design's `y0_mm`…`y4_mm` and `tension_n` (cable 1's) and, as its
-//! `routing_id`, the row key of its cable run's row
-//! ([`super::cables::row_key`]). The cable sweep spec, written beside the
+//! `routing_id`, the row key of its cable run's row ([`row_key`]). The
+//! cable sweep spec, written beside the
 //! map's tables as [`CABLES_FILE`], turns that key back into the whole
 //! actuator: every cable's routing and tension, the rod, the solver settings.
 //! From it come the explorer's rows and pasteable commands, `feasible`'s
 //! list, the modes' captions and the explorer's header, so a design shown
 //! anywhere is one a user can solve again to the map's tip.
 
-use super::cables::row_of_key;
 use super::ReduceError;
 use crate::model::routing::CONTROL_POINTS;
 use crate::model::spatial::record::{simulate_command, SimulateCommand};
-use crate::model::spatial::Actuator;
-use crate::sweep::cables::{Axis, CableSweepSpec};
+use crate::model::Actuator;
+use crate::sweep::schema::Axis;
+use crate::sweep::CableSweepSpec;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
+
+/// The row key of a cable sweep's row in its planar map (the map's
+/// `routing_id`): routing_id × tension combinations + the combination's
+/// index in grid order (cable 1's tension slowest). [`row_of_key`] inverts it.
+pub fn row_key(routing_id: u64, combination: u64, combinations: u64) -> u64 {
+    routing_id * combinations + combination
+}
+
+/// (routing_id, combination index) of a planar map's `routing_id` (see [`row_key`]).
+pub fn row_of_key(key: u64, combinations: u64) -> (u64, usize) {
+    (key / combinations, (key % combinations) as usize)
+}
 
 /// The cable sweep spec beside a several-cable map's tables.
 pub const CABLES_FILE: &str = "cables.json";
@@ -68,9 +80,14 @@ impl MapCables {
         super::tables::write_file(&path, json.as_bytes())
     }
 
+    /// The run's spec.
+    pub fn spec(&self) -> &CableSweepSpec {
+        &self.spec
+    }
+
     /// Cables per actuator.
     pub fn count(&self) -> usize {
-        self.spec.cables.len()
+        self.spec.actuator.cables.len()
     }
 
     /// The actuator of the design whose `routing_id` is `row_key`.
@@ -110,17 +127,19 @@ impl MapCables {
     pub fn describe(&self) -> Vec<String> {
         let list = |v: &[f64]| v.iter().map(|x| crate::io::fmt_num(*x)).collect::<Vec<_>>().join(", ");
         self.spec
+            .actuator
             .cables
             .iter()
+            .zip(&self.spec.grids)
             .enumerate()
-            .map(|(i, c)| {
+            .map(|(i, (c, g))| {
                 let mut s = format!("cable {}: y = [{}] mm", i + 1, list(&c.y_mm));
-                for sweep in &c.sweeps {
+                for sweep in &g.sweeps {
                     let axis = if sweep.axis == Axis::Y { "y" } else { "z" };
                     let indices: Vec<String> = sweep.points.iter().map(|p| format!("{axis}{p}")).collect();
                     s.push_str(&format!(", {} swept over {} mm", indices.join(", "), list(&sweep.levels_mm)));
                 }
-                let t = &c.tension_n;
+                let t = &g.tension_n;
                 if t.count <= 1 {
                     s.push_str(&format!("; tension {} N", crate::io::fmt_num(t.min)));
                 } else {
@@ -172,10 +191,17 @@ tension_n = { min = 0.0, max = 2.0, count = 11 }
 "#;
 
     #[test]
+    fn row_keys_round_trip() {
+        for (id, k, n) in [(0, 0, 1), (3, 5, 6), (12, 120, 121)] {
+            assert_eq!(row_of_key(row_key(id, k, n), n), (id, k as usize));
+        }
+    }
+
+    #[test]
     fn a_designs_row_key_gives_every_cable_and_the_file_reads_back() {
         let cables = MapCables::of_spec(&CableSweepSpec::from_toml(SPEC, "test").unwrap());
         // Routing 1 (y1 at its second level), combination 9·11 + 4: 1.8 N and 0.8 N.
-        let key = super::super::cables::row_key(1, 9 * 11 + 4, 121) as i64;
+        let key = row_key(1, 9 * 11 + 4, 121) as i64;
         let a = cables.actuator(key);
         assert_eq!(a.cables[0].y_mm, [3.0, 2.5, 1.0, 3.0, 3.0]);
         assert_eq!(a.cables.iter().map(|c| c.tension_n).collect::<Vec<_>>(), [1.8, 0.8]);

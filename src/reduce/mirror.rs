@@ -4,7 +4,7 @@
 //! under y → −y (control points, tip y, tip angle, every a_i) is negated,
 //! the rest (tip x, tension, routing id) is kept.
 
-use super::samples::Sample;
+use super::sample::{RowRef, Sample};
 use super::Design;
 
 /// How many simulations a stored row stands for: 2 when the run dropped
@@ -31,7 +31,7 @@ impl Mirror for Sample {
     }
 }
 
-impl Mirror for super::samples::RowRef {
+impl Mirror for RowRef {
     fn mirror(&self) -> Self {
         Self { mirrored: true, ..*self }
     }

@@ -3,7 +3,7 @@
 //! table.
 
 use super::cells::CellTable;
-use super::samples::{RowRef, Sample};
+use super::sample::{RowRef, Sample};
 use super::select;
 use super::spill::Samples;
 use super::{Design, ModeBoundaries, ModeStats, ReduceError, MODES};

@@ -1,10 +1,18 @@
 //! Writing a map directory: its tables (`tables`), pictures and explorer
-//! page, put in place as a whole.
+//! page, put in place as a whole; a cable sweep's map with its reach tables
+//! and picture and, for a planar run, its feasibility map.
 
 use super::drawings::ModeDrawings;
 use super::plots::{self, draw_heatmap, Picture, Scale};
-use super::{explorer, tables, CoefficientStats, MapCables, MapData, ReduceError, COEFFICIENT_UNIT};
+use super::reach::{Reach, PLANES};
+use super::tables::PLANAR_MAP_DIR;
+use super::{explorer, tables, CableMapSummary, CoefficientStats, MapCables, MapData, ReduceError, COEFFICIENT_UNIT};
+use crate::model::Rod;
+use crate::plot::spatial::{draw_reach_maps, ReachPlane};
 use std::path::Path;
+
+/// The picture of a cable sweep's reach: the three planes side by side.
+pub const REACH_PICTURE: &str = "reach.png";
 
 /// Writes the map directory `dir` as a whole: everything is written into a
 /// staging directory beside it (`.NAME.tmp-TOKEN`), which then replaces
@@ -73,7 +81,7 @@ fn is_map_dir(dir: &Path) -> bool {
     // file a map consists of, so a user's own files are never deleted.
     let legacy_summary = summary.get("format").is_none()
         && (serde_json::from_value::<super::MapSummary>(summary.clone()).is_ok()
-            || serde_json::from_value::<super::cables::CableMapSummary>(summary).is_ok());
+            || serde_json::from_value::<CableMapSummary>(summary).is_ok());
     legacy_summary && holds_only_map_files(dir, 0)
 }
 
@@ -139,6 +147,49 @@ pub fn write_map_drawn(
     Ok(pictures)
 }
 
+/// Writes a cable sweep's map directory `dir` as a whole (with
+/// [`write_map_replacing`]'s guarantees): the reach tables and picture,
+/// summary.json and, for a planar run (`planar`: its map, its modes drawn
+/// with all their cables, the cables), its feasibility map in
+/// [`PLANAR_MAP_DIR`]. Returns the planar map and its pictures.
+pub(crate) fn write_cable_map(
+    dir: &Path,
+    summary: &CableMapSummary,
+    reach: &Reach,
+    planar: Option<(MapData, ModeDrawings, MapCables)>,
+    rod: &Rod,
+) -> Result<Option<(MapData, Vec<Picture>)>, ReduceError> {
+    write_dir_replacing(dir, |dir| {
+        tables::write_reach(dir, reach)?;
+        draw_reach(&dir.join(REACH_PICTURE), reach)?;
+        tables::write_cable_summary(dir, summary)?;
+        planar
+            .map(|(map, drawings, cables)| {
+                let pictures = write_map_drawn(&dir.join(PLANAR_MAP_DIR), &map, rod, &drawings, Some(&cables))?;
+                Ok((map, pictures))
+            })
+            .transpose()
+    })
+}
+
+/// Draws the three reach planes side by side: x down the page, the other
+/// coordinate across; y–z with y across and z down.
+fn draw_reach(path: &Path, reach: &Reach) -> Result<(), ReduceError> {
+    let planes: Vec<ReachPlane> = PLANES
+        .iter()
+        .zip(&reach.planes)
+        .map(|((_, names), counts)| {
+            if names[0] == "x" {
+                ReachPlane { axes: (names[1], "x"), cells: counts.iter().map(|(c, &n)| (c[1], c[0], n)).collect() }
+            } else {
+                ReachPlane { axes: (names[0], names[1]), cells: counts.iter().map(|(c, &n)| (c[0], c[1], n)).collect() }
+            }
+        })
+        .collect();
+    let title = format!("reach: {} solutions, cells of {} mm", reach.tips, reach.cell_mm);
+    Ok(draw_reach_maps(path, &title, &planes, reach.cell_mm)?)
+}
+
 /// Draws reach.png and the per-cell pictures of each coefficient.
 fn coefficient_pictures(dir: &Path, map: &MapData) -> Result<Vec<Picture>, ReduceError> {
     let s = &map.summary;
@@ -182,4 +233,107 @@ fn coefficient_pictures(dir: &Path, map: &MapData) -> Result<Vec<Picture>, Reduc
         }
     }
     Ok(pictures)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::reduce::{reduce_batches, MapBody, ReduceOptions, RunInfo};
+    use crate::shape::LengthBasis;
+    use arrow::record_batch::RecordBatch;
+    use crate::model::{Rod, Routing, Simulator, SolverOptions};
+    use arrow::array::{ArrayRef, Float64Array, Int64Array, StringArray};
+    use arrow::datatypes::{DataType, Field, Schema};
+    use std::sync::Arc;
+
+    /// A small real run: 3 levels per control point, 4 tensions, as one batch.
+    fn small_run() -> RecordBatch {
+        let actuator = Rod::default();
+        let mut sim = Simulator::new(&actuator, &SolverOptions::default()).unwrap();
+        let (mut ids, mut status, mut ys, mut t, mut out) = (vec![], vec![], vec![[0.0; 5]; 0], vec![], vec![]);
+        for id in 0..243i64 {
+            let mut k = id;
+            let y: [f64; 5] = std::array::from_fn(|_| {
+                let level = (k % 3) as f64 - 1.0;
+                k /= 3;
+                level * 3.0
+            });
+            sim.set_routing(&Routing::new(&y, 65.0, 5.0).unwrap());
+            for tension in [1.0, 1.3, 1.6, 2.0] {
+                let pose = sim.solve(tension).unwrap();
+                let mut a = [0.0; 3];
+                sim.coefficients_into(crate::shape::LengthBasis::default(), &mut a);
+                ids.push(id);
+                status.push("ok");
+                ys.push(y);
+                t.push(tension);
+                out.push([pose.tip_x_mm, pose.tip_y_mm, pose.tip_angle_rad, a[0], a[1], a[2]]);
+            }
+        }
+        let mut fields = vec![Field::new("routing_id", DataType::Int64, false), Field::new("status", DataType::Utf8, false)];
+        let mut cols: Vec<ArrayRef> = vec![Arc::new(Int64Array::from(ids)), Arc::new(StringArray::from(status))];
+        for k in 0..5 {
+            fields.push(Field::new(format!("y{k}_mm"), DataType::Float64, false));
+            cols.push(Arc::new(Float64Array::from(ys.iter().map(|y| y[k]).collect::<Vec<_>>())));
+        }
+        fields.push(Field::new("tension_n", DataType::Float64, false));
+        cols.push(Arc::new(Float64Array::from(t)));
+        for (j, name) in ["tip_x_mm", "tip_y_mm", "tip_angle_rad", "a0", "a1", "a2"].iter().enumerate() {
+            fields.push(Field::new(*name, DataType::Float64, true));
+            cols.push(Arc::new(Float64Array::from(out.iter().map(|o| o[j]).collect::<Vec<_>>())));
+        }
+        RecordBatch::try_new(Arc::new(Schema::new(fields)), cols).unwrap()
+    }
+
+    #[test]
+    fn map_directory_has_tables_and_non_blank_pictures() {
+        let b = small_run();
+        let info = RunInfo {
+            mirrored: false,
+            order: 2,
+            tension_range_n: [1.0, 2.0],
+            radius_mm: 5.0,
+            length_mm: 65.0,
+            run_dir: "small".into(),
+            spec_hash: "h".into(),
+            length_basis: LengthBasis::Rest,
+            body: MapBody::default(),
+        };
+        let map = reduce_batches(&info, &ReduceOptions::default(), || Ok(vec![Ok(b.clone())].into_iter())).unwrap();
+        let dir = std::env::var_os("CABLEMAP_KEEP_MAP").map(std::path::PathBuf::from);
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = dir.unwrap_or_else(|| tmp.path().to_path_buf());
+        let pictures = write_map(&dir, &map, &Rod::default(), &SolverOptions::default()).unwrap();
+        assert_eq!(pictures.len(), 1 + 3 * 3 + 1);
+        for p in &pictures {
+            let img = image::open(dir.join(&p.file)).unwrap().to_rgb8();
+            // Sized from the map's extent at equal aspect (plots.rs checks the aspect).
+            let (w, h) = img.dimensions();
+            assert!(w >= 600 && h >= 400 && w <= 2400 && h <= 4000, "{}: {w}×{h}", p.file);
+            // Not blank: many distinct colours and a good share of non-white pixels.
+            let non_white = img.pixels().filter(|px| px.0 != [255, 255, 255]).count();
+            let mut colours: Vec<[u8; 3]> = img.pixels().map(|px| px.0).collect();
+            colours.sort_unstable();
+            colours.dedup();
+            assert!(non_white * 50 > img.pixels().len(), "{}: {non_white} non-white pixels", p.file);
+            assert!(colours.len() > 20, "{}: only {} colours", p.file, colours.len());
+        }
+        let html = std::fs::read_to_string(dir.join("index.html")).unwrap();
+        assert!(html.contains("<script src=\"explorer-data.js\">"));
+        let data = std::fs::read_to_string(dir.join(explorer::DATA_FILE)).unwrap();
+        let json = data.trim().strip_prefix("// Written by `cablemap reduce`: the map explorer's data (index.html).\nwindow.CABLEMAP_MAP = ").unwrap();
+        let v: serde_json::Value = serde_json::from_str(json.strip_suffix(';').unwrap()).unwrap();
+        for p in &pictures {
+            assert!(v["pictures"].as_array().unwrap().iter().any(|f| f["file"] == p.file.as_str()), "{}", p.file);
+        }
+        assert_eq!(v["cells"]["ix"].as_array().unwrap().len(), map.cells.len());
+        assert_eq!(v["designs"]["ix"].as_array().unwrap().len(), map.designs.len());
+        // Every a_i is a curvature (mm⁻¹) and the page names the basis.
+        assert!(!html.contains("mm⁻²") && !data.contains("mm⁻²"));
+        assert_eq!(v["length_basis_description"], "per unit rest length L (the thesis's basis)");
+        assert!(pictures.iter().filter(|p| p.file.starts_with("a2")).all(|p| !p.explanation.contains("Fig.")));
+        for table in ["cells.parquet", "modes.parquet", "designs.parquet", "summary.json"] {
+            assert!(dir.join(table).exists(), "{table}");
+        }
+    }
 }

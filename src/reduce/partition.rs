@@ -8,7 +8,7 @@
 use super::cells::{self, CellTable};
 use super::grid::Grid;
 use super::modes::{ModeSplit, Nearest};
-use super::samples::{RowRef, Sample};
+use super::sample::{RowRef, Sample};
 use super::spill::{self, Samples, SpillWriter};
 use super::{ReduceError, MODES};
 use std::collections::HashMap;

@@ -11,7 +11,7 @@
 //! one reduction (and of a part, see `parts`), not an exchange format.
 
 use super::mirror::Mirror;
-use super::samples::{RowRef, Sample};
+use super::sample::{RowRef, Sample};
 use super::ReduceError;
 use std::fs::File;
 use std::io::{BufReader, BufWriter, Read, Write};

@@ -1,11 +1,16 @@
-//! The map format (docs/maps.md), one owner: the file and column names of a
-//! map directory's tables, their writer and their reader. `summary.json` is
-//! [`MapSummary`] serialised; `cells.parquet`, `modes.parquet` and
-//! `designs.parquet` hold [`CellStats`], [`ModeStats`](super::ModeStats) and [`Design`] rows.
-//! The design columns are the sweep's own (`sweep::schema`).
+//! The map format (docs/maps.md, docs/schema.md), one owner: the file and
+//! column names of a map directory's tables, their writer and their reader.
+//! `summary.json` is [`MapSummary`] serialised; `cells.parquet`,
+//! `modes.parquet` and `designs.parquet` hold [`CellStats`],
+//! [`ModeStats`](super::ModeStats) and [`Design`] rows. The design columns
+//! are the sweep's own (`sweep::schema`). A cable sweep's map holds
+//! [`CableMapSummary`] as its `summary.json`, the reach tables
+//! ([`REACH_FILES`]) and, for a planar run, a feasibility map in
+//! [`PLANAR_MAP_DIR`].
 
+use super::reach::{Reach, PLANES, VOXEL_AXES};
+use super::{CableMapSummary, CellStats, CoefficientStats, Design, MapData, MapSummary, ReduceError, CELL_STATS_ORDER, MAX_CELLS_PER_AXIS, MODES};
 use crate::model::ControlPoints;
-use super::{CellStats, CoefficientStats, Design, MapData, MapSummary, ReduceError, CELL_STATS_ORDER, MAX_CELLS_PER_AXIS, MODES};
 use crate::sweep::schema::{coefficient_column, ROUTING_ID, TENSION_N, TIP_ANGLE_RAD, TIP_X_MM, TIP_Y_MM, Y_MM};
 use arrow::array::{Array, ArrayRef, AsArray, BooleanArray, Float64Array, Int32Array, Int64Array};
 use arrow::datatypes::{DataType, Field, Float64Type, Int32Type, Int64Type, Schema};
@@ -14,6 +19,7 @@ use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
 use parquet::arrow::ArrowWriter;
 use parquet::basic::{Compression, ZstdLevel};
 use parquet::file::properties::WriterProperties;
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -31,6 +37,12 @@ pub const CELLS_FILE: &str = "cells.parquet";
 pub const MODES_FILE: &str = "modes.parquet";
 /// The simulated designs kept per cell.
 pub const DESIGNS_FILE: &str = "designs.parquet";
+/// Reach tables of a cable sweep's map: solved tips per cell on the x–y,
+/// x–z and y–z planes, and per 3-D voxel. Columns: `i{axis}` (cell index,
+/// i32) and `{axis}_mm` (cell centre, f64) per axis, then `count` (i64).
+pub const REACH_FILES: [&str; 4] = ["reach_xy.parquet", "reach_xz.parquet", "reach_yz.parquet", "reach_3d.parquet"];
+/// Folder, inside a cable sweep's map, of a planar run's feasibility map.
+pub const PLANAR_MAP_DIR: &str = "planar";
 
 /// Columns of `cells.parquet`.
 pub mod cell_columns {
@@ -235,6 +247,34 @@ pub fn write_tables(dir: &Path, map: &MapData) -> Result<(), ReduceError> {
     write_file(&path, &json)
 }
 
+/// Writes a cable sweep's reach tables ([`REACH_FILES`]) into `dir`.
+pub(crate) fn write_reach(dir: &Path, reach: &Reach) -> Result<(), ReduceError> {
+    for ((_, axes), (file, counts)) in PLANES.iter().zip(REACH_FILES.iter().zip(&reach.planes)) {
+        counts_table(counts, axes, reach.cell_mm).write(&dir.join(file))?;
+    }
+    counts_table(&reach.voxels, &VOXEL_AXES, reach.cell_mm).write(&dir.join(REACH_FILES[3]))
+}
+
+/// One reach table: `i{axis}`, `{axis}_mm` per axis, then `count`.
+fn counts_table<const N: usize>(counts: &BTreeMap<[i32; N], i64>, axes: &[&str; N], cell_mm: f64) -> Table {
+    let mut table = Table::default();
+    for (k, axis) in axes.iter().enumerate() {
+        table.i32(&format!("i{axis}"), counts.keys().map(|c| c[k]).collect());
+    }
+    for (k, axis) in axes.iter().enumerate() {
+        table.f64_all(&format!("{axis}_mm"), counts.keys().map(|c| (c[k] as f64 + 0.5) * cell_mm).collect());
+    }
+    table.i64("count", counts.values().copied().collect());
+    table
+}
+
+/// Writes a cable sweep map's `summary.json` into `dir`.
+pub(crate) fn write_cable_summary(dir: &Path, summary: &CableMapSummary) -> Result<(), ReduceError> {
+    let path = dir.join(SUMMARY_FILE);
+    let json = serde_json::to_string_pretty(summary).map_err(|source| ReduceError::WriteJson { path: path.clone(), source })? + "\n";
+    write_file(&path, json.as_bytes())
+}
+
 /// A map table that cannot be read, or breaks the map format.
 #[derive(Debug, Clone, thiserror::Error)]
 #[error("map {}: {message}", path.display())]
@@ -257,12 +297,12 @@ pub fn read_summary(dir: &Path) -> Result<MapSummary, ReadError> {
         _ => read_error(&path, format!("cannot read ({e}); give a map directory written by `cablemap reduce`")),
     })?;
     let summary: MapSummary = serde_json::from_str(&text).map_err(|e| {
-        // A cable sweep's map (reduce::cables) is not a feasibility map; a
+        // A cable sweep's map is not a feasibility map; a
         // planar one holds one in its `planar` folder.
         match serde_json::from_str::<serde_json::Value>(&text).ok().filter(|v| v["kind"] == "cables") {
             Some(v) if v["planar_map"].is_string() => read_error(&path, format!(
                 "is the map of a cable sweep (reach counts); its planar feasibility map is {}",
-                dir.join(super::cables::PLANAR_MAP_DIR).display()
+                dir.join(PLANAR_MAP_DIR).display()
             )),
             Some(_) => read_error(&path, "is the map of a spatial cable sweep (reach counts only): it has no feasibility map"),
             None => read_error(&path, format!("does not match the map contract: {e}")),

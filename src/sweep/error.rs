@@ -1,6 +1,6 @@
 //! Why a sweep, a status query or a read failed.
 
-use super::{run, spec, status, store};
+use super::{kind, run, spec, status, store};
 use std::path::PathBuf;
 
 /// Why a sweep, a status query or a read failed. Messages name the file or
@@ -15,7 +15,16 @@ pub enum SweepError {
         /// What is wrong.
         source: spec::SpecError,
     },
-    /// A spec of another kind than planar (a cable sweep) is malformed or invalid.
+    /// A cable sweep spec is malformed or invalid.
+    #[error("bad cable sweep spec {origin}: {source}")]
+    BadCableSpec {
+        /// The spec file, or where an in-memory spec came from.
+        origin: String,
+        /// What is wrong.
+        source: kind::InvalidSpec,
+    },
+    /// A spec the engine refuses ([`super::RunSpec::check`] of an in-memory
+    /// spec of any kind), or a cable sweep larger than a sweep may be by default.
     #[error("bad sweep spec {origin}: {message}")]
     InvalidSpec {
         /// The spec file, or where an in-memory spec came from.

@@ -1,22 +1,26 @@
-//! The kinds of sweep the engine runs. One engine ([`super::run`]) and one
-//! run directory ([`super::store`]) serve every kind: a kind is a spec that
-//! enumerates routings (ids 0..routings, each with the same number of rows)
-//! and solves one routing into rows of a fixed Arrow schema.
-//!
-//! - [`super::SweepSpec`]: one planar cable (`cablemap-sweep/2` runs).
-//! - [`super::cables::CableSweepSpec`]: several or spatial cables
-//!   (`cablemap-cables/1` runs), recognised by its `[[cable]]` tables
-//!   (`crate::job::Job::load` tells a spec file's kind).
+//! What a kind of sweep is to the engine: a spec that enumerates routings
+//! (ids 0..routings, each with the same number of rows) and solves one
+//! routing into rows of a fixed Arrow schema ([`RunSpec`]). The one engine
+//! ([`crate::sweep::run`]) and the one run directory ([`crate::sweep::store`])
+//! serve every kind; each spec declares its kind once, in its `impl RunSpec`
+//! ([`crate::sweep::spec::planar`], [`crate::sweep::spec::cables`]).
 //!
 //! Chunks, shards and row counts follow from [`ChunkLayout`] alone, so
-//! sharding, resume, checksums and status are the same code for both.
+//! sharding, resume, checksums and status are the same code for every kind,
+//! within the same limits ([`MAX_CHUNK_ROWS`], [`MAX_ROWS`]).
 
 use super::SweepError;
 use crate::shape::LengthBasis;
 use arrow::datatypes::SchemaRef;
 use arrow::record_batch::RecordBatch;
 use std::ops::Range;
-use std::path::Path;
+
+/// Most rows per chunk file, of any kind of sweep (a chunk is built in
+/// memory before writing).
+pub const MAX_CHUNK_ROWS: u64 = 2_000_000;
+/// Most rows of a sweep of any kind without `--allow-large` (≈1600 × the
+/// thesis sweep).
+pub const MAX_ROWS: u64 = 1_000_000_000;
 
 /// Routings cut into chunks and chunks dealt to shards: index arithmetic only.
 ///
@@ -121,31 +125,14 @@ pub trait RunSpec: Clone + PartialEq + std::fmt::Debug + serde::Serialize + serd
 #[error("{0}")]
 pub struct InvalidSpec(pub String);
 
-/// The kind of sweep a run directory holds, from its manifest's format tag.
+/// The kind of sweep a run directory holds, from its manifest's format tag
+/// ([`crate::sweep::store::run_kind`] reads it).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum RunKind {
-    /// A planar single-cable sweep ([`super::SweepSpec`]).
+    /// A planar single-cable sweep ([`crate::sweep::SweepSpec`]).
     Planar,
-    /// A sweep of several or spatial cables ([`super::cables::CableSweepSpec`]).
+    /// A sweep of several or spatial cables ([`crate::sweep::CableSweepSpec`]).
     Cables,
-}
-
-/// Which kind of sweep `dir` holds (read from `DIR/manifest.json`'s
-/// `format`); [`SweepError::no_run`] without a manifest. Unknown formats are
-/// reported as planar, whose reader then names the format it expected.
-pub fn run_kind(dir: &Path) -> Result<RunKind, SweepError> {
-    let path = dir.join(super::store::MANIFEST);
-    let text = match crate::io::read_utf8(&path) {
-        Ok(t) => t,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Err(SweepError::no_run(dir)),
-        Err(source) => return Err(crate::io::FileError::new("reading", path, source).into()),
-    };
-    let value: serde_json::Value =
-        serde_json::from_str(&text).map_err(|e| SweepError::CorruptManifest { path: path.clone(), message: e.to_string() })?;
-    Ok(match value.get("format").and_then(|f| f.as_str()) {
-        Some(f) if f == <super::cables::CableSweepSpec as RunSpec>::FORMAT => RunKind::Cables,
-        _ => RunKind::Planar,
-    })
 }
 
 #[cfg(test)]

@@ -1,11 +1,15 @@
-//! The sharded, resumable sweep: every routing of a grid solved through a
-//! tension ladder, written as Parquet chunks (thesis Ch. 4, model-notes §5).
+//! The sharded, resumable sweep: every routing of a spec solved through its
+//! tensions, written as Parquet chunks (thesis Ch. 4, model-notes §5). One
+//! engine serves every kind of sweep; a spec declares its kind once.
 //!
-//! - [`spec`]: the TOML job spec and its hash.
-//! - [`kind`]: what a kind of sweep provides the engine ([`RunSpec`]): the
-//!   planar spec, or [`cables`] (several or spatial cables).
-//! - [`enumerate`]: routing ids, mirror de-duplication, chunks and shards.
-//! - [`schema`]: the row schema (`docs/schema.md`) and batch building.
+//! - [`spec`]: the TOML job specs and their hashes, each with its kind
+//!   ([`RunSpec`]): the planar [`SweepSpec`], the [`CableSweepSpec`] of
+//!   several or spatial cables.
+//! - [`kind`]: what a kind of sweep provides the engine, and the limits every
+//!   kind keeps.
+//! - [`enumerate`]: planar routing ids, mirror de-duplication, chunks and shards.
+//! - [`solve`]: one routing solved into its rows, for each kind.
+//! - [`schema`]: the columns of every run format (`docs/schema.md`) and batch building.
 //! - [`store`]: the run directory: manifest, atomic chunk files, checks.
 //! - [`run`]: the engine (parallel solving, resume, progress, summary).
 //! - [`status`]: done/total per shard, failures, completeness.
@@ -13,7 +17,6 @@
 //! - [`read`]: **the reader other stages use**: [`read::open_run`] checks a
 //!   run directory and streams its rows as Arrow record batches.
 
-pub mod cables;
 pub mod enumerate;
 pub mod error;
 pub mod kind;
@@ -22,15 +25,17 @@ pub mod read;
 pub mod report;
 pub mod run;
 pub mod schema;
+pub mod solve;
 pub mod spec;
 pub mod status;
 pub mod store;
 
 pub use enumerate::SweepPlan;
 pub use error::SweepError;
-pub use kind::{run_kind, ChunkLayout, InvalidSpec, RunKind, RunSpec};
+pub use kind::{ChunkLayout, InvalidSpec, RunKind, RunSpec};
 pub use read::{open_run, open_run_of, Completeness, SweepRun};
 pub use report::{StatusReport, SweepReport};
 pub use run::{run_sweep, run_sweep_of, SweepOptions, SweepSummary, MAX_SHARDS};
-pub use spec::SweepSpec;
+pub use spec::{CableSweepSpec, SweepSpec};
 pub use status::{run_status, run_status_of, RunStatus};
+pub use store::run_kind;

@@ -10,19 +10,16 @@
 //!
 //! Parallelism is two-level with rayon: chunks in parallel, and the routings
 //! of a chunk in parallel (so a shard with a single chunk still uses every
-//! thread). Each worker has its own [`Simulator`]; a routing is solved cold
-//! through its rising tension ladder (continuation), independent of every
-//! other routing, so results do not depend on threads or shards. Memory is
+//! thread). Each worker has its own solver state ([`RunSpec::Worker`]); a
+//! routing is solved cold (`sweep::solve`), independent of every other
+//! routing, so results do not depend on threads or shards. Memory is
 //! bounded by the chunks in flight, not by the number of rows.
 
-use super::enumerate::SweepPlan;
 use super::kind::{ChunkLayout, RunSpec};
 use super::progress::{Progress, ProgressMode};
-use super::schema::{arrow_schema, build_batch, SolvedRouting, SolvedRow};
-use super::spec::{OutputSpec, SweepSpec};
+use super::spec::SweepSpec;
 use super::store::{total_status_counts, ChunkInfo, RunDir};
 use super::SweepError;
-use crate::model::{Routing, Simulator, STATUS_OK};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -39,7 +36,7 @@ pub struct SweepOptions {
     pub threads: Option<usize>,
     /// Progress display.
     pub progress: ProgressMode,
-    /// Accept a sweep of more than [`super::spec::MAX_ROWS`] rows.
+    /// Accept a sweep of more than [`super::kind::MAX_ROWS`] rows.
     pub allow_large: bool,
 }
 
@@ -298,102 +295,4 @@ pub fn run_sweep_of<S: RunSpec>(spec: &S, dir: &Path, options: &SweepOptions) ->
         wall_s,
         solves_per_s: rows_written as f64 / wall_s.max(1e-9),
     })
-}
-
-/// The planar single-cable sweep: one [`Simulator`] per worker, each
-/// routing solved through the rising tension ladder.
-impl RunSpec for SweepSpec {
-    const FORMAT: &'static str = super::store::FORMAT;
-    const KIND: &'static str = "planar single-cable sweep";
-    type Worker = Simulator;
-    type Solved = SolvedRouting;
-
-    fn check(&self) -> Result<(), super::kind::InvalidSpec> {
-        self.validate().map_err(|e| super::kind::InvalidSpec(e.to_string()))
-    }
-
-    fn check_run_size(&self, allow_large: bool) -> Result<(), SweepError> {
-        self.check_size(allow_large).map_err(|source| SweepError::BadSpec { origin: "(size)".into(), source })
-    }
-
-    fn canonical_json(&self) -> String {
-        SweepSpec::canonical_json(self)
-    }
-
-    fn hash_hex(&self) -> String {
-        SweepSpec::hash_hex(self)
-    }
-
-    fn length_basis(&self) -> crate::shape::LengthBasis {
-        self.output.length_basis
-    }
-
-    fn order(&self) -> usize {
-        self.output.order
-    }
-
-    fn layout(&self) -> ChunkLayout {
-        SweepPlan::new(self).layout()
-    }
-
-    fn schema(&self) -> arrow::datatypes::SchemaRef {
-        arrow_schema(self)
-    }
-
-    fn row_bytes(&self) -> u64 {
-        SweepSpec::row_bytes(self)
-    }
-
-    fn worker(&self) -> Result<Simulator, SweepError> {
-        Ok(Simulator::new(&self.actuator, &self.solver)?)
-    }
-
-    fn solve(&self, worker: &mut Simulator, id: u64) -> Result<SolvedRouting, SweepError> {
-        // The plan holds only the levels (a few numbers): cheap per routing.
-        solve_routing(worker, &SweepPlan::new(self), self, &self.tensions_n(), id)
-    }
-
-    fn batch(&self, schema: &arrow::datatypes::SchemaRef, solved: &[SolvedRouting]) -> arrow::record_batch::RecordBatch {
-        build_batch(schema, self.output.order, self.output.centreline, solved)
-    }
-}
-
-/// Solves routing `id` through the tension ladder.
-fn solve_routing(
-    sim: &mut Simulator,
-    plan: &SweepPlan,
-    spec: &SweepSpec,
-    tensions_n: &[f64],
-    id: u64,
-) -> Result<SolvedRouting, SweepError> {
-    let y_mm = plan.routing_mm(id);
-    let routing = Routing::for_actuator(y_mm, &spec.actuator)?;
-    sim.set_routing(&routing);
-    let rows = tensions_n.iter().map(|&t| solve_row(sim, t, &spec.output)).collect();
-    Ok(SolvedRouting { id, routing_mm: y_mm, rows })
-}
-
-/// One solve as a row: outputs only for a successful, finite solve.
-fn solve_row(sim: &mut Simulator, tension_n: f64, output: &OutputSpec) -> SolvedRow {
-    let failed = |status| SolvedRow { tension_n, status, pose: None, a: Vec::new(), centreline: None };
-    match sim.solve(tension_n) {
-        Ok(pose) => {
-            let mut a = vec![0.0; output.order + 1];
-            // Coefficients the discretisation does not resolve are a failure too.
-            if let Err(failure) = sim.coefficients_checked(output.length_basis, &mut a) {
-                return failed(failure.status());
-            }
-            let scalars = [pose.tip_x_mm, pose.tip_y_mm, pose.tip_angle_rad, pose.base_angle_rad, pose.length_mm];
-            if !scalars.iter().chain(&a).all(|v| v.is_finite()) {
-                // Stored as a failure so that outputs are never NaN.
-                return failed(crate::model::SolveFailure::NonFinite { s_mm: f64::NAN }.status());
-            }
-            let centreline = output.centreline.then(|| {
-                let points = sim.centreline();
-                (points.iter().map(|p| p.x_mm).collect(), points.iter().map(|p| p.y_mm).collect())
-            });
-            SolvedRow { tension_n, status: STATUS_OK, pose: Some(pose), a, centreline }
-        }
-        Err(failure) => failed(failure.status()),
-    }
 }

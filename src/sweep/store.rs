@@ -23,10 +23,10 @@
 //! instead. Its spec hash and counts are recomputed on every read, so an
 //! edited manifest is refused.
 
-use super::kind::RunSpec;
+use super::kind::{RunKind, RunSpec};
 use super::spec::SweepSpec;
-use crate::shape::LengthBasis;
 use super::SweepError;
+use crate::shape::LengthBasis;
 use crate::io::FileError;
 use arrow::record_batch::RecordBatch;
 use parquet::arrow::ArrowWriter;
@@ -75,7 +75,7 @@ pub mod keys {
 
 /// The run's manifest (`DIR/manifest.json`). Written once, never changed.
 /// `S` is the kind of sweep ([`RunSpec`]): a planar [`SweepSpec`] by
-/// default, or a [`super::cables::CableSweepSpec`].
+/// default, or a [`super::spec::CableSweepSpec`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Manifest<S = SweepSpec> {
@@ -553,6 +553,24 @@ impl RunDir {
         crate::io::sync_dir(&self.shards_dir());
         Ok(ChunkInfo { chunk, path, rows: batch.num_rows() as u64, status_counts })
     }
+}
+
+/// Which kind of sweep `dir` holds (read from `DIR/manifest.json`'s
+/// `format`); [`SweepError::no_run`] without a manifest. Unknown formats are
+/// reported as planar, whose reader then names the format it expected.
+pub fn run_kind(dir: &Path) -> Result<RunKind, SweepError> {
+    let path = dir.join(MANIFEST);
+    let text = match crate::io::read_utf8(&path) {
+        Ok(t) => t,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Err(SweepError::no_run(dir)),
+        Err(source) => return Err(FileError::new("reading", path, source).into()),
+    };
+    let value: serde_json::Value =
+        serde_json::from_str(&text).map_err(|e| SweepError::CorruptManifest { path: path.clone(), message: e.to_string() })?;
+    Ok(match value.get("format").and_then(|f| f.as_str()) {
+        Some(crate::io::run_markers::CABLES_FORMAT) => RunKind::Cables,
+        _ => RunKind::Planar,
+    })
 }
 
 /// What [`RunDir::scan`] found.

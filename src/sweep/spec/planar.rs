@@ -1,6 +1,9 @@
-//! The sweep job spec: a TOML file naming the actuator, the solver settings,
-//! the routing grid, the tension ladder and what to store. Unknown fields
-//! are rejected so that a typo never silently falls back to a default.
+//! The planar single-cable sweep spec (`cablemap-sweep/2` runs): a TOML
+//! file naming the actuator, the solver settings, the routing grid, the
+//! tension ladder and what to store. Unknown fields are rejected so that a
+//! typo never silently falls back to a default. Its kind ([`RunSpec`]): one
+//! [`Simulator`] per worker, each routing solved through the rising tension
+//! ladder ([`solve::planar_routing`]).
 //!
 //! ```toml
 //! [actuator]            # model::Rod; omitted fields keep the thesis values
@@ -23,16 +26,22 @@
 //! chunk_routings = 256  # routings per Parquet chunk file
 //! ```
 
-use super::SweepError;
-use crate::model::{Rod, SolverOptions};
+use crate::model::{Rod, Routing, Simulator, SolverOptions};
 use crate::shape::LengthBasis;
+use crate::sweep::enumerate::SweepPlan;
+use crate::sweep::kind::{ChunkLayout, InvalidSpec, RunSpec, MAX_CHUNK_ROWS, MAX_ROWS};
+use crate::sweep::schema::{arrow_schema, build_batch, SolvedRouting};
+use crate::sweep::solve::{self, Stored};
+use crate::sweep::SweepError;
+use arrow::datatypes::SchemaRef;
+use arrow::record_batch::RecordBatch;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use std::path::Path;
 
 /// The thesis sweep (thesis Ch. 4, model-notes §5): `jobs/thesis.toml`,
 /// built into the binary as the default spec.
-pub const THESIS_SPEC_TOML: &str = include_str!("../../jobs/thesis.toml");
+pub const THESIS_SPEC_TOML: &str = include_str!("../../../jobs/thesis.toml");
 
 /// Most levels per control point (the grid has levels⁵ routings).
 pub const MAX_LEVELS: u32 = 99;
@@ -42,10 +51,6 @@ pub const MAX_ORDER: usize = 12;
 pub const MAX_TENSIONS: u32 = 100_000;
 /// Most RK4 steps per span (memory grows with it; 24 is the default).
 pub const MAX_STEPS_PER_SPAN: usize = 100_000;
-/// Most rows per chunk file (a chunk is built in memory before writing).
-pub const MAX_CHUNK_ROWS: u64 = 2_000_000;
-/// Most rows of a sweep without `--allow-large` (≈1600 × the thesis sweep).
-pub const MAX_ROWS: u64 = 1_000_000_000;
 /// Most memory one chunk may take while it is built (its solved rows, the
 /// Arrow batch and the Parquet encoder's buffers; [`SweepSpec::row_bytes`]).
 /// Chunks are built one per thread at once, so this bounds the sweep's
@@ -323,7 +328,7 @@ impl SweepSpec {
     /// refused (a typo like `levels = 99` means 10¹¹ rows) unless
     /// `allow_large`, for a deliberate huge job.
     pub fn check_size(&self, allow_large: bool) -> Result<(), SpecError> {
-        let plan = super::SweepPlan::new(self);
+        let plan = SweepPlan::new(self);
         let rows = plan.total_rows();
         if rows > MAX_ROWS && !allow_large {
             return Err(SpecError::TooLarge(format!(
@@ -382,6 +387,68 @@ impl SweepSpec {
     /// Parses the canonical JSON written by [`Self::canonical_json`].
     pub fn from_canonical_json(text: &str) -> Result<Self, serde_json::Error> {
         serde_json::from_str(text)
+    }
+}
+
+/// The planar single-cable sweep: one [`Simulator`] per worker, each
+/// routing solved through the rising tension ladder.
+impl RunSpec for SweepSpec {
+    const FORMAT: &'static str = crate::io::run_markers::PLANAR_FORMAT;
+    const KIND: &'static str = "planar single-cable sweep";
+    type Worker = Simulator;
+    type Solved = SolvedRouting;
+
+    fn check(&self) -> Result<(), InvalidSpec> {
+        self.validate().map_err(|e| InvalidSpec(e.to_string()))
+    }
+
+    fn check_run_size(&self, allow_large: bool) -> Result<(), SweepError> {
+        self.check_size(allow_large).map_err(|source| SweepError::BadSpec { origin: "(size)".into(), source })
+    }
+
+    fn canonical_json(&self) -> String {
+        SweepSpec::canonical_json(self)
+    }
+
+    fn hash_hex(&self) -> String {
+        SweepSpec::hash_hex(self)
+    }
+
+    fn length_basis(&self) -> LengthBasis {
+        self.output.length_basis
+    }
+
+    fn order(&self) -> usize {
+        self.output.order
+    }
+
+    fn layout(&self) -> ChunkLayout {
+        SweepPlan::new(self).layout()
+    }
+
+    fn schema(&self) -> SchemaRef {
+        arrow_schema(self.output.order, self.output.centreline)
+    }
+
+    fn row_bytes(&self) -> u64 {
+        SweepSpec::row_bytes(self)
+    }
+
+    fn worker(&self) -> Result<Simulator, SweepError> {
+        Ok(Simulator::new(&self.actuator, &self.solver)?)
+    }
+
+    fn solve(&self, worker: &mut Simulator, id: u64) -> Result<SolvedRouting, SweepError> {
+        // The plan holds only the levels (a few numbers): cheap per routing.
+        let routing_mm = SweepPlan::new(self).routing_mm(id);
+        let routing = Routing::for_actuator(routing_mm, &self.actuator)?;
+        let o = &self.output;
+        let stored = Stored { order: o.order, length_basis: o.length_basis, centreline: o.centreline };
+        Ok(solve::planar_routing(worker, id, routing_mm, &routing, &self.tensions_n(), stored))
+    }
+
+    fn batch(&self, schema: &SchemaRef, solved: &[SolvedRouting]) -> RecordBatch {
+        build_batch(schema, self.output.order, self.output.centreline, solved)
     }
 }
 

@@ -1,0 +1,80 @@
+//! The options of a reduction: cell size, mode boundaries, designs kept,
+//! and the memory bound.
+
+use super::ReduceError;
+use serde::{Deserialize, Serialize};
+use std::path::PathBuf;
+
+/// Boundaries of the characteristic modes: a_0 split into 4 ranges by three
+/// values, a_1 into 3 by two (both mm⁻¹, in the run's length basis).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ModeBoundaries {
+    /// Ascending a_0 boundaries.
+    pub a0: [f64; 3],
+    /// Ascending a_1 boundaries.
+    pub a1: [f64; 2],
+}
+
+impl ModeBoundaries {
+    /// Checks that both lists are finite and ascending.
+    pub fn validate(&self) -> Result<(), ReduceError> {
+        let ok = |v: &[f64]| v.iter().all(|x| x.is_finite()) && v.windows(2).all(|w| w[0] < w[1]);
+        if ok(&self.a0) && ok(&self.a1) {
+            Ok(())
+        } else {
+            Err(ReduceError::Boundaries { a0: self.a0, a1: self.a1 })
+        }
+    }
+
+    /// (a_0 range, a_1 range) of a coefficient pair.
+    pub fn ranges(&self, a0: f64, a1: f64) -> (usize, usize) {
+        (self.a0.iter().filter(|&&b| a0 >= b).count(), self.a1.iter().filter(|&&b| a1 >= b).count())
+    }
+
+    /// Mode index 3·i + j.
+    pub fn mode(&self, a0: f64, a1: f64) -> usize {
+        let (i, j) = self.ranges(a0, a1);
+        3 * i + j
+    }
+
+    /// Bounds (lo, hi) of range `i` of a list (open ends are ±inf).
+    pub(crate) fn bounds(list: &[f64], i: usize) -> (f64, f64) {
+        let lo = if i == 0 { f64::NEG_INFINITY } else { list[i - 1] };
+        let hi = if i == list.len() { f64::INFINITY } else { list[i] };
+        (lo, hi)
+    }
+}
+
+/// Options of a reduction.
+#[derive(Debug, Clone)]
+pub struct ReduceOptions {
+    /// Cell size of the grid, mm.
+    pub cell_mm: f64,
+    /// Explicit mode boundaries; `None` takes quantiles of the data.
+    pub mode_boundaries: Option<ModeBoundaries>,
+    /// Designs kept per cell in designs.parquet.
+    pub designs_per_cell: usize,
+    /// Samples (48 bytes each) held in memory at once: the bound on the
+    /// reduction's memory, whatever the run's size (one cell's samples are
+    /// always held together). The tables do not depend on it.
+    pub memory_samples: usize,
+    /// Where the scratch files go (about 48 bytes per converged row);
+    /// `None` for the system's temporary directory.
+    pub scratch_dir: Option<PathBuf>,
+}
+
+/// Default of [`ReduceOptions::memory_samples`]: 8 Mi samples, 384 MiB.
+pub const DEFAULT_MEMORY_SAMPLES: usize = 8 << 20;
+
+impl Default for ReduceOptions {
+    fn default() -> Self {
+        Self { cell_mm: 1.0, mode_boundaries: None, designs_per_cell: 16, memory_samples: DEFAULT_MEMORY_SAMPLES, scratch_dir: None }
+    }
+}
+
+impl ReduceOptions {
+    /// The directory scratch files go in.
+    pub(crate) fn scratch_parent(&self) -> PathBuf {
+        self.scratch_dir.clone().unwrap_or_else(std::env::temp_dir)
+    }
+}

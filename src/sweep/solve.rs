@@ -1,0 +1,192 @@
+//! Solving one routing of a sweep into its rows, for each kind of sweep:
+//! the planar routing through its rising tension ladder, a routing of
+//! several or spatial cables through its tension grid in snake order. Each
+//! routing is solved from cold, independent of every other, so rows do not
+//! depend on threads or shards. The rows are the batch builders' input
+//! ([`super::schema`]).
+
+use super::schema::{CableRow, SolvedRouting, SolvedRow, STATUS_FAILED, STATUS_INVALID_ROUTING};
+use crate::model::routing::ControlPoints;
+use crate::model::spatial::{Actuator, SpatialOptions, SpatialPose, SpatialSolver};
+use crate::model::{Routing, Simulator, SolveFailure, STATUS_OK};
+use crate::shape::LengthBasis;
+
+/// What each solve of a sweep stores besides its pose: a_0 … a_`order` per
+/// unit of `length_basis`, and (planar rows) the centreline when `centreline`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Stored {
+    /// Highest Legendre order.
+    pub order: usize,
+    /// The length the a_i are per unit of.
+    pub length_basis: LengthBasis,
+    /// Store each solve's centreline.
+    pub centreline: bool,
+}
+
+/// Solves the planar routing `routing` (id `id`, control points
+/// `routing_mm`) through the tension ladder `tensions_n` (rising:
+/// continuation from one tension to the next).
+pub fn planar_routing(
+    sim: &mut Simulator,
+    id: u64,
+    routing_mm: ControlPoints,
+    routing: &Routing,
+    tensions_n: &[f64],
+    stored: Stored,
+) -> SolvedRouting {
+    sim.set_routing(routing);
+    let rows = tensions_n.iter().map(|&t| planar_row(sim, t, stored)).collect();
+    SolvedRouting { id, routing_mm, rows }
+}
+
+/// One planar solve as a row: outputs only for a successful, finite solve.
+fn planar_row(sim: &mut Simulator, tension_n: f64, stored: Stored) -> SolvedRow {
+    let failed = |status| SolvedRow { tension_n, status, pose: None, a: Vec::new(), centreline: None };
+    match sim.solve(tension_n) {
+        Ok(pose) => {
+            let mut a = vec![0.0; stored.order + 1];
+            // Coefficients the discretisation does not resolve are a failure too.
+            if let Err(failure) = sim.coefficients_checked(stored.length_basis, &mut a) {
+                return failed(failure.status());
+            }
+            let scalars = [pose.tip_x_mm, pose.tip_y_mm, pose.tip_angle_rad, pose.base_angle_rad, pose.length_mm];
+            if !scalars.iter().chain(&a).all(|v| v.is_finite()) {
+                // Stored as a failure so that outputs are never NaN.
+                return failed(SolveFailure::NonFinite { s_mm: f64::NAN }.status());
+            }
+            let centreline = stored.centreline.then(|| {
+                let points = sim.centreline();
+                (points.iter().map(|p| p.x_mm).collect(), points.iter().map(|p| p.y_mm).collect())
+            });
+            SolvedRow { tension_n, status: STATUS_OK, pose: Some(pose), a, centreline }
+        }
+        Err(failure) => failed(failure.status()),
+    }
+}
+
+/// A routing's tension grids, per cable (N), and their combinations in the
+/// order they are solved (snake order). Computed once per worker.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TensionCombinations {
+    /// Each cable's tension grid, N.
+    pub grids: Vec<Vec<f64>>,
+    /// Every combination (per-cable grid indices), in snake order.
+    pub snake: Vec<Vec<usize>>,
+}
+
+impl TensionCombinations {
+    /// The combinations of `grids`.
+    pub fn new(grids: Vec<Vec<f64>>) -> Self {
+        Self { snake: snake(&grids), grids }
+    }
+
+    /// The tensions of combination `combo`, N.
+    fn tensions_n(&self, combo: &[usize]) -> Vec<f64> {
+        combo.iter().zip(&self.grids).map(|(&j, g)| g[j]).collect()
+    }
+}
+
+/// Tension combinations in snake order: each step changes one cable's
+/// tension by one grid step, so the solver's warm start (and its
+/// extrapolation along a straight run) stays close.
+fn snake(grids: &[Vec<f64>]) -> Vec<Vec<usize>> {
+    let mut out: Vec<Vec<usize>> = vec![vec![]];
+    for grid in grids {
+        let mut next = Vec::with_capacity(out.len() * grid.len());
+        for (k, prefix) in out.iter().enumerate() {
+            let order: Vec<usize> = if k % 2 == 0 { (0..grid.len()).collect() } else { (0..grid.len()).rev().collect() };
+            for j in order {
+                let mut p = prefix.clone();
+                p.push(j);
+                next.push(p);
+            }
+        }
+        out = next;
+    }
+    out
+}
+
+/// Position of a tension combination (per-cable grid indices) in grid
+/// order: cable 1's index most significant.
+pub fn combination_index(combo: &[usize], grids: &[Vec<f64>]) -> usize {
+    combo.iter().zip(grids).fold(0, |k, (&j, g)| k * g.len() + j)
+}
+
+/// Solves routing `id` of a cable sweep, `actuator` (its cables' tensions
+/// are set per combination), through every tension combination by one
+/// [`SpatialSolver`]: from zero up to the first combination, then along the
+/// snake. Returns the rows in grid order (cable 1's tension slowest). An
+/// actuator the solver refuses gives rows of [`STATUS_INVALID_ROUTING`].
+pub fn cable_routing(id: u64, mut actuator: Actuator, options: &SpatialOptions, stored: Stored, combinations: &TensionCombinations) -> Vec<CableRow> {
+    let combos = &combinations.snake;
+    let geometry: Vec<_> = actuator.cables.iter().map(|c| (c.y_mm, c.z_mm)).collect();
+    let row = |combo: &[usize], status, passes, pose, a| CableRow {
+        routing_id: id as i64,
+        cables: geometry.clone(),
+        tensions: combinations.tensions_n(combo),
+        status,
+        passes,
+        pose,
+        a,
+    };
+    // Build with the first combination's tensions so validation sees them.
+    let first = combinations.tensions_n(&combos[0]);
+    for (c, &t) in actuator.cables.iter_mut().zip(&first) {
+        c.tension_n = t;
+    }
+    let mut solver = match SpatialSolver::new(&actuator, options) {
+        Ok(s) => s,
+        Err(_) => return combos.iter().map(|c| row(c, STATUS_INVALID_ROUTING, 0, None, None)).collect(),
+    };
+    let mut rows: Vec<Option<CableRow>> = vec![None; combos.len()];
+    // Continuation from zero to the first combination (rungs of ≤ 0.25 N).
+    let top = first.iter().copied().fold(0.0, f64::max);
+    let rungs = ((top / 0.25).ceil() as usize).max(1);
+    for k in 1..rungs {
+        let t: Vec<f64> = first.iter().map(|t| t * k as f64 / rungs as f64).collect();
+        // A rung that fails only leaves a worse warm start; the rows report failures.
+        let _ = solver.solve(&t);
+    }
+    for combo in combos {
+        let t = combinations.tensions_n(combo);
+        let solved = match solver.solve(&t) {
+            Ok(pose) => match solver.coefficients(stored.order, stored.length_basis) {
+                Ok(a) if finite_cable_row(&pose, &a) => row(combo, STATUS_OK, pose.passes as i32, Some(pose), Some(a)),
+                _ => row(combo, STATUS_FAILED, 0, None, None),
+            },
+            Err(_) => row(combo, STATUS_FAILED, 0, None, None),
+        };
+        rows[combination_index(combo, &combinations.grids)] = Some(solved);
+    }
+    // Rows in grid order (cable 1's tension slowest), whatever the snake.
+    rows.into_iter().map(|r| r.expect("the snake visits every combination")).collect()
+}
+
+/// A solve whose outputs are all finite (others are stored as failures, so
+/// that no output is NaN).
+fn finite_cable_row(pose: &SpatialPose, a: &[Vec<f64>; 3]) -> bool {
+    let p = pose;
+    p.tip_mm.iter().chain(&p.tip_tangent).chain(&p.tip_body_y_axis).chain([&p.tip_angle_rad, &p.length_mm]).all(|v| v.is_finite())
+        && a.iter().flatten().all(|v| v.is_finite())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn snake_order_visits_every_combination_one_step_at_a_time() {
+        let grids = vec![vec![0.0, 1.0, 2.0], vec![0.0, 1.0], vec![5.0, 6.0]];
+        let s = snake(&grids);
+        assert_eq!(s.len(), 12);
+        let unique: std::collections::BTreeSet<_> = s.iter().cloned().collect();
+        assert_eq!(unique.len(), 12);
+        for w in s.windows(2) {
+            let steps: usize = w[0].iter().zip(&w[1]).map(|(a, b)| a.abs_diff(*b)).sum();
+            assert_eq!(steps, 1, "{w:?}");
+        }
+        for (k, combo) in s.iter().enumerate() {
+            assert!(combination_index(combo, &grids) < 12, "{k}");
+        }
+    }
+}

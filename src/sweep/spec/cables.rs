@@ -1,0 +1,559 @@
+//! The spec of a sweep of several or spatial cables (issue 16;
+//! `cablemap-cables/1` runs): the actuator file's settings, each cable's
+//! tension grid and which of its control points (y or z) are swept over
+//! which levels. Every routing is solved through the product of the tension
+//! grids by the 3-D solver; the rows carry one tension column per cable and
+//! the 3-D tip (docs/schema.md, "Cable sweeps").
+//!
+//! ```toml
+//! gravity_direction = [1, 0, 0]   # optional, as in the actuator file
+//! [rod]                            # optional: model::Rod
+//! [solver]                         # optional: SpatialOptions
+//! [output]
+//! order = 3                        # a0…a3, a_bend_y0…, a_twist0…
+//! cell_mm = 1.0                    # reach-map cell / voxel size
+//! chunk_routings = 64              # routings per chunk file (engine chunks)
+//!
+//! [[cable]]                        # an antagonistic pair
+//! y_mm = [2, 2, 2, 2, 2]           # fixed values (swept points override them)
+//! tension_n = { min = 0.0, max = 2.0, count = 11 }
+//! [[cable.sweep]]
+//! axis = "y"
+//! points = [1, 2, 3]               # each swept independently over the levels
+//! levels_mm = [1.0, 2.5, 4.0]
+//!
+//! [[cable]]
+//! y_mm = [-2, -2, -2, -2, -2]
+//! tension_n = { min = 0.0, max = 2.0, count = 11 }
+//! ```
+//!
+//! In memory the spec holds the model's own [`Actuator`] (every setting of
+//! an actuator file is a setting of the sweep) and, per cable, what the
+//! sweep varies ([`CableGrid`]). Routing ids are the mixed-radix numbers of
+//! the swept levels (the first swept point fastest), and each routing's rows
+//! are its tension combinations in grid order (cable 1's tension slowest),
+//! solved in snake order for warm starts ([`solve::cable_routing`]); a chunk
+//! holds `output.chunk_routings` routings.
+
+use crate::model::routing::CONTROL_POINTS;
+use crate::model::spatial::{SpatialError, SpatialOptions};
+use crate::model::{Actuator, Cable, Rod, MAX_CABLES};
+use crate::shape::LengthBasis;
+use crate::sweep::kind::{ChunkLayout, InvalidSpec, RunSpec, MAX_CHUNK_ROWS, MAX_ROWS};
+use crate::sweep::schema::{cable_batch, cable_schema, Axis, CableRow};
+use crate::sweep::solve::{self, Stored, TensionCombinations};
+use crate::sweep::SweepError;
+use arrow::datatypes::SchemaRef;
+use arrow::record_batch::RecordBatch;
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+
+/// Most values in one tension grid.
+pub const MAX_TENSION_COUNT: u32 = 10_000;
+
+/// A cable sweep job: the actuator it varies, how each cable varies, the
+/// solver settings and what to store. Reads and writes the TOML above (and
+/// the same keys, in the same order, as the canonical JSON its hash covers).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(from = "SpecFile", into = "SpecFile")]
+pub struct CableSweepSpec {
+    /// The actuator every routing varies: rod, torsion, gravity direction and
+    /// each cable's fixed control points and anchor (its swept points at
+    /// these values until a routing sets them), every tension 0 (a row's
+    /// tensions come from [`Self::grids`]).
+    pub actuator: Actuator,
+    /// What the sweep varies of each cable, in the actuator's cable order.
+    pub grids: Vec<CableGrid>,
+    /// Numerical settings of the 3-D solver.
+    pub solver: SpatialOptions,
+    /// What each row stores; the map resolution.
+    pub output: CableOutputSpec,
+}
+
+/// What a sweep varies of one cable: its tension over a grid, and control
+/// points over levels.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CableGrid {
+    /// The cable's tension grid.
+    pub tension_n: TensionGrid,
+    /// Its swept control points.
+    pub sweeps: Vec<PointSweep>,
+}
+
+/// Control points of one axis of a cable, each swept over `levels_mm`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PointSweep {
+    /// `y` or `z`.
+    pub axis: Axis,
+    /// Control-point indices 0…4; each is swept independently (a product).
+    pub points: Vec<usize>,
+    /// The levels, mm.
+    pub levels_mm: Vec<f64>,
+}
+
+/// `count` tensions evenly spaced from `min` to `max`, N.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TensionGrid {
+    /// First tension, N (≥ 0).
+    pub min: f64,
+    /// Last tension, N (≥ min).
+    pub max: f64,
+    /// Number of tensions (1: `min` only).
+    pub count: u32,
+}
+
+impl TensionGrid {
+    /// The tensions, N.
+    pub fn values(&self) -> Vec<f64> {
+        if self.count <= 1 {
+            return vec![self.min];
+        }
+        (0..self.count).map(|k| self.min + (self.max - self.min) * k as f64 / (self.count - 1) as f64).collect()
+    }
+}
+
+/// Output settings.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct CableOutputSpec {
+    /// Highest Legendre order stored (each of the three series).
+    pub order: usize,
+    /// Basis of the coefficients.
+    pub length_basis: LengthBasis,
+    /// Cell size of the reach maps, mm.
+    pub cell_mm: f64,
+    /// Routings per chunk file (each chunk is built in memory: at most
+    /// [`MAX_CHUNK_ROWS`] rows with the tension combinations).
+    pub chunk_routings: u32,
+}
+
+impl Default for CableOutputSpec {
+    fn default() -> Self {
+        Self { order: 3, length_basis: LengthBasis::Rest, cell_mm: 1.0, chunk_routings: 64 }
+    }
+}
+
+/// The file layout of a cable sweep spec: an actuator file's keys, with each
+/// `[[cable]]`'s tension a grid and its swept points, and `[solver]`,
+/// `[output]`. The key order is the canonical JSON's, which the spec hash
+/// of every run covers, so it is written out here rather than taken from
+/// [`Actuator`]'s (whose cables come last); the conversions take
+/// [`Actuator`] and [`Cable`] apart field by field, so a field added to
+/// either does not compile until the format says where it goes.
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SpecFile {
+    #[serde(default)]
+    rod: Rod,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    gj_n_mm2: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    gravity_direction: Option<[f64; 3]>,
+    #[serde(default)]
+    solver: SpatialOptions,
+    #[serde(default)]
+    output: CableOutputSpec,
+    #[serde(rename = "cable")]
+    cables: Vec<CableFile>,
+}
+
+/// One `[[cable]]` of [`SpecFile`]: a [`Cable`] whose tension is a grid,
+/// with its swept points.
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CableFile {
+    y_mm: [f64; CONTROL_POINTS],
+    #[serde(default)]
+    z_mm: [f64; CONTROL_POINTS],
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    anchor_mm: Option<f64>,
+    tension_n: TensionGrid,
+    #[serde(default, rename = "sweep")]
+    sweeps: Vec<PointSweep>,
+}
+
+impl From<SpecFile> for CableSweepSpec {
+    fn from(file: SpecFile) -> Self {
+        let SpecFile { rod, gj_n_mm2, gravity_direction, solver, output, cables } = file;
+        let (cables, grids) = cables
+            .into_iter()
+            .map(|c| {
+                let CableFile { y_mm, z_mm, anchor_mm, tension_n, sweeps } = c;
+                (Cable { y_mm, z_mm, tension_n: 0.0, anchor_mm }, CableGrid { tension_n, sweeps })
+            })
+            .unzip();
+        Self { actuator: Actuator { rod, gj_n_mm2, gravity_direction, cables }, grids, solver, output }
+    }
+}
+
+impl From<CableSweepSpec> for SpecFile {
+    fn from(spec: CableSweepSpec) -> Self {
+        let CableSweepSpec { actuator, grids, solver, output } = spec;
+        let Actuator { rod, gj_n_mm2, gravity_direction, cables } = actuator;
+        let cables = cables
+            .into_iter()
+            .zip(grids)
+            .map(|(cable, grid)| {
+                // The tension is the grid's; the actuator's is always 0.
+                let Cable { y_mm, z_mm, tension_n: _, anchor_mm } = cable;
+                CableFile { y_mm, z_mm, anchor_mm, tension_n: grid.tension_n, sweeps: grid.sweeps }
+            })
+            .collect();
+        SpecFile { rod, gj_n_mm2, gravity_direction, solver, output, cables }
+    }
+}
+
+/// One swept dimension: cable, axis, control point, levels.
+#[derive(Debug, Clone, PartialEq)]
+struct Dimension {
+    cable: usize,
+    axis: Axis,
+    point: usize,
+    levels: Vec<f64>,
+}
+
+impl CableSweepSpec {
+    /// Reads and checks a spec; `origin` names it in errors.
+    pub fn from_toml(text: &str, origin: &str) -> Result<Self, SweepError> {
+        let bad = |source| SweepError::BadCableSpec { origin: origin.into(), source };
+        let spec: Self = toml::from_str(text).map_err(|e| bad(InvalidSpec(e.to_string())))?;
+        spec.validate().map_err(bad)?;
+        Ok(spec)
+    }
+
+    fn dimensions(&self) -> Vec<Dimension> {
+        let mut dims = Vec::new();
+        for (cable, g) in self.grids.iter().enumerate() {
+            for s in &g.sweeps {
+                for &point in &s.points {
+                    dims.push(Dimension { cable, axis: s.axis, point, levels: s.levels_mm.clone() });
+                }
+            }
+        }
+        dims
+    }
+
+    /// Number of routings (the product of the swept levels).
+    pub fn routings(&self) -> u64 {
+        self.dimensions().iter().map(|d| d.levels.len() as u64).product()
+    }
+
+    /// Number of tension combinations per routing.
+    pub fn tension_combinations(&self) -> u64 {
+        self.grids.iter().map(|g| u64::from(g.tension_n.count.max(1))).product()
+    }
+
+    /// Checks the spec; messages name the field.
+    pub fn validate(&self) -> Result<(), InvalidSpec> {
+        let bad = |message: String| InvalidSpec(message);
+        let cables = &self.actuator.cables;
+        if cables.is_empty() || cables.len() > MAX_CABLES {
+            return Err(bad(format!("give 1 to {MAX_CABLES} [[cable]] tables, got {}", cables.len())));
+        }
+        for (i, (c, g)) in cables.iter().zip(&self.grids).enumerate() {
+            let n = i + 1;
+            let t = &g.tension_n;
+            if !(t.min.is_finite() && t.max.is_finite() && t.min >= 0.0 && t.max >= t.min) {
+                return Err(bad(format!("cable {n}: tension_n needs 0 ≤ min ≤ max (finite), got min = {}, max = {}", t.min, t.max)));
+            }
+            if t.count == 0 || t.count > MAX_TENSION_COUNT {
+                return Err(bad(format!("cable {n}: tension_n.count = {} must be 1 … {MAX_TENSION_COUNT}", t.count)));
+            }
+            // The anchor is not swept: outside the rod, every routing's rows
+            // would be invalid_routing.
+            if let Some(anchor) = c.anchor_mm {
+                let length = self.actuator.rod.length_mm;
+                if !(anchor.is_finite() && anchor > 0.0 && anchor <= length) {
+                    return Err(bad(format!(
+                        "cable {n}: anchor_mm = {} must lie on the rod, in (0, {length}] mm (the rod's length_mm; leave \
+                         anchor_mm out for the tip)",
+                        crate::io::fmt_num(anchor)
+                    )));
+                }
+            }
+            let mut seen = std::collections::BTreeSet::new();
+            for s in &g.sweeps {
+                if s.levels_mm.is_empty() || s.levels_mm.iter().any(|v| !v.is_finite()) {
+                    return Err(bad(format!("cable {n}: a sweep needs at least one finite level in levels_mm")));
+                }
+                if s.points.is_empty() {
+                    return Err(bad(format!("cable {n}: a sweep needs at least one control point in points (0 … 4)")));
+                }
+                for &p in &s.points {
+                    if p >= CONTROL_POINTS {
+                        return Err(bad(format!("cable {n}: control point {p} does not exist (points are 0 … 4)")));
+                    }
+                    if !seen.insert((s.axis, p)) {
+                        return Err(bad(format!("cable {n}: {:?} control point {p} is swept twice", s.axis).to_lowercase()));
+                    }
+                }
+            }
+        }
+        crate::model::spatial::check_order(self.output.order, &self.solver).map_err(|e| bad(e.to_string()))?;
+        if !(self.output.cell_mm.is_finite() && self.output.cell_mm > 0.0) {
+            return Err(bad(format!("output.cell_mm = {} must be a positive length", self.output.cell_mm)));
+        }
+        if self.output.chunk_routings == 0 {
+            return Err(bad("output.chunk_routings = 0: a chunk needs at least one routing".into()));
+        }
+        let combos = self.tension_combinations();
+        let chunk_rows = u64::from(self.output.chunk_routings).saturating_mul(combos);
+        if chunk_rows > MAX_CHUNK_ROWS {
+            return Err(bad(if combos > MAX_CHUNK_ROWS {
+                format!("{combos} tension combinations per routing (the product of the cables' tension_n.count) is more than {MAX_CHUNK_ROWS} rows per chunk: use fewer tensions")
+            } else {
+                format!(
+                    "output.chunk_routings = {} × {combos} tension combinations gives {chunk_rows} rows per chunk, more than {MAX_CHUNK_ROWS} (each chunk is built in memory): lower chunk_routings to ≤ {}",
+                    self.output.chunk_routings,
+                    MAX_CHUNK_ROWS / combos
+                )
+            }));
+        }
+        // The base actuator (swept points at their first level) must be a
+        // rod the 3-D solver models; a routing's own faults are its rows' status.
+        let base = self.actuator_for(0, &self.dimensions());
+        match base.validate() {
+            Err(SpatialError::Parameter(e)) => return Err(bad(e.to_string())),
+            Err(e @ SpatialError::Unsupported(_)) => return Err(bad(format!("[rod] {e}"))),
+            Err(e @ SpatialError::GravityDirection(_)) => return Err(bad(e.to_string())),
+            _ => {}
+        }
+        Ok(())
+    }
+
+    /// The actuator of routing `id` (mixed radix over the dimensions, the
+    /// first fastest), tensions at zero.
+    fn actuator_for(&self, id: u64, dims: &[Dimension]) -> Actuator {
+        let mut actuator = self.actuator.clone();
+        let mut k = id;
+        for d in dims {
+            let n = d.levels.len() as u64;
+            let level = d.levels[(k % n) as usize];
+            k /= n;
+            let c = &mut actuator.cables[d.cable];
+            match d.axis {
+                Axis::Y => c.y_mm[d.point] = level,
+                Axis::Z => c.z_mm[d.point] = level,
+            }
+        }
+        actuator
+    }
+
+    /// Each cable's tension grid, N.
+    pub fn tension_grids(&self) -> Vec<Vec<f64>> {
+        self.grids.iter().map(|g| g.tension_n.values()).collect()
+    }
+
+    /// Whether the run is planar: every cable and its swept points lie in
+    /// the x–y plane (z ≡ 0) and gravity has no z component. Planar runs also
+    /// get the planar feasibility maps.
+    pub fn is_planar(&self) -> bool {
+        self.actuator.cables.iter().all(Cable::is_planar)
+            && self.grids.iter().all(|g| g.sweeps.iter().all(|s| s.axis == Axis::Y))
+            && self.actuator.gravity_direction.is_none_or(|g| g[2] == 0.0)
+    }
+
+    /// Routing `id` and the tensions of its `k`-th combination (grid order):
+    /// the actuator of the row with `routing_id = id` at that combination,
+    /// e.g. to solve it again.
+    pub fn actuator_at(&self, id: u64, k: usize) -> Actuator {
+        let mut actuator = self.actuator_for(id, &self.dimensions());
+        let grids = self.tension_grids();
+        let mut rest = k;
+        for (c, g) in actuator.cables.iter_mut().zip(&grids).rev() {
+            c.tension_n = g[rest % g.len()];
+            rest /= g.len();
+        }
+        actuator
+    }
+}
+
+/// What a worker of a cable sweep holds: the swept dimensions and the
+/// tension combinations (computed once per worker).
+#[derive(Debug, Clone)]
+pub struct CableWorker {
+    dims: Vec<Dimension>,
+    combinations: TensionCombinations,
+}
+
+/// The sweep of several or spatial cables: each routing is solved by its
+/// own 3-D solver through its tension combinations ([`solve::cable_routing`]).
+impl RunSpec for CableSweepSpec {
+    const FORMAT: &'static str = crate::io::run_markers::CABLES_FORMAT;
+    const KIND: &'static str = "cable sweep";
+    type Worker = CableWorker;
+    type Solved = Vec<CableRow>;
+
+    fn check(&self) -> Result<(), InvalidSpec> {
+        self.validate()
+    }
+
+    fn check_run_size(&self, allow_large: bool) -> Result<(), SweepError> {
+        let rows = self.routings().saturating_mul(self.tension_combinations());
+        if rows > MAX_ROWS && !allow_large {
+            return Err(SweepError::InvalidSpec {
+                origin: "(size)".into(),
+                message: format!(
+                    "the sweep has {rows} rows ({} routings × {} tension combinations), more than {MAX_ROWS}: check the levels and tension counts, \
+                     or pass --allow-large if the job is meant to be this big",
+                    self.routings(),
+                    self.tension_combinations(),
+                ),
+            });
+        }
+        Ok(())
+    }
+
+    fn canonical_json(&self) -> String {
+        serde_json::to_string(self).expect("spec serialises")
+    }
+
+    fn hash_hex(&self) -> String {
+        Sha256::digest(self.canonical_json().as_bytes()).iter().map(|b| format!("{b:02x}")).collect()
+    }
+
+    fn length_basis(&self) -> LengthBasis {
+        self.output.length_basis
+    }
+
+    fn order(&self) -> usize {
+        self.output.order
+    }
+
+    fn layout(&self) -> ChunkLayout {
+        ChunkLayout::new(self.routings(), self.tension_combinations(), u64::from(self.output.chunk_routings))
+    }
+
+    fn schema(&self) -> SchemaRef {
+        cable_schema(self.actuator.cables.len(), self.output.order)
+    }
+
+    fn row_bytes(&self) -> u64 {
+        // Per copy: the row (its cables' control points, tensions, pose and
+        // three series) or its columns; three copies as for planar rows.
+        let (cables, terms) = (self.actuator.cables.len() as u64, self.output.order as u64 + 1);
+        3 * (256 + 96 * cables + 24 * terms)
+    }
+
+    fn worker(&self) -> Result<CableWorker, SweepError> {
+        Ok(CableWorker { dims: self.dimensions(), combinations: TensionCombinations::new(self.tension_grids()) })
+    }
+
+    fn solve(&self, worker: &mut CableWorker, id: u64) -> Result<Vec<CableRow>, SweepError> {
+        let actuator = self.actuator_for(id, &worker.dims);
+        let stored = Stored { order: self.output.order, length_basis: self.output.length_basis, centreline: false };
+        Ok(solve::cable_routing(id, actuator, &self.solver, stored, &worker.combinations))
+    }
+
+    fn batch(&self, schema: &SchemaRef, solved: &[Vec<CableRow>]) -> RecordBatch {
+        let rows: Vec<&CableRow> = solved.iter().flatten().collect();
+        cable_batch(schema, &rows, self.actuator.cables.len(), self.output.order)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sweep::solve::combination_index;
+
+    const SPEC: &str = r#"
+[rod.gravity]
+enabled = false
+[[cable]]
+y_mm = [2, 2, 2, 2, 2]
+tension_n = { min = 0.0, max = 1.0, count = 3 }
+[[cable.sweep]]
+axis = "y"
+points = [1, 3]
+levels_mm = [1.0, 3.0]
+[[cable]]
+y_mm = [-2, -2, -2, -2, -2]
+tension_n = { min = 0.5, max = 1.0, count = 2 }
+[[cable.sweep]]
+axis = "z"
+points = [4]
+levels_mm = [0.0, 1.5, -1.5]
+"#;
+
+    #[test]
+    fn spec_counts_routings_and_tensions() {
+        let spec = CableSweepSpec::from_toml(SPEC, "test").unwrap();
+        assert_eq!(spec.routings(), 2 * 2 * 3);
+        assert_eq!(spec.tension_combinations(), 6);
+        let dims = spec.dimensions();
+        // Id 0: every swept point at its first level; id 1 moves the first dimension.
+        let a0 = spec.actuator_for(0, &dims);
+        assert_eq!(a0.cables[0].y_mm, [2.0, 1.0, 2.0, 1.0, 2.0]);
+        assert_eq!(a0.cables[1].z_mm, [0.0; 5]);
+        let a1 = spec.actuator_for(1, &dims);
+        assert_eq!(a1.cables[0].y_mm, [2.0, 3.0, 2.0, 1.0, 2.0]);
+        let last = spec.actuator_for(11, &dims);
+        assert_eq!(last.cables[0].y_mm, [2.0, 3.0, 2.0, 3.0, 2.0]);
+        assert_eq!(last.cables[1].z_mm, [0.0, 0.0, 0.0, 0.0, -1.5]);
+    }
+
+    #[test]
+    fn the_file_layout_round_trips_in_its_key_order() {
+        let spec = CableSweepSpec::from_toml(&format!("gj_n_mm2 = 4000\ngravity_direction = [1, 0, 0]\n{SPEC}"), "test").unwrap();
+        let json = spec.canonical_json();
+        // The canonical order (the spec hash covers it): the actuator's
+        // settings, solver, output, then the cables with their grids.
+        let at = |key: &str| json.find(&format!("\"{key}\"")).unwrap_or_else(|| panic!("{key} in {json}"));
+        let keys = ["rod", "gj_n_mm2", "gravity_direction", "solver", "output", "cable", "y_mm", "z_mm", "tension_n", "sweep"];
+        assert!(keys.windows(2).all(|w| at(w[0]) < at(w[1])), "{json}");
+        assert!(!json.contains("anchor_mm"), "no anchor, no key: {json}");
+        let back: CableSweepSpec = serde_json::from_str(&json).unwrap();
+        assert_eq!(back, spec);
+        assert_eq!(back.actuator.gj_n_mm2, Some(4000.0));
+        assert!(back.actuator.cables.iter().all(|c| c.tension_n == 0.0));
+    }
+
+    #[test]
+    fn a_routings_rows_are_in_grid_order_and_actuator_at_rebuilds_each() {
+        let spec = CableSweepSpec::from_toml(SPEC, "test").unwrap();
+        let layout = spec.layout();
+        assert_eq!((layout.routings, layout.tensions), (12, 6));
+        let mut worker = spec.worker().unwrap();
+        let rows = spec.solve(&mut worker, 7).unwrap();
+        assert_eq!(rows.len(), 6);
+        let grids = spec.tension_grids();
+        for (k, row) in rows.iter().enumerate() {
+            assert_eq!(row.routing_id, 7);
+            let combo: Vec<usize> = row.tensions.iter().zip(&grids).map(|(t, g)| g.iter().position(|v| v == t).unwrap()).collect();
+            assert_eq!(combination_index(&combo, &grids), k, "grid order, cable 1 slowest");
+            let actuator = spec.actuator_at(7, k);
+            assert_eq!(actuator.cables.iter().map(|c| c.tension_n).collect::<Vec<_>>(), row.tensions);
+            assert_eq!(actuator.cables.iter().map(|c| (c.y_mm, c.z_mm)).collect::<Vec<_>>(), row.cables);
+        }
+        // The batch has the fixed schema whatever the rows' nulls.
+        let schema = spec.schema();
+        let batch = spec.batch(&schema, &[rows]);
+        assert_eq!(batch.schema(), schema);
+        assert_eq!(batch.num_rows(), 6);
+    }
+
+    #[test]
+    fn bad_specs_name_the_problem() {
+        for (text, needle) in [
+            (SPEC.replace("points = [1, 3]", "points = [1, 5]"), "control point 5"),
+            (SPEC.replace("points = [1, 3]", "points = [1, 1]"), "swept twice"),
+            (SPEC.replace("count = 3", "count = 0"), "count = 0"),
+            (SPEC.replace("min = 0.5", "min = -0.5"), "0 ≤ min"),
+            (SPEC.replace("levels_mm = [1.0, 3.0]", "levels_mm = []"), "levels_mm"),
+            (SPEC.replace("[rod.gravity]", "[rod.effects]\nfriction_mu = 0.1\n[rod.gravity]"), "friction_mu"),
+            (format!("{SPEC}\n[output]\norder = 7\n"), "steps_per_span"),
+            (SPEC.replace("axis = \"z\"", "axis = \"x\""), "unknown variant"),
+            (
+                SPEC.replace("y_mm = [2, 2, 2, 2, 2]", "y_mm = [2, 2, 2, 2, 2]\nanchor_mm = -1"),
+                "cable 1: anchor_mm = -1 must lie on the rod",
+            ),
+            (SPEC.replace("y_mm = [-2, -2, -2, -2, -2]", "y_mm = [-2, -2, -2, -2, -2]\nanchor_mm = 70"), "cable 2: anchor_mm = 70"),
+            ("[rod]\n".to_string(), "cable"),
+        ] {
+            let e = CableSweepSpec::from_toml(&text, "spec.toml").unwrap_err().to_string();
+            assert!(e.contains(needle) && e.contains("spec.toml"), "{needle}: {e}");
+        }
+    }
+}
