@@ -183,7 +183,7 @@ pub struct FeasibilityReport {
 
 /// Judges `target` against `map`; `nearest` designs are listed. The
 /// target's coefficients are per unit of `basis`; a map made in the other
-/// basis is refused when the target has coefficients ([`check_length_basis`]).
+/// basis is refused when the target has coefficients (no exact conversion exists).
 pub fn check(map: &MapDir, target: &Target, basis: LengthBasis, weights: &Weights, nearest: usize) -> Result<FeasibilityReport, DesignError> {
     check_length_basis(map, basis, target)?;
     let x = target.get(Component::TipX);

@@ -37,7 +37,7 @@
 //! - [`record`]: the study directory: `study.json`, each `v{i}/spec.toml`.
 //! - [`comparison`]: the variants' maps compared (`comparison.csv`/`.json`).
 //! - [`page`]: `index.html`, the maps side by side, and its pictures.
-//! - [`run`]: the workflow, request → report; one variant's sweep and map.
+//! - [`run`](mod@run): the workflow, request → report; one variant's sweep and map.
 //! - [`error`]: what can go wrong.
 
 pub mod axes;
