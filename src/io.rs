@@ -147,11 +147,11 @@ fn parent_dir(path: &Path) -> &Path {
 /// new or a regular file ([`check_regular_or_new`]: the rename would
 /// otherwise replace a symlink, a FIFO or a device node such as
 /// `/dev/full` by a regular file), and it must not lie inside a sweep run
-/// directory at any depth ([`check_not_in_run_dir`]: `--csv RUN/manifest.json`
+/// directory at any depth ([`check_outside_run_dir`]: `--csv RUN/manifest.json`
 /// would destroy the run). The sweep engine writes its own files inside
 /// its run with [`write_atomic_in_run`].
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    check_not_in_run_dir(path, "the output file").map_err(|m| std::io::Error::new(std::io::ErrorKind::InvalidInput, m))?;
+    check_outside_run_dir(path, "the output file").map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidInput, e))?;
     write_atomic_in_run(path, bytes)
 }
 
@@ -320,7 +320,7 @@ pub fn enclosing_run_dir(path: &Path) -> Option<PathBuf> {
 }
 
 /// An output that is, or lies inside, a sweep run directory
-/// ([`check_not_in_run_dir`]).
+/// ([`check_outside_run_dir`]).
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 #[error(
     "{what} {} {} the sweep run directory {}; writing there would make the run unusable: give a path outside the run",
@@ -348,13 +348,6 @@ pub fn check_outside_run_dir(out: &Path, what: &str) -> Result<(), InsideRunDir>
     let Some(run) = enclosing_run_dir(out) else { return Ok(()) };
     let is_the_run = std::fs::canonicalize(out).is_ok_and(|o| o == run);
     Err(InsideRunDir { what: what.to_string(), out: out.to_path_buf(), run, is_the_run })
-}
-
-/// [`check_outside_run_dir`] with the message as text, for the layers whose
-/// error enums still hold it as a string (calibrate's report directory,
-/// reduce's map directory); new code takes [`InsideRunDir`].
-pub fn check_not_in_run_dir(out: &Path, what: &str) -> Result<(), String> {
-    check_outside_run_dir(out, what).map_err(|e| e.to_string())
 }
 
 /// A file operation that failed: which file, what was being done, and why.
@@ -708,7 +701,7 @@ mod tests {
             for inside in ["", "manifest.json", "shards/map", "shards/new/deeper/map", "shards/../x"] {
                 let path = run.join(inside);
                 assert_eq!(enclosing_run_dir(&path), Some(run.clone()), "{}", path.display());
-                let e = check_not_in_run_dir(&path, "the map directory").unwrap_err();
+                let e = check_outside_run_dir(&path, "the map directory").unwrap_err().to_string();
                 assert!(
                     e.contains("sweep run directory") && e.contains(if inside.is_empty() { " is the " } else { " is inside the " }),
                     "{e}"
@@ -718,7 +711,7 @@ mod tests {
             write_atomic_in_run(&run.join("shards/x.csv"), b"x").unwrap();
         }
         assert_eq!(enclosing_run_dir(&dir.path().join("elsewhere/map")), None);
-        assert!(check_not_in_run_dir(Path::new("relative/new/map"), "x").is_ok());
+        assert!(check_outside_run_dir(Path::new("relative/new/map"), "x").is_ok());
     }
 
     /// A run is told by its manifest's `format`, of any version and even

@@ -23,7 +23,7 @@ fn feasible(target: &str) -> Value {
 fn a_simulated_design_inside_its_cells_percentiles_is_feasible_and_nearest() {
     let (path, _) = common::map();
     let map = MapDir::open(path).unwrap();
-    let designs = map.designs().unwrap();
+    let designs = &map.designs;
     // A design of a well-populated cell whose coefficients sit inside the cell's percentiles.
     let d = designs
         .iter()

@@ -339,6 +339,54 @@ tension_n = { min = 0.0, max = 2.0, count = 5 }
     }
 }
 
+/// The antagonistic pair's map (jobs/antagonistic-pair.toml): `feasible
+/// --json` gives each nearest design with every cable (as an actuator file
+/// writes them) and the command the text shows, which solves it again to the
+/// map's tip; `design --map` refuses the map, whose designs are of a
+/// two-cable actuator, instead of seeding a one-cable search with cable 1.
+#[test]
+fn a_two_cable_maps_nearest_designs_carry_every_cable_and_design_refuses_the_map() {
+    let spec = Path::new(env!("CARGO_MANIFEST_DIR")).join("jobs/antagonistic-pair.toml");
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("pair");
+    let (ok, _, stderr) = run(&["map", s(&spec), "--out", s(&out)]);
+    assert!(ok, "{stderr}");
+    let planar = out.join("map/planar");
+    let target = "x=58,y=5";
+    let (ok, text, stderr) = run(&["feasible", "--map", s(&planar), "--target", target, "--nearest", "3"]);
+    assert!(ok, "{stderr}");
+    let (ok, json, stderr) = run(&["feasible", "--map", s(&planar), "--target", target, "--nearest", "3", "--json"]);
+    assert!(ok, "{stderr}");
+    let v: serde_json::Value = serde_json::from_str(&json).unwrap();
+    let nearest = v["nearest"].as_array().unwrap();
+    assert_eq!(nearest.len(), 3, "{v}");
+    let shown: Vec<&str> = text.lines().map(str::trim).filter(|l| l.starts_with("cablemap simulate")).collect();
+    let mut pulled_both = 0;
+    for (near, shown) in nearest.iter().zip(&shown) {
+        let cables = near["cables"].as_array().unwrap_or_else(|| panic!("no cables in {near}"));
+        assert_eq!(cables.len(), 2, "{near}");
+        // Cable 1 is the design's routing and tension; cable 2 is there too.
+        assert_eq!(cables[0]["y_mm"], near["routing_mm"], "{near}");
+        assert_eq!(cables[0]["tension_n"], near["tension_n"], "{near}");
+        assert_eq!(cables[1]["y_mm"][0], -3.0, "{near}");
+        pulled_both += usize::from(cables[1]["tension_n"].as_f64().unwrap() > 0.0);
+        let command = near["command"].as_str().unwrap();
+        assert_eq!(command, *shown, "the JSON's command is the one the text shows");
+        for cable in cables {
+            let y: Vec<String> = cable["y_mm"].as_array().unwrap().iter().map(|y| y.as_f64().unwrap().to_string()).collect();
+            let tension = cable["tension_n"].as_f64().unwrap();
+            assert!(command.contains(&format!("y={} tension={tension}", y.join(","))), "{command} lacks {cable}");
+        }
+        let (x, y) = tip_of_command(command);
+        let gap = (x - near["tip_x_mm"].as_f64().unwrap()).hypot(y - near["tip_y_mm"].as_f64().unwrap());
+        assert!(gap < 1e-3, "`{command}` ends {gap} mm from the map's tip");
+    }
+    assert!(pulled_both > 0, "some nearest design pulls both cables: {v}");
+    let (ok, _, stderr) = run(&["design", "--target", target, "--map", s(&planar), "--json"]);
+    assert!(!ok, "design --map on a two-cable map must be refused");
+    assert!(stderr.contains("an actuator of 2 cables") && stderr.contains("cablemap feasible --map"), "{stderr}");
+}
+
 /// A cable spec of many small chunks, slow enough that kills land mid-run.
 const KILL_SPEC: &str = r#"
 gravity_direction = [1, 0, 0]

@@ -69,9 +69,12 @@ pub enum CalibrateError {
     /// An effect is both fitted and held.
     #[error("--effect {0} and --fix {1}=…: an effect is either fitted or held, not both", .effect.name(), .effect.parameter_name())]
     FittedAndHeld { effect: Effect },
-    /// The report directory is inside a sweep's run directory.
-    #[error("{message}")]
-    ReportDir { message: String },
+    /// The report directory is, or lies inside, a sweep's run directory.
+    #[error(transparent)]
+    ReportDir(#[from] crate::io::InsideRunDir),
+    /// The actuator file to start from cannot be used.
+    #[error(transparent)]
+    ActuatorFile(#[from] crate::model::rod::ActuatorFileError),
     /// Drawing a plot.
     #[error(transparent)]
     Plot(#[from] crate::plot::PlotError),

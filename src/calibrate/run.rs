@@ -7,11 +7,11 @@
 //! which serialises itself (the `--json` object) and displays itself (the
 //! text report).
 
-use super::data::{read_centrelines, read_markers, split_holdout, Dataset};
+use super::data::{read_centrelines, read_markers, read_measurements, split_holdout, Dataset};
 use super::fit::{apply_held, fit_observed, rms_per_routing, FitProgress, FitResult, FitSpec, Held, Loss, Noise, RoutingRms, ShapeData};
 use super::predict::predict;
 use super::{CalibrateError, Effect};
-use crate::model::{Rod, SolverOptions};
+use crate::model::{Rod, RodOverrides, SolverOptions};
 use serde::{Serialize, Serializer};
 use std::fmt;
 use std::path::PathBuf;
@@ -81,10 +81,11 @@ impl FitSettings {
 /// Everything a calibration needs.
 #[derive(Debug, Clone)]
 pub struct CalibrateRequest {
-    /// The measurements.
-    pub data: Dataset,
-    /// Starting values and fixed parameters (validated here).
-    pub actuator: Rod,
+    /// The measurement file (CSV, or Parquet by its extension).
+    pub data_path: PathBuf,
+    /// Starting values and fixed parameters: overrides on the rod file's,
+    /// else the measurement file's, else the thesis's rod (validated here).
+    pub actuator: RodOverrides,
     /// Solver settings.
     pub options: SolverOptions,
     /// Noise, held parameters, loss, shapes.
@@ -175,11 +176,12 @@ pub fn run(request: &CalibrateRequest) -> Result<CalibrateReport, CalibrateError
 
 /// [`run`], reporting the cost and progress of a fit on large data.
 pub fn run_observed(request: &CalibrateRequest, observe: &mut dyn FnMut(CalibrateProgress)) -> Result<CalibrateReport, CalibrateError> {
-    let data = &request.data;
-    request.actuator.validate()?;
+    let data = &read_measurements(&request.data_path)?;
+    let actuator = request.actuator.resolve(data.actuator.as_ref())?;
+    actuator.validate()?;
     let options = &request.options;
     let (train, held) = split_holdout(data, request.holdout.as_deref())?;
-    let (mut spec, start, held_effects) = request.fit.resolve(&request.actuator, data)?;
+    let (mut spec, start, held_effects) = request.fit.resolve(&actuator, data)?;
     for &e in &request.effects {
         if !spec.effects.contains(&e) {
             spec.effects.push(e);

@@ -29,7 +29,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         args.routings,
         cablemap::bench::MAX_ROUTINGS
     );
-    let base = args.actuator.resolve(None)?;
+    let base = args.actuator.resolve()?;
     let options = args.actuator.solver_options(&SolverOptions::default());
     let routings = sample_thesis_routings(args.routings, base.radius_mm);
     let rows = bench_with_reference(&base, &options, &routings, !args.no_reference)?;

@@ -6,7 +6,7 @@ use super::ActuatorArgs;
 use anyhow::bail;
 use cablemap::calibrate::fit::{parse_held, Held, Loss, Noise};
 use cablemap::calibrate::run::run_observed;
-use cablemap::calibrate::{read_measurements, CalibrateError, CalibrateRequest, Effect, FitSettings};
+use cablemap::calibrate::{CalibrateError, CalibrateRequest, Effect, FitSettings};
 use cablemap::model::SolverOptions;
 use clap::Args;
 use std::io::Write;
@@ -90,6 +90,7 @@ impl FitArgs {
 pub fn with_flag(e: CalibrateError, holdout_flag: bool) -> anyhow::Error {
     match e {
         CalibrateError::Held(inner) => anyhow::Error::new(*inner).context("--fix"),
+        CalibrateError::ActuatorFile(_) => anyhow::Error::new(e).context("--actuator-file"),
         CalibrateError::Noise(_) => anyhow::Error::new(e).context("--noise-mm / --noise-deg"),
         CalibrateError::Holdout(_) if holdout_flag => anyhow::Error::new(e).context("--holdout"),
         e => anyhow::Error::new(e),
@@ -135,14 +136,13 @@ pub fn parse_effects(names: &[String]) -> anyhow::Result<Vec<Effect>> {
 
 /// Runs `cablemap calibrate`.
 pub fn run(args: &CalibrateArgs) -> anyhow::Result<()> {
-    let data = read_measurements(&args.data)?;
     let request = CalibrateRequest {
-        actuator: args.actuator.resolve(data.actuator.as_ref())?,
+        data_path: args.data.clone(),
+        actuator: args.actuator.overrides(),
         options: args.actuator.solver_options(&SolverOptions::default()),
         fit: args.fit.settings()?,
         effects: parse_effects(&args.effects)?,
         holdout: args.holdout.clone(),
-        data,
     };
     // Progress on stderr (stdout may be --json).
     let report = run_observed(&request, &mut |p| eprintln!("{p}")).map_err(|e| with_flag(e, true))?;

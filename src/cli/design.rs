@@ -3,10 +3,9 @@
 use super::{ActuatorArgs, LengthBasisArgs};
 use anyhow::Context;
 use cablemap::design::run::DesignRequest;
-use cablemap::design::{self, ComponentResult, DesignError, DesignOutcome, Objective, SearchOptions, Target, Weights};
+use cablemap::design::{self, DesignError, SearchOptions, Target, Weights};
 use cablemap::model::SolverOptions;
 use clap::Args;
-use std::io::Write;
 use std::path::PathBuf;
 
 /// Arguments of `cablemap design`.
@@ -70,7 +69,7 @@ fn request(args: &DesignArgs) -> anyhow::Result<DesignRequest> {
         None => Weights::default(),
     };
     Ok(DesignRequest {
-        actuator: args.actuator.resolve(None)?,
+        actuator: args.actuator.resolve()?,
         options: args.actuator.solver_options(&SolverOptions::default()),
         target: Target::parse(&args.target).context("--target")?,
         weights,
@@ -82,20 +81,17 @@ fn request(args: &DesignArgs) -> anyhow::Result<DesignRequest> {
         search: SearchOptions { starts: args.starts, max_evaluations: args.max_evaluations, ..SearchOptions::default() },
         tolerance_pct: args.tolerance_pct,
         out: args.out.clone(),
-        moulds: args.moulds.then(|| args.mould.params()),
+        mould: args.mould.params(),
+        write_moulds: args.moulds,
     })
 }
 
 /// Runs `cablemap design`.
 pub fn run(args: &DesignArgs) -> anyhow::Result<()> {
     let request = request(args)?;
-    let mould = args.mould.params();
-    if let Some(b) = request.mould_bound_exceeded(&mould) {
+    if let Some(bound) = request.mould_bound_exceeded() {
         // Before the search, on stderr (stdout may be --json).
-        eprintln!(
-            "note: `cablemap mould` (tube Ø {} mm, skin {} mm) needs |y_i| ≤ {:.3} mm, this search allows {:.3} mm: add --moulds to design within it",
-            mould.tube_diameter_mm, mould.min_skin_mm, b.mould_max_offset_mm, b.search_max_offset_mm
-        );
+        eprintln!("note: {bound}");
     }
     let done = design::run::run(&request).map_err(|e| match e {
         DesignError::ExportDir { .. } => anyhow::Error::new(e).context("--out"),
@@ -103,81 +99,10 @@ pub fn run(args: &DesignArgs) -> anyhow::Result<()> {
         DesignError::Mould(m) => super::mould::with_flag(m),
         e => anyhow::Error::new(e),
     })?;
-    let stdout = std::io::stdout();
-    let mut out = stdout.lock();
     if args.json {
-        writeln!(out, "{}", done.record.to_json_line())?;
-        return Ok(());
-    }
-    if let Some(f) = &done.feasibility {
-        writeln!(out, "map verdict  {}: {}\n", f.verdict.label(), f.reasons.join("; "))?;
-    }
-    write!(out, "{}", report(&done.objective, &done.outcome, &done.results, args.tolerance_pct))?;
-    if let Some(dir) = &args.out {
-        writeln!(out, "exported {} to {}", done.exported.join(", "), dir.display())?;
-    }
-    if let (Some(dir), Some(summary)) = (&args.out, &done.moulds) {
-        write!(out, "{}", super::mould::report(dir, summary))?;
+        println!("{}", done.record.to_json_line());
+    } else {
+        print!("{done}");
     }
     Ok(())
-}
-
-/// The text report: a table in the form of the thesis's Table 5.1, the design,
-/// and which components (if any) could not be met.
-pub fn report(objective: &Objective, outcome: &DesignOutcome, results: &[ComponentResult], tolerance_pct: f64) -> String {
-    let mut s = String::new();
-    let col = 14;
-    s.push_str(&format!("{:<10}", ""));
-    for r in results {
-        s.push_str(&format!("{:>col$}", format!("{} [{}]", r.component, r.component.unit())));
-    }
-    s.push('\n');
-    let digits = |r: &ComponentResult| if matches!(r.component, design::Component::A(_)) { 6 } else { 4 };
-    s.push_str(&format!("{:<10}", "Target"));
-    for r in results {
-        s.push_str(&format!("{:>col$.*}", digits(r), r.target));
-    }
-    s.push('\n');
-    s.push_str(&format!("{:<10}", "Achieved"));
-    for r in results {
-        s.push_str(&format!("{:>col$.*}", digits(r), r.achieved));
-    }
-    s.push('\n');
-    s.push_str(&format!("{:<10}", "Error"));
-    for r in results {
-        let e = r.error_pct.map_or("n/a (t=0)".to_string(), |e| format!("{e:.3}%"));
-        s.push_str(&format!("{e:>col$}"));
-    }
-    s.push('\n');
-    let e = &outcome.best;
-    s.push('\n');
-    // Pasteable into `simulate` and `design`: --routing takes a plain comma list.
-    s.push_str(&format!(
-        "routing      y0..y4 (mm): --routing {} --tension-n {:.4}\n",
-        e.routing_mm.iter().map(|y| format!("{y:.4}")).collect::<Vec<_>>().join(","),
-        e.tension_n
-    ));
-    s.push_str(&format!(
-        "tension      {:.4} N   (bounds {} … {} N)\n",
-        e.tension_n, objective.bounds.tension_min_n, objective.bounds.tension_max_n
-    ));
-    s.push_str(&format!("shape        a = [{}] 1/mm\n", e.a.iter().map(|a| format!("{a:.6}")).collect::<Vec<_>>().join(", ")));
-    s.push_str(&format!("basis        a_i {} (--length-basis {})\n", objective.length_basis.describe(), objective.length_basis));
-    s.push_str(&format!(
-        "objective    {:.3e}   ({} seed designs simulated, {} refined, {:.2} s)\n",
-        outcome.cost,
-        outcome.seeds_simulated,
-        outcome.starts.len(),
-        outcome.seconds
-    ));
-    let unmet: Vec<&ComponentResult> = results.iter().filter(|r| !r.met).collect();
-    if unmet.is_empty() {
-        s.push_str(&format!("verdict      every component met within {tolerance_pct}%\n"));
-    } else {
-        s.push_str(&format!(
-            "verdict      NOT REACHABLE as asked: {} could not be met within {tolerance_pct}%; the design above is the closest achievable (least eq. 3.17 cost)\n",
-            unmet.iter().map(|r| r.component.to_string()).collect::<Vec<_>>().join(", ")
-        ));
-    }
-    s
 }

@@ -4,7 +4,7 @@
 use super::calibrate::{with_flag, FitArgs};
 use super::ActuatorArgs;
 use cablemap::calibrate::diagnose::{self, DiagnoseRequest};
-use cablemap::calibrate::{read_measurements, CalibrateError};
+use cablemap::calibrate::CalibrateError;
 use cablemap::model::SolverOptions;
 use clap::Args;
 use std::io::Write;
@@ -50,15 +50,9 @@ pub struct DiagnoseArgs {
 
 /// Runs `cablemap diagnose`.
 pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
-    // A report directory inside a run is refused before the data are read.
-    if let (false, Some(out)) = (args.no_report, &args.out) {
-        cablemap::io::check_not_in_run_dir(out, "the report directory")
-            .map_err(|message| anyhow::Error::new(CalibrateError::ReportDir { message }).context("--out"))?;
-    }
-    let data = read_measurements(&args.data)?;
     let request = DiagnoseRequest {
         data_path: args.data.clone(),
-        actuator: args.actuator.resolve(data.actuator.as_ref())?,
+        actuator: args.actuator.overrides(),
         options: args.actuator.solver_options(&SolverOptions::default()),
         fit: args.fit.settings()?,
         holdout: args.holdout.clone(),
@@ -67,10 +61,9 @@ pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
         margin: args.margin,
         max_effects: args.max_effects,
         report_dir: (!args.no_report).then(|| args.out.clone().unwrap_or_else(|| DiagnoseRequest::default_report_dir(&args.data))),
-        data,
     };
     let report = diagnose::run(&request).map_err(|e| match e {
-        CalibrateError::ReportDir { .. } => anyhow::Error::new(e).context("--out"),
+        CalibrateError::ReportDir(_) => anyhow::Error::new(e).context("--out"),
         e => with_flag(e, false),
     })?;
     let stdout = std::io::stdout();

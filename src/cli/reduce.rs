@@ -1,9 +1,9 @@
 //! `cablemap reduce` and `cablemap map` (sweep then reduce: the main job).
 
+use super::output::Output;
 use cablemap::job::{Job, JobSpec};
-use cablemap::map::{self, MapError, MapReport, MapRequest, MapSettings, PartRequest, ReduceReport, ReduceRequest, Source};
+use cablemap::map::{self, MapError, MapReport, MapRequest, MapSettings, PartRequest, ReduceRequest, Source};
 use cablemap::reduce::{ModeBoundaries, ReduceError};
-use cablemap::study::StudyReport;
 use clap::Args;
 use std::path::{Path, PathBuf};
 
@@ -80,41 +80,6 @@ pub struct ReduceArgs {
     pub map: MapOptionArgs,
 }
 
-/// Prints a map's report: its text, or its JSON with the note on stderr
-/// (stdout then holds the JSON alone).
-fn print_map(report: &ReduceReport, json: bool) -> anyhow::Result<()> {
-    if json {
-        println!("{}", serde_json::to_value(report)?);
-        if let Some(note) = report.note() {
-            eprintln!("{note}");
-        }
-    } else {
-        print!("{report}");
-    }
-    Ok(())
-}
-
-/// Prints a study's progress line: on stdout, on stderr beside `--json`
-/// (stdout then carries only the comparison).
-pub fn say(line: &dyn std::fmt::Display, json: bool) {
-    if json {
-        eprintln!("{line}");
-    } else {
-        println!("{line}");
-    }
-}
-
-/// Prints a study's report: the comparison (text, or JSON with `json`), or
-/// the command that finishes a split study.
-pub fn print_study(report: &StudyReport, json: bool) -> anyhow::Result<()> {
-    match report {
-        StudyReport::TaskDone { .. } => say(&report.to_string().trim_end(), json),
-        StudyReport::Compared { .. } if json => println!("{}", serde_json::to_string(report)?),
-        StudyReport::Compared { .. } => print!("{report}"),
-    }
-    Ok(())
-}
-
 /// The library's error, with the flag that fixes it where there is one.
 fn with_flags(e: MapError, run: &Path, out: &Path) -> anyhow::Error {
     match e {
@@ -170,7 +135,7 @@ pub fn run(args: &ReduceArgs) -> anyhow::Result<()> {
     let source = if args.merge { Source::Parts } else { Source::Run { partial: args.partial } };
     let request = ReduceRequest { run: args.run.clone(), out: args.out.clone(), source, settings: args.map.settings()? };
     let report = map::reduce(&request).map_err(|e| with_flags(e, &args.run, &args.out))?;
-    print_map(&report, args.map.json)
+    Output::of_json_flag(args.map.json).map(&report)
 }
 
 /// Arguments of `cablemap map`.
@@ -206,17 +171,17 @@ pub fn run_map(args: &MapArgs) -> anyhow::Result<()> {
         allow_large: args.allow_large,
         settings: args.map.settings()?,
     };
-    let json = args.map.json;
+    let output = Output::of_json_flag(args.map.json);
     if !matches!(request.job.spec, JobSpec::Study(_)) {
         super::sweep::resume_hint_on_interrupt();
     }
-    let report = map::run(&request, &mut |p| say(p, json)).map_err(|e| with_flags(e, &request.out.join("run"), &request.out.join("map")))?;
+    let report = map::run(&request, &mut |p| output.progress(p)).map_err(|e| with_flags(e, &request.out.join("run"), &request.out.join("map")))?;
     match &report {
         // The sweep's lines stay text beside --json, as they always were.
         MapReport::Swept { sweep, map } => {
             print!("{sweep}");
-            print_map(map, json)
+            output.map(map)
         }
-        MapReport::Study(study) => print_study(study, json),
+        MapReport::Study(study) => output.study(study),
     }
 }

@@ -87,7 +87,7 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
             "say what to simulate: --routing Y0,..,Y4 --tension-n T (one planar cable), --cable \"y=.. z=.. tension=T\" (repeatable), or --actuator FILE.toml"
         );
     };
-    let actuator = args.actuator.resolve(None)?;
+    let actuator = args.actuator.resolve()?;
     actuator.validate()?;
     let options = args.actuator.solver_options(&SolverOptions::default());
     anyhow::ensure!(
@@ -98,8 +98,7 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     let y = parse_list(routing_text, "--routing")?;
     let routing = Routing::for_actuator(&y, &actuator).context("--routing")?;
     // The one check: a setting the planar backend of --method does not read is refused.
-    let one = cablemap::model::Actuator::with_cables(actuator.clone(), vec![cablemap::model::Cable::planar(routing.control_points_mm().0, tension)]);
-    Backend::planar(options.method).check(&one, &options, given_settings(args))?;
+    Backend::check_planar(&actuator, &options, given_settings(args))?;
     let direction = if args.direction == "unload" { LoadDirection::Unload } else { LoadDirection::Load };
     let hold = Hold { direction, dwell_s: args.dwell_s.unwrap_or(actuator.effects.creep_hold_s) };
     // The thesis route computes its own coefficients from the centreline
@@ -189,7 +188,7 @@ fn run_spatial(args: &SimulateArgs) -> anyhow::Result<()> {
             spatial.rod = args.actuator.apply(&spatial.rod);
             spatial
         }
-        None => Actuator::with_cables(args.actuator.resolve(None)?, Vec::new()),
+        None => Actuator::with_cables(args.actuator.resolve()?, Vec::new()),
     };
     if !args.cable.is_empty() {
         spatial.cables = args.cable.iter().map(|c| c.parse::<Cable>()).collect::<Result<_, _>>().context("--cable")?;

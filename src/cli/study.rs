@@ -1,7 +1,8 @@
 //! `cablemap study` (and `cablemap map` on a study spec): one resumable
 //! sweep and map per actuator variant, then the comparison.
 
-use super::reduce::{print_study, say, MapOptionArgs};
+use super::output::Output;
+use super::reduce::MapOptionArgs;
 use cablemap::study::{StudyRequest, StudySpec, StudyTask};
 use clap::Args;
 use std::path::PathBuf;
@@ -58,7 +59,7 @@ pub fn run(args: &StudyArgs) -> anyhow::Result<()> {
         allow_large: args.allow_large,
         settings: args.map.settings()?,
     };
-    let json = args.map.json;
-    let report = cablemap::study::run(&request, &mut |p| say(p, json))?;
-    print_study(&report, json)
+    let output = Output::of_json_flag(args.map.json);
+    let report = cablemap::study::run(&request, &mut |p| output.progress(p))?;
+    output.study(&report)
 }

@@ -153,7 +153,7 @@ fn hidden_effect(args: &SynthArgs) -> anyhow::Result<HiddenEffect> {
 
 /// The synth request the arguments describe.
 fn request(args: &SynthArgs) -> anyhow::Result<SynthRequest> {
-    let actuator = args.actuator.resolve(None)?;
+    let actuator = args.actuator.resolve()?;
     let effect = hidden_effect(args)?;
     let (routings, routing_tilts_rad) = match &args.routings {
         Some(t) => {

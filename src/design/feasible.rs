@@ -3,9 +3,11 @@
 //! the sweep saw there, which characteristic mode the target falls in, and
 //! which simulated designs are nearest.
 
-use super::map::{Cell, MapDir, NearDesign, CELL_STATS_ORDER, MODES};
+use super::map::{map_error, Cell, MapDesign, MapDir, CELL_STATS_ORDER, MODES};
+use super::optimise::{Seed, SeedSource};
 use super::target::{Component, Target, Weights};
 use super::DesignError;
+use crate::model::Cable;
 use crate::shape::LengthBasis;
 use serde::Serialize;
 use std::fmt;
@@ -98,6 +100,62 @@ pub struct ModeCheck {
     pub count_in_cell: Option<i64>,
 }
 
+/// A design of the map with its weighted distance to a target.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NearDesign {
+    /// The design (on a map of several cables: cable 1's routing and tension).
+    pub design: MapDesign,
+    /// √(Σ λ_j (c_j − t_j)²) over the target's components the map stores.
+    pub distance: f64,
+    /// On a map of several cables, the design's actuation; `None` on a map
+    /// of one planar cable, whose routing and tension are `design`'s.
+    pub cables: Option<DesignCables>,
+}
+
+/// Every cable of a design of a several-cable map, and the command that
+/// solves it again.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DesignCables {
+    /// Each cable: its channel, tension and anchor (the actuator file's form).
+    pub cables: Vec<Cable>,
+    /// The `cablemap simulate` command that solves the design again.
+    pub command: String,
+}
+
+impl NearDesign {
+    /// As a starting design for the optimiser (a one-cable design's).
+    pub fn seed(&self) -> Seed {
+        Seed { routing_mm: self.design.routing_mm, tension_n: self.design.tension_n, source: SeedSource::Map }
+    }
+}
+
+/// JSON with the names `design` uses (`routing_mm`, `tension_n`, `tip_x_mm`,
+/// …); a design of a several-cable map adds `cables` (every cable, as in an
+/// actuator file) and `command` (the `cablemap simulate` command).
+impl Serialize for NearDesign {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let d = &self.design;
+        let mut value = serde_json::json!({
+            "routing_mm": d.routing_mm,
+            "tension_n": d.tension_n,
+            "tip_x_mm": d.tip_x_mm,
+            "tip_y_mm": d.tip_y_mm,
+            "tip_angle_rad": d.tip_angle_rad,
+            "a": d.a,
+            "ix": d.ix,
+            "iy": d.iy,
+            "routing_id": d.routing_id,
+            "mirrored": d.mirrored,
+            "distance": self.distance,
+        });
+        if let Some(c) = &self.cables {
+            value["cables"] = serde_json::to_value(&c.cables).map_err(serde::ser::Error::custom)?;
+            value["command"] = serde_json::json!(c.command);
+        }
+        value.serialize(s)
+    }
+}
+
 /// The full answer of `feasible`.
 #[derive(Debug, Clone, Serialize)]
 pub struct FeasibilityReport {
@@ -117,21 +175,21 @@ pub struct FeasibilityReport {
     pub nearest: Vec<NearDesign>,
     /// The length the coefficients (target, map, designs) are per unit of.
     pub length_basis: LengthBasis,
-    /// A several-cable map's cables, so that each design lists every cable
-    /// and the command that solves it again (`None`: one planar cable).
+    /// A several-cable map's cables, so that each design's line lists every
+    /// cable (`None`: one planar cable).
     #[serde(skip)]
     pub cables: Option<crate::reduce::MapCables>,
 }
 
 /// Judges `target` against `map`; `nearest` designs are listed. The
 /// target's coefficients are per unit of `basis`; a map made in the other
-/// basis is refused when the target has coefficients ([`MapDir::check_length_basis`]).
+/// basis is refused when the target has coefficients (no exact conversion exists).
 pub fn check(map: &MapDir, target: &Target, basis: LengthBasis, weights: &Weights, nearest: usize) -> Result<FeasibilityReport, DesignError> {
-    map.check_length_basis(basis, target)?;
+    check_length_basis(map, basis, target)?;
     let x = target.get(Component::TipX);
     let y = target.get(Component::TipY);
-    let column = map.column_of(x);
-    let row = map.row_of(y);
+    let column = x.map(|x| cell_index(x, map.summary.x_min_mm, map.summary.cell_mm));
+    let row = y.map(|y| cell_index(y, map.summary.y_min_mm, map.summary.cell_mm));
     let within = |c: &Cell, reach: i32| {
         column.is_none_or(|ix| (c.ix - ix).abs() <= reach) && row.is_none_or(|iy| (c.iy - iy).abs() <= reach)
     };
@@ -244,11 +302,78 @@ pub fn check(map: &MapDir, target: &Target, basis: LengthBasis, weights: &Weight
         coefficients,
         unchecked,
         mode,
-        nearest: map.nearest_designs(target, weights, nearest)?,
+        nearest: nearest_designs(map, target, weights, nearest),
         length_basis: map.summary.length_basis,
-        cables: crate::reduce::MapCables::open(&map.path)
-            .map_err(|e| DesignError::Map { path: map.path.display().to_string(), message: e.to_string() })?,
+        cables: map.cables.clone(),
     })
+}
+
+/// Refuses a target whose coefficients are in another basis than the
+/// map's. There is no exact conversion: a_i change by ℓ/L, and ℓ differs
+/// from design to design within a cell, so percentiles do not convert.
+/// A target without coefficients is judged in either basis.
+fn check_length_basis(map: &MapDir, basis: LengthBasis, target: &Target) -> Result<(), DesignError> {
+    let map_basis = map.summary.length_basis;
+    if map_basis == basis || target.highest_order().is_none() {
+        return Ok(());
+    }
+    Err(map_error(
+        &map.path,
+        format!(
+            "the map's coefficients are {} ({map_basis} basis) but the target's are {} ({basis} basis); they differ \
+             by ℓ/L, which varies from design to design, so they cannot be compared: give the target in the map's \
+             basis (length basis '{map_basis}'), or reduce a sweep made with [output] length_basis = \"{basis}\"",
+            map_basis.describe(),
+            basis.describe()
+        ),
+    ))
+}
+
+/// The index of the cell containing coordinate `v` along an axis whose
+/// cells of `cell_mm` start at `min_mm`. A coordinate far off the map gives
+/// an index far off the grid: clamped to ±2³⁰, far outside every map (cells
+/// lie in 0..[`crate::reduce::MAX_CELLS_PER_AXIS`]) and small enough that
+/// index differences cannot overflow, never wrapped onto it.
+fn cell_index(v: f64, min_mm: f64, cell_mm: f64) -> i32 {
+    const FAR: i64 = 1 << 30;
+    (((v - min_mm) / cell_mm).floor() as i64).clamp(-FAR, FAR) as i32
+}
+
+/// The value of `component` in a map design (None for an order the map does not store).
+fn design_value(d: &MapDesign, component: Component) -> Option<f64> {
+    match component {
+        Component::TipX => Some(d.tip_x_mm),
+        Component::TipY => Some(d.tip_y_mm),
+        Component::A(k) => d.a.get(k).copied(),
+    }
+}
+
+/// The `count` designs of the map nearest to `target` by the weighted
+/// distance √(Σ λ_j (c_j − t_j)²) over the target components the map
+/// stores (coefficients above the map's order are ignored); on a map of
+/// several cables, each with every cable and its command.
+fn nearest_designs(map: &MapDir, target: &Target, weights: &Weights, count: usize) -> Vec<NearDesign> {
+    let distance = |d: &MapDesign| {
+        target
+            .components
+            .iter()
+            .filter_map(|(c, t)| design_value(d, *c).map(|v| weights.get(*c) * (v - t).powi(2)))
+            .sum::<f64>()
+            .sqrt()
+    };
+    let mut near: Vec<(f64, &MapDesign)> = map.designs.iter().map(|d| (distance(d), d)).collect();
+    near.sort_by(|p, q| p.0.total_cmp(&q.0));
+    near.truncate(count);
+    near.into_iter()
+        .map(|(distance, d)| NearDesign {
+            design: d.clone(),
+            distance,
+            cables: map.cables.as_ref().map(|c| DesignCables {
+                cables: c.actuator(d.routing_id).cables,
+                command: c.command(d.routing_id).text,
+            }),
+        })
+        .collect()
 }
 
 fn mode_check(map: &MapDir, target: &Target, cell: Option<&Cell>) -> ModeCheck {
@@ -419,8 +544,8 @@ impl fmt::Display for FeasibilityReport {
                 d.a.iter().map(|v| format!("{v:.4}")).collect::<Vec<_>>().join(", "),
                 near.distance
             )?;
-            if let Some(cables) = &r.cables {
-                writeln!(f, "    {}", cables.command(d.routing_id).text)?;
+            if let Some(cables) = &near.cables {
+                writeln!(f, "    {}", cables.command)?;
             }
         }
         Ok(())

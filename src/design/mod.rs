@@ -7,7 +7,8 @@
 //! - [`feasible`]: the map's verdict on a target before any optimisation.
 //! - [`record`]: design.json, its fields, writer and reader.
 //! - [`export`]: the design's files: design.json, channel CSV, 1:1 mould SVG, achieved-vs-target PNG.
-//! - [`run`]: the whole workflow of `cablemap design`.
+//! - [`run`]: the whole workflow of `cablemap design` (its request);
+//!   [`report`]: what it returns and the text it prints.
 
 pub mod export;
 pub mod feasible;
@@ -15,6 +16,7 @@ pub mod map;
 pub mod objective;
 pub mod optimise;
 pub mod record;
+pub mod report;
 pub mod run;
 pub mod target;
 

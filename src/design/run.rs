@@ -2,15 +2,16 @@
 //! feasibility map's tension range and verdict when one is given), search,
 //! compare with the target, and export the design (and its moulds).
 
-use super::feasible::{self, FeasibilityReport};
+use super::feasible;
 use super::map::MapDir;
 use super::objective::{Bounds, Objective};
-use super::optimise::{self, compare, ComponentResult, DesignOutcome, SearchOptions, Seed};
+use super::optimise::{self, compare, SearchOptions, Seed};
 use super::record::DesignRecord;
+use super::report::DesignRun;
 use super::target::{Target, Weights};
 use super::DesignError;
 use crate::model::{Rod, Routing, SolverOptions};
-use crate::mould::{MouldParams, MouldSet, MouldSummary};
+use crate::mould::{MouldParams, MouldSet};
 use crate::shape::LengthBasis;
 use std::path::PathBuf;
 
@@ -45,40 +46,36 @@ pub struct DesignRequest {
     pub tolerance_pct: f64,
     /// Export directory (design.json, channel.csv, mould.svg, shape.png).
     pub out: Option<PathBuf>,
-    /// With `out`: also the printable moulds, with these parameters; the
-    /// search then keeps the channel where they can cast it.
-    pub moulds: Option<MouldParams>,
-}
-
-/// A finished design.
-#[derive(Debug, Clone)]
-pub struct DesignRun {
-    /// The objective searched.
-    pub objective: Objective,
-    /// The search's result.
-    pub outcome: DesignOutcome,
-    /// Each target component, achieved vs asked.
-    pub results: Vec<ComponentResult>,
-    /// The map's verdict, when a map was given.
-    pub feasibility: Option<FeasibilityReport>,
-    /// design.json's content.
-    pub record: DesignRecord,
-    /// The names of the design's files written into `out` (design.json,
-    /// channel.csv, mould.svg for a uniform body, shape.png), in order;
-    /// empty without `out`. The moulds' files are in `moulds`.
-    pub exported: Vec<String>,
-    /// The moulds written, when asked for.
-    pub moulds: Option<MouldSummary>,
+    /// The moulds' parameters: with `write_moulds` the moulds written;
+    /// without, the bound `cablemap mould` will need is named when this
+    /// search allows more ([`DesignRequest::mould_bound_exceeded`]).
+    pub mould: MouldParams,
+    /// With `out`: also write the printable moulds; the search then keeps
+    /// the channel where they can cast it.
+    pub write_moulds: bool,
 }
 
 /// The channel offset `cablemap mould` will need, when a design's search
 /// allows more ([`DesignRequest::mould_bound_exceeded`]).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct MouldBound {
     /// The search's largest |y_i|, mm.
     pub search_max_offset_mm: f64,
     /// The largest |y_c| the moulds can cast, mm ([`MouldParams::max_channel_offset_mm`]).
     pub mould_max_offset_mm: f64,
+    /// The moulds' parameters that bound it.
+    pub mould: MouldParams,
+}
+
+impl std::fmt::Display for MouldBound {
+    /// The note `design` prints before its search.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "`cablemap mould` (tube Ø {} mm, skin {} mm) needs |y_i| ≤ {:.3} mm, this search allows {:.3} mm: add --moulds to design within it",
+            self.mould.tube_diameter_mm, self.mould.min_skin_mm, self.mould_max_offset_mm, self.search_max_offset_mm
+        )
+    }
 }
 
 /// How far inside the moulds' limit `design --moulds` keeps the control
@@ -88,9 +85,13 @@ const MOULD_ROUNDING_MM: f64 = 1e-9;
 
 impl DesignRequest {
     /// The objective, with bounds from the request, else the map's tension
-    /// range, else the defaults.
+    /// range, else the defaults; a map made for another actuator is refused
+    /// ([`MapDir::check_actuator`]).
     pub fn objective(&self, map: Option<&MapDir>) -> Result<Objective, DesignError> {
         self.actuator.validate()?;
+        if let Some(m) = map {
+            m.check_actuator(&self.actuator)?;
+        }
         if !(self.tolerance_pct.is_finite() && self.tolerance_pct >= 0.0) {
             return Err(DesignError::BadSearch(format!("the tolerance must be a finite number ≥ 0 %, got {}", self.tolerance_pct)));
         }
@@ -100,7 +101,7 @@ impl DesignRequest {
         let [lo, hi] = map.map_or(DEFAULT_TENSION_RANGE_N, |m| m.summary.tension_range_n);
         let mut bounds = Bounds::thesis(self.actuator.channel_radius_mm(), self.tension_min_n.unwrap_or(lo), self.tension_max_n.unwrap_or(hi));
         bounds.max_offset_mm = self.requested_max_offset_mm();
-        if let Some(params) = &self.moulds {
+        if let Some(params) = self.moulds() {
             bounds.max_offset_mm = bounds.max_offset_mm.min(params.max_channel_offset_mm(self.actuator.radius_mm) - MOULD_ROUNDING_MM);
         }
         Ok(Objective::new(self.actuator.clone(), self.options.clone(), self.target.clone(), self.weights.clone(), bounds)?
@@ -112,16 +113,22 @@ impl DesignRequest {
         self.max_offset_mm.unwrap_or_else(|| Bounds::thesis_max_offset_mm(self.actuator.channel_radius_mm()))
     }
 
+    /// The moulds' parameters when the moulds are to be written.
+    fn moulds(&self) -> Option<&MouldParams> {
+        self.write_moulds.then_some(&self.mould)
+    }
+
     /// Without moulds asked for: the bound `cablemap mould` (with `mould`)
     /// will need, when this search's is wider and the body is one mould
     /// makes (uniform); `None` otherwise.
-    pub fn mould_bound_exceeded(&self, mould: &MouldParams) -> Option<MouldBound> {
-        if self.moulds.is_some() || crate::mould::check_uniform_body(&self.actuator).is_err() {
+    pub fn mould_bound_exceeded(&self) -> Option<MouldBound> {
+        if self.write_moulds || crate::mould::check_uniform_body(&self.actuator).is_err() {
             return None;
         }
         let bound = MouldBound {
             search_max_offset_mm: self.requested_max_offset_mm(),
-            mould_max_offset_mm: mould.max_channel_offset_mm(self.actuator.radius_mm),
+            mould_max_offset_mm: self.mould.max_channel_offset_mm(self.actuator.radius_mm),
+            mould: self.mould.clone(),
         };
         (bound.search_max_offset_mm > bound.mould_max_offset_mm).then_some(bound)
     }
@@ -130,7 +137,7 @@ impl DesignRequest {
     /// cannot cast and mould parameters they refuse (checked on a straight
     /// channel, which every usable parameter set casts).
     fn check_moulds(&self) -> Result<(), DesignError> {
-        let Some(params) = &self.moulds else { return Ok(()) };
+        let Some(params) = self.moulds() else { return Ok(()) };
         let act = &self.actuator;
         crate::mould::check_uniform_body(act)?;
         act.validate()?;
@@ -151,9 +158,6 @@ pub fn run(request: &DesignRequest) -> Result<DesignRun, DesignError> {
     request.check_moulds()?;
     let map = request.map.as_deref().map(MapDir::open).transpose()?;
     let objective = request.objective(map.as_ref())?;
-    if let Some(m) = &map {
-        m.check_actuator(&objective.actuator)?;
-    }
     let feasibility = match &map {
         Some(m) => Some(feasible::check(m, &objective.target, objective.length_basis, &objective.weights, 2 * request.search.starts)?),
         None => None,
@@ -167,15 +171,15 @@ pub fn run(request: &DesignRequest) -> Result<DesignRun, DesignError> {
     }
     let (mut exported, mut moulds) = (Vec::new(), None);
     if let Some(dir) = &request.out {
-        let tube_mm = request.moulds.as_ref().map_or(MouldParams::default().tube_diameter_mm, |p| p.tube_diameter_mm);
+        let tube_mm = request.moulds().map_or(MouldParams::default().tube_diameter_mm, |p| p.tube_diameter_mm);
         exported = super::export::write_all(dir, &objective, &outcome.best, &record, tube_mm)?;
-        if let Some(params) = &request.moulds {
+        if let Some(params) = request.moulds() {
             let act = &objective.actuator;
             let routing = Routing::for_actuator(&outcome.best.routing_mm, act)?;
             moulds = Some(MouldSet::new(&routing, act.radius_mm, params)?.write_all(dir)?);
         }
     }
-    Ok(DesignRun { objective, outcome, results, feasibility, record, exported, moulds })
+    Ok(DesignRun { objective, outcome, results, tolerance_pct: request.tolerance_pct, feasibility, record, out: request.out.clone(), exported, moulds })
 }
 
 #[cfg(test)]
@@ -184,6 +188,8 @@ mod tests {
 
     fn request(moulds: Option<MouldParams>, max_offset_mm: Option<f64>) -> DesignRequest {
         DesignRequest {
+            write_moulds: moulds.is_some(),
+            mould: moulds.unwrap_or_default(),
             actuator: Rod::default(),
             options: SolverOptions::default(),
             target: Target::parse("x=50,y=5").unwrap(),
@@ -196,7 +202,6 @@ mod tests {
             search: SearchOptions::default(),
             tolerance_pct: 5.0,
             out: None,
-            moulds,
         }
     }
 
@@ -223,12 +228,15 @@ mod tests {
         assert!(crate::mould::Moulds::new(&edge, act.radius_mm, &params).is_ok());
         // Without moulds: the thesis's bound, and the moulds' named.
         assert_eq!(bound(&request(None, None)), Bounds::thesis_max_offset_mm(5.0));
-        let note = request(None, None).mould_bound_exceeded(&params).expect("the default bound exceeds the moulds'");
-        assert_eq!(note, MouldBound { search_max_offset_mm: Bounds::thesis_max_offset_mm(5.0), mould_max_offset_mm: limit_mm });
-        assert_eq!(request(None, Some(4.0)).mould_bound_exceeded(&params), None);
-        assert_eq!(request(Some(params.clone()), None).mould_bound_exceeded(&params), None);
+        let note = request(None, None).mould_bound_exceeded().expect("the default bound exceeds the moulds'");
+        assert_eq!(
+            note,
+            MouldBound { search_max_offset_mm: Bounds::thesis_max_offset_mm(5.0), mould_max_offset_mm: limit_mm, mould: params.clone() }
+        );
+        assert_eq!(request(None, Some(4.0)).mould_bound_exceeded(), None);
+        assert_eq!(request(Some(params.clone()), None).mould_bound_exceeded(), None);
         let mut tapered = request(None, None);
         tapered.actuator.radius_profile_mm = vec![(0.0, 5.0), (65.0, 4.0)];
-        assert_eq!(tapered.mould_bound_exceeded(&params), None, "mould makes no tapered body: nothing to say");
+        assert_eq!(tapered.mould_bound_exceeded(), None, "mould makes no tapered body: nothing to say");
     }
 }

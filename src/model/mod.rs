@@ -4,6 +4,7 @@
 //! writes ([`record`]).
 
 pub mod actuator;
+pub mod rod_overrides;
 pub mod body;
 pub mod cable;
 pub mod effect_parameters;
@@ -23,6 +24,7 @@ pub use cable::{Cable, MAX_CABLES};
 pub use effect_parameters::{Effects, LoadDirection};
 pub use parameter::{ParameterError, PlausibleRange};
 pub use rod::{Gravity, Rod};
+pub use rod_overrides::RodOverrides;
 pub use effects::{EffectInfo, REGISTRY};
 pub use routing::{ControlPoints, Routing, RoutingError};
 pub use solver::{Backend, Given, Unsupported};

@@ -380,7 +380,7 @@ impl Simulator {
             options.nodes_per_span
         };
         let body = actuator.body()?;
-        Backend::check_planar(actuator, options)?;
+        Backend::check_planar(actuator, options, Given::default())?;
         let spans = span_boundaries(actuator, body.as_ref(), 0.5 * actuator.cable_length_mm()).len() - 1;
         // Per-point buffers: RK4 stage points, or collocation nodes.
         let points = match options.method {

@@ -75,6 +75,44 @@ pub struct MouldSummary {
     pub mould2_body_mm3: f64,
 }
 
+impl MouldSummary {
+    /// The text `mould` prints once the moulds are written into `dir`.
+    pub fn report(&self, dir: &Path) -> String {
+        let s = self;
+        let mut out = String::new();
+        out.push_str(&format!(
+            "moulds for y0..y4 = [{}] mm, L = {} mm, r = {} mm, clamp block {} mm, tube Ø {} mm\n",
+            s.routing_mm.iter().map(|y| format!("{y:.3}")).collect::<Vec<_>>().join(", "),
+            s.length_mm,
+            s.radius_mm,
+            s.params.clamp_mm,
+            s.params.tube_diameter_mm
+        ));
+        for f in &s.files {
+            let desc: Vec<String> = f
+                .parts
+                .iter()
+                .map(|p| {
+                    format!(
+                        "{} '{}' {:.1} cm³{}",
+                        p.part.name(),
+                        p.letter,
+                        p.volume_mm3 / 1000.0,
+                        if p.watertight { "" } else { " NOT WATERTIGHT" }
+                    )
+                })
+                .collect();
+            out.push_str(&format!("{:<12} {}\n", f.file, desc.join(", ")));
+        }
+        out.push_str(&format!(
+            "cavity 1     {:.1} mm³ (half body minus half channel {:.1} mm³)\ncavity 2     {:.1} mm³ (body {:.1} mm³)\n",
+            s.mould1_cavity_mm3, s.mould1_body_mm3, s.mould2_cavity_mm3, s.mould2_body_mm3
+        ));
+        out.push_str(&format!("wrote mould1.stl, mould2.stl, mould1.png, mould2.png, channel.csv, mould.json to {}\n", dir.display()));
+        out
+    }
+}
+
 impl MouldSet {
     /// Builds the tray, lid and cover.
     pub fn build(moulds: Moulds) -> Self {

@@ -48,6 +48,6 @@ impl PlotError {
 /// come first here.
 pub fn png_backend(path: &Path, size_px: (u32, u32)) -> Result<BitMapBackend<'_>, PlotError> {
     crate::io::check_regular_or_new(path).map_err(|e| PlotError::new(path, e))?;
-    crate::io::check_not_in_run_dir(path, "the picture").map_err(|e| PlotError::new(path, e))?;
+    crate::io::check_outside_run_dir(path, "the picture").map_err(|e| PlotError::new(path, e))?;
     Ok(BitMapBackend::new(path, size_px))
 }

@@ -4,14 +4,19 @@
 //! variant done is told to a progress callback as it finishes, since a
 //! study runs for hours.
 
-use super::{compare, run_variant, Comparison, StudyError, StudySpec, VariantRun, COMPARISON_CSV, COMPARISON_JSON, PAGE_FILE};
+use super::comparison::{compare, Comparison, COMPARISON_CSV, COMPARISON_JSON};
+use super::error::StudyError;
+use super::page::PAGE_FILE;
+use super::spec::{StudySpec, Variant};
+use crate::io::FileError;
 use crate::map::MapSettings;
+use crate::reduce::tables::{read_cells, read_summary};
 use crate::reduce::ReduceOptions;
 use crate::sweep::progress::ProgressMode;
 use crate::sweep::SweepOptions;
 use serde::Serialize;
 use std::fmt;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// One task of a study split among `shards` tasks (a cluster array).
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -190,6 +195,75 @@ pub fn run(request: &StudyRequest, progress: &mut dyn FnMut(&StudyProgress)) -> 
         }
     }
     let comparison = compare(study, out)?;
-    comparison.write(out)?;
+    write_comparison(&comparison, out)?;
     Ok(StudyReport::Compared { comparison, out: out.clone() })
+}
+
+/// Writes comparison.csv, comparison.json, the page's reach pictures and
+/// index.html into `dir` (reading the variants' maps again).
+fn write_comparison(comparison: &Comparison, dir: &Path) -> Result<(), StudyError> {
+    let mut maps = Vec::with_capacity(comparison.variants.len());
+    for r in &comparison.variants {
+        let map = dir.join(&r.map);
+        let err = |source| StudyError::Map { index: r.index, source };
+        let summary = read_summary(&map).map_err(err)?;
+        let cells = read_cells(&map, summary.order).map_err(err)?;
+        maps.push((summary, cells));
+    }
+    let pictures = comparison.draw_pictures(dir, &maps)?;
+    let json = serde_json::to_string_pretty(comparison).expect("serializes") + "\n";
+    for (file, text) in [(COMPARISON_CSV, comparison.csv()), (COMPARISON_JSON, json), (PAGE_FILE, comparison.html(&pictures))] {
+        let path = dir.join(file);
+        crate::io::write_atomic(&path, text.as_bytes()).map_err(FileError::on("writing", &path))?;
+    }
+    Ok(())
+}
+
+/// What running one variant did.
+#[derive(Debug, Clone)]
+pub struct VariantRun {
+    /// The sweep (rows solved now and before).
+    pub sweep: crate::sweep::SweepSummary,
+    /// The map's summary.
+    pub map: crate::reduce::MapSummary,
+    /// Seconds for the sweep and the map.
+    pub wall_s: f64,
+}
+
+/// Runs variant `v` of the study in `dir`: its sweep (resumed where it
+/// stopped, always as one shard: a cluster task runs whole variants) and
+/// its map, exactly as `cablemap map` of its spec into `v{i}/`. The map's
+/// scratch goes beside it unless `reduce.scratch_dir` says otherwise.
+pub fn run_variant(
+    v: &Variant,
+    dir: &Path,
+    sweep: &crate::sweep::SweepOptions,
+    reduce: &crate::reduce::ReduceOptions,
+) -> Result<VariantRun, StudyError> {
+    let start = std::time::Instant::now();
+    let options = crate::sweep::SweepOptions {
+        shard: 0,
+        shards: 1,
+        ..sweep.clone()
+    };
+    let run = v.run_dir(dir);
+    let summary = crate::sweep::run_sweep(&v.spec, &run, &options).map_err(|source| StudyError::Sweep {
+        index: v.index,
+        label: v.label(),
+        source,
+    })?;
+    let reduce_err = |source| StudyError::Reduce {
+        index: v.index,
+        label: v.label(),
+        source,
+    };
+    let mut reduce = reduce.clone();
+    reduce.scratch_dir.get_or_insert_with(|| v.dir(dir));
+    let (map, spec) = crate::reduce::reduce_run(&run, false, &reduce).map_err(reduce_err)?;
+    crate::reduce::write_map_replacing(&v.map_dir(dir), &map, &spec.actuator, &spec.solver).map_err(reduce_err)?;
+    Ok(VariantRun {
+        sweep: summary,
+        map: map.summary,
+        wall_s: start.elapsed().as_secs_f64(),
+    })
 }

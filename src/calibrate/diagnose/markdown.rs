@@ -14,15 +14,15 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 /// Writes `report.md` and its plots into `dir` (created if needed);
-/// returns the report's path.
-pub fn write_report(
+/// returns the report's path. [`crate::calibrate::diagnose::run()`] has refused a `dir` inside a
+/// sweep run before reading the measurements.
+pub(super) fn write_report(
     dir: &Path,
     data_path: &Path,
     data: &Dataset,
     d: &Diagnosis,
     spec: &DiagnoseSpec,
 ) -> Result<PathBuf, CalibrateError> {
-    crate::io::check_not_in_run_dir(dir, "the report directory").map_err(|message| CalibrateError::ReportDir { message })?;
     std::fs::create_dir_all(dir)
         .map_err(|source| CalibrateError::Io { context: format!("creating report directory {}", dir.display()), source })?;
     let groups = data.groups();

@@ -1,25 +1,25 @@
-//! A diagnosis as a request: the measurements, the starting actuator, the
-//! fit settings and the criterion's thresholds in; the diagnosis and the
-//! report's path out.
+//! A diagnosis as a request: the measurement file, the starting actuator,
+//! the fit settings and the criterion's thresholds in; the diagnosis and
+//! the report's path out. The report directory is refused before anything
+//! is read.
 
 use super::analysis::{diagnose, DiagnoseSpec};
 use super::markdown::write_report;
 use super::report::DiagnoseReport;
-use crate::calibrate::data::Dataset;
+use crate::calibrate::data::read_measurements;
 use crate::calibrate::run::FitSettings;
 use crate::calibrate::CalibrateError;
-use crate::model::{Rod, SolverOptions};
+use crate::model::{RodOverrides, SolverOptions};
 use std::path::{Path, PathBuf};
 
 /// Everything a diagnosis needs.
 #[derive(Debug, Clone)]
 pub struct DiagnoseRequest {
-    /// Where the measurements came from (named in the report).
+    /// The measurement file (CSV, or Parquet by its extension).
     pub data_path: PathBuf,
-    /// The measurements.
-    pub data: Dataset,
-    /// Starting values and fixed parameters (validated here).
-    pub actuator: Rod,
+    /// Starting values and fixed parameters: overrides on the rod file's,
+    /// else the measurement file's, else the thesis's rod (validated here).
+    pub actuator: RodOverrides,
     /// Solver settings.
     pub options: SolverOptions,
     /// Noise, held parameters, loss, shapes.
@@ -48,14 +48,17 @@ impl DiagnoseRequest {
     }
 }
 
-/// Runs a diagnosis and writes its report (when asked for).
+/// Runs a diagnosis and writes its report (when asked for): a report
+/// directory inside a sweep run is refused first, before the measurements
+/// are read and the fits run.
 pub fn run(request: &DiagnoseRequest) -> Result<DiagnoseReport, CalibrateError> {
     if let Some(dir) = &request.report_dir {
-        // Before the fits, not after them.
-        crate::io::check_not_in_run_dir(dir, "the report directory").map_err(|message| CalibrateError::ReportDir { message })?;
+        crate::io::check_outside_run_dir(dir, "the report directory")?;
     }
-    request.actuator.validate()?;
-    let (fit, start, held_effects) = request.fit.resolve(&request.actuator, &request.data)?;
+    let data = read_measurements(&request.data_path)?;
+    let actuator = request.actuator.resolve(data.actuator.as_ref())?;
+    actuator.validate()?;
+    let (fit, start, held_effects) = request.fit.resolve(&actuator, &data)?;
     let spec = DiagnoseSpec {
         holdout: request.holdout.clone(),
         fit,
@@ -65,9 +68,9 @@ pub fn run(request: &DiagnoseRequest) -> Result<DiagnoseReport, CalibrateError> 
         alpha: request.alpha,
         held_effects,
     };
-    let diagnosis = diagnose(&start, &request.options, &request.data, &spec)?;
+    let diagnosis = diagnose(&start, &request.options, &data, &spec)?;
     let report = match &request.report_dir {
-        Some(dir) => Some(write_report(dir, &request.data_path, &request.data, &diagnosis, &spec)?),
+        Some(dir) => Some(write_report(dir, &request.data_path, &data, &diagnosis, &spec)?),
         None => None,
     };
     Ok(DiagnoseReport { diagnosis, report })

@@ -20,7 +20,7 @@
 //! models once ([`Backend::support`]); the check compares the two, so a
 //! new feature or backend is one line in each.
 
-use crate::model::{Actuator, Rod};
+use crate::model::{Actuator, Cable, Rod};
 use crate::model::solver::{SolverMethod, SolverOptions};
 
 /// A way to solve an actuator's statics.
@@ -220,7 +220,22 @@ impl Backend {
     /// (the settings in `given` asked for explicitly); otherwise what it does
     /// not model and which backend would serve the whole request, if any.
     pub fn check(self, actuator: &Actuator, options: &SolverOptions, given: Given) -> Result<(), Unsupported> {
-        let needs = needs(actuator, options, given);
+        let request = Request { rod: &actuator.rod, cables: &actuator.cables, gravity_direction: actuator.gravity_direction };
+        self.check_needs(&needs(request, options, given))
+    }
+
+    /// [`Backend::check`] of the planar backend of `options.method` for the
+    /// planar solver's own input: `rod` with its one in-plane cable (the
+    /// routing and tension do not matter to the check), without copying the rod.
+    pub fn check_planar(rod: &Rod, options: &SolverOptions, given: Given) -> Result<(), Unsupported> {
+        let one = [Cable::planar([0.0; 5], 0.0)];
+        let request = Request { rod, cables: &one, gravity_direction: None };
+        Backend::planar(options.method).check_needs(&needs(request, options, given))
+    }
+
+    /// `Ok` if this backend serves every one of `needs`; otherwise the first
+    /// it does not, and which backend would serve them all, if any.
+    fn check_needs(self, needs: &[(Need, String)]) -> Result<(), Unsupported> {
         let Some(&(need, ref what)) = needs.iter().find(|(need, _)| !self.serves(*need)) else {
             return Ok(());
         };
@@ -244,12 +259,6 @@ impl Backend {
         Ok(backend)
     }
 
-    /// [`Backend::check`] of the planar backend of `options.method` for the
-    /// planar solver's own input: `rod` with its one in-plane cable.
-    pub fn check_planar(rod: &Rod, options: &SolverOptions) -> Result<(), Unsupported> {
-        let one = Actuator::with_cables(rod.clone(), vec![crate::model::Cable::planar([0.0; 5], 0.0)]);
-        Backend::planar(options.method).check(&one, options, Given::default())
-    }
 }
 
 /// Whether `actuator` is planar: one cable with z ≡ 0 and gravity (if on) in
@@ -260,19 +269,29 @@ pub fn is_planar(actuator: &Actuator) -> bool {
     actuator.cables.len() == 1 && actuator.cables[0].is_planar() && gravity_in_plane
 }
 
-/// Everything `actuator` with `options` needs of a backend, each with the
+/// What the check reads of a request: the rod, the cables and the
+/// direction of gravity (an [`Actuator`]'s, or the planar solver's rod with
+/// its one in-plane cable).
+#[derive(Clone, Copy)]
+struct Request<'a> {
+    rod: &'a Rod,
+    cables: &'a [Cable],
+    gravity_direction: Option<[f64; 3]>,
+}
+
+/// Everything `request` with `options` needs of a backend, each with the
 /// words that name it in a refusal.
-fn needs(actuator: &Actuator, options: &SolverOptions, given: Given) -> Vec<(Need, String)> {
-    let rod = &actuator.rod;
+fn needs(request: Request<'_>, options: &SolverOptions, given: Given) -> Vec<(Need, String)> {
+    let Request { rod, cables, gravity_direction } = request;
     let mut needs = Vec::new();
     let mut need = |n: Need, what: String| needs.push((n, what));
-    if actuator.cables.len() > 1 {
-        need(Need::SeveralCables, format!("{} cables (it takes one)", actuator.cables.len()));
+    if cables.len() > 1 {
+        need(Need::SeveralCables, format!("{} cables (it takes one)", cables.len()));
     }
-    if let Some(i) = actuator.cables.iter().position(|c| !c.is_planar()) {
+    if let Some(i) = cables.iter().position(|c| !c.is_planar()) {
         need(Need::OutOfPlaneChannel, format!("an out-of-plane channel (cable {}: z ≠ 0)", i + 1));
     }
-    if rod.gravity.enabled && actuator.gravity_direction.is_some_and(|g| g[2] != 0.0) {
+    if rod.gravity.enabled && gravity_direction.is_some_and(|g| g[2] != 0.0) {
         need(Need::GravityOutOfPlane, "gravity out of the x–y plane (--gravity-direction with Z ≠ 0)".into());
     }
     if !rod.radius_profile_mm.is_empty() || !rod.segments.is_empty() {
@@ -285,7 +304,7 @@ fn needs(actuator: &Actuator, options: &SolverOptions, given: Given) -> Vec<(Nee
         need(Need::RodAnchor, "the rod-level cable_anchor_mm (--cable-anchor-mm): give each cable its own anchor (anchor=S)".into());
     }
     let length = rod.length_mm;
-    let anchored = rod.cable_anchor_mm.is_some_and(|k| k < length) || actuator.cables.iter().any(|c| c.anchor_mm.is_some_and(|k| k < length));
+    let anchored = rod.cable_anchor_mm.is_some_and(|k| k < length) || cables.iter().any(|c| c.anchor_mm.is_some_and(|k| k < length));
     if anchored {
         need(Need::AnchorBeforeTip, "a cable anchored before the tip (it knots the cable at the tip only)".into());
     }
@@ -341,5 +360,34 @@ fn advice(served_by: Option<Backend>, but_not: Option<&str>) -> String {
         (Some(b), None) => format!("{} serves this request", how(b)),
         (Some(b), Some(rest)) => format!("{} models it, but not {rest}", how(b)),
         (None, _) => "no solver models it".into(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The planar solver's entry is the one check: a rod alone gets the
+    /// answer an actuator of that rod and one in-plane cable gets.
+    #[test]
+    fn a_rod_is_checked_as_the_rod_with_its_one_planar_cable() {
+        let tapered = Rod { radius_profile_mm: vec![(0.0, 5.0), (65.0, 4.0)], ..Rod::default() };
+        let anchored = Rod { cable_anchor_mm: Some(40.0), ..Rod::default() };
+        let mut rubbing = Rod::default();
+        rubbing.effects.friction_mu = 0.2;
+        let rk4 = SolverOptions { method: SolverMethod::Rk4, ..SolverOptions::default() };
+        let nodes = Given { nodes_per_span: true, ..Given::default() };
+        let mut refused = 0;
+        for rod in [Rod::default(), tapered, anchored, rubbing] {
+            for options in [SolverOptions::default(), rk4.clone()] {
+                for given in [Given::default(), nodes] {
+                    let actuator = Actuator::with_cables(rod.clone(), vec![Cable::planar([1.0, -2.0, 0.5, 0.0, 3.0], 1.5)]);
+                    let whole = Backend::planar(options.method).check(&actuator, &options, given);
+                    assert_eq!(Backend::check_planar(&rod, &options, given), whole);
+                    refused += usize::from(whole.is_err());
+                }
+            }
+        }
+        assert!(refused > 0, "some of these the planar backends refuse");
     }
 }
