@@ -396,7 +396,8 @@ mod tests {
         assert_eq!(planar.anchor_mm, Some(40.0));
         for (text, needle) in [
             ("y=1,2,3 tension=1", "5 control points, got 3"),
-            ("y=1,2,3,4,5", "tension= is missing"),
+            ("y=1,2,3,4,5", "tension= (N) or displacement= (mm) is missing"),
+            ("y=1,2,3,4,5 tension=1 displacement=2", "not both"),
             ("z=1,2,3,4,5 tension=1", "y= is missing"),
             ("y=1,2,x,4,5 tension=1", "'x' is not a number"),
             ("y=1,2,3,4,5 tension=1 colour=red", "unknown field 'colour'"),

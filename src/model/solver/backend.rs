@@ -297,7 +297,7 @@ fn needs(request: Request<'_>, options: &SolverOptions, given: Given) -> Vec<(Ne
     if !rod.radius_profile_mm.is_empty() || !rod.segments.is_empty() {
         need(Need::NonUniformBody, "a tapered or segmented body (radius_profile_mm, segments): it models a uniform rod".into());
     }
-    if let Some(i) = actuator.cables.iter().position(|c| c.is_displacement_driven()) {
+    if let Some(i) = cables.iter().position(|c| c.is_displacement_driven()) {
         need(Need::Displacement, format!("a cable driven by its displacement (cable {}: displacement_mm; the RK4 methods do not integrate the cables' paths)", i + 1));
     }
     if rod.cable_anchor_mm.is_some() {

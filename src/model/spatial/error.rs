@@ -46,7 +46,7 @@ pub enum SpatialError {
     #[error(transparent)]
     Planar(#[from] crate::model::SimulateError),
     /// The `--cable` text could not be read.
-    #[error("cable \"{text}\": {why} (expected \"y=Y0,Y1,Y2,Y3,Y4 z=Z0,Z1,Z2,Z3,Z4 tension=T\", z= optional, anchor=S optional)")]
+    #[error("cable \"{text}\": {why} (expected \"y=Y0,Y1,Y2,Y3,Y4 z=Z0,Z1,Z2,Z3,Z4 tension=T\" or displacement=D in place of tension=T; z=, ea=EA (the cable's stiffness, N) and anchor=S optional)")]
     CableSpec { text: String, why: String },
     /// An actuator file is not valid TOML or has unknown fields.
     #[error("actuator file {source_name}: {message}(see docs/schema.md, \"Spatial actuator file\")")]
