@@ -60,6 +60,7 @@ use crate::model::{Body, Hold, Rod};
 use crate::numerics::anderson::Anderson;
 use crate::numerics::chebyshev::{self, next_coefficient, ESTIMATE_SAFETY};
 use crate::shape::{LegendreSeries, LengthBasis};
+use std::sync::Arc;
 use nalgebra::{DMatrix, DVector, Matrix3, Matrix6, Quaternion, Rotation3, UnitQuaternion, Vector3, Vector6};
 
 type V3 = Vector3<f64>;
@@ -68,7 +69,7 @@ type M3 = Matrix3<f64>;
 /// Most fixed-point sweeps before Newton takes over.
 const MAX_SWEEPS: u32 = 40;
 /// Change of the frames between sweeps accepted as settled, rad.
-const SWEEP_ANGLE_TOLERANCE_RAD: f64 = 1e-9;
+const SWEEP_ANGLE_TOLERANCE_RAD: f64 = 3e-10;
 /// Newton on the whole system: scaled residual (rad) accepted as converged.
 const NEWTON_TOLERANCE: f64 = 1e-11;
 /// Newton iterations per solve before giving up.
@@ -91,6 +92,9 @@ const CHORD_CONTRACTION: f64 = 0.25;
 /// tension comes from differences of displacements, so each solve is
 /// converged past the discretisation's noise (≈ 1e-13 mm in a path length).
 const PRECISE_TOLERANCE_SCALE: f64 = 1e-3;
+/// Converged solves kept for the prediction of the next (Lagrange
+/// extrapolation along a tension ladder: cubic with four).
+const HISTORY: usize = 4;
 /// Local Newton: most steps.
 const LOCAL_MAX_ITERATIONS: usize = 100;
 /// Material stiffening's law: Newton's tolerance and iteration cap.
@@ -101,6 +105,65 @@ const STIFFENING_MAX_ITERATIONS: usize = 50;
 const MIN_NODES_WITH_STIFFENING: usize = 16;
 /// Most collocation intervals per span (the buffers of a span are this + 1 long).
 const MAX_NODES: usize = crate::model::solver::MAX_NODES_PER_SPAN;
+
+/// The Chebyshev–Lobatto matrices of one span at m intervals, with the
+/// rows this solver's Magnus steps and friction grid read: built once per m
+/// and shared ([`Grid::of`]), since a sweep builds a solver per routing.
+#[derive(Debug)]
+struct Grid {
+    /// Nodes on [−1, 1].
+    xn: Vec<f64>,
+    /// Integration matrix (row m: the Clenshaw–Curtis weights).
+    q: Vec<f64>,
+    /// Differentiation matrix.
+    diff: Vec<f64>,
+    /// The discrete Chebyshev transform's highest rows (error estimates).
+    tail: Vec<f64>,
+    /// Per interval [x_{j−1}, x_j], the rows its Magnus step reads: the exact
+    /// integral of the interpolant over the interval, and at its Gauss points
+    /// c = ½ − √15/10, ½, ½ + √15/10 the combinations u(c₂), u(c₃) − u(c₁),
+    /// u(c₃) − 2u(c₂) + u(c₁) (4 m rows of m + 1).
+    magnus: Vec<f64>,
+    /// Interpolation rows onto the friction grid of each interval
+    /// (m (FRICTION_SUBSTEPS − 1) rows of m + 1).
+    fine: Vec<f64>,
+}
+
+impl Grid {
+    /// The grid of `m` intervals, built on first use.
+    fn of(m: usize) -> Arc<Grid> {
+        static GRIDS: std::sync::OnceLock<std::sync::Mutex<Vec<Option<Arc<Grid>>>>> = std::sync::OnceLock::new();
+        let grids = GRIDS.get_or_init(|| std::sync::Mutex::new(vec![None; MAX_NODES + 1]));
+        let mut grids = grids.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+        grids[m].get_or_insert_with(|| Arc::new(Grid::build(m))).clone()
+    }
+
+    fn build(m: usize) -> Grid {
+        let np = m + 1;
+        let xn = chebyshev::lobatto_nodes(m);
+        let q = chebyshev::integration_matrix(m);
+        let mut magnus = Vec::with_capacity(4 * m * np);
+        let mut g = [vec![0.0; np], vec![0.0; np], vec![0.0; np]];
+        for j in 1..np {
+            for (row, c) in g.iter_mut().zip([0.5 - 15f64.sqrt() / 10.0, 0.5, 0.5 + 15f64.sqrt() / 10.0]) {
+                chebyshev::interpolation_weights(&xn, xn[j - 1] + c * (xn[j] - xn[j - 1]), row);
+            }
+            magnus.extend((0..np).map(|k| q[j * np + k] - q[(j - 1) * np + k]));
+            magnus.extend_from_slice(&g[1]);
+            magnus.extend((0..np).map(|k| g[2][k] - g[0][k]));
+            magnus.extend((0..np).map(|k| g[2][k] - 2.0 * g[1][k] + g[0][k]));
+        }
+        let mut fine = Vec::with_capacity(m * (FRICTION_SUBSTEPS - 1) * np);
+        let mut row = vec![0.0; np];
+        for j in 1..np {
+            for k in 1..FRICTION_SUBSTEPS {
+                chebyshev::interpolation_weights(&xn, xn[j - 1] + (xn[j] - xn[j - 1]) * k as f64 / FRICTION_SUBSTEPS as f64, &mut row);
+                fine.extend_from_slice(&row);
+            }
+        }
+        Grid { diff: chebyshev::differentiation_matrix(m), tail: chebyshev::tail_rows(m), xn, q, magnus, fine }
+    }
+}
 
 /// The cross-section at a node.
 #[derive(Debug, Clone, Copy)]
@@ -150,23 +213,16 @@ pub struct SpatialSolver {
     signed_mu: f64,
     /// Where the friction profiles τ_c(s)/τ_c(0) start in the state (nn × cables, node-major).
     ratio_at: usize,
-    /// Interpolation rows onto the friction grid of each interval
-    /// ((m) × (FRICTION_SUBSTEPS − 1) rows of np).
-    fine: Vec<f64>,
     /// The cables' global directions at the nodes (node-major), scratch.
     global_dir: Vec<V3>,
     /// Viscoelastic creep in bending: two components (about body y and z) per node.
     creep: Creep,
     hold: Hold,
-    // The collocation grid.
+    // The collocation grid: intervals per span, nodes per span, the span
+    // matrices (shared by every solver of the same m).
     m: usize,
     np: usize,
-    xn: Vec<f64>,
-    q: Vec<f64>,
-    diff: Vec<f64>,
-    tail: Vec<f64>,
-    /// Per interval, the rows of its Magnus step (4 m rows of np; [`SpatialSolver::new`]).
-    magnus: Vec<f64>,
+    grid: Arc<Grid>,
     start: Vec<f64>,
     half: Vec<f64>,
     // Per node.
@@ -214,10 +270,7 @@ pub struct SpatialSolver {
     /// for displacement-driven cables, whose tensions are found by
     /// differences of solves).
     tolerance_scale: f64,
-    /// Whether the last solve's sweeps stalled (a heavy rod): the next
-    /// solve goes to Newton at once.
-    sweeps_stall: bool,
-    /// The last three converged solves, newest first (`solved` of them valid).
+    /// The last [`HISTORY`] converged solves, newest first (`solved` of them valid).
     history: Vec<Solved>,
     solved: usize,
     passes: u32,
@@ -245,7 +298,6 @@ impl SpatialSolver {
         }
         let cuts = crate::model::body::merge_sorted(cuts, length);
         let spans = cuts.len() - 1;
-        let xn = chebyshev::lobatto_nodes(m);
         let nn = spans * np;
         let nc = channels.len();
         let gj_uniform = actuator.torsional_rigidity_n_mm2();
@@ -257,6 +309,8 @@ impl SpatialSolver {
             Some(_) if !rod.gravity.enabled => 0.0,
             Some(_) => rod.gravity.scale * 1e-6 * std::f64::consts::PI * rod.gravity.g_m_s2,
         };
+        let grid = Grid::of(m);
+        let xn = &grid.xn;
         let mut s = Vec::with_capacity(nn);
         let mut section = Vec::with_capacity(nn);
         let mut distal_weight = Vec::with_capacity(nn);
@@ -317,23 +371,7 @@ impl SpatialSolver {
         if let Some(b) = &body {
             check_channels_inside(actuator, &channels, b, delta)?;
         }
-        let q = chebyshev::integration_matrix(m);
-        // Per interval [x_{j−1}, x_j], the rows the Magnus step reads: the
-        // exact integral of the interpolant over the interval, and at its
-        // Gauss points c = ½ − √15/10, ½, ½ + √15/10 the combinations
-        // u(c₂), u(c₃) − u(c₁), u(c₃) − 2u(c₂) + u(c₁).
-        let mut magnus = Vec::with_capacity(4 * m * np);
-        let mut g = [vec![0.0; np], vec![0.0; np], vec![0.0; np]];
-        let mut row = vec![0.0; np];
-        for j in 1..np {
-            for (row, c) in g.iter_mut().zip([0.5 - 15f64.sqrt() / 10.0, 0.5, 0.5 + 15f64.sqrt() / 10.0]) {
-                chebyshev::interpolation_weights(&xn, xn[j - 1] + c * (xn[j] - xn[j - 1]), row);
-            }
-            magnus.extend((0..np).map(|k| q[j * np + k] - q[(j - 1) * np + k]));
-            magnus.extend_from_slice(&g[1]);
-            magnus.extend((0..np).map(|k| g[2][k] - g[0][k]));
-            magnus.extend((0..np).map(|k| g[2][k] - 2.0 * g[1][k] + g[0][k]));
-        }
+        let q = &grid.q;
         // Each cable's rest path, by the span quadrature the deformed one takes.
         let mut rest_length_mm = vec![0.0; nc];
         for (span, &h) in half.iter().enumerate() {
@@ -351,15 +389,6 @@ impl SpatialSolver {
         let ei0 = section[0].ei;
         let friction = rod.effects.friction_mu > 0.0;
         let n_state = 3 + 6 * nn + if friction { nn * nc } else { 0 };
-        let mut fine = Vec::with_capacity(m * (FRICTION_SUBSTEPS - 1) * np);
-        if friction {
-            for j in 1..np {
-                for k in 1..FRICTION_SUBSTEPS {
-                    chebyshev::interpolation_weights(&xn, xn[j - 1] + (xn[j] - xn[j - 1]) * k as f64 / FRICTION_SUBSTEPS as f64, &mut row);
-                    fine.extend_from_slice(&row);
-                }
-            }
-        }
         let hold = Hold { direction: rod.effects.load_direction, dwell_s: rod.effects.creep_hold_s };
         let mut creep = Creep::new(&rod.effects, rod.ei_n_mm2, 2 * nn);
         creep.set_dwell(hold.dwell_s);
@@ -377,17 +406,12 @@ impl SpatialSolver {
             friction,
             signed_mu: rod.effects.friction_mu * rod.effects.load_direction.slip_sign(),
             ratio_at: 3 + 6 * nn,
-            fine,
             global_dir: vec![V3::x(); nn * nc],
             creep,
             hold,
             m,
             np,
-            xn,
-            diff: chebyshev::differentiation_matrix(m),
-            tail: chebyshev::tail_rows(m),
-            q,
-            magnus,
+            grid: grid.clone(),
             start,
             half,
             s,
@@ -420,7 +444,6 @@ impl SpatialSolver {
             anderson: Anderson::new(n_state),
             newton_factors: None,
             tolerance_scale: if actuator.cables.iter().any(|c| c.is_displacement_driven()) { PRECISE_TOLERANCE_SCALE } else { 1.0 },
-            sweeps_stall: false,
             history: Vec::with_capacity(3),
             solved: 0,
             passes: 0,
@@ -487,6 +510,7 @@ impl SpatialSolver {
         self.creep.begin_solve();
         match self.solve_inner(&tensions) {
             Ok(passes) => {
+                self.settle_outputs();
                 self.creep.end_solve();
                 self.passes = passes;
                 let pose = self.pose_of_state(passes, &tensions);
@@ -533,7 +557,7 @@ impl SpatialSolver {
     /// Keeps the converged state of `tensions` as the newest of the last
     /// three solves (ring buffers: no allocation after the first three).
     fn remember(&mut self, tensions: &[f64]) {
-        if self.history.len() < 3 {
+        if self.history.len() < HISTORY {
             self.history.push(Solved { tensions: tensions.to_vec(), state: self.state.clone(), local: self.local.clone() });
             self.history.rotate_right(1);
         } else {
@@ -543,7 +567,7 @@ impl SpatialSolver {
             h.state.copy_from_slice(&self.state);
             h.local.copy_from_slice(&self.local);
         }
-        self.solved = (self.solved + 1).min(3);
+        self.solved = (self.solved + 1).min(HISTORY);
     }
 
     /// Forgets the warm start (after a failed solve).
@@ -582,7 +606,7 @@ impl SpatialSolver {
             }
         }
         let k = params.len();
-        let mut w = [0.0; 3];
+        let mut w = [0.0; HISTORY];
         for i in 0..k {
             let mut weight = 1.0;
             for j in 0..k {
@@ -593,7 +617,8 @@ impl SpatialSolver {
             w[i] = weight;
         }
         if !w.iter().all(|v| v.is_finite()) {
-            w = [1.0, 0.0, 0.0];
+            w = [0.0; HISTORY];
+            w[0] = 1.0;
         }
         for (i, v) in self.state.iter_mut().enumerate() {
             *v = (0..k).map(|h| w[h] * self.history[h].state[i]).sum();
@@ -612,13 +637,12 @@ impl SpatialSolver {
             return Ok(1);
         }
         let mut passes = 0u32;
-        let mut previous = f64::INFINITY;
+        // The changes of the last two sweeps (newest first).
+        let mut previous = [f64::INFINITY; 2];
         self.anderson.restart();
         // The prediction, for Newton to start from if the sweeps stall.
         let predicted = (self.state.clone(), self.local.clone());
-        let outcome = if self.sweeps_stall && has_weight {
-            Err(SpatialFailure::Gravity { passes: 0, residual_n_mm: f64::NAN })
-        } else {
+        let outcome = {
             loop {
             self.anderson.input_mut().copy_from_slice(&self.state);
             let change = match self.sweep(tensions, true) {
@@ -626,10 +650,11 @@ impl SpatialSolver {
                 Err(e) => break Err(e),
             };
             passes += 1;
+            if std::env::var("DEBUG_SWEEP").is_ok() { eprintln!("  sweep {passes}: {:.2e} {:.2e} {:.2e}", change.0, change.1, change.2); }
             let k = self.tolerance_scale;
             let settled = change.0 <= k * SWEEP_ANGLE_TOLERANCE_RAD && change.1 <= k * self.options.moment_tolerance_n_mm * self.m_scale && change.2 < k * FRICTION_TOLERANCE;
             let change = change.0.max(change.1).max(change.2);
-            if settled && (passes == 1 || change <= 0.5 * previous || !has_weight) {
+            if settled && (passes == 1 || change <= 0.5 * previous[0] || !has_weight) {
                 std::mem::swap(&mut self.state, &mut self.next);
                 break Ok(());
             }
@@ -637,10 +662,13 @@ impl SpatialSolver {
             if !has_weight && passes >= most {
                 break Err(SpatialFailure::Friction);
             }
-            if passes >= most || (has_weight && passes >= 3 && change > 0.5 * previous) {
+            // Stalled (a heavy rod, where the sweeps do not contract): less
+            // than a third off over two sweeps (Anderson's changes are not
+            // monotone from one sweep to the next).
+            if passes >= most || (has_weight && passes >= 3 && change > 0.67 * previous[1]) {
                 break Err(SpatialFailure::Gravity { passes, residual_n_mm: change / self.m_scale });
             }
-            previous = change;
+            previous = [change, previous[0]];
             self.anderson.output_mut().copy_from_slice(&self.next);
             match self.anderson.step() {
                 Some(z) => self.state.copy_from_slice(z),
@@ -649,14 +677,11 @@ impl SpatialSolver {
             }
         };
         match outcome {
-            Ok(()) => {
-                self.sweeps_stall = false;
-                Ok(passes)
-            }
+            Ok(()) => Ok(passes),
             Err(SpatialFailure::Friction) => Err(SpatialFailure::Friction),
             Err(_) => {
+                if std::env::var("DEBUG_SWEEP").is_ok() { eprintln!("  -> newton at tensions {tensions:?}"); }
                 self.anderson.clear();
-                self.sweeps_stall = true;
                 self.state.copy_from_slice(&predicted.0);
                 self.local.copy_from_slice(&predicted.1);
                 Ok(passes + self.newton_continued(tensions)?)
@@ -886,11 +911,6 @@ impl SpatialSolver {
             self.dp[i] = rot_out[i] * self.vbuf[i];
         }
         if commit {
-            for i in 0..nn {
-                self.speed[i] = self.vbuf[i].norm();
-            }
-        }
-        if commit {
             self.rot = rot_out;
         } else {
             self.rot_alt = rot_out;
@@ -929,18 +949,6 @@ impl SpatialSolver {
         self.ubuf = ubuf;
         self.mbuf = mom;
         let change_ratio = if self.friction { self.friction_profiles(commit) } else { 0.0 };
-        if commit {
-            self.positions();
-            if self.creep.is_on() {
-                for i in 0..nn {
-                    let x = self.local[i];
-                    let m = self.moment_of_curvature(&V3::new(x[3], x[4], x[5]), i);
-                    let ei = self.section[i].ei;
-                    self.creep.record_moment(2 * i, m[1], ei);
-                    self.creep.record_moment(2 * i + 1, m[2], ei);
-                }
-            }
-        }
         if !(change + change_m + change_ratio).is_finite() {
             return Err(SpatialFailure::NonFinite);
         }
@@ -978,7 +986,7 @@ impl SpatialSolver {
                 comp[2][k] = uk[2];
             }
             for j in 1..np {
-                let rows = &self.magnus[4 * (j - 1) * np..4 * j * np];
+                let rows = &self.grid.magnus[4 * (j - 1) * np..4 * j * np];
                 // The four functionals of each component in one pass (twelve
                 // independent sums).
                 let mut acc = [[0.0f64; 3]; 4];
@@ -992,7 +1000,7 @@ impl SpatialSolver {
                     }
                 }
                 let g = acc.map(V3::from);
-                let step = h * (self.xn[j] - self.xn[j - 1]);
+                let step = h * (self.grid.xn[j] - self.grid.xn[j - 1]);
                 let integral = g[0] * h;
                 let a1 = g[1] * step;
                 let a2 = g[2] * (sqrt15 * step / 3.0);
@@ -1006,6 +1014,27 @@ impl SpatialSolver {
         }
     }
 
+    /// What a converged solve leaves besides the state: |v|, the positions
+    /// and deformed arc length (from the last committed sweep's `dp`), and
+    /// the bending moments creep keeps.
+    fn settle_outputs(&mut self) {
+        let nn = self.nodes_count();
+        for i in 0..nn {
+            let x = &self.local[i];
+            self.speed[i] = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
+        }
+        self.positions();
+        if self.creep.is_on() {
+            for i in 0..nn {
+                let x = self.local[i];
+                let m = self.moment_of_curvature(&V3::new(x[3], x[4], x[5]), i);
+                let ei = self.section[i].ei;
+                self.creep.record_moment(2 * i, m[1], ei);
+                self.creep.record_moment(2 * i + 1, m[2], ei);
+            }
+        }
+    }
+
     /// Positions and deformed arc length from `self.dp` and the local v.
     fn positions(&mut self) {
         let np = self.np;
@@ -1014,7 +1043,7 @@ impl SpatialSolver {
             let base = span * np;
             let h = self.half[span];
             for j in 0..np {
-                let row = &self.q[j * np..(j + 1) * np];
+                let row = &self.grid.q[j * np..(j + 1) * np];
                 let (mut ap, mut asg) = (V3::zeros(), 0.0);
                 for k in 0..np {
                     ap += self.dp[base + k] * row[k];
@@ -1035,9 +1064,9 @@ impl SpatialSolver {
         for span in (0..self.spans()).rev() {
             let base = span * np;
             let h = self.half[span];
-            let last = &self.q[(np - 1) * np..np * np];
+            let last = &self.grid.q[(np - 1) * np..np * np];
             for j in 0..np {
-                let row = &self.q[j * np..(j + 1) * np];
+                let row = &self.grid.q[j * np..(j + 1) * np];
                 let mut acc = V3::zeros();
                 for k in 0..np {
                     acc += self.dmom[base + k] * (last[k] - row[k]);
@@ -1310,7 +1339,7 @@ impl SpatialSolver {
                             let g = if k == FRICTION_SUBSTEPS {
                                 self.global_dir[i * nc + c]
                             } else {
-                                let row = &self.fine[((j - 1) * (FRICTION_SUBSTEPS - 1) + (k - 1)) * np..][..np];
+                                let row = &self.grid.fine[((j - 1) * (FRICTION_SUBSTEPS - 1) + (k - 1)) * np..][..np];
                                 let mut g = V3::zeros();
                                 for (w, jj) in row.iter().zip(0..np) {
                                     g += self.global_dir[(base + jj) * nc + c] * *w;
@@ -1419,7 +1448,7 @@ impl SpatialSolver {
                 }
             }
             let slice = |k: usize| &comps[k * np..(k + 1) * np];
-            let tails = chebyshev::tails_of(&self.tail, np, [slice(0), slice(1), slice(2), slice(3), slice(4), slice(5), slice(6), slice(7), slice(8)]);
+            let tails = chebyshev::tails_of(&self.grid.tail, np, [slice(0), slice(1), slice(2), slice(3), slice(4), slice(5), slice(6), slice(7), slice(8)]);
             let next = tails.map(next_coefficient);
             angle += length * next[0].max(next[1]).max(next[2]);
             position += length * next[3].max(next[4]).max(next[5]);
@@ -1479,7 +1508,7 @@ impl SpatialSolver {
         for span in 0..self.spans() {
             let base = span * np;
             for j in 0..np {
-                let row = &self.diff[j * np..(j + 1) * np];
+                let row = &self.grid.diff[j * np..(j + 1) * np];
                 let mut d = V3::zeros();
                 for k in 0..np {
                     d += vhat[base + k] * row[k];
@@ -1503,7 +1532,7 @@ impl SpatialSolver {
                 let i = base + j;
                 let t = 2.0 * self.sigma[i] / ell - 1.0;
                 let mut legendre = LegendreSeries::new(t);
-                let w = h * self.q[(np - 1) * np + j];
+                let w = h * self.grid.q[(np - 1) * np + j];
                 for n in 0..=order {
                     if n > 0 {
                         legendre.advance();
@@ -1518,7 +1547,7 @@ impl SpatialSolver {
             for n in 0..=order {
                 let worst = (0..3)
                     .map(|k| {
-                        let [tail] = chebyshev::tails_of(&self.tail, np, [&values[(n * 3 + k) * np..(n * 3 + k + 1) * np]]);
+                        let [tail] = chebyshev::tails_of(&self.grid.tail, np, [&values[(n * 3 + k) * np..(n * 3 + k + 1) * np]]);
                         next_coefficient(tail)
                     })
                     .fold(0.0, f64::max);
@@ -1605,7 +1634,7 @@ impl SpatialSolver {
                     for (j, v) in vals[..np].iter_mut().enumerate() {
                         *v = f(base + j);
                     }
-                    chebyshev::interpolate(&self.xn, &vals[..np], x)
+                    chebyshev::interpolate(&self.grid.xn, &vals[..np], x)
                 };
                 let p = [at(&|i| self.pos[i][0]), at(&|i| self.pos[i][1]), at(&|i| self.pos[i][2])];
                 let qv: [f64; 4] = std::array::from_fn(|c| at(&|i| quats[i][c]));
@@ -1660,7 +1689,7 @@ impl SpatialSolver {
                     let x = &self.local[i];
                     let ch = &self.chan[i * nc + c];
                     let dl = (V3::new(x[0], x[1], x[2]) + V3::new(x[3], x[4], x[5]).cross(&ch.r) + ch.dr).norm();
-                    let w = self.half[span] * self.q[(np - 1) * np + j];
+                    let w = self.half[span] * self.grid.q[(np - 1) * np + j];
                     path += w * dl;
                     pulled += w * dl * self.tension_at(tensions, i, c);
                 }
@@ -1686,7 +1715,7 @@ impl SpatialSolver {
                     let x = &self.local[base + j];
                     let ch = &self.chan[(base + j) * nc + c];
                     let q = V3::new(x[0], x[1], x[2]) + V3::new(x[3], x[4], x[5]).cross(&ch.r) + ch.dr;
-                    out[c] += h * self.q[(np - 1) * np + j] * q.norm();
+                    out[c] += h * self.grid.q[(np - 1) * np + j] * q.norm();
                 }
             }
         }
@@ -1713,10 +1742,17 @@ fn exp_so3(w: &V3) -> M3 {
     let t2 = w.norm_squared();
     let k = w.cross_matrix();
     let (a, b) = if t2 < 0.25 {
-        // sin θ/θ = Σ (−θ²)^n/(2n+1)!, (1 − cos θ)/θ² = Σ (−θ²)^n/(2n+2)!.
-        let a = 1.0 - t2 / 6.0 * (1.0 - t2 / 20.0 * (1.0 - t2 / 42.0 * (1.0 - t2 / 72.0 * (1.0 - t2 / 110.0 * (1.0 - t2 / 156.0 * (1.0 - t2 / 210.0))))));
-        let b = 0.5 * (1.0 - t2 / 12.0 * (1.0 - t2 / 30.0 * (1.0 - t2 / 56.0 * (1.0 - t2 / 90.0 * (1.0 - t2 / 132.0 * (1.0 - t2 / 182.0 * (1.0 - t2 / 240.0)))))));
-        (a, b)
+        // sin θ/θ = Σ (−θ²)^n/(2n+1)!, (1 − cos θ)/θ² = Σ (−θ²)^n/(2n+2)!,
+        // by Horner with the coefficients' ratios as products (a division
+        // costs several multiplications).
+        const A: [f64; 7] = [1.0 / 6.0, 1.0 / 20.0, 1.0 / 42.0, 1.0 / 72.0, 1.0 / 110.0, 1.0 / 156.0, 1.0 / 210.0];
+        const B: [f64; 7] = [1.0 / 12.0, 1.0 / 30.0, 1.0 / 56.0, 1.0 / 90.0, 1.0 / 132.0, 1.0 / 182.0, 1.0 / 240.0];
+        let (mut a, mut b) = (1.0, 1.0);
+        for k in (0..7).rev() {
+            a = 1.0 - t2 * A[k] * a;
+            b = 1.0 - t2 * B[k] * b;
+        }
+        (a, 0.5 * b)
     } else {
         let theta = t2.sqrt();
         (theta.sin() / theta, (1.0 - theta.cos()) / t2)
@@ -2032,3 +2068,29 @@ mod timing {
     }
 }
 
+#[cfg(test)]
+mod debug_bench {
+    use super::*;
+    #[test]
+    #[ignore]
+    fn debug_bench_pairs() {
+        let pairs = crate::bench::sample_spatial_pairs(50, 5.0);
+        let rod = Rod::default();
+        for _repeat in 0..std::env::var("REPEAT").map_or(1, |r| r.parse().unwrap()) {
+        for (n, pair) in pairs.iter().enumerate() {
+            let mut a = Actuator::with_cables(rod.clone(), pair.to_vec());
+            a.gravity_direction = Some([0.0, 0.6, 0.8]);
+            a.rod.gravity.enabled = std::env::var("GRAVITY").map_or(true, |g| g != "off");
+            let mut col = SpatialSolver::new(&a, &SpatialOptions::default()).unwrap();
+            let start = std::time::Instant::now();
+            for k in 0..21 {
+                let t = 1.0 + k as f64 / 20.0;
+                if std::env::var("DEBUG_PAIR").map_or(false, |p| p == n.to_string()) { eprintln!("tension {t}"); }
+                col.solve(&[t, 0.5 * t]).unwrap();
+                std::hint::black_box(col.coefficients(3, LengthBasis::Rest).unwrap());
+            }
+            eprintln!("pair {n}: {:.1} µs per solve", start.elapsed().as_secs_f64() * 1e6 / 21.0);
+        }
+        }
+    }
+}
