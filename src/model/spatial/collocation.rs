@@ -650,7 +650,6 @@ impl SpatialSolver {
                 Err(e) => break Err(e),
             };
             passes += 1;
-            if std::env::var("DEBUG_SWEEP").is_ok() { eprintln!("  sweep {passes}: {:.2e} {:.2e} {:.2e}", change.0, change.1, change.2); }
             let k = self.tolerance_scale;
             let settled = change.0 <= k * SWEEP_ANGLE_TOLERANCE_RAD && change.1 <= k * self.options.moment_tolerance_n_mm * self.m_scale && change.2 < k * FRICTION_TOLERANCE;
             let change = change.0.max(change.1).max(change.2);
@@ -680,7 +679,6 @@ impl SpatialSolver {
             Ok(()) => Ok(passes),
             Err(SpatialFailure::Friction) => Err(SpatialFailure::Friction),
             Err(_) => {
-                if std::env::var("DEBUG_SWEEP").is_ok() { eprintln!("  -> newton at tensions {tensions:?}"); }
                 self.anderson.clear();
                 self.state.copy_from_slice(&predicted.0);
                 self.local.copy_from_slice(&predicted.1);
@@ -2004,93 +2002,3 @@ mod tests {
     }
 }
 
-#[cfg(test)]
-mod timing {
-    use super::*;
-    use crate::model::spatial::SpatialRk4Solver;
-    use std::time::Instant;
-
-    /// Not a check: prints µs per solve of both 3-D solvers and the planar
-    /// one on the bench's cases (`cargo test --release -- --ignored timing --nocapture`).
-    #[test]
-    #[ignore]
-    fn print_timings() {
-        let pairs = crate::bench::sample_spatial_pairs(200, 5.0);
-        for gravity in [None, Some([1.0, 0.0, 0.0])] {
-            let mut rod = Rod::default();
-            rod.gravity.enabled = gravity.is_some();
-            let (mut t_col, mut t_rk4, mut n) = (0.0, 0.0, 0);
-            let mut passes = 0u64;
-            let mut worst = 0.0f64;
-            for pair in &pairs {
-                let mut a = Actuator::with_cables(rod.clone(), pair.to_vec());
-                a.gravity_direction = gravity;
-                let start = Instant::now();
-                let mut col = SpatialSolver::new(&a, &SpatialOptions::default()).unwrap();
-                let mut last = None;
-                for k in 0..21 {
-                    let t = 1.0 + k as f64 / 20.0;
-                    let p = col.solve(&[t, 0.5 * t]).unwrap();
-                    passes += p.iterations as u64;
-                    let c = col.coefficients(3, LengthBasis::Rest).unwrap();
-                    std::hint::black_box(c);
-                    last = Some(p);
-                }
-                t_col += start.elapsed().as_secs_f64();
-                let start = Instant::now();
-                let mut rk = SpatialRk4Solver::new(&a, &SpatialOptions::default()).unwrap();
-                let mut last_rk = None;
-                for k in 0..21 {
-                    let t = 1.0 + k as f64 / 20.0;
-                    last_rk = Some(rk.solve(&[t, 0.5 * t]).unwrap());
-                    std::hint::black_box(rk.coefficients(3, LengthBasis::Rest).unwrap());
-                }
-                t_rk4 += start.elapsed().as_secs_f64();
-                let (p, q) = (last.unwrap(), last_rk.unwrap());
-                worst = worst.max((0..3).map(|i| (p.tip_mm()[i] - q.tip_mm()[i]).abs()).fold(0.0, f64::max));
-                n += 21;
-            }
-            eprintln!("passes per solve {:.2}", passes as f64 / n as f64);
-            eprintln!("gravity {gravity:?}: collocation {:.2} µs, rk4 {:.2} µs per solve; tips differ ≤ {worst:.1e} mm", t_col / n as f64 * 1e6, t_rk4 / n as f64 * 1e6);
-            let mut sim = crate::model::Simulator::new(&rod, &crate::model::SolverOptions::default()).unwrap();
-            let routings = crate::bench::sample_thesis_routings(200, 5.0);
-            let start = Instant::now();
-            let mut a = [0.0; 4];
-            for y in &routings {
-                sim.set_routing_mm(&y.0).unwrap();
-                for k in 0..21 {
-                    sim.solve(1.0 + k as f64 / 20.0).unwrap();
-                    sim.coefficients_into(LengthBasis::Rest, &mut a);
-                }
-            }
-            eprintln!("   planar {:.2} µs per solve", start.elapsed().as_secs_f64() / (21 * routings.len()) as f64 * 1e6);
-        }
-    }
-}
-
-#[cfg(test)]
-mod debug_bench {
-    use super::*;
-    #[test]
-    #[ignore]
-    fn debug_bench_pairs() {
-        let pairs = crate::bench::sample_spatial_pairs(50, 5.0);
-        let rod = Rod::default();
-        for _repeat in 0..std::env::var("REPEAT").map_or(1, |r| r.parse().unwrap()) {
-        for (n, pair) in pairs.iter().enumerate() {
-            let mut a = Actuator::with_cables(rod.clone(), pair.to_vec());
-            a.gravity_direction = Some([0.0, 0.6, 0.8]);
-            a.rod.gravity.enabled = std::env::var("GRAVITY").map_or(true, |g| g != "off");
-            let mut col = SpatialSolver::new(&a, &SpatialOptions::default()).unwrap();
-            let start = std::time::Instant::now();
-            for k in 0..21 {
-                let t = 1.0 + k as f64 / 20.0;
-                if std::env::var("DEBUG_PAIR").map_or(false, |p| p == n.to_string()) { eprintln!("tension {t}"); }
-                col.solve(&[t, 0.5 * t]).unwrap();
-                std::hint::black_box(col.coefficients(3, LengthBasis::Rest).unwrap());
-            }
-            eprintln!("pair {n}: {:.1} µs per solve", start.elapsed().as_secs_f64() * 1e6 / 21.0);
-        }
-        }
-    }
-}
