@@ -63,24 +63,35 @@ fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
     ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
 }
 
+/// The 3-D collocation (the default) against the independent reference
+/// within 1e-6 mm and 1e-7 rad (the issue asks 1e-4 mm and 1e-6 rad; at 10
+/// intervals per span it is within 2.1e-7 mm), and its RK4 reference within
+/// 1e-3 mm and 1e-5 rad.
 #[test]
 fn every_reference_case_agrees() {
+    let rk4 = SpatialOptions { method: cablemap::model::SolverMethod::Rk4, ..SpatialOptions::default() };
+    for (options, tip_mm, angle_rad) in [(SpatialOptions::default(), 1e-6, 1e-7), (rk4, 1e-3, 1e-5)] {
+        reference_cases_agree(&options, tip_mm, angle_rad);
+    }
+}
+
+fn reference_cases_agree(options: &SpatialOptions, tip_mm: f64, angle_rad: f64) {
     let cases = cases();
     assert_eq!(cases.len(), 8);
     let mut worst = [0.0f64; 4];
     for case in &cases {
         let name = case["name"].as_str().unwrap();
-        let sim = run(&actuator_for(case));
+        let sim = simulate_spatial(&actuator_for(case), options, 3, LengthBasis::Rest).unwrap();
         let p = sim.pose;
         let tip = dist(p.tip_mm(), arr3(&case["tip_mm"]));
         let tangent = angle(p.tip_tangent(), arr3(&case["tip_tangent"]));
         let body_y = angle(p.tip_body_y_axis(), arr3(&case["tip_body_y_axis"]));
         let length = (p.length_mm - case["deformed_length_mm"].as_f64().unwrap()).abs();
         eprintln!("{name}: tip {tip:.2e} mm, tangent {tangent:.2e} rad, body y {body_y:.2e} rad, length {length:.2e} mm, {} passes", p.iterations);
-        assert!(tip < 1e-3, "{name}: tip {:?} vs {}", p.tip_mm(), case["tip_mm"]);
-        assert!(tangent < 1e-5, "{name}: tangent off by {tangent} rad");
-        assert!(body_y < 1e-5, "{name}: body y-axis off by {body_y} rad");
-        assert!(length < 1e-3, "{name}: length off by {length} mm");
+        assert!(tip < tip_mm, "{name}: tip {:?} vs {}", p.tip_mm(), case["tip_mm"]);
+        assert!(tangent < angle_rad, "{name}: tangent off by {tangent} rad");
+        assert!(body_y < angle_rad, "{name}: body y-axis off by {body_y} rad");
+        assert!(length < tip_mm, "{name}: length off by {length} mm");
         // The centreline at the reference's 65 stations (s = 0 … L): our
         // nodes are on a different grid, so compare the clamp and tip only,
         // plus the curvature at the clamp (the shooting unknown there).
@@ -93,7 +104,7 @@ fn every_reference_case_agrees() {
             *w = w.max(x);
         }
     }
-    eprintln!("worst: tip {:.2e} mm, tangent {:.2e} rad, body y {:.2e} rad, length {:.2e} mm", worst[0], worst[1], worst[2], worst[3]);
+    eprintln!("{:?}: worst tip {:.2e} mm, tangent {:.2e} rad, body y {:.2e} rad, length {:.2e} mm", options.method, worst[0], worst[1], worst[2], worst[3]);
 }
 
 fn no_gravity() -> Rod {

@@ -105,6 +105,21 @@ pub enum SpatialFailure {
     Unresolved(crate::model::solver::Unresolved),
 }
 
+impl SpatialError {
+    /// Checks a solve's tensions: one per cable, each finite and ≥ 0.
+    pub fn check_tensions(tensions_n: &[f64], cables: usize) -> Result<(), SpatialError> {
+        if tensions_n.len() != cables {
+            return Err(SpatialError::Option(format!("{} tensions given for {cables} cables", tensions_n.len())));
+        }
+        for (i, &t) in tensions_n.iter().enumerate() {
+            if !(t.is_finite() && t >= 0.0) {
+                return Err(SpatialError::Tension { cable: i + 1, tension_n: t });
+            }
+        }
+        Ok(())
+    }
+}
+
 impl SpatialFailure {
     /// Short machine-readable status (as the planar solver's
     /// [`crate::model::SolveFailure::status`]).

@@ -376,14 +376,7 @@ impl SpatialRk4Solver {
 
     /// Sets every cable's tension (N, one per cable, each ≥ 0) and solves.
     pub fn solve(&mut self, tensions_n: &[f64]) -> Result<TipPose, SpatialError> {
-        if tensions_n.len() != self.cables {
-            return Err(SpatialError::Option(format!("{} tensions given for {} cables", tensions_n.len(), self.cables)));
-        }
-        for (i, &t) in tensions_n.iter().enumerate() {
-            if !(t.is_finite() && t >= 0.0) {
-                return Err(SpatialError::Tension { cable: i + 1, tension_n: t });
-            }
-        }
+        SpatialError::check_tensions(tensions_n, self.cables)?;
         self.base_tension_n.copy_from_slice(tensions_n);
         self.solve_scaled(1.0)
     }
