@@ -16,6 +16,8 @@ mod backends;
 mod bodies;
 #[path = "calibrate.rs"]
 mod calibrate;
+#[path = "design_cables.rs"]
+mod design_cables;
 #[path = "effects.rs"]
 mod effects;
 #[path = "feasible.rs"]

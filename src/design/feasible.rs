@@ -561,7 +561,7 @@ pub fn design_command(target: &Target, map_dir: &Path) -> String {
 
 /// `text` as one shell word: as it is when it holds only characters no shell
 /// treats specially, else in single quotes.
-fn shell_word(text: &str) -> String {
+pub(crate) fn shell_word(text: &str) -> String {
     let plain = |c: char| c.is_ascii_alphanumeric() || "-_./,:=+@%".contains(c);
     if !text.is_empty() && text.chars().all(plain) {
         text.to_string()

@@ -10,6 +10,7 @@
 //! - [`run`]: the whole workflow of `cablemap design` (its request);
 //!   [`report`]: what it returns and the text it prints.
 
+pub mod cables;
 pub mod export;
 pub mod feasible;
 pub mod map;
@@ -60,6 +61,9 @@ pub enum DesignError {
     /// Building or writing the moulds.
     #[error(transparent)]
     Mould(#[from] crate::mould::MouldError),
+    /// No design can reach the targets (found before any search).
+    #[error("unreachable: {0}")]
+    Unreachable(String),
     /// Tension or offset bounds are unusable.
     #[error("bad bounds: {0}")]
     BadBounds(String),

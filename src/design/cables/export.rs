@@ -1,0 +1,81 @@
+//! The files of a several-cable design (`design --targets … --out DIR`):
+//! design.json, one channel CSV per cable, and per target the actuator
+//! file that reproduces it (`target_N.toml`, for `simulate --actuator`) and
+//! its picture (`target_N.png`); for a trajectory, the sampled path
+//! (`trajectory.csv`).
+
+use super::search::Setup;
+use super::CableDesignRun;
+use super::super::DesignError;
+use crate::io::FileError;
+use crate::model::cable;
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// The actuator file of target `index` (from 0).
+pub fn actuator_file_name(index: usize) -> String {
+    format!("target_{}.toml", index + 1)
+}
+
+/// Channel samples per mm of the CSVs.
+const CSV_SAMPLES_PER_MM: f64 = 4.0;
+
+/// `s_mm,y_mm,z_mm,dy_ds,dz_ds` of one channel over [0, its anchor].
+pub fn channel_csv(channel: &cable::Channel, end_mm: f64) -> String {
+    let mut out = String::from("s_mm,y_mm,z_mm,dy_ds,dz_ds\n");
+    let n = (end_mm * CSV_SAMPLES_PER_MM).round().max(1.0) as usize;
+    for k in 0..=n {
+        let s = end_mm * k as f64 / n as f64;
+        let p = channel.at(s);
+        let _ = writeln!(out, "{s:.4},{:.6},{:.6},{:.6},{:.6}", p.r_mm[0], p.r_mm[1], p.dr_ds[0], p.dr_ds[1]);
+    }
+    out
+}
+
+/// Writes the design's files into `dir` and returns their names, in order.
+pub fn write_all(dir: &Path, run: &CableDesignRun, setup: &Setup) -> Result<Vec<String>, DesignError> {
+    super::super::export::check_export_dir(dir)?;
+    std::fs::create_dir_all(dir).map_err(FileError::on("creating", dir))?;
+    let mut written = Vec::new();
+    let mut write = |name: &str, bytes: &[u8]| {
+        let p = dir.join(name);
+        crate::io::write_atomic(&p, bytes).map_err(FileError::on("writing", &p))?;
+        written.push(name.to_string());
+        Ok::<_, DesignError>(())
+    };
+    let mut text = serde_json::to_string_pretty(&run.to_json()).expect("JSON values serialise");
+    text.push('\n');
+    write("design.json", text.as_bytes())?;
+    let first = &run.targets[0].actuator;
+    let channels = first.channels().map_err(|e| DesignError::BadBounds(format!("the designed channels: {e}")))?;
+    for (i, ch) in channels.iter().enumerate() {
+        let end = first.cables[i].anchor_or_tip_mm(first.rod.length_mm);
+        write(&format!("channel_{}.csv", i + 1), channel_csv(ch, end).as_bytes())?;
+    }
+    for (i, t) in run.targets.iter().enumerate() {
+        let toml = toml::to_string(&t.actuator).map_err(|e| DesignError::BadBounds(format!("writing the actuator of {}: {e}", t.target.name)))?;
+        let head = format!("# {}: the actuator of this design at this target; cablemap simulate --actuator FILE solves it again\n", t.target.name);
+        write(&actuator_file_name(i), format!("{head}{toml}").as_bytes())?;
+    }
+    if let Some(tr) = &run.trajectory {
+        let mut csv = String::from("leg,step,cable,actuation,tension_n,tip_x_mm,tip_y_mm,tip_z_mm,deviation_mm\n");
+        for l in &tr.legs {
+            for s in &l.samples {
+                for (c, a) in s.actuation.iter().enumerate() {
+                    let num = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v}"));
+                    let tip = s.tip_mm.map_or([None; 3], |t| t.map(Some));
+                    let _ = writeln!(csv, "{},{},{},{a},{},{},{},{},{}", l.from, s.step, c + 1, num(s.tensions_n.as_ref().map(|t| t[c])), num(tip[0]), num(tip[1]), num(tip[2]), num(s.deviation_mm));
+                }
+            }
+        }
+        write("trajectory.csv", csv.as_bytes())?;
+    }
+    for (i, t) in run.targets.iter().enumerate() {
+        let sim = setup.simulate(&t.actuator).map_err(|e| DesignError::BadBounds(format!("re-simulating {}: {e}", t.target.name)))?;
+        let name = format!("target_{}.png", i + 1);
+        let tensions: Vec<String> = sim.pose.tensions_n.iter().map(|v| format!("{v:.3}")).collect();
+        crate::plot::spatial::draw_spatial(&dir.join(&name), &format!("{}: tensions [{}] N", t.target.name, tensions.join(", ")), &sim)?;
+        written.push(name);
+    }
+    Ok(written)
+}

@@ -1,0 +1,571 @@
+//! The search of a several-cable design: one set of channels and one
+//! actuation vector per target, minimising the weighted squared errors of
+//! every target together (eq. 3.17 summed over the targets).
+//!
+//! Variables live in a unit box for the library's one bounded
+//! Levenberg–Marquardt ([`crate::numerics::lm`]): a control point free in
+//! y and z is a point (u, v) of the square [−1, 1]², carried onto the disc
+//! of radius `max_offset_mm` by the elliptical grid map
+//! y = R u √(1 − v²/2), z = R v √(1 − u²/2) (smooth, one to one); a B-spline
+//! lies in the convex hull of its control points, so the whole channel
+//! stays within the disc. A point free in y alone moves within
+//! √(R² − z_i²). Each actuation is its range scaled to [0, 1].
+//!
+//! Every evaluation solves each target's actuator with
+//! [`crate::model::simulate_actuator`], the path `cablemap simulate` takes,
+//! so a design's reported values are what its `simulate` command prints.
+//! Starts come from a coarse grid (straight channels in 8 directions, or
+//! 5 levels and ramps for one free coordinate, × 3 actuation levels per
+//! cable) or from a map's nearest designs; the best few are refined in
+//! parallel, each deterministically, and the least cost wins (ties to the
+//! earlier start): the same answer on every run and thread count.
+
+use super::spec::{ActuationBounds, CableFreedom, DesignActuator};
+use super::targets::{Quantity, ShapeTarget};
+use super::super::DesignError;
+use crate::model::spatial::{SpatialError, SpatialOptions};
+use crate::model::{simulate_actuator, Actuator, Given, Simulation, SolverOptions, TipPose};
+use crate::numerics::lm;
+use crate::shape::LengthBasis;
+use nalgebra::DMatrix;
+use rayon::prelude::*;
+use serde::Serialize;
+
+/// What one solve of one target's actuator achieved.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Achieved {
+    /// The pose (tip, tangent, tensions, displacements).
+    pub pose: TipPose,
+    /// In-plane bending series, 1/mm.
+    pub a_bend_z: Vec<f64>,
+    /// Out-of-plane bending series, 1/mm.
+    pub a_bend_y: Vec<f64>,
+    /// Twist series, 1/mm.
+    pub a_twist: Vec<f64>,
+}
+
+impl Achieved {
+    /// From a simulation.
+    pub fn of(sim: &Simulation) -> Self {
+        Self { pose: sim.pose, a_bend_z: sim.a_bend_z.clone(), a_bend_y: sim.a_bend_y.clone(), a_twist: sim.a_twist.clone() }
+    }
+
+    /// The achieved value of `q` (NaN for an order not computed).
+    pub fn value(&self, q: Quantity) -> f64 {
+        let at = |s: &[f64], k: usize| s.get(k).copied().unwrap_or(f64::NAN);
+        match q {
+            Quantity::TipX => self.pose.tip_x_mm,
+            Quantity::TipY => self.pose.tip_y_mm,
+            Quantity::TipZ => self.pose.tip_z_mm,
+            Quantity::Tangent(i) => self.pose.tip_tangent()[i],
+            Quantity::BendZ(k) => at(&self.a_bend_z, k),
+            Quantity::BendY(k) => at(&self.a_bend_y, k),
+            Quantity::Twist(k) => at(&self.a_twist, k),
+        }
+    }
+}
+
+/// Search settings of a several-cable design.
+#[derive(Debug, Clone, Serialize)]
+pub struct CableSearch {
+    /// Starts refined to convergence.
+    pub starts: usize,
+    /// Most target solves per start, per target.
+    pub max_evaluations: usize,
+}
+
+impl Default for CableSearch {
+    fn default() -> Self {
+        Self { starts: 4, max_evaluations: 1500 }
+    }
+}
+
+/// The problem: actuator, freedoms, targets and solver settings.
+#[derive(Debug, Clone)]
+pub struct Setup {
+    /// The actuator and what may change.
+    pub design: DesignActuator,
+    /// The targets, in order.
+    pub targets: Vec<ShapeTarget>,
+    /// Planar solver settings (the planar fast path, and the collocation's intervals).
+    pub options: SolverOptions,
+    /// The coefficients' length basis.
+    pub basis: LengthBasis,
+}
+
+/// A point of the search: the unit-box coordinates.
+type Point = Vec<f64>;
+
+/// Control points (y, z) of one cable.
+pub type Channel = ([f64; 5], [f64; 5]);
+
+/// Square → disc, both normalised (the elliptical grid map).
+fn disc_of(u: f64, v: f64) -> (f64, f64) {
+    (u * (1.0 - 0.5 * v * v).max(0.0).sqrt(), v * (1.0 - 0.5 * u * u).max(0.0).sqrt())
+}
+
+/// Disc → square (the inverse of [`disc_of`]), clamped into the square.
+fn square_of(x: f64, y: f64) -> (f64, f64) {
+    let s2 = 2.0 * std::f64::consts::SQRT_2;
+    let half = |a: f64, b: f64| {
+        let p = (2.0 + a * a - b * b + s2 * a).max(0.0).sqrt();
+        let m = (2.0 + a * a - b * b - s2 * a).max(0.0).sqrt();
+        (0.5 * (p - m)).clamp(-1.0, 1.0)
+    };
+    (half(x, y), half(y, x))
+}
+
+impl Setup {
+    /// Number of cables.
+    pub fn cables(&self) -> usize {
+        self.design.cables()
+    }
+
+    /// Channel variables of cable `c`.
+    fn channel_vars(&self, c: usize) -> usize {
+        let f = &self.design.freedom[c];
+        5 * (f.free_y as usize + f.free_z as usize)
+    }
+
+    /// Index of cable `c`'s first channel variable.
+    fn channel_start(&self, c: usize) -> usize {
+        (0..c).map(|k| self.channel_vars(k)).sum()
+    }
+
+    /// Number of channel variables (shared by every target).
+    pub fn channel_var_count(&self) -> usize {
+        self.channel_start(self.cables())
+    }
+
+    /// Index of target `t`'s first actuation variable.
+    fn actuation_start(&self, t: usize) -> usize {
+        self.channel_var_count() + t * self.cables()
+    }
+
+    /// Number of variables.
+    pub fn var_count(&self) -> usize {
+        self.actuation_start(self.targets.len())
+    }
+
+    /// The coefficient order every solve computes.
+    pub fn order(&self) -> usize {
+        self.targets.iter().map(ShapeTarget::order).max().unwrap_or(2)
+    }
+
+    /// The channels at `x`.
+    pub fn channels(&self, x: &[f64]) -> Vec<Channel> {
+        (0..self.cables())
+            .map(|c| {
+                let f = &self.design.freedom[c];
+                let cable = &self.design.actuator.cables[c];
+                let (mut y, mut z) = (cable.y_mm, cable.z_mm);
+                let s = self.channel_start(c);
+                let r = f.max_offset_mm;
+                match (f.free_y, f.free_z) {
+                    (true, true) => {
+                        for i in 0..5 {
+                            let (a, b) = disc_of(x[s + i], x[s + 5 + i]);
+                            y[i] = r * a;
+                            z[i] = r * b;
+                        }
+                    }
+                    (true, false) => (0..5).for_each(|i| y[i] = x[s + i] * (r * r - z[i] * z[i]).sqrt()),
+                    (false, true) => (0..5).for_each(|i| z[i] = x[s + i] * (r * r - y[i] * y[i]).sqrt()),
+                    (false, false) => {}
+                }
+                (y, z)
+            })
+            .collect()
+    }
+
+    /// The unit coordinates of cable `c`'s channel (inside its bounds).
+    fn unit_channel(&self, c: usize, ch: &Channel) -> Vec<f64> {
+        let f = &self.design.freedom[c];
+        let r = f.max_offset_mm;
+        let (y, z) = ch;
+        match (f.free_y, f.free_z) {
+            (true, true) => {
+                let pairs: Vec<(f64, f64)> = (0..5)
+                    .map(|i| {
+                        let (a, b) = (y[i] / r, z[i] / r);
+                        let n = a.hypot(b);
+                        let (a, b) = if n > 1.0 { (a / n, b / n) } else { (a, b) };
+                        square_of(a, b)
+                    })
+                    .collect();
+                pairs.iter().map(|p| p.0).chain(pairs.iter().map(|p| p.1)).collect()
+            }
+            (true, false) => (0..5).map(|i| (y[i] / (r * r - z[i] * z[i]).sqrt()).clamp(-1.0, 1.0)).collect(),
+            (false, true) => (0..5).map(|i| (z[i] / (r * r - y[i] * y[i]).sqrt()).clamp(-1.0, 1.0)).collect(),
+            (false, false) => Vec::new(),
+        }
+    }
+
+    /// The actuation of target `t` at `x` (tension in N or displacement in mm, per cable).
+    pub fn actuation(&self, x: &[f64], t: usize) -> Vec<f64> {
+        let s = self.actuation_start(t);
+        self.design.freedom.iter().enumerate().map(|(c, f)| {
+            let (lo, hi) = f.actuation.range();
+            lo + (hi - lo) * x[s + c]
+        }).collect()
+    }
+
+    /// The actuator with `channels` and `actuation`.
+    pub fn actuator(&self, channels: &[Channel], actuation: &[f64]) -> Actuator {
+        let mut a = self.design.actuator.clone();
+        for ((cable, (y, z)), (f, &v)) in a.cables.iter_mut().zip(channels).zip(self.design.freedom.iter().zip(actuation)) {
+            cable.y_mm = *y;
+            cable.z_mm = *z;
+            match f.actuation {
+                ActuationBounds::Tension { .. } => {
+                    cable.tension_n = v;
+                    cable.displacement_mm = None;
+                }
+                ActuationBounds::Displacement { .. } => {
+                    cable.tension_n = 0.0;
+                    cable.displacement_mm = Some(v);
+                }
+            }
+        }
+        a
+    }
+
+    /// Solves one actuator by the backend `simulate` would use.
+    pub fn simulate(&self, actuator: &Actuator) -> Result<Simulation, SpatialError> {
+        simulate_actuator(actuator, &self.options, &SpatialOptions::default(), Given::default(), None, self.order(), self.basis)
+    }
+
+    /// Solves target `t` at `x`.
+    fn solve(&self, channels: &[Channel], x: &[f64], t: usize) -> Result<Achieved, SpatialError> {
+        self.simulate(&self.actuator(channels, &self.actuation(x, t))).map(|s| Achieved::of(&s))
+    }
+
+    /// Target `t`'s weighted residuals √λ (achieved − asked).
+    pub fn residuals_of(&self, t: usize, a: &Achieved) -> Vec<f64> {
+        self.targets[t].components.iter().map(|(q, v, w)| w.sqrt() * (a.value(*q) - v)).collect()
+    }
+
+    /// Target `t`'s cost.
+    pub fn cost_of(&self, t: usize, a: &Achieved) -> f64 {
+        self.residuals_of(t, a).iter().map(|r| r * r).sum()
+    }
+
+    /// The unit box and the free variables (an actuation whose bounds coincide is held).
+    fn settings(&self) -> lm::Settings {
+        let nc = self.channel_var_count();
+        let bounds: Vec<(f64, f64)> = (0..self.var_count()).map(|i| if i < nc { (-1.0, 1.0) } else { (0.0, 1.0) }).collect();
+        let free = (0..self.var_count())
+            .filter(|&i| {
+                i < nc || {
+                    let c = (i - nc) % self.cables();
+                    let (lo, hi) = self.design.freedom[c].actuation.range();
+                    hi > lo
+                }
+            })
+            .collect();
+        lm::Settings { bounds, free, max_iterations: usize::MAX }
+    }
+}
+
+/// One start's refinement.
+#[derive(Debug, Clone, Serialize)]
+pub struct StartReport {
+    /// Cost at the start.
+    pub seed_cost: f64,
+    /// Cost at the end (inf when the start could not be solved).
+    pub cost: f64,
+    /// Target solves used.
+    pub evaluations: usize,
+    /// Where the start came from (`grid` or `map`).
+    pub source: &'static str,
+    /// Why it stopped.
+    pub termination: String,
+}
+
+/// The search's best design.
+#[derive(Debug, Clone)]
+pub struct Found {
+    /// Its unit coordinates.
+    pub x: Vec<f64>,
+    /// The channels.
+    pub channels: Vec<Channel>,
+    /// Per target: its actuation and what it achieved.
+    pub achieved: Vec<(Vec<f64>, Achieved)>,
+    /// The summed cost.
+    pub cost: f64,
+    /// Every refined start, in start order.
+    pub starts: Vec<StartReport>,
+    /// Designs simulated to seed the search.
+    pub seeds_simulated: usize,
+}
+
+/// Finite-difference step in the unit box (about 1e-5 mm on the thesis
+/// rod): large against the solver's convergence noise, small against curvature.
+const FD_STEP: f64 = 2e-6;
+
+/// Below this summed cost the fit is exact to the solver's noise.
+const COST_FLOOR: f64 = 1e-20;
+
+struct Problem<'a> {
+    setup: &'a Setup,
+    best: Option<(f64, Point, Vec<Achieved>)>,
+    evaluations: usize,
+    max_evaluations: usize,
+}
+
+impl Problem<'_> {
+    fn solve_all(&mut self, x: &[f64]) -> Option<(Vec<f64>, Vec<Achieved>)> {
+        let channels = self.setup.channels(x);
+        let mut r = Vec::new();
+        let mut all = Vec::with_capacity(self.setup.targets.len());
+        for t in 0..self.setup.targets.len() {
+            self.evaluations += 1;
+            let a = self.setup.solve(&channels, x, t).ok()?;
+            r.extend(self.setup.residuals_of(t, &a));
+            all.push(a);
+        }
+        let cost: f64 = r.iter().map(|v| v * v).sum();
+        if cost.is_finite() && self.best.as_ref().is_none_or(|b| cost < b.0) {
+            self.best = Some((cost, x.to_vec(), all.clone()));
+        }
+        Some((r, all))
+    }
+
+    /// Rows of target `t` in the residual vector.
+    fn rows(&self, t: usize) -> std::ops::Range<usize> {
+        let start: usize = self.setup.targets[..t].iter().map(|g| g.components.len()).sum();
+        start..start + self.setup.targets[t].components.len()
+    }
+}
+
+impl lm::Problem for Problem<'_> {
+    fn residuals(&mut self, x: &[f64]) -> Option<Vec<f64>> {
+        self.solve_all(x).map(|r| r.0)
+    }
+
+    /// Forward differences, inward at an upper bound; a channel variable
+    /// moves every target, an actuation variable only its own target.
+    fn jacobian(&mut self, x: &[f64], r: &[f64], free: &[usize]) -> Option<DMatrix<f64>> {
+        let setup = self.setup;
+        let mut jac = DMatrix::zeros(r.len(), free.len());
+        let nc = setup.channel_var_count();
+        let channels = setup.channels(x);
+        for (k, &j) in free.iter().enumerate() {
+            let (lo, hi) = if j < nc { (-1.0, 1.0) } else { (0.0, 1.0) };
+            let mut h = if x[j] + FD_STEP > hi { -FD_STEP } else { FD_STEP };
+            let mut at = x.to_vec();
+            at[j] += h;
+            if at[j] < lo {
+                h = -h;
+                at[j] = x[j] + h;
+            }
+            if j < nc {
+                let (rh, _) = self.solve_all(&at)?;
+                for i in 0..r.len() {
+                    jac[(i, k)] = (rh[i] - r[i]) / h;
+                }
+            } else {
+                let t = (j - nc) / setup.cables();
+                self.evaluations += 1;
+                let a = setup.solve(&channels, &at, t).ok()?;
+                let rh = setup.residuals_of(t, &a);
+                for (i, row) in self.rows(t).enumerate() {
+                    jac[(row, k)] = (rh[i] - r[row]) / h;
+                }
+            }
+        }
+        Some(jac)
+    }
+
+    fn stop(&mut self) -> bool {
+        self.best.as_ref().is_some_and(|b| b.0 <= COST_FLOOR) || self.evaluations >= self.max_evaluations
+    }
+}
+
+/// Candidate channels of one cable for the seed grid, as unit coordinates:
+/// straight channels in 8 directions at 0.6 of the bound (y and z free);
+/// the axis, ±0.6 and ramps 0 → ±0.8 of the bound (one coordinate free);
+/// the channel as given (fixed).
+fn candidates(f: &CableFreedom) -> Vec<Vec<f64>> {
+    match (f.free_y, f.free_z) {
+        (true, true) => (0..8)
+            .map(|k| {
+                let th = k as f64 * std::f64::consts::FRAC_PI_4;
+                let (u, v) = square_of(0.6 * th.cos(), 0.6 * th.sin());
+                [u; 5].into_iter().chain([v; 5]).collect()
+            })
+            .collect(),
+        (false, false) => vec![Vec::new()],
+        _ => {
+            let ramp = [0.0, 0.2, 0.4, 0.6, 0.8];
+            vec![vec![0.6; 5], vec![-0.6; 5], ramp.to_vec(), ramp.iter().map(|v| -v).collect(), vec![0.0; 5]]
+        }
+    }
+}
+
+/// Most seed solves (channel combinations × actuation levels) of the grid.
+const MAX_SEED_SOLVES: usize = 1500;
+
+/// The seed grid: every combination of the cables' candidate channels (an
+/// evenly spaced subset when there are too many), each solved at every
+/// actuation level vector; a combination's cost is the sum over targets
+/// of the least cost over its levels. Returns (cost, start point), best
+/// first (ties in combination order), and the number of solves.
+fn grid_seeds(setup: &Setup) -> (Vec<(f64, Point)>, usize) {
+    let n = setup.cables();
+    let per_cable: Vec<Vec<Vec<f64>>> = setup.design.freedom.iter().map(candidates).collect();
+    let levels: Vec<f64> = if n <= 3 { vec![0.0, 0.5, 1.0] } else { vec![0.0, 1.0] };
+    let level_vectors: Vec<Vec<f64>> = (0..levels.len().pow(n as u32))
+        .map(|mut k| {
+            (0..n)
+                .map(|_| {
+                    let l = levels[k % levels.len()];
+                    k /= levels.len();
+                    l
+                })
+                .collect()
+        })
+        .collect();
+    let total: usize = per_cable.iter().map(Vec::len).product();
+    let cap = (MAX_SEED_SOLVES / level_vectors.len()).max(4);
+    let picks: Vec<usize> = if total <= cap { (0..total).collect() } else { (0..cap).map(|i| i * total / cap).collect() };
+    let combos: Vec<Vec<f64>> = picks
+        .into_iter()
+        .filter_map(|mut k| {
+            let mut x = Vec::new();
+            for c in &per_cable {
+                x.extend(&c[k % c.len()]);
+                k /= c.len();
+            }
+            x.resize(setup.var_count(), 0.0);
+            // Two cables cannot share one path.
+            let ch = setup.channels(&x);
+            let distinct = (0..n).all(|a| (a + 1..n).all(|b| ch[a] != ch[b]));
+            distinct.then_some(x)
+        })
+        .collect();
+    let solves = combos.len() * level_vectors.len();
+    let nt = setup.targets.len();
+    let mut seeds: Vec<(usize, f64, Point)> = combos
+        .par_iter()
+        .enumerate()
+        .filter_map(|(i, x)| {
+            let channels = setup.channels(x);
+            let mut best: Vec<(f64, usize)> = vec![(f64::INFINITY, 0); nt];
+            for (li, lv) in level_vectors.iter().enumerate() {
+                let act: Vec<f64> = setup.design.freedom.iter().zip(lv).map(|(f, l)| {
+                    let (lo, hi) = f.actuation.range();
+                    lo + (hi - lo) * l
+                }).collect();
+                let Ok(sim) = setup.simulate(&setup.actuator(&channels, &act)) else { continue };
+                let a = Achieved::of(&sim);
+                for (t, b) in best.iter_mut().enumerate() {
+                    let c = setup.cost_of(t, &a);
+                    if c < b.0 {
+                        *b = (c, li);
+                    }
+                }
+            }
+            let cost: f64 = best.iter().map(|b| b.0).sum();
+            if !cost.is_finite() {
+                return None;
+            }
+            let mut x = x.clone();
+            for (t, b) in best.iter().enumerate() {
+                let s = setup.actuation_start(t);
+                x[s..s + n].copy_from_slice(&level_vectors[b.1]);
+            }
+            Some((i, cost, x))
+        })
+        .collect();
+    seeds.sort_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)));
+    (seeds.into_iter().map(|s| (s.1, s.2)).collect(), solves)
+}
+
+/// A start from given channels (a map's design): each target's actuation
+/// from the grid's levels, as [`grid_seeds`] does for its combinations.
+pub fn point_of(setup: &Setup, channels: &[Channel]) -> Point {
+    let mut x: Point = (0..setup.cables()).flat_map(|c| setup.unit_channel(c, &channels[c])).collect();
+    x.resize(setup.var_count(), 0.5);
+    x
+}
+
+/// Refines one start; returns the best point seen with its cost and solves.
+fn refine(setup: &Setup, x0: &[f64], max_evaluations: usize, source: &'static str) -> (Option<(f64, Point, Vec<Achieved>)>, StartReport) {
+    let mut p = Problem { setup, best: None, evaluations: 0, max_evaluations };
+    let start = p.solve_all(x0);
+    let seed_cost = start.as_ref().map_or(f64::INFINITY, |s| s.0.iter().map(|v| v * v).sum());
+    let termination = match start {
+        Some((r, _)) => lm::minimise(&mut p, x0.to_vec(), r, &setup.settings(), &mut |_| {}).termination.to_string(),
+        None => "the start could not be solved".into(),
+    };
+    let cost = p.best.as_ref().map_or(f64::INFINITY, |b| b.0);
+    let termination = if cost <= COST_FLOOR {
+        "exact fit (objective at the noise floor)".into()
+    } else if p.evaluations >= max_evaluations {
+        "evaluation budget reached".into()
+    } else {
+        termination
+    };
+    let report = StartReport { seed_cost, cost, evaluations: p.evaluations, source, termination };
+    (p.best, report)
+}
+
+/// Designs: seeds from the grid (and `extra`, e.g. a map's designs' channels,
+/// which come first), the best `search.starts` refined in parallel, the
+/// least cost kept (ties to the earlier start).
+pub fn search(setup: &Setup, search: &CableSearch, extra: &[Vec<Channel>]) -> Result<Found, DesignError> {
+    if search.starts == 0 {
+        return Err(DesignError::BadSearch("the number of starts must be at least 1".into()));
+    }
+    let (grid, mut seeds_simulated) = grid_seeds(setup);
+    let mut starts: Vec<(Point, &'static str)> = Vec::new();
+    // A map's designs take up to half of the starts, ahead of the grid's.
+    for channels in extra.iter().take(search.starts.div_ceil(2)) {
+        seeds_simulated += 1;
+        let mut x = point_of(setup, channels);
+        // Their actuation: the best grid combination's levels, per target.
+        if let Some((_, g)) = grid.first() {
+            let s = setup.channel_var_count();
+            x[s..].copy_from_slice(&g[s..]);
+        }
+        starts.push((x, "map"));
+    }
+    for (_, x) in &grid {
+        if starts.len() >= search.starts {
+            break;
+        }
+        starts.push((x.clone(), "grid"));
+    }
+    if starts.is_empty() {
+        return Err(DesignError::NoSeed);
+    }
+    let budget = search.max_evaluations * setup.targets.len();
+    let results: Vec<_> = starts.par_iter().map(|(x, source)| refine(setup, x, budget, source)).collect();
+    let mut best: Option<(f64, Point, Vec<Achieved>)> = None;
+    for (b, _) in &results {
+        if let Some(b) = b {
+            if best.as_ref().is_none_or(|c| b.0 < c.0) {
+                best = Some(b.clone());
+            }
+        }
+    }
+    let (cost, x, achieved) = best.ok_or(DesignError::NoSeed)?;
+    let achieved = achieved.into_iter().enumerate().map(|(t, a)| (setup.actuation(&x, t), a)).collect();
+    Ok(Found { channels: setup.channels(&x), x, achieved, cost, starts: results.into_iter().map(|r| r.1).collect(), seeds_simulated })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_disc_map_round_trips_and_stays_inside() {
+        for &(u, v) in &[(0.3, -0.7), (1.0, 1.0), (-1.0, 0.2), (0.0, 0.0), (0.99, -0.5)] {
+            let (x, y) = disc_of(u, v);
+            assert!(x.hypot(y) <= 1.0 + 1e-12);
+            let (a, b) = square_of(x, y);
+            assert!((a - u).abs() < 1e-9 && (b - v).abs() < 1e-9, "{u},{v} → {a},{b}");
+        }
+    }
+}

@@ -1,0 +1,201 @@
+//! `cablemap design --actuator A.toml --targets T.toml` as a user runs it:
+//! several cables with free spatial channels reaching a sequence of
+//! simulated shapes (re-simulated independently of the optimiser), the
+//! thesis's Table 5.1 through the same request, unreachable targets refused
+//! with the reason, a trajectory's reported path against a re-simulation,
+//! and determinism across thread counts.
+
+use serde_json::Value;
+use std::path::Path;
+use std::process::Command;
+
+fn run_env(args: &[&str], env: &[(&str, &str)]) -> (bool, String, String) {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_cablemap"));
+    cmd.args(args);
+    for (k, v) in env {
+        cmd.env(k, v);
+    }
+    let out = cmd.output().expect("runs");
+    (out.status.success(), String::from_utf8_lossy(&out.stdout).into(), String::from_utf8_lossy(&out.stderr).into())
+}
+
+fn run(args: &[&str]) -> (bool, String, String) {
+    run_env(args, &[])
+}
+
+fn json(args: &[&str]) -> Value {
+    let (ok, stdout, stderr) = run(args);
+    assert!(ok, "{args:?} failed: {stderr}");
+    serde_json::from_str(stdout.trim()).unwrap_or_else(|e| panic!("{e}: {stdout}"))
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> String {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p.display().to_string()
+}
+
+fn floats(v: &Value) -> Vec<f64> {
+    v.as_array().unwrap_or_else(|| panic!("not a list: {v}")).iter().map(|x| x.as_f64().unwrap()).collect()
+}
+
+fn angle_deg(a: &[f64], b: &[f64]) -> f64 {
+    let dot: f64 = a.iter().zip(b).map(|(x, y)| x * y).sum();
+    let n = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
+    (dot / (n(a) * n(b))).clamp(-1.0, 1.0).acos().to_degrees()
+}
+
+fn distance(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| (x - y).powi(2)).sum::<f64>().sqrt()
+}
+
+/// Two spatial cables at a tension pair, as `simulate --actuator` reads them.
+fn spatial_pair(t1: f64, t2: f64) -> String {
+    format!(
+        "[[cable]]\ny_mm = [2.0, 2.5, 1.5, 2.0, 2.5]\nz_mm = [1.0, 0.5, 1.5, 1.0, 0.0]\ntension_n = {t1}\n\n\
+         [[cable]]\ny_mm = [-2.0, -1.5, -2.5, -2.0, -1.0]\nz_mm = [-1.0, 0.0, 1.0, 1.5, 2.0]\ntension_n = {t2}\n"
+    )
+}
+
+#[test]
+fn a_sequence_of_two_simulated_spatial_shapes_is_reached_and_resimulated() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut targets = String::new();
+    let mut asked = Vec::new();
+    for (i, (t1, t2)) in [(1.0, 0.3), (0.2, 1.2)].into_iter().enumerate() {
+        let file = write(dir.path(), &format!("pair{i}.toml"), &spatial_pair(t1, t2));
+        let v = json(&["simulate", "--actuator", &file, "--json"]);
+        let tip = [v["tip_x_mm"].as_f64().unwrap(), v["tip_y_mm"].as_f64().unwrap(), v["tip_z_mm"].as_f64().unwrap()];
+        let tangent = floats(&v["tip_tangent"]);
+        targets += &format!(
+            "[[target]]\ntip_mm = {tip:?}\ntip_tangent = {tangent:?}\na_bend_z = {:?}\na_bend_y = {:?}\na_twist = {:?}\n\n",
+            floats(&v["a_bend_z"]),
+            floats(&v["a_bend_y"]),
+            floats(&v["a_twist"])
+        );
+        asked.push((tip.to_vec(), tangent));
+    }
+    let targets = write(dir.path(), "targets.toml", &targets);
+    // Both channels free (no y_mm/z_mm), tensions within the default 0 … 2 N.
+    let actuator = write(dir.path(), "free.toml", "[[cable]]\n\n[[cable]]\n");
+    let out = dir.path().join("design");
+    let d = json(&["design", "--actuator", &actuator, "--targets", &targets, "--out", out.to_str().unwrap(), "--json"]);
+    let cables = d["cables"].as_array().unwrap();
+    assert_eq!(cables.len(), 2);
+    for c in cables {
+        assert_eq!(floats(&c["y_mm"]).len(), 5);
+        assert_eq!(floats(&c["z_mm"]).len(), 5);
+        assert_eq!(c["free"], serde_json::json!(["y", "z"]));
+    }
+    let file: Value = serde_json::from_str(&std::fs::read_to_string(out.join("design.json")).unwrap()).unwrap();
+    assert_eq!(file["cables"], d["cables"], "--json prints design.json's object");
+    for name in ["channel_1.csv", "channel_2.csv", "target_1.png", "target_2.png", "target_1.toml", "target_2.toml"] {
+        assert!(out.join(name).exists(), "{name} not written");
+    }
+    let targets = d["targets"].as_array().unwrap();
+    assert_eq!(targets.len(), 2);
+    for (k, (t, (tip, tangent))) in targets.iter().zip(&asked).enumerate() {
+        assert_eq!(floats(&t["tensions_n"]).len(), 2);
+        assert!(distance(&floats(&t["tip_mm"]), tip) < 0.1, "{t}");
+        assert!(angle_deg(&floats(&t["tip_tangent"]), tangent) < 0.1, "{t}");
+        // Re-simulated independently of the optimiser: the actuator file the design wrote.
+        let again = json(&["simulate", "--actuator", out.join(format!("target_{}.toml", k + 1)).to_str().unwrap(), "--json"]);
+        let tip_again = [again["tip_x_mm"].as_f64().unwrap(), again["tip_y_mm"].as_f64().unwrap(), again["tip_z_mm"].as_f64().unwrap()];
+        assert!(distance(&tip_again, tip) < 0.1, "target {}: re-simulated tip {tip_again:?} vs {tip:?}", k + 1);
+        assert!(angle_deg(&floats(&again["tip_tangent"]), tangent) < 0.1, "target {}: {again}", k + 1);
+        // The same channels at both targets: only the tensions differ.
+        let cables_again = again["cables"].as_array().unwrap();
+        for (c, designed) in cables_again.iter().zip(cables) {
+            assert_eq!(c["y_mm"], designed["y_mm"]);
+            assert_eq!(c["z_mm"], designed["z_mm"]);
+        }
+        assert_eq!(floats(&again["tension_n"]), floats(&t["tensions_n"]));
+    }
+}
+
+/// Table 5.1's targets through the several-cable request (one planar cable
+/// free in y, the thesis's 1 … 2 N) give the answers of `design --target`.
+#[test]
+fn table_5_1_through_the_cable_request_gives_todays_answers() {
+    let dir = tempfile::tempdir().unwrap();
+    let actuator = write(dir.path(), "one.toml", "[[cable]]\ny_mm = [0, 0, 0, 0, 0]\nfree = [\"y\"]\ntension_min_n = 1.0\ntension_max_n = 2.0\n");
+    for (target, tip, a) in [
+        ("x=50,y=5,a0=-0.025,a1=-0.06,a2=0.015", "{ x = 50, y = 5 }", "[-0.025, -0.06, 0.015]"),
+        ("x=10,y=50,a0=0.015,a1=-0.07,a2=-0.03", "{ x = 10, y = 50 }", "[0.015, -0.07, -0.03]"),
+    ] {
+        let today = json(&["design", "--target", target, "--json"]);
+        let targets = write(dir.path(), "t.toml", &format!("[[target]]\ntip_mm = {tip}\na_bend_z = {a}\n"));
+        let v = json(&["design", "--actuator", &actuator, "--targets", &targets, "--json"]);
+        let y = floats(&v["cables"][0]["y_mm"]);
+        for (got, want) in y.iter().zip(floats(&today["routing_mm"])) {
+            assert!((got - want).abs() < 1e-9, "{target}: {y:?} vs {}", today["routing_mm"]);
+        }
+        assert_eq!(floats(&v["cables"][0]["z_mm"]), vec![0.0; 5]);
+        let t = &v["targets"][0];
+        assert!((floats(&t["tensions_n"])[0] - today["tension_n"].as_f64().unwrap()).abs() < 1e-9);
+        for (key, old) in [("tip_x_mm", "x"), ("tip_y_mm", "y"), ("a_bend_z0", "a0"), ("a_bend_z1", "a1"), ("a_bend_z2", "a2")] {
+            let (new, old) = (t["error_pct"][key].as_f64().unwrap(), today["error_pct"][old].as_f64().unwrap());
+            assert!((new - old).abs() < 1e-9, "{target} {key}: {new} vs {old}");
+        }
+        assert_eq!(t["met"], today["met"]);
+    }
+}
+
+#[test]
+fn unreachable_targets_are_refused_with_the_reason() {
+    let dir = tempfile::tempdir().unwrap();
+    let one = write(dir.path(), "one.toml", "[[cable]]\ny_mm = [0, 0, 0, 0, 0]\nfree = [\"y\"]\n");
+    // A tip beyond the rod's length: refused before any search.
+    let far = write(dir.path(), "far.toml", "[[target]]\ntip_mm = { x = 80, y = 0 }\n");
+    let (ok, _, stderr) = run(&["design", "--actuator", &one, "--targets", &far]);
+    assert!(!ok);
+    assert!(stderr.contains("unreachable") && stderr.contains("target 1") && stderr.contains("beyond the rod's length L = 65 mm") && stderr.contains("misses by at least 15"), "{stderr}");
+    // Opposite bends in one sequence with one cable: one channel cannot bend both ways.
+    let both = write(dir.path(), "both.toml", "[[target]]\ntip_mm = { x = 50, y = 20 }\n\n[[target]]\ntip_mm = { x = 50, y = -20 }\n");
+    let v = json(&["design", "--actuator", &one, "--targets", &both, "--json"]);
+    assert_eq!(v["met"], false, "{v}");
+    let unmet: Vec<&str> = v["unmet"].as_array().unwrap().iter().map(|s| s.as_str().unwrap()).collect();
+    assert!(unmet.iter().any(|u| u.contains("tip_y_mm misses by")), "{unmet:?}");
+    // Which target misses, and by as much as the achieved values say.
+    for t in v["targets"].as_array().unwrap() {
+        for miss in t["unmet"].as_array().unwrap() {
+            assert!(miss.as_str().unwrap().starts_with(t["name"].as_str().unwrap()), "{miss}");
+        }
+    }
+    let worst = v["targets"].as_array().unwrap().iter().map(|t| (t["achieved"]["tip_y_mm"].as_f64().unwrap() - t["target"]["tip_mm"]["y"].as_f64().unwrap()).abs()).fold(0.0, f64::max);
+    assert!(worst > 10.0, "{v}");
+    let (ok, stdout, _) = run(&["design", "--actuator", &one, "--targets", &both]);
+    assert!(ok && stdout.contains("NOT REACHABLE") && stdout.contains("tip_y_mm misses by"), "{stdout}");
+}
+
+#[test]
+fn the_same_design_on_every_thread_count() {
+    let dir = tempfile::tempdir().unwrap();
+    let two = write(dir.path(), "two.toml", "[[cable]]\nfree = [\"y\"]\ny_mm = [1, 1, 1, 1, 1]\n\n[[cable]]\nfree = [\"y\"]\ny_mm = [-1, -1, -1, -1, -1]\n");
+    let t = write(dir.path(), "t.toml", "[[target]]\ntip_mm = { x = 55, y = 15 }\n\n[[target]]\ntip_mm = { x = 57, y = -12 }\n");
+    let args = ["design", "--actuator", two.as_str(), "--targets", t.as_str(), "--json", "--starts", "2"];
+    let strip = |text: &str| {
+        let mut v: Value = serde_json::from_str(text.trim()).unwrap();
+        v.as_object_mut().unwrap().remove("seconds");
+        v
+    };
+    let (ok1, one, e1) = run_env(&args, &[("RAYON_NUM_THREADS", "1")]);
+    let (ok2, many, e2) = run_env(&args, &[("RAYON_NUM_THREADS", "3")]);
+    assert!(ok1 && ok2, "{e1}{e2}");
+    assert_eq!(strip(&one), strip(&many));
+}
+
+#[test]
+fn bad_design_files_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let one = write(dir.path(), "one.toml", "[[cable]]\nfree = [\"x\"]\n");
+    let t = write(dir.path(), "t.toml", "[[target]]\ntip_mm = [50, 5, 0]\n");
+    let (ok, _, stderr) = run(&["design", "--actuator", &one, "--targets", &t]);
+    assert!(!ok && stderr.contains("--actuator") && stderr.contains("free"), "{stderr}");
+    let ok_actuator = write(dir.path(), "ok.toml", "[[cable]]\n");
+    let bad_t = write(dir.path(), "bad.toml", "[[target]]\ntip_mm = [50, 5]\n");
+    let (ok, _, stderr) = run(&["design", "--actuator", &ok_actuator, "--targets", &bad_t]);
+    assert!(!ok && stderr.contains("--targets") && stderr.contains("tip_mm has 2 numbers"), "{stderr}");
+    let (ok, _, stderr) = run(&["design", "--actuator", &ok_actuator, "--targets", &t, "--weights", "x=2"]);
+    assert!(!ok && stderr.contains("--weights does not apply to --targets"), "{stderr}");
+}
