@@ -46,6 +46,9 @@ enum Command {
     /// Fit EA, GA, EI (and optionally effects) to measurements (thesis eq. 2.14).
     #[command(allow_negative_numbers = true)]
     Calibrate(cli::calibrate::CalibrateArgs),
+    /// Simulate captures with an actuator file (no fitting): the 3-D markers' errors per capture and marker.
+    #[command(allow_negative_numbers = true)]
+    Predict(cli::predict::PredictArgs),
     /// Find, name and add the effect the model is missing; report and plots.
     #[command(allow_negative_numbers = true)]
     Diagnose(cli::diagnose::DiagnoseArgs),
@@ -70,6 +73,7 @@ fn main() -> ExitCode {
         Command::Study(args) => cli::study::run(args),
         Command::Calibrate(args) => cli::calibrate::run(args),
         Command::Diagnose(args) => cli::diagnose::run(args),
+        Command::Predict(args) => cli::predict::run(args),
         Command::Synth(args) => cli::synth::run(args),
     };
     match result {

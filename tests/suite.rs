@@ -16,6 +16,8 @@ mod backends;
 mod bodies;
 #[path = "calibrate.rs"]
 mod calibrate;
+#[path = "captures.rs"]
+mod captures;
 #[path = "design_cables.rs"]
 mod design_cables;
 #[path = "effects.rs"]

@@ -146,9 +146,11 @@ impl Dataset {
 }
 
 /// A table of text cells with a header, as read from CSV or Parquet.
-struct Table {
-    header: Vec<String>,
-    rows: Vec<Vec<String>>,
+pub(crate) struct Table {
+    /// Column names.
+    pub(crate) header: Vec<String>,
+    /// Data rows, cells as text.
+    pub(crate) rows: Vec<Vec<String>>,
     /// The '#' lines before the header, '#' removed (CSV only).
     front: String,
 }
@@ -197,7 +199,8 @@ fn actuator_of_front_matter(path: &Path, front: &str) -> Result<Option<crate::mo
     Rod::from_toml_str(&text).map(Some).map_err(|e| bad(e.to_string()))
 }
 
-fn read_table(path: &Path) -> Result<Table, CalibrateError> {
+/// Reads a CSV or (by its `.parquet` extension) Parquet file as text cells.
+pub(crate) fn read_table(path: &Path) -> Result<Table, CalibrateError> {
     let is_parquet = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("parquet"));
     if is_parquet {
         read_parquet_table(path)
@@ -351,7 +354,7 @@ fn read_parquet_table(path: &Path) -> Result<Table, CalibrateError> {
 }
 
 /// Column lookup that names what is missing.
-fn column_index(path: &Path, table: &Table, name: &str) -> Result<usize, CalibrateError> {
+pub(crate) fn column_index(path: &Path, table: &Table, name: &str) -> Result<usize, CalibrateError> {
     table.header.iter().position(|h| h == name).ok_or_else(|| CalibrateError::MissingColumn {
         path: path.display().to_string(),
         column: name.to_string(),
@@ -359,14 +362,19 @@ fn column_index(path: &Path, table: &Table, name: &str) -> Result<usize, Calibra
     })
 }
 
-struct Cells<'a> {
-    path: &'a Path,
-    row: usize,
-    cells: &'a [String],
+/// One row's cells, for checked reads whose errors name file, row and column.
+pub(crate) struct Cells<'a> {
+    /// The file.
+    pub(crate) path: &'a Path,
+    /// Data row, from 1.
+    pub(crate) row: usize,
+    /// The cells.
+    pub(crate) cells: &'a [String],
 }
 
 impl Cells<'_> {
-    fn bad(&self, column: &str, value: &str, expected: &str) -> CalibrateError {
+    /// The error for `value` in `column` that is not `expected`.
+    pub(crate) fn bad(&self, column: &str, value: &str, expected: &str) -> CalibrateError {
         CalibrateError::BadValue {
             path: self.path.display().to_string(),
             row: self.row,
@@ -375,21 +383,24 @@ impl Cells<'_> {
             expected: expected.to_string(),
         }
     }
-    fn text(&self, idx: usize, column: &str) -> Result<&str, CalibrateError> {
+    /// A non-empty cell.
+    pub(crate) fn text(&self, idx: usize, column: &str) -> Result<&str, CalibrateError> {
         let v = self.cells[idx].as_str();
         if v.is_empty() {
             return Err(self.bad(column, v, "a value (the cell is empty)"));
         }
         Ok(v)
     }
-    fn float(&self, idx: usize, column: &str) -> Result<f64, CalibrateError> {
+    /// A finite number.
+    pub(crate) fn float(&self, idx: usize, column: &str) -> Result<f64, CalibrateError> {
         let v = self.text(idx, column)?;
         match v.parse::<f64>() {
             Ok(x) if x.is_finite() => Ok(x),
             _ => Err(self.bad(column, v, "a finite number")),
         }
     }
-    fn int(&self, idx: usize, column: &str) -> Result<i64, CalibrateError> {
+    /// An integer.
+    pub(crate) fn int(&self, idx: usize, column: &str) -> Result<i64, CalibrateError> {
         let v = self.text(idx, column)?;
         v.parse::<i64>().map_err(|_| self.bad(column, v, "an integer"))
     }
@@ -397,7 +408,7 @@ impl Cells<'_> {
 
 /// Refuses a header that names a column twice: which of the two a reader
 /// takes is arbitrary, so neither is (the error names both positions).
-fn check_unique_columns(path: &Path, table: &Table) -> Result<(), CalibrateError> {
+pub(crate) fn check_unique_columns(path: &Path, table: &Table) -> Result<(), CalibrateError> {
     let mut seen: HashMap<&str, usize> = HashMap::new();
     for (i, name) in table.header.iter().enumerate() {
         if let Some(first) = seen.insert(name.as_str(), i) {

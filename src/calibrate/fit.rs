@@ -105,7 +105,7 @@ impl Default for Loss {
 impl Loss {
     /// The residual whose square is the loss of `z` (sign kept), so that a
     /// least-squares solver minimises Σ ρ.
-    fn transform(self, z: f64) -> f64 {
+    pub(crate) fn transform(self, z: f64) -> f64 {
         match self {
             Loss::Squared => z,
             Loss::Huber { k } if z.abs() > k => z.signum() * (2.0 * k * z.abs() - k * k).sqrt(),

@@ -3,6 +3,7 @@
 //! eq. 2.14) with or without extra effects, and the diagnosis that names the
 //! missing effect.
 
+pub mod captures;
 pub mod data;
 pub mod diagnose;
 pub mod effect;
@@ -78,4 +79,10 @@ pub enum CalibrateError {
     /// Drawing a plot.
     #[error(transparent)]
     Plot(#[from] crate::plot::PlotError),
+    /// The actuator of a 3-D calibration cannot be used.
+    #[error("the actuator: {0}")]
+    Actuator(crate::model::spatial::SpatialError),
+    /// The 3-D model could not be solved for a capture.
+    #[error("capture {measurement} (row {row} of the captures file): {failure}")]
+    Capture { measurement: i64, row: usize, failure: crate::model::spatial::SpatialError },
 }

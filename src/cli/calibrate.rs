@@ -24,9 +24,10 @@ pub struct FitArgs {
     /// Hold a parameter at a value instead of fitting it (repeatable): EA, GA, EI or an effect parameter, e.g. GA=1.70866 or friction_mu=0.05.
     #[arg(long = "fix", value_name = "NAME=VALUE")]
     pub fix: Vec<String>,
-    /// Loss on the noise-whitened residuals: huber (robust to a few bad readings) or squares.
-    #[arg(long, default_value = "huber", value_name = "LOSS")]
-    pub loss: String,
+    /// Loss on the noise-whitened residuals: huber (robust to a few bad readings) or squares
+    /// [default: huber; squares for captures with --actuator].
+    #[arg(long, value_name = "LOSS")]
+    pub loss: Option<String>,
     /// Where the Huber loss turns linear, in noise σ.
     #[arg(long, default_value_t = 3.0, value_name = "SIGMA")]
     pub huber_k: f64,
@@ -36,7 +37,8 @@ pub struct FitArgs {
     /// Measured centreline points (measurement,x_mm,y_mm), fitted as distances to the simulated centreline.
     #[arg(long, value_name = "FILE")]
     pub centrelines: Option<PathBuf>,
-    /// Markers off the centreline (measurement,s_mm,offset_mm,x_mm,y_mm), fitted by position.
+    /// Markers off the centreline (measurement,s_mm,offset_mm,x_mm,y_mm), fitted by position; with
+    /// --actuator, 3-D markers (measurement,marker,s_mm,offset_y_mm,offset_z_mm,x_mm,y_mm,z_mm[,sd_mm]).
     #[arg(long, value_name = "FILE")]
     pub markers: Option<PathBuf>,
     /// Weight of the tip angle in the reported mm-equivalent RMS, mm per degree (the fit weights by the noise).
@@ -45,6 +47,20 @@ pub struct FitArgs {
 }
 
 impl FitArgs {
+    /// The loss the flags describe, `default` when --loss is not given.
+    pub fn loss(&self, default: &str) -> anyhow::Result<Loss> {
+        match self.loss.as_deref().unwrap_or(default) {
+            "huber" => {
+                if !(self.huber_k.is_finite() && self.huber_k > 0.0) {
+                    bail!("--huber-k {}: must be a number of σ > 0", self.huber_k);
+                }
+                Ok(Loss::Huber { k: self.huber_k })
+            }
+            "squares" => Ok(Loss::Squared),
+            other => bail!("--loss {other}: use huber or squares"),
+        }
+    }
+
     /// The fit settings the flags describe.
     pub fn settings(&self) -> anyhow::Result<FitSettings> {
         let mut held: Vec<(Held, f64)> = Vec::new();
@@ -61,16 +77,7 @@ impl FitArgs {
             };
             held.push((h, v));
         }
-        let loss = match self.loss.as_str() {
-            "huber" => {
-                if !(self.huber_k.is_finite() && self.huber_k > 0.0) {
-                    bail!("--huber-k {}: must be a number of σ > 0", self.huber_k);
-                }
-                Loss::Huber { k: self.huber_k }
-            }
-            "squares" => Loss::Squared,
-            other => bail!("--loss {other}: use huber or squares"),
-        };
+        let loss = self.loss("huber")?;
         if self.max_iterations == 0 {
             bail!("--max-iterations must be at least 1");
         }
@@ -100,8 +107,19 @@ pub fn with_flag(e: CalibrateError, holdout_flag: bool) -> anyhow::Error {
 /// Arguments of `cablemap calibrate`.
 #[derive(Debug, Clone, Args)]
 pub struct CalibrateArgs {
-    /// Measurement file (CSV, or Parquet by its .parquet extension); see docs/measurements.md.
+    /// Measurement file (CSV, or Parquet by its .parquet extension); with --actuator, the captures
+    /// file (one tension_K_n or displacement_K_mm column per cable); see docs/measurements.md.
     pub data: PathBuf,
+    /// A whole actuator (rod, torsion, gravity, cables) as TOML: calibrate several-cable captures
+    /// against 3-D markers (--markers) with the 3-D solver; the start and everything not fitted.
+    #[arg(long = "actuator", value_name = "FILE.toml")]
+    pub spatial_actuator: Option<PathBuf>,
+    /// With --actuator: write DIR/calibrated.toml (the fitted actuator) and DIR/fit.json.
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// With --actuator: fit on the captures where cable K does not pull, predict the others.
+    #[arg(long, value_name = "K")]
+    pub holdout_cable: Option<usize>,
     /// Leave this routing out of the fit and report the error on it.
     #[arg(long, value_name = "ROUTING")]
     pub holdout: Option<String>,
@@ -136,6 +154,12 @@ pub fn parse_effects(names: &[String]) -> anyhow::Result<Vec<Effect>> {
 
 /// Runs `cablemap calibrate`.
 pub fn run(args: &CalibrateArgs) -> anyhow::Result<()> {
+    if let Some(actuator) = &args.spatial_actuator {
+        return run_captures(args, actuator);
+    }
+    if args.out.is_some() || args.holdout_cable.is_some() {
+        bail!("--out and --holdout-cable calibrate captures against 3-D markers: give the actuator with --actuator FILE.toml");
+    }
     let request = CalibrateRequest {
         data_path: args.data.clone(),
         actuator: args.actuator.overrides(),
@@ -154,4 +178,77 @@ pub fn run(args: &CalibrateArgs) -> anyhow::Result<()> {
         write!(out, "{report}")?;
     }
     Ok(())
+}
+
+/// The 3-D route of `cablemap calibrate` (`--actuator FILE.toml`): captures
+/// and 3-D markers, the fit by the 3-D solver.
+fn run_captures(args: &CalibrateArgs, actuator: &std::path::Path) -> anyhow::Result<()> {
+    use cablemap::calibrate::captures::{self, Calibrate3Request, Param};
+    if args.holdout.is_some() {
+        bail!("--holdout takes a routing of planar data; with --actuator, hold out a cable's captures by --holdout-cable K");
+    }
+    if args.fit.centrelines.is_some() {
+        bail!("--centrelines: planar centreline points; with --actuator, give 3-D markers by --markers");
+    }
+    if args.actuator.sets_the_rod() {
+        bail!("with --actuator the rod and its effects come from FILE.toml's [rod] table; edit it instead of giving rod flags");
+    }
+    let mut held = Vec::new();
+    for item in &args.fit.fix {
+        let Some((name, value)) = item.split_once('=') else {
+            bail!("--fix {item}: expected NAME=VALUE, e.g. GJ=9624");
+        };
+        let Some(p) = Param::parse(name) else {
+            let effects: Vec<&str> = Effect::ALL.iter().map(|e| e.parameter_name()).collect();
+            bail!("--fix {item}: unknown parameter '{name}'; use EI, EA, GA, GJ, density or one of {}", effects.join(", "));
+        };
+        let Ok(v) = value.trim().parse::<f64>() else {
+            bail!("--fix {item}: '{value}' is not a number");
+        };
+        held.push((p, v));
+    }
+    if !(args.fit.noise_mm.is_finite() && args.fit.noise_mm > 0.0) {
+        bail!("--noise-mm {}: the markers' noise must be a standard deviation > 0 mm", args.fit.noise_mm);
+    }
+    if args.fit.max_iterations == 0 {
+        bail!("--max-iterations must be at least 1");
+    }
+    let mut request = Calibrate3Request::new(args.data.clone(), args.fit.markers.clone(), actuator.to_path_buf());
+    request.held = held;
+    request.effects = parse_effects(&args.effects)?;
+    request.noise_mm = args.fit.noise_mm;
+    request.loss = args.fit.loss("squares")?;
+    request.max_iterations = args.fit.max_iterations;
+    request.holdout_cable = args.holdout_cable;
+    request.out = args.out.clone();
+    request.options = spatial_options(&args.actuator);
+    let report = captures::calibrate(&request, &mut |step| {
+        eprintln!("calibrate: iteration {}: marker RMS {:.3} σ", step.iteration, (step.cost / step.residuals as f64).sqrt())
+    })
+    .map_err(|e| with_flag(e, false))?;
+    let stdout = std::io::stdout();
+    let mut out = stdout.lock();
+    if args.json {
+        writeln!(out, "{}", report.to_json_line())?;
+    } else {
+        write!(out, "{report}")?;
+    }
+    Ok(())
+}
+
+/// The 3-D solver's settings from the solver flags (--nodes-per-span,
+/// --steps-per-span for the centreline's resolution, --method).
+pub fn spatial_options(args: &ActuatorArgs) -> cablemap::model::spatial::SpatialOptions {
+    let mut o = cablemap::model::spatial::SpatialOptions::default();
+    let solver = args.solver_options(&SolverOptions::default());
+    if args.nodes_per_span.is_some() {
+        o.nodes_per_span = solver.nodes_per_span;
+    }
+    if args.steps_per_span.is_some() {
+        o.steps_per_span = solver.steps_per_span;
+    }
+    if args.method.is_some() {
+        o.method = solver.method;
+    }
+    o
 }

@@ -22,6 +22,7 @@ pub mod design;
 pub mod diagnose;
 pub mod feasible;
 pub mod mould;
+pub mod predict;
 pub mod reduce;
 pub mod simulate;
 pub mod study;

@@ -1589,9 +1589,6 @@ impl SpatialSolver {
     /// accurate on each span); a boundary's point is taken from the span
     /// before it, so that a cable anchored there still runs through it.
     pub fn nodes(&self, count: usize) -> Vec<CentrelinePoint> {
-        assert!(self.last.is_some(), "nodes needs a successful solve");
-        let np = self.np;
-        let nc = self.cables;
         let length = self.rod.length_mm;
         let count = count.max(2);
         let mut samples: Vec<f64> = (0..count).map(|k| length * k as f64 / (count - 1) as f64).collect();
@@ -1600,6 +1597,22 @@ impl SpatialSolver {
                 samples.insert(samples.partition_point(|&s| s < b), b);
             }
         }
+        self.points_at(&samples)
+    }
+
+    /// The centreline of the last solve at the rest arc lengths `s_mm`
+    /// (each clamped into [0, L]), interpolated from the nodes (spectrally
+    /// accurate on each span); a span boundary's point is taken from the
+    /// span before it. Body-fixed points (markers) are evaluated here.
+    ///
+    /// # Panics
+    /// Before a successful solve.
+    pub fn points_at(&self, s_mm: &[f64]) -> Vec<CentrelinePoint> {
+        assert!(self.last.is_some(), "points_at needs a successful solve");
+        let np = self.np;
+        let nc = self.cables;
+        let length = self.rod.length_mm;
+        let samples = s_mm.iter().map(|s| s.clamp(0.0, length));
         // Quaternions of the node frames, sign-continuous.
         let mut quats: Vec<[f64; 4]> = Vec::with_capacity(self.rot.len());
         let mut prev: Option<UnitQuaternion<f64>> = None;

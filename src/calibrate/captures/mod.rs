@@ -1,0 +1,24 @@
+//! Calibration, prediction and diagnosis with several cables and 3-D
+//! markers (issue 26): captures with one actuation column per cable,
+//! body-fixed markers measured in the clamp frame, an actuator file, and
+//! the 3-D solver ([`crate::model::spatial::SpatialSolver`]).
+//!
+//! - [`files`]: reading the captures and markers files (CSV, Parquet).
+//! - [`simulate`]: solving captures in warm-started chains; markers on the body.
+//! - [`errors`]: the markers' 3-D errors per capture, per marker and overall.
+//! - [`fit`]: the fit of rigidities, weight and effects.
+//! - [`synth`]: synthetic captures with a hidden effect and noise.
+//! - [`run`]: the `predict` and `calibrate` requests and their reports.
+
+pub mod errors;
+pub mod files;
+pub mod fit;
+pub mod run;
+pub mod simulate;
+pub mod synth;
+
+pub use errors::ErrorReport;
+pub use files::{read_capture_set, Actuation, Capture, CaptureSet, MarkerReading};
+pub use fit::{fit_captures, Fit3Result, Fit3Spec, Param};
+pub use run::{calibrate, predict, Calibrate3Report, Calibrate3Request, PredictReport, PredictRequest};
+pub use simulate::{solve_captures, CaptureSolution};

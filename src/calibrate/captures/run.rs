@@ -1,0 +1,286 @@
+//! The workflows behind `cablemap predict` and `cablemap calibrate` with
+//! `--actuator FILE.toml --markers MARKERS`: requests in, reports out.
+//!
+//! [`predict`] simulates every capture with the given actuator (no
+//! fitting) and reports the markers' 3-D errors. [`calibrate`] fits the
+//! rigidities, the weight and any effect asked for, optionally on the
+//! captures where one cable does not pull (the others held out and
+//! predicted), and writes `calibrated.toml` and `fit.json`.
+
+use super::errors::ErrorReport;
+use super::files::{read_capture_set, CaptureSet};
+use super::fit::{fit_captures, Fit3Result, Fit3Spec, Param, Status};
+use super::simulate::solve_captures;
+use crate::calibrate::fit::Loss;
+use crate::calibrate::{CalibrateError, Effect};
+use crate::model::spatial::SpatialOptions;
+use crate::model::Actuator;
+use serde::Serialize;
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+/// What `predict` needs.
+#[derive(Debug, Clone)]
+pub struct PredictRequest {
+    /// The captures file.
+    pub captures: PathBuf,
+    /// The markers file (optional when the captures file has tip columns).
+    pub markers: Option<PathBuf>,
+    /// The actuator file.
+    pub actuator: PathBuf,
+    /// The 3-D solver's settings.
+    pub options: SpatialOptions,
+}
+
+/// The markers' errors of a prediction; serialises to `predict --json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct PredictReport {
+    /// The actuator file used.
+    pub actuator: String,
+    /// The errors.
+    #[serde(flatten)]
+    pub errors: ErrorReport,
+}
+
+fn read_actuator(path: &Path) -> Result<Actuator, CalibrateError> {
+    Actuator::read(path).map_err(CalibrateError::Actuator)
+}
+
+fn read_set(captures: &Path, markers: Option<&Path>, actuator: &Actuator) -> Result<CaptureSet, CalibrateError> {
+    read_capture_set(captures, markers, actuator.cables.len(), actuator.rod.length_mm)
+}
+
+/// Simulates every capture with the request's actuator and reports the errors.
+pub fn predict(request: &PredictRequest) -> Result<PredictReport, CalibrateError> {
+    let actuator = read_actuator(&request.actuator)?;
+    let set = read_set(&request.captures, request.markers.as_deref(), &actuator)?;
+    let solutions = solve_captures(&actuator, &request.options, &set)?;
+    Ok(PredictReport { actuator: request.actuator.display().to_string(), errors: ErrorReport::of(&set, &solutions) })
+}
+
+impl PredictReport {
+    /// The `--json` object on one line.
+    pub fn to_json_line(&self) -> String {
+        serde_json::to_value(self).expect("a report serialises").to_string()
+    }
+}
+
+impl fmt::Display for PredictReport {
+    fn fmt(&self, out: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(out, "prediction with {} (no fitting)", self.actuator)?;
+        write!(out, "{}", self.errors)
+    }
+}
+
+/// What a 3-D calibration needs.
+#[derive(Debug, Clone)]
+pub struct Calibrate3Request {
+    /// The captures file.
+    pub captures: PathBuf,
+    /// The markers file.
+    pub markers: Option<PathBuf>,
+    /// The actuator file: the starting values and everything not fitted.
+    pub actuator: PathBuf,
+    /// Parameters held at a value (`--fix`), not fitted.
+    pub held: Vec<(Param, f64)>,
+    /// Effects fitted besides the rigidities and the weight.
+    pub effects: Vec<Effect>,
+    /// The system's noise per coordinate, mm (added to a marker's `sd_mm`).
+    pub noise_mm: f64,
+    /// Loss on the whitened residuals.
+    pub loss: Loss,
+    /// Most Levenberg–Marquardt iterations.
+    pub max_iterations: usize,
+    /// Fit on the captures where this cable (1-based) does not pull; the
+    /// others are predicted with the fitted actuator.
+    pub holdout_cable: Option<usize>,
+    /// Where to write `calibrated.toml` and `fit.json` (none: not written).
+    pub out: Option<PathBuf>,
+    /// The 3-D solver's settings.
+    pub options: SpatialOptions,
+}
+
+impl Calibrate3Request {
+    /// A request with the defaults: fit EI, EA, GA, GJ and (with gravity)
+    /// the density, noise 1 mm, least squares, at most 40 iterations.
+    pub fn new(captures: PathBuf, markers: Option<PathBuf>, actuator: PathBuf) -> Self {
+        let spec = Fit3Spec::default();
+        Self {
+            captures,
+            markers,
+            actuator,
+            held: Vec::new(),
+            effects: Vec::new(),
+            noise_mm: spec.noise_mm,
+            loss: spec.loss,
+            max_iterations: spec.max_iterations,
+            holdout_cable: None,
+            out: None,
+            options: SpatialOptions::default(),
+        }
+    }
+}
+
+/// A finished 3-D calibration; serialises to `fit.json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct Calibrate3Report {
+    /// The fit on the fitted captures.
+    #[serde(flatten)]
+    pub fit: Fit3Result,
+    /// Parameters held at a given value (`--fix`).
+    pub held: Vec<(String, f64)>,
+    /// The held-out cable (1-based), if any.
+    pub holdout_cable: Option<usize>,
+    /// The errors on the held-out captures, predicted with the fitted actuator.
+    pub holdout: Option<ErrorReport>,
+    /// Captures fitted.
+    pub captures_fitted: usize,
+    /// Wall time of the fit, s.
+    pub elapsed_s: f64,
+    /// The files written.
+    #[serde(skip)]
+    pub written: Vec<PathBuf>,
+}
+
+impl Calibrate3Report {
+    /// `fit.json`'s text (pretty-printed).
+    pub fn to_json_pretty(&self) -> String {
+        serde_json::to_string_pretty(self).expect("a report serialises")
+    }
+
+    /// One line of JSON.
+    pub fn to_json_line(&self) -> String {
+        serde_json::to_value(self).expect("a report serialises").to_string()
+    }
+}
+
+/// The actuator file of a fit: the start with the fitted values, and a
+/// header saying where they came from.
+pub fn calibrated_toml(report: &Calibrate3Report, source: &Path) -> Result<String, CalibrateError> {
+    let body = toml::to_string(&report.fit.actuator).map_err(|e| CalibrateError::Invalid(format!("writing the calibrated actuator: {e}")))?;
+    let mut head = format!("# cablemap calibrate: {} fitted to {} captures, starting from {}\n", fitted_names(&report.fit), report.captures_fitted, source.display());
+    for p in &report.fit.parameters {
+        match p.status {
+            Status::Fitted => head.push_str(&format!("#   {} = {} ± {}\n", p.name, p.value, crate::io::fmt_sig(p.se, 3))),
+            Status::Undetermined => head.push_str(&format!("#   {} = {} (undetermined by the data: held at its start)\n", p.name, p.value)),
+        }
+    }
+    head.push_str(&format!("#   marker RMS {:.3} mm; χ²/dof {:.3}\n", report.fit.errors.rms_mm, report.fit.reduced_chi2));
+    Ok(head + &body)
+}
+
+fn fitted_names(fit: &Fit3Result) -> String {
+    let names: Vec<&str> = fit.parameters.iter().filter(|p| p.status == Status::Fitted).map(|p| p.name.as_str()).collect();
+    if names.is_empty() {
+        "nothing".into()
+    } else {
+        names.join(", ")
+    }
+}
+
+/// Runs a 3-D calibration, reporting each accepted step to `observe`.
+pub fn calibrate(request: &Calibrate3Request, observe: &mut dyn FnMut(crate::numerics::lm::Step)) -> Result<Calibrate3Report, CalibrateError> {
+    let started = std::time::Instant::now();
+    let mut base = read_actuator(&request.actuator)?;
+    let set = read_set(&request.captures, request.markers.as_deref(), &base)?;
+    for &(p, v) in &request.held {
+        if !(v.is_finite() && (matches!(p, Param::Effect(_)) || v > 0.0)) {
+            return Err(CalibrateError::Held(Box::new(CalibrateError::Invalid(format!("{} = {v}: a held value must be a finite number (> 0 for a rigidity or the density)", p.name())))));
+        }
+        p.set(&mut base, v);
+    }
+    let is_held = |p: Param| request.held.iter().any(|(h, _)| *h == p);
+    if let Some(&e) = request.effects.iter().find(|&&e| is_held(Param::Effect(e))) {
+        return Err(CalibrateError::FittedAndHeld { effect: e });
+    }
+    let mut params: Vec<Param> = Param::BODY.iter().copied().filter(|&p| !is_held(p)).collect();
+    if !base.rod.gravity.enabled {
+        params.retain(|&p| p != Param::Density);
+    }
+    params.extend(request.effects.iter().map(|&e| Param::Effect(e)));
+    let (train, test) = match request.holdout_cable {
+        None => (set, None),
+        Some(k) => {
+            if k == 0 || k > base.cables.len() {
+                return Err(CalibrateError::Holdout(format!("cable {k}: the actuator has cables 1 to {}", base.cables.len())));
+            }
+            let train = set.subset(|c| !c.pulling_cables().contains(&k));
+            let test = set.subset(|c| c.pulling_cables().contains(&k));
+            if train.captures.is_empty() || test.captures.is_empty() {
+                return Err(CalibrateError::Holdout(format!(
+                    "cable {k}: {} captures pull it and {} do not; holding it out needs both",
+                    test.captures.len(),
+                    train.captures.len()
+                )));
+            }
+            (train, Some(test))
+        }
+    };
+    let spec = Fit3Spec { params, noise_mm: request.noise_mm, loss: request.loss, max_iterations: request.max_iterations, options: request.options.clone() };
+    let fit = fit_captures(&base, &train, &spec, observe)?;
+    let holdout = match &test {
+        Some(t) => Some(ErrorReport::of(t, &solve_captures(&fit.actuator, &request.options, t)?)),
+        None => None,
+    };
+    let mut report = Calibrate3Report {
+        held: request.held.iter().map(|(p, v)| (p.name().to_string(), *v)).collect(),
+        holdout_cable: request.holdout_cable,
+        holdout,
+        captures_fitted: train.captures.len(),
+        elapsed_s: started.elapsed().as_secs_f64(),
+        written: Vec::new(),
+        fit,
+    };
+    if let Some(dir) = &request.out {
+        let io = |context: String| move |source| CalibrateError::Io { context, source };
+        std::fs::create_dir_all(dir).map_err(io(format!("creating {}", dir.display())))?;
+        let toml_path = dir.join("calibrated.toml");
+        std::fs::write(&toml_path, calibrated_toml(&report, &request.actuator)?).map_err(io(format!("writing {}", toml_path.display())))?;
+        let json_path = dir.join("fit.json");
+        std::fs::write(&json_path, report.to_json_pretty() + "\n").map_err(io(format!("writing {}", json_path.display())))?;
+        report.written = vec![toml_path, json_path];
+    }
+    Ok(report)
+}
+
+impl fmt::Display for Calibrate3Report {
+    fn fmt(&self, out: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let fit = &self.fit;
+        writeln!(
+            out,
+            "3-D fit of {} captures ({} marker coordinates, noise √(sd² + {} mm²) each); {:.1} s",
+            self.captures_fitted,
+            fit.n_residuals,
+            fit.noise_mm,
+            self.elapsed_s
+        )?;
+        for p in &fit.parameters {
+            match p.status {
+                Status::Fitted => writeln!(out, "  {:<24} {:>14.6} ± {:<10}  (start {})", p.name, p.value, crate::io::fmt_sig(p.se, 3), crate::io::fmt_sig(p.start, 6))?,
+                Status::Undetermined => writeln!(out, "  {:<24} {:>14.6}   undetermined by these data: held at its start", p.name, p.value)?,
+            }
+        }
+        for (name, v) in &self.held {
+            writeln!(out, "  {name:<24} {v:>14.6}   (held)")?;
+        }
+        write!(out, "{}", fit.errors)?;
+        writeln!(
+            out,
+            "χ² = {:.1} on {} dof (χ²/dof = {:.3}, {}){}",
+            fit.chi2,
+            fit.dof,
+            fit.reduced_chi2,
+            crate::calibrate::stats::p_text(fit.p_value),
+            if fit.p_value < 1e-3 { ": the model misses the markers by more than the stated noise" } else { ": consistent with the stated noise" }
+        )?;
+        writeln!(out, "{} iterations: {}", fit.iterations, fit.termination)?;
+        if let (Some(k), Some(h)) = (self.holdout_cable, &self.holdout) {
+            writeln!(out, "held out: the {} captures where cable {k} pulls, predicted with the fitted actuator:", h.captures.len())?;
+            write!(out, "{h}")?;
+        }
+        for p in &self.written {
+            writeln!(out, "wrote {}", p.display())?;
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,211 @@
+//! Several-cable captures with 3-D markers (issue 26): `predict` and
+//! `calibrate --actuator` as a user runs them on the real SoRoMoX tentacle
+//! (tests/data/soromox, MIT), and the 3-D fit's round trip on synthetic
+//! captures whose truth is known.
+
+use cablemap::calibrate::captures::synth::{one_cable_at_a_time, synth_captures, MarkerSpec};
+use cablemap::calibrate::captures::fit::Status;
+use cablemap::calibrate::captures::{fit_captures, Fit3Spec, Param};
+use cablemap::model::spatial::SpatialOptions;
+use cablemap::model::Actuator;
+use std::path::PathBuf;
+use std::process::Command;
+
+fn cablemap(args: &[&str]) -> (bool, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_cablemap")).args(args).output().expect("runs");
+    (out.status.success(), String::from_utf8_lossy(&out.stdout).into(), String::from_utf8_lossy(&out.stderr).into())
+}
+
+fn soromox(file: &str) -> String {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/soromox").join(file).display().to_string()
+}
+
+fn json(stdout: &str) -> serde_json::Value {
+    serde_json::from_str(stdout.trim()).unwrap_or_else(|e| panic!("not JSON ({e}): {stdout}"))
+}
+
+/// `predict --json` on the real captures with `actuator`.
+fn predict(actuator: &str) -> serde_json::Value {
+    let (ok, stdout, stderr) = cablemap(&["predict", &soromox("captures.csv"), "--actuator", actuator, "--markers", &soromox("markers.csv"), "--json"]);
+    assert!(ok, "{stderr}");
+    json(&stdout)
+}
+
+fn by_marker(v: &serde_json::Value) -> Vec<(String, f64)> {
+    v["rms_by_marker_mm"].as_object().unwrap().iter().map(|(k, x)| (k.clone(), x.as_f64().unwrap())).collect()
+}
+
+fn by_marker_text(v: &[(String, f64)]) -> String {
+    v.iter().map(|(k, x)| format!("{k} {x:.2}")).collect::<Vec<_>>().join(", ")
+}
+
+#[test]
+fn predict_reports_every_capture_and_marker_in_3d() {
+    let v = predict(&soromox("actuator.toml"));
+    let captures = v["captures"].as_array().unwrap();
+    assert_eq!(captures.len(), 14);
+    for c in captures {
+        let markers = c["markers"].as_array().unwrap();
+        assert_eq!(markers.len(), 4);
+        let errors: Vec<f64> = markers.iter().map(|m| m["error_mm"].as_f64().unwrap()).collect();
+        let rms = (errors.iter().map(|e| e * e).sum::<f64>() / 4.0).sqrt();
+        assert!((c["rms_mm"].as_f64().unwrap() - rms).abs() < 1e-9, "{c}");
+        assert!(c["measurement"].as_i64().is_some() && markers[3]["marker"] == "p4");
+    }
+    let markers = by_marker(&v);
+    assert_eq!(markers.iter().map(|(k, _)| k.as_str()).collect::<Vec<_>>(), ["p1", "p2", "p3", "p4"]);
+    println!("predict with the nominal materials: per-marker RMS {} mm, overall {:.2} mm", by_marker_text(&markers), v["rms_mm"].as_f64().unwrap());
+    // The text form prints the same per-marker RMS.
+    let (ok, stdout, _) = cablemap(&["predict", &soromox("captures.csv"), "--actuator", &soromox("actuator.toml"), "--markers", &soromox("markers.csv")]);
+    assert!(ok && stdout.contains("RMS per marker: p1") && stdout.contains("capture   14"), "{stdout}");
+}
+
+#[test]
+fn calibrate_fits_the_real_tentacle_and_its_actuator_predicts() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("all");
+    let (ok, stdout, stderr) = cablemap(&[
+        "calibrate",
+        &soromox("captures.csv"),
+        "--actuator",
+        &soromox("actuator.toml"),
+        "--markers",
+        &soromox("markers.csv"),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stderr}");
+    assert!(stdout.contains("RMS per marker") && stdout.contains("calibrated.toml"), "{stdout}");
+    let fit = json(&std::fs::read_to_string(out.join("fit.json")).unwrap());
+    assert_eq!(fit["converged"], true, "{fit}");
+    let params = fit["parameters"].as_array().unwrap();
+    let param = |name: &str| params.iter().find(|p| p["name"] == name).unwrap_or_else(|| panic!("{name} in {fit}"));
+    // EI and the weight are determined by the markers (at full weight).
+    for name in ["ei_n_mm2", "density_g_cm3"] {
+        let p = param(name);
+        assert_eq!(p["status"], "fitted", "{p}");
+        let (value, se) = (p["value"].as_f64().unwrap(), p["se"].as_f64().unwrap());
+        assert!(value > 0.0 && se > 0.0 && se < 0.2 * value, "{p}");
+    }
+    // A parameter is fitted with a finite SE or reported undetermined at its start.
+    for p in params {
+        match p["status"].as_str().unwrap() {
+            "fitted" => assert!(p["se"].as_f64().is_some_and(f64::is_finite), "{p}"),
+            "undetermined" => assert_eq!(p["value"], p["start"], "{p}"),
+            other => panic!("status {other}"),
+        }
+    }
+    let fitted = by_marker(&fit);
+    let nominal = by_marker(&predict(&soromox("actuator.toml")));
+    println!("calibrate on all 14 captures: per-marker RMS {} mm (nominal materials {}; the authors' fit about 11 / 16 / 16 / 33 mm)", by_marker_text(&fitted), by_marker_text(&nominal));
+    let rms = fit["rms_mm"].as_f64().unwrap();
+    let nominal_rms = predict(&soromox("actuator.toml"))["rms_mm"].as_f64().unwrap();
+    assert!(rms < 0.5 * nominal_rms, "the fit lowers the error: {rms} vs {nominal_rms}");
+    // The calibrated actuator is an actuator file every command reads:
+    // predict reproduces the fit's errors with it.
+    let calibrated = out.join("calibrated.toml");
+    let again = predict(calibrated.to_str().unwrap());
+    assert!((again["rms_mm"].as_f64().unwrap() - rms).abs() < 1e-6, "{} vs {rms}", again["rms_mm"]);
+    let (ok, _, stderr) = cablemap(&["simulate", "--actuator", calibrated.to_str().unwrap(), "--json"]);
+    assert!(ok, "{stderr}");
+    // The fit's residuals per capture and marker.
+    let first = &fit["captures"][0]["markers"][0];
+    assert!(first["residual_mm"].as_array().unwrap().len() == 3 && first["error_mm"].as_f64().is_some(), "{first}");
+    assert!(fit["chi2"].as_f64().unwrap() > 0.0 && fit["dof"].as_u64().unwrap() > 0);
+}
+
+#[test]
+fn calibrate_on_one_tendon_predicts_the_other() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("t1");
+    let (ok, stdout, stderr) = cablemap(&[
+        "calibrate",
+        &soromox("captures.csv"),
+        "--actuator",
+        &soromox("actuator.toml"),
+        "--markers",
+        &soromox("markers.csv"),
+        "--holdout-cable",
+        "2",
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ]);
+    assert!(ok, "{stderr}");
+    let fit = json(&stdout);
+    assert_eq!(fit["converged"], true);
+    assert_eq!(fit["captures_fitted"], 7);
+    assert_eq!(fit["captures"].as_array().unwrap().len(), 7);
+    let held = &fit["holdout"];
+    assert_eq!(held["captures"].as_array().unwrap().len(), 7);
+    let fitted = by_marker(&fit);
+    let predicted = by_marker(held);
+    println!("calibrate on tendon 1's 7 captures: fitted per-marker RMS {} mm; tendon 2's 7 predicted: {} mm", by_marker_text(&fitted), by_marker_text(&predicted));
+    // predict with the calibrated actuator gives the same held-out errors.
+    let all = predict(out.join("calibrated.toml").to_str().unwrap());
+    for c in held["captures"].as_array().unwrap() {
+        let same = all["captures"].as_array().unwrap().iter().find(|a| a["measurement"] == c["measurement"]).unwrap();
+        assert!((same["rms_mm"].as_f64().unwrap() - c["rms_mm"].as_f64().unwrap()).abs() < 1e-6, "{same} vs {c}");
+    }
+    // A cable the actuator does not have is refused.
+    let (ok, _, stderr) = cablemap(&["calibrate", &soromox("captures.csv"), "--actuator", &soromox("actuator.toml"), "--markers", &soromox("markers.csv"), "--holdout-cable", "3"]);
+    assert!(!ok && stderr.contains("cable 3"), "{stderr}");
+}
+
+#[test]
+fn bad_captures_and_markers_name_file_row_and_column() {
+    let dir = tempfile::tempdir().unwrap();
+    let markers = dir.path().join("markers.csv");
+    let mut text = std::fs::read_to_string(soromox("markers.csv")).unwrap();
+    text = text.replacen("1,p2,219.5,0.0,-21.0,217.334", "1,p2,219.5,0.0,-21.0,abc", 1);
+    std::fs::write(&markers, text).unwrap();
+    let (ok, _, stderr) = cablemap(&["predict", &soromox("captures.csv"), "--actuator", &soromox("actuator.toml"), "--markers", markers.to_str().unwrap()]);
+    assert!(!ok && stderr.contains("markers.csv") && stderr.contains("row 2") && stderr.contains("'x_mm'"), "{stderr}");
+    // Rod flags are refused: the rod is the actuator file's.
+    let (ok, _, stderr) = cablemap(&["predict", &soromox("captures.csv"), "--actuator", &soromox("actuator.toml"), "--markers", &soromox("markers.csv"), "--ei-n-mm2", "100"]);
+    assert!(!ok && stderr.contains("[rod]"), "{stderr}");
+}
+
+/// The tentacle with the authors' identified materials: the truth of the
+/// synthetic round trip (not the file's start, so the fit has to move).
+fn tentacle_truth() -> Actuator {
+    let mut a = Actuator::read(std::path::Path::new(&soromox("actuator.toml"))).unwrap();
+    a.rod.ei_n_mm2 = 13955.3;
+    a.rod.ea_n = 235.07;
+    a.rod.ga_n = 81.06;
+    a.gj_n_mm2 = Some(9624.4);
+    a.rod.density_g_cm3 = 1.3177;
+    a
+}
+
+#[test]
+fn the_3d_fit_recovers_the_rigidities_within_their_standard_errors() {
+    let truth = tentacle_truth();
+    let options = SpatialOptions::default();
+    let markers = [MarkerSpec::new("p1", 129.1, 0.0, 25.0), MarkerSpec::new("p2", 219.5, 0.0, -21.0), MarkerSpec::new("p3", 280.0, 0.0, 20.0), MarkerSpec::new("p4", 368.0, 0.0, 0.0)];
+    let captures = one_cable_at_a_time(2, &[1.5, 3.0, 4.5, 6.0, 7.5], 5.0);
+    let set = synth_captures(&truth, &options, captures, &markers, 1.0, 7, false).unwrap();
+    let start = Actuator::read(std::path::Path::new(&soromox("actuator.toml"))).unwrap();
+    let spec = Fit3Spec { params: Param::BODY.to_vec(), noise_mm: 1.0, ..Fit3Spec::default() };
+    let fit = fit_captures(&start, &set, &spec, &mut |_| {}).unwrap();
+    assert!(fit.converged, "{}", fit.termination);
+    for f in &fit.parameters {
+        let want = f.param.get(&truth);
+        println!("{}: {:?} {} ± {} (truth {want}, start {})", f.name, f.status, f.value, f.se, f.start);
+    }
+    for p in Param::BODY {
+        let f = fit.parameter(p).unwrap();
+        let want = p.get(&truth);
+        match f.status {
+            Status::Fitted => assert!((f.value - want).abs() <= 2.0 * f.se, "{}: {} ± {} vs truth {want}", f.name, f.value, f.se),
+            Status::Undetermined => assert_eq!(f.value, f.start),
+        }
+    }
+    for p in [Param::Ei, Param::Density] {
+        let f = fit.parameter(p).unwrap();
+        assert!(f.status == Status::Fitted && f.se < 0.05 * p.get(&truth), "{f:?}");
+    }
+    // 1 mm noise: χ²/dof near 1 and the marker RMS near √3 mm.
+    assert!((0.6..1.5).contains(&fit.reduced_chi2), "{}", fit.reduced_chi2);
+    assert!((1.2..2.3).contains(&fit.errors.rms_mm), "{}", fit.errors.rms_mm);
+}
