@@ -199,3 +199,56 @@ fn bad_design_files_are_named() {
     let (ok, _, stderr) = run(&["design", "--actuator", &ok_actuator, "--targets", &t, "--weights", "x=2"]);
     assert!(!ok && stderr.contains("--weights does not apply to --targets"), "{stderr}");
 }
+
+/// Distance of `p` from the segment a–b.
+fn segment_distance(p: &[f64], a: &[f64], b: &[f64]) -> f64 {
+    let d: Vec<f64> = (0..3).map(|i| b[i] - a[i]).collect();
+    let w: Vec<f64> = (0..3).map(|i| p[i] - a[i]).collect();
+    let dd: f64 = d.iter().map(|v| v * v).sum();
+    let t = (w.iter().zip(&d).map(|(x, y)| x * y).sum::<f64>() / dd).clamp(0.0, 1.0);
+    (0..3).map(|i| (w[i] - t * d[i]).powi(2)).sum::<f64>().sqrt()
+}
+
+/// A trajectory of 4 waypoints for the antagonistic pair (channels as
+/// given, tensions designed): the reported path deviation is that of a
+/// re-simulation of every sample, by `simulate`, to 1e-6 mm.
+#[test]
+fn a_trajectory_reports_the_path_a_resimulation_follows() {
+    let dir = tempfile::tempdir().unwrap();
+    let pair = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/spatial/antagonistic.toml");
+    let pair = pair.to_str().unwrap();
+    let cables = |t1: f64, t2: f64| {
+        [format!("y=2.4,3.1,1.8,2.6,2.8 tension={t1}"), format!("y=-1.7,-2.4,-1.6,-3.2,-3.1 tension={t2}")]
+    };
+    let tip_of = |v: &Value| vec![v["tip_x_mm"].as_f64().unwrap(), v["tip_y_mm"].as_f64().unwrap(), v["tip_z_mm"].as_f64().unwrap()];
+    let simulate = |t1: f64, t2: f64| {
+        let [c1, c2] = cables(t1, t2);
+        json(&["simulate", "--actuator", pair, "--cable", &c1, "--cable", &c2, "--json"])
+    };
+    let waypoints: Vec<Vec<f64>> = [(0.2, 1.2), (0.8, 0.6), (1.4, 0.3), (1.8, 1.0)].iter().map(|&(a, b)| tip_of(&simulate(a, b))).collect();
+    let targets = write(dir.path(), "path.toml", &format!("[trajectory]\nwaypoints = {waypoints:?}\nsmooth = true\n"));
+    let d = json(&["design", "--actuator", pair, "--targets", &targets, "--json"]);
+    assert_eq!(d["met"], true, "{d}");
+    let path = &d["trajectory"];
+    assert_eq!(path["steps_per_leg"], 20);
+    let legs = path["legs"].as_array().unwrap();
+    assert_eq!(legs.len(), 3);
+    let mut largest = 0.0f64;
+    for (k, leg) in legs.iter().enumerate() {
+        let samples = leg["samples"].as_array().unwrap();
+        assert_eq!(samples.len(), 21);
+        let mut worst = 0.0f64;
+        for s in samples {
+            let a = floats(&s["actuation"]);
+            let tip = tip_of(&simulate(a[0], a[1]));
+            worst = worst.max(segment_distance(&tip, &waypoints[k], &waypoints[k + 1]));
+        }
+        let reported = leg["max_deviation_mm"].as_f64().unwrap();
+        assert!((reported - worst).abs() < 1e-6, "leg {}: reported {reported} mm, re-simulated {worst} mm", k + 1);
+        assert!(leg["reversals"].as_array().unwrap().is_empty());
+        largest = largest.max(worst);
+    }
+    assert!((path["max_deviation_mm"].as_f64().unwrap() - largest).abs() < 1e-6);
+    assert!(largest > 0.1, "the path leaves the straight legs: the check is not empty ({largest} mm)");
+    assert_eq!(path["failed_samples"], 0);
+}

@@ -357,7 +357,15 @@ fn compare(t: &ShapeTarget, a: &Achieved, length_mm: f64) -> Vec<ComponentOutcom
 fn command_of(actuator: &Actuator, file: Option<&std::path::Path>) -> String {
     match file {
         Some(p) => format!("cablemap simulate --actuator {} --json", super::feasible::shell_word(&p.display().to_string())),
-        None => crate::model::record::simulate_command(actuator, &crate::model::spatial::SpatialOptions::default()).text,
+        None => {
+            let c = crate::model::record::simulate_command(actuator, &crate::model::spatial::SpatialOptions::default());
+            if c.missing.is_empty() {
+                c.text
+            } else {
+                // What no flag gives: the command alone would solve another actuator.
+                format!("{}  # with no flag for: {}; --out writes the actuator file that has them", c.text, c.missing.join(", "))
+            }
+        }
     }
 }
 
@@ -451,7 +459,18 @@ pub fn run(request: &CableDesignRequest) -> Result<CableDesignRun, DesignError> 
             None => Vec::new(),
         };
         let found = search::search(&setup, &request.search, &extra)?;
-        (found.channels, found.achieved, found.cost, found.starts, found.seeds_simulated, "cables")
+        // Reported as `simulate` solves the design (the search may have
+        // solved it without the ladder).
+        let achieved = found
+            .achieved
+            .into_iter()
+            .map(|(actuation, _)| {
+                let sim = setup.simulate(&setup.actuator(&found.channels, &actuation))?;
+                Ok((actuation, Achieved::of(&sim)))
+            })
+            .collect::<Result<Vec<_>, crate::model::spatial::SpatialError>>()
+            .map_err(|e| DesignError::BadSearch(format!("re-simulating the design found: {e}")))?;
+        (found.channels, achieved, found.cost, found.starts, found.seeds_simulated, "cables")
     };
     let mut targets: Vec<TargetOutcome> = request
         .targets

@@ -23,7 +23,7 @@
 use super::spec::{ActuationBounds, CableFreedom, DesignActuator};
 use super::targets::{Quantity, ShapeTarget};
 use super::super::DesignError;
-use crate::model::spatial::{SpatialError, SpatialOptions};
+use crate::model::spatial::{SpatialError, SpatialOptions, SpatialSolver};
 use crate::model::{simulate_actuator, Actuator, Given, Simulation, SolverOptions, TipPose};
 use crate::numerics::lm;
 use crate::shape::LengthBasis;
@@ -235,9 +235,34 @@ impl Setup {
         simulate_actuator(actuator, &self.options, &SpatialOptions::default(), Given::default(), None, self.order(), self.basis)
     }
 
-    /// Solves target `t` at `x`.
+    /// Solves target `t` at `x` ([`Setup::quick`]).
     fn solve(&self, channels: &[Channel], x: &[f64], t: usize) -> Result<Achieved, SpatialError> {
-        self.simulate(&self.actuator(channels, &self.actuation(x, t))).map(|s| Achieved::of(&s))
+        self.quick(&self.actuator(channels, &self.actuation(x, t)))
+    }
+
+    /// What the search solves: for a tension-driven actuator the 3-D
+    /// collocation serves, one cold solve at the full tensions (about 4×
+    /// cheaper than the ladder, the same pose to the solver's tolerance);
+    /// where that fails, and for every other actuator, [`Setup::simulate`].
+    /// The design's reported values are [`Setup::simulate`]'s.
+    pub fn quick(&self, actuator: &Actuator) -> Result<Achieved, SpatialError> {
+        let spatial = !crate::model::solver::backend::is_planar(actuator)
+            && !actuator.cables.iter().any(|c| c.is_displacement_driven())
+            && self.options.method == crate::model::SolverMethod::Collocation;
+        if spatial {
+            let options = SpatialOptions { nodes_per_span: self.options.nodes_per_span, ..SpatialOptions::default() };
+            if let Ok(mut solver) = SpatialSolver::new(actuator, &options) {
+                let tensions: Vec<f64> = actuator.cables.iter().map(|c| c.tension_n).collect();
+                if let Ok(pose) = solver.solve(&tensions) {
+                    if let Ok([a_twist, a_bend_y, a_bend_z]) = solver.coefficients(self.order(), self.basis) {
+                        if a_twist.iter().chain(&a_bend_y).chain(&a_bend_z).all(|v| v.is_finite()) {
+                            return Ok(Achieved { pose, a_bend_z, a_bend_y, a_twist });
+                        }
+                    }
+                }
+            }
+        }
+        self.simulate(actuator).map(|s| Achieved::of(&s))
     }
 
     /// Target `t`'s weighted residuals √λ (achieved − asked).
@@ -311,6 +336,23 @@ struct Problem<'a> {
     best: Option<(f64, Point, Vec<Achieved>)>,
     evaluations: usize,
     max_evaluations: usize,
+    /// The best cost at each Jacobian.
+    history: Vec<f64>,
+}
+
+/// A start stops when its best cost fell by less than [`STALL_FRACTION`]
+/// over this many iterations: a flat valley, where the remaining gain is
+/// below what any target's tolerance resolves.
+const STALL_ITERATIONS: usize = 10;
+
+/// See [`STALL_ITERATIONS`].
+const STALL_FRACTION: f64 = 0.01;
+
+impl Problem<'_> {
+    fn stalled(&self) -> bool {
+        let h = &self.history;
+        h.len() > STALL_ITERATIONS && h[h.len() - 1] > (1.0 - STALL_FRACTION) * h[h.len() - 1 - STALL_ITERATIONS]
+    }
 }
 
 impl Problem<'_> {
@@ -347,6 +389,7 @@ impl lm::Problem for Problem<'_> {
     /// moves every target, an actuation variable only its own target.
     fn jacobian(&mut self, x: &[f64], r: &[f64], free: &[usize]) -> Option<DMatrix<f64>> {
         let setup = self.setup;
+        self.history.push(self.best.as_ref().map_or(f64::INFINITY, |b| b.0));
         let mut jac = DMatrix::zeros(r.len(), free.len());
         let nc = setup.channel_var_count();
         let channels = setup.channels(x);
@@ -378,7 +421,7 @@ impl lm::Problem for Problem<'_> {
     }
 
     fn stop(&mut self) -> bool {
-        self.best.as_ref().is_some_and(|b| b.0 <= COST_FLOOR) || self.evaluations >= self.max_evaluations
+        self.best.as_ref().is_some_and(|b| b.0 <= COST_FLOOR) || self.evaluations >= self.max_evaluations || self.stalled()
     }
 }
 
@@ -457,8 +500,7 @@ fn grid_seeds(setup: &Setup) -> (Vec<(f64, Point)>, usize) {
                     let (lo, hi) = f.actuation.range();
                     lo + (hi - lo) * l
                 }).collect();
-                let Ok(sim) = setup.simulate(&setup.actuator(&channels, &act)) else { continue };
-                let a = Achieved::of(&sim);
+                let Ok(a) = setup.quick(&setup.actuator(&channels, &act)) else { continue };
                 for (t, b) in best.iter_mut().enumerate() {
                     let c = setup.cost_of(t, &a);
                     if c < b.0 {
@@ -492,7 +534,7 @@ pub fn point_of(setup: &Setup, channels: &[Channel]) -> Point {
 
 /// Refines one start; returns the best point seen with its cost and solves.
 fn refine(setup: &Setup, x0: &[f64], max_evaluations: usize, source: &'static str) -> (Option<(f64, Point, Vec<Achieved>)>, StartReport) {
-    let mut p = Problem { setup, best: None, evaluations: 0, max_evaluations };
+    let mut p = Problem { setup, best: None, evaluations: 0, max_evaluations, history: Vec::new() };
     let start = p.solve_all(x0);
     let seed_cost = start.as_ref().map_or(f64::INFINITY, |s| s.0.iter().map(|v| v * v).sum());
     let termination = match start {
@@ -504,6 +546,8 @@ fn refine(setup: &Setup, x0: &[f64], max_evaluations: usize, source: &'static st
         "exact fit (objective at the noise floor)".into()
     } else if p.evaluations >= max_evaluations {
         "evaluation budget reached".into()
+    } else if p.stalled() {
+        format!("stalled: the cost fell by less than {} % over {STALL_ITERATIONS} iterations", 100.0 * STALL_FRACTION)
     } else {
         termination
     };
@@ -531,10 +575,17 @@ pub fn search(setup: &Setup, search: &CableSearch, extra: &[Vec<Channel>]) -> Re
         }
         starts.push((x, "map"));
     }
-    for (_, x) in &grid {
+    // Seeds of equal cost are one design twice (two interchangeable cables
+    // swapped): one of them is refined.
+    let mut last_cost = f64::NAN;
+    for (cost, x) in &grid {
         if starts.len() >= search.starts {
             break;
         }
+        if (cost - last_cost).abs() <= 1e-9 * cost.abs() {
+            continue;
+        }
+        last_cost = *cost;
         starts.push((x.clone(), "grid"));
     }
     if starts.is_empty() {
