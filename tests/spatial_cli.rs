@@ -187,3 +187,48 @@ fn the_documented_actuator_file_runs() {
     assert_eq!(f3(&v["gravity_direction"]), [0.0, -1.0, 0.0]);
     assert!(v["tip_y_mm"].as_f64().unwrap() > 5.0, "the stronger cable at +y wins: {v}");
 }
+
+/// Displacement as the input, as a user drives a motor: the record carries
+/// both actuations; the displacement a tension produced, given back,
+/// returns that tension and shape (the round trip through the binary, its
+/// JSON numbers printed exactly); a long cable is slack; a negative
+/// displacement and RK4 (which does not integrate the cable's path) are
+/// refused with the reason.
+#[test]
+fn displacement_drives_a_cable_from_the_command_line() {
+    let num = |v: &Value, k: &str| v[k].as_f64().unwrap_or_else(|| panic!("{k} in {v}"));
+    let by_tension = json(&["simulate", "--routing", "1,-2,4,4,-4", "--tension-n", "1.2", "--json"]);
+    let d = num(&by_tension, "displacement_mm");
+    assert!(d > 0.5, "a pulled cable is pulled in: {by_tension}");
+    let by_displacement = json(&["simulate", "--routing", "1,-2,4,4,-4", "--displacement-mm", &format!("{d:e}"), "--json"]);
+    assert!((num(&by_displacement, "tension_n") - 1.2).abs() < 1e-8, "{by_displacement}");
+    for k in ["tip_x_mm", "tip_y_mm"] {
+        assert!((num(&by_displacement, k) - num(&by_tension, k)).abs() < 1e-8, "{k}: {by_displacement} vs {by_tension}");
+    }
+    // Slack: a cable pulled in by nothing, across a rod whose weight sags
+    // it toward the cable (its path shortens), carries nothing: the shape is
+    // the weight's alone. (Hanging along the axis the weight stretches the
+    // rod, and a cable pulled in by 0 mm holds it: taut.)
+    let across = ["--routing", "3,3,3,3,3", "--gravity-direction", "0,1,0", "--json"];
+    let slack = json(&[&["simulate", "--displacement-mm", "0"][..], &across[..]].concat());
+    let hanging = json(&[&["simulate", "--tension-n", "0"][..], &across[..]].concat());
+    assert_eq!(slack["tension_n"][0].as_f64(), Some(0.0), "{slack}");
+    assert!((num(&slack, "tip_y_mm") - num(&hanging, "tip_y_mm")).abs() < 1e-12);
+    assert!(num(&hanging, "tip_y_mm") > 1.0, "the weight bends the rod: {hanging}");
+    // A stiffer-than-infinite cable stretches: more displacement for the same tension.
+    let stretchy = json(&["simulate", "--routing", "1,-2,4,4,-4", "--tension-n", "1.2", "--cable-ea-n", "100", "--json"]);
+    assert!((num(&stretchy, "displacement_mm") - d - 1.2 * 64.0 / 100.0).abs() < 0.05, "{stretchy}");
+    // Several cables: each carries its tension and displacement.
+    let two = json(&["simulate", "--cable", "y=3,3,3,3,3 displacement=2", "--cable", "y=-3,-3,-3,-3,-3 tension=0.5", "--json"]);
+    assert!((two["displacement_mm"][0].as_f64().unwrap() - 2.0).abs() < 1e-9, "{two}");
+    assert!(two["tension_n"][0].as_f64().unwrap() > 0.0 && two["tension_n"][1].as_f64().unwrap() == 0.5, "{two}");
+    assert!(two["displacement_mm"][1].as_f64().unwrap().is_finite());
+    let (ok, _, err) = run(&["simulate", "--routing", "1,-2,4,4,-4", "--displacement-mm", "-1"]);
+    assert!(!ok && err.contains("negative displacement"), "{err}");
+    let (ok, _, err) = run(&["simulate", "--routing", "1,-2,4,4,-4", "--displacement-mm", "1", "--method", "rk4"]);
+    assert!(!ok && err.contains("displacement") && err.contains("collocation"), "{err}");
+    let (ok, _, err) = run(&["simulate", "--routing", "1,-2,4,4,-4"]);
+    assert!(!ok && err.contains("--displacement-mm"), "{err}");
+    let (ok, _, err) = run(&["simulate", "--routing", "1,-2,4,4,-4", "--tension-n", "1", "--displacement-mm", "1"]);
+    assert!(!ok && err.contains("cannot be used with"), "{err}");
+}

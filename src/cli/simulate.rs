@@ -2,7 +2,7 @@
 
 use super::{parse_list, ActuatorArgs, LengthBasisArgs};
 use cablemap::model::record::{self, SimulationRecord};
-use cablemap::model::{simulate_held, Backend, Given, Hold, LoadDirection, Routing, SimulateError, SolverOptions};
+use cablemap::model::{simulate_actuator, simulate_held, Actuator, Backend, Cable, Given, Hold, LoadDirection, Routing, SimulateError, SolverOptions};
 use cablemap::plot::{draw_bodies, BodyDrawing};
 use anyhow::Context;
 use clap::Args;
@@ -14,11 +14,20 @@ use std::path::PathBuf;
 #[derive(Debug, Clone, Args)]
 pub struct SimulateArgs {
     /// Routing control points y0,y1,y2,y3,y4 in mm (each |y_i| < r): one planar cable.
-    #[arg(long, value_name = "Y0,Y1,Y2,Y3,Y4", allow_hyphen_values = true, requires = "tension_n", conflicts_with_all = ["cable"])]
+    #[arg(long, value_name = "Y0,Y1,Y2,Y3,Y4", allow_hyphen_values = true, conflicts_with_all = ["cable"])]
     pub routing: Option<String>,
     /// Cable tension τ, N (≥ 0), with --routing (`--tension` is the old name).
     #[arg(long = "tension-n", alias = "tension", value_name = "N", allow_hyphen_values = true, requires = "routing")]
     pub tension_n: Option<f64>,
+    /// Cable displacement Δℓ, mm (≥ 0), with --routing, in place of
+    /// --tension-n: the length pulled in at the base (a motor's position);
+    /// the tension is found. A cable longer than its path is slack.
+    #[arg(long = "displacement-mm", value_name = "MM", allow_hyphen_values = true, requires = "routing", conflicts_with = "tension_n")]
+    pub displacement_mm: Option<f64>,
+    /// The cable's axial stiffness EA, N, with --routing (its stretch under
+    /// tension is part of its displacement) [default: inextensible].
+    #[arg(long = "cable-ea-n", value_name = "N", allow_hyphen_values = true, requires = "routing")]
+    pub cable_ea_n: Option<f64>,
     /// One cable of several or spatial cables, repeatable:
     /// "y=Y0,..,Y4 z=Z0,..,Z4 tension=T" (mm, N; z= may be left out for a
     /// planar cable; anchor=S knots it at s = S mm). Solved by the 3-D solver.
@@ -82,9 +91,9 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     if !args.cable.is_empty() || args.spatial_actuator.is_some() || args.gravity_direction.is_some() {
         return run_spatial(args);
     }
-    let (Some(routing_text), Some(tension)) = (&args.routing, args.tension_n) else {
+    let (Some(routing_text), Some(actuation)) = (&args.routing, planar_actuation(args)?) else {
         anyhow::bail!(
-            "say what to simulate: --routing Y0,..,Y4 --tension-n T (one planar cable), --cable \"y=.. z=.. tension=T\" (repeatable), or --actuator FILE.toml"
+            "say what to simulate: --routing Y0,..,Y4 with --tension-n T or --displacement-mm D (one planar cable), --cable \"y=.. z=.. tension=T\" (repeatable), or --actuator FILE.toml"
         );
     };
     let actuator = args.actuator.resolve()?;
@@ -109,11 +118,33 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         CoefficientRoute::Thesis => args.order.min(cablemap::model::resolution::max_order(&options)),
     };
     let basis = args.basis.length_basis;
-    let solved = simulate_held(&actuator, &options, &routing, tension, exact_order, basis, hold);
-    if let (Err(SimulateError::Solve(failure)), true) = (&solved, args.json) {
-        print_failure_json(failure.status(), &failure.to_string())?;
-    }
-    let mut sim = solved.with_context(|| format!("simulating routing {y:?} at {} N", cablemap::io::fmt_num(tension)))?;
+    let mut sim = match actuation {
+        Actuation::Tension(t) if args.cable_ea_n.is_none() => {
+            let solved = simulate_held(&actuator, &options, &routing, t, exact_order, basis, hold);
+            if let (Err(SimulateError::Solve(failure)), true) = (&solved, args.json) {
+                print_failure_json(failure.status(), &failure.to_string())?;
+            }
+            solved.with_context(|| format!("simulating routing {y:?} at {actuation}"))?
+        }
+        // A displacement, or a stiffness: the actuator's one cable, checked
+        // and solved as every actuator's (the same planar backend).
+        _ => {
+            let cable = Cable { cable_ea_n: args.cable_ea_n, ..Cable::planar(routing.control_points_mm().0, 0.0) };
+            let cable = match actuation {
+                Actuation::Tension(t) => Cable { tension_n: t, ..cable },
+                Actuation::Displacement(d) => Cable { displacement_mm: Some(d), ..cable },
+            };
+            let one = Actuator::with_cables(actuator.clone(), vec![cable]);
+            let spatial_options = cablemap::model::spatial::SpatialOptions::default();
+            let solved = simulate_actuator(&one, &options, &spatial_options, given_settings(args), Some(hold), exact_order, basis);
+            if let (Err(e), true) = (&solved, args.json) {
+                if let Some(status) = e.failure_status() {
+                    print_failure_json(status, &e.to_string())?;
+                }
+            }
+            solved.with_context(|| format!("simulating routing {y:?} at {actuation}"))?
+        }
+    };
     if args.coefficients == CoefficientRoute::Thesis {
         let points: Vec<[f64; 2]> = sim.centreline.iter().map(|c| [c.x_mm, c.y_mm]).collect();
         sim.a_bend_z = cablemap::shape::thesis_coefficients(&points, args.order, args.n_d)
@@ -125,7 +156,7 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         record::write_planar_centreline_csv(path, &sim).with_context(|| format!("writing centreline CSV {}", path.display()))?;
     }
     if let Some(path) = &args.png {
-        let title = format!("routing [{}] mm, tension {:.3} N", fmt_list(&y), tension);
+        let title = format!("routing [{}] mm, tension {:.3} N", fmt_list(&y), sim.pose.tension_n());
         let drawing = BodyDrawing::of_body(&sim, &actuator, "body (outline at ±r)".into(), BLUE_800);
         draw_bodies(path, &title, &[drawing], &[])?;
     }
@@ -139,6 +170,11 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     let p = &sim.pose;
     writeln!(out, "routing        [{}] mm", fmt_list(&y))?;
     writeln!(out, "tension        {:.6} N   (gravity {})", p.tension_n(), if actuator.gravity.enabled { "on" } else { "off" })?;
+    match (actuation, p.displacement_mm()) {
+        (_, d) if !d.is_finite() => writeln!(out, "displacement   not integrated by the RK4 method")?,
+        (Actuation::Displacement(_), d) => writeln!(out, "displacement   {d:.6} mm (given; the tension above is found)")?,
+        (Actuation::Tension(_), d) => writeln!(out, "displacement   {d:.6} mm (pulled in at the base)")?,
+    }
     writeln!(out, "tip            x = {:.6} mm, y = {:.6} mm", p.tip_x_mm, p.tip_y_mm)?;
     writeln!(out, "tip angle      {:.8} rad ({:.4}°)", p.tip_angle_rad, p.tip_angle_rad.to_degrees())?;
     writeln!(out, "base angle     {:.8} rad ({:.4}°)", p.base_angle_rad, p.base_angle_rad.to_degrees())?;
@@ -174,7 +210,6 @@ fn report_png(args: &SimulateArgs) {
 /// reported in the actuator's terms (the spatial record).
 fn run_spatial(args: &SimulateArgs) -> anyhow::Result<()> {
     use cablemap::model::spatial::SpatialOptions;
-    use cablemap::model::{record, simulate_actuator, Actuator, Cable};
     use cablemap::model::Hold;
     // The rod: the spatial file's [rod], else an --actuator-file, else the
     // thesis's; rod flags override either.
@@ -193,10 +228,14 @@ fn run_spatial(args: &SimulateArgs) -> anyhow::Result<()> {
     if !args.cable.is_empty() {
         spatial.cables = args.cable.iter().map(|c| c.parse::<Cable>()).collect::<Result<_, _>>().context("--cable")?;
     }
-    if let (Some(routing), Some(tension)) = (&args.routing, args.tension_n) {
+    if let (Some(routing), Some(actuation)) = (&args.routing, planar_actuation(args)?) {
         let y = parse_list(routing, "--routing")?;
         let y: [f64; 5] = y.try_into().map_err(|y: Vec<f64>| anyhow::anyhow!("--routing: a routing needs exactly 5 control points y0..y4 (mm), got {}", y.len()))?;
-        spatial.cables = vec![Cable::planar(y, tension)];
+        let cable = Cable::planar(y, 0.0);
+        spatial.cables = vec![match actuation {
+            Actuation::Tension(t) => Cable { tension_n: t, cable_ea_n: args.cable_ea_n, ..cable },
+            Actuation::Displacement(d) => Cable { displacement_mm: Some(d), cable_ea_n: args.cable_ea_n, ..cable },
+        }];
     }
     anyhow::ensure!(
         !spatial.cables.is_empty(),
@@ -259,6 +298,37 @@ fn run_spatial(args: &SimulateArgs) -> anyhow::Result<()> {
     drop(out);
     report_png(args);
     Ok(())
+}
+
+/// How `--routing`'s one cable is driven.
+#[derive(Debug, Clone, Copy)]
+enum Actuation {
+    /// By its tension, N.
+    Tension(f64),
+    /// By its displacement, mm.
+    Displacement(f64),
+}
+
+impl std::fmt::Display for Actuation {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Actuation::Tension(t) => write!(f, "{} N", cablemap::io::fmt_num(*t)),
+            Actuation::Displacement(d) => write!(f, "a displacement of {} mm", cablemap::io::fmt_num(*d)),
+        }
+    }
+}
+
+/// `--routing`'s actuation: --tension-n or --displacement-mm (clap refuses
+/// both); `None` when neither is given.
+fn planar_actuation(args: &SimulateArgs) -> anyhow::Result<Option<Actuation>> {
+    match (args.tension_n, args.displacement_mm) {
+        (Some(t), None) => Ok(Some(Actuation::Tension(t))),
+        (None, Some(d)) => Ok(Some(Actuation::Displacement(d))),
+        (None, None) if args.routing.is_some() => {
+            anyhow::bail!("--routing needs its actuation: --tension-n T (N) or --displacement-mm D (mm, the length pulled in at the base)")
+        }
+        _ => Ok(None),
+    }
 }
 
 /// The settings given by flags rather than left at their defaults: the

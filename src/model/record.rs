@@ -34,8 +34,15 @@ pub struct SimulationRecord {
     pub status: String,
     /// Routing control points y_0..y_4, mm.
     pub routing_mm: ControlPoints,
-    /// Tension, N.
+    /// Tension, N (of a displacement-driven cable, the tension found).
     pub tension_n: f64,
+    /// The cable's displacement Δℓ at the base, mm: the pulled-in length
+    /// (its path's shortening plus its stretch); the command of a
+    /// displacement-driven cable, the displacement a tension produced
+    /// otherwise. `null` from the RK4 method, which does not integrate the
+    /// cable's path.
+    #[serde(default)]
+    pub displacement_mm: Option<f64>,
     /// Tip position along the clamp axis, mm.
     pub tip_x_mm: f64,
     /// Tip position across the clamp axis, mm.
@@ -65,6 +72,7 @@ impl From<&Simulation> for SimulationRecord {
             status: STATUS_OK.to_string(),
             routing_mm: sim.routing_mm(),
             tension_n: p.tension_n(),
+            displacement_mm: Some(p.displacement_mm()).filter(|d| d.is_finite()),
             tip_x_mm: p.tip_x_mm,
             tip_y_mm: p.tip_y_mm,
             tip_angle_rad: p.tip_angle_rad,
@@ -310,7 +318,8 @@ pub fn simulation_json(sim: &Simulation) -> serde_json::Value {
     json!({
         "status": STATUS_OK,
         "cables": sim.actuator.cables,
-        "tension_n": sim.actuator.cables.iter().map(|c| c.tension_n).collect::<Vec<_>>(),
+        "tension_n": p.tensions_n.to_vec(),
+        "displacement_mm": p.displacements_mm.iter().map(|&d| Some(d).filter(|d| d.is_finite())).collect::<Vec<_>>(),
         "gravity": sim.actuator.rod.gravity.enabled,
         "gravity_direction": sim.actuator.gravity_unit().ok(),
         "gj_n_mm2": sim.actuator.torsional_rigidity_n_mm2(),
@@ -339,14 +348,14 @@ pub fn report(sim: &Simulation) -> String {
     let list = |v: &[f64]| v.iter().map(|x| format!("{x}")).collect::<Vec<_>>().join(", ");
     for (i, c) in a.cables.iter().enumerate() {
         let anchor = c.anchor_mm.map_or(String::from("tip"), |s| format!("s = {s} mm"));
-        let _ = writeln!(
-            out,
-            "cable {}        y [{}] mm, z [{}] mm, tension {:.6} N, anchor {anchor}",
-            i + 1,
-            list(&c.y_mm),
-            list(&c.z_mm),
-            c.tension_n
-        );
+        // Both actuations, the given one first.
+        let (tension, displacement) = (p.tensions_n[i], p.displacements_mm[i]);
+        let displacement = if displacement.is_finite() { format!("{displacement:.6} mm") } else { "not integrated (RK4)".into() };
+        let actuation = match c.displacement_mm {
+            Some(_) => format!("displacement {displacement} (given), tension {tension:.6} N"),
+            None => format!("tension {tension:.6} N, displacement {displacement}"),
+        };
+        let _ = writeln!(out, "cable {}        y [{}] mm, z [{}] mm, {actuation}, anchor {anchor}", i + 1, list(&c.y_mm), list(&c.z_mm));
     }
     let gravity = match (a.rod.gravity.enabled, a.gravity_unit()) {
         (true, Ok(g)) => format!("along ({:.4}, {:.4}, {:.4}), {:.4e} N/mm", g[0], g[1], g[2], a.rod.weight_n_per_mm()),
