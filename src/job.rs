@@ -12,7 +12,7 @@ use crate::sweep::{run_status_of, run_sweep_of, CableSweepSpec, RunSpec, SweepEr
 use std::path::{Path, PathBuf};
 
 /// Top-level tables of a planar sweep spec (docs/schema.md).
-const PLANAR_TABLES: [&str; 5] = ["actuator", "solver", "grid", "tension", "output"];
+const PLANAR_TABLES: [&str; 6] = ["actuator", "solver", "grid", "tension", "displacement", "output"];
 /// Top-level keys of a cable sweep spec besides `[[cable]]`.
 const CABLE_KEYS: [&str; 5] = ["rod", "gj_n_mm2", "gravity_direction", "solver", "output"];
 
@@ -46,7 +46,7 @@ pub enum JobError {
     File(#[from] FileError),
     /// The file is TOML but no kind of job spec.
     #[error(
-        "{} is not a job spec: it has none of the tables of a planar sweep ([grid], [tension], [actuator], [solver], [output]), \
+        "{} is not a job spec: it has none of the tables of a planar sweep ([grid], [tension] or [displacement], [actuator], [solver], [output]), \
          a cable sweep ([[cable]]) or a study ([study]), only {}: give a sweep or study spec (jobs/thesis.toml, jobs/antagonistic-pair.toml, jobs/study.toml)",
         path.display(),
         tables.iter().map(|t| format!("'{t}'")).collect::<Vec<_>>().join(", ")

@@ -103,7 +103,7 @@ fn quick_sweep_has_every_row_once_with_the_documented_columns() {
     assert_eq!((run.rows_done(), run.rows_total()), (610, 610));
     let names: Vec<String> = run.schema().fields().iter().map(|f| f.name().clone()).collect();
     let expected = [
-        "routing_id", "y0_mm", "y1_mm", "y2_mm", "y3_mm", "y4_mm", "tension_n", "status", "iterations", "tip_x_mm", "tip_y_mm",
+        "routing_id", "y0_mm", "y1_mm", "y2_mm", "y3_mm", "y4_mm", "tension_n", "displacement_mm", "status", "iterations", "tip_x_mm", "tip_y_mm",
         "tip_angle_rad", "base_angle_rad", "length_mm", "a0", "a1", "a2", "a3",
     ];
     assert_eq!(names, expected);
@@ -168,6 +168,77 @@ fn sweep_rows_agree_with_simulate() {
             let (a, b) = (f(&format!("a{i}"), r), v["a"][i].as_f64().unwrap());
             assert!((a - b).abs() < 1e-6, "row {r} a{i}: sweep {a} vs simulate {b}");
         }
+    }
+}
+
+/// A displacement ladder (`[displacement]` in place of `[tension]`): each
+/// row stores its commanded displacement and the tension found; `simulate
+/// --displacement-mm` gives the same rows; the tension ladder's rows carry
+/// the displacement they produced, which given back returns their tension;
+/// the map reduces it, its tension range the designs'. Bad ladders are
+/// refused before anything is written.
+#[test]
+fn a_displacement_ladder_sweeps_and_maps_like_a_tension_ladder() {
+    let tmp = tempfile::tempdir().unwrap();
+    let spec = write_spec(tmp.path(), "d.toml", "[grid]\nlevels = 2\n[displacement]\nmin_mm = 0.5\nmax_mm = 3.0\ncount = 4\n[output]\nchunk_routings = 4\n");
+    let dir = tmp.path().join("run");
+    let (ok, stdout, stderr) = sweep(&spec, &dir, &[]);
+    assert!(ok, "{stdout}{stderr}");
+    let drun = open_run(&dir, Completeness::Complete).unwrap();
+    assert_eq!(drun.rows_total(), 16 * 4);
+    let mut checked = 0;
+    for batch in drun.batches() {
+        let batch = batch.unwrap();
+        let f = |name: &str, r: usize| batch.column_by_name(name).unwrap().as_primitive::<Float64Type>().value(r);
+        for r in 0..batch.num_rows() {
+            assert_eq!(batch.column_by_name("status").unwrap().as_string::<i32>().value(r), "ok");
+            let d = f("displacement_mm", r);
+            assert!([0.5, 0.5 + 2.5 / 3.0, 0.5 + 5.0 / 3.0, 3.0].iter().any(|v| (v - d).abs() < 1e-12), "{d}");
+            if r % 5 != 0 {
+                continue;
+            }
+            let y: Vec<String> = ["y0_mm", "y1_mm", "y2_mm", "y3_mm", "y4_mm"].iter().map(|c| format!("{}", f(c, r))).collect();
+            let (ok, out, err) = run(&["simulate", "--routing", &y.join(","), "--displacement-mm", &format!("{d}"), "--json"]);
+            assert!(ok, "{err}");
+            let v: serde_json::Value = serde_json::from_str(out.trim()).unwrap();
+            for (name, tol) in [("tension_n", 1e-7), ("tip_x_mm", 1e-6), ("tip_y_mm", 1e-6), ("tip_angle_rad", 1e-7)] {
+                assert!((f(name, r) - v[name].as_f64().unwrap()).abs() < tol, "row {r} {name}: {} vs {v}", f(name, r));
+            }
+            checked += 1;
+        }
+    }
+    assert!(checked >= 4, "{checked}");
+    // A tension ladder's rows carry the displacement they produced.
+    let tdir = tmp.path().join("t");
+    assert!(sweep(Path::new(QUICK), &tdir, &[]).0);
+    let trun = open_run(&tdir, Completeness::Complete).unwrap();
+    let batch = trun.batches().next().unwrap().unwrap();
+    let f = |name: &str, r: usize| batch.column_by_name(name).unwrap().as_primitive::<Float64Type>().value(r);
+    let y: Vec<String> = ["y0_mm", "y1_mm", "y2_mm", "y3_mm", "y4_mm"].iter().map(|c| format!("{}", f(c, 7))).collect();
+    let (ok, out, err) = run(&["simulate", "--routing", &y.join(","), "--displacement-mm", &format!("{:e}", f("displacement_mm", 7)), "--json"]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value = serde_json::from_str(out.trim()).unwrap();
+    assert!((v["tension_n"].as_f64().unwrap() - f("tension_n", 7)).abs() < 1e-7, "{v}");
+    // The map of the displacement run.
+    let map = tmp.path().join("map");
+    let (ok, _, err) = run(&["reduce", dir.to_str().unwrap(), "--out", map.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    let summary: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(map.join("summary.json")).unwrap()).unwrap();
+    let range = &summary["tension_range_n"];
+    assert!(range[0].as_f64().unwrap() > 0.0 && range[1].as_f64().unwrap() > range[0].as_f64().unwrap(), "{summary}");
+    // Refused before writing: both tables; RK4; a negative or absurd displacement.
+    for (text, needle) in [
+        ("[tension]\ncount = 2\n[displacement]\nmin_mm = 0.0\nmax_mm = 1.0\ncount = 2\n", "not both"),
+        ("[solver]\nmethod = \"rk4\"\n[displacement]\nmin_mm = 0.0\nmax_mm = 1.0\ncount = 2\n", "rk4"),
+        ("[displacement]\nmin_mm = -1.0\nmax_mm = 1.0\ncount = 2\n", "min_mm = -1"),
+        ("[displacement]\nmin_mm = 0.0\nmax_mm = 100.0\ncount = 2\n", "max_mm = 100"),
+        ("[displacement]\nmin_mm = 0.0\nmax_mm = 1.0\ncount = 2\ncable_ea_n = 0\n", "cable_ea_n"),
+    ] {
+        let bad = write_spec(tmp.path(), "bad.toml", text);
+        let out_dir = tmp.path().join("bad-run");
+        let (ok, _, err) = sweep(&bad, &out_dir, &[]);
+        assert!(!ok && err.contains(needle), "{text}: {err}");
+        assert!(!out_dir.exists(), "{text}: nothing written");
     }
 }
 

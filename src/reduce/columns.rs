@@ -79,6 +79,7 @@ impl RowColumns {
     pub fn converged(&self, i: usize) -> bool {
         !self.status.is_null(i)
             && self.status.value(i) == crate::model::STATUS_OK
+            && !self.tension_n.is_null(i)
             && !self.tip_x_mm.is_null(i)
             && !self.tip_y_mm.is_null(i)
             && self.a.iter().all(|a| !a.is_null(i))

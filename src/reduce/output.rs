@@ -292,6 +292,7 @@ mod tests {
             mirrored: false,
             order: 2,
             tension_range_n: [1.0, 2.0],
+            tensions_found: false,
             radius_mm: 5.0,
             length_mm: 65.0,
             run_dir: "small".into(),

@@ -102,7 +102,14 @@ where
         mode_boundaries: split.boundaries,
         mode_boundaries_source: split.source.into(),
         cells: cells.cells.len(),
-        tension_range_n: info.tension_range_n,
+        // A displacement-driven run's tensions were found: the range its designs span.
+        tension_range_n: match info.tensions_found {
+            true if !designs.is_empty() => {
+                [designs.iter().map(|d| d.tension_n).fold(f64::INFINITY, f64::min), designs.iter().map(|d| d.tension_n).fold(0.0, f64::max)]
+            }
+            true => [0.0, 0.0],
+            false => info.tension_range_n,
+        },
         radius_mm: info.radius_mm,
         length_mm: info.length_mm,
         run_dir: info.run_dir.clone(),
@@ -281,6 +288,7 @@ mod tests {
             mirrored,
             order: 2,
             tension_range_n: [1.0, 2.0],
+            tensions_found: false,
             radius_mm: 5.0,
             length_mm: 65.0,
             run_dir: "test".into(),

@@ -19,6 +19,10 @@ pub struct RunInfo {
     pub order: usize,
     /// Tension range of the run, N.
     pub tension_range_n: [f64; 2],
+    /// Whether the run's tensions were found (its cables driven by their
+    /// displacement): the map's tension range is then its designs'.
+    #[serde(default)]
+    pub tensions_found: bool,
     /// Rod radius, mm.
     pub radius_mm: f64,
     /// Rod length, mm.
@@ -51,6 +55,7 @@ impl PlanarSource for SweepSpec {
             mirrored: spec.grid.mirror_dedup,
             order: spec.output.order,
             tension_range_n: [spec.tension.min_n, spec.tension.max_n],
+            tensions_found: spec.displacement.is_some(),
             radius_mm: spec.actuator.radius_mm,
             length_mm: spec.actuator.length_mm,
             run_dir: run.dir().display().to_string(),
@@ -81,6 +86,7 @@ impl PlanarSource for CableSweepSpec {
             mirrored: false,
             order: spec.output.order,
             tension_range_n: [tensions.iter().copied().fold(f64::MAX, f64::min), tensions.iter().copied().fold(0.0, f64::max)],
+            tensions_found: false,
             radius_mm: rod.radius_mm,
             length_mm: rod.length_mm,
             run_dir: run.dir().display().to_string(),

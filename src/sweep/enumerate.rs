@@ -54,7 +54,7 @@ impl SweepPlan {
         Self {
             levels_mm: spec.levels_mm(),
             routings,
-            tensions: u64::from(spec.tension.count),
+            tensions: u64::from(spec.ladder_count()),
             chunk_routings,
             chunks: routings.div_ceil(chunk_routings),
         }

@@ -23,8 +23,14 @@ use std::sync::Arc;
 pub const ROUTING_ID: &str = "routing_id";
 /// Control-point columns y0_mm … y4_mm (f64, mm).
 pub const Y_MM: [&str; CONTROL_POINTS] = ["y0_mm", "y1_mm", "y2_mm", "y3_mm", "y4_mm"];
-/// Cable tension (f64, N).
+/// Cable tension (f64, N): the command of a tension ladder; of a
+/// displacement ladder the tension found (null when the solve failed).
 pub const TENSION_N: &str = "tension_n";
+/// Cable displacement Δℓ at the base (nullable f64, mm): the command of a
+/// displacement ladder; of a tension ladder the displacement it produced
+/// (null when the solve failed, or with RK4, which does not integrate the
+/// cable's path).
+pub const DISPLACEMENT_MM: &str = "displacement_mm";
 /// Solve status (utf8, non-null): `ok` or a failure status.
 pub const STATUS: &str = "status";
 /// Integration passes of the solve (i32, non-null; 0 for failed solves).
@@ -55,7 +61,8 @@ pub fn coefficient_column(i: usize) -> String {
 pub fn arrow_schema(order: usize, centreline: bool) -> SchemaRef {
     let mut fields = vec![Field::new(ROUTING_ID, DataType::Int64, false)];
     fields.extend(Y_MM.iter().map(|n| Field::new(*n, DataType::Float64, false)));
-    fields.push(Field::new(TENSION_N, DataType::Float64, false));
+    fields.push(Field::new(TENSION_N, DataType::Float64, true));
+    fields.push(Field::new(DISPLACEMENT_MM, DataType::Float64, true));
     fields.push(Field::new(STATUS, DataType::Utf8, false));
     fields.push(Field::new(ITERATIONS, DataType::Int32, false));
     fields.extend(POSE_COLUMNS.iter().map(|n| Field::new(*n, DataType::Float64, true)));
@@ -72,8 +79,10 @@ pub fn arrow_schema(order: usize, centreline: bool) -> SchemaRef {
 /// The outcome of one planar solve, ready to become a row.
 #[derive(Debug, Clone)]
 pub struct SolvedRow {
-    /// Tension, N.
+    /// Tension, N ([`TENSION_N`]; NaN when unknown, stored as null).
     pub tension_n: f64,
+    /// Displacement, mm ([`DISPLACEMENT_MM`]; NaN when unknown, stored as null).
+    pub displacement_mm: f64,
     /// `ok` or the failure status.
     pub status: &'static str,
     /// The pose of a successful solve.
@@ -101,6 +110,7 @@ pub fn build_batch(schema: &SchemaRef, order: usize, centreline: bool, routings:
     let mut id = Int64Builder::with_capacity(rows);
     let mut y: Vec<Float64Builder> = (0..CONTROL_POINTS).map(|_| Float64Builder::with_capacity(rows)).collect();
     let mut tension = Float64Builder::with_capacity(rows);
+    let mut displacement = Float64Builder::with_capacity(rows);
     let mut status = StringBuilder::with_capacity(rows, rows * 2);
     let mut iterations = Int32Builder::with_capacity(rows);
     let mut pose: Vec<Float64Builder> = (0..POSE_COLUMNS.len()).map(|_| Float64Builder::with_capacity(rows)).collect();
@@ -113,7 +123,8 @@ pub fn build_batch(schema: &SchemaRef, order: usize, centreline: bool, routings:
             for (b, v) in y.iter_mut().zip(r.routing_mm.0) {
                 b.append_value(v);
             }
-            tension.append_value(row.tension_n);
+            tension.append_option(finite(row.tension_n));
+            displacement.append_option(finite(row.displacement_mm));
             status.append_value(row.status);
             match &row.pose {
                 Some(p) => {
@@ -150,6 +161,7 @@ pub fn build_batch(schema: &SchemaRef, order: usize, centreline: bool, routings:
     let mut columns: Vec<ArrayRef> = vec![Arc::new(id.finish())];
     columns.extend(y.iter_mut().map(|b| Arc::new(b.finish()) as ArrayRef));
     columns.push(Arc::new(tension.finish()));
+    columns.push(Arc::new(displacement.finish()));
     columns.push(Arc::new(status.finish()));
     columns.push(Arc::new(iterations.finish()));
     columns.extend(pose.iter_mut().chain(a.iter_mut()).map(|b| Arc::new(b.finish()) as ArrayRef));

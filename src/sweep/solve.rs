@@ -8,7 +8,9 @@
 use super::schema::{CableRow, SolvedRouting, SolvedRow, STATUS_FAILED, STATUS_INVALID_ROUTING};
 use crate::model::routing::ControlPoints;
 use crate::model::spatial::{Actuator, SpatialOptions, SpatialSolver};
+use crate::model::solver::actuation;
 use crate::model::{Routing, Simulator, SolveFailure, TipPose, STATUS_OK};
+use crate::sweep::spec::Ladder;
 use crate::shape::LengthBasis;
 
 /// What each solve of a sweep stores besides its pose: a_0 … a_`order` per
@@ -24,25 +26,47 @@ pub struct Stored {
 }
 
 /// Solves the planar routing `routing` (id `id`, control points
-/// `routing_mm`) through the tension ladder `tensions_n` (rising:
-/// continuation from one tension to the next).
-pub fn planar_routing(
-    sim: &mut Simulator,
-    id: u64,
-    routing_mm: ControlPoints,
-    routing: &Routing,
-    tensions_n: &[f64],
-    stored: Stored,
-) -> SolvedRouting {
+/// `routing_mm`) through the actuation ladder `ladder` (rising tensions,
+/// or rising displacements with each tension found: continuation from one
+/// value to the next).
+pub fn planar_routing(sim: &mut Simulator, id: u64, routing_mm: ControlPoints, routing: &Routing, ladder: &Ladder, stored: Stored) -> SolvedRouting {
     sim.set_routing(routing);
-    let rows = tensions_n.iter().map(|&t| planar_row(sim, t, stored)).collect();
+    let rows = match ladder {
+        Ladder::TensionN(tensions) => tensions.iter().map(|&t| planar_row(sim, Actuation::TensionN(t), stored)).collect(),
+        Ladder::DisplacementMm(displacements) => {
+            // The tension found at one displacement starts the next.
+            let mut tension = [0.0];
+            displacements.iter().map(|&d| planar_row(sim, Actuation::DisplacementMm(d, &mut tension), stored)).collect()
+        }
+    };
     SolvedRouting { id, routing_mm, rows }
 }
 
+/// One rung of a planar ladder.
+enum Actuation<'a> {
+    /// At this tension, N.
+    TensionN(f64),
+    /// At this displacement, mm, from (and into) this tension.
+    DisplacementMm(f64, &'a mut [f64; 1]),
+}
+
 /// One planar solve as a row: outputs only for a successful, finite solve.
-fn planar_row(sim: &mut Simulator, tension_n: f64, stored: Stored) -> SolvedRow {
-    let failed = |status| SolvedRow { tension_n, status, pose: None, a: Vec::new(), centreline: None };
-    match sim.solve(tension_n) {
+/// The row's tension and displacement are the command and what it produced
+/// (a tension's displacement; a displacement's tension, unknown when it failed).
+fn planar_row(sim: &mut Simulator, actuation: Actuation, stored: Stored) -> SolvedRow {
+    let (solved, command) = match actuation {
+        Actuation::TensionN(t) => (sim.solve(t), (t, f64::NAN)),
+        Actuation::DisplacementMm(d, tension) => {
+            let solved = actuation::meet_displacements(sim, &[Some(d)], tension);
+            if solved.is_err() {
+                // A failed rung leaves no tension to start from: the next starts from zero.
+                tension[0] = 0.0;
+            }
+            (solved, (f64::NAN, d))
+        }
+    };
+    let failed = |status| SolvedRow { tension_n: command.0, displacement_mm: command.1, status, pose: None, a: Vec::new(), centreline: None };
+    match solved {
         Ok(pose) => {
             let mut a = vec![0.0; stored.order + 1];
             // Coefficients the discretisation does not resolve are a failure too.
@@ -58,7 +82,10 @@ fn planar_row(sim: &mut Simulator, tension_n: f64, stored: Stored) -> SolvedRow 
                 let points = sim.centreline();
                 (points.iter().map(|p| p.x_mm).collect(), points.iter().map(|p| p.y_mm).collect())
             });
-            SolvedRow { tension_n, status: STATUS_OK, pose: Some(pose), a, centreline }
+            // The command exactly; what it produced from the pose.
+            let tension_n = if command.0.is_nan() { pose.tension_n() } else { command.0 };
+            let displacement_mm = if command.1.is_nan() { pose.displacement_mm() } else { command.1 };
+            SolvedRow { tension_n, displacement_mm, status: STATUS_OK, pose: Some(pose), a, centreline }
         }
         Err(failure) => failed(failure.status()),
     }

@@ -82,6 +82,7 @@ pub fn write_map(dir: &Path, rows: &[Row]) {
         mirrored: true,
         order: 2,
         tension_range_n: [TENSIONS_N[0], TENSIONS_N[TENSIONS_N.len() - 1]],
+        tensions_found: false,
         radius_mm: 5.0,
         length_mm: 65.0,
         run_dir: "tests/common (simulated in the test)".into(),

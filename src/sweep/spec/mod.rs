@@ -16,6 +16,6 @@ pub mod planar;
 pub use super::kind::{MAX_CHUNK_ROWS, MAX_ROWS};
 pub use cables::{CableGrid, CableOutputSpec, CableSweepSpec, CableWorker, PointSweep, TensionGrid, MAX_TENSION_COUNT};
 pub use planar::{
-    GridSpec, OutputSpec, SpecError, SweepSpec, TensionSpec, MAX_CHUNK_BYTES, MAX_LEVELS, MAX_ORDER, MAX_STEPS_PER_SPAN, MAX_TENSIONS,
+    DisplacementSpec, GridSpec, Ladder, OutputSpec, SpecError, SweepSpec, TensionSpec, MAX_CHUNK_BYTES, MAX_LEVELS, MAX_ORDER, MAX_STEPS_PER_SPAN, MAX_TENSIONS,
     THESIS_SPEC_TOML,
 };

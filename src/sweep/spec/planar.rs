@@ -19,6 +19,12 @@
 //! min_n = 1.0
 //! max_n = 2.0
 //! count = 21
+//! # or, driving the cable by its displacement (a motor's position):
+//! # [displacement]
+//! # min_mm = 0.0
+//! # max_mm = 4.0
+//! # count = 9
+//! # cable_ea_n = 2000.0   # optional: the cable's stiffness (default inextensible)
 //! [output]
 //! order = 3             # store a0 … a3
 //! length_basis = "rest" # a_i per unit rest length (thesis); or "deformed"
@@ -75,8 +81,13 @@ pub struct SweepSpec {
     pub solver: SolverOptions,
     /// The grid of routings.
     pub grid: GridSpec,
-    /// The tension ladder each routing is solved through.
+    /// The tension ladder each routing is solved through (unless
+    /// `displacement` is given).
     pub tension: TensionSpec,
+    /// The displacement ladder each routing is solved through instead of
+    /// the tension ladder: the cable driven by its displacement.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub displacement: Option<DisplacementSpec>,
     /// What each row stores and how rows are grouped into files.
     pub output: OutputSpec,
 }
@@ -120,6 +131,34 @@ impl Default for TensionSpec {
     fn default() -> Self {
         Self { min_n: 1.0, max_n: 2.0, count: 21 }
     }
+}
+
+/// Displacements: `count` values evenly spaced from `min_mm` to `max_mm`,
+/// solved in rising order for each routing, each cable's tension found
+/// (docs/model.md, "Actuation by displacement").
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DisplacementSpec {
+    /// Smallest displacement, mm (≥ 0).
+    pub min_mm: f64,
+    /// Largest displacement, mm.
+    pub max_mm: f64,
+    /// Number of displacements (1 needs min_mm = max_mm).
+    pub count: u32,
+    /// The cable's axial stiffness EA, N (its stretch is part of its
+    /// displacement); inextensible when left out.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cable_ea_n: Option<f64>,
+}
+
+/// The actuation ladder of a planar sweep: each routing is solved through
+/// these values in order.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Ladder {
+    /// Tensions, N.
+    TensionN(Vec<f64>),
+    /// Displacements, mm.
+    DisplacementMm(Vec<f64>),
 }
 
 /// What is stored.
@@ -182,6 +221,13 @@ impl SweepSpec {
     pub fn from_toml(text: &str, origin: &str) -> Result<Self, SweepError> {
         let spec: SweepSpec =
             toml::from_str(text).map_err(|e| SweepError::BadSpec { origin: origin.to_string(), source: SpecError::Toml(e) })?;
+        // A [tension] table beside [displacement] would be silently unused.
+        if spec.displacement.is_some() && toml::from_str::<toml::Table>(text).is_ok_and(|t| t.contains_key("tension")) {
+            return Err(SweepError::BadSpec {
+                origin: origin.to_string(),
+                source: SpecError::setting("displacement", "give either [tension] or [displacement], not both: the cable is driven by one of them"),
+            });
+        }
         spec.validate().map_err(|source| SweepError::BadSpec { origin: origin.to_string(), source })?;
         Ok(spec)
     }
@@ -206,6 +252,27 @@ impl SweepSpec {
         }
         if self.tension.count > MAX_TENSIONS {
             return Err(SpecError::setting("tension", format!("count = {} is more than {MAX_TENSIONS} tensions per routing", self.tension.count)));
+        }
+        if let Some(d) = &self.displacement {
+            let bad = |why: String| Err(SpecError::setting("displacement", why));
+            if d.count == 0 || d.count > MAX_TENSIONS {
+                return bad(format!("count = {} must be 1 … {MAX_TENSIONS} displacements per routing", d.count));
+            }
+            if !(d.min_mm.is_finite() && d.min_mm >= 0.0) {
+                return bad(format!("min_mm = {} must be a finite displacement ≥ 0 mm (the length pulled in at the base)", d.min_mm));
+            }
+            if !(d.max_mm.is_finite() && d.max_mm >= d.min_mm) || (d.count == 1 && d.max_mm != d.min_mm) {
+                return bad(format!("max_mm = {} must be finite and ≥ min_mm = {} (equal when count = 1)", d.max_mm, d.min_mm));
+            }
+            if d.max_mm >= self.actuator.length_mm {
+                return bad(format!("max_mm = {} is not shorter than the rod ({} mm): a cable cannot be pulled in by its length", d.max_mm, self.actuator.length_mm));
+            }
+            if let Some(ea) = d.cable_ea_n.filter(|ea| !(ea.is_finite() && *ea > 0.0)) {
+                return bad(format!("cable_ea_n = {ea} must be a finite stiffness > 0 N (leave it out for an inextensible cable)"));
+            }
+            if self.solver.method == crate::model::SolverMethod::Rk4 {
+                return bad("[solver] method = \"rk4\" does not integrate the cable's path, so it cannot meet a displacement: use the default collocation".into());
+            }
         }
         crate::model::Simulator::new(&self.actuator, &self.solver).map_err(|e| SpecError::setting("solver", e.to_string()))?;
         let g = &self.grid;
@@ -254,17 +321,19 @@ impl SweepSpec {
         if o.chunk_routings == 0 {
             return Err(SpecError::setting("output", "chunk_routings = 0: a chunk needs at least one routing"));
         }
-        let chunk_rows = u64::from(o.chunk_routings) * u64::from(t.count);
+        let count = self.ladder_count();
+        let chunk_rows = u64::from(o.chunk_routings) * u64::from(count);
         let chunk_bytes = chunk_rows.saturating_mul(self.row_bytes());
         if chunk_rows <= MAX_CHUNK_ROWS && chunk_bytes > MAX_CHUNK_BYTES {
             return Err(SpecError::setting("output", self.chunk_bytes_advice(chunk_rows, chunk_bytes)));
         }
         if chunk_rows > MAX_CHUNK_ROWS {
-            return Err(SpecError::setting("output", format!("chunk_routings = {} × [tension] count = {} gives {chunk_rows} rows per chunk, more than \
+            return Err(SpecError::setting("output", format!("chunk_routings = {} × {} count = {} gives {chunk_rows} rows per chunk, more than \
                  {MAX_CHUNK_ROWS} (each chunk is built in memory): lower chunk_routings to ≤ {}",
                 o.chunk_routings,
-                t.count,
-                (MAX_CHUNK_ROWS / u64::from(t.count)).max(1)
+                self.ladder_table(),
+                count,
+                (MAX_CHUNK_ROWS / u64::from(count)).max(1)
             )));
         }
         Ok(())
@@ -293,7 +362,7 @@ impl SweepSpec {
     /// `chunk_bytes` (more than [`MAX_CHUNK_BYTES`]).
     fn chunk_bytes_advice(&self, chunk_rows: u64, chunk_bytes: u64) -> String {
         let o = &self.output;
-        let routing_bytes = u64::from(self.tension.count) * self.row_bytes();
+        let routing_bytes = u64::from(self.ladder_count()) * self.row_bytes();
         let what = if o.centreline {
             format!(
                 "with centreline = true each row holds {} centreline points ([solver] steps_per_span = {})",
@@ -305,9 +374,10 @@ impl SweepSpec {
         };
         let fix = match MAX_CHUNK_BYTES / routing_bytes.max(1) {
             0 => format!(
-                "one routing's {} rows alone take {}: lower [solver] steps_per_span or [tension] count, or set centreline = false",
-                self.tension.count,
-                crate::io::fmt_bytes(routing_bytes)
+                "one routing's {} rows alone take {}: lower [solver] steps_per_span or {} count, or set centreline = false",
+                self.ladder_count(),
+                crate::io::fmt_bytes(routing_bytes),
+                self.ladder_table()
             ),
             most if o.centreline => {
                 format!("lower chunk_routings to ≤ {most} (or [solver] steps_per_span, or set centreline = false)")
@@ -315,10 +385,11 @@ impl SweepSpec {
             most => format!("lower chunk_routings to ≤ {most}"),
         };
         format!(
-            "chunk_routings = {} × [tension] count = {} gives {chunk_rows} rows per chunk taking about {} of memory while it is \
+            "chunk_routings = {} × {} count = {} gives {chunk_rows} rows per chunk taking about {} of memory while it is \
              built, more than {} ({what}): {fix}",
             o.chunk_routings,
-            self.tension.count,
+            self.ladder_table(),
+            self.ladder_count(),
             crate::io::fmt_bytes(chunk_bytes),
             crate::io::fmt_bytes(MAX_CHUNK_BYTES)
         )
@@ -332,9 +403,9 @@ impl SweepSpec {
         let rows = plan.total_rows();
         if rows > MAX_ROWS && !allow_large {
             return Err(SpecError::TooLarge(format!(
-                "the sweep has {rows} rows ({} routings × {} tensions), more than {MAX_ROWS}: check [grid] levels and \
-                 [tension] count, or pass --allow-large if the job is meant to be this big",
-                plan.routings, plan.tensions
+                "the sweep has {rows} rows ({} routings × {} actuations), more than {MAX_ROWS}: check [grid] levels and \
+                 {} count, or pass --allow-large if the job is meant to be this big",
+                plan.routings, plan.tensions, self.ladder_table()
             )));
         }
         Ok(())
@@ -347,6 +418,32 @@ impl SweepSpec {
             let l = l.trim();
             l.is_empty() || l.starts_with('#')
         })
+    }
+
+    /// The actuation ladder: the displacements when given, else the tensions.
+    pub fn ladder(&self) -> Ladder {
+        match &self.displacement {
+            Some(d) if d.count == 1 => Ladder::DisplacementMm(vec![d.min_mm]),
+            Some(d) => {
+                let steps = f64::from(d.count - 1);
+                Ladder::DisplacementMm((0..d.count).map(|k| d.min_mm + (d.max_mm - d.min_mm) * f64::from(k) / steps).collect())
+            }
+            None => Ladder::TensionN(self.tensions_n()),
+        }
+    }
+
+    /// Values of the actuation ladder per routing (rows per routing).
+    pub fn ladder_count(&self) -> u32 {
+        self.displacement.as_ref().map_or(self.tension.count, |d| d.count)
+    }
+
+    /// The spec table holding the ladder, for messages: `[tension]` or `[displacement]`.
+    fn ladder_table(&self) -> &'static str {
+        if self.displacement.is_some() {
+            "[displacement]"
+        } else {
+            "[tension]"
+        }
     }
 
     /// The tension ladder, N, in rising order.
@@ -435,7 +532,9 @@ impl RunSpec for SweepSpec {
     }
 
     fn worker(&self) -> Result<Simulator, SweepError> {
-        Ok(Simulator::new(&self.actuator, &self.solver)?)
+        let mut sim = Simulator::new(&self.actuator, &self.solver)?;
+        sim.set_cable_stiffness(self.displacement.as_ref().and_then(|d| d.cable_ea_n));
+        Ok(sim)
     }
 
     fn solve(&self, worker: &mut Simulator, id: u64) -> Result<SolvedRouting, SweepError> {
@@ -444,7 +543,7 @@ impl RunSpec for SweepSpec {
         let routing = Routing::for_actuator(routing_mm, &self.actuator)?;
         let o = &self.output;
         let stored = Stored { order: o.order, length_basis: o.length_basis, centreline: o.centreline };
-        Ok(solve::planar_routing(worker, id, routing_mm, &routing, &self.tensions_n(), stored))
+        Ok(solve::planar_routing(worker, id, routing_mm, &routing, &self.ladder(), stored))
     }
 
     fn batch(&self, schema: &SchemaRef, solved: &[SolvedRouting]) -> RecordBatch {
