@@ -45,7 +45,7 @@ def check_pyarrow(run):
     assert table.num_rows == m["total_rows"], (table.num_rows, m["total_rows"])
     s = table.schema
     assert s.field("routing_id").type == pa.int64()
-    for c in Y + ["tension_n"] + POSE + coefficient_names(m):
+    for c in Y + ["tension_n", "displacement_mm"] + POSE + coefficient_names(m):
         assert s.field(c).type == pa.float64(), (c, s.field(c).type)
     assert s.field("status").type == pa.string()
     assert s.field("iterations").type == pa.int32()
