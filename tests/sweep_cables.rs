@@ -554,6 +554,78 @@ fn the_shipped_job_specs_are_valid() {
         let job = cablemap::job::Job::load(&path).unwrap();
         assert!(matches!(job.spec, cablemap::job::JobSpec::Cables(_)), "{name}");
         let spec = CableSweepSpec::from_toml(&text, name).unwrap();
-        assert!(spec.routings() > 1 && spec.tension_combinations() > 1);
+        assert!(spec.routings() > 1 && spec.actuation_combinations() > 1);
+    }
+}
+
+/// A cable driven by its displacement in a cable sweep: its rows store the
+/// commanded `displacement1_mm` exactly and the tension found; the other
+/// cable's rows its commanded tension and the displacement it produced;
+/// each row solves again by `simulate --cable "… displacement=D"`; the map's
+/// designs carry the displacement as cable 1's command (the explorer's
+/// command reproduces the tip). A spec giving both or neither is refused.
+#[test]
+fn a_displacement_driven_cable_sweeps_and_maps() {
+    let spec_text = r#"
+[[cable]]
+y_mm = [3, 3, 3, 3, 3]
+displacement_mm = { min = 0.5, max = 3.0, count = 3 }
+cable_ea_n = 5000
+[[cable.sweep]]
+axis = "y"
+points = [2]
+levels_mm = [1.0, 4.0]
+[[cable]]
+y_mm = [-3, -3, -3, -3, -3]
+tension_n = { min = 0.0, max = 1.0, count = 2 }
+"#;
+    let dir = tempfile::tempdir().unwrap();
+    let spec = dir.path().join("d.toml");
+    std::fs::write(&spec, spec_text).unwrap();
+    let out = dir.path().join("out");
+    let (ok, _, stderr) = run(&["map", s(&spec), "--out", s(&out)]);
+    assert!(ok, "{stderr}");
+    let rows = rows_of(&out.join("run"));
+    assert_eq!(rows.num_rows(), 2 * 3 * 2);
+    let (d1, t1, t2, d2) = (f64s(&rows, "displacement1_mm"), f64s(&rows, "tension1_n"), f64s(&rows, "tension2_n"), f64s(&rows, "displacement2_mm"));
+    let (x, y) = (f64s(&rows, "tip_x_mm"), f64s(&rows, "tip_y_mm"));
+    let y2 = f64s(&rows, "cable1_y2_mm");
+    for r in 0..rows.num_rows() {
+        assert!([0.5, 1.75, 3.0].contains(&d1[r].unwrap()), "the command exactly: {:?}", d1[r]);
+        assert!([0.0, 1.0].contains(&t2[r].unwrap()));
+        assert!(t1[r].unwrap() >= 0.0 && d2[r].is_some(), "found and produced: {:?} {:?}", t1[r], d2[r]);
+        let cable1 = format!("y=3,3,{},3,3 displacement={} ea=5000", y2[r].unwrap(), d1[r].unwrap());
+        let cable2 = format!("y=-3,-3,-3,-3,-3 tension={}", t2[r].unwrap());
+        let (ok, json, stderr) = run(&["simulate", "--cable", &cable1, "--cable", &cable2, "--json"]);
+        assert!(ok, "{stderr}");
+        let v: serde_json::Value = serde_json::from_str(json.trim()).unwrap();
+        let gap = (v["tip_x_mm"].as_f64().unwrap() - x[r].unwrap()).hypot(v["tip_y_mm"].as_f64().unwrap() - y[r].unwrap());
+        assert!(gap < 1e-6, "row {r}: {gap} mm");
+        assert!((v["tension_n"][0].as_f64().unwrap() - t1[r].unwrap()).abs() < 1e-7, "row {r}: {v}");
+    }
+    // The map: every design's command drives cable 1 by its displacement and reproduces the tip.
+    let planar = out.join("map/planar");
+    let designs = read(&planar.join("designs.parquet"));
+    let (xs, ys) = (f64s(&designs, "tip_x_mm"), f64s(&designs, "tip_y_mm"));
+    let script = std::fs::read_to_string(planar.join("explorer-data.js")).unwrap();
+    let json = script.split_once("window.CABLEMAP_MAP = ").unwrap().1.trim_end().trim_end_matches(';');
+    let data: serde_json::Value = serde_json::from_str(json).unwrap();
+    assert!(data["cables"]["describe"][0].as_str().unwrap().contains("displacement 0.5 … 3 mm"), "{}", data["cables"]);
+    for (k, command) in data["designs"]["command"].as_array().unwrap().iter().enumerate() {
+        let command = command.as_str().unwrap();
+        assert!(command.contains("displacement="), "{command}");
+        assert!(data["designs"]["cables"][k][0]["displacement_mm"].as_f64().is_some());
+        let (x, y) = tip_of_command(command);
+        assert!((x - xs[k].unwrap()).hypot(y - ys[k].unwrap()) < 1e-3, "design {k}: `{command}`");
+    }
+    // Both, or neither, is refused.
+    for (text, needle) in [
+        ("[[cable]]\ny_mm = [1, 1, 1, 1, 1]\ntension_n = { min = 0.0, max = 1.0, count = 2 }\ndisplacement_mm = { min = 0.0, max = 1.0, count = 2 }\n", "only one"),
+        ("[[cable]]\ny_mm = [1, 1, 1, 1, 1]\n", "give one of tension_n"),
+    ] {
+        std::fs::write(&spec, text).unwrap();
+        let (ok, _, stderr) = run(&["sweep", s(&spec), "--out", s(&dir.path().join("bad"))]);
+        assert!(!ok && stderr.contains(needle), "{text}: {stderr}");
+        assert!(!dir.path().join("bad").exists());
     }
 }

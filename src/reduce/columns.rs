@@ -8,7 +8,7 @@ use super::{Design, ReduceError};
 use crate::model::routing::{ControlPoints, CONTROL_POINTS};
 use crate::shape::LengthBasis;
 use crate::sweep::schema::{
-    coefficient_column, control_point_column, tension_column, Axis, LENGTH_MM, ROUTING_ID, STATUS, TENSION_N, TIP_ANGLE_RAD,
+    coefficient_column, control_point_column, displacement_column, tension_column, Axis, LENGTH_MM, ROUTING_ID, STATUS, TENSION_N, TIP_ANGLE_RAD,
     TIP_TANGENT_X, TIP_TANGENT_Y, TIP_X_MM, TIP_Y_MM, Y_MM,
 };
 use crate::sweep::CableSweepSpec;
@@ -126,6 +126,8 @@ pub(crate) fn cable_planar_columns(spec: &CableSweepSpec) -> Vec<String> {
     let mut names: Vec<String> = vec![ROUTING_ID.into(), STATUS.into()];
     names.extend((0..CONTROL_POINTS).map(|p| control_point_column(1, Axis::Y, p)));
     names.extend((1..=spec.actuator.cables.len()).map(tension_column));
+    // A displacement-driven cable's command (its row key) is its displacement.
+    names.extend(spec.grids.iter().enumerate().filter(|(_, g)| g.by_displacement).map(|(c, _)| displacement_column(c + 1)));
     names.extend([TIP_X_MM, TIP_Y_MM, TIP_TANGENT_X, TIP_TANGENT_Y, LENGTH_MM].map(String::from));
     names.extend((0..=spec.output.order).map(coefficient_column));
     names
@@ -138,18 +140,21 @@ pub(crate) fn cable_planar_columns(spec: &CableSweepSpec) -> Vec<String> {
 /// continuous from the clamp. No mirror images are added (a pair's mirror
 /// is another routing of the spec, if swept).
 pub(crate) fn cable_planar_batch(spec: &CableSweepSpec, batch: &RecordBatch) -> Result<RecordBatch, ReduceError> {
-    let grids = spec.tension_grids();
+    let grids = spec.actuation_grids();
     let f = |name: &str| batch.column_by_name(name).expect("projected").as_primitive::<Float64Type>().clone();
     let ids = batch.column_by_name(ROUTING_ID).expect("projected").as_primitive::<Int64Type>().clone();
     let tensions: Vec<Float64Array> = (1..=grids.len()).map(|c| f(&tension_column(c))).collect();
+    // Each cable's command: its tension, or its displacement.
+    let commands: Vec<Float64Array> =
+        spec.grids.iter().enumerate().map(|(c, g)| if g.by_displacement { f(&displacement_column(c + 1)) } else { tensions[c].clone() }).collect();
     let combinations: u64 = grids.iter().map(|g| g.len() as u64).product();
     let n = batch.num_rows();
     let mut keys = Vec::with_capacity(n);
     for i in 0..n {
-        // Stored tensions are the grid's values bit for bit: find their indices.
+        // Stored commands are the grid's values bit for bit: find their indices.
         let mut k = 0u64;
         for (c, g) in grids.iter().enumerate() {
-            let t = tensions[c].value(i);
+            let t = commands[c].value(i);
             let j = g.iter().position(|&v| v == t).ok_or(ReduceError::TensionOffGrid { cable: c + 1, tension_n: t })?;
             k = k * g.len() as u64 + j as u64;
         }

@@ -40,11 +40,18 @@ fn points(pts: &[(f64, f64)]) -> Value {
     Value::Array(pts.iter().map(|&(x, y)| json!([num(x), num(y)])).collect())
 }
 
-/// Every cable of a design of a several-cable map: `[{y, tension_n, anchor_mm}, …]`.
+/// Every cable of a design of a several-cable map: `[{y, tension_n,
+/// displacement_mm, anchor_mm}, …]` (a displacement-driven cable's command
+/// is its `displacement_mm`, its `tension_n` null: it was found per row).
 fn design_cables(cables: &MapCables, routing_id: i64) -> Value {
     let actuator = cables.actuator(routing_id);
     Value::Array(
-        actuator.cables.iter().map(|c| json!({ "y": nums(c.y_mm), "tension_n": num(c.tension_n), "anchor_mm": c.anchor_mm })).collect(),
+        actuator.cables.iter().map(|c| json!({
+            "y": nums(c.y_mm),
+            "tension_n": if c.displacement_mm.is_some() { serde_json::Value::Null } else { num(c.tension_n) },
+            "displacement_mm": c.displacement_mm,
+            "anchor_mm": c.anchor_mm,
+        })).collect(),
     )
 }
 

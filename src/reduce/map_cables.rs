@@ -92,7 +92,7 @@ impl MapCables {
 
     /// The actuator of the design whose `routing_id` is `row_key`.
     pub fn actuator(&self, row_key: i64) -> Actuator {
-        let (id, k) = row_of_key(row_key as u64, self.spec.tension_combinations());
+        let (id, k) = row_of_key(row_key as u64, self.spec.actuation_combinations());
         self.spec.actuator_at(id, k)
     }
 
@@ -102,10 +102,16 @@ impl MapCables {
         simulate_command(&self.actuator(row_key), &self.spec.solver)
     }
 
-    /// Every cable's tension of a design, e.g. `1.80, 0.80 N`.
+    /// Every cable's actuation of a design, e.g. `1.80, 0.80 N` (a
+    /// displacement-driven cable's in mm: `2.50 mm, 0.80 N`).
     pub fn tensions_text(&self, row_key: i64) -> String {
-        let tensions: Vec<String> = self.actuator(row_key).cables.iter().map(|c| format!("{:.2}", c.tension_n)).collect();
-        format!("{} N", tensions.join(", "))
+        let cables = self.actuator(row_key).cables;
+        if cables.iter().all(|c| c.displacement_mm.is_none()) {
+            let tensions: Vec<String> = cables.iter().map(|c| format!("{:.2}", c.tension_n)).collect();
+            return format!("{} N", tensions.join(", "));
+        }
+        let each: Vec<String> = cables.iter().map(|c| c.displacement_mm.map_or(format!("{:.2} N", c.tension_n), |d| format!("{d:.2} mm"))).collect();
+        each.join(", ")
     }
 
     /// Every cable's routing and tension of a design, for a line of text:
@@ -116,7 +122,10 @@ impl MapCables {
             .cables
             .iter()
             .enumerate()
-            .map(|(i, c)| format!("cable {} y = [{}] mm at {:.3} N", i + 1, points(&c.y_mm), c.tension_n))
+            .map(|(i, c)| {
+                let at = c.displacement_mm.map_or(format!("{:.3} N", c.tension_n), |d| format!("a displacement of {d:.3} mm"));
+                format!("cable {} y = [{}] mm at {at}", i + 1, points(&c.y_mm))
+            })
             .collect();
         cables.join(", ")
     }
@@ -139,11 +148,12 @@ impl MapCables {
                     let indices: Vec<String> = sweep.points.iter().map(|p| format!("{axis}{p}")).collect();
                     s.push_str(&format!(", {} swept over {} mm", indices.join(", "), list(&sweep.levels_mm)));
                 }
-                let t = &g.tension_n;
+                let t = &g.actuation;
+                let (what, unit) = if g.by_displacement { ("displacement", "mm") } else { ("tension", "N") };
                 if t.count <= 1 {
-                    s.push_str(&format!("; tension {} N", crate::io::fmt_num(t.min)));
+                    s.push_str(&format!("; {what} {} {unit}", crate::io::fmt_num(t.min)));
                 } else {
-                    s.push_str(&format!("; tension {} … {} N ({} values)", crate::io::fmt_num(t.min), crate::io::fmt_num(t.max), t.count));
+                    s.push_str(&format!("; {what} {} … {} {unit} ({} values)", crate::io::fmt_num(t.min), crate::io::fmt_num(t.max), t.count));
                 }
                 match c.anchor_mm {
                     Some(anchor) => s.push_str(&format!("; knotted at s = {} mm", crate::io::fmt_num(anchor))),

@@ -80,13 +80,13 @@ impl PlanarSource for SweepSpec {
 impl PlanarSource for CableSweepSpec {
     fn run_info(run: &SweepRun<Self>) -> RunInfo {
         let spec = run.spec();
-        let tensions: Vec<f64> = spec.grids.iter().flat_map(|g| [g.tension_n.min, g.tension_n.max]).collect();
+        let tensions: Vec<f64> = spec.grids.iter().filter(|g| !g.by_displacement).flat_map(|g| [g.actuation.min, g.actuation.max]).collect();
         let rod = &spec.actuator.rod;
         RunInfo {
             mirrored: false,
             order: spec.output.order,
             tension_range_n: [tensions.iter().copied().fold(f64::MAX, f64::min), tensions.iter().copied().fold(0.0, f64::max)],
-            tensions_found: false,
+            tensions_found: spec.grids.iter().any(|g| g.by_displacement),
             radius_mm: rod.radius_mm,
             length_mm: rod.length_mm,
             run_dir: run.dir().display().to_string(),

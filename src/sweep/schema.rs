@@ -200,9 +200,18 @@ pub fn control_point_column(cable: usize, axis: Axis, point: usize) -> String {
     format!("cable{cable}_{}{point}_mm", if axis == Axis::Y { "y" } else { "z" })
 }
 
-/// Name of a cable's tension column (f64, N), e.g. `tension1_n` (cables from 1).
+/// Name of a cable's tension column (f64, N), e.g. `tension1_n` (cables from
+/// 1): the command of a tension-driven cable, the tension found for a
+/// displacement-driven one (null when its solve failed).
 pub fn tension_column(cable: usize) -> String {
     format!("tension{cable}_n")
+}
+
+/// Name of a cable's displacement column (nullable f64, mm), e.g.
+/// `displacement1_mm`: the command of a displacement-driven cable, what the
+/// tension produced for a tension-driven one (null when the solve failed).
+pub fn displacement_column(cable: usize) -> String {
+    format!("displacement{cable}_mm")
 }
 
 /// Tip position z (nullable f64, mm; cable rows).
@@ -238,8 +247,12 @@ pub struct CableRow {
     pub routing_id: i64,
     /// Each cable's (y, z) control points, mm.
     pub cables: Vec<([f64; CONTROL_POINTS], [f64; CONTROL_POINTS])>,
-    /// Each cable's tension, N.
+    /// Each cable's tension, N: its command, or (displacement-driven) the
+    /// tension found; NaN (stored as null) when unknown.
     pub tensions: Vec<f64>,
+    /// Each cable's displacement, mm: its command, or (tension-driven) what
+    /// the tension produced; NaN (stored as null) when unknown.
+    pub displacements: Vec<f64>,
     /// `ok`, [`STATUS_FAILED`] or [`STATUS_INVALID_ROUTING`].
     pub status: &'static str,
     /// Solver passes (0 when not solved).
@@ -260,7 +273,8 @@ pub fn cable_schema(n_cables: usize, order: usize) -> SchemaRef {
             fields.extend((0..CONTROL_POINTS).map(|p| Field::new(control_point_column(c + 1, axis, p), DataType::Float64, false)));
         }
     }
-    fields.extend((0..n_cables).map(|c| Field::new(tension_column(c + 1), DataType::Float64, false)));
+    fields.extend((0..n_cables).map(|c| Field::new(tension_column(c + 1), DataType::Float64, true)));
+    fields.extend((0..n_cables).map(|c| Field::new(displacement_column(c + 1), DataType::Float64, true)));
     fields.push(Field::new(STATUS, DataType::Utf8, false));
     fields.push(Field::new(ITERATIONS, DataType::Int32, false));
     fields.extend(CABLE_POSE_COLUMNS.iter().map(|n| Field::new(*n, DataType::Float64, true)));
@@ -282,7 +296,10 @@ pub fn cable_batch(schema: &SchemaRef, rows: &[&CableRow], n_cables: usize, orde
         }
     }
     for c in 0..n_cables {
-        columns.push(Arc::new(Float64Array::from_iter_values(rows.iter().map(|r| r.tensions[c]))));
+        columns.push(Arc::new(rows.iter().map(|r| finite(r.tensions[c])).collect::<Float64Array>()));
+    }
+    for c in 0..n_cables {
+        columns.push(Arc::new(rows.iter().map(|r| finite(r.displacements[c])).collect::<Float64Array>()));
     }
     columns.push(Arc::new(StringArray::from_iter_values(rows.iter().map(|r| r.status))));
     columns.push(Arc::new(Int32Array::from_iter_values(rows.iter().map(|r| r.passes))));

@@ -7,7 +7,7 @@
 
 use super::schema::{CableRow, SolvedRouting, SolvedRow, STATUS_FAILED, STATUS_INVALID_ROUTING};
 use crate::model::routing::ControlPoints;
-use crate::model::spatial::{Actuator, SpatialOptions, SpatialSolver};
+use crate::model::spatial::{Actuator, SpatialError, SpatialOptions, SpatialSolver};
 use crate::model::solver::actuation;
 use crate::model::{Routing, Simulator, SolveFailure, TipPose, STATUS_OK};
 use crate::sweep::spec::Ladder;
@@ -91,25 +91,52 @@ fn planar_row(sim: &mut Simulator, actuation: Actuation, stored: Stored) -> Solv
     }
 }
 
-/// A routing's tension grids, per cable (N), and their combinations in the
-/// order they are solved (snake order). Computed once per worker.
+/// A routing's actuation grids, per cable (tensions, N, or displacements,
+/// mm), and their combinations in the order they are solved (snake order).
+/// Computed once per worker.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TensionCombinations {
-    /// Each cable's tension grid, N.
+    /// Each cable's grid.
     pub grids: Vec<Vec<f64>>,
+    /// Which cables are driven by their displacement (their grid in mm).
+    pub by_displacement: Vec<bool>,
     /// Every combination (per-cable grid indices), in snake order.
     pub snake: Vec<Vec<usize>>,
 }
 
 impl TensionCombinations {
-    /// The combinations of `grids`.
-    pub fn new(grids: Vec<Vec<f64>>) -> Self {
-        Self { snake: snake(&grids), grids }
+    /// The combinations of `grids`; `by_displacement[i]`: cable i's grid is of displacements.
+    pub fn new(grids: Vec<Vec<f64>>, by_displacement: Vec<bool>) -> Self {
+        Self { snake: snake(&grids), grids, by_displacement }
     }
 
-    /// The tensions of combination `combo`, N.
-    fn tensions_n(&self, combo: &[usize]) -> Vec<f64> {
+    /// Each cable's command at combination `combo`.
+    fn values(&self, combo: &[usize]) -> Vec<f64> {
         combo.iter().zip(&self.grids).map(|(&j, g)| g[j]).collect()
+    }
+
+    /// Whether any cable is driven by its displacement.
+    fn any_displacement(&self) -> bool {
+        self.by_displacement.iter().any(|&d| d)
+    }
+
+    /// Solves at `values` (each cable's command, scaled by `scale`): the
+    /// tension-driven cables at theirs, the others' tensions found from
+    /// `tensions_n` (which receives them).
+    fn solve(&self, solver: &mut SpatialSolver, values: &[f64], scale: f64, tensions_n: &mut [f64]) -> Result<TipPose, SpatialError> {
+        if !self.any_displacement() {
+            let t: Vec<f64> = values.iter().map(|v| v * scale).collect();
+            return solver.solve(&t);
+        }
+        let mut targets = [None; crate::model::MAX_CABLES];
+        for (i, (&v, &d)) in values.iter().zip(&self.by_displacement).enumerate() {
+            if d {
+                targets[i] = Some(v * scale);
+            } else {
+                tensions_n[i] = v * scale;
+            }
+        }
+        actuation::meet_displacements(solver, &targets[..values.len()], tensions_n)
     }
 }
 
@@ -147,45 +174,60 @@ pub fn combination_index(combo: &[usize], grids: &[Vec<f64>]) -> usize {
 pub fn cable_routing(id: u64, mut actuator: Actuator, options: &SpatialOptions, stored: Stored, combinations: &TensionCombinations) -> Vec<CableRow> {
     let combos = &combinations.snake;
     let geometry: Vec<_> = actuator.cables.iter().map(|c| (c.y_mm, c.z_mm)).collect();
-    let row = |combo: &[usize], status, passes, pose, a| CableRow {
-        routing_id: id as i64,
-        cables: geometry.clone(),
-        tensions: combinations.tensions_n(combo),
-        status,
-        passes,
-        pose,
-        a,
+    // A row's tension and displacement per cable: the command exactly, and
+    // what the solve produced (NaN, stored as null, when it failed).
+    let row = |combo: &[usize], status, passes, pose: Option<TipPose>, a| {
+        let values = combinations.values(combo);
+        let (mut tensions, mut displacements) = (vec![f64::NAN; values.len()], vec![f64::NAN; values.len()]);
+        for (i, (&v, &d)) in values.iter().zip(&combinations.by_displacement).enumerate() {
+            let (command, produced, from_pose) = if d { (&mut displacements, &mut tensions, pose.map(|p| p.tensions_n[i])) } else { (&mut tensions, &mut displacements, pose.map(|p| p.displacements_mm[i])) };
+            command[i] = v;
+            produced[i] = from_pose.unwrap_or(f64::NAN);
+        }
+        CableRow { routing_id: id as i64, cables: geometry.clone(), tensions, displacements, status, passes, pose, a }
     };
-    // Build with the first combination's tensions so validation sees them.
-    let first = combinations.tensions_n(&combos[0]);
-    for (c, &t) in actuator.cables.iter_mut().zip(&first) {
-        c.tension_n = t;
+    // Build with the first combination's commands so validation sees them.
+    let first = combinations.values(&combos[0]);
+    for ((c, &v), &d) in actuator.cables.iter_mut().zip(&first).zip(&combinations.by_displacement) {
+        if d {
+            c.displacement_mm = Some(v);
+        } else {
+            c.tension_n = v;
+        }
     }
     let mut solver = match SpatialSolver::new(&actuator, options) {
         Ok(s) => s,
         Err(_) => return combos.iter().map(|c| row(c, STATUS_INVALID_ROUTING, 0, None, None)).collect(),
     };
     let mut rows: Vec<Option<CableRow>> = vec![None; combos.len()];
-    // Continuation from zero to the first combination (rungs of ≤ 0.25 N).
-    let top = first.iter().copied().fold(0.0, f64::max);
-    let rungs = ((top / 0.25).ceil() as usize).max(1);
+    let mut tensions = vec![0.0; first.len()];
+    // Continuation from zero to the first combination (rungs of ≤ 0.25 N
+    // and ≤ 0.5 mm).
+    let rung = |(&v, &d): (&f64, &bool)| if d { v / crate::model::solver::simulate::DISPLACEMENT_RUNG_MM } else { v / 0.25 };
+    let top = first.iter().zip(&combinations.by_displacement).map(rung).fold(0.0, f64::max);
+    let rungs = (top.ceil() as usize).max(1);
     for k in 1..rungs {
-        let t: Vec<f64> = first.iter().map(|t| t * k as f64 / rungs as f64).collect();
         // A rung that fails only leaves a worse warm start; the rows report failures.
-        let _ = solver.solve(&t);
+        if combinations.solve(&mut solver, &first, k as f64 / rungs as f64, &mut tensions).is_err() {
+            tensions.iter_mut().for_each(|t| *t = 0.0);
+        }
     }
     for combo in combos {
-        let t = combinations.tensions_n(combo);
-        let solved = match solver.solve(&t) {
+        let values = combinations.values(combo);
+        let solved = match combinations.solve(&mut solver, &values, 1.0, &mut tensions) {
             Ok(pose) => match solver.coefficients(stored.order, stored.length_basis) {
                 Ok(a) if finite_cable_row(&pose, &a) => row(combo, STATUS_OK, pose.iterations as i32, Some(pose), Some(a)),
                 _ => row(combo, STATUS_FAILED, 0, None, None),
             },
-            Err(_) => row(combo, STATUS_FAILED, 0, None, None),
+            Err(_) => {
+                // No tension to start the next displacement from.
+                tensions.iter_mut().for_each(|t| *t = 0.0);
+                row(combo, STATUS_FAILED, 0, None, None)
+            }
         };
         rows[combination_index(combo, &combinations.grids)] = Some(solved);
     }
-    // Rows in grid order (cable 1's tension slowest), whatever the snake.
+    // Rows in grid order (cable 1's command slowest), whatever the snake.
     rows.into_iter().map(|r| r.expect("the snake visits every combination")).collect()
 }
 

@@ -25,6 +25,10 @@
 //! [[cable]]
 //! y_mm = [-2, -2, -2, -2, -2]
 //! tension_n = { min = 0.0, max = 2.0, count = 11 }
+//! # or driven by its displacement (mm pulled in at the base; its tension
+//! # found), with an optional stiffness:
+//! # displacement_mm = { min = 0.0, max = 4.0, count = 9 }
+//! # cable_ea_n = 2000.0
 //! ```
 //!
 //! In memory the spec holds the model's own [`Actuator`] (every setting of
@@ -55,7 +59,7 @@ pub const MAX_TENSION_COUNT: u32 = 10_000;
 /// solver settings and what to store. Reads and writes the TOML above (and
 /// the same keys, in the same order, as the canonical JSON its hash covers).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(from = "SpecFile", into = "SpecFile")]
+#[serde(try_from = "SpecFile", into = "SpecFile")]
 pub struct CableSweepSpec {
     /// The actuator every routing varies: rod, torsion, gravity direction and
     /// each cable's fixed control points and anchor (its swept points at
@@ -70,12 +74,15 @@ pub struct CableSweepSpec {
     pub output: CableOutputSpec,
 }
 
-/// What a sweep varies of one cable: its tension over a grid, and control
-/// points over levels.
+/// What a sweep varies of one cable: its actuation (tension or
+/// displacement) over a grid, and control points over levels.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CableGrid {
-    /// The cable's tension grid.
-    pub tension_n: TensionGrid,
+    /// The grid of the cable's command: tensions, N, or (when
+    /// `by_displacement`) displacements, mm.
+    pub actuation: ValueGrid,
+    /// Whether the cable is driven by its displacement (its tension found).
+    pub by_displacement: bool,
     /// Its swept control points.
     pub sweeps: Vec<PointSweep>,
 }
@@ -92,20 +99,21 @@ pub struct PointSweep {
     pub levels_mm: Vec<f64>,
 }
 
-/// `count` tensions evenly spaced from `min` to `max`, N.
+/// `count` values evenly spaced from `min` to `max`: a cable's tensions (N)
+/// or displacements (mm).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct TensionGrid {
-    /// First tension, N (≥ 0).
+pub struct ValueGrid {
+    /// First value (≥ 0).
     pub min: f64,
-    /// Last tension, N (≥ min).
+    /// Last value (≥ min).
     pub max: f64,
-    /// Number of tensions (1: `min` only).
+    /// Number of values (1: `min` only).
     pub count: u32,
 }
 
-impl TensionGrid {
-    /// The tensions, N.
+impl ValueGrid {
+    /// The values.
     pub fn values(&self) -> Vec<f64> {
         if self.count <= 1 {
             return vec![self.min];
@@ -169,22 +177,43 @@ struct CableFile {
     z_mm: [f64; CONTROL_POINTS],
     #[serde(default, skip_serializing_if = "Option::is_none")]
     anchor_mm: Option<f64>,
-    tension_n: TensionGrid,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    tension_n: Option<ValueGrid>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    displacement_mm: Option<ValueGrid>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    cable_ea_n: Option<f64>,
     #[serde(default, rename = "sweep")]
     sweeps: Vec<PointSweep>,
 }
 
-impl From<SpecFile> for CableSweepSpec {
-    fn from(file: SpecFile) -> Self {
+impl TryFrom<SpecFile> for CableSweepSpec {
+    type Error = String;
+
+    fn try_from(file: SpecFile) -> Result<Self, String> {
         let SpecFile { rod, gj_n_mm2, gravity_direction, solver, output, cables } = file;
         let (cables, grids) = cables
             .into_iter()
-            .map(|c| {
-                let CableFile { y_mm, z_mm, anchor_mm, tension_n, sweeps } = c;
-                (Cable { anchor_mm, ..Cable::spatial(y_mm, z_mm, 0.0) }, CableGrid { tension_n, sweeps })
+            .enumerate()
+            .map(|(i, c)| {
+                let CableFile { y_mm, z_mm, anchor_mm, tension_n, displacement_mm, cable_ea_n, sweeps } = c;
+                let (actuation, by_displacement) = match (tension_n, displacement_mm) {
+                    (Some(t), None) => (t, false),
+                    (None, Some(d)) => (d, true),
+                    (t, _) => {
+                        return Err(format!(
+                            "cable {}: give {} of tension_n = {{ min, max, count }} (N) and displacement_mm = {{ min, max, count }} (mm)",
+                            i + 1,
+                            if t.is_some() { "only one" } else { "one" }
+                        ))
+                    }
+                };
+                Ok((Cable { anchor_mm, cable_ea_n, ..Cable::spatial(y_mm, z_mm, 0.0) }, CableGrid { actuation, by_displacement, sweeps }))
             })
+            .collect::<Result<Vec<_>, String>>()?
+            .into_iter()
             .unzip();
-        Self { actuator: Actuator { rod, gj_n_mm2, gravity_direction, cables }, grids, solver, output }
+        Ok(Self { actuator: Actuator { rod, gj_n_mm2, gravity_direction, cables }, grids, solver, output })
     }
 }
 
@@ -196,9 +225,10 @@ impl From<CableSweepSpec> for SpecFile {
             .into_iter()
             .zip(grids)
             .map(|(cable, grid)| {
-                // The tension is the grid's; the actuator's is always 0.
-                let Cable { y_mm, z_mm, anchor_mm, .. } = cable;
-                CableFile { y_mm, z_mm, anchor_mm, tension_n: grid.tension_n, sweeps: grid.sweeps }
+                // The actuation is the grid's; the actuator's tension is always 0.
+                let Cable { y_mm, z_mm, anchor_mm, cable_ea_n, .. } = cable;
+                let (tension_n, displacement_mm) = if grid.by_displacement { (None, Some(grid.actuation)) } else { (Some(grid.actuation), None) };
+                CableFile { y_mm, z_mm, anchor_mm, tension_n, displacement_mm, cable_ea_n, sweeps: grid.sweeps }
             })
             .collect();
         SpecFile { rod, gj_n_mm2, gravity_direction, solver, output, cables }
@@ -240,9 +270,9 @@ impl CableSweepSpec {
         self.dimensions().iter().map(|d| d.levels.len() as u64).product()
     }
 
-    /// Number of tension combinations per routing.
-    pub fn tension_combinations(&self) -> u64 {
-        self.grids.iter().map(|g| u64::from(g.tension_n.count.max(1))).product()
+    /// Number of actuation combinations per routing (rows per routing).
+    pub fn actuation_combinations(&self) -> u64 {
+        self.grids.iter().map(|g| u64::from(g.actuation.count.max(1))).product()
     }
 
     /// Checks the spec; messages name the field.
@@ -254,12 +284,22 @@ impl CableSweepSpec {
         }
         for (i, (c, g)) in cables.iter().zip(&self.grids).enumerate() {
             let n = i + 1;
-            let t = &g.tension_n;
+            let t = &g.actuation;
+            let key = if g.by_displacement { "displacement_mm" } else { "tension_n" };
             if !(t.min.is_finite() && t.max.is_finite() && t.min >= 0.0 && t.max >= t.min) {
-                return Err(bad(format!("cable {n}: tension_n needs 0 ≤ min ≤ max (finite), got min = {}, max = {}", t.min, t.max)));
+                return Err(bad(format!("cable {n}: {key} needs 0 ≤ min ≤ max (finite), got min = {}, max = {}", t.min, t.max)));
             }
             if t.count == 0 || t.count > MAX_TENSION_COUNT {
-                return Err(bad(format!("cable {n}: tension_n.count = {} must be 1 … {MAX_TENSION_COUNT}", t.count)));
+                return Err(bad(format!("cable {n}: {key}.count = {} must be 1 … {MAX_TENSION_COUNT}", t.count)));
+            }
+            if g.by_displacement && t.max >= self.actuator.rod.length_mm {
+                return Err(bad(format!("cable {n}: displacement_mm.max = {} is not shorter than the rod ({} mm): a cable cannot be pulled in by its length", t.max, self.actuator.rod.length_mm)));
+            }
+            if let Some(ea) = c.cable_ea_n.filter(|ea| !(ea.is_finite() && *ea > 0.0)) {
+                return Err(bad(format!("cable {n}: cable_ea_n = {ea} must be a finite stiffness > 0 N (leave it out for an inextensible cable)")));
+            }
+            if g.by_displacement && self.solver.method == crate::model::SolverMethod::Rk4 {
+                return Err(bad(format!("cable {n} is driven by its displacement: [solver] method = \"rk4\" does not integrate the cables' paths; use the default collocation")));
             }
             // The anchor is not swept: outside the rod, every routing's rows
             // would be invalid_routing.
@@ -298,7 +338,7 @@ impl CableSweepSpec {
         if self.output.chunk_routings == 0 {
             return Err(bad("output.chunk_routings = 0: a chunk needs at least one routing".into()));
         }
-        let combos = self.tension_combinations();
+        let combos = self.actuation_combinations();
         let chunk_rows = u64::from(self.output.chunk_routings).saturating_mul(combos);
         if chunk_rows > MAX_CHUNK_ROWS {
             return Err(bad(if combos > MAX_CHUNK_ROWS {
@@ -341,9 +381,14 @@ impl CableSweepSpec {
         actuator
     }
 
-    /// Each cable's tension grid, N.
-    pub fn tension_grids(&self) -> Vec<Vec<f64>> {
-        self.grids.iter().map(|g| g.tension_n.values()).collect()
+    /// Each cable's actuation grid: tensions, N, or displacements, mm.
+    pub fn actuation_grids(&self) -> Vec<Vec<f64>> {
+        self.grids.iter().map(|g| g.actuation.values()).collect()
+    }
+
+    /// Each cable's actuation grid, and which cables are driven by their displacement.
+    pub fn combinations(&self) -> TensionCombinations {
+        TensionCombinations::new(self.actuation_grids(), self.grids.iter().map(|g| g.by_displacement).collect())
     }
 
     /// Whether the run is planar: every cable and its swept points lie in
@@ -360,10 +405,15 @@ impl CableSweepSpec {
     /// e.g. to solve it again.
     pub fn actuator_at(&self, id: u64, k: usize) -> Actuator {
         let mut actuator = self.actuator_for(id, &self.dimensions());
-        let grids = self.tension_grids();
+        let grids = self.actuation_grids();
         let mut rest = k;
-        for (c, g) in actuator.cables.iter_mut().zip(&grids).rev() {
-            c.tension_n = g[rest % g.len()];
+        for ((c, g), spec) in actuator.cables.iter_mut().zip(&grids).zip(&self.grids).rev() {
+            let value = g[rest % g.len()];
+            if spec.by_displacement {
+                c.displacement_mm = Some(value);
+            } else {
+                c.tension_n = value;
+            }
             rest /= g.len();
         }
         actuator
@@ -391,7 +441,7 @@ impl RunSpec for CableSweepSpec {
     }
 
     fn check_run_size(&self, allow_large: bool) -> Result<(), SweepError> {
-        let rows = self.routings().saturating_mul(self.tension_combinations());
+        let rows = self.routings().saturating_mul(self.actuation_combinations());
         if rows > MAX_ROWS && !allow_large {
             return Err(SweepError::InvalidSpec {
                 origin: "(size)".into(),
@@ -399,7 +449,7 @@ impl RunSpec for CableSweepSpec {
                     "the sweep has {rows} rows ({} routings × {} tension combinations), more than {MAX_ROWS}: check the levels and tension counts, \
                      or pass --allow-large if the job is meant to be this big",
                     self.routings(),
-                    self.tension_combinations(),
+                    self.actuation_combinations(),
                 ),
             });
         }
@@ -423,7 +473,7 @@ impl RunSpec for CableSweepSpec {
     }
 
     fn layout(&self) -> ChunkLayout {
-        ChunkLayout::new(self.routings(), self.tension_combinations(), u64::from(self.output.chunk_routings))
+        ChunkLayout::new(self.routings(), self.actuation_combinations(), u64::from(self.output.chunk_routings))
     }
 
     fn schema(&self) -> SchemaRef {
@@ -438,7 +488,7 @@ impl RunSpec for CableSweepSpec {
     }
 
     fn worker(&self) -> Result<CableWorker, SweepError> {
-        Ok(CableWorker { dims: self.dimensions(), combinations: TensionCombinations::new(self.tension_grids()) })
+        Ok(CableWorker { dims: self.dimensions(), combinations: self.combinations() })
     }
 
     fn solve(&self, worker: &mut CableWorker, id: u64) -> Result<Vec<CableRow>, SweepError> {
@@ -481,7 +531,7 @@ levels_mm = [0.0, 1.5, -1.5]
     fn spec_counts_routings_and_tensions() {
         let spec = CableSweepSpec::from_toml(SPEC, "test").unwrap();
         assert_eq!(spec.routings(), 2 * 2 * 3);
-        assert_eq!(spec.tension_combinations(), 6);
+        assert_eq!(spec.actuation_combinations(), 6);
         let dims = spec.dimensions();
         // Id 0: every swept point at its first level; id 1 moves the first dimension.
         let a0 = spec.actuator_for(0, &dims);
@@ -518,7 +568,7 @@ levels_mm = [0.0, 1.5, -1.5]
         let mut worker = spec.worker().unwrap();
         let rows = spec.solve(&mut worker, 7).unwrap();
         assert_eq!(rows.len(), 6);
-        let grids = spec.tension_grids();
+        let grids = spec.actuation_grids();
         for (k, row) in rows.iter().enumerate() {
             assert_eq!(row.routing_id, 7);
             let combo: Vec<usize> = row.tensions.iter().zip(&grids).map(|(t, g)| g.iter().position(|v| v == t).unwrap()).collect();
