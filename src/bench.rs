@@ -137,6 +137,49 @@ pub fn bench_solver(
     Ok(figures(label, per_solve, tensions, passes as f64 / solves.max(1) as f64, failures, method_label(options)))
 }
 
+/// Times displacement-driven solves: for each routing, `count`
+/// displacements evenly spaced from `min_mm` to `max_mm` (continuation, the
+/// tension found by Newton's method on the warm-started tension solves, as
+/// a displacement sweep steps it), a_0 … a_3 included.
+pub fn bench_displacement(
+    actuator: &Rod,
+    options: &SolverOptions,
+    routings: &[ControlPoints],
+    min_mm: f64,
+    max_mm: f64,
+    count: usize,
+    label: &str,
+) -> Result<BenchFigures, crate::Error> {
+    use crate::model::solver::actuation::meet_displacements;
+    let mut sim = Simulator::new(actuator, options)?;
+    let ladder: Vec<f64> = (0..count).map(|k| min_mm + (max_mm - min_mm) * k as f64 / (count.max(2) - 1) as f64).collect();
+    let mut per_solve = Vec::with_capacity(routings.len());
+    let mut a = [0.0; 4];
+    let (mut passes, mut solves, mut failures) = (0u64, 0u64, 0usize);
+    for y in routings {
+        let routing = Routing::for_actuator(y, actuator)?;
+        let start = Instant::now();
+        sim.set_routing(&routing);
+        let mut tension = [0.0];
+        for &d in &ladder {
+            match meet_displacements(&mut sim, &[Some(d)], &mut tension) {
+                Ok(pose) => {
+                    sim.coefficients_into(crate::shape::LengthBasis::default(), &mut a);
+                    passes += u64::from(pose.iterations);
+                    solves += 1;
+                }
+                Err(_) => {
+                    tension[0] = 0.0;
+                    failures += 1;
+                }
+            }
+        }
+        per_solve.push(start.elapsed().as_secs_f64() * 1e6 / ladder.len() as f64);
+    }
+    std::hint::black_box(a);
+    Ok(figures(label, per_solve, count, passes as f64 / solves.max(1) as f64, failures, method_label(options)))
+}
+
 /// Figures from the mean µs per solve of each routing (any order).
 fn figures(label: &str, mut per_solve: Vec<f64>, tensions: usize, mean_passes: f64, failures: usize, method: String) -> BenchFigures {
     per_solve.sort_by(f64::total_cmp);

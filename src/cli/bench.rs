@@ -53,6 +53,24 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
             );
         }
     }
+    // Actuation by displacement (the collocation): the same routings driven
+    // through a displacement ladder, each tension found; its ratio to the
+    // tension-driven solve of this run.
+    if options.method == cablemap::model::SolverMethod::Collocation {
+        let f = cablemap::bench::bench_displacement(&base, &options, &routings, 0.5, 5.0, 21, "displacement")?;
+        println!(
+            "displacement-driven, the same routings x 21 displacements (0.5..5.0 mm, continuation, tension found), gravity {}",
+            if base.gravity.enabled { "on" } else { "off" }
+        );
+        println!(
+            "{:<12} {:<16} {:>10.2} {:>8.2} {:>8.2} {:>8.2} {:>9}",
+            f.label, f.method, f.median_us_per_solve, f.p10_us_per_solve, f.p90_us_per_solve, f.mean_passes, f.failures
+        );
+        let same_gravity = if base.gravity.enabled { "gravity on" } else { "gravity off" };
+        if let Some(p) = rows.iter().find(|r| r.label == same_gravity) {
+            println!("displacement-driven solve {:.2} µs = {:.2}x the tension-driven {:.2} µs (medians, same run)", f.median_us_per_solve, f.median_us_per_solve / p.median_us_per_solve, p.median_us_per_solve);
+        }
+    }
     // The 3-D solver: two spatial cables, in the table only (the JSON
     // array keeps its two planar rows), with its RK4 reference unless
     // --no-reference, and its ratio to the planar single-cable solve of this run.

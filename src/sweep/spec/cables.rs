@@ -188,9 +188,9 @@ struct CableFile {
 }
 
 impl TryFrom<SpecFile> for CableSweepSpec {
-    type Error = String;
+    type Error = InvalidSpec;
 
-    fn try_from(file: SpecFile) -> Result<Self, String> {
+    fn try_from(file: SpecFile) -> Result<Self, InvalidSpec> {
         let SpecFile { rod, gj_n_mm2, gravity_direction, solver, output, cables } = file;
         let (cables, grids) = cables
             .into_iter()
@@ -201,16 +201,16 @@ impl TryFrom<SpecFile> for CableSweepSpec {
                     (Some(t), None) => (t, false),
                     (None, Some(d)) => (d, true),
                     (t, _) => {
-                        return Err(format!(
+                        return Err(InvalidSpec(format!(
                             "cable {}: give {} of tension_n = {{ min, max, count }} (N) and displacement_mm = {{ min, max, count }} (mm)",
                             i + 1,
                             if t.is_some() { "only one" } else { "one" }
-                        ))
+                        )))
                     }
                 };
                 Ok((Cable { anchor_mm, cable_ea_n, ..Cable::spatial(y_mm, z_mm, 0.0) }, CableGrid { actuation, by_displacement, sweeps }))
             })
-            .collect::<Result<Vec<_>, String>>()?
+            .collect::<Result<Vec<_>, InvalidSpec>>()?
             .into_iter()
             .unzip();
         Ok(Self { actuator: Actuator { rod, gj_n_mm2, gravity_direction, cables }, grids, solver, output })
