@@ -155,7 +155,9 @@ cable_sweeps() {
 moulds() {
     echo "== Python read-back of moulds (trimesh)"
     step "mould" "$bin" mould --routing 1,-2,3,0.5,-3 --out "$work/mould" || return
-    check check_moulds tests/python/check_moulds.py "$work/mould"
+    step "mould planar-trio.toml" "$bin" mould --actuator tests/data/moulds/planar-trio.toml --out "$work/mould-trio" || return
+    step "mould spatial-pair-tapered.toml" "$bin" mould --actuator tests/data/moulds/spatial-pair-tapered.toml --out "$work/mould-lumens" || return
+    check check_moulds tests/python/check_moulds.py "$work/mould" "$work/mould-trio" "$work/mould-lumens"
 }
 
 groups=(sweeps_and_maps cable_sweeps moulds)

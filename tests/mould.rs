@@ -128,3 +128,115 @@ fn bad_mould_input_is_refused_with_a_reason() {
     assert!(!ok && stderr.contains("routing_mm"), "{stderr}");
     assert!(!out.join("mould1.stl").exists());
 }
+
+/// Centre of the loop that the plane x = `x` cuts from `mesh` near `near`
+/// (length-weighted midpoints of the cut's segments), (y, z).
+fn section_centre(mesh: &Mesh, x: f64, near: [f64; 2]) -> [f64; 2] {
+    let (mut sy, mut sz, mut w) = (0.0, 0.0, 0.0);
+    for [a, b] in mesh.slice_x(x) {
+        let mid = [(a.0 + b.0) / 2.0, (a.1 + b.1) / 2.0];
+        if (mid[0] - near[0]).hypot(mid[1] - near[1]) < 1.0 {
+            let len = (a.0 - b.0).hypot(a.1 - b.1);
+            sy += mid[0] * len;
+            sz += mid[1] * len;
+            w += len;
+        }
+    }
+    [sy / w, sz / w]
+}
+
+#[test]
+fn mould_actuator_casts_every_planar_channel_with_its_own_protrusion() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("m");
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/moulds/planar-trio.toml");
+    let (ok, stdout, stderr) = run(&["mould", "--actuator", file.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    assert!(ok, "{stderr}");
+    assert!(stdout.contains("3 channels") && stdout.contains("channel_3.csv"), "{stdout}");
+    let summary: Value = serde_json::from_str(&std::fs::read_to_string(out.join("mould.json")).unwrap()).unwrap();
+    assert_eq!(summary["style"], "two_part");
+    for number in [1, 2] {
+        let (_, mesh) = read_stl(&out.join(format!("mould{number}.stl")));
+        let report = mesh.check();
+        assert!(report.is_watertight() && report.shell_volumes_mm3.len() == 2, "mould{number}.stl: {report:?}");
+    }
+    let actuator = cablemap::model::Actuator::read(&file).unwrap();
+    let (_, mesh) = read_stl(&out.join("mould1.stl"));
+    let off: Vec<f64> = summary["files"][0]["parts"][1]["offset_mm"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+    let mut worst: f64 = 0.0;
+    for cable in &actuator.cables {
+        let routing = Routing::new(cable.y_mm, 65.0, 5.0).unwrap();
+        for k in 0..120 {
+            let x = 0.1 + k as f64 * 0.54;
+            let yc = routing.channel_at(x).y_mm;
+            let (y, z) = crest(&mesh, x, off[1] - yc);
+            worst = worst.max((-(y - off[1]) - yc).abs());
+            assert!((z - off[2] - 0.5).abs() < 0.01, "x = {x}: crest height {} mm", z - off[2]);
+        }
+    }
+    // From the f32 file: within 0.01 mm of each channel's y_c(s).
+    assert!(worst < 0.01, "crest off y_c(s) by up to {worst} mm");
+    let csv = std::fs::read_to_string(out.join("channel_2.csv")).unwrap();
+    assert!(csv.starts_with("s_mm,y_mm,dy_ds\n0.0000,0.000000"), "{}", &csv[..40]);
+}
+
+#[test]
+fn mould_actuator_prints_spatial_channels_as_a_body_with_lumens_and_cores() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("m");
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/moulds/spatial-pair-tapered.toml");
+    let (ok, stdout, stderr) = run(&["mould", "--actuator", file.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    assert!(ok, "{stderr}");
+    assert!(stdout.contains("2 lumen(s)") && stdout.contains("body.stl"), "{stdout}");
+    let summary: Value = serde_json::from_str(&std::fs::read_to_string(out.join("mould.json")).unwrap()).unwrap();
+    assert_eq!(summary["style"], "lumens");
+    let (_, body) = read_stl(&out.join("body.stl"));
+    let (_, core) = read_stl(&out.join("core.stl"));
+    for (mesh, shells, entry) in [(&body, 1, 0), (&core, 2, 1)] {
+        let r = mesh.check();
+        assert!(r.is_watertight() && r.shell_volumes_mm3.len() == shells, "{r:?}");
+        let listed = summary["files"][entry]["volume_mm3"].as_f64().unwrap();
+        assert!((r.volume_mm3 - listed).abs() < 1e-4 * listed);
+    }
+    let expected = summary["body_expected_mm3"].as_f64().unwrap();
+    assert!(((body.volume_mm3() - expected) / expected).abs() < 0.002);
+    // The outline follows the taper: r = 6 at the clamp, 5 at the tip.
+    let (lo, hi) = body.bounds_mm();
+    assert!((hi[1] - 6.0).abs() < 1e-4 && (lo[0] + 10.0).abs() < 1e-6 && (hi[0] - 65.0).abs() < 1e-6, "{lo:?} {hi:?}");
+    // Each lumen (and core) is centred on its channel, read from the files.
+    let actuator = cablemap::model::Actuator::read(&file).unwrap();
+    let channels = actuator.channels().unwrap();
+    let mut worst: f64 = 0.0;
+    for ch in &channels {
+        for k in 0..100 {
+            let s = 0.31 + k as f64 * 0.6437;
+            let c = ch.at(s).r_mm;
+            for mesh in [&body, &core] {
+                let got = section_centre(mesh, s, c);
+                worst = worst.max((got[0] - c[0]).hypot(got[1] - c[1]));
+            }
+        }
+    }
+    assert!(worst < 0.01, "lumen centre off the channel by up to {worst} mm");
+    // Forcing the two-part mould on spatial channels is refused with the reason.
+    let (ok, _, stderr) = run(&["mould", "--actuator", file.to_str().unwrap(), "--style", "two-part", "--out", dir.path().join("x").to_str().unwrap()]);
+    assert!(!ok && stderr.contains("radius profile") && stderr.contains("--style lumens"), "{stderr}");
+}
+
+#[test]
+fn mould_actuator_refuses_channels_too_close_naming_cables_s_and_gap() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = dir.path().join("m");
+    let o = o.to_str().unwrap();
+    let (ok, _, stderr) = run(&["mould", "--cable", "y=0.6,0.6,0.6,0.6,0.6 tension=1", "--cable", "y=-0.6,-0.6,-0.6,-0.6,-0.6 tension=1", "--out", o]);
+    assert!(!ok && stderr.contains("cables 1 and 2") && stderr.contains("0.200 mm") && stderr.contains("s = 0.00"), "{stderr}");
+    let (ok, _, stderr) = run(&["mould", "--cable", "y=3,3,3,3,3 z=3,3,3,3,3 tension=1", "--out", o]);
+    assert!(!ok && stderr.contains("lumen of cable 1") && stderr.contains("0.257 mm"), "{stderr}");
+    let (ok, _, stderr) = run(&["mould", "--cable", "y=1,1,1,1,1 tension=1", "--cable", "y=-3,-3,-3,-3,-3 z=0,1,0,0,0 tension=1", "--style", "two-part", "--out", o]);
+    assert!(!ok && stderr.contains("cable 2 leaves the bending plane"), "{stderr}");
+    let (ok, _, stderr) = run(&["mould", "--cable", "y=1,1,1,1,1 tension=1 anchor=40", "--out", o]);
+    assert!(!ok && stderr.contains("cable 1 knotted before the tip"), "{stderr}");
+    let (ok, _, stderr) = run(&["mould", "--routing", "0,0,0,0,0", "--style", "lumens", "--out", o]);
+    assert!(!ok && stderr.contains("--style"), "{stderr}");
+    assert!(!Path::new(o).exists());
+}

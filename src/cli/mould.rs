@@ -1,8 +1,8 @@
-//! `cablemap mould`: printable moulds (binary STL) for a routing.
+//! `cablemap mould`: printable moulds (binary STL) for a routing or any actuator.
 
 use super::{parse_list, ActuatorArgs};
 use cablemap::model::{Rod, Routing};
-use cablemap::mould::{MouldError, MouldParams, MouldSet};
+use cablemap::mould::{MouldError, MouldOptions, MouldParams, MouldSet, MouldStyle};
 use anyhow::Context;
 use clap::Args;
 use std::io::Write;
@@ -42,15 +42,49 @@ impl MouldParamArgs {
     }
 }
 
+/// Which moulds `mould --actuator` makes (`--style`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum StyleArg {
+    /// Two-part moulds for channels all in the bending plane on a uniform body, else lumens.
+    #[default]
+    Auto,
+    /// The thesis's tray, lid (a protrusion per channel) and cover.
+    TwoPart,
+    /// A printable body with a lumen per channel and the lumens' castable cores.
+    Lumens,
+}
+
+impl StyleArg {
+    /// The library's style.
+    pub fn style(self) -> MouldStyle {
+        match self {
+            StyleArg::Auto => MouldStyle::Auto,
+            StyleArg::TwoPart => MouldStyle::TwoPart,
+            StyleArg::Lumens => MouldStyle::Lumens,
+        }
+    }
+}
+
 /// Arguments of `cablemap mould`.
 #[derive(Debug, Clone, Args)]
 pub struct MouldArgs {
     /// Control-point offsets y0..y4, mm, e.g. 1,-2,0.5,0,3.
-    #[arg(long, value_name = "Y0,..,Y4", allow_hyphen_values = true, conflicts_with = "design", required_unless_present = "design")]
+    #[arg(long, value_name = "Y0,..,Y4", allow_hyphen_values = true, conflicts_with_all = ["design", "spatial_actuator", "cable"], required_unless_present_any = ["design", "spatial_actuator", "cable"])]
     pub routing: Option<String>,
     /// A design.json written by `cablemap design --out`: its routing and actuator.
-    #[arg(long, value_name = "FILE")]
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["spatial_actuator", "cable"])]
     pub design: Option<PathBuf>,
+    /// A whole actuator as TOML (the file of `simulate --actuator`: [rod] and 1–8 [[cable]]
+    /// tables): moulds for every cable's channel, in the style --style picks.
+    #[arg(long = "actuator", value_name = "FILE.toml")]
+    pub spatial_actuator: Option<PathBuf>,
+    /// A cable "y=Y0,..,Y4 [z=Z0,..,Z4] tension=T" (repeatable; replaces --actuator's cables).
+    #[arg(long, value_name = "SPEC")]
+    pub cable: Vec<String>,
+    /// With --actuator or --cable: two-part moulds (planar channels on a uniform body), a printed
+    /// body with lumens and its cores, or auto (two-part when the channels allow it).
+    #[arg(long, value_enum, default_value_t = StyleArg::Auto)]
+    pub style: StyleArg,
     /// Directory for mould1.stl, mould2.stl, mould1.png, mould2.png, channel.csv, mould.json: new,
     /// empty or an earlier mould directory, written as a whole (a killed run leaves nothing partial).
     #[arg(long, value_name = "DIR")]
@@ -77,6 +111,10 @@ pub fn with_flag(e: MouldError) -> anyhow::Error {
 
 /// Runs `cablemap mould`.
 pub fn run(args: &MouldArgs) -> anyhow::Result<()> {
+    if args.spatial_actuator.is_some() || !args.cable.is_empty() {
+        return run_actuator(args);
+    }
+    anyhow::ensure!(args.style == StyleArg::Auto, "--style is for --actuator or --cable (a routing gets the two-part moulds)");
     let (ys, base) = match (&args.routing, &args.design) {
         (Some(r), _) => (parse_list(r, "--routing")?, Rod::default()),
         (None, Some(d)) => {
@@ -99,5 +137,37 @@ pub fn run(args: &MouldArgs) -> anyhow::Result<()> {
     } else {
         write!(out, "{}", summary.report(&args.out))?;
     }
+    Ok(())
+}
+
+/// `cablemap mould --actuator FILE` / `--cable …`: one library request
+/// ([`cablemap::mould::build`]) for every cable's channel.
+fn run_actuator(args: &MouldArgs) -> anyhow::Result<()> {
+    use cablemap::model::{Actuator, Cable};
+    let mut actuator = match &args.spatial_actuator {
+        Some(path) => {
+            anyhow::ensure!(
+                args.actuator.actuator_file.is_none(),
+                "give the rod either in --actuator FILE's [rod] table or by --actuator-file, not both"
+            );
+            let mut a = Actuator::read(path).with_context(|| format!("--actuator {}", path.display()))?;
+            a.rod = args.actuator.apply(&a.rod);
+            a
+        }
+        None => Actuator::with_cables(args.actuator.resolve()?, Vec::new()),
+    };
+    if !args.cable.is_empty() {
+        actuator.cables = args.cable.iter().map(|c| c.parse::<Cable>()).collect::<Result<_, _>>().context("--cable")?;
+    }
+    let options = MouldOptions { params: args.mould.params(), style: args.style.style() };
+    let report = cablemap::mould::build(&actuator, &options).and_then(|m| m.write_dir(&args.out)).map_err(with_flag)?;
+    let stdout = std::io::stdout();
+    let mut out = stdout.lock();
+    if args.json {
+        writeln!(out, "{}", serde_json::to_string(&report)?)?;
+    } else {
+        write!(out, "{}", report.report(&args.out))?;
+    }
+    debug_assert!(report.style() != MouldStyle::Auto);
     Ok(())
 }

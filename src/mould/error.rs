@@ -31,16 +31,39 @@ pub enum MouldError {
         /// Its value and what it must be.
         message: String,
     },
-    /// The channel comes too close to the body surface to be cast.
+    /// A channel comes too close to the body surface to be cast.
     #[error(
-        "the channel (tube Ø {tube_mm} mm) comes within {skin_mm:.3} mm of the body surface at s = {s_mm:.2} mm \
+        "the channel of cable {cable} (tube Ø {tube_mm} mm) comes within {skin_mm:.3} mm of the body surface at s = {s_mm:.2} mm \
          (|y_c| = {y_mm:.3} mm, r = {radius_mm} mm); it needs at least {min_skin_mm} mm of silicone: \
          use a routing with |y_c| ≤ {limit_mm:.3} mm (design --max-offset-mm), a thinner tube, or --min-skin-mm"
     )]
-    ChannelTooClose { tube_mm: f64, skin_mm: f64, s_mm: f64, y_mm: f64, radius_mm: f64, min_skin_mm: f64, limit_mm: f64 },
+    ChannelTooClose { cable: usize, tube_mm: f64, skin_mm: f64, s_mm: f64, y_mm: f64, radius_mm: f64, min_skin_mm: f64, limit_mm: f64 },
+    /// Two channels come too close to each other to be cast.
+    #[error(
+        "the channels of cables {first} and {second} (tube Ø {tube_mm} mm) keep only {gap_mm:.3} mm of silicone between them at s = {s_mm:.2} mm \
+         (cable {first}'s s); they need at least {needed_mm:.3} mm: route them farther apart there, use a thinner tube \
+         (--tube-diameter-mm), or a smaller --min-skin-mm"
+    )]
+    ChannelsTooClose { first: usize, second: usize, s_mm: f64, gap_mm: f64, needed_mm: f64, tube_mm: f64 },
+    /// A lumen (spatial channel) comes too close to the body surface.
+    #[error(
+        "the lumen of cable {cable} (Ø {tube_mm} mm) comes within {skin_mm:.3} mm of the body surface at s = {s_mm:.2} mm \
+         (its centre {distance_mm:.3} mm from the axis, r(s) = {radius_mm:.3} mm); it needs at least {min_skin_mm} mm of silicone: \
+         move the channel nearer the axis there, use a thinner tube (--tube-diameter-mm), or a smaller --min-skin-mm"
+    )]
+    LumenTooClose { cable: usize, tube_mm: f64, skin_mm: f64, s_mm: f64, distance_mm: f64, radius_mm: f64, min_skin_mm: f64 },
+    /// The actuator cannot be moulded in the style asked for.
+    #[error("{0}")]
+    Unsupported(String),
     /// The actuator is not a uniform cylinder with the cable knotted at the tip.
-    #[error("moulds are made for uniform cylinders only, but this actuator has {0}: the two-part mould's tray and plate assume one radius and a channel to the tip; cast a tapered or segmented body in a mould of your own (channel.csv gives the channel)")]
+    #[error("moulds are made for uniform cylinders only, but this actuator has {0}: the two-part mould's tray and plate assume one radius, and every mould channels that leave through the tip and one material; cast such a body in a mould of your own (channel.csv gives the channel)")]
     NonUniformBody(String),
+    /// The actuator's cables are invalid.
+    #[error(transparent)]
+    Actuator(#[from] crate::model::spatial::SpatialError),
+    /// The rod's parameters are invalid.
+    #[error(transparent)]
+    Rod(#[from] crate::model::ParameterError),
     /// Writing a file.
     #[error(transparent)]
     File(#[from] crate::io::FileError),

@@ -129,6 +129,26 @@ impl Mesh {
         }
     }
 
+    /// The segments in which the plane x = `x_mm` cuts the triangles, as
+    /// (y, z) pairs (a cross-section, for checks and drawings).
+    pub fn slice_x(&self, x_mm: f64) -> Vec<[(f64, f64); 2]> {
+        let mut out = Vec::new();
+        for t in &self.triangles {
+            let mut pts = Vec::new();
+            for k in 0..3 {
+                let (a, b) = (self.vertices[t[k] as usize], self.vertices[t[(k + 1) % 3] as usize]);
+                if (a[0] - x_mm) * (b[0] - x_mm) < 0.0 {
+                    let f = (x_mm - a[0]) / (b[0] - a[0]);
+                    pts.push((a[1] + f * (b[1] - a[1]), a[2] + f * (b[2] - a[2])));
+                }
+            }
+            if pts.len() == 2 {
+                out.push([pts[0], pts[1]]);
+            }
+        }
+        out
+    }
+
     /// Appends `other` as further shells of this mesh.
     pub fn append(&mut self, other: &Mesh) {
         let base = self.vertices.len() as u32;

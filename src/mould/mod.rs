@@ -29,21 +29,30 @@
 //! clamp end, an arrow and "+Y" in the margin on the +y side, and the part's
 //! letter; a mirrored print reads backwards.
 //!
-//! Only the uniform planar body with one cable exists in cablemap today, so
-//! only its moulds are made: no tapered/segmented or spatial-channel variants.
+//! Several planar channels get a protrusion each on the lid and a notch
+//! each in the tip-end walls. Channels in space (or a tapered body) get a
+//! printed body with lumens and the lumens' castable cores instead
+//! ([`lumens`]); [`request`] picks the style for any actuator
+//! ([`for_actuator`], the one entry point of `mould --actuator` and
+//! `design --moulds`).
 
 pub mod error;
 mod font;
+pub mod lumens;
 pub mod mesh;
 pub mod moulds;
 pub mod params;
+pub mod polygon;
 pub mod preview;
+pub mod request;
 pub mod set;
 pub mod stl;
 
 pub use error::MouldError;
 pub use moulds::{volume_below_face_mm3, Moulds, Part, PartKind};
 pub use params::{check_uniform_body, MouldParams, MAX_SIZE_MM, MAX_TRIANGLES};
+pub use lumens::{LumenSummary, Lumens};
+pub use request::{build, check, check_body, for_actuator, resolve_style, ActuatorMoulds, MouldOptions, MouldReport, MouldStyle};
 pub use set::{MouldFile, MouldSet, MouldSummary, PlacedPart};
 
 /// The file every mould directory holds: an output directory that has it

@@ -1,5 +1,5 @@
-//! The moulds of one routing: the geometry of tray, lid and cover, and
-//! each part's heightfield mesh in its print frame.
+//! The two-part moulds of one or more planar channels: the geometry of
+//! tray, lid and cover, and each part's heightfield mesh in its print frame.
 
 use super::font::{text_pixels, text_width_mm};
 use super::mesh::{heightfield_solid, sided, Mesh, Sided};
@@ -67,16 +67,22 @@ struct Feature {
     dz_mm: f64,
 }
 
-/// The moulds of one routing: geometry and meshes.
+/// The moulds of one or more planar channels (all in the cutting plane):
+/// geometry and meshes.
 #[derive(Debug, Clone)]
 pub struct Moulds {
-    routing: Routing,
+    /// The channels, in the actuator's cable order.
+    channels: Vec<Routing>,
+    /// Channel indices in increasing y (the same at every x: channels
+    /// closer than the tube are refused, so they never cross).
+    order: Vec<usize>,
+    length_mm: f64,
     radius_mm: f64,
     params: MouldParams,
     /// Tube radius ρ, mm.
     pub(super) tube_radius_mm: f64,
-    /// Widest x-section half-width of the protrusion, ρ·max √(1 + y_c′²), mm.
-    ridge_half_width_max_mm: f64,
+    /// Widest x-section half-width of each channel's protrusion, ρ·max √(1 + y_c′²), mm.
+    ridge_half_width_max_mm: Vec<f64>,
     x_range_mm: [f64; 2],
     y_half_mm: f64,
     sprue_depth_mm: f64,
@@ -100,10 +106,32 @@ fn trough(r: f64, y: f64) -> f64 {
 }
 
 impl Moulds {
-    /// Checks the parameters and the routing's channel against the body.
+    /// Checks the parameters and the routing's channel against the body
+    /// (one channel: the thesis's actuator).
     pub fn new(routing: &Routing, radius_mm: f64, params: &MouldParams) -> Result<Self, MouldError> {
+        Self::planar(std::slice::from_ref(routing), radius_mm, params)
+    }
+
+    /// Checks the parameters and every channel against the body and each
+    /// other: each keeps `min_skin_mm` of silicone to the surface
+    /// ([`MouldError::ChannelTooClose`]) and to every other channel's tube
+    /// ([`MouldError::ChannelsTooClose`]). The channels are the cables'
+    /// y_c(s) in the cutting plane, in cable order, all of one length.
+    pub fn planar(channels: &[Routing], radius_mm: f64, params: &MouldParams) -> Result<Self, MouldError> {
         let p = params;
         let bad = |name: &'static str, message: String| Err(MouldError::BadParameter { name, message });
+        let Some(first) = channels.first() else {
+            return bad("channels", "no channel given: the moulds need at least one cable".into());
+        };
+        let length = first.length_mm();
+        if let Some(k) = channels.iter().position(|c| c.length_mm() != length) {
+            return bad("channels", format!(
+                "cable {} spans {} mm, cable 1 {} mm: every channel must run from the clamp to the tip (no cable_anchor_mm before the tip)",
+                k + 1,
+                crate::io::fmt_num(channels[k].length_mm()),
+                crate::io::fmt_num(length)
+            ));
+        }
         let sizes = [
             ("wall_mm", p.wall_mm),
             ("tube_diameter_mm", p.tube_diameter_mm),
@@ -112,7 +140,7 @@ impl Moulds {
             ("min_skin_mm", p.min_skin_mm),
             ("station_step_mm", p.station_step_mm),
             ("radius_mm", radius_mm),
-            ("length_mm", routing.length_mm()),
+            ("length_mm", length),
         ];
         for (name, value) in sizes {
             if !value.is_finite() {
@@ -149,7 +177,6 @@ impl Moulds {
         if !(0.01..=2.0).contains(&p.station_step_mm) {
             return bad("station_step_mm", format!("{} mm must be between 0.01 and 2", p.station_step_mm));
         }
-        let length = routing.length_mm();
         let text_mm = text_width_mm("CL ^+Y");
         if length + p.clamp_mm < text_mm + 12.0 {
             return bad("clamp_mm", format!(
@@ -162,29 +189,37 @@ impl Moulds {
         // The channel must keep min_skin of silicone to the surface everywhere.
         let limit = p.max_channel_offset_mm(radius_mm);
         let n = (length / 0.05).ceil() as usize;
-        let mut widest = 1.0_f64;
-        for i in 0..=n {
-            let s = length * i as f64 / n as f64;
-            let c = routing.channel_at(s);
-            widest = widest.max((1.0 + c.dy_ds * c.dy_ds).sqrt());
-            if c.y_mm.abs() > limit {
-                return Err(MouldError::ChannelTooClose {
-                    tube_mm: p.tube_diameter_mm,
-                    skin_mm: radius_mm - rho - c.y_mm.abs(),
-                    s_mm: s,
-                    y_mm: c.y_mm.abs(),
-                    radius_mm,
-                    min_skin_mm: p.min_skin_mm,
-                    limit_mm: limit,
-                });
+        let mut widest = vec![1.0_f64; channels.len()];
+        for (k, routing) in channels.iter().enumerate() {
+            for i in 0..=n {
+                let s = length * i as f64 / n as f64;
+                let c = routing.channel_at(s);
+                widest[k] = widest[k].max((1.0 + c.dy_ds * c.dy_ds).sqrt());
+                if c.y_mm.abs() > limit {
+                    return Err(MouldError::ChannelTooClose {
+                        cable: k + 1,
+                        tube_mm: p.tube_diameter_mm,
+                        skin_mm: radius_mm - rho - c.y_mm.abs(),
+                        s_mm: s,
+                        y_mm: c.y_mm.abs(),
+                        radius_mm,
+                        min_skin_mm: p.min_skin_mm,
+                        limit_mm: limit,
+                    });
+                }
             }
         }
+        check_channel_gaps(channels, rho, p.min_skin_mm)?;
+        let mut order: Vec<usize> = (0..channels.len()).collect();
+        order.sort_by(|a, b| channels[*a].channel_at(0.0).y_mm.total_cmp(&channels[*b].channel_at(0.0).y_mm));
         let moulds = Self {
-            routing: routing.clone(),
+            channels: channels.to_vec(),
+            order,
+            length_mm: length,
             radius_mm,
             params: p.clone(),
             tube_radius_mm: rho,
-            ridge_half_width_max_mm: rho * widest,
+            ridge_half_width_max_mm: widest.iter().map(|w| rho * w).collect(),
             x_range_mm: [-p.clamp_mm - p.wall_mm, length + p.wall_mm],
             y_half_mm: radius_mm + p.wall_mm + BAND_MM,
             sprue_depth_mm: radius_mm / 2.0,
@@ -193,15 +228,38 @@ impl Moulds {
         if triangles > MAX_TRIANGLES {
             return Err(MouldError::TooLarge { triangles, length_mm: length, radius_mm, wall_mm: p.wall_mm, clamp_mm: p.clamp_mm });
         }
-        // The samples across the channel must lie inside the trough.
-        let w = moulds.ridge_half_width_max_mm.max(rho + p.clearance_mm);
+        // The samples across each channel must lie inside the trough, and
+        // neighbouring channels' sample blocks (protrusion, tip notch) must
+        // not overlap.
+        let notch = rho + p.clearance_mm;
         for i in 0..=n {
-            let y = routing.channel_at(length * i as f64 / n as f64).y_mm.abs();
-            if y + w >= radius_mm {
-                return bad("tube_diameter_mm", format!(
-                    "the protrusion (half-width {w:.3} mm in x-sections) at |y_c| = {y:.3} mm reaches the body surface r = {radius_mm} mm; \
-                     use a routing further from the surface or a thinner tube"
-                ));
+            let s = length * i as f64 / n as f64;
+            let mut prev: Option<(usize, f64, f64, f64)> = None;
+            for &k in &moulds.order {
+                let w = moulds.ridge_half_width_max_mm[k].max(notch);
+                let y = channels[k].channel_at(s).y_mm;
+                if y.abs() + w >= radius_mm {
+                    return bad("tube_diameter_mm", format!(
+                        "the protrusion of cable {} (half-width {w:.3} mm in x-sections) at |y_c| = {:.3} mm reaches the body surface r = {radius_mm} mm at s = {s:.2} mm; \
+                         use a routing further from the surface or a thinner tube",
+                        k + 1,
+                        y.abs()
+                    ));
+                }
+                if let Some((j, yj, wj, _)) = prev {
+                    if y - w <= yj + wj {
+                        let gap = channel_gap_mm(&channels[j], &channels[k], rho);
+                        return Err(MouldError::ChannelsTooClose {
+                            first: j.min(k) + 1,
+                            second: j.max(k) + 1,
+                            s_mm: s,
+                            gap_mm: gap.0.min(y - yj - 2.0 * rho),
+                            needed_mm: (w + wj - 2.0 * rho).max(p.min_skin_mm),
+                            tube_mm: p.tube_diameter_mm,
+                        });
+                    }
+                }
+                prev = Some((k, y, w, s));
             }
         }
         Ok(moulds)
@@ -232,9 +290,14 @@ impl Moulds {
             .sum()
     }
 
-    /// The routing the moulds are for.
-    pub fn routing(&self) -> &Routing {
-        &self.routing
+    /// The channels the moulds are for, in cable order.
+    pub fn channels(&self) -> &[Routing] {
+        &self.channels
+    }
+
+    /// Body length L, mm.
+    pub fn length_mm(&self) -> f64 {
+        self.length_mm
     }
 
     /// Body radius r, mm.
@@ -259,37 +322,38 @@ impl Moulds {
 
     /// The cavity's x range: the clamp block's end to the tip, mm.
     pub fn cavity_x_mm(&self) -> [f64; 2] {
-        [-self.params.clamp_mm, self.routing.length_mm()]
+        [-self.params.clamp_mm, self.length_mm]
     }
 
-    /// Channel centreline y at x (assembly frame): y_c(x) on the body,
-    /// straight along x in the clamp block and beyond the tip, mm.
-    pub fn channel_y_mm(&self, x_mm: f64) -> f64 {
-        self.routing.channel_at(x_mm.clamp(0.0, self.routing.length_mm())).y_mm
+    /// Centreline y of channel `k` (cable order, from 0) at x (assembly
+    /// frame): y_c(x) on the body, straight along x in the clamp block and
+    /// beyond the tip, mm.
+    pub fn channel_y_mm(&self, k: usize, x_mm: f64) -> f64 {
+        self.channels[k].channel_at(x_mm.clamp(0.0, self.length_mm)).y_mm
     }
 
     /// dy/dx of the channel at a station: the spline's slope on the body, 0
     /// on the straight ends; at x = 0 and x = L the side picks the limit.
     /// Evaluated at the station itself (not the sided offset) so both sides of
     /// a step elsewhere give bit-identical points.
-    fn channel_slope(&self, x: Sided) -> f64 {
-        let l = self.routing.length_mm();
+    fn channel_slope(&self, k: usize, x: Sided) -> f64 {
+        let l = self.length_mm;
         let on_body = (x.0 > 0.0 && x.0 < l) || (x.0 == 0.0 && x.1 > 0) || (x.0 == l && x.1 < 0);
         if on_body {
-            self.routing.channel_at(x.0).dy_ds
+            self.channels[k].channel_at(x.0).dy_ds
         } else {
             0.0
         }
     }
 
-    /// Length of the channel inside the cavity (clamp block + arc of y_c), mm.
-    pub fn channel_length_mm(&self) -> f64 {
-        let l = self.routing.length_mm();
+    /// Length of channel `k` inside the cavity (clamp block + arc of y_c), mm.
+    pub fn channel_length_mm(&self, k: usize) -> f64 {
+        let l = self.length_mm;
         let n = 4000;
         let arc: f64 = (0..n)
             .map(|i| {
                 let s = l * (i as f64 + 0.5) / n as f64;
-                (1.0 + self.routing.channel_at(s).dy_ds.powi(2)).sqrt() * l / n as f64
+                (1.0 + self.channels[k].channel_at(s).dy_ds.powi(2)).sqrt() * l / n as f64
             })
             .sum();
         self.params.clamp_mm + arc
@@ -352,24 +416,37 @@ impl Moulds {
                     // wall down to r/2 (the tube passes through it too).
                     trough(r, ye).max(-self.sprue_depth_mm)
                 } else {
-                    // Tip-end wall: a notch for the tube (mould 2) or the lid's protrusion (mould 1).
+                    // Tip-end wall: a notch per tube (mould 2) or protrusion (mould 1).
                     let rn = self.tube_radius_mm + self.params.clearance_mm;
-                    let u = ye - s * self.channel_y_mm(c1);
-                    let notch = if u.abs() < rn { -(rn * rn - u * u).sqrt() } else { 0.0 };
+                    let notch = (0..self.channels.len())
+                        .map(|k| {
+                            let u = ye - s * self.channel_y_mm(k, c1);
+                            if u.abs() < rn {
+                                -(rn * rn - u * u).sqrt()
+                            } else {
+                                0.0
+                            }
+                        })
+                        .fold(0.0, f64::min);
                     notch.max(trough(r, ye))
                 }
             }
             PartKind::Lid => {
-                // The protrusion: in an x-section the half tube of radius ρ
-                // about the channel is a half ellipse ρ·√(1 + y_c′²) wide.
+                // The protrusions: in an x-section the half tube of radius ρ
+                // about a channel is a half ellipse ρ·√(1 + y_c′²) wide;
+                // the channels' are disjoint (checked in `planar`).
                 let rho = self.tube_radius_mm;
-                let w = rho * (1.0 + self.channel_slope(x).powi(2)).sqrt();
-                let u = ye - s * self.channel_y_mm(x.0);
-                if u.abs() < w {
-                    rho * (1.0 - (u / w).powi(2)).sqrt()
-                } else {
-                    0.0
-                }
+                (0..self.channels.len())
+                    .map(|k| {
+                        let w = rho * (1.0 + self.channel_slope(k, x).powi(2)).sqrt();
+                        let u = ye - s * self.channel_y_mm(k, x.0);
+                        if u.abs() < w {
+                            rho * (1.0 - (u / w).powi(2)).sqrt()
+                        } else {
+                            0.0
+                        }
+                    })
+                    .fold(0.0, f64::max)
             }
         };
         for f in features {
@@ -382,29 +459,52 @@ impl Moulds {
 
     /// y samples of a part at station x (print frame): the margins with
     /// every feature edge twice, the trough by angle, and a block across
-    /// the channel that moves with it (so the crest is a grid line).
+    /// each channel that moves with it (so each crest is a grid line). The
+    /// count is the same at every station.
     fn samples(&self, kind: PartKind, features: &[Feature], x: Sided) -> Vec<Sided> {
         let s = kind.frame_sign();
         let r = self.radius_mm;
         let mut edges: Vec<f64> = features.iter().flat_map(|f| f.y_mm).collect();
         edges.sort_by(f64::total_cmp);
         edges.dedup();
-        let (centre, w, n_side) = match kind {
-            PartKind::Lid => (s * self.channel_y_mm(x.0), self.ridge_half_width_max_mm, 4),
-            PartKind::Tray | PartKind::Cover => {
-                (s * self.channel_y_mm(self.routing.length_mm()), self.tube_radius_mm + self.params.clearance_mm, TROUGH_SAMPLES)
-            }
+        // Blocks (centre, half-width) in increasing print-frame y.
+        let mut blocks: Vec<(f64, f64)> = self
+            .order
+            .iter()
+            .map(|&k| match kind {
+                PartKind::Lid => (s * self.channel_y_mm(k, x.0), self.ridge_half_width_max_mm[k]),
+                PartKind::Tray | PartKind::Cover => (s * self.channel_y_mm(k, self.length_mm), self.tube_radius_mm + self.params.clearance_mm),
+            })
+            .collect();
+        if s < 0.0 {
+            blocks.reverse();
+        }
+        let n_side = match kind {
+            PartKind::Lid => 4,
+            PartKind::Tray | PartKind::Cover => TROUGH_SAMPLES,
         };
+        let pi = std::f64::consts::PI;
         let mut out: Vec<Sided> = vec![(-self.y_half_mm, 0)];
         out.extend(edges.iter().filter(|e| **e < -r).flat_map(|e| [(*e, -1), (*e, 1)]));
-        // Trough left of the channel block: y = r cos φ, φ from π down to φ_a.
-        let phi_a = ((centre - w) / r).clamp(-1.0, 1.0).acos();
-        out.extend((0..n_side).map(|k| (r * (std::f64::consts::PI - (std::f64::consts::PI - phi_a) * k as f64 / n_side as f64).cos(), 0)));
-        out.extend((0..=CHANNEL_SAMPLES).map(|k| {
-            let theta = std::f64::consts::PI * (1.0 - k as f64 / CHANNEL_SAMPLES as f64);
-            (centre + w * theta.cos(), 0)
-        }));
-        let phi_b = ((centre + w) / r).clamp(-1.0, 1.0).acos();
+        // Trough left of the first block: y = r cos φ, φ from π down to φ_a.
+        let (c, w) = blocks[0];
+        let phi_a = ((c - w) / r).clamp(-1.0, 1.0).acos();
+        out.extend((0..n_side).map(|k| (r * (pi - (pi - phi_a) * k as f64 / n_side as f64).cos(), 0)));
+        for (i, &(c, w)) in blocks.iter().enumerate() {
+            if i > 0 {
+                // Trough between two blocks, both ends excluded.
+                let (cp, wp) = blocks[i - 1];
+                let phi_b = ((cp + wp) / r).clamp(-1.0, 1.0).acos();
+                let phi_a = ((c - w) / r).clamp(-1.0, 1.0).acos();
+                out.extend((1..n_side).map(|k| (r * (phi_b + (phi_a - phi_b) * k as f64 / n_side as f64).cos(), 0)));
+            }
+            out.extend((0..=CHANNEL_SAMPLES).map(|k| {
+                let theta = pi * (1.0 - k as f64 / CHANNEL_SAMPLES as f64);
+                (c + w * theta.cos(), 0)
+            }));
+        }
+        let (c, w) = blocks[blocks.len() - 1];
+        let phi_b = ((c + w) / r).clamp(-1.0, 1.0).acos();
         out.extend((1..=n_side).map(|k| (r * (phi_b * (1.0 - k as f64 / n_side as f64)).cos(), 0)));
         out.extend(edges.iter().filter(|e| **e > r).flat_map(|e| [(*e, -1), (*e, 1)]));
         out.push((self.y_half_mm, 0));
@@ -500,3 +600,46 @@ pub fn volume_below_face_mm3(mesh: &Mesh, cavity_x_mm: [f64; 2], radius_mm: f64)
 #[cfg(test)]
 #[path = "tests.rs"]
 mod tests;
+
+/// The smallest silicone gap between the tubes (diameter 2ρ) of two planar
+/// channels, mm, and the arc length s on `a` where it occurs: the least
+/// distance between the centrelines (x = s, y = y_c(s)) less 2ρ. Sampled
+/// every 0.02 mm along both; only pairs within 2ρ + 3 mm in x are compared
+/// (farther pairs are farther apart than that anyway).
+pub(super) fn channel_gap_mm(a: &Routing, b: &Routing, rho: f64) -> (f64, f64) {
+    let pts = |r: &Routing| -> Vec<[f64; 2]> {
+        let l = r.length_mm();
+        let n = (l / 0.02).ceil() as usize;
+        (0..=n).map(|i| l * i as f64 / n as f64).map(|s| [s, r.channel_at(s).y_mm]).collect()
+    };
+    let (pa, pb) = (pts(a), pts(b));
+    let window = 2.0 * rho + 3.0;
+    let mut best = (f64::INFINITY, 0.0);
+    let mut lo = 0;
+    for p in &pa {
+        while lo < pb.len() && pb[lo][0] < p[0] - window {
+            lo += 1;
+        }
+        for q in pb[lo..].iter().take_while(|q| q[0] <= p[0] + window) {
+            let d = (p[0] - q[0]).hypot(p[1] - q[1]);
+            if d < best.0 - 1e-9 {
+                best = (d, p[0]);
+            }
+        }
+    }
+    (best.0.min(window) - 2.0 * rho, best.1)
+}
+
+/// Refuses two channels whose tubes keep less than `min_skin_mm` of
+/// silicone between them ([`MouldError::ChannelsTooClose`]).
+fn check_channel_gaps(channels: &[Routing], rho: f64, min_skin_mm: f64) -> Result<(), MouldError> {
+    for (i, a) in channels.iter().enumerate() {
+        for (j, b) in channels.iter().enumerate().skip(i + 1) {
+            let (gap, s) = channel_gap_mm(a, b, rho);
+            if gap < min_skin_mm {
+                return Err(MouldError::ChannelsTooClose { first: i + 1, second: j + 1, s_mm: s, gap_mm: gap, needed_mm: min_skin_mm, tube_mm: 2.0 * rho });
+            }
+        }
+    }
+    Ok(())
+}

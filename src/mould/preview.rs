@@ -51,7 +51,7 @@ pub fn write_png(path: &Path, set: &MouldSet, number: u8) -> Result<(), PlotErro
         plan.draw_series(cells).map_err(|e| err(&e))?;
     }
     // Section of the assembled mould at mid-length.
-    let x_mid = m.routing().length_mm() / 2.0;
+    let x_mid = m.length_mm() / 2.0;
     let w = m.params().wall_mm;
     let zb = m.radius_mm() + w;
     let mut sec = ChartBuilder::on(&bottom)
@@ -77,7 +77,6 @@ pub fn write_png(path: &Path, set: &MouldSet, number: u8) -> Result<(), PlotErro
             .label(format!("{} ({})", kind.name(), kind.letter()))
             .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 14, y + 5)], colour.filled()));
     }
-    let yc = m.channel_y_mm(x_mid);
     let rho = m.params().tube_diameter_mm / 2.0;
     let circle = |cx: f64, r: f64| (0..=72).map(move |k| {
         let a = k as f64 * std::f64::consts::TAU / 72.0;
@@ -87,10 +86,21 @@ pub fn write_png(path: &Path, set: &MouldSet, number: u8) -> Result<(), PlotErro
         .map_err(|e| err(&e))?
         .label("body outline (r)")
         .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 14, y)], BLACK));
-    let tube_label = if number == 1 { "channel (the lid's protrusion)" } else { "PTFE tube in the groove" };
-    sec.draw_series(std::iter::once(PathElement::new(circle(yc, rho).collect::<Vec<_>>(), RED.stroke_width(2))))
+    let one = m.channels().len() == 1;
+    let tube_label = match (number, one) {
+        (1, true) => "channel (the lid's protrusion)",
+        (1, false) => "channels (the lid's protrusions)",
+        (_, true) => "PTFE tube in the groove",
+        (_, false) => "PTFE tubes in the grooves",
+    };
+    let ycs: Vec<f64> = (0..m.channels().len()).map(|k| m.channel_y_mm(k, x_mid)).collect();
+    let label = match ycs.as_slice() {
+        [yc] => format!("{tube_label}, y_c = {yc:.2} mm"),
+        several => format!("{tube_label}, y_c = {} mm (cables 1..{})", several.iter().map(|y| format!("{y:.2}")).collect::<Vec<_>>().join(", "), several.len()),
+    };
+    sec.draw_series(ycs.iter().map(|yc| PathElement::new(circle(*yc, rho).collect::<Vec<_>>(), RED.stroke_width(2))))
         .map_err(|e| err(&e))?
-        .label(format!("{tube_label}, y_c = {yc:.2} mm"))
+        .label(label)
         .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 14, y)], RED));
     sec.configure_series_labels()
         .background_style(WHITE.mix(0.85))
@@ -121,12 +131,12 @@ pub fn write_png(path: &Path, set: &MouldSet, number: u8) -> Result<(), PlotErro
     };
     let mut all = lines;
     all.push(String::new());
-    all.push(format!("L = {} mm, r = {} mm, clamp block {} mm", m.routing().length_mm(), m.radius_mm(), m.params().clamp_mm));
+    all.push(format!("L = {} mm, r = {} mm, clamp block {} mm", m.length_mm(), m.radius_mm(), m.params().clamp_mm));
     all.push(format!("tube Ø {} mm, clearance {cl} mm, wall {} mm", m.params().tube_diameter_mm, m.params().wall_mm));
-    all.push(format!(
-        "y0..y4 = [{}] mm",
-        m.routing().control_points_mm().iter().map(|y| format!("{y:.2}")).collect::<Vec<_>>().join(", ")
-    ));
+    for (k, c) in m.channels().iter().enumerate() {
+        let ys = c.control_points_mm().iter().map(|y| format!("{y:.2}")).collect::<Vec<_>>().join(", ");
+        all.push(if m.channels().len() == 1 { format!("y0..y4 = [{ys}] mm") } else { format!("cable {}: y0..y4 = [{ys}] mm", k + 1) });
+    }
     all.push("Marks: 'CL' = clamp end, arrow + '+Y' = +y side;".to_string());
     all.push("text reading backwards = mirrored print.".to_string());
     for (i, line) in all.iter().enumerate() {

@@ -11,7 +11,7 @@ use std::path::Path;
 /// Gap between the two parts of one print plate, mm.
 const PLATE_GAP_MM: f64 = 6.0;
 
-/// The three parts of a routing's moulds, built once.
+/// The three parts of the two-part moulds of one or more planar channels, built once.
 #[derive(Debug, Clone)]
 pub struct MouldSet {
     /// The geometry they were built from.
@@ -53,15 +53,22 @@ pub struct MouldFile {
 /// What `write_all` wrote (also saved as mould.json).
 #[derive(Debug, Clone, Serialize)]
 pub struct MouldSummary {
-    /// Control points y0..y4, mm.
-    pub routing_mm: crate::model::routing::ControlPoints,
+    /// "two_part": the thesis's tray, lid and cover.
+    pub style: &'static str,
+    /// Control points y0..y4 of the one channel, mm (absent with several).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub routing_mm: Option<crate::model::routing::ControlPoints>,
+    /// Control points y0..y4 of every channel, in cable order, mm.
+    pub channels_y_mm: Vec<crate::model::routing::ControlPoints>,
+    /// The channels' centreline files (channel.csv for one, channel_K.csv for cable K of several).
+    pub channel_files: Vec<String>,
     /// Body length L and radius r, mm.
     pub length_mm: f64,
     /// Body radius r, mm.
     pub radius_mm: f64,
     /// Mould parameters.
     pub params: MouldParams,
-    /// Channel length inside the body (clamp block + arc), mm.
+    /// Channel length inside the body (clamp block + arc), mm; of several, their sum.
     pub channel_length_mm: f64,
     /// The STL files with their parts.
     pub files: Vec<MouldFile>,
@@ -80,9 +87,17 @@ impl MouldSummary {
     pub fn report(&self, dir: &Path) -> String {
         let s = self;
         let mut out = String::new();
+        let list = |c: &crate::model::routing::ControlPoints| c.iter().map(|y| format!("{y:.3}")).collect::<Vec<_>>().join(", ");
+        let what = match &s.routing_mm {
+            Some(r) => format!("y0..y4 = [{}] mm", list(r)),
+            None => format!(
+                "{} channels ({})",
+                s.channels_y_mm.len(),
+                s.channels_y_mm.iter().enumerate().map(|(k, c)| format!("cable {}: y0..y4 = [{}] mm", k + 1, list(c))).collect::<Vec<_>>().join("; ")
+            ),
+        };
         out.push_str(&format!(
-            "moulds for y0..y4 = [{}] mm, L = {} mm, r = {} mm, clamp block {} mm, tube Ø {} mm\n",
-            s.routing_mm.iter().map(|y| format!("{y:.3}")).collect::<Vec<_>>().join(", "),
+            "moulds for {what}, L = {} mm, r = {} mm, clamp block {} mm, tube Ø {} mm\n",
             s.length_mm,
             s.radius_mm,
             s.params.clamp_mm,
@@ -108,7 +123,7 @@ impl MouldSummary {
             "cavity 1     {:.1} mm³ (half body minus half channel {:.1} mm³)\ncavity 2     {:.1} mm³ (body {:.1} mm³)\n",
             s.mould1_cavity_mm3, s.mould1_body_mm3, s.mould2_cavity_mm3, s.mould2_body_mm3
         ));
-        out.push_str(&format!("wrote mould1.stl, mould2.stl, mould1.png, mould2.png, channel.csv, mould.json to {}\n", dir.display()));
+        out.push_str(&format!("wrote mould1.stl, mould2.stl, mould1.png, mould2.png, {}, mould.json to {}\n", s.channel_files.join(", "), dir.display()));
         out
     }
 }
@@ -125,6 +140,12 @@ impl MouldSet {
     /// Checks and builds the moulds of `routing` on a body of radius `radius_mm`.
     pub fn new(routing: &Routing, radius_mm: f64, params: &MouldParams) -> Result<Self, MouldError> {
         Ok(Self::build(Moulds::new(routing, radius_mm, params)?))
+    }
+
+    /// Checks and builds the moulds of several planar channels (cable
+    /// order) on a body of radius `radius_mm` ([`Moulds::planar`]).
+    pub fn planar(channels: &[Routing], radius_mm: f64, params: &MouldParams) -> Result<Self, MouldError> {
+        Ok(Self::build(Moulds::planar(channels, radius_mm, params)?))
     }
 
     /// The part of a kind.
@@ -179,7 +200,8 @@ impl MouldSet {
         let [c0, c1] = m.cavity_x_mm();
         let full = std::f64::consts::PI * m.radius_mm().powi(2) * (c1 - c0);
         if number == 1 {
-            full / 2.0 - std::f64::consts::PI * m.tube_radius_mm.powi(2) / 2.0 * m.channel_length_mm()
+            let channels: f64 = (0..m.channels().len()).map(|k| m.channel_length_mm(k)).sum();
+            full / 2.0 - std::f64::consts::PI * m.tube_radius_mm.powi(2) / 2.0 * channels
         } else {
             full
         }
@@ -191,21 +213,7 @@ impl MouldSet {
     /// partial `dir` (and an earlier one whole). `dir` must be new, empty or
     /// an earlier mould directory (it has [`SUMMARY_FILE`]).
     pub fn write_dir(&self, dir: &Path) -> Result<MouldSummary, MouldError> {
-        let name = dir.file_name().map(|n| n.to_string_lossy().into_owned()).filter(|n| n != "." && n != "..");
-        let Some(name) = name else {
-            return Err(MouldError::OutUnnamed { path: dir.to_path_buf() });
-        };
-        let holds_files = std::fs::read_dir(dir).is_ok_and(|mut entries| entries.next().is_some());
-        if holds_files && !dir.join(SUMMARY_FILE).is_file() {
-            return Err(MouldError::NotAMouldDir { path: dir.to_path_buf() });
-        }
-        crate::io::write_dir_replacing(dir, &name, |staging| self.write_all(staging), |step, path, source| {
-            let what = match step {
-                crate::io::DirStep::Create => "creating",
-                crate::io::DirStep::Replace => "putting the new moulds in place at",
-            };
-            FileError::new(what, path, source).into()
-        })
+        write_mould_dir(dir, |staging| self.write_all(staging))
     }
 
     /// Writes mould1.stl, mould2.stl, mould1.png, mould2.png, channel.csv and
@@ -215,27 +223,37 @@ impl MouldSet {
     pub fn write_all(&self, dir: &Path) -> Result<MouldSummary, MouldError> {
         std::fs::create_dir_all(dir).map_err(FileError::on("creating", dir))?;
         let m = &self.moulds;
-        let routing = m.routing();
-        let ys = routing.control_points_mm().iter().map(|y| format!("{y:.3}")).collect::<Vec<_>>().join(",");
+        let channels = m.channels();
+        let header = match channels {
+            [one] => format!("y=[{}]", one.control_points_mm().iter().map(|y| format!("{y:.3}")).collect::<Vec<_>>().join(",")),
+            several => format!("{} channels", several.len()),
+        };
         let mut files = Vec::new();
         for number in [1u8, 2] {
             let (mesh, placed) = self.plate(number);
-            let title = format!("cablemap mould{number}, units mm, L={} r={} y=[{ys}]", routing.length_mm(), m.radius_mm());
+            let title = format!("cablemap mould{number}, units mm, L={} r={} {header}", m.length_mm(), m.radius_mm());
             let name = format!("mould{number}.stl");
             let path = dir.join(&name);
             crate::io::write_atomic(&path, &stl::to_bytes(&mesh, &title)).map_err(FileError::on("writing", &path))?;
             preview::write_png(&dir.join(format!("mould{number}.png")), self, number)?;
             files.push(MouldFile { file: name, parts: placed });
         }
-        let path = dir.join("channel.csv");
-        crate::io::write_atomic(&path, routing.channel_csv().as_bytes())
-            .map_err(FileError::on("writing", &path))?;
+        let mut channel_files = Vec::new();
+        for (k, routing) in channels.iter().enumerate() {
+            let name = if channels.len() == 1 { "channel.csv".to_string() } else { format!("channel_{}.csv", k + 1) };
+            let path = dir.join(&name);
+            crate::io::write_atomic(&path, routing.channel_csv().as_bytes()).map_err(FileError::on("writing", &path))?;
+            channel_files.push(name);
+        }
         let summary = MouldSummary {
-            routing_mm: routing.control_points_mm(),
-            length_mm: routing.length_mm(),
+            style: "two_part",
+            routing_mm: (channels.len() == 1).then(|| channels[0].control_points_mm()),
+            channels_y_mm: channels.iter().map(|c| c.control_points_mm()).collect(),
+            channel_files,
+            length_mm: m.length_mm(),
             radius_mm: m.radius_mm(),
             params: m.params().clone(),
-            channel_length_mm: m.channel_length_mm(),
+            channel_length_mm: (0..channels.len()).map(|k| m.channel_length_mm(k)).sum(),
             files,
             mould1_cavity_mm3: self.cavity_volume_mm3(1),
             mould1_body_mm3: self.body_volume_mm3(1),
@@ -249,3 +267,26 @@ impl MouldSet {
     }
 }
 
+
+/// Writes the mould directory `dir` as a whole with `write` (into a
+/// staging directory beside it, which then replaces `dir`,
+/// [`crate::io::write_dir_replacing`]): a killed run leaves no partial
+/// `dir`. `dir` must be new, empty or an earlier mould directory (it has
+/// [`SUMMARY_FILE`]).
+pub(super) fn write_mould_dir<T>(dir: &Path, write: impl FnOnce(&Path) -> Result<T, MouldError>) -> Result<T, MouldError> {
+    let name = dir.file_name().map(|n| n.to_string_lossy().into_owned()).filter(|n| n != "." && n != "..");
+    let Some(name) = name else {
+        return Err(MouldError::OutUnnamed { path: dir.to_path_buf() });
+    };
+    let holds_files = std::fs::read_dir(dir).is_ok_and(|mut entries| entries.next().is_some());
+    if holds_files && !dir.join(SUMMARY_FILE).is_file() {
+        return Err(MouldError::NotAMouldDir { path: dir.to_path_buf() });
+    }
+    crate::io::write_dir_replacing(dir, &name, write, |step, path, source| {
+        let what = match step {
+            crate::io::DirStep::Create => "creating",
+            crate::io::DirStep::Replace => "putting the new moulds in place at",
+        };
+        FileError::new(what, path, source).into()
+    })
+}

@@ -74,10 +74,10 @@ fn the_protrusion_follows_the_routing_with_the_tube_diameter() {
             let s = set(y, &p);
             let lid = &s.lid.mesh;
             let rho = p.tube_diameter_mm / 2.0;
-            let routing = s.moulds.routing();
+            let routing = &s.moulds.channels()[0];
             let mut x = -p.clamp_mm + 0.137;
             while x < 65.0 {
-                let yc = s.moulds.channel_y_mm(x);
+                let yc = s.moulds.channel_y_mm(0, x);
                 // Print frame: the lid is turned over, its protrusion at −y_c.
                 let near = |q: &(f64, f64)| (q.0 + yc).abs() < 3.0 * rho;
                 let segs: Vec<[(f64, f64); 2]> = slice(lid, x).into_iter().filter(|g| near(&g[0]) && near(&g[1])).collect();
@@ -111,7 +111,7 @@ fn cavities_hold_the_body() {
             }
             // The groove is really there: the protrusion inside the cavity is half the tube.
             let ridge = -volume_below_face_mm3(&s.lid.mesh, s.moulds.cavity_x_mm(), 5.0);
-            let channel = std::f64::consts::PI * (p.tube_diameter_mm / 2.0).powi(2) / 2.0 * s.moulds.channel_length_mm();
+            let channel = std::f64::consts::PI * (p.tube_diameter_mm / 2.0).powi(2) / 2.0 * s.moulds.channel_length_mm(0);
             assert!((ridge - channel).abs() < 0.02 * channel, "protrusion {ridge} mm³ vs half tube {channel} mm³");
         }
     }
@@ -257,3 +257,95 @@ fn the_triangle_estimate_matches_the_meshes_and_bounds_them() {
     assert!(matches!(e, MouldError::TooLarge { .. }) && e.to_string().contains("triangles"), "{e}");
 }
 
+
+/// Three channels in the bending plane, well apart.
+const TRIO: [[f64; 5]; 3] = [[3.0, 3.2, 2.5, 3.0, 3.3], [0.0, -0.5, 0.5, 0.0, 0.2], [-3.0, -2.5, -3.5, -3.0, -2.8]];
+
+fn planar_set(ys: &[[f64; 5]], params: &MouldParams) -> MouldSet {
+    let channels: Vec<Routing> = ys.iter().map(|y| Routing::new(y, 65.0, 5.0).unwrap()).collect();
+    MouldSet::planar(&channels, 5.0, params).unwrap()
+}
+
+#[test]
+fn several_channels_give_one_protrusion_each_and_closed_parts() {
+    for p in variants() {
+        let s = planar_set(&TRIO, &p);
+        for kind in [PartKind::Tray, PartKind::Lid, PartKind::Cover] {
+            let r = s.part(kind).mesh.check();
+            assert!(r.is_watertight() && r.shell_volumes_mm3.len() == 1, "{kind:?} {p:?}: {r:?}");
+            let (_, back) = stl::read(&stl::to_bytes(&s.part(kind).mesh, "t")).unwrap();
+            assert!(back.check().is_watertight(), "{kind:?} as STL");
+        }
+        for number in [1, 2] {
+            let (cavity, body) = (s.cavity_volume_mm3(number), s.body_volume_mm3(number));
+            assert!(((cavity - body) / body).abs() < 0.005, "mould {number}: cavity {cavity} vs body {body}");
+        }
+        // Each protrusion's crest at y_c(s) of its own channel within 0.01 mm, at height ρ.
+        let rho = p.tube_diameter_mm / 2.0;
+        let mut worst: f64 = 0.0;
+        for k in 0..TRIO.len() {
+            let mut x = -p.clamp_mm + 0.137;
+            while x < 65.0 {
+                let yc = s.moulds.channel_y_mm(k, x);
+                let near = |q: &(f64, f64)| (q.0 + yc).abs() < 3.0 * rho;
+                let crest = s.lid.mesh.slice_x(x).into_iter().filter(|g| near(&g[0]) && near(&g[1])).flatten().fold((0.0, f64::NEG_INFINITY), |a, q| if q.1 > a.1 { q } else { a });
+                worst = worst.max((-crest.0 - yc).abs());
+                assert!((-crest.0 - yc).abs() < 0.01, "cable {} x = {x}: crest at y = {} vs y_c = {yc}", k + 1, -crest.0);
+                assert!((crest.1 - rho).abs() < 0.01, "cable {} x = {x}: crest height {} vs ρ = {rho}", k + 1, crest.1);
+                x += 0.731;
+            }
+        }
+        assert!(worst < 0.01, "{worst}");
+        // A notch per tube in the tip-end wall of tray and cover.
+        for kind in [PartKind::Tray, PartKind::Cover] {
+            let x = 65.0 + p.wall_mm / 2.0;
+            for k in 0..TRIO.len() {
+                let y = kind.frame_sign() * s.moulds.channel_y_mm(k, 65.0);
+                assert!(s.moulds.height_mm(kind, x, y) <= -rho, "{kind:?}: no notch for cable {}", k + 1);
+            }
+            assert!(s.moulds.height_mm(kind, x, kind.frame_sign() * 1.5) == 0.0, "{kind:?}: wall between notches");
+        }
+    }
+}
+
+#[test]
+fn mirrored_channels_give_mirrored_two_part_moulds() {
+    let p = MouldParams::default();
+    let a = planar_set(&TRIO, &p);
+    let mirrored: Vec<[f64; 5]> = TRIO.iter().map(|y| y.map(|v| -v)).collect();
+    let b = planar_set(&mirrored, &p);
+    for kind in [PartKind::Tray, PartKind::Lid, PartKind::Cover] {
+        let (ra, rb) = (region(&a.part(kind).mesh.mirrored_y(), -5.0, 5.0), region(&b.part(kind).mesh, -5.0, 5.0));
+        assert!(ra.len() > 1000);
+        assert_eq!(ra, rb, "{kind:?}: the cavity regions are not mirror images");
+    }
+}
+
+#[test]
+fn channels_too_close_to_each_other_are_refused_with_cables_s_and_gap() {
+    let p = MouldParams::default();
+    // Straight channels 1.2 mm apart: 0.2 mm of silicone between the 1 mm tubes.
+    let near: Vec<Routing> = [[0.6; 5], [3.0; 5], [-0.6; 5]].iter().map(|y| Routing::new(y, 65.0, 5.0).unwrap()).collect();
+    let e = Moulds::planar(&near, 5.0, &p).unwrap_err();
+    match &e {
+        MouldError::ChannelsTooClose { first: 1, second: 3, s_mm, gap_mm, needed_mm, .. } => {
+            assert!(*s_mm < 0.1 && (gap_mm - 0.2).abs() < 1e-9 && *needed_mm == 0.3, "{e}");
+        }
+        _ => panic!("{e}"),
+    }
+    let text = e.to_string();
+    assert!(text.contains("cables 1 and 3") && text.contains("0.200 mm") && text.contains("s = 0.00"), "{text}");
+    // Crossing channels meet somewhere: refused where they do.
+    let crossing: Vec<Routing> = [[2.0, 2.0, 0.0, -2.0, -2.0], [-2.0, -2.0, 0.0, 2.0, 2.0]].iter().map(|y| Routing::new(y, 65.0, 5.0).unwrap()).collect();
+    match Moulds::planar(&crossing, 5.0, &p).unwrap_err() {
+        MouldError::ChannelsTooClose { s_mm, gap_mm, .. } => assert!((s_mm - 32.5).abs() < 1.0 && gap_mm < -0.9, "{s_mm} {gap_mm}"),
+        e => panic!("{e}"),
+    }
+    // One near the surface names its cable.
+    let surface: Vec<Routing> = [[0.0; 5], [4.5, 0.0, 0.0, 0.0, 0.0]].iter().map(|y| Routing::new(y, 65.0, 5.0).unwrap()).collect();
+    let e = Moulds::planar(&surface, 5.0, &p).unwrap_err();
+    assert!(matches!(e, MouldError::ChannelTooClose { cable: 2, .. }) && e.to_string().contains("cable 2"), "{e}");
+    // Apart by the skin and a little: accepted.
+    let apart: Vec<Routing> = [[0.66; 5], [-0.66; 5]].iter().map(|y| Routing::new(y, 65.0, 5.0).unwrap()).collect();
+    assert!(Moulds::planar(&apart, 5.0, &p).is_ok());
+}
