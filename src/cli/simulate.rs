@@ -167,23 +167,7 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         report_png(args);
         return Ok(());
     }
-    let p = &sim.pose;
-    writeln!(out, "routing        [{}] mm", fmt_list(&y))?;
-    writeln!(out, "tension        {:.6} N   (gravity {})", p.tension_n(), if actuator.gravity.enabled { "on" } else { "off" })?;
-    match (actuation, p.displacement_mm()) {
-        (_, d) if !d.is_finite() => writeln!(out, "displacement   not integrated by the RK4 method")?,
-        (Actuation::Displacement(_), d) => writeln!(out, "displacement   {d:.6} mm (given; the tension above is found)")?,
-        (Actuation::Tension(_), d) => writeln!(out, "displacement   {d:.6} mm (pulled in at the base)")?,
-    }
-    writeln!(out, "tip            x = {:.6} mm, y = {:.6} mm", p.tip_x_mm, p.tip_y_mm)?;
-    writeln!(out, "tip angle      {:.8} rad ({:.4}°)", p.tip_angle_rad, p.tip_angle_rad.to_degrees())?;
-    writeln!(out, "base angle     {:.8} rad ({:.4}°)", p.base_angle_rad, p.base_angle_rad.to_degrees())?;
-    writeln!(out, "length ℓ       {:.6} mm", p.length_mm)?;
-    writeln!(out, "coefficients   a_i {}", basis.describe())?;
-    for (i, a) in sim.a_bend_z.iter().enumerate() {
-        writeln!(out, "a_{i:<12} {a:.8e} mm^-1")?;
-    }
-    writeln!(out, "iterations     {} integration pass(es)", p.iterations)?;
+    write!(out, "{}", record::planar_report(&sim))?;
     drop(out);
     report_png(args);
     Ok(())

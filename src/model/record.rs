@@ -339,6 +339,34 @@ pub fn simulation_json(sim: &Simulation) -> serde_json::Value {
     })
 }
 
+/// The human-readable report of `cablemap simulate --routing …`: one
+/// planar cable (its routing, tension and displacement, the tip, angles,
+/// length and a_i of the in-plane series).
+pub fn planar_report(sim: &Simulation) -> String {
+    let p = &sim.pose;
+    let rod = &sim.actuator.rod;
+    let mut out = String::new();
+    let list = |v: &[f64]| v.iter().map(|x| format!("{x}")).collect::<Vec<_>>().join(", ");
+    let _ = writeln!(out, "routing        [{}] mm", list(&sim.routing_mm().0));
+    let _ = writeln!(out, "tension        {:.6} N   (gravity {})", p.tension_n(), if rod.gravity.enabled { "on" } else { "off" });
+    let given = sim.actuator.cables.first().is_some_and(|c| c.displacement_mm.is_some());
+    let _ = match p.displacement_mm() {
+        d if !d.is_finite() => writeln!(out, "displacement   not integrated by the RK4 method"),
+        d if given => writeln!(out, "displacement   {d:.6} mm (given; the tension above is found)"),
+        d => writeln!(out, "displacement   {d:.6} mm (pulled in at the base)"),
+    };
+    let _ = writeln!(out, "tip            x = {:.6} mm, y = {:.6} mm", p.tip_x_mm, p.tip_y_mm);
+    let _ = writeln!(out, "tip angle      {:.8} rad ({:.4}°)", p.tip_angle_rad, p.tip_angle_rad.to_degrees());
+    let _ = writeln!(out, "base angle     {:.8} rad ({:.4}°)", p.base_angle_rad, p.base_angle_rad.to_degrees());
+    let _ = writeln!(out, "length ℓ       {:.6} mm", p.length_mm);
+    let _ = writeln!(out, "coefficients   a_i {}", sim.length_basis.describe());
+    for (i, a) in sim.a_bend_z.iter().enumerate() {
+        let _ = writeln!(out, "a_{i:<12} {a:.8e} mm^-1");
+    }
+    let _ = writeln!(out, "iterations     {} integration pass(es)", p.iterations);
+    out
+}
+
 /// The human-readable report of `cablemap simulate` for an actuator given by
 /// its cables.
 pub fn report(sim: &Simulation) -> String {
