@@ -112,6 +112,14 @@ impl StudySpec {
             if axes.iter().any(|(n, _)| *n == a.name) {
                 return Err(bad(format!("[[study.axis]] {} is given twice: give each axis once, with all its values", a.name)));
             }
+            // The tension ladder of a cable driven by its displacement is unused.
+            if base.displacement.is_some() && changes.iter().any(|(_, c)| matches!(c, Change::Tension { .. })) {
+                return Err(bad(format!(
+                    "[[study.axis]] {} varies the tension ladder, but the base spec drives the cable by its displacement ([displacement]): \
+                     vary its displacements in the base spec, or give the base spec a [tension] ladder",
+                    a.name
+                )));
+            }
             axes.push((a.name.clone(), changes));
         }
         let count = axes.iter().try_fold(1usize, |n, (_, v)| n.checked_mul(v.len())).filter(|&n| n <= MAX_VARIANTS);
@@ -214,6 +222,11 @@ mod tests {
         assert!(err("[study]\n[[study.axis]]\nname = \"length_mm\"\nvalues = [\"a\"]\n").contains("not a number"));
         assert!(err("[study]\n[[study.axis]]\nname = \"ei_n_mm2\"\nscale = [-1.0]\n").contains("positive"));
         assert!(err("[study]\n[[study.axis]]\nname = \"tension_n\"\nvalues = [[1.0]]\n").contains("pair"));
+        let displaced = "[displacement]\nmin_mm = 0.5\nmax_mm = 2.0\ncount = 3\n";
+        assert!(err(&format!("{displaced}[study]\n[[study.axis]]\nname = \"tension_n\"\nvalues = [[1.0, 2.0]]\n")).contains("[displacement]"));
+        // Other axes over a displacement-driven base keep its ladder.
+        let s = StudySpec::from_toml(&format!("{displaced}[study]\n[[study.axis]]\nname = \"ei_n_mm2\"\nvalues = [100.0, 120.0]\n"), "t").unwrap();
+        assert!(s.variants.iter().all(|v| v.spec.displacement.as_ref().is_some_and(|d| d.count == 3)));
         let e = err("[study]\n[[study.axis]]\nname = \"length_mm\"\nvalues = [65, -5]\n");
         assert!(e.contains("variant 1 (length_mm=-5)") && e.contains("length_mm"), "{e}");
         assert!(err("[grid]\nlevles = 3\n[study]\n[[study.axis]]\nname = \"length_mm\"\nvalues = [65]\n").contains("levles"));
