@@ -252,3 +252,48 @@ fn a_trajectory_reports_the_path_a_resimulation_follows() {
     assert!(largest > 0.1, "the path leaves the straight legs: the check is not empty ({largest} mm)");
     assert_eq!(path["failed_samples"], 0);
 }
+
+/// The antagonistic pair's map (jobs/antagonistic-pair.toml): `feasible
+/// --targets` says which target tips the sweep reached (voxels, plane
+/// cells), gives the planar verdict with the nearest designs showing every
+/// cable, and `design --targets --map` starts from the map's designs.
+#[test]
+fn feasible_and_design_with_a_cable_sweeps_map() {
+    let spec = Path::new(env!("CARGO_MANIFEST_DIR")).join("jobs/antagonistic-pair.toml");
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("pair");
+    let (ok, _, stderr) = run(&["map", spec.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    assert!(ok, "{stderr}");
+    let map = out.join("map");
+    // A design of the sweep's grid: its tip is one of the map's.
+    let v = json(&["simulate", "--cable", "y=3,2.5,2.5,2.5,3 tension=1", "--cable", "y=-3,-3,-4,-3,-3 tension=0.4", "--json"]);
+    let tip = [v["tip_x_mm"].as_f64().unwrap(), v["tip_y_mm"].as_f64().unwrap(), v["tip_z_mm"].as_f64().unwrap()];
+    let targets = write(
+        dir.path(),
+        "t.toml",
+        &format!("[[target]]\nname = \"grid tip\"\ntip_mm = {tip:?}\n\n[[target]]\nname = \"sideways\"\ntip_mm = [5, 60, 0]\n\n[[target]]\nname = \"plane\"\ntip_mm = {{ x = {}, y = {} }}\n", tip[0], tip[1]),
+    );
+    let f = json(&["feasible", "--map", map.to_str().unwrap(), "--targets", &targets, "--nearest", "3", "--json"]);
+    assert_eq!(f["cables"], 2, "{f}");
+    let t = f["targets"].as_array().unwrap();
+    assert_eq!(t[0]["tip"]["verdict"], "reached", "{f}");
+    assert_eq!(t[0]["tip"]["table"], "3d");
+    assert!(t[0]["tip"]["count"].as_i64().unwrap() >= 1);
+    assert_eq!(t[1]["tip"]["verdict"], "not_reached", "{f}");
+    assert_eq!((t[2]["tip"]["verdict"].as_str(), t[2]["tip"]["table"].as_str()), (Some("reached"), Some("xy")), "{f}");
+    let nearest = t[0]["planar"]["nearest"].as_array().unwrap();
+    assert_eq!(nearest.len(), 3);
+    for near in nearest {
+        assert_eq!(near["cables"].as_array().unwrap().len(), 2, "every cable of a nearest design: {near}");
+        assert!(near["command"].as_str().unwrap().starts_with("cablemap simulate"));
+    }
+    let (ok, text, stderr) = run(&["feasible", "--map", map.to_str().unwrap(), "--targets", &targets]);
+    assert!(ok && text.contains("grid tip   reached") && text.contains("sideways   not reached by the sweep"), "{text}{stderr}");
+    // The map's designs seed a design of the pair (channels free in y).
+    let pair = write(dir.path(), "pair.toml", "[[cable]]\ny_mm = [3, 3, 3, 3, 3]\nfree = [\"y\"]\n\n[[cable]]\ny_mm = [-3, -3, -3, -3, -3]\nfree = [\"y\"]\n");
+    let one = write(dir.path(), "one.toml", &format!("[[target]]\ntip_mm = {tip:?}\n"));
+    let d = json(&["design", "--actuator", &pair, "--targets", &one, "--map", map.to_str().unwrap(), "--json"]);
+    assert!(d["starts"].as_array().unwrap().iter().any(|s| s["source"] == "map"), "{d}");
+    assert_eq!(d["met"], true, "{d}");
+    assert!(d["targets"][0]["tip_error_mm"].as_f64().unwrap() < 1e-3, "{d}");
+}

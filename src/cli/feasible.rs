@@ -17,8 +17,14 @@ pub struct FeasibleArgs {
     pub study: Option<PathBuf>,
     /// Target, any subset of x, y (tip, mm) and a0, a1, … (1/mm),
     /// e.g. x=50,y=5,a0=-0.025,a1=-0.06,a2=0.015.
-    #[arg(long, value_name = "K=V,…", allow_hyphen_values = true)]
-    pub target: String,
+    #[arg(long, value_name = "K=V,…", allow_hyphen_values = true, required_unless_present = "targets", conflicts_with = "targets")]
+    pub target: Option<String>,
+    /// A targets file of a several-cable design (`design --targets`): with the
+    /// map of a cable sweep, whether its sweep reached each target's tip
+    /// (voxels, plane cells) and, in the plane, its coefficient ranges and
+    /// nearest designs with every cable.
+    #[arg(long, value_name = "FILE.toml", requires = "map")]
+    pub targets: Option<PathBuf>,
     /// Weights λ for the distance to the nearest designs [defaults x=1,y=1,a0=100,a1=50,a2=25].
     #[arg(long, value_name = "K=V,…")]
     pub weights: Option<String>,
@@ -34,7 +40,22 @@ pub struct FeasibleArgs {
 
 /// Runs `cablemap feasible`.
 pub fn run(args: &FeasibleArgs) -> anyhow::Result<()> {
-    let target = Target::parse(&args.target)?;
+    if let (Some(file), Some(map)) = (&args.targets, &args.map) {
+        anyhow::ensure!(args.weights.is_none(), "--weights does not apply to --targets: give weights = {{ … }} in each [[target]]");
+        // The rod's length only sets default weights; the map's own rod is the thesis's unless its spec says otherwise.
+        let length_mm = cablemap::model::Rod::default().length_mm;
+        let targets = cablemap::design::cables::targets::TargetSet::read(file, length_mm).map_err(|e| anyhow::Error::new(e).context("--targets"))?;
+        let report = cablemap::design::cables::feasible::check(map, &targets, args.basis.length_basis, args.nearest)?;
+        let stdout = std::io::stdout();
+        let mut out = stdout.lock();
+        if args.json {
+            writeln!(out, "{}", serde_json::to_value(&report)?)?;
+        } else {
+            write!(out, "{report}")?;
+        }
+        return Ok(());
+    }
+    let target = Target::parse(args.target.as_deref().unwrap_or_default())?;
     let weights = match &args.weights {
         Some(w) => Weights::parse(w)?,
         None => Weights::default(),

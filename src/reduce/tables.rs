@@ -474,3 +474,48 @@ pub fn read_designs(dir: &Path, order: usize) -> Result<Vec<Design>, ReadError> 
     }
     Ok(out)
 }
+
+/// The reach of a cable sweep's map, as its reach tables hold it.
+#[derive(Debug, Clone)]
+pub struct ReachTables {
+    /// `summary.json`.
+    pub summary: CableMapSummary,
+    /// Solved tips per cell of the x–y, x–z and y–z planes (cell indices along the plane's axes).
+    pub planes: [std::collections::BTreeMap<[i32; 2], i64>; 3],
+    /// Solved tips per voxel (indices along x, y, z).
+    pub voxels: std::collections::BTreeMap<[i32; 3], i64>,
+}
+
+/// Reads a cable sweep map's `summary.json` and reach tables ([`REACH_FILES`]).
+pub fn read_reach(dir: &Path) -> Result<ReachTables, ReadError> {
+    let path = dir.join(SUMMARY_FILE);
+    let text = crate::io::read_utf8(&path).map_err(|e| read_error(&path, format!("cannot read ({e}); give the map directory of a cable sweep (`cablemap map` of a spec with [[cable]] tables)")))?;
+    let summary: CableMapSummary = serde_json::from_str(&text)
+        .ok()
+        .filter(|s: &CableMapSummary| s.kind == "cables")
+        .ok_or_else(|| read_error(&path, "is not the summary of a cable sweep's map (kind = \"cables\"): give the map of a cable sweep"))?;
+    if !(summary.cell_mm > 0.0 && summary.cell_mm.is_finite()) {
+        return Err(read_error(&path, format!("cell_mm must be positive, got {}", summary.cell_mm)));
+    }
+    let mut planes: [std::collections::BTreeMap<[i32; 2], i64>; 3] = Default::default();
+    for (k, ((_, axes), file)) in PLANES.iter().zip(REACH_FILES.iter()).enumerate() {
+        let path = dir.join(file);
+        for batch in read_batches(&path)? {
+            let c = Columns { path: &path, batch: &batch };
+            let (a, b, count) = (c.i32(&format!("i{}", axes[0]))?, c.i32(&format!("i{}", axes[1]))?, c.i64("count")?);
+            for r in 0..batch.num_rows() {
+                planes[k].insert([a[r], b[r]], count[r]);
+            }
+        }
+    }
+    let mut voxels = std::collections::BTreeMap::new();
+    let path = dir.join(REACH_FILES[3]);
+    for batch in read_batches(&path)? {
+        let c = Columns { path: &path, batch: &batch };
+        let (x, y, z, count) = (c.i32("ix")?, c.i32("iy")?, c.i32("iz")?, c.i64("count")?);
+        for r in 0..batch.num_rows() {
+            voxels.insert([x[r], y[r], z[r]], count[r]);
+        }
+    }
+    Ok(ReachTables { summary, planes, voxels })
+}

@@ -8,10 +8,11 @@ use super::super::map::{map_error, MapDir};
 use super::super::DesignError;
 use std::path::Path;
 
-/// Opens `dir`, or its `planar/` map (the layout `cablemap map` writes for a cable sweep).
+/// Opens the planar map of a cable sweep's map `dir` (its `planar/` folder, which
+/// holds the designs), or `dir` itself.
 pub fn open(dir: &Path) -> Result<MapDir, DesignError> {
     let planar = dir.join("planar");
-    if !dir.join("summary.json").exists() && planar.join("summary.json").exists() {
+    if planar.join("summary.json").exists() {
         MapDir::open(&planar)
     } else {
         MapDir::open(dir)

@@ -14,6 +14,7 @@
 //! ([`super::optimise::design`], the same answers as `design --target`).
 
 pub mod export;
+pub mod feasible;
 pub mod map;
 pub mod search;
 pub mod spec;
