@@ -13,8 +13,17 @@ use std::path::PathBuf;
 /// Arguments of `cablemap diagnose`.
 #[derive(Debug, Clone, Args)]
 pub struct DiagnoseArgs {
-    /// Measurement file (CSV, or Parquet by its .parquet extension); see docs/measurements.md.
+    /// Measurement file (CSV, or Parquet by its .parquet extension); with --actuator, the captures
+    /// file (one tension_K_n or displacement_K_mm column per cable); see docs/measurements.md.
     pub data: PathBuf,
+    /// A whole actuator (rod, torsion, gravity, cables) as TOML: diagnose several-cable captures
+    /// against 3-D markers (--markers) with the 3-D solver.
+    #[arg(long = "actuator", value_name = "FILE.toml")]
+    pub spatial_actuator: Option<PathBuf>,
+    /// With --actuator: fit on the captures where cable K does not pull; the gap on the others
+    /// is shown before and after.
+    #[arg(long, value_name = "K")]
+    pub holdout_cable: Option<usize>,
     /// Routing left out of every fit; the gap on it is shown before and after.
     #[arg(long, value_name = "ROUTING")]
     pub holdout: Option<String>,
@@ -50,6 +59,10 @@ pub struct DiagnoseArgs {
 
 /// Runs `cablemap diagnose`.
 pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
+    if let Some(actuator) = &args.spatial_actuator {
+        return run_captures(args, actuator);
+    }
+    anyhow::ensure!(args.holdout_cable.is_none(), "--holdout-cable holds out a cable's captures: give the actuator with --actuator FILE.toml");
     let request = DiagnoseRequest {
         data_path: args.data.clone(),
         actuator: args.actuator.overrides(),
@@ -66,6 +79,40 @@ pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
         CalibrateError::ReportDir(_) => anyhow::Error::new(e).context("--out"),
         e => with_flag(e, false),
     })?;
+    let stdout = std::io::stdout();
+    let mut out = stdout.lock();
+    if args.json {
+        writeln!(out, "{}", report.to_json_line())?;
+    } else {
+        write!(out, "{report}")?;
+    }
+    Ok(())
+}
+
+/// The 3-D route of `cablemap diagnose` (`--actuator FILE.toml`).
+fn run_captures(args: &DiagnoseArgs, actuator: &std::path::Path) -> anyhow::Result<()> {
+    use cablemap::calibrate::captures::diagnose::{diagnose_request, Diagnose3Request};
+    anyhow::ensure!(args.holdout.is_none(), "--holdout takes a routing of planar data; with --actuator, hold out a cable's captures by --holdout-cable K");
+    anyhow::ensure!(args.fit.centrelines.is_none(), "--centrelines: planar centreline points; with --actuator, give 3-D markers by --markers");
+    anyhow::ensure!(!args.actuator.sets_the_rod(), "with --actuator the rod and its effects come from FILE.toml's [rod] table; edit it instead of giving rod flags");
+    anyhow::ensure!(args.fit.fix.is_empty(), "--fix with --actuator: set the value in FILE.toml instead (a diagnosis fits the body the data determine)");
+    anyhow::ensure!(args.fit.noise_mm.is_finite() && args.fit.noise_mm > 0.0, "--noise-mm {}: the markers' noise must be a standard deviation > 0 mm", args.fit.noise_mm);
+    anyhow::ensure!(args.fit.max_iterations > 0, "--max-iterations must be at least 1");
+    let request = Diagnose3Request {
+        captures: args.data.clone(),
+        markers: args.fit.markers.clone(),
+        actuator: actuator.to_path_buf(),
+        noise_mm: args.fit.noise_mm,
+        loss: args.fit.loss("squares")?,
+        max_iterations: args.fit.max_iterations,
+        holdout_cable: args.holdout_cable,
+        alpha: args.alpha,
+        threshold: args.threshold,
+        margin: args.margin,
+        max_effects: args.max_effects,
+        options: super::calibrate::spatial_options(&args.actuator),
+    };
+    let report = diagnose_request(&request).map_err(|e| with_flag(e, false))?;
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
     if args.json {

@@ -17,6 +17,7 @@ use super::files::CaptureSet;
 use super::simulate::{solve_captures, CaptureSolution};
 use crate::calibrate::fit::Loss;
 use crate::calibrate::{stats, CalibrateError, Effect};
+use crate::model::effects::Domain;
 use crate::model::spatial::SpatialOptions;
 use crate::model::Actuator;
 use crate::numerics::lm;
@@ -151,6 +152,9 @@ pub enum Status {
     Fitted,
     /// Asked for, but the data do not determine it: held at its start.
     Undetermined,
+    /// An effect run to a bound of its search range (toward its thesis
+    /// value, or past any plausible size): the data do not call for it.
+    AtBound,
 }
 
 /// One parameter of a 3-D fit.
@@ -308,6 +312,12 @@ const ENOUGH_REDUCTION: f64 = 1e-6;
 
 /// Parameters may move this factor either way from their start.
 const RANGE: f64 = 100.0;
+/// A positive effect parameter may move this factor either way from its start.
+const EFFECT_RANGE: f64 = 1e4;
+/// Bound of a signed effect parameter (a channel offset in mm, a stiffness gradient's β).
+const EFFECT_SIGNED_BOUND: f64 = 10.0;
+/// Bound of a fraction's logit (f from 3e-7 to 1 − 3e-7).
+const EFFECT_LOGIT_BOUND: f64 = 15.0;
 /// A fitted parameter whose standard error in its log spans more than this
 /// (a factor e) is undetermined.
 const UNDETERMINED_LOG_SE: f64 = 1.0;
@@ -342,7 +352,14 @@ pub fn fit_captures(base: &Actuator, set: &CaptureSet, spec: &Fit3Spec, observe:
         .iter()
         .zip(&start)
         .map(|(p, &x)| match p {
-            Param::Effect(_) => (-50.0, 50.0),
+            // An effect that the data do not call for runs toward its
+            // thesis value (0, or an infinitely stiff clamp): bounded near
+            // where it no longer matters, so the fit does not spend steps on the way.
+            Param::Effect(e) => match e.fit().domain {
+                Domain::Signed => (-EFFECT_SIGNED_BOUND, EFFECT_SIGNED_BOUND),
+                Domain::Fraction => (-EFFECT_LOGIT_BOUND, EFFECT_LOGIT_BOUND),
+                Domain::Positive => (x - EFFECT_RANGE.ln(), x + EFFECT_RANGE.ln()),
+            },
             _ => (x - RANGE.ln(), x + RANGE.ln()),
         })
         .collect();
@@ -391,13 +408,13 @@ pub fn fit_captures(base: &Actuator, set: &CaptureSet, spec: &Fit3Spec, observe:
             .iter()
             .enumerate()
             .filter(|&(k, &idx)| {
+                if matches!(params[idx], Param::Effect(_)) {
+                    // Reported at its bound, not held: see `Status::AtBound`.
+                    return false;
+                }
                 let (lo, hi) = bounds[idx];
                 let at_bound = x[idx] <= lo + 1e-9 || x[idx] >= hi - 1e-9;
-                let se = cov.as_ref().map_or(f64::INFINITY, |c| c[(k, k)].max(0.0).sqrt());
-                let log_se = match params[idx] {
-                    Param::Effect(_) => 0.0,
-                    _ => se,
-                };
+                let log_se = cov.as_ref().map_or(f64::INFINITY, |c| c[(k, k)].max(0.0).sqrt());
                 at_bound || !(log_se <= UNDETERMINED_LOG_SE)
             })
             .map(|(_, &idx)| idx)
@@ -433,7 +450,11 @@ pub fn fit_captures(base: &Actuator, set: &CaptureSet, spec: &Fit3Spec, observe:
                 value: param.from_internal(x[k]),
                 start: param.from_internal(start[k]),
                 se: if fitted { param.derivative(x[k]).abs() * v.max(0.0).sqrt() } else { f64::NAN },
-                status: if fitted { Status::Fitted } else { Status::Undetermined },
+                status: match (fitted, param) {
+                    (false, _) => Status::Undetermined,
+                    (true, Param::Effect(_)) if x[k] <= bounds[k].0 + 1e-9 || x[k] >= bounds[k].1 - 1e-9 => Status::AtBound,
+                    _ => Status::Fitted,
+                },
             }
         })
         .collect();

@@ -9,7 +9,9 @@
 //! - [`fit`]: the fit of rigidities, weight and effects.
 //! - [`synth`]: synthetic captures with a hidden effect and noise.
 //! - [`run`]: the `predict` and `calibrate` requests and their reports.
+//! - [`diagnose`]: the planar diagnosis's verdicts over the registry's effects in 3-D.
 
+pub mod diagnose;
 pub mod errors;
 pub mod files;
 pub mod fit;
@@ -17,6 +19,7 @@ pub mod run;
 pub mod simulate;
 pub mod synth;
 
+pub use diagnose::{diagnose_captures, diagnose_request, Diagnose3Request, Diagnose3Spec, Diagnosis3};
 pub use errors::ErrorReport;
 pub use files::{read_capture_set, Actuation, Capture, CaptureSet, MarkerReading};
 pub use fit::{fit_captures, Fit3Result, Fit3Spec, Param};

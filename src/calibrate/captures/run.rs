@@ -163,6 +163,7 @@ pub fn calibrated_toml(report: &Calibrate3Report, source: &Path) -> Result<Strin
         match p.status {
             Status::Fitted => head.push_str(&format!("#   {} = {} ± {}\n", p.name, p.value, crate::io::fmt_sig(p.se, 3))),
             Status::Undetermined => head.push_str(&format!("#   {} = {} (undetermined by the data: held at its start)\n", p.name, p.value)),
+            Status::AtBound => head.push_str(&format!("#   {} = {} (run to the bound of its range: the data do not call for it)\n", p.name, p.value)),
         }
     }
     head.push_str(&format!("#   marker RMS {:.3} mm; χ²/dof {:.3}\n", report.fit.errors.rms_mm, report.fit.reduced_chi2));
@@ -258,6 +259,7 @@ impl fmt::Display for Calibrate3Report {
             match p.status {
                 Status::Fitted => writeln!(out, "  {:<24} {:>14.6} ± {:<10}  (start {})", p.name, p.value, crate::io::fmt_sig(p.se, 3), crate::io::fmt_sig(p.start, 6))?,
                 Status::Undetermined => writeln!(out, "  {:<24} {:>14.6}   undetermined by these data: held at its start", p.name, p.value)?,
+                Status::AtBound => writeln!(out, "  {:<24} {:>14.6}   at the bound of its range: the data do not call for it", p.name, p.value)?,
             }
         }
         for (name, v) in &self.held {

@@ -7,9 +7,9 @@
 //! extrapolation from the chain's previous ones (a few Newton steps instead
 //! of a ladder from the straight rod). A protocol (load, unload, rest rows)
 //! is one chain in step order, its hold (friction's direction, creep's
-//! dwell) following the rows. With creep on, static captures are solved one
-//! by one from a virgin rod, as their independence demands. Chains run in
-//! parallel.
+//! dwell) following the rows. Static captures are each held from a virgin
+//! rod (creep's history does not carry over; only the warm start does), as
+//! their independence demands. Chains run in parallel.
 
 use super::files::{Actuation, Capture, CaptureSet, MarkerReading};
 use crate::calibrate::data::Direction;
@@ -45,15 +45,12 @@ fn markers_on(solver: &SpatialSolver, markers: &[MarkerReading], length_mm: f64)
 }
 
 /// The chains: lists of capture indices solved in order by one solver.
-fn chains(actuator: &Actuator, captures: &[Capture]) -> Vec<Vec<usize>> {
+fn chains(captures: &[Capture]) -> Vec<Vec<usize>> {
     let protocol = captures.iter().any(|c| c.direction != Direction::Static);
     if protocol {
         let mut order: Vec<usize> = (0..captures.len()).collect();
         order.sort_by_key(|&i| captures[i].step);
         return vec![order];
-    }
-    if actuator.rod.effects.creep_fraction > 0.0 {
-        return (0..captures.len()).map(|i| vec![i]).collect();
     }
     let mut groups: Vec<(Vec<usize>, Vec<usize>)> = Vec::new();
     for (i, c) in captures.iter().enumerate() {
@@ -67,10 +64,32 @@ fn chains(actuator: &Actuator, captures: &[Capture]) -> Vec<Vec<usize>> {
         .into_iter()
         .map(|(_, mut list)| {
             list.sort_by(|&a, &b| captures[a].magnitude().total_cmp(&captures[b].magnitude()));
-            list
+            // From the smallest, each next capture the nearest in actuation
+            // (one cable's ladder stays in order; pairs of cables are not
+            // crossed in long jumps).
+            let mut ordered = vec![list.remove(0)];
+            while !list.is_empty() {
+                let last = &captures[*ordered.last().expect("not empty")];
+                let distance = |i: usize| {
+                    let c = &captures[i];
+                    c.actuation.iter().zip(&last.actuation).map(|(a, b)| {
+                        let (Actuation::Tension(x) | Actuation::Displacement(x)) = a;
+                        let (Actuation::Tension(y) | Actuation::Displacement(y)) = b;
+                        (x - y).abs()
+                    }).fold(0.0, f64::max)
+                };
+                let k = (0..list.len()).min_by(|&a, &b| distance(list[a]).total_cmp(&distance(list[b]))).expect("not empty");
+                ordered.push(list.remove(k));
+            }
+            ordered
         })
         .collect()
 }
+
+/// Largest change of any cable's tension from one solve of a chain to the
+/// next, N: beyond it the chain steps in rungs (a failed jump would cost a
+/// ladder from the straight rod).
+const MAX_JUMP_N: f64 = 2.0;
 
 /// The hold a capture is read at.
 fn hold_of(c: &Capture) -> Hold {
@@ -113,25 +132,46 @@ fn solve_chain(actuator: &Actuator, options: &SpatialOptions, set: &CaptureSet, 
     let mut tensions = vec![0.0; actuator.cables.len()];
     let mut out = Vec::with_capacity(chain.len());
     let no_markers = Vec::new();
+    let mut previous: Option<Vec<f64>> = None;
     for &i in chain {
         let c = &set.captures[i];
         let fail = |failure: SpatialError| CalibrateError::Capture { measurement: c.measurement, row: c.row, failure };
         // Friction's direction and creep's dwell matter only with those effects on.
         let hold = hold_of(c);
-        if protocol || solver.hold() != hold {
-            solver.set_hold(hold).map_err(fail)?;
+        let set_hold = |solver: &mut SpatialSolver, hold: Hold| if protocol { solver.set_hold(hold) } else { solver.set_independent_hold(hold) };
+        set_hold(&mut solver, hold).map_err(fail)?;
+        // A long jump from the previous capture's tensions leaves the warm
+        // start's basin: cross it in rungs of at most MAX_JUMP_N (static
+        // captures only: in a protocol every solve is part of the history).
+        let target = c.tensions_n();
+        let all_tension = c.actuation.iter().all(|a| matches!(a, Actuation::Tension(_)));
+        if let (false, true, Some(prev)) = (protocol, all_tension, previous.as_ref()) {
+            let jump = target.iter().zip(prev).map(|(a, b): (&f64, &f64)| (a - b).abs()).fold(0.0, f64::max);
+            let rungs = (jump / MAX_JUMP_N).ceil() as usize;
+            if rungs > 1 {
+                set_hold(&mut solver, Hold { direction: hold.direction, dwell_s: 0.0 }).map_err(fail)?;
+                for k in 1..rungs {
+                    let f = k as f64 / rungs as f64;
+                    let t: Vec<f64> = prev.iter().zip(&target).map(|(a, b)| a + (b - a) * f).collect();
+                    if solver.solve(&t).is_err() {
+                        break;
+                    }
+                }
+                set_hold(&mut solver, hold).map_err(fail)?;
+            }
         }
+        previous = Some(target);
         let pose = match solve_at(&mut solver, c, 1.0, &mut tensions) {
             Ok(p) => p,
             Err(_) => {
                 // Out of the warm start's basin: climb from the straight rod
                 // in small rungs without dwell (which leaves creep's history alone).
                 let n = rungs(c);
-                solver.set_hold(Hold { direction: hold.direction, dwell_s: 0.0 }).map_err(fail)?;
+                set_hold(&mut solver, Hold { direction: hold.direction, dwell_s: 0.0 }).map_err(fail)?;
                 for k in 1..n {
                     solve_at(&mut solver, c, k as f64 / n as f64, &mut tensions).map_err(fail)?;
                 }
-                solver.set_hold(hold).map_err(fail)?;
+                set_hold(&mut solver, hold).map_err(fail)?;
                 solve_at(&mut solver, c, 1.0, &mut tensions).map_err(fail)?
             }
         };
@@ -146,7 +186,7 @@ fn solve_chain(actuator: &Actuator, options: &SpatialOptions, set: &CaptureSet, 
 /// discretisation does not resolve is solved again at twice the collocation
 /// intervals (up to the most there are), as single solves are.
 pub fn solve_captures(actuator: &Actuator, options: &SpatialOptions, set: &CaptureSet) -> Result<Vec<CaptureSolution>, CalibrateError> {
-    let chains = chains(actuator, &set.captures);
+    let chains = chains(&set.captures);
     let solved: Vec<Vec<(usize, CaptureSolution)>> = chains
         .par_iter()
         .map(|chain| {

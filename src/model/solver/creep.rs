@@ -81,6 +81,12 @@ impl Creep {
         self.virgin_holds = false;
     }
 
+    /// From now on every solve starts from a rod with no load history
+    /// (independent captures), as before [`Creep::follow_protocol`].
+    pub(crate) fn start_each_solve_virgin(&mut self) {
+        self.virgin_holds = true;
+    }
+
     /// Before a solve: outside a protocol the rod starts as new.
     pub(crate) fn begin_solve(&mut self) {
         if self.virgin_holds && self.fraction > 0.0 {

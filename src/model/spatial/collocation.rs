@@ -542,6 +542,21 @@ impl SpatialSolver {
         Ok(())
     }
 
+    /// Like [`SpatialSolver::set_hold`] for independent captures: each of
+    /// the next solves is reached in `hold.direction` and held `hold.dwell_s`
+    /// from a rod with no load history (creep's history does not carry
+    /// over from solve to solve; the warm start does).
+    pub fn set_independent_hold(&mut self, hold: Hold) -> Result<(), SpatialError> {
+        if !(hold.dwell_s.is_finite() && hold.dwell_s >= 0.0) {
+            return Err(SpatialError::Option(format!("dwell_s = {} must be a finite time ≥ 0 s", hold.dwell_s)));
+        }
+        self.creep.start_each_solve_virgin();
+        self.creep.set_dwell(hold.dwell_s);
+        self.signed_mu = self.rod.effects.friction_mu * hold.direction.slip_sign();
+        self.hold = hold;
+        Ok(())
+    }
+
     /// The hold of the next solves.
     pub fn hold(&self) -> Hold {
         self.hold

@@ -1,0 +1,645 @@
+//! The model-discrepancy workflow for captures with 3-D markers: the
+//! planar diagnosis's verdicts (`none`, a named effect with its parameter,
+//! `ambiguous`, `unexplained` with the residual's signature,
+//! `inconclusive`) over the registry's effects in their 3-D form, by the
+//! same rule ([`crate::calibrate::diagnose::analysis`]):
+//!
+//! 1. Fit the body (the rigidities and the weight the data determine) on
+//!    the fitted captures (all, or those where the held-out cable does not
+//!    pull).
+//! 2. Refit with each candidate effect, from the baseline's optimum; an
+//!    effect is named when its fit lowers the BIC by at least `threshold`
+//!    against the model without it, leads the runner-up by at least
+//!    `margin`, converged and has a plausible value; forward-stepwise, at
+//!    most `max_effects`.
+//! 3. Adequacy by the χ² of the noise-whitened marker coordinates: `none`
+//!    only when the body fit is consistent with the noise (p ≥ `alpha`) and
+//!    no effect is warranted; `unexplained` when even the best model with
+//!    one or two library effects stays above the noise; `inconclusive`
+//!    when the body fit did not converge.
+//!
+//! Gravity's scale is no candidate when the density is fitted: the two
+//! scale the same weight.
+
+use super::errors::ErrorReport;
+use super::files::CaptureSet;
+use super::fit::{fit_captures, Fit3Result, Fit3Spec, Param, Status};
+use super::simulate::solve_captures;
+use crate::calibrate::diagnose::Verdict;
+use crate::calibrate::{stats, CalibrateError, Effect};
+use crate::model::Actuator;
+use rayon::prelude::*;
+use serde::Serialize;
+use std::collections::BTreeMap;
+
+/// Settings of a 3-D diagnosis.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Diagnose3Spec {
+    /// The body parameters to fit and the fit's settings (its `params` are
+    /// the body's; the candidates are added to them).
+    pub fit: Fit3Spec,
+    /// Captures in which this cable (1-based) pulls are held out.
+    pub holdout_cable: Option<usize>,
+    /// Required BIC decrease against the model without the effect.
+    pub threshold: f64,
+    /// Required BIC lead over the runner-up.
+    pub margin: f64,
+    /// Most effects added.
+    pub max_effects: usize,
+    /// Consistent with the noise when P(χ²_dof ≥ χ²) ≥ alpha.
+    pub alpha: f64,
+}
+
+impl Default for Diagnose3Spec {
+    fn default() -> Self {
+        Self { fit: Fit3Spec::default(), holdout_cable: None, threshold: 10.0, margin: 10.0, max_effects: 2, alpha: 1e-3 }
+    }
+}
+
+/// One candidate effect refitted with the body.
+#[derive(Debug, Clone, Serialize)]
+pub struct Candidate3 {
+    /// Rank (1 = lowest BIC).
+    pub rank: usize,
+    /// The effect.
+    pub effect: Effect,
+    /// Parameter name with unit.
+    pub parameter_name: &'static str,
+    /// Fitted value (NaN if the fit failed).
+    pub parameter: f64,
+    /// Its standard error.
+    pub parameter_se: f64,
+    /// BIC change against the model without it (negative: better).
+    pub delta_bic: f64,
+    /// RMS of the 3-D marker errors, mm.
+    pub rms_mm: f64,
+    /// χ², dof, χ²/dof, p.
+    pub chi2: f64,
+    /// Degrees of freedom.
+    pub dof: usize,
+    /// χ²/dof.
+    pub reduced_chi2: f64,
+    /// P(χ²_dof ≥ χ²).
+    pub p_value: f64,
+    /// Whether the fit converged.
+    pub converged: bool,
+    /// Whether its value is plausible and determined.
+    pub plausible: bool,
+    /// Why the fit failed, if it did.
+    pub error: Option<String>,
+}
+
+impl Candidate3 {
+    /// Whether this fit counts as evidence.
+    pub fn counts(&self) -> bool {
+        self.error.is_none() && self.converged && self.plausible && self.delta_bic.is_finite()
+    }
+}
+
+/// An effect of the final model.
+#[derive(Debug, Clone, Serialize)]
+pub struct Named3 {
+    /// The effect.
+    pub effect: Effect,
+    /// Parameter name.
+    pub parameter_name: &'static str,
+    /// Fitted value.
+    pub parameter: f64,
+    /// Standard error.
+    pub parameter_se: f64,
+    /// BIC change that admitted it.
+    pub delta_bic: f64,
+}
+
+/// A fit in brief, for the report.
+#[derive(Debug, Clone, Serialize)]
+pub struct FitSummary {
+    /// The model: the body and its effects.
+    pub model: String,
+    /// Parameters (name, value, SE, status).
+    pub parameters: Vec<super::fit::Fitted3>,
+    /// χ².
+    pub chi2: f64,
+    /// Degrees of freedom.
+    pub dof: usize,
+    /// χ²/dof.
+    pub reduced_chi2: f64,
+    /// P(χ²_dof ≥ χ²).
+    pub p_value: f64,
+    /// BIC.
+    pub bic: f64,
+    /// RMS of the 3-D marker errors, mm.
+    pub rms_mm: f64,
+    /// Per marker, mm.
+    pub rms_by_marker_mm: BTreeMap<String, f64>,
+    /// Whether it converged.
+    pub converged: bool,
+    /// Iterations.
+    pub iterations: usize,
+}
+
+fn model_name(effects: &[Effect]) -> String {
+    if effects.is_empty() {
+        "the body (rigidities and weight)".into()
+    } else {
+        format!("the body with {}", effects.iter().map(|e| e.name()).collect::<Vec<_>>().join(" and "))
+    }
+}
+
+fn summary(f: &Fit3Result, effects: &[Effect]) -> FitSummary {
+    FitSummary {
+        model: model_name(effects),
+        parameters: f.parameters.clone(),
+        chi2: f.chi2,
+        dof: f.dof,
+        reduced_chi2: f.reduced_chi2,
+        p_value: f.p_value,
+        bic: f.bic,
+        rms_mm: f.errors.rms_mm,
+        rms_by_marker_mm: f.errors.rms_by_marker_mm.clone(),
+        converged: f.converged,
+        iterations: f.iterations,
+    }
+}
+
+/// Where the best model's residuals sit, when no library effect explains them.
+#[derive(Debug, Clone, Serialize)]
+pub struct Signature3 {
+    /// The model described.
+    pub model: String,
+    /// RMS per marker, mm.
+    pub rms_by_marker_mm: BTreeMap<String, f64>,
+    /// RMS of the captures grouped by the cables that pull (`1`, `2`, `1+2`, `none`), mm.
+    pub rms_by_cables_mm: BTreeMap<String, f64>,
+    /// Mean residual (simulated − measured) per marker, x y z, mm: a systematic offset.
+    pub mean_residual_by_marker_mm: BTreeMap<String, [f64; 3]>,
+    /// The same in words.
+    pub summary: Vec<String>,
+}
+
+fn signature(set: &CaptureSet, f: &Fit3Result, effects: &[Effect]) -> Signature3 {
+    let mut by_cables: BTreeMap<String, Vec<f64>> = BTreeMap::new();
+    let mut sums: BTreeMap<String, ([f64; 3], usize)> = BTreeMap::new();
+    for (c, e) in set.captures.iter().zip(&f.errors.captures) {
+        let cables = c.pulling_cables();
+        let key = if cables.is_empty() { "none".into() } else { cables.iter().map(|k| k.to_string()).collect::<Vec<_>>().join("+") };
+        by_cables.entry(key).or_default().extend(e.markers.iter().map(|m| m.error_mm));
+        for m in &e.markers {
+            let s = sums.entry(m.marker.clone()).or_insert(([0.0; 3], 0));
+            for k in 0..3 {
+                s.0[k] += m.residual_mm[k];
+            }
+            s.1 += 1;
+        }
+    }
+    let rms = |v: &[f64]| (v.iter().map(|x| x * x).sum::<f64>() / v.len().max(1) as f64).sqrt();
+    let rms_by_cables_mm: BTreeMap<String, f64> = by_cables.iter().map(|(k, v)| (k.clone(), rms(v))).collect();
+    let mean_residual_by_marker_mm: BTreeMap<String, [f64; 3]> = sums.into_iter().map(|(k, (s, n))| (k, s.map(|v| v / n as f64))).collect();
+    let mut summary = Vec::new();
+    if let Some((worst, v)) = f.errors.rms_by_marker_mm.iter().max_by(|a, b| a.1.total_cmp(b.1)) {
+        summary.push(format!("the largest error is at marker {worst} ({v:.2} mm RMS; all markers {:.2} mm)", f.errors.rms_mm));
+    }
+    for (k, m) in &mean_residual_by_marker_mm {
+        let norm = m.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let r = f.errors.rms_by_marker_mm.get(k).copied().unwrap_or(0.0);
+        if norm > 0.5 * r && norm > 3.0 * f.noise_mm {
+            summary.push(format!("marker {k} is off by a systematic ({:.2}, {:.2}, {:.2}) mm in every capture (a misplaced marker or a frame offset?)", m[0], m[1], m[2]));
+        }
+    }
+    if rms_by_cables_mm.len() > 1 {
+        let parts: Vec<String> = rms_by_cables_mm.iter().map(|(k, v)| format!("cable(s) {k}: {v:.2} mm")).collect();
+        summary.push(format!("by the cables that pull: {}", parts.join(", ")));
+    }
+    Signature3 { model: model_name(effects), rms_by_marker_mm: f.errors.rms_by_marker_mm.clone(), rms_by_cables_mm, mean_residual_by_marker_mm, summary }
+}
+
+/// The outcome of a 3-D diagnosis; serialises to `diagnose --json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct Diagnosis3 {
+    /// The verdict's word.
+    pub verdict: Verdict,
+    /// Why, in one sentence.
+    pub reason: String,
+    /// The first named effect's parameter name, value and SE.
+    pub parameter_name: Option<&'static str>,
+    /// Its value.
+    pub parameter: Option<f64>,
+    /// Its SE.
+    pub parameter_se: Option<f64>,
+    /// The final model's effects in the order added.
+    pub effects: Vec<Named3>,
+    /// With `unexplained`: effects that lower the BIC but leave the fit above the noise.
+    pub partial_effects: Vec<Named3>,
+    /// The two effects the data cannot tell apart, if ambiguous.
+    pub ambiguous_between: Vec<Effect>,
+    /// The measurement that would separate them.
+    pub separating_measurement: Option<String>,
+    /// Ranked candidates of the first round.
+    pub candidates: Vec<Candidate3>,
+    /// Of the second round.
+    pub second_round: Vec<Candidate3>,
+    /// Candidates left out, and why.
+    pub not_candidates: Vec<String>,
+    /// The body fit.
+    pub baseline: FitSummary,
+    /// The final model's fit.
+    pub extended: FitSummary,
+    /// The residual's signature (with `unexplained`).
+    pub signature: Option<Signature3>,
+    /// The held-out cable.
+    pub holdout_cable: Option<usize>,
+    /// RMS of the held-out captures with the baseline and the final model, mm.
+    pub holdout_rms_before: Option<f64>,
+    /// After.
+    pub holdout_rms_after: Option<f64>,
+    /// The decision rule in words.
+    pub criterion: String,
+    /// The noise test's level.
+    pub alpha: f64,
+    /// Captures fitted.
+    pub captures_fitted: usize,
+    /// Wall time, s.
+    pub elapsed_s: f64,
+    /// The final model's actuator.
+    #[serde(skip)]
+    pub actuator: Actuator,
+}
+
+fn candidate(effect: Effect, reference_bic: f64, result: &Result<Fit3Result, CalibrateError>) -> Candidate3 {
+    match result {
+        Ok(f) => {
+            let p = f.parameter(Param::Effect(effect)).expect("fitted effect");
+            Candidate3 {
+                rank: 0,
+                effect,
+                parameter_name: effect.parameter_name(),
+                parameter: p.value,
+                parameter_se: p.se,
+                delta_bic: f.bic - reference_bic,
+                rms_mm: f.errors.rms_mm,
+                chi2: f.chi2,
+                dof: f.dof,
+                reduced_chi2: f.reduced_chi2,
+                p_value: f.p_value,
+                converged: f.converged,
+                plausible: p.status == Status::Fitted && effect.plausible(p.value) && p.se.is_finite(),
+                error: None,
+            }
+        }
+        Err(e) => Candidate3 {
+            rank: 0,
+            effect,
+            parameter_name: effect.parameter_name(),
+            parameter: f64::NAN,
+            parameter_se: f64::NAN,
+            delta_bic: f64::INFINITY,
+            rms_mm: f64::NAN,
+            chi2: f64::NAN,
+            dof: 0,
+            reduced_chi2: f64::NAN,
+            p_value: f64::NAN,
+            converged: false,
+            plausible: false,
+            error: Some(e.to_string()),
+        },
+    }
+}
+
+#[derive(Clone, Copy)]
+enum Decision {
+    None,
+    Named(Effect),
+    Ambiguous(Effect, Effect),
+}
+
+fn decide(ranked: &[Candidate3], spec: &Diagnose3Spec) -> Decision {
+    let ok: Vec<&Candidate3> = ranked.iter().filter(|c| c.counts()).collect();
+    let Some(best) = ok.first() else { return Decision::None };
+    if best.delta_bic > -spec.threshold {
+        return Decision::None;
+    }
+    match ok.get(1) {
+        Some(runner) if runner.delta_bic - best.delta_bic < spec.margin => Decision::Ambiguous(best.effect, runner.effect),
+        _ => Decision::Named(best.effect),
+    }
+}
+
+/// The state a round starts from: the reference fit and its effects.
+struct Round<'a> {
+    base: &'a Actuator,
+    set: &'a CaptureSet,
+    spec: &'a Diagnose3Spec,
+    body: Vec<Param>,
+    candidates: Vec<Effect>,
+}
+
+impl Round<'_> {
+    /// Every candidate not in `effects`, refitted with them from `reference`'s optimum.
+    fn run(&self, effects: &[Effect], reference: &Fit3Result) -> (Vec<Candidate3>, Vec<(Effect, Fit3Result)>) {
+        let todo: Vec<Effect> = self.candidates.iter().copied().filter(|e| !effects.contains(e)).collect();
+        let results: Vec<(Effect, Result<Fit3Result, CalibrateError>)> = todo
+            .par_iter()
+            .map(|&e| {
+                let mut params = self.body.clone();
+                params.extend(effects.iter().map(|&x| Param::Effect(x)));
+                params.push(Param::Effect(e));
+                // From the reference's optimum, the new effect at its start.
+                let mut start = reference.actuator.clone();
+                Param::Effect(e).set(&mut start, e.start());
+                let spec = Fit3Spec { params, ..self.spec.fit.clone() };
+                (e, fit_captures(&start, self.set, &spec, &mut |_| {}))
+            })
+            .collect();
+        let mut cands = Vec::new();
+        let mut fits = Vec::new();
+        for (e, r) in results {
+            cands.push(candidate(e, reference.bic, &r));
+            if let Ok(f) = r {
+                fits.push((e, f));
+            }
+        }
+        cands.sort_by(|a, b| a.delta_bic.total_cmp(&b.delta_bic));
+        for (k, c) in cands.iter_mut().enumerate() {
+            c.rank = k + 1;
+        }
+        let _ = self.base;
+        (cands, fits)
+    }
+}
+
+fn named(e: Effect, c: &Candidate3) -> Named3 {
+    Named3 { effect: e, parameter_name: e.parameter_name(), parameter: c.parameter, parameter_se: c.parameter_se, delta_bic: c.delta_bic }
+}
+
+fn fit_of(fits: &[(Effect, Fit3Result)], e: Effect) -> Fit3Result {
+    fits.iter().find(|(f, _)| *f == e).expect("a candidate that counts was fitted").1.clone()
+}
+
+fn chi2_text(f: &Fit3Result) -> String {
+    format!("χ² = {:.1} on {} dof, χ²/dof = {:.2}, {}", f.chi2, f.dof, f.reduced_chi2, stats::p_text(f.p_value))
+}
+
+/// Runs the 3-D diagnosis of `set` from the actuator `base`.
+pub fn diagnose_captures(base: &Actuator, set: &CaptureSet, spec: &Diagnose3Spec) -> Result<Diagnosis3, CalibrateError> {
+    let started = std::time::Instant::now();
+    if !(spec.alpha > 0.0 && spec.alpha < 1.0) {
+        return Err(CalibrateError::Invalid(format!("the noise test's level must lie in (0, 1), got {}", spec.alpha)));
+    }
+    let (train, test) = match spec.holdout_cable {
+        None => (set.clone(), None),
+        Some(k) => {
+            if k == 0 || k > base.cables.len() {
+                return Err(CalibrateError::Holdout(format!("cable {k}: the actuator has cables 1 to {}", base.cables.len())));
+            }
+            let train = set.subset(|c| !c.pulling_cables().contains(&k));
+            let test = set.subset(|c| c.pulling_cables().contains(&k));
+            if train.captures.is_empty() || test.captures.is_empty() {
+                return Err(CalibrateError::Holdout(format!("cable {k}: {} captures pull it and {} do not; holding it out needs both", test.captures.len(), train.captures.len())));
+            }
+            (train, Some(test))
+        }
+    };
+    let body: Vec<Param> = spec.fit.params.iter().copied().filter(|p| !matches!(p, Param::Effect(_))).collect();
+    let baseline = fit_captures(base, &train, &Fit3Spec { params: body.clone(), ..spec.fit.clone() }, &mut |_| {})?;
+    // The body parameters the baseline determined; undetermined ones stay held.
+    let body: Vec<Param> = baseline.parameters.iter().filter(|p| p.status == Status::Fitted).map(|p| p.param).collect();
+    let mut not_candidates = Vec::new();
+    let candidates: Vec<Effect> = Effect::ALL
+        .into_iter()
+        .filter(|&e| {
+            let keep = !(e == Effect::Gravity && body.contains(&Param::Density));
+            if !keep {
+                not_candidates.push(format!("{}: the density is fitted, and both scale the same weight", e.name()));
+            }
+            keep
+        })
+        .filter(|e| spec.fit.params.iter().all(|p| *p != Param::Effect(*e)))
+        .collect();
+    let round = Round { base, set: &train, spec, body, candidates };
+    let (first, fits) = round.run(&[], &baseline);
+    let mut effects: Vec<Named3> = Vec::new();
+    let mut partial_effects = Vec::new();
+    let mut ambiguous_between = Vec::new();
+    let mut separating_measurement = None;
+    let mut second_round = Vec::new();
+    let mut extended = baseline.clone();
+    let mut extended_effects: Vec<Effect> = Vec::new();
+    let mut verdict;
+    let decision = decide(&first, spec);
+    match decision {
+        Decision::None => verdict = Verdict::Consistent,
+        Decision::Ambiguous(a, b) => {
+            ambiguous_between = vec![a, b];
+            separating_measurement = Some(a.separating_measurement(b).to_string());
+            verdict = Verdict::Ambiguous(a, b);
+        }
+        Decision::Named(e) => {
+            let c = first.iter().find(|c| c.effect == e).expect("candidate");
+            effects.push(named(e, c));
+            extended = fit_of(&fits, e);
+            extended_effects = vec![e];
+            // A second effect only when the first leaves the fit above the noise.
+            if spec.max_effects > 1 && !extended.p_value.ge(&spec.alpha) {
+                let (cands2, fits2) = round.run(&[e], &extended);
+                if let Decision::Named(e2) = decide(&cands2, spec) {
+                    let f2 = fit_of(&fits2, e2);
+                    let c2 = cands2.iter().find(|c| c.effect == e2).expect("candidate");
+                    if let Some(p1) = f2.parameter(Param::Effect(e)) {
+                        effects[0].parameter = p1.value;
+                        effects[0].parameter_se = p1.se;
+                    }
+                    effects.push(named(e2, c2));
+                    extended = f2;
+                    extended_effects.push(e2);
+                }
+                second_round = cands2;
+            }
+            verdict = Verdict::Named(e);
+        }
+    }
+    let judged = match decision {
+        Decision::Ambiguous(a, _) => fit_of(&fits, a),
+        _ => extended.clone(),
+    };
+    let any_counts = first.iter().any(Candidate3::counts);
+    let reason;
+    let mut signature_of = None;
+    if !baseline.converged {
+        verdict = Verdict::Inconclusive;
+        effects.clear();
+        extended = baseline.clone();
+        extended_effects.clear();
+        reason = format!("the body fit did not converge ({}), so nothing can be concluded", baseline.termination);
+    } else if judged.p_value >= spec.alpha {
+        reason = match verdict {
+            Verdict::Consistent if !any_counts => {
+                verdict = Verdict::Inconclusive;
+                "the body fit is consistent with the noise, but no candidate fit converged to a plausible value, so no effect can be ruled out".to_string()
+            }
+            Verdict::Consistent => format!("the body (rigidities and weight) explains the markers to within the stated noise ({}) and no candidate effect is warranted", chi2_text(&baseline)),
+            Verdict::Ambiguous(..) => format!("two effects fit equally well and the better one is consistent with the noise ({})", chi2_text(&judged)),
+            _ => format!("{} explains the markers to within the stated noise ({})", model_name(&extended_effects), chi2_text(&extended)),
+        };
+    } else {
+        // Not explained: the effects that help are reported, named nowhere.
+        let mut best = judged.clone();
+        let mut best_effects = match decision {
+            Decision::Ambiguous(a, _) => vec![a],
+            _ => extended_effects.clone(),
+        };
+        if best_effects.is_empty() {
+            if let Some(c) = first.iter().find(|c| c.counts()) {
+                let f = fit_of(&fits, c.effect);
+                if f.chi2 < best.chi2 {
+                    best = f;
+                    best_effects = vec![c.effect];
+                }
+            }
+        }
+        partial_effects = std::mem::take(&mut effects);
+        if partial_effects.is_empty() {
+            if let Some(c) = first.iter().find(|c| c.counts() && c.delta_bic <= -spec.threshold) {
+                partial_effects.push(named(c.effect, c));
+            }
+        }
+        ambiguous_between.clear();
+        separating_measurement = None;
+        extended = baseline.clone();
+        extended_effects.clear();
+        verdict = Verdict::Unexplained;
+        reason = format!(
+            "even the best model tried ({}) stays above the stated noise: {}, below {:.0e} (chi-square test of the noise-whitened marker coordinates); the markers show something no candidate effect describes, or the noise is larger than stated",
+            model_name(&best_effects),
+            chi2_text(&best),
+            spec.alpha
+        );
+        signature_of = Some(signature(&train, &best, &best_effects));
+    }
+    let (holdout_rms_before, holdout_rms_after) = match &test {
+        Some(t) => {
+            let rms = |a: &Actuator| -> Result<f64, CalibrateError> { Ok(ErrorReport::of(t, &solve_captures(a, &spec.fit.options, t)?).rms_mm) };
+            (Some(rms(&baseline.actuator)?), Some(rms(&extended.actuator)?))
+        }
+        None => (None, None),
+    };
+    let first_named = effects.first();
+    let criterion = format!(
+        "residuals are the markers' 3-D errors over σ = √(sd² + {} mm²) per coordinate; adequacy: χ² of these against χ²_dof, consistent when p ≥ {:.0e}; \
+         `none` only when the body fit is consistent and a candidate fit converged, `unexplained` when the best model with one or two library effects has p < {:.0e}; \
+         an effect is named when refitting it with the body lowers the BIC (n ln(Σρ/n) + p ln n) by at least {} against the model without it, leads the runner-up \
+         by at least {} and has a plausible, determined value; effects are added forward-stepwise by the same rule (at most {}); only converged fits count",
+        spec.fit.noise_mm, spec.alpha, spec.alpha, spec.threshold, spec.margin, spec.max_effects
+    );
+    Ok(Diagnosis3 {
+        verdict,
+        reason,
+        parameter_name: first_named.map(|n| n.parameter_name),
+        parameter: first_named.map(|n| n.parameter),
+        parameter_se: first_named.map(|n| n.parameter_se),
+        effects,
+        partial_effects,
+        ambiguous_between,
+        separating_measurement,
+        candidates: first,
+        second_round,
+        not_candidates,
+        baseline: summary(&baseline, &[]),
+        extended: summary(&extended, &extended_effects),
+        signature: signature_of,
+        holdout_cable: spec.holdout_cable,
+        holdout_rms_before,
+        holdout_rms_after,
+        criterion,
+        alpha: spec.alpha,
+        captures_fitted: train.captures.len(),
+        elapsed_s: started.elapsed().as_secs_f64(),
+        actuator: extended.actuator.clone(),
+    })
+}
+
+impl Diagnosis3 {
+    /// The `--json` object on one line.
+    pub fn to_json_line(&self) -> String {
+        serde_json::to_value(self).expect("a diagnosis serialises").to_string()
+    }
+}
+
+impl std::fmt::Display for Diagnosis3 {
+    fn fmt(&self, out: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        writeln!(out, "verdict: {}", self.verdict)?;
+        writeln!(out, "  {}", self.reason)?;
+        for n in &self.effects {
+            writeln!(out, "  {} = {} ± {} (ΔBIC {:.1})", n.parameter_name, crate::io::fmt_sig(n.parameter, 4), crate::io::fmt_sig(n.parameter_se, 2), n.delta_bic)?;
+        }
+        for n in &self.partial_effects {
+            writeln!(out, "  helps but does not explain: {} = {} (ΔBIC {:.1})", n.parameter_name, crate::io::fmt_sig(n.parameter, 4), n.delta_bic)?;
+        }
+        writeln!(out, "body fit on {} captures: marker RMS {:.3} mm, χ²/dof {:.3}", self.captures_fitted, self.baseline.rms_mm, self.baseline.reduced_chi2)?;
+        writeln!(out, "candidates (ΔBIC against the body fit):")?;
+        for c in &self.candidates {
+            let status = if c.counts() { String::new() } else { format!("  (does not count: {})", c.error.clone().unwrap_or_else(|| if c.converged { "implausible or undetermined value".into() } else { "did not converge".into() })) };
+            writeln!(out, "  {:>2}. {:<20} {:>12} ± {:<10} ΔBIC {:>10.1}  RMS {:.3} mm{status}", c.rank, c.effect.name(), crate::io::fmt_sig(c.parameter, 4), crate::io::fmt_sig(c.parameter_se, 2), c.delta_bic, c.rms_mm)?;
+        }
+        for n in &self.not_candidates {
+            writeln!(out, "  not a candidate: {n}")?;
+        }
+        if let Some(s) = &self.signature {
+            writeln!(out, "residual signature ({}):", s.model)?;
+            for line in &s.summary {
+                writeln!(out, "  {line}")?;
+            }
+        }
+        if let (Some(k), Some(b), Some(a)) = (self.holdout_cable, self.holdout_rms_before, self.holdout_rms_after) {
+            writeln!(out, "held out (captures where cable {k} pulls): marker RMS {b:.3} mm with the body fit, {a:.3} mm with the final model")?;
+        }
+        writeln!(out, "{:.1} s", self.elapsed_s)
+    }
+}
+
+/// What `diagnose --actuator` needs.
+#[derive(Debug, Clone)]
+pub struct Diagnose3Request {
+    /// The captures file.
+    pub captures: std::path::PathBuf,
+    /// The markers file.
+    pub markers: Option<std::path::PathBuf>,
+    /// The actuator file: the start and everything not fitted.
+    pub actuator: std::path::PathBuf,
+    /// The system's noise per coordinate, mm.
+    pub noise_mm: f64,
+    /// Loss on the whitened residuals.
+    pub loss: crate::calibrate::fit::Loss,
+    /// Most Levenberg–Marquardt iterations per fit.
+    pub max_iterations: usize,
+    /// Captures in which this cable pulls are held out.
+    pub holdout_cable: Option<usize>,
+    /// The noise test's level.
+    pub alpha: f64,
+    /// BIC decrease an effect needs.
+    pub threshold: f64,
+    /// BIC lead over the runner-up.
+    pub margin: f64,
+    /// Most effects added.
+    pub max_effects: usize,
+    /// The 3-D solver's settings.
+    pub options: crate::model::spatial::SpatialOptions,
+}
+
+/// Reads the request's files and runs [`diagnose_captures`].
+pub fn diagnose_request(request: &Diagnose3Request) -> Result<Diagnosis3, CalibrateError> {
+    let base = Actuator::read(&request.actuator).map_err(CalibrateError::Actuator)?;
+    let set = super::files::read_capture_set(&request.captures, request.markers.as_deref(), base.cables.len(), base.rod.length_mm)?;
+    let mut params: Vec<Param> = Param::BODY.to_vec();
+    if !base.rod.gravity.enabled {
+        params.retain(|&p| p != Param::Density);
+    }
+    let spec = Diagnose3Spec {
+        fit: Fit3Spec { params, noise_mm: request.noise_mm, loss: request.loss, max_iterations: request.max_iterations, options: request.options.clone() },
+        holdout_cable: request.holdout_cable,
+        threshold: request.threshold,
+        margin: request.margin,
+        max_effects: request.max_effects,
+        alpha: request.alpha,
+    };
+    diagnose_captures(&base, &set, &spec)
+}
