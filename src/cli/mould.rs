@@ -101,7 +101,8 @@ pub struct MouldArgs {
 /// A mould error, with the flag of the parameter it names.
 pub fn with_flag(e: MouldError) -> anyhow::Error {
     match &e {
-        MouldError::BadParameter { name, .. } if *name != "station_step_mm" => {
+        // station_step_mm and channels have no flag.
+        MouldError::BadParameter { name, .. } if !matches!(*name, "station_step_mm" | "channels") => {
             let flag = format!("--{}", name.replace('_', "-"));
             anyhow::Error::new(e).context(flag)
         }
