@@ -297,3 +297,21 @@ fn feasible_and_design_with_a_cable_sweeps_map() {
     assert_eq!(d["met"], true, "{d}");
     assert!(d["targets"][0]["tip_error_mm"].as_f64().unwrap() < 1e-3, "{d}");
 }
+
+/// `design --targets --out DIR --moulds` writes every channel's moulds
+/// (the moulds' own request, `mould::for_actuator`) beside the design.
+#[test]
+fn a_sequence_design_writes_the_moulds_of_every_channel() {
+    let dir = tempfile::tempdir().unwrap();
+    let pair = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/spatial/antagonistic.toml");
+    let t = write(dir.path(), "t.toml", "[[target]]\ntip_mm = { x = 45, y = 30 }\n\n[[target]]\ntip_mm = { x = 45, y = -30 }\n");
+    let out = dir.path().join("d");
+    let (ok, stdout, stderr) = run(&["design", "--actuator", pair.to_str().unwrap(), "--targets", &t, "--out", out.to_str().unwrap(), "--moulds"]);
+    assert!(ok, "{stderr}");
+    assert!(stdout.contains("moulds for 2 channels"), "{stdout}");
+    for name in ["mould1.stl", "mould2.stl", "mould.json", "design.json"] {
+        assert!(out.join(name).exists(), "{name} not written: {stdout}");
+    }
+    let v: Value = serde_json::from_str(&std::fs::read_to_string(out.join("design.json")).unwrap()).unwrap();
+    assert!(v["moulds"].is_object(), "{v}");
+}

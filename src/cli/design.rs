@@ -109,7 +109,6 @@ fn cables_request(args: &DesignArgs, targets: &std::path::Path) -> anyhow::Resul
         (args.tension_min_n.is_some(), "--tension-min-n", "tension_min_n in each [[cable]] of --actuator"),
         (args.tension_max_n.is_some(), "--tension-max-n", "tension_max_n in each [[cable]] of --actuator"),
         (args.max_offset_mm.is_some(), "--max-offset-mm", "max_offset_mm in each [[cable]] of --actuator"),
-        (args.moulds, "--moulds", "the moulds of a one-cable design with --target, or `cablemap mould`"),
     ] {
         anyhow::ensure!(!given, "{flag} does not apply to --targets: give {instead}");
     }
@@ -132,6 +131,7 @@ fn cables_request(args: &DesignArgs, targets: &std::path::Path) -> anyhow::Resul
         search: CableSearch { starts: args.starts.unwrap_or(CableSearch::default().starts), max_evaluations: args.max_evaluations },
         map: args.map.clone(),
         out: args.out.clone(),
+        moulds: args.moulds.then(|| cablemap::mould::MouldOptions { params: args.mould.params(), ..Default::default() }),
     })
 }
 

@@ -51,6 +51,9 @@ pub struct CableDesignRequest {
     pub map: Option<PathBuf>,
     /// Export directory.
     pub out: Option<PathBuf>,
+    /// With `out`: also write every channel's moulds ([`crate::mould::for_actuator`]);
+    /// the free channels are then kept within what the moulds cast.
+    pub moulds: Option<crate::mould::MouldOptions>,
 }
 
 /// One target component, asked vs achieved.
@@ -162,6 +165,8 @@ pub struct CableDesignRun {
     pub out: Option<PathBuf>,
     /// Files written, in order.
     pub exported: Vec<String>,
+    /// The moulds written, when asked for.
+    pub moulds: Option<crate::mould::MouldReport>,
 }
 
 impl CableDesignRun {
@@ -252,6 +257,7 @@ impl CableDesignRun {
             "seeds_simulated": self.seeds_simulated,
             "seconds": self.seconds,
             "trajectory": self.trajectory,
+            "moulds": self.moulds,
         })
     }
 }
@@ -303,6 +309,9 @@ impl fmt::Display for CableDesignRun {
         }
         if let Some(dir) = &self.out {
             writeln!(f, "exported {} to {}", self.exported.join(", "), dir.display())?;
+            if let Some(m) = &self.moulds {
+                write!(f, "{}", m.report(dir))?;
+            }
         }
         Ok(())
     }
@@ -434,8 +443,16 @@ pub fn run(request: &CableDesignRequest) -> Result<CableDesignRun, DesignError> 
         super::export::check_export_dir(dir)?;
     }
     check_reachable(&request.design, &request.targets)?;
+    let mut design = request.design.clone();
+    if let (Some(m), true) = (&request.moulds, request.out.is_some()) {
+        // The moulds' rule (tube and skin inside r), a hair inside it.
+        let limit = m.params.max_channel_offset_mm(design.actuator.rod.radius_mm) - 1e-9;
+        for f in design.freedom.iter_mut().filter(|f| f.free_y || f.free_z) {
+            f.max_offset_mm = f.max_offset_mm.min(limit);
+        }
+    }
     let setup = Setup {
-        design: request.design.clone(),
+        design: design.clone(),
         targets: request.targets.targets.clone(),
         options: request.options.clone(),
         basis: request.length_basis,
@@ -488,7 +505,7 @@ pub fn run(request: &CableDesignRequest) -> Result<CableDesignRun, DesignError> 
         None => None,
     };
     let mut run = CableDesignRun {
-        design: request.design.clone(),
+        design,
         channels,
         targets: Vec::new(),
         cost,
@@ -500,6 +517,7 @@ pub fn run(request: &CableDesignRequest) -> Result<CableDesignRun, DesignError> 
         trajectory,
         out: request.out.clone(),
         exported: Vec::new(),
+        moulds: None,
     };
     if let Some(dir) = &request.out {
         for (i, t) in targets.iter_mut().enumerate() {
@@ -509,6 +527,9 @@ pub fn run(request: &CableDesignRequest) -> Result<CableDesignRun, DesignError> 
     run.targets = targets;
     run.seconds = started.elapsed().as_secs_f64();
     if let Some(dir) = &request.out {
+        if let Some(m) = &request.moulds {
+            run.moulds = Some(crate::mould::for_actuator(&run.targets[0].actuator, m, dir)?);
+        }
         run.exported = export::write_all(dir, &run, &setup)?;
     }
     Ok(run)
