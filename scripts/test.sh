@@ -24,7 +24,7 @@ fi
 bin=$target/release/cablemap
 venv=${CABLEMAP_VENV:-$target/python-venv}
 artefacts=${CABLEMAP_TEST_ARTEFACTS:-$target/test-artefacts}
-python_packages="pandas polars pyarrow selenium trimesh numpy"
+python_packages="pandas polars pyarrow selenium trimesh numpy maturin pytest"
 work=$(mktemp -d)
 # No kill of the background jobs on exit: an install must not be cut short.
 trap 'rm -rf "$work"' EXIT
@@ -77,6 +77,29 @@ if cargo test --release --all-targets --no-run && cargo build --release --quiet;
 else
     built=0
     record build 0 1
+fi
+
+# The Python package (python/, pyo3 + maturin): built from this tree into
+# the venv (`pip install ./python`, maturin from the venv: no download per
+# run) after the main build, whose dependencies in target/ it shares.
+wheel=0
+if [ "$built" = 1 ]; then
+    echo "== Python package: build and install (pip install ./python, maturin)"
+    if wait_for python; then
+        start=$SECONDS
+        if PATH="$venv/bin:$PATH" CARGO_TARGET_DIR="$target" "$venv/bin/python" -m pip install --quiet --disable-pip-version-check \
+            --no-build-isolation --force-reinstall --no-deps ./python > "$work/logs/wheel.log" 2>&1; then
+            wheel=1
+            echo "python package: built and installed in $((SECONDS - start)) s"
+        else
+            echo "FAIL python package: pip install ./python failed; the end of its log:"
+            tail -n 30 "$work/logs/wheel.log"
+            record wheel 0 1
+        fi
+    else
+        echo "FAIL python package: not built, the Python packages could not be installed"
+        record wheel 0 1
+    fi
 fi
 
 # The Python checks. check NAME SCRIPT ARGS...: runs one check script, which
@@ -160,7 +183,25 @@ moulds() {
     check check_moulds tests/python/check_moulds.py "$work/mould" "$work/mould-trio" "$work/mould-lumens"
 }
 
-groups=(sweeps_and_maps cable_sweeps moulds)
+python_package() {
+    echo "== Python package (pytest python/tests: the binding against the binary)"
+    [ "$wheel" = 1 ] || return
+    CABLEMAP_BIN="$bin" "$venv/bin/python" -m pytest -q -p no:cacheprovider python/tests > "$work/logs/pytest.out" 2>&1
+    local rc=$?
+    cat "$work/logs/pytest.out"
+    local line passed failed
+    line=$(tail -n 1 "$work/logs/pytest.out")
+    passed=$(echo "$line" | grep -oE '[0-9]+ passed' | awk '{print $1}')
+    failed=$(echo "$line" | grep -oE '[0-9]+ (failed|error|errors)' | awk '{s += $1} END {print s+0}')
+    passed=${passed:-0}
+    if [ "$rc" != 0 ] && [ "$failed" = 0 ]; then
+        echo "FAIL pytest exited with status $rc (no tests collected, or it crashed)"
+        failed=1
+    fi
+    record pytest "$passed" "$failed"
+}
+
+groups=(sweeps_and_maps cable_sweeps moulds python_package)
 declare -A group_pid
 if [ "$built" = 1 ]; then
     for g in "${groups[@]}"; do
