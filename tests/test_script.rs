@@ -61,8 +61,10 @@ echo "PASS one"; echo "PASS two"; echo "python: 2 passed, 0 failed"
         .unwrap();
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(!out.status.success(), "a failing test must fail the script: {stdout}");
-    // Rust 8 + 1; five Python and browser checks × 2 passed, the mould check one failure.
-    assert_eq!(stdout.lines().last(), Some("18 passed, 2 failed"), "{stdout}");
+    // Rust 8 + 1; five Python and browser checks and the Python package's
+    // pytest (the fake python's last line, "2 passed") × 2 passed, the mould
+    // check one failure.
+    assert_eq!(stdout.lines().last(), Some("20 passed, 2 failed"), "{stdout}");
     assert!(stdout.contains("rust: 8 passed, 1 failed") && stdout.contains("failed: check_moulds (1)"), "{stdout}");
     assert!(stdout.contains("FAIL check_moulds: exited with status 1 before counting its checks"), "{stdout}");
 }
