@@ -110,31 +110,7 @@ pub fn bench_solver(
     tensions: usize,
     label: &str,
 ) -> Result<BenchFigures, crate::Error> {
-    let mut sim = Simulator::new(actuator, options)?;
-    let ladder: Vec<f64> = (0..tensions)
-        .map(|k| tension_min_n + (tension_max_n - tension_min_n) * k as f64 / (tensions.max(2) - 1) as f64)
-        .collect();
-    let mut per_solve = Vec::with_capacity(routings.len());
-    let mut a = [0.0; 4];
-    let (mut passes, mut solves, mut failures) = (0u64, 0u64, 0usize);
-    for y in routings {
-        let routing = Routing::for_actuator(y, actuator)?;
-        let start = Instant::now();
-        sim.set_routing(&routing);
-        for &t in &ladder {
-            match sim.solve(t) {
-                Ok(pose) => {
-                    sim.coefficients_into(crate::shape::LengthBasis::default(), &mut a);
-                    passes += u64::from(pose.iterations);
-                    solves += 1;
-                }
-                Err(_) => failures += 1,
-            }
-        }
-        per_solve.push(start.elapsed().as_secs_f64() * 1e6 / ladder.len() as f64);
-    }
-    std::hint::black_box(a);
-    Ok(figures(label, per_solve, tensions, passes as f64 / solves.max(1) as f64, failures, method_label(options)))
+    bench_ladder(actuator, options, routings, &evenly(tension_min_n, tension_max_n, tensions), false, label)
 }
 
 /// Times displacement-driven solves: for each routing, `count`
@@ -150,9 +126,26 @@ pub fn bench_displacement(
     count: usize,
     label: &str,
 ) -> Result<BenchFigures, crate::Error> {
+    bench_ladder(actuator, options, routings, &evenly(min_mm, max_mm, count), true, label)
+}
+
+/// `count` values evenly spaced from `min` to `max` (`min` alone for one).
+fn evenly(min: f64, max: f64, count: usize) -> Vec<f64> {
+    (0..count).map(|k| min + (max - min) * k as f64 / (count.max(2) - 1) as f64).collect()
+}
+
+/// Times each routing solved through `ladder`: tensions, N, or (when
+/// `by_displacement`) displacements, mm, each tension found from the last.
+fn bench_ladder(
+    actuator: &Rod,
+    options: &SolverOptions,
+    routings: &[ControlPoints],
+    ladder: &[f64],
+    by_displacement: bool,
+    label: &str,
+) -> Result<BenchFigures, crate::Error> {
     use crate::model::solver::actuation::meet_displacements;
     let mut sim = Simulator::new(actuator, options)?;
-    let ladder: Vec<f64> = (0..count).map(|k| min_mm + (max_mm - min_mm) * k as f64 / (count.max(2) - 1) as f64).collect();
     let mut per_solve = Vec::with_capacity(routings.len());
     let mut a = [0.0; 4];
     let (mut passes, mut solves, mut failures) = (0u64, 0u64, 0usize);
@@ -161,14 +154,16 @@ pub fn bench_displacement(
         let start = Instant::now();
         sim.set_routing(&routing);
         let mut tension = [0.0];
-        for &d in &ladder {
-            match meet_displacements(&mut sim, &[Some(d)], &mut tension) {
+        for &v in ladder {
+            let solved = if by_displacement { meet_displacements(&mut sim, &[Some(v)], &mut tension) } else { sim.solve(v) };
+            match solved {
                 Ok(pose) => {
                     sim.coefficients_into(crate::shape::LengthBasis::default(), &mut a);
                     passes += u64::from(pose.iterations);
                     solves += 1;
                 }
                 Err(_) => {
+                    // No tension to start the next displacement from.
                     tension[0] = 0.0;
                     failures += 1;
                 }
@@ -177,7 +172,7 @@ pub fn bench_displacement(
         per_solve.push(start.elapsed().as_secs_f64() * 1e6 / ladder.len() as f64);
     }
     std::hint::black_box(a);
-    Ok(figures(label, per_solve, count, passes as f64 / solves.max(1) as f64, failures, method_label(options)))
+    Ok(figures(label, per_solve, ladder.len(), passes as f64 / solves.max(1) as f64, failures, method_label(options)))
 }
 
 /// Figures from the mean µs per solve of each routing (any order).

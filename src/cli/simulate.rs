@@ -129,12 +129,7 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         // A displacement, or a stiffness: the actuator's one cable, checked
         // and solved as every actuator's (the same planar backend).
         _ => {
-            let cable = Cable { cable_ea_n: args.cable_ea_n, ..Cable::planar(routing.control_points_mm().0, 0.0) };
-            let cable = match actuation {
-                Actuation::Tension(t) => Cable { tension_n: t, ..cable },
-                Actuation::Displacement(d) => Cable { displacement_mm: Some(d), ..cable },
-            };
-            let one = Actuator::with_cables(actuator.clone(), vec![cable]);
+            let one = Actuator::with_cables(actuator.clone(), vec![actuation.cable(routing.control_points_mm().0, args.cable_ea_n)]);
             let spatial_options = cablemap::model::spatial::SpatialOptions::default();
             let solved = simulate_actuator(&one, &options, &spatial_options, given_settings(args), Some(hold), exact_order, basis);
             if let (Err(e), true) = (&solved, args.json) {
@@ -215,11 +210,7 @@ fn run_spatial(args: &SimulateArgs) -> anyhow::Result<()> {
     if let (Some(routing), Some(actuation)) = (&args.routing, planar_actuation(args)?) {
         let y = parse_list(routing, "--routing")?;
         let y: [f64; 5] = y.try_into().map_err(|y: Vec<f64>| anyhow::anyhow!("--routing: a routing needs exactly 5 control points y0..y4 (mm), got {}", y.len()))?;
-        let cable = Cable::planar(y, 0.0);
-        spatial.cables = vec![match actuation {
-            Actuation::Tension(t) => Cable { tension_n: t, cable_ea_n: args.cable_ea_n, ..cable },
-            Actuation::Displacement(d) => Cable { displacement_mm: Some(d), cable_ea_n: args.cable_ea_n, ..cable },
-        }];
+        spatial.cables = vec![actuation.cable(y, args.cable_ea_n)];
     }
     anyhow::ensure!(
         !spatial.cables.is_empty(),
@@ -291,6 +282,17 @@ enum Actuation {
     Tension(f64),
     /// By its displacement, mm.
     Displacement(f64),
+}
+
+impl Actuation {
+    /// The planar cable on routing `y_mm` driven so, with stiffness `cable_ea_n`.
+    fn cable(self, y_mm: [f64; 5], cable_ea_n: Option<f64>) -> Cable {
+        let cable = Cable { cable_ea_n, ..Cable::planar(y_mm, 0.0) };
+        match self {
+            Actuation::Tension(t) => Cable { tension_n: t, ..cable },
+            Actuation::Displacement(d) => Cable { displacement_mm: Some(d), ..cable },
+        }
+    }
 }
 
 impl std::fmt::Display for Actuation {

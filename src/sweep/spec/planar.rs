@@ -39,6 +39,7 @@ use crate::sweep::kind::{ChunkLayout, InvalidSpec, RunSpec, MAX_CHUNK_ROWS, MAX_
 use crate::sweep::schema::{arrow_schema, build_batch, SolvedRouting};
 use crate::sweep::solve::{self, Stored};
 use crate::sweep::SweepError;
+use crate::sweep::spec::ValueGrid;
 use arrow::datatypes::SchemaRef;
 use arrow::record_batch::RecordBatch;
 use serde::{Deserialize, Serialize};
@@ -423,11 +424,7 @@ impl SweepSpec {
     /// The actuation ladder: the displacements when given, else the tensions.
     pub fn ladder(&self) -> Ladder {
         match &self.displacement {
-            Some(d) if d.count == 1 => Ladder::DisplacementMm(vec![d.min_mm]),
-            Some(d) => {
-                let steps = f64::from(d.count - 1);
-                Ladder::DisplacementMm((0..d.count).map(|k| d.min_mm + (d.max_mm - d.min_mm) * f64::from(k) / steps).collect())
-            }
+            Some(d) => Ladder::DisplacementMm(ValueGrid { min: d.min_mm, max: d.max_mm, count: d.count }.values()),
             None => Ladder::TensionN(self.tensions_n()),
         }
     }
@@ -449,11 +446,7 @@ impl SweepSpec {
     /// The tension ladder, N, in rising order.
     pub fn tensions_n(&self) -> Vec<f64> {
         let t = &self.tension;
-        if t.count == 1 {
-            return vec![t.min_n];
-        }
-        let steps = f64::from(t.count - 1);
-        (0..t.count).map(|k| t.min_n + (t.max_n - t.min_n) * f64::from(k) / steps).collect()
+        ValueGrid { min: t.min_n, max: t.max_n, count: t.count }.values()
     }
 
     /// The level values of one control point, mm, ascending; symmetric
