@@ -10,6 +10,9 @@ and returns the library's records:
   fields), with the centreline as a numpy array.
 - :func:`solve_batch`: many routings, each stepped through a tension ladder,
   solved in parallel in Rust with the GIL released.
+- :func:`sweep`, :func:`reduce`: a sweep spec into a run directory, a run
+  into a map (``cablemap sweep``, ``cablemap reduce``); :func:`read_run`,
+  :func:`read_map`: their files as polars data frames.
 
 Errors are :mod:`cablemap.errors`' exceptions carrying the library's messages.
 """
@@ -35,6 +38,8 @@ __all__ = [
     "SolveError",
     "FileFormatError",
 ]
+from ._data import *  # noqa: E402,F401,F403 (sweep, reduce, read_run, read_map: _data.py)
+__all__ += _data.__all__  # type: ignore[name-defined]  # noqa: F405
 
 PathLike = Union[str, "os.PathLike[str]"]
 

@@ -74,6 +74,8 @@ impl From<SimulateError> for Failure {
 
 type Result<T> = std::result::Result<T, Failure>;
 
+mod data;
+
 fn bad(message: impl Into<String>) -> Failure {
     Failure::BadInput(message.into())
 }
@@ -447,6 +449,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(actuator_to_toml, m)?)?;
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(solve_batch, m)?)?;
+    data::register(m)?;
     m.add("CENTRELINE_COLUMNS", CENTRELINE.to_vec())?;
     m.add("BATCH_FIELDS", BATCH_FIELDS.to_vec())?;
     Ok(())

@@ -43,6 +43,8 @@ pub const DESIGNS_FILE: &str = "designs.parquet";
 pub const REACH_FILES: [&str; 4] = ["reach_xy.parquet", "reach_xz.parquet", "reach_yz.parquet", "reach_3d.parquet"];
 /// Folder, inside a cable sweep's map, of a planar run's feasibility map.
 pub const PLANAR_MAP_DIR: &str = "planar";
+/// The tables of a feasibility map, in the order a reader lists them.
+pub const FEASIBILITY_FILES: [&str; 3] = [CELLS_FILE, MODES_FILE, DESIGNS_FILE];
 
 /// Columns of `cells.parquet`.
 pub mod cell_columns {
@@ -518,4 +520,43 @@ pub fn read_reach(dir: &Path) -> Result<ReachTables, ReadError> {
         }
     }
     Ok(ReachTables { summary, planes, voxels })
+}
+
+/// One table of a map directory: its name (the file's stem: `cells`,
+/// `reach_xy`, …) and its file.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct MapTable {
+    /// The table's name, its file name without `.parquet`.
+    pub name: String,
+    /// The Parquet file.
+    pub path: PathBuf,
+}
+
+/// Every table of map directory `dir`, for readers outside cablemap (the
+/// Python package's `read_map`): a feasibility map's [`FEASIBILITY_FILES`];
+/// a cable sweep's map's [`REACH_FILES`] and, when it holds a planar map
+/// ([`PLANAR_MAP_DIR`]), that map's feasibility tables under their own
+/// names. The summary is checked first, so a run or an empty folder given
+/// in place of a map is refused with what to give instead.
+pub fn map_tables(dir: &Path) -> Result<Vec<MapTable>, ReadError> {
+    let table = |dir: &Path, file: &str| MapTable { name: file.trim_end_matches(".parquet").to_string(), path: dir.join(file) };
+    let feasibility = |dir: &Path| -> Result<Vec<MapTable>, ReadError> {
+        read_summary(dir)?;
+        Ok(FEASIBILITY_FILES.iter().map(|f| table(dir, f)).collect())
+    };
+    let is_cable_map = crate::io::read_utf8(&dir.join(SUMMARY_FILE))
+        .ok()
+        .and_then(|text| serde_json::from_str::<serde_json::Value>(&text).ok())
+        .is_some_and(|v| v["kind"] == "cables");
+    if !is_cable_map {
+        return feasibility(dir);
+    }
+    let path = dir.join(SUMMARY_FILE);
+    let text = crate::io::read_utf8(&path).map_err(|e| read_error(&path, format!("cannot read ({e})")))?;
+    let summary: CableMapSummary = serde_json::from_str(&text).map_err(|e| read_error(&path, format!("does not match the cable map contract: {e}")))?;
+    let mut tables: Vec<MapTable> = REACH_FILES.iter().map(|f| table(dir, f)).collect();
+    if let Some(planar) = &summary.planar_map {
+        tables.extend(feasibility(&dir.join(planar))?);
+    }
+    Ok(tables)
 }
