@@ -114,18 +114,24 @@ fn a_sequence_of_two_simulated_spatial_shapes_is_reached_and_resimulated() {
 }
 
 /// Table 5.1's targets through the several-cable request (one planar cable
-/// free in y, the thesis's 1 … 2 N) give the answers of `design --target`.
+/// free in y, the default bounds: one cable's are the thesis's 1 … 2 N of
+/// `design --target`) give the answers of `design --target`, with the
+/// actuator file and without one (the rod of the flags, one cable).
 #[test]
 fn table_5_1_through_the_cable_request_gives_todays_answers() {
     let dir = tempfile::tempdir().unwrap();
-    let actuator = write(dir.path(), "one.toml", "[[cable]]\ny_mm = [0, 0, 0, 0, 0]\nfree = [\"y\"]\ntension_min_n = 1.0\ntension_max_n = 2.0\n");
-    for (target, tip, a) in [
-        ("x=50,y=5,a0=-0.025,a1=-0.06,a2=0.015", "{ x = 50, y = 5 }", "[-0.025, -0.06, 0.015]"),
-        ("x=10,y=50,a0=0.015,a1=-0.07,a2=-0.03", "{ x = 10, y = 50 }", "[0.015, -0.07, -0.03]"),
-    ] {
+    let actuator = write(dir.path(), "one.toml", "[[cable]]\ny_mm = [0, 0, 0, 0, 0]\nfree = [\"y\"]\n");
+    let cases = [
+        ("x=50,y=5,a0=-0.025,a1=-0.06,a2=0.015", "{ x = 50, y = 5 }", "[-0.025, -0.06, 0.015]", true),
+        ("x=10,y=50,a0=0.015,a1=-0.07,a2=-0.03", "{ x = 10, y = 50 }", "[0.015, -0.07, -0.03]", true),
+        ("x=50,y=5,a0=-0.025,a1=-0.06,a2=0.015", "{ x = 50, y = 5 }", "[-0.025, -0.06, 0.015]", false),
+    ];
+    for (target, tip, a, with_file) in cases {
         let today = json(&["design", "--target", target, "--json"]);
         let targets = write(dir.path(), "t.toml", &format!("[[target]]\ntip_mm = {tip}\na_bend_z = {a}\n"));
-        let v = json(&["design", "--actuator", &actuator, "--targets", &targets, "--json"]);
+        let v = if with_file { json(&["design", "--actuator", &actuator, "--targets", &targets, "--json"]) } else { json(&["design", "--targets", &targets, "--json"]) };
+        assert_eq!(v["method"], "planar", "{v}");
+        assert_eq!(v["cables"][0]["actuation"], serde_json::json!({"kind": "tension", "min_n": 1.0, "max_n": 2.0}));
         let y = floats(&v["cables"][0]["y_mm"]);
         for (got, want) in y.iter().zip(floats(&today["routing_mm"])) {
             assert!((got - want).abs() < 1e-9, "{target}: {y:?} vs {}", today["routing_mm"]);
@@ -227,7 +233,14 @@ fn a_trajectory_reports_the_path_a_resimulation_follows() {
     };
     let waypoints: Vec<Vec<f64>> = [(0.2, 1.2), (0.8, 0.6), (1.4, 0.3), (1.8, 1.0)].iter().map(|&(a, b)| tip_of(&simulate(a, b))).collect();
     let targets = write(dir.path(), "path.toml", &format!("[trajectory]\nwaypoints = {waypoints:?}\nsmooth = true\n"));
-    let d = json(&["design", "--actuator", pair, "--targets", &targets, "--json"]);
+    let out = dir.path().join("d");
+    let d = json(&["design", "--actuator", pair, "--targets", &targets, "--out", out.to_str().unwrap(), "--json"]);
+    // The trajectory's picture: the target pictures' two views, the sampled path drawn in red.
+    let png = image::open(out.join("trajectory.png")).unwrap().to_rgb8();
+    assert_eq!(png.dimensions(), (1400, 760));
+    let red = png.pixels().filter(|p| p.0 == [255, 0, 0]).count();
+    assert!(red > 1000, "{red} pixels of the tip path");
+    assert_eq!(std::fs::read_to_string(out.join("trajectory.csv")).unwrap().lines().count(), 1 + 3 * 21 * 2);
     assert_eq!(d["met"], true, "{d}");
     let path = &d["trajectory"];
     assert_eq!(path["steps_per_leg"], 20);
@@ -314,4 +327,78 @@ fn a_sequence_design_writes_the_moulds_of_every_channel() {
     }
     let v: Value = serde_json::from_str(&std::fs::read_to_string(out.join("design.json")).unwrap()).unwrap();
     assert!(v["moulds"].is_object(), "{v}");
+    // One owner of the channel files: the moulds list the design's
+    // channel_K.csv, and `mould --actuator` of the designed actuator writes
+    // the same bytes.
+    assert_eq!(v["moulds"]["channel_files"], serde_json::json!(["channel_1.csv", "channel_2.csv"]), "{v}");
+    let again = dir.path().join("m");
+    let (ok, _, stderr) = run(&["mould", "--actuator", out.join("target_1.toml").to_str().unwrap(), "--out", again.to_str().unwrap()]);
+    assert!(ok, "{stderr}");
+    for name in ["channel_1.csv", "channel_2.csv"] {
+        let (design, mould) = (std::fs::read_to_string(out.join(name)).unwrap(), std::fs::read_to_string(again.join(name)).unwrap());
+        assert!(design.starts_with("s_mm,y_mm,z_mm,dy_ds,dz_ds\n"), "{name}: {}", &design[..60]);
+        assert_eq!(design, mould, "{name}: the design's and the mould's channel files differ");
+    }
+}
+
+/// `smooth = true` is enforced by the search. The antagonistic pair's
+/// channels, both cables displacement-driven: two waypoints simulated at
+/// displacements A = (0.5, 2.5) mm and B = (2.0, d) mm with d chosen so
+/// cable 2's tension is the same at both, so along the straight leg A → B
+/// it dips (by about 0.4 mN) and comes back: the exact fit reverses. With
+/// `smooth = true` the design moves the waypoints' actuation (within the
+/// tolerance) until no sample of the leg reverses.
+#[test]
+fn a_smooth_trajectory_has_no_tension_reversal_where_the_exact_fit_has_one() {
+    let dir = tempfile::tempdir().unwrap();
+    // The pair's rod and gravity (across the rod, as in the x–y plane), its cables displacement-driven.
+    let rod = "gj_n_mm2 = 76.74\ngravity_direction = [0, -1, 0]\n\n[rod]\nei_n_mm2 = 115.117\n\n";
+    let pair = write(
+        dir.path(),
+        "pair.toml",
+        &format!("{rod}[[cable]]\ny_mm = [2.4, 3.1, 1.8, 2.6, 2.8]\ndisplacement_max_mm = 5\n\n[[cable]]\ny_mm = [-1.7, -2.4, -1.6, -3.2, -3.1]\ndisplacement_max_mm = 5\n"),
+    );
+    // `simulate` reads the same rod, its cables given by --cable.
+    let rod_only = write(dir.path(), "rod.toml", &format!("{rod}[[cable]]\ny_mm = [0, 0, 0, 0, 0]\ntension_n = 0\n"));
+    let channels = ["y=2.4,3.1,1.8,2.6,2.8", "y=-1.7,-2.4,-1.6,-3.2,-3.1"];
+    let simulate = |d1: f64, d2: f64| {
+        let (c1, c2) = (format!("{} displacement={d1}", channels[0]), format!("{} displacement={d2}", channels[1]));
+        json(&["simulate", "--actuator", &rod_only, "--cable", &c1, "--cable", &c2, "--json"])
+    };
+    let tension2 = |v: &Value| floats(&v["tension_n"])[1];
+    let a = simulate(0.5, 2.5);
+    // Bisection on d: cable 2's tension rises with its displacement.
+    let (mut lo, mut hi) = (0.5, 4.0);
+    for _ in 0..40 {
+        let mid = 0.5 * (lo + hi);
+        if tension2(&simulate(2.0, mid)) < tension2(&a) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let b = simulate(2.0, 0.5 * (lo + hi));
+    let tip = |v: &Value| vec![v["tip_x_mm"].as_f64().unwrap(), v["tip_y_mm"].as_f64().unwrap(), v["tip_z_mm"].as_f64().unwrap()];
+    let design = |smooth: bool| {
+        let t = write(dir.path(), "leg.toml", &format!("[trajectory]\nwaypoints = [{:?}, {:?}]\nsteps_per_leg = 10\nsmooth = {smooth}\n", tip(&a), tip(&b)));
+        json(&["design", "--actuator", &pair, "--targets", &t, "--json"])
+    };
+    let exact = design(false);
+    assert_eq!(exact["met"], true, "{exact}");
+    let leg = &exact["trajectory"]["legs"][0];
+    assert_eq!(leg["reversals"], serde_json::json!([2]), "the exact fit dips: {leg}");
+    let smooth = design(true);
+    assert_eq!(smooth["met"], true, "{smooth}");
+    assert_eq!(smooth["unmet"], serde_json::json!([]), "{smooth}");
+    let leg = &smooth["trajectory"]["legs"][0];
+    assert_eq!(leg["reversals"], serde_json::json!([]), "{leg}");
+    // Cable 2's tension along the leg, as reported, never moves against its
+    // direction (beyond the report's rounding, 1e-9 of the tension).
+    let t2: Vec<f64> = leg["samples"].as_array().unwrap().iter().map(|s| floats(&s["tensions_n"])[1]).collect();
+    let steps: Vec<f64> = t2.windows(2).map(|w| w[1] - w[0]).collect();
+    assert!(steps.iter().all(|d| *d >= -1e-9) || steps.iter().all(|d| *d <= 1e-9), "{t2:?}");
+    assert!(t2[0] - t2[10] > 1e-4 || t2[10] - t2[0] > 1e-4, "the ends now differ: {t2:?}");
+    // It paid for that with waypoints off by a little, within the tolerance.
+    let off = smooth["targets"].as_array().unwrap().iter().map(|t| t["tip_error_mm"].as_f64().unwrap()).fold(0.0, f64::max);
+    assert!(off > 1e-4 && off < 0.5, "{off} mm");
 }

@@ -177,7 +177,10 @@ fn mould_actuator_casts_every_planar_channel_with_its_own_protrusion() {
     // From the f32 file: within 0.01 mm of each channel's y_c(s).
     assert!(worst < 0.01, "crest off y_c(s) by up to {worst} mm");
     let csv = std::fs::read_to_string(out.join("channel_2.csv")).unwrap();
-    assert!(csv.starts_with("s_mm,y_mm,dy_ds\n0.0000,0.000000"), "{}", &csv[..40]);
+    // Cable K's channel_K.csv, the one format of an actuator's channels (z ≡ 0 here).
+    assert!(csv.starts_with("s_mm,y_mm,z_mm,dy_ds,dz_ds\n0.0000,0.000000,0.000000,"), "{}", &csv[..60]);
+    let channels = actuator.channels().unwrap();
+    assert_eq!(csv, channels[1].csv(65.0), "the mould writes cable 2's channel as the actuator's one writer does");
 }
 
 #[test]

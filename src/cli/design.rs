@@ -3,7 +3,7 @@
 use super::{ActuatorArgs, LengthBasisArgs};
 use anyhow::Context;
 use cablemap::design::cables::search::CableSearch;
-use cablemap::design::cables::spec::DesignActuator;
+use cablemap::design::cables::spec::{self, DesignActuator};
 use cablemap::design::cables::targets::TargetSet;
 use cablemap::design::cables::CableDesignRequest;
 use cablemap::design::run::DesignRequest;
@@ -117,7 +117,7 @@ fn cables_request(args: &DesignArgs, targets: &std::path::Path) -> anyhow::Resul
             anyhow::ensure!(args.actuator.actuator_file.is_none(), "give the rod either in --actuator FILE's [rod] table or by --actuator-file, not both");
             DesignActuator::read(path, |rod| args.actuator.apply(rod)).context("--actuator")?
         }
-        None => DesignActuator::planar(args.actuator.resolve()?, 0.0, cablemap::design::cables::spec::DEFAULT_TENSION_MAX_N, None),
+        None => DesignActuator::planar(args.actuator.resolve()?, spec::default_tension_min_n(1), spec::DEFAULT_TENSION_MAX_N, None),
     };
     let mut targets = TargetSet::read(targets, design.actuator.rod.length_mm).context("--targets")?;
     if let Some(tol) = args.tolerance_pct {

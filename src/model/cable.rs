@@ -7,12 +7,18 @@
 //! frame. z ≡ 0 is today's planar routing.
 
 use crate::model::spatial::SpatialError;
-use crate::model::routing::{ChannelPoint, Routing, CONTROL_POINTS};
+use crate::model::routing::{ChannelPoint, Routing, CHANNEL_STEP_MM, CONTROL_POINTS};
 use crate::model::Rod;
 use serde::{Deserialize, Serialize};
 
 /// Most cables an actuator may have.
 pub const MAX_CABLES: usize = 8;
+
+/// The file of cable `k`'s channel (from 0): `channel_{k+1}.csv`, written by
+/// [`Channel::csv`] wherever an actuator's channels are written.
+pub fn channel_file_name(k: usize) -> String {
+    format!("channel_{}.csv", k + 1)
+}
 
 /// Points per knot span at which the channel is checked against the radius.
 const RADIUS_CHECK_POINTS_PER_SPAN: usize = 512;
@@ -171,6 +177,29 @@ impl Channel {
             (1.0 + p.dr_ds[0] * p.dr_ds[0] + p.dr_ds[1] * p.dr_ds[1]).sqrt()
         };
         (0..=n).map(|k| f(k as f64 * h) * if k == 0 || k == n { 1.0 } else if k % 2 == 1 { 4.0 } else { 2.0 }).sum::<f64>() * h / 3.0
+    }
+
+    /// The channel of a routing in the bending plane (z ≡ 0), as a cable
+    /// with every z_i = 0 has.
+    pub fn in_plane(y: &Routing) -> Self {
+        Self { y: y.clone(), z: Routing::from_points_unchecked([0.0; CONTROL_POINTS], y.length_mm()) }
+    }
+
+    /// The channel as `channel_K.csv` (cable K of an actuator, written by
+    /// `design --targets --out` and by `mould` for several channels or a
+    /// printed body): `s_mm,y_mm,z_mm,dy_ds,dz_ds` over [0, `end_mm`]
+    /// every [`CHANNEL_STEP_MM`] or closer. This is the file's one writer
+    /// (the one planar channel's `channel.csv` is [`Routing::channel_csv`]).
+    pub fn csv(&self, end_mm: f64) -> String {
+        use std::fmt::Write as _;
+        let mut out = String::from("s_mm,y_mm,z_mm,dy_ds,dz_ds\n");
+        let n = (end_mm / CHANNEL_STEP_MM).ceil().max(1.0) as usize;
+        for k in 0..=n {
+            let s = end_mm * k as f64 / n as f64;
+            let p = self.at(s);
+            let _ = writeln!(out, "{s:.4},{:.6},{:.6},{:.6},{:.6}", p.r_mm[0], p.r_mm[1], p.dr_ds[0], p.dr_ds[1]);
+        }
+        out
     }
 
     fn radius_at_parameter(&self, zeta: f64) -> (f64, f64) {

@@ -256,7 +256,7 @@ impl Routing {
 
     /// Builds the spline without checking against a radius (used for the
     /// channel-offset effect, which shifts an already validated routing).
-    fn from_points_unchecked(y_mm: [f64; CONTROL_POINTS], length_mm: f64) -> Self {
+    pub(crate) fn from_points_unchecked(y_mm: [f64; CONTROL_POINTS], length_mm: f64) -> Self {
         let s_ctrl: [f64; CONTROL_POINTS] =
             std::array::from_fn(|i| i as f64 * length_mm / (CONTROL_POINTS - 1) as f64);
         let combine = |values: &[f64; CONTROL_POINTS]| -> [[f64; 4]; 2] {

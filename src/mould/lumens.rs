@@ -500,9 +500,9 @@ impl Lumens {
         }
         let mut channels = Vec::new();
         for k in 0..self.channels.len() {
-            let name = if self.channels.len() == 1 { "channel.csv".to_string() } else { format!("channel_{}.csv", k + 1) };
+            let name = crate::model::cable::channel_file_name(k);
             let path = dir.join(&name);
-            crate::io::write_atomic(&path, self.channel_csv(k).as_bytes()).map_err(FileError::on("writing", &path))?;
+            crate::io::write_atomic(&path, self.channels[k].csv(self.length_mm).as_bytes()).map_err(FileError::on("writing", &path))?;
             let (y_mm, z_mm) = self.control_points_mm[k];
             channels.push(LumenChannel { cable: k + 1, y_mm, z_mm, lumen_length_mm: self.lumen_length_mm(k), file: name });
         }
@@ -521,19 +521,6 @@ impl Lumens {
         let json = serde_json::to_string_pretty(&summary).expect("summary serialises") + "\n";
         crate::io::write_atomic(&path, json.as_bytes()).map_err(FileError::on("writing", &path))?;
         Ok(summary)
-    }
-
-    /// Channel `k`'s centreline: `s_mm,y_mm,z_mm,dy_ds,dz_ds` every 0.25 mm.
-    pub fn channel_csv(&self, k: usize) -> String {
-        use std::fmt::Write as _;
-        let mut out = String::from("s_mm,y_mm,z_mm,dy_ds,dz_ds\n");
-        let n = (self.length_mm / crate::model::routing::CHANNEL_STEP_MM).ceil() as usize;
-        for i in 0..=n {
-            let s = self.length_mm * i as f64 / n as f64;
-            let c = self.channels[k].at(s);
-            let _ = writeln!(out, "{s:.4},{:.6},{:.6},{:.6},{:.6}", c.r_mm[0], c.r_mm[1], c.dr_ds[0], c.dr_ds[1]);
-        }
-        out
     }
 }
 

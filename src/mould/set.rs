@@ -240,9 +240,14 @@ impl MouldSet {
         }
         let mut channel_files = Vec::new();
         for (k, routing) in channels.iter().enumerate() {
-            let name = if channels.len() == 1 { "channel.csv".to_string() } else { format!("channel_{}.csv", k + 1) };
+            // One planar channel: the thesis's channel.csv; several: each
+            // cable's channel_K.csv, as every actuator's channels are written.
+            let (name, csv) = match channels {
+                [one] => ("channel.csv".to_string(), one.channel_csv()),
+                _ => (crate::model::cable::channel_file_name(k), crate::model::cable::Channel::in_plane(routing).csv(m.length_mm())),
+            };
             let path = dir.join(&name);
-            crate::io::write_atomic(&path, routing.channel_csv().as_bytes()).map_err(FileError::on("writing", &path))?;
+            crate::io::write_atomic(&path, csv.as_bytes()).map_err(FileError::on("writing", &path))?;
             channel_files.push(name);
         }
         let summary = MouldSummary {

@@ -19,13 +19,11 @@ struct View {
     name: &'static str,
 }
 
+/// The two views every spatial picture shows: x–y (looking along z) and x–z (looking along y).
+const VIEWS: [View; 2] = [View { axis: 1, name: "y" }, View { axis: 2, name: "z" }];
+
 /// Draws `sim` as two side-by-side views into `path` (PNG, 1400 × 760 px).
 pub fn draw_spatial(path: &Path, title: &str, sim: &Simulation) -> Result<(), PlotError> {
-    register_fonts();
-    let root = png_backend(path, (1400, 760))?.into_drawing_area();
-    root.fill(&WHITE).map_err(|e| PlotError::new(path, e))?;
-    let root = root.titled(title, (FONT, 22)).map_err(|e| PlotError::new(path, e))?;
-    let panels = root.split_evenly((1, 2));
     let radius = sim.actuator.rod.radius_mm;
     let paths = sim.cable_paths_mm();
     // One scale for both views: the range of x and of both lateral coordinates.
@@ -37,16 +35,7 @@ pub fn draw_spatial(path: &Path, title: &str, sim: &Simulation) -> Result<(), Pl
             hi[i] = hi[i].max(p[i] + radius);
         }
     }
-    let lat_lo = lo[1].min(lo[2]);
-    let lat_hi = hi[1].max(hi[2]);
-    let span = (hi[0] - lo[0]).max(lat_hi - lat_lo) + 10.0;
-    let (cx, cl) = (0.5 * (lo[0] + hi[0]), 0.5 * (lat_lo + lat_hi));
-    let x_range = (cx - span / 2.0, cx + span / 2.0);
-    let lat_range = (cl - span / 2.0, cl + span / 2.0);
-    for (panel, view) in panels.iter().zip([View { axis: 1, name: "y" }, View { axis: 2, name: "z" }]) {
-        let caption = format!("x–{} view (looking along {})", view.name, if view.axis == 1 { "z" } else { "y" });
-        let lateral = format!("{} (mm)", view.name);
-        let mut chart = page_chart(panel, path, (&caption, 18), (&lateral, lat_range), (-x_range.1, -x_range.0))?;
+    draw_views(path, title, (lo, hi), |view| {
         let a = view.axis;
         // Series in the view's body frame (x, lateral), as the planar pictures.
         let in_view = |p: [f64; 3]| (p[0], p[a]);
@@ -74,6 +63,89 @@ pub fn draw_spatial(path: &Path, title: &str, sim: &Simulation) -> Result<(), Pl
             let mark = Mark::Dot { at: in_view(n.position_mm()), radius_px: 5 };
             series.push(PictureSeries { legend: "tip".into(), colour: BLUE_800.to_rgba(), mark });
         }
+        series
+    })
+}
+
+/// A tip trajectory to draw: its waypoints and, per leg, the tip at each
+/// sample (`None` where the sample's solve failed), mm.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TrajectoryDrawing {
+    /// The waypoints as asked (x, y, z; NaN for a component not asked).
+    pub waypoints: Vec<[f64; 3]>,
+    /// Per leg (waypoint k to k + 1), the sampled tips in order.
+    pub legs: Vec<Vec<Option<[f64; 3]>>>,
+    /// The body's radius at the clamp, mm (the drawn clamp's size).
+    pub base_radius_mm: f64,
+}
+
+/// Colour of the sampled tip path.
+pub const TRAJECTORY_PATH_COLOUR: RGBColor = RED;
+
+impl TrajectoryDrawing {
+    /// The series of the view whose lateral coordinate is `axis` (1 = y,
+    /// 2 = z), in the body frame (x, lateral): the clamp, the straight
+    /// legs between waypoints, the sampled tip path through every solved
+    /// sample (one polyline per run of solved samples: one per leg when
+    /// none failed) and the waypoints.
+    pub fn series(&self, axis: usize) -> Vec<PictureSeries> {
+        let in_view = |p: &[f64; 3]| (p[0], p[axis]);
+        let finite = |p: &&[f64; 3]| p.iter().all(|v| v.is_finite());
+        let legs: Vec<Vec<(f64, f64)>> = self.waypoints.windows(2).filter(|w| w.iter().all(|p| finite(&p))).map(|w| vec![in_view(&w[0]), in_view(&w[1])]).collect();
+        let mut runs: Vec<Vec<(f64, f64)>> = Vec::new();
+        for leg in &self.legs {
+            let mut run = Vec::new();
+            for tip in leg {
+                match tip {
+                    Some(p) => run.push(in_view(p)),
+                    None => runs.extend((run.len() > 1).then(|| std::mem::take(&mut run))),
+                }
+            }
+            runs.extend((run.len() > 1).then_some(run));
+        }
+        vec![
+            clamp_series(self.base_radius_mm),
+            PictureSeries { legend: "straight legs between the waypoints".into(), colour: BLACK.mix(0.35), mark: Mark::Lines { paths: legs, width_px: 1 } },
+            PictureSeries { legend: "tip path (actuation linear in each leg)".into(), colour: TRAJECTORY_PATH_COLOUR.to_rgba(), mark: Mark::Lines { paths: runs, width_px: 2 } },
+            PictureSeries { legend: "waypoints".into(), colour: BLACK.to_rgba(), mark: Mark::Crosses { at: self.waypoints.iter().filter(finite).map(in_view).collect() } },
+        ]
+    }
+
+    /// Draws the trajectory as [`draw_spatial`] draws a rod: x–y and x–z
+    /// views side by side on one scale, into `path` (PNG, 1400 × 760 px).
+    pub fn draw(&self, path: &Path, title: &str) -> Result<(), PlotError> {
+        let (mut lo, mut hi) = ([0.0f64; 3], [0.0f64; 3]);
+        let points = self.waypoints.iter().chain(self.legs.iter().flatten().flatten());
+        for p in points.filter(|p| p.iter().all(|v| v.is_finite())) {
+            for i in 0..3 {
+                lo[i] = lo[i].min(p[i]);
+                hi[i] = hi[i].max(p[i]);
+            }
+        }
+        draw_views(path, title, (lo, hi), |view| self.series(view.axis))
+    }
+}
+
+/// Draws the two [`VIEWS`] side by side into `path` (PNG, 1400 × 760 px),
+/// on one scale covering `(lo, hi)` (x, y, z, mm) with a margin; each
+/// view's series come from `series_of`, its legend in the upper right.
+fn draw_views(path: &Path, title: &str, (lo, hi): ([f64; 3], [f64; 3]), series_of: impl Fn(&View) -> Vec<PictureSeries>) -> Result<(), PlotError> {
+    register_fonts();
+    let root = png_backend(path, (1400, 760))?.into_drawing_area();
+    root.fill(&WHITE).map_err(|e| PlotError::new(path, e))?;
+    let root = root.titled(title, (FONT, 22)).map_err(|e| PlotError::new(path, e))?;
+    let panels = root.split_evenly((1, 2));
+    let lat_lo = lo[1].min(lo[2]);
+    let lat_hi = hi[1].max(hi[2]);
+    let span = (hi[0] - lo[0]).max(lat_hi - lat_lo) + 10.0;
+    let (cx, cl) = (0.5 * (lo[0] + hi[0]), 0.5 * (lat_lo + lat_hi));
+    let x_range = (cx - span / 2.0, cx + span / 2.0);
+    let lat_range = (cl - span / 2.0, cl + span / 2.0);
+    for (panel, view) in panels.iter().zip(&VIEWS) {
+        let caption = format!("x–{} view (looking along {})", view.name, if view.axis == 1 { "z" } else { "y" });
+        let lateral = format!("{} (mm)", view.name);
+        let mut chart = page_chart(panel, path, (&caption, 18), (&lateral, lat_range), (-x_range.1, -x_range.0))?;
+        let series = series_of(view);
         for s in &series {
             draw_series_on(&mut chart, path, s)?;
         }
@@ -115,3 +187,57 @@ fn silhouette(sim: &Simulation, a: usize, radius: f64) -> (Outline, Outline) {
     (left, right)
 }
 
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn lines(s: &PictureSeries) -> &Vec<Vec<(f64, f64)>> {
+        match &s.mark {
+            Mark::Lines { paths, .. } => paths,
+            other => panic!("{}: not lines: {other:?}", s.legend),
+        }
+    }
+
+    /// Four waypoints, three legs of 21 samples: one straight line and one
+    /// sampled polyline per leg in each view, through the samples' (x, lateral);
+    /// a failed sample splits its leg's polyline.
+    #[test]
+    fn a_trajectory_draws_one_polyline_per_leg_through_its_samples() {
+        let waypoints = vec![[40.0, -30.0, 1.0], [60.0, 0.0, 2.0], [45.0, 30.0, -1.0], [50.0, 25.0, 0.0]];
+        let legs: Vec<Vec<Option<[f64; 3]>>> = waypoints
+            .windows(2)
+            .map(|w| (0..=20).map(|j| {
+                let f = j as f64 / 20.0;
+                Some([0, 1, 2].map(|i| w[0][i] + f * (w[1][i] - w[0][i]) + 3.0 * (std::f64::consts::PI * f).sin()))
+            }).collect())
+            .collect();
+        let mut drawing = TrajectoryDrawing { waypoints: waypoints.clone(), legs, base_radius_mm: 5.0 };
+        for axis in [1, 2] {
+            let series = drawing.series(axis);
+            let straight = lines(&series[1]);
+            assert_eq!(straight.len(), 3);
+            assert_eq!(straight[2], vec![(45.0, waypoints[2][axis]), (50.0, waypoints[3][axis])]);
+            let path = lines(&series[2]);
+            assert_eq!(path.len(), 3, "one polyline per leg");
+            for (leg, line) in drawing.legs.iter().zip(path) {
+                let want: Vec<(f64, f64)> = leg.iter().flatten().map(|p| (p[0], p[axis])).collect();
+                assert_eq!(line, &want);
+            }
+            assert!(matches!(&series[3].mark, Mark::Crosses { at } if at.len() == 4));
+        }
+        drawing.legs[1][7] = None;
+        let series = drawing.series(1);
+        let path = lines(&series[2]);
+        assert_eq!(path.iter().map(Vec::len).collect::<Vec<_>>(), [21, 7, 13, 21], "the failed sample splits leg 2");
+        // Drawn: a PNG of the two views with the path's colour on it.
+        let dir = tempfile::tempdir().unwrap();
+        let file = dir.path().join("trajectory.png");
+        drawing.draw(&file, "test").unwrap();
+        let png = image::open(&file).unwrap().to_rgb8();
+        assert_eq!(png.dimensions(), (1400, 760));
+        let c = TRAJECTORY_PATH_COLOUR;
+        let red = png.pixels().filter(|p| p.0 == [c.0, c.1, c.2]).count();
+        assert!(red > 500, "{red} pixels of the path's colour");
+    }
+}

@@ -2,7 +2,7 @@
 //! design.json, one channel CSV per cable, and per target the actuator
 //! file that reproduces it (`target_N.toml`, for `simulate --actuator`) and
 //! its picture (`target_N.png`); for a trajectory, the sampled path
-//! (`trajectory.csv`).
+//! (`trajectory.csv`) and its picture (`trajectory.png`).
 
 use super::search::Setup;
 use super::CableDesignRun;
@@ -15,21 +15,6 @@ use std::path::Path;
 /// The actuator file of target `index` (from 0).
 pub fn actuator_file_name(index: usize) -> String {
     format!("target_{}.toml", index + 1)
-}
-
-/// Channel samples per mm of the CSVs.
-const CSV_SAMPLES_PER_MM: f64 = 4.0;
-
-/// `s_mm,y_mm,z_mm,dy_ds,dz_ds` of one channel over [0, its anchor].
-pub fn channel_csv(channel: &cable::Channel, end_mm: f64) -> String {
-    let mut out = String::from("s_mm,y_mm,z_mm,dy_ds,dz_ds\n");
-    let n = (end_mm * CSV_SAMPLES_PER_MM).round().max(1.0) as usize;
-    for k in 0..=n {
-        let s = end_mm * k as f64 / n as f64;
-        let p = channel.at(s);
-        let _ = writeln!(out, "{s:.4},{:.6},{:.6},{:.6},{:.6}", p.r_mm[0], p.r_mm[1], p.dr_ds[0], p.dr_ds[1]);
-    }
-    out
 }
 
 /// Writes the design's files into `dir` and returns their names, in order.
@@ -50,7 +35,7 @@ pub fn write_all(dir: &Path, run: &CableDesignRun, setup: &Setup) -> Result<Vec<
     let channels = first.channels().map_err(|e| DesignError::BadBounds(format!("the designed channels: {e}")))?;
     for (i, ch) in channels.iter().enumerate() {
         let end = first.cables[i].anchor_or_tip_mm(first.rod.length_mm);
-        write(&format!("channel_{}.csv", i + 1), channel_csv(ch, end).as_bytes())?;
+        write(&cable::channel_file_name(i), ch.csv(end).as_bytes())?;
     }
     for (i, t) in run.targets.iter().enumerate() {
         let toml = toml::to_string(&t.actuator).map_err(|e| DesignError::BadBounds(format!("writing the actuator of {}: {e}", t.target.name)))?;
@@ -69,6 +54,15 @@ pub fn write_all(dir: &Path, run: &CableDesignRun, setup: &Setup) -> Result<Vec<
             }
         }
         write("trajectory.csv", csv.as_bytes())?;
+        let waypoint = |t: &super::TargetOutcome| t.target.tip_mm().map(|v| v.unwrap_or(f64::NAN));
+        let drawing = crate::plot::spatial::TrajectoryDrawing {
+            waypoints: run.targets.iter().map(waypoint).collect(),
+            legs: tr.legs.iter().map(|l| l.samples.iter().map(|s| s.tip_mm).collect()).collect(),
+            base_radius_mm: run.design.actuator.rod.radius_at(0.0),
+        };
+        let title = format!("trajectory: {} waypoints, actuation linear in each leg, {} steps per leg; largest distance from the straight legs {:.3} mm", run.targets.len(), tr.steps_per_leg, tr.max_deviation_mm);
+        drawing.draw(&dir.join("trajectory.png"), &title)?;
+        written.push("trajectory.png".to_string());
     }
     for (i, t) in run.targets.iter().enumerate() {
         let sim = setup.simulate(&t.actuator).map_err(|e| DesignError::BadBounds(format!("re-simulating {}: {e}", t.target.name)))?;

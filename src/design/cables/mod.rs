@@ -380,8 +380,9 @@ fn command_of(actuator: &Actuator, file: Option<&std::path::Path>) -> String {
 }
 
 /// Whether the request is the thesis's design: one tension-driven planar
-/// cable free in y, gravity in its plane, one target asking only for the
-/// in-plane tip and a_bend_z.
+/// cable free in y with a positive lower tension bound (the planar search's
+/// τ_l > 0; `tension_min_n = 0` goes to the general search), gravity in its
+/// plane, one target asking only for the in-plane tip and a_bend_z.
 fn planar_case(r: &CableDesignRequest) -> bool {
     let d = &r.design;
     let [f] = d.freedom.as_slice() else { return false };
@@ -393,7 +394,7 @@ fn planar_case(r: &CableDesignRequest) -> bool {
         Quantity::TipZ => *v == 0.0,
         _ => false,
     });
-    f.free_y && !f.free_z && cable.is_planar() && matches!(f.actuation, ActuationBounds::Tension { .. }) && in_plane && planar_target && r.targets.trajectory.is_none() && r.map.is_none()
+    f.free_y && !f.free_z && cable.is_planar() && matches!(f.actuation, ActuationBounds::Tension { min_n, .. } if min_n > 0.0) && in_plane && planar_target && r.targets.trajectory.is_none() && r.map.is_none()
 }
 
 /// The planar request of the thesis's case ([`planar_case`]).
@@ -456,6 +457,7 @@ pub fn run(request: &CableDesignRequest) -> Result<CableDesignRun, DesignError> 
         targets: request.targets.targets.clone(),
         options: request.options.clone(),
         basis: request.length_basis,
+        smooth_steps: request.targets.trajectory.as_ref().filter(|t| t.smooth).map(|t| t.steps_per_leg),
     };
     let length = request.design.actuator.rod.length_mm;
     let (channels, achieved, cost, starts, seeds_simulated, method) = if planar_case(request) {

@@ -91,7 +91,17 @@ pub struct Setup {
     pub options: SolverOptions,
     /// The coefficients' length basis.
     pub basis: LengthBasis,
+    /// A trajectory with `smooth = true`: its steps per leg. No cable's
+    /// tension may reverse at the leg's samples ([`Setup::enforces_smooth`]).
+    pub smooth_steps: Option<usize>,
 }
+
+/// Weight of a leg's tension reversal ([`super::trajectory::reversal_n`]) in
+/// the objective, per (N per leg)²: a reversal of 0.1 mN per leg costs as
+/// much as a tip 1 mm off its target. Large, because a least-squares
+/// penalty only shrinks a violation by 1/(1 + w k²) (k its sensitivity to
+/// the design), never to zero.
+pub const REVERSAL_WEIGHT: f64 = 1e8;
 
 /// A point of the search: the unit-box coordinates.
 type Point = Vec<f64>;
@@ -140,6 +150,50 @@ impl Setup {
     /// Index of target `t`'s first actuation variable.
     fn actuation_start(&self, t: usize) -> usize {
         self.channel_var_count() + t * self.cables()
+    }
+
+    /// Whether the search penalises tension reversals: a trajectory with
+    /// `smooth = true` and a displacement-driven cable (a tension-driven
+    /// cable's tension is linear in a leg and never reverses).
+    pub fn enforces_smooth(&self) -> bool {
+        self.smooth_steps.is_some() && self.targets.len() > 1 && !self.reversal_cables().is_empty()
+    }
+
+    /// Interior samples per leg the search solves for a smooth trajectory
+    /// (those of the report: `steps_per_leg` − 1), 0 when not enforced.
+    pub fn smooth_samples(&self) -> usize {
+        match self.smooth_steps {
+            Some(n) if self.enforces_smooth() => n.saturating_sub(1),
+            _ => 0,
+        }
+    }
+
+    /// The cables whose tension may reverse inside a leg: the displacement-driven ones.
+    fn reversal_cables(&self) -> Vec<usize> {
+        self.design.freedom.iter().enumerate().filter(|(_, f)| matches!(f.actuation, ActuationBounds::Displacement { .. })).map(|(c, _)| c).collect()
+    }
+
+    /// A leg's reversal residuals, one per displacement-driven cable:
+    /// √w · [`super::trajectory::reversal_n`] of its tension at the leg's
+    /// ends (`ends`, as solved) and at the report's interior samples
+    /// ([`Setup::smooth_samples`]), the actuation moving linearly from
+    /// `from` to `to`. None when a sample's solve fails.
+    pub fn leg_residuals(&self, channels: &[Channel], (from, to): (&[f64], &[f64]), ends: (&Achieved, &Achieved)) -> Option<Vec<f64>> {
+        let cables = self.reversal_cables();
+        let mut series: Vec<Vec<f64>> = cables.iter().map(|&c| vec![ends.0.pose.tensions_n[c]]).collect();
+        let n = self.smooth_samples();
+        for j in 1..=n {
+            let f = j as f64 / (n + 1) as f64;
+            let act: Vec<f64> = from.iter().zip(to).map(|(p, q)| p + f * (q - p)).collect();
+            let a = self.quick(&self.actuator(channels, &act)).ok()?;
+            for (s, &c) in series.iter_mut().zip(&cables) {
+                s.push(a.pose.tensions_n[c]);
+            }
+        }
+        for (s, &c) in series.iter_mut().zip(&cables) {
+            s.push(ends.1.pose.tensions_n[c]);
+        }
+        Some(series.iter().map(|s| REVERSAL_WEIGHT.sqrt() * super::trajectory::reversal_n(s)).collect())
     }
 
     /// Number of variables.
@@ -333,6 +387,9 @@ const COST_FLOOR: f64 = 1e-20;
 
 struct Problem<'a> {
     setup: &'a Setup,
+    /// The last point solved and every target's solve there (a smooth
+    /// trajectory's Jacobian needs the neighbours of a moved target).
+    last: Option<(Point, Vec<Achieved>)>,
     best: Option<(f64, Point, Vec<Achieved>)>,
     evaluations: usize,
     max_evaluations: usize,
@@ -366,6 +423,14 @@ impl Problem<'_> {
             r.extend(self.setup.residuals_of(t, &a));
             all.push(a);
         }
+        if self.setup.enforces_smooth() {
+            for k in 0..all.len() - 1 {
+                self.evaluations += self.setup.smooth_samples();
+                let leg = self.setup.leg_residuals(&channels, (&self.setup.actuation(x, k), &self.setup.actuation(x, k + 1)), (&all[k], &all[k + 1]))?;
+                r.extend(leg);
+            }
+        }
+        self.last = Some((x.to_vec(), all.clone()));
         let cost: f64 = r.iter().map(|v| v * v).sum();
         if cost.is_finite() && self.best.as_ref().is_none_or(|b| cost < b.0) {
             self.best = Some((cost, x.to_vec(), all.clone()));
@@ -377,6 +442,21 @@ impl Problem<'_> {
     fn rows(&self, t: usize) -> std::ops::Range<usize> {
         let start: usize = self.setup.targets[..t].iter().map(|g| g.components.len()).sum();
         start..start + self.setup.targets[t].components.len()
+    }
+
+    /// Rows of leg `k`'s reversal residuals (after every target's rows).
+    fn leg_rows(&self, k: usize) -> std::ops::Range<usize> {
+        let n = self.setup.reversal_cables().len();
+        let start = self.rows(self.setup.targets.len() - 1).end + k * n;
+        start..start + n
+    }
+
+    /// Every target's solve at `x` (the last solve's, when it was at `x`).
+    fn solved_at(&mut self, x: &[f64]) -> Option<Vec<Achieved>> {
+        match &self.last {
+            Some((at, all)) if at.as_slice() == x => Some(all.clone()),
+            _ => self.solve_all(x).map(|r| r.1),
+        }
     }
 }
 
@@ -414,6 +494,18 @@ impl lm::Problem for Problem<'_> {
                 let rh = setup.residuals_of(t, &a);
                 for (i, row) in self.rows(t).enumerate() {
                     jac[(row, k)] = (rh[i] - r[row]) / h;
+                }
+                if setup.enforces_smooth() {
+                    // The legs into and out of target t move with it.
+                    let base = self.solved_at(x)?;
+                    for leg in t.saturating_sub(1)..(t + 1).min(setup.targets.len() - 1) {
+                        let ends = if leg == t { (&a, &base[t + 1]) } else { (&base[leg], &a) };
+                        self.evaluations += setup.smooth_samples();
+                        let lh = setup.leg_residuals(&channels, (&setup.actuation(&at, leg), &setup.actuation(&at, leg + 1)), ends)?;
+                        for (i, row) in self.leg_rows(leg).enumerate() {
+                            jac[(row, k)] = (lh[i] - r[row]) / h;
+                        }
+                    }
                 }
             }
         }
@@ -534,7 +626,7 @@ pub fn point_of(setup: &Setup, channels: &[Channel]) -> Point {
 
 /// Refines one start; returns the best point seen with its cost and solves.
 fn refine(setup: &Setup, x0: &[f64], max_evaluations: usize, source: &'static str) -> (Option<(f64, Point, Vec<Achieved>)>, StartReport) {
-    let mut p = Problem { setup, best: None, evaluations: 0, max_evaluations, history: Vec::new() };
+    let mut p = Problem { setup, last: None, best: None, evaluations: 0, max_evaluations, history: Vec::new() };
     let start = p.solve_all(x0);
     let seed_cost = start.as_ref().map_or(f64::INFINITY, |s| s.0.iter().map(|v| v * v).sum());
     let termination = match start {
@@ -591,7 +683,9 @@ pub fn search(setup: &Setup, search: &CableSearch, extra: &[Vec<Channel>]) -> Re
     if starts.is_empty() {
         return Err(DesignError::NoSeed);
     }
-    let budget = search.max_evaluations * setup.targets.len();
+    // Per target, and per leg its samples when the trajectory is smooth.
+    let legs = if setup.enforces_smooth() { setup.targets.len() - 1 } else { 0 };
+    let budget = search.max_evaluations * (setup.targets.len() + legs * setup.smooth_samples());
     let results: Vec<_> = starts.par_iter().map(|(x, source)| refine(setup, x, budget, source)).collect();
     let mut best: Option<(f64, Point, Vec<Achieved>)> = None;
     for (b, _) in &results {

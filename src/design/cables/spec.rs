@@ -4,7 +4,8 @@
 //! one with them is fixed unless it says `free = ["y"]`, `["z"]` or
 //! `["y", "z"]`. Its actuation is designed per target within
 //! `tension_min_n`/`tension_max_n` (default 0 … 2 N, the thesis's upper
-//! bound) or, for a displacement-driven cable (`displacement_mm` or
+//! bound; 1 … 2 N, the thesis's and `design --target`'s, for an actuator
+//! of one cable: [`default_tension_min_n`]) or, for a displacement-driven cable (`displacement_mm` or
 //! `displacement_max_mm` given), within 0 … `displacement_max_mm`.
 //! A free coordinate stays within `max_offset_mm` of the axis (default the
 //! thesis's 0.999 r: the radius less a skin of 0.1 %).
@@ -17,6 +18,19 @@ use std::path::Path;
 
 /// Default upper tension bound of a designed cable, N (the thesis's τ_u).
 pub const DEFAULT_TENSION_MAX_N: f64 = 2.0;
+
+/// Default lower tension bound of a designed cable of an actuator with
+/// `cables` cables, N: for one cable the thesis's τ_l = 1 N, the default of
+/// `design --target` (whose search, the thesis's, serves one planar cable
+/// and needs τ_l > 0), so the thesis's design through `--targets` gives
+/// its answers; for several, 0 N (an antagonist must be able to go slack).
+pub fn default_tension_min_n(cables: usize) -> f64 {
+    if cables == 1 {
+        crate::design::run::DEFAULT_TENSION_RANGE_N[0]
+    } else {
+        0.0
+    }
+}
 
 /// Default upper displacement bound of a displacement-driven cable, mm
 /// (the thesis rod's ≈ 2.5 mm/N at its 2 N).
@@ -117,6 +131,7 @@ impl DesignActuator {
             _ => return Err(bad(source, "no [[cable]] tables: a design needs 1 to 8 cables (a [[cable]] without y_mm/z_mm has a free channel)".into())),
         };
         let mut pending = Vec::with_capacity(cables.len());
+        let tension_min_n = default_tension_min_n(cables.len());
         for (i, cable) in cables.iter_mut().enumerate() {
             let no = i + 1;
             let toml::Value::Table(t) = cable else { return Err(bad(source, format!("cable {no} is not a table"))) };
@@ -169,7 +184,7 @@ impl DesignActuator {
             } else {
                 t.insert("tension_n".into(), toml::Value::Float(0.0));
                 ActuationBounds::Tension {
-                    min_n: number("tension_min_n")?.unwrap_or(0.0),
+                    min_n: number("tension_min_n")?.unwrap_or(tension_min_n),
                     max_n: number("tension_max_n")?.unwrap_or(DEFAULT_TENSION_MAX_N),
                 }
             };
@@ -236,6 +251,11 @@ mod tests {
         assert_eq!((f[2].free_y, f[2].free_z), (false, false));
         assert_eq!(f[3].actuation, ActuationBounds::Displacement { min_mm: 0.0, max_mm: 3.0 });
         assert_eq!(d.actuator.cables[1].y_mm, [-2.0; 5]);
+        // One cable: the thesis's 1 … 2 N of `design --target`, unless given.
+        let one = DesignActuator::parse("[[cable]]\n", "test", |r| r.clone()).unwrap();
+        assert_eq!(one.freedom[0].actuation, ActuationBounds::Tension { min_n: 1.0, max_n: 2.0 });
+        let zero = DesignActuator::parse("[[cable]]\ntension_min_n = 0\n", "test", |r| r.clone()).unwrap();
+        assert_eq!(zero.freedom[0].actuation, ActuationBounds::Tension { min_n: 0.0, max_n: 2.0 });
     }
 
     #[test]
