@@ -96,7 +96,7 @@ pub struct Setup {
     pub smooth_steps: Option<usize>,
 }
 
-/// Weight of a leg's tension reversal ([`super::trajectory::reversal_n`]) in
+/// Weight of a leg's tension reversal ([`reversal_n`]) in
 /// the objective, per (N per leg)²: a reversal of 0.1 mN per leg costs as
 /// much as a tip 1 mm off its target. Large, because a least-squares
 /// penalty only shrinks a violation by 1/(1 + w k²) (k its sensitivity to
@@ -174,7 +174,7 @@ impl Setup {
     }
 
     /// A leg's reversal residuals, one per displacement-driven cable:
-    /// √w · [`super::trajectory::reversal_n`] of its tension at the leg's
+    /// √w · [`reversal_n`] of its tension at the leg's
     /// ends (`ends`, as solved) and at the report's interior samples
     /// ([`Setup::smooth_samples`]), the actuation moving linearly from
     /// `from` to `to`. None when a sample's solve fails.
@@ -193,7 +193,7 @@ impl Setup {
         for (s, &c) in series.iter_mut().zip(&cables) {
             s.push(ends.1.pose.tensions_n[c]);
         }
-        Some(series.iter().map(|s| REVERSAL_WEIGHT.sqrt() * super::trajectory::reversal_n(s)).collect())
+        Some(series.iter().map(|s| REVERSAL_WEIGHT.sqrt() * reversal_n(s)).collect())
     }
 
     /// Number of variables.
@@ -700,6 +700,19 @@ pub fn search(setup: &Setup, search: &CableSearch, extra: &[Vec<Channel>]) -> Re
     Ok(Found { channels: setup.channels(&x), x, achieved, cost, starts: results.into_iter().map(|r| r.1).collect(), seeds_simulated })
 }
 
+/// How steeply `values` (a cable's tension at evenly spaced samples of a
+/// leg, N) move against their direction: over the two directions, the
+/// lesser of the largest step against it, times the number of steps (N per
+/// leg). Zero exactly when the values never both rise and fall, and, unlike
+/// the depth of a dip, linear in how far a design is from not reversing,
+/// so a least-squares penalty drives it to zero
+/// ([`Setup::leg_residuals`]).
+pub fn reversal_n(values: &[f64]) -> f64 {
+    let steps: Vec<f64> = values.windows(2).map(|w| w[1] - w[0]).collect();
+    let against = |sign: f64| steps.iter().map(|d| (-sign * d).max(0.0)).fold(0.0, f64::max);
+    steps.len() as f64 * against(1.0).min(against(-1.0))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -711,6 +724,26 @@ mod tests {
             assert!(x.hypot(y) <= 1.0 + 1e-12);
             let (a, b) = square_of(x, y);
             assert!((a - u).abs() < 1e-9 && (b - v).abs() < 1e-9, "{u},{v} → {a},{b}");
+        }
+    }
+
+    /// The search's penalty: zero exactly for a series that never moves
+    /// against its overall direction, else how far it does.
+    #[test]
+    fn the_reversal_penalty_is_zero_only_without_a_reversal() {
+        assert_eq!(reversal_n(&[0.0, 0.5, 1.0, 1.0]), 0.0);
+        assert_eq!(reversal_n(&[2.0, 1.5, 1.5, 0.2]), 0.0);
+        assert_eq!(reversal_n(&[]), 0.0);
+        // Up 1.0 then down 0.4 (2 steps): the lesser steepest step against a direction, 0.4, × 2.
+        assert!((reversal_n(&[0.0, 1.0, 0.6]) - 0.8).abs() < 1e-15);
+        // A hump: against rising, its steepest fall 0.3; against falling, its steepest rise 0.3; × 4 steps.
+        assert!((reversal_n(&[1.0, 1.3, 1.5, 1.2, 1.0]) - 1.2).abs() < 1e-15);
+        // Linear in the dip as a trend removes it: a dip c f (f − 1) plus a trend D f.
+        let dip = |d: f64| reversal_n(&(0..=20).map(|j| { let f = j as f64 / 20.0; d * f + f * (f - 1.0) }).collect::<Vec<_>>());
+        assert!((dip(0.5) - 0.45).abs() < 1e-12 && (dip(0.75) - 0.2).abs() < 1e-12, "{} {}", dip(0.5), dip(0.75));
+        assert_eq!(dip(1.0), 0.0);
+        for v in [[0.0, 0.5, 0.4], [1.0, 0.2, 0.3]] {
+            assert!(reversal_n(&v) > 0.0);
         }
     }
 }

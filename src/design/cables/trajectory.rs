@@ -111,19 +111,6 @@ pub fn distance_to_segment(p: [f64; 3], a: [f64; 3], b: [f64; 3]) -> f64 {
     (0..3).map(|i| (w[i] - t * d[i]).powi(2)).sum::<f64>().sqrt()
 }
 
-/// How steeply `values` (a cable's tension at evenly spaced samples of a
-/// leg, N) move against their direction: over the two directions, the
-/// lesser of the largest step against it, times the number of steps (N per
-/// leg). Zero exactly when the values never both rise and fall, and, unlike
-/// the depth of a dip, linear in how far a design is from not reversing,
-/// so a least-squares penalty drives it to zero
-/// ([`super::search::Setup::leg_residuals`]).
-pub fn reversal_n(values: &[f64]) -> f64 {
-    let steps: Vec<f64> = values.windows(2).map(|w| w[1] - w[0]).collect();
-    let against = |sign: f64| steps.iter().map(|d| (-sign * d).max(0.0)).fold(0.0, f64::max);
-    steps.len() as f64 * against(1.0).min(against(-1.0))
-}
-
 /// Whether `values` both rise and fall (beyond rounding).
 fn reverses(values: &[f64]) -> bool {
     let scale = values.iter().fold(1e-9_f64, |m, v| m.max(v.abs()));
@@ -186,25 +173,5 @@ mod tests {
         assert!(!reverses(&[0.0, 0.5, 1.0, 1.0]));
         assert!(reverses(&[0.0, 0.5, 0.4]));
         assert!(!reverses(&[1.0, 1.0 + 1e-13, 1.0]));
-    }
-
-    /// The search's penalty: zero exactly for a series that never moves
-    /// against its overall direction, else how far it does.
-    #[test]
-    fn the_reversal_penalty_is_zero_only_without_a_reversal() {
-        assert_eq!(reversal_n(&[0.0, 0.5, 1.0, 1.0]), 0.0);
-        assert_eq!(reversal_n(&[2.0, 1.5, 1.5, 0.2]), 0.0);
-        assert_eq!(reversal_n(&[]), 0.0);
-        // Up 1.0 then down 0.4 (2 steps): the lesser steepest step against a direction, 0.4, × 2.
-        assert!((reversal_n(&[0.0, 1.0, 0.6]) - 0.8).abs() < 1e-15);
-        // A hump: against rising, its steepest fall 0.3; against falling, its steepest rise 0.3; × 4 steps.
-        assert!((reversal_n(&[1.0, 1.3, 1.5, 1.2, 1.0]) - 1.2).abs() < 1e-15);
-        // Linear in the dip as a trend removes it: a dip c f (f − 1) plus a trend D f.
-        let dip = |d: f64| reversal_n(&(0..=20).map(|j| { let f = j as f64 / 20.0; d * f + f * (f - 1.0) }).collect::<Vec<_>>());
-        assert!((dip(0.5) - 0.45).abs() < 1e-12 && (dip(0.75) - 0.2).abs() < 1e-12, "{} {}", dip(0.5), dip(0.75));
-        assert_eq!(dip(1.0), 0.0);
-        for v in [[0.0, 0.5, 0.4], [1.0, 0.2, 0.3]] {
-            assert!(reversal_n(&v) > 0.0 && reverses(&v));
-        }
     }
 }
