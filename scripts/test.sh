@@ -24,7 +24,7 @@ fi
 bin=$target/release/cablemap
 venv=${CABLEMAP_VENV:-$target/python-venv}
 artefacts=${CABLEMAP_TEST_ARTEFACTS:-$target/test-artefacts}
-python_packages="pandas polars pyarrow selenium trimesh numpy maturin pytest"
+python_packages="pandas polars pyarrow selenium trimesh numpy maturin pytest matplotlib"
 work=$(mktemp -d)
 # No kill of the background jobs on exit: an install must not be cut short.
 trap 'rm -rf "$work"' EXIT

@@ -329,3 +329,8 @@ def solve_batch(
     result["a"] = np.frombuffer(out["a"], dtype=np.float64).reshape(n, m, k).copy()
     result["status"] = np.array(out["status"], dtype=object).reshape(n, m)
     return result
+
+from ._reports import *  # noqa: E402,F401,F403  reports: design, feasible, calibrate, diagnose, predict (_reports.py)
+from ._reports import __all__ as _reports_all  # noqa: E402
+
+__all__ += _reports_all

@@ -170,3 +170,154 @@ def read_map(path: PathLike) -> Dict[str, _pl.DataFrame]:
     """Every table of a map directory, keyed by table name: `cells`, `modes`,
     `designs` (a cable sweep's map: `reach_xy`, `reach_xz`, `reach_yz`,
     `reach_3d`, and its planar map's `cells`, `modes`, `designs`)."""
+
+# ---------------------------------------------------------------- reports
+# design, feasible, calibrate, diagnose, predict (python/cablemap/_reports.py)
+
+from typing import Iterable, Mapping
+
+class Report:
+    """A workflow's report: the command's `--json` fields as attributes.
+
+    `to_dict()` is exactly that object; `text` (and `str(report)`) the report
+    the command prints without `--json`; `pictures` the paths of the pictures
+    the workflow wrote (PNG, SVG), embedded by `_repr_html_` in notebooks.
+    """
+
+    text: str
+    pictures: List[str]
+    def __getattr__(self, name: str) -> Any: ...
+    def to_dict(self) -> Dict[str, Any]:
+        """The command's `--json` object, exactly."""
+    def _repr_html_(self) -> str:
+        """The summary, the pictures (PNG as base64, SVG inline) and the text report."""
+
+class DesignReport(Report):
+    """`cablemap design --json`: routing_mm, tension_n, tip_x_mm, tip_y_mm, a, error_pct, met, unmet, cost, …
+    (with targets=: cables, targets, met, unmet, cost, method, …)."""
+
+    met: bool
+    unmet: List[str]
+    cost: float
+
+class FeasibleReport(Report):
+    """`cablemap feasible --json`: verdict, reasons, tip_cell, coefficients, mode, nearest, …"""
+
+class CalibrateReport(Report):
+    """`cablemap calibrate --json`: the fitted parameters with standard errors, correlation, RMS errors, …"""
+
+class DiagnoseReport(Report):
+    """`cablemap diagnose --json`: verdict, reason, effects, parameter, candidates, baseline/extended/best fits, report."""
+
+    verdict: str
+    reason: str
+
+class PredictReport(Report):
+    """`cablemap predict --json`: actuator, captures (each capture's marker errors), rms_by_marker_mm, rms_mm."""
+
+    rms_mm: float
+
+def design(
+    target: Union[str, Mapping[str, float], None] = ...,
+    *,
+    targets: Optional[PathLike] = ...,
+    actuator: Union[Actuator, PathLike, None] = ...,
+    weights: Union[str, Mapping[str, float], None] = ...,
+    map: Optional[PathLike] = ...,
+    tension_min_n: Optional[float] = ...,
+    tension_max_n: Optional[float] = ...,
+    max_offset_mm: Optional[float] = ...,
+    length_basis: str = ...,
+    starts: Optional[int] = ...,
+    max_evaluations: Optional[int] = ...,
+    tolerance_pct: Optional[float] = ...,
+    out: Optional[PathLike] = ...,
+    moulds: bool = ...,
+    wall_mm: Optional[float] = ...,
+    tube_diameter_mm: Optional[float] = ...,
+    clearance_mm: Optional[float] = ...,
+    clamp_mm: Optional[float] = ...,
+    min_skin_mm: Optional[float] = ...,
+    method: Optional[str] = ...,
+    nodes_per_span: Optional[int] = ...,
+    steps_per_span: Optional[int] = ...,
+    **actuator_fields: Any,
+) -> DesignReport:
+    """`cablemap design --json`: target= (one planar cable, eq. 3.17) or targets=FILE.toml (several cables, actuator=FILE.toml)."""
+
+def feasible(
+    target: Union[str, Mapping[str, float], None] = ...,
+    *,
+    map: Optional[PathLike] = ...,
+    study: Optional[PathLike] = ...,
+    targets: Optional[PathLike] = ...,
+    weights: Union[str, Mapping[str, float], None] = ...,
+    nearest: int = ...,
+    length_basis: str = ...,
+) -> FeasibleReport:
+    """`cablemap feasible --json`: a map's (map=) or a study's (study=) verdict on a target, or a cable sweep's map on targets=FILE.toml."""
+
+def calibrate(
+    data: PathLike,
+    *,
+    actuator: Optional[PathLike] = ...,
+    markers: Optional[PathLike] = ...,
+    centrelines: Optional[PathLike] = ...,
+    out: Optional[PathLike] = ...,
+    effects: Union[str, Iterable[str], None] = ...,
+    fix: Union[Mapping[str, float], Iterable[str], None] = ...,
+    holdout: Optional[str] = ...,
+    holdout_cable: Optional[int] = ...,
+    noise_mm: float = ...,
+    noise_deg: float = ...,
+    loss: Optional[str] = ...,
+    huber_k: float = ...,
+    max_iterations: int = ...,
+    angle_weight: float = ...,
+    actuator_file: Optional[PathLike] = ...,
+    method: Optional[str] = ...,
+    nodes_per_span: Optional[int] = ...,
+    steps_per_span: Optional[int] = ...,
+    **rod_fields: Any,
+) -> CalibrateReport:
+    """`cablemap calibrate DATA --json`: planar measurements, or captures and 3-D markers with actuator=FILE.toml."""
+
+def diagnose(
+    data: PathLike,
+    *,
+    actuator: Optional[PathLike] = ...,
+    markers: Optional[PathLike] = ...,
+    centrelines: Optional[PathLike] = ...,
+    out: Optional[PathLike] = ...,
+    report: bool = ...,
+    fix: Union[Mapping[str, float], Iterable[str], None] = ...,
+    holdout: Optional[str] = ...,
+    holdout_cable: Optional[int] = ...,
+    noise_mm: float = ...,
+    noise_deg: float = ...,
+    loss: Optional[str] = ...,
+    huber_k: float = ...,
+    max_iterations: int = ...,
+    angle_weight: float = ...,
+    alpha: float = ...,
+    threshold: float = ...,
+    margin: float = ...,
+    max_effects: int = ...,
+    actuator_file: Optional[PathLike] = ...,
+    method: Optional[str] = ...,
+    nodes_per_span: Optional[int] = ...,
+    steps_per_span: Optional[int] = ...,
+    **rod_fields: Any,
+) -> DiagnoseReport:
+    """`cablemap diagnose DATA --json`: the effect the model misses; report.md and plots in out= (planar)."""
+
+def predict(
+    captures: PathLike,
+    actuator: PathLike,
+    *,
+    markers: Optional[PathLike] = ...,
+    method: Optional[str] = ...,
+    nodes_per_span: Optional[int] = ...,
+    steps_per_span: Optional[int] = ...,
+) -> PredictReport:
+    """`cablemap predict CAPTURES --actuator A.toml --json`: the markers' 3-D errors, no fitting."""

@@ -24,6 +24,8 @@ use rayon::prelude::*;
 use serde::Deserialize;
 use serde_json::{Map, Value};
 
+mod reports;
+
 /// What went wrong, as the Python exception it becomes.
 #[derive(Debug)]
 enum Failure {
@@ -450,6 +452,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(solve_batch, m)?)?;
     data::register(m)?;
+    reports::register(m)?;
     m.add("CENTRELINE_COLUMNS", CENTRELINE.to_vec())?;
     m.add("BATCH_FIELDS", BATCH_FIELDS.to_vec())?;
     Ok(())

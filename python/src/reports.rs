@@ -1,0 +1,634 @@
+//! The workflows that answer with a report: `design`, `feasible`,
+//! `calibrate`, `diagnose` and `predict` (the functions
+//! `cablemap.design`, … of `python/cablemap/_reports.py`).
+//!
+//! Each function takes a request as JSON (the command's flags by their
+//! names, built from keyword arguments), builds the library's request the
+//! way the command in `src/cli/` does, runs it with the GIL released and
+//! returns `(the --json object, the command's text report, the pictures
+//! the request wrote)`. Errors become the package's exceptions with the
+//! library's messages.
+
+use super::{actuator_with, bad, Failure, Result, SolverRequest};
+use cablemap::calibrate::captures::diagnose::{diagnose_request, Diagnose3Request};
+use cablemap::calibrate::captures::{self, Calibrate3Request, Param, PredictRequest};
+use cablemap::calibrate::diagnose::DiagnoseRequest;
+use cablemap::calibrate::fit::{parse_held, Held, Loss, Noise};
+use cablemap::calibrate::{CalibrateError, CalibrateRequest, Effect, FitSettings};
+use cablemap::design::cables::search::CableSearch;
+use cablemap::design::cables::spec::{DesignActuator, DEFAULT_TENSION_MAX_N};
+use cablemap::design::cables::targets::TargetSet;
+use cablemap::design::cables::CableDesignRequest;
+use cablemap::design::feasible::{FeasibleRequest, MapSource};
+use cablemap::design::run::DesignRequest;
+use cablemap::design::{DesignError, SearchOptions, Target, Weights};
+use cablemap::model::spatial::SpatialOptions;
+use cablemap::model::{Actuator, Rod, RodOverrides, REGISTRY};
+use cablemap::mould::{MouldOptions, MouldParams};
+use cablemap::shape::LengthBasis;
+use pyo3::prelude::*;
+use serde::Deserialize;
+use serde_json::{Map, Value};
+use std::path::{Path, PathBuf};
+
+/// A finished workflow: its `--json` object (as JSON text), the command's
+/// text report, and the paths of the pictures it wrote (PNG, SVG).
+type Finished = (String, String, Vec<String>);
+
+/// The library's design errors as the package's exceptions.
+fn design_failure(e: DesignError) -> Failure {
+    let message = e.to_string();
+    match e {
+        DesignError::Simulate(s) => s.into(),
+        DesignError::NoSeed => Failure::Solve { status: "failed".into(), message },
+        DesignError::File(_) | DesignError::MapTable(_) | DesignError::Map { .. } | DesignError::Study(_) | DesignError::Plot(_) => {
+            Failure::File(message)
+        }
+        DesignError::Variant { source, .. } => match design_failure(*source) {
+            Failure::File(_) => Failure::File(message),
+            Failure::Solve { status, .. } => Failure::Solve { status, message },
+            Failure::BadInput(_) => Failure::BadInput(message),
+        },
+        _ => Failure::BadInput(message),
+    }
+}
+
+/// The library's calibration errors as the package's exceptions.
+fn calibrate_failure(e: CalibrateError) -> Failure {
+    let message = e.to_string();
+    match e {
+        CalibrateError::Io { .. }
+        | CalibrateError::Empty { .. }
+        | CalibrateError::MissingColumn { .. }
+        | CalibrateError::BadValue { .. }
+        | CalibrateError::Malformed { .. }
+        | CalibrateError::Geometry { .. }
+        | CalibrateError::Inconsistent { .. }
+        | CalibrateError::ActuatorFile(_)
+        | CalibrateError::Plot(_) => Failure::File(message),
+        CalibrateError::Solve { failure, .. } => Failure::Solve { status: failure.status().to_string(), message },
+        CalibrateError::Actuator(s) | CalibrateError::Capture { failure: s, .. } => match Failure::from(s) {
+            Failure::File(_) => Failure::File(message),
+            Failure::Solve { status, .. } => Failure::Solve { status, message },
+            Failure::BadInput(_) => Failure::BadInput(message),
+        },
+        CalibrateError::Held(inner) => match calibrate_failure(*inner) {
+            Failure::BadInput(m) => Failure::BadInput(format!("fix: {m}")),
+            other => other,
+        },
+        _ => Failure::BadInput(message),
+    }
+}
+
+/// Runs `work` with the GIL released and turns its failure into the
+/// package's exception.
+fn detached<T: Send>(py: Python<'_>, work: impl FnOnce() -> Result<T> + Send) -> PyResult<T> {
+    py.detach(work).map_err(|e| e.into_py(py))
+}
+
+/// `dir/name` for each picture among `names` (PNG and SVG files).
+fn pictures(dir: Option<&Path>, names: &[String]) -> Vec<String> {
+    let Some(dir) = dir else { return Vec::new() };
+    names.iter().filter(|n| n.ends_with(".png") || n.ends_with(".svg")).map(|n| dir.join(n).display().to_string()).collect()
+}
+
+/// The length basis by its name (`rest` or `deformed`).
+fn length_basis(name: &str) -> Result<LengthBasis> {
+    super::from_json(&format!("\"{name}\""), "length_basis (\"rest\" or \"deformed\")")
+}
+
+/// The 3-D solver's settings from the solver's fields, as the commands'
+/// `spatial_options`: only those given change the defaults.
+fn spatial_options(solver: &SolverRequest) -> Result<SpatialOptions> {
+    let given = solver.options()?;
+    let mut o = SpatialOptions::default();
+    if solver.nodes_per_span.is_some() {
+        o.nodes_per_span = given.nodes_per_span;
+    }
+    if solver.steps_per_span.is_some() {
+        o.steps_per_span = given.steps_per_span;
+    }
+    if solver.method.is_some() {
+        o.method = given.method;
+    }
+    Ok(o)
+}
+
+/// The rod overrides of a planar fit (the rod flags of `calibrate` and
+/// `diagnose`): `actuator_file`, the rod's fields by their flags' names,
+/// `gravity=False` for `--no-gravity`, and effects by their registry names.
+fn rod_overrides(fields: Map<String, Value>) -> Result<RodOverrides> {
+    let mut o = RodOverrides::default();
+    let number = |key: &str, v: &Value| v.as_f64().ok_or_else(|| bad(format!("{key}: expected a number, got {v}")));
+    for (key, value) in fields {
+        let slot = match key.as_str() {
+            "length_mm" => &mut o.length_mm,
+            "radius_mm" => &mut o.radius_mm,
+            "ea_n" => &mut o.ea_n,
+            "ga_n" => &mut o.ga_n,
+            "ei_n_mm2" => &mut o.ei_n_mm2,
+            "density_g_cm3" => &mut o.density_g_cm3,
+            "cable_anchor_mm" => &mut o.cable_anchor_mm,
+            "actuator_file" => {
+                let path = value.as_str().ok_or_else(|| bad(format!("actuator_file: expected a rod file's path, got {value}")))?;
+                o.file = Some(PathBuf::from(path));
+                continue;
+            }
+            "gravity" => {
+                o.no_gravity = !value.as_bool().ok_or_else(|| bad(format!("gravity: expected True or False, got {value}")))?;
+                continue;
+            }
+            "radius_profile_mm" => {
+                o.radius_profile_mm = Some(super::from_json(&value.to_string(), "radius_profile_mm (a list of [s_mm, r_mm] points)")?);
+                continue;
+            }
+            _ => {
+                if let Some(info) = REGISTRY.iter().find(|i| i.name == key) {
+                    o.effects.push((*info, number(&key, &value)?));
+                    continue;
+                }
+                let mut known = ["actuator_file", "length_mm", "radius_mm", "ea_n", "ga_n", "ei_n_mm2", "density_g_cm3", "gravity", "radius_profile_mm", "cable_anchor_mm"]
+                    .map(String::from)
+                    .to_vec();
+                known.extend(REGISTRY.iter().map(|i| i.name.to_string()));
+                return Err(bad(format!("unknown rod field {key:?}: the fields are {}", known.join(", "))));
+            }
+        };
+        *slot = Some(number(&key, &value)?);
+    }
+    Ok(o)
+}
+
+// ---------------------------------------------------------------- design
+
+/// The moulds' parameters of `design --moulds` (`--wall-mm`, …), each
+/// the default when not given.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MouldRequest {
+    wall_mm: Option<f64>,
+    tube_diameter_mm: Option<f64>,
+    clearance_mm: Option<f64>,
+    clamp_mm: Option<f64>,
+    min_skin_mm: Option<f64>,
+}
+
+impl MouldRequest {
+    fn params(&self) -> MouldParams {
+        let d = MouldParams::default();
+        MouldParams {
+            wall_mm: self.wall_mm.unwrap_or(d.wall_mm),
+            tube_diameter_mm: self.tube_diameter_mm.unwrap_or(d.tube_diameter_mm),
+            clearance_mm: self.clearance_mm.unwrap_or(d.clearance_mm),
+            clamp_mm: self.clamp_mm.unwrap_or(d.clamp_mm),
+            min_skin_mm: self.min_skin_mm.unwrap_or(d.min_skin_mm),
+            ..d
+        }
+    }
+}
+
+/// What `cablemap.design` asks: the flags of `cablemap design`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct DesignPy {
+    /// The rod (with its fields set), when no design actuator file is given.
+    actuator: Actuator,
+    /// `--actuator FILE.toml` with `--targets`: the actuator to design.
+    design_actuator: Option<PathBuf>,
+    /// Rod fields set on the design actuator file's rod (the rod flags).
+    #[serde(default)]
+    rod_fields: Map<String, Value>,
+    /// `--target K=V,…`.
+    target: Option<String>,
+    /// `--targets FILE.toml`.
+    targets: Option<PathBuf>,
+    weights: Option<String>,
+    map: Option<PathBuf>,
+    tension_min_n: Option<f64>,
+    tension_max_n: Option<f64>,
+    max_offset_mm: Option<f64>,
+    length_basis: String,
+    starts: Option<usize>,
+    max_evaluations: Option<usize>,
+    tolerance_pct: Option<f64>,
+    out: Option<PathBuf>,
+    #[serde(default)]
+    moulds: bool,
+    #[serde(default)]
+    mould: MouldRequest,
+    #[serde(default)]
+    solver: SolverRequest,
+}
+
+/// The planar design (`design --target`).
+fn design_planar(r: DesignPy) -> Result<Finished> {
+    let weights = r.weights.as_deref().map(Weights::parse).transpose().map_err(|e| bad(format!("weights: {e}")))?.unwrap_or_default();
+    if !r.actuator.cables.is_empty() || r.actuator.gj_n_mm2.is_some() || r.actuator.gravity_direction.is_some() {
+        return Err(bad(
+            "design(target=…) designs one planar cable on a rod: give the rod alone (no cables, gj_n_mm2 or gravity_direction), or targets=FILE.toml with actuator=FILE.toml for several cables",
+        ));
+    }
+    let request = DesignRequest {
+        actuator: r.actuator.rod,
+        options: r.solver.options()?,
+        target: Target::parse(r.target.as_deref().unwrap_or_default()).map_err(|e| bad(format!("target: {e}")))?,
+        weights,
+        tension_min_n: r.tension_min_n,
+        tension_max_n: r.tension_max_n,
+        max_offset_mm: r.max_offset_mm,
+        length_basis: length_basis(&r.length_basis)?,
+        map: r.map,
+        search: SearchOptions {
+            starts: r.starts.unwrap_or(8),
+            max_evaluations: r.max_evaluations.unwrap_or(SearchOptions::default().max_evaluations),
+            ..SearchOptions::default()
+        },
+        tolerance_pct: r.tolerance_pct.unwrap_or(5.0),
+        out: r.out,
+        mould: r.mould.params(),
+        write_moulds: r.moulds,
+    };
+    let done = cablemap::design::run::run(&request).map_err(design_failure)?;
+    Ok((done.record.to_json_line(), done.to_string(), pictures(done.out.as_deref(), &done.exported)))
+}
+
+/// The several-cable design (`design --targets FILE.toml [--actuator FILE.toml]`).
+fn design_cables(r: DesignPy, targets: &Path) -> Result<Finished> {
+    for (given, name, instead) in [
+        (r.weights.is_some(), "weights", "weights = { … } in each [[target]]"),
+        (r.tension_min_n.is_some(), "tension_min_n", "tension_min_n in each [[cable]] of the actuator file"),
+        (r.tension_max_n.is_some(), "tension_max_n", "tension_max_n in each [[cable]] of the actuator file"),
+        (r.max_offset_mm.is_some(), "max_offset_mm", "max_offset_mm in each [[cable]] of the actuator file"),
+    ] {
+        if given {
+            return Err(bad(format!("{name} does not apply to targets=: give {instead}")));
+        }
+    }
+    let design = match &r.design_actuator {
+        Some(path) => {
+            // The rod fields apply to the file's rod; the first refusal is kept.
+            let refused = std::cell::RefCell::new(None);
+            let apply = |rod: &Rod| match actuator_with(Some(Actuator::with_cables(rod.clone(), Vec::new())), r.rod_fields.clone()) {
+                Ok(a) => a.rod,
+                Err(e) => {
+                    refused.borrow_mut().get_or_insert(e);
+                    rod.clone()
+                }
+            };
+            let design = DesignActuator::read(path, apply).map_err(design_failure);
+            if let Some(e) = refused.into_inner() {
+                return Err(e);
+            }
+            design?
+        }
+        None => DesignActuator::planar(r.actuator.rod.clone(), 0.0, DEFAULT_TENSION_MAX_N, None),
+    };
+    let mut targets = TargetSet::read(targets, design.actuator.rod.length_mm).map_err(design_failure)?;
+    if let Some(tol) = r.tolerance_pct {
+        targets.targets.iter_mut().for_each(|t| t.tolerance_pct = tol);
+    }
+    let request = CableDesignRequest {
+        design,
+        targets,
+        options: r.solver.options()?,
+        length_basis: length_basis(&r.length_basis)?,
+        search: CableSearch {
+            starts: r.starts.unwrap_or(CableSearch::default().starts),
+            max_evaluations: r.max_evaluations.unwrap_or(SearchOptions::default().max_evaluations),
+        },
+        map: r.map,
+        out: r.out,
+        moulds: r.moulds.then(|| MouldOptions { params: r.mould.params(), ..Default::default() }),
+    };
+    let done = cablemap::design::cables::run(&request).map_err(design_failure)?;
+    Ok((done.to_json().to_string(), done.to_string(), pictures(done.out.as_deref(), &done.exported)))
+}
+
+/// `cablemap design`: with `targets` the several-cable design, else the
+/// planar one of `target`.
+#[pyfunction]
+pub(crate) fn design(py: Python<'_>, request_json: &str) -> PyResult<Finished> {
+    let request: DesignPy = super::from_json(request_json, "design").map_err(|e| e.into_py(py))?;
+    detached(py, move || match request.targets.clone() {
+        Some(targets) => design_cables(request, &targets),
+        None => design_planar(request),
+    })
+}
+
+// ---------------------------------------------------------------- feasible
+
+/// What `cablemap.feasible` asks: the flags of `cablemap feasible`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FeasiblePy {
+    map: Option<PathBuf>,
+    study: Option<PathBuf>,
+    target: Option<String>,
+    targets: Option<PathBuf>,
+    weights: Option<String>,
+    nearest: usize,
+    length_basis: String,
+}
+
+fn feasible_run(r: FeasiblePy) -> Result<Finished> {
+    let basis = length_basis(&r.length_basis)?;
+    if let Some(file) = &r.targets {
+        let Some(map) = &r.map else { return Err(bad("targets= needs map=: the map of a cable sweep")) };
+        if r.weights.is_some() {
+            return Err(bad("weights does not apply to targets=: give weights = { … } in each [[target]]"));
+        }
+        // As the command: the rod's length only sets the targets' default weights.
+        let targets = TargetSet::read(file, Rod::default().length_mm).map_err(design_failure)?;
+        let report = cablemap::design::cables::feasible::check(map, &targets, basis, r.nearest).map_err(design_failure)?;
+        return Ok((super::to_json(&report), report.to_string(), Vec::new()));
+    }
+    let target = Target::parse(r.target.as_deref().ok_or_else(|| bad("give target= (or targets= with map=)"))?).map_err(|e| bad(format!("target: {e}")))?;
+    let weights = r.weights.as_deref().map(Weights::parse).transpose().map_err(|e| bad(format!("weights: {e}")))?.unwrap_or_default();
+    let source = match (r.map, r.study) {
+        (Some(_), Some(_)) => return Err(bad("give map= or study=, not both")),
+        (Some(map), None) => MapSource::Map(map),
+        (None, Some(study)) => MapSource::Study(study),
+        (None, None) => return Err(bad("give map=MAP_DIR (a `cablemap reduce` output) or study=DIR (a `cablemap study` output)")),
+    };
+    let request = FeasibleRequest { source, target, weights, length_basis: basis, nearest: r.nearest };
+    let report = cablemap::design::feasible::run(&request).map_err(design_failure)?;
+    Ok((super::to_json(&report), report.to_string(), Vec::new()))
+}
+
+/// `cablemap feasible`: a map's (or a study's maps') verdict on a target,
+/// or a cable sweep's map on a targets file.
+#[pyfunction]
+pub(crate) fn feasible(py: Python<'_>, request_json: &str) -> PyResult<Finished> {
+    let request: FeasiblePy = super::from_json(request_json, "feasible").map_err(|e| e.into_py(py))?;
+    detached(py, move || feasible_run(request))
+}
+
+// ---------------------------------------------------------------- fits
+
+/// The settings every fit shares (`calibrate` and `diagnose`'s flags).
+/// Flattened into each fit's request, so unknown fields are not denied
+/// (serde cannot beside `flatten`): the Python functions name every field.
+#[derive(Debug, Deserialize)]
+struct FitPy {
+    /// The measurements (planar) or the captures (with `actuator`).
+    data: PathBuf,
+    /// `--actuator FILE.toml`: the 3-D route (captures and 3-D markers).
+    actuator: Option<PathBuf>,
+    /// The planar route's rod: `actuator_file` and rod fields.
+    #[serde(default)]
+    rod_fields: Map<String, Value>,
+    markers: Option<PathBuf>,
+    centrelines: Option<PathBuf>,
+    holdout: Option<String>,
+    holdout_cable: Option<usize>,
+    noise_mm: f64,
+    noise_deg: f64,
+    /// `--fix NAME=VALUE`, each.
+    #[serde(default)]
+    fix: Vec<String>,
+    loss: Option<String>,
+    huber_k: f64,
+    max_iterations: usize,
+    angle_weight: f64,
+    #[serde(default)]
+    solver: SolverRequest,
+}
+
+impl FitPy {
+    /// The loss asked for, `default` when none.
+    fn loss(&self, default: &str) -> Result<Loss> {
+        match self.loss.as_deref().unwrap_or(default) {
+            "squares" => Ok(Loss::Squared),
+            "huber" if self.huber_k.is_finite() && self.huber_k > 0.0 => Ok(Loss::Huber { k: self.huber_k }),
+            "huber" => Err(bad(format!("huber_k {}: must be a number of σ > 0", self.huber_k))),
+            other => Err(bad(format!("loss {other:?}: use \"huber\" or \"squares\""))),
+        }
+    }
+
+    /// Each `fix` item as (name, value), the name parsed by `parse`.
+    fn held<P>(&self, parse: impl Fn(&str) -> Option<P>, names: &str) -> Result<Vec<(P, f64)>> {
+        self.fix
+            .iter()
+            .map(|item| {
+                let (name, value) = item.split_once('=').ok_or_else(|| bad(format!("fix {item}: expected NAME=VALUE, e.g. GA=1.70866")))?;
+                let p = parse(name).ok_or_else(|| {
+                    let effects: Vec<&str> = Effect::ALL.iter().map(|e| e.parameter_name()).collect();
+                    bad(format!("fix {item}: unknown parameter '{name}'; use {names} or one of {}", effects.join(", ")))
+                })?;
+                let v = value.trim().parse::<f64>().map_err(|_| bad(format!("fix {item}: '{value}' is not a number")))?;
+                Ok((p, v))
+            })
+            .collect()
+    }
+
+    /// The planar fit's settings (`calibrate`/`diagnose` without `--actuator`).
+    fn settings(&self) -> Result<FitSettings> {
+        if self.holdout_cable.is_some() {
+            return Err(bad("holdout_cable holds out a cable's captures: give the actuator file by actuator=FILE.toml"));
+        }
+        if self.max_iterations == 0 {
+            return Err(bad("max_iterations must be at least 1"));
+        }
+        let held: Vec<(Held, f64)> = self.held(parse_held, "EA, GA, EI")?;
+        Ok(FitSettings {
+            noise: Noise { mm: self.noise_mm, deg: self.noise_deg },
+            held,
+            loss: self.loss("huber")?,
+            max_iterations: self.max_iterations,
+            centrelines: self.centrelines.clone(),
+            markers: self.markers.clone(),
+            angle_weight_mm_per_deg: self.angle_weight,
+        })
+    }
+
+    /// The checks of the 3-D route (`--actuator FILE.toml`) every fit shares.
+    fn check_captures(&self) -> Result<()> {
+        if self.holdout.is_some() {
+            return Err(bad("holdout takes a routing of planar data; with actuator=FILE.toml, hold out a cable's captures by holdout_cable=K"));
+        }
+        if self.centrelines.is_some() {
+            return Err(bad("centrelines: planar centreline points; with actuator=FILE.toml, give 3-D markers by markers="));
+        }
+        if !self.rod_fields.is_empty() {
+            let names: Vec<&str> = self.rod_fields.keys().map(String::as_str).collect();
+            return Err(bad(format!(
+                "{}: with actuator=FILE.toml the rod and its effects come from FILE.toml's [rod] table; edit it instead",
+                names.join(", ")
+            )));
+        }
+        if !(self.noise_mm.is_finite() && self.noise_mm > 0.0) {
+            return Err(bad(format!("noise_mm {}: the markers' noise must be a standard deviation > 0 mm", self.noise_mm)));
+        }
+        if self.max_iterations == 0 {
+            return Err(bad("max_iterations must be at least 1"));
+        }
+        Ok(())
+    }
+}
+
+/// Effects by name, each once, the unknown one named.
+fn effects(names: &[String]) -> Result<Vec<Effect>> {
+    let mut out = Vec::new();
+    for n in names {
+        let e = Effect::parse(n).ok_or_else(|| {
+            let all: Vec<&str> = Effect::ALL.iter().map(|e| e.name()).collect();
+            bad(format!("effect {n:?}: unknown effect; use one of {}", all.join(", ")))
+        })?;
+        if !out.contains(&e) {
+            out.push(e);
+        }
+    }
+    Ok(out)
+}
+
+/// What `cablemap.calibrate` asks: the flags of `cablemap calibrate`.
+#[derive(Debug, Deserialize)]
+struct CalibratePy {
+    #[serde(flatten)]
+    fit: FitPy,
+    /// `--effect`, each.
+    #[serde(default)]
+    effects: Vec<String>,
+    /// With `actuator`: where to write calibrated.toml and fit.json.
+    out: Option<PathBuf>,
+}
+
+fn calibrate_run(r: CalibratePy) -> Result<Finished> {
+    let CalibratePy { fit, effects: names, out } = r;
+    let effects = effects(&names)?;
+    let Some(actuator) = &fit.actuator else {
+        if out.is_some() {
+            return Err(bad("out= writes a calibrated actuator file: calibrate captures against 3-D markers with actuator=FILE.toml"));
+        }
+        let request = CalibrateRequest {
+            data_path: fit.data.clone(),
+            actuator: rod_overrides(fit.rod_fields.clone())?,
+            options: fit.solver.options()?,
+            fit: fit.settings()?,
+            effects,
+            holdout: fit.holdout.clone(),
+        };
+        let report = cablemap::calibrate::run(&request).map_err(calibrate_failure)?;
+        return Ok((report.to_json_line(), report.to_string(), Vec::new()));
+    };
+    fit.check_captures()?;
+    let mut request = Calibrate3Request::new(fit.data.clone(), fit.markers.clone(), actuator.clone());
+    request.held = fit.held(Param::parse, "EI, EA, GA, GJ, density")?;
+    request.effects = effects;
+    request.noise_mm = fit.noise_mm;
+    request.loss = fit.loss("squares")?;
+    request.max_iterations = fit.max_iterations;
+    request.holdout_cable = fit.holdout_cable;
+    request.out = out;
+    request.options = spatial_options(&fit.solver)?;
+    let report = captures::calibrate(&request, &mut |_| {}).map_err(calibrate_failure)?;
+    Ok((report.to_json_line(), report.to_string(), Vec::new()))
+}
+
+/// `cablemap calibrate`: fits the rod to measurements (planar) or the
+/// actuator to captures and 3-D markers (with `actuator`).
+#[pyfunction]
+pub(crate) fn calibrate(py: Python<'_>, request_json: &str) -> PyResult<Finished> {
+    let request: CalibratePy = super::from_json(request_json, "calibrate").map_err(|e| e.into_py(py))?;
+    detached(py, move || calibrate_run(request))
+}
+
+/// What `cablemap.diagnose` asks: the flags of `cablemap diagnose`.
+#[derive(Debug, Deserialize)]
+struct DiagnosePy {
+    #[serde(flatten)]
+    fit: FitPy,
+    alpha: f64,
+    threshold: f64,
+    margin: f64,
+    max_effects: usize,
+    /// The report directory (planar), the command's default when none.
+    out: Option<PathBuf>,
+    /// Write the report and its plots (`--no-report` when false).
+    report: bool,
+}
+
+/// The plots a planar diagnosis writes beside report.md.
+const DIAGNOSIS_PLOTS: [&str; 3] = ["residuals.png", "loops.png", "shapes.png"];
+
+fn diagnose_run(r: DiagnosePy) -> Result<Finished> {
+    let DiagnosePy { fit, alpha, threshold, margin, max_effects, out, report } = r;
+    let Some(actuator) = &fit.actuator else {
+        let report_dir = report.then(|| out.clone().unwrap_or_else(|| DiagnoseRequest::default_report_dir(&fit.data)));
+        let request = DiagnoseRequest {
+            data_path: fit.data.clone(),
+            actuator: rod_overrides(fit.rod_fields.clone())?,
+            options: fit.solver.options()?,
+            fit: fit.settings()?,
+            holdout: fit.holdout.clone(),
+            alpha,
+            threshold,
+            margin,
+            max_effects,
+            report_dir,
+        };
+        let done = cablemap::calibrate::diagnose::run(&request).map_err(calibrate_failure)?;
+        let dir = done.report.as_deref().and_then(Path::parent);
+        let plots = pictures(dir, &DIAGNOSIS_PLOTS.map(String::from));
+        return Ok((done.to_json_line(), done.to_string(), plots));
+    };
+    fit.check_captures()?;
+    if !fit.fix.is_empty() {
+        return Err(bad("fix with actuator=FILE.toml: set the value in FILE.toml instead (a diagnosis fits the body the data determine)"));
+    }
+    let request = Diagnose3Request {
+        captures: fit.data.clone(),
+        markers: fit.markers.clone(),
+        actuator: actuator.clone(),
+        noise_mm: fit.noise_mm,
+        loss: fit.loss("squares")?,
+        max_iterations: fit.max_iterations,
+        holdout_cable: fit.holdout_cable,
+        alpha,
+        threshold,
+        margin,
+        max_effects,
+        options: spatial_options(&fit.solver)?,
+    };
+    let done = diagnose_request(&request).map_err(calibrate_failure)?;
+    Ok((done.to_json_line(), done.to_string(), Vec::new()))
+}
+
+/// `cablemap diagnose`: finds, names and adds the effect the model misses.
+#[pyfunction]
+pub(crate) fn diagnose(py: Python<'_>, request_json: &str) -> PyResult<Finished> {
+    let request: DiagnosePy = super::from_json(request_json, "diagnose").map_err(|e| e.into_py(py))?;
+    detached(py, move || diagnose_run(request))
+}
+
+/// What `cablemap.predict` asks: the flags of `cablemap predict`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PredictPy {
+    captures: PathBuf,
+    actuator: PathBuf,
+    markers: Option<PathBuf>,
+    #[serde(default)]
+    solver: SolverRequest,
+}
+
+/// `cablemap predict`: the markers' errors of an actuator on captures, no fitting.
+#[pyfunction]
+pub(crate) fn predict(py: Python<'_>, request_json: &str) -> PyResult<Finished> {
+    let r: PredictPy = super::from_json(request_json, "predict").map_err(|e| e.into_py(py))?;
+    detached(py, move || {
+        let request = PredictRequest { captures: r.captures, markers: r.markers, actuator: r.actuator, options: spatial_options(&r.solver)? };
+        let report = captures::predict(&request).map_err(calibrate_failure)?;
+        Ok((report.to_json_line(), report.to_string(), Vec::new()))
+    })
+}
+
+/// Adds the report workflows to the module `cablemap._native`.
+pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(design, m)?)?;
+    m.add_function(wrap_pyfunction!(feasible, m)?)?;
+    m.add_function(wrap_pyfunction!(calibrate, m)?)?;
+    m.add_function(wrap_pyfunction!(diagnose, m)?)?;
+    m.add_function(wrap_pyfunction!(predict, m)?)?;
+    Ok(())
+}
