@@ -162,18 +162,3 @@ def test_bad_shard_and_missing_files_are_refused(quick, tmp_path):
         cablemap.read_run(root / "map")
     with pytest.raises(cablemap.FileFormatError, match="reduce it first"):
         cablemap.read_map(root / "run")
-
-
-def test_the_walkthrough_runs(tmp_path, monkeypatch):
-    """Every ```python block of docs/python.md, in order, in one namespace,
-    in a scratch directory holding the repository's jobs/."""
-    text = (REPO / "docs" / "python.md").read_text()
-    blocks = [b.split("```", 1)[0] for b in text.split("```python\n")[1:]]
-    assert any("cablemap.sweep(" in b for b in blocks) and any("cablemap.read_map(" in b for b in blocks)
-    (tmp_path / "jobs").symlink_to(REPO / "jobs")
-    monkeypatch.chdir(tmp_path)
-    namespace = {}
-    for block in blocks:
-        exec(compile(block, "docs/python.md", "exec"), namespace)
-    assert set(namespace["tables"]) == {"cells", "modes", "designs"}
-    assert namespace["reach"].height > 0

@@ -38,6 +38,8 @@ def test_the_walkthrough_runs(tmp_path, monkeypatch):
     for i, block in enumerate(blocks, 1):
         exec(compile(block, f"docs/python.md (python block {i})", "exec"), namespace)
     # What the steps wrote.
+    assert set(namespace["tables"]) == {"cells", "modes", "designs"}
+    assert namespace["reach"].height > 0
     assert (tmp_path / "target-I" / "shape.png").exists()
     assert (tmp_path / "diagnosis" / "report.md").exists()
     assert (tmp_path / "loops.png").stat().st_size > 1000
