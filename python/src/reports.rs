@@ -16,7 +16,7 @@ use cablemap::calibrate::diagnose::DiagnoseRequest;
 use cablemap::calibrate::fit::{parse_held, Held, Loss, Noise};
 use cablemap::calibrate::{CalibrateError, CalibrateRequest, Effect, FitSettings};
 use cablemap::design::cables::search::CableSearch;
-use cablemap::design::cables::spec::{DesignActuator, DEFAULT_TENSION_MAX_N};
+use cablemap::design::cables::spec::{self, DesignActuator, DEFAULT_TENSION_MAX_N};
 use cablemap::design::cables::targets::TargetSet;
 use cablemap::design::cables::CableDesignRequest;
 use cablemap::design::feasible::{FeasibleRequest, MapSource};
@@ -281,7 +281,7 @@ fn design_cables(r: DesignPy, targets: &Path) -> Result<Finished> {
             }
             design?
         }
-        None => DesignActuator::planar(r.actuator.rod.clone(), 0.0, DEFAULT_TENSION_MAX_N, None),
+        None => DesignActuator::planar(r.actuator.rod.clone(), spec::default_tension_min_n(1), DEFAULT_TENSION_MAX_N, None),
     };
     let mut targets = TargetSet::read(targets, design.actuator.rod.length_mm).map_err(design_failure)?;
     if let Some(tol) = r.tolerance_pct {
