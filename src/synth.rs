@@ -3,13 +3,22 @@
 //! ([`crate::calibrate::synth`] generates the readings; this puts the
 //! effect into the actuator, refuses to overwrite files, writes them and
 //! says whether the noise hides the effect). Request in, report out.
+//!
+//! With an actuator file ([`CaptureSynthRequest`], `synth --actuator`):
+//! several-cable captures and 3-D markers in the format `calibrate`,
+//! `diagnose` and `predict` read ([`crate::calibrate::captures::synth`]
+//! generates them).
 
 use crate::calibrate::data::{centrelines_csv, markers_csv, measurements_csv};
 use crate::calibrate::synth::{default_routings, hidden_effect_size, synthesize_with_markers, Planted, SynthSpec, VISIBLE_NOISE_SDS};
 use crate::calibrate::{CalibrateError, Effect};
 use crate::io::FileError;
 use crate::model::routing::CONTROL_POINTS;
-use crate::model::{ParameterError, Rod, SolverOptions};
+use crate::calibrate::captures::files::{captures_csv, markers_3d_csv, Capture};
+use crate::calibrate::captures::solve_captures;
+use crate::calibrate::captures::synth::{default_markers, default_plan, synth_captures, MarkerSpec};
+use crate::model::spatial::SpatialOptions;
+use crate::model::{Actuator, ParameterError, Rod, SolverOptions};
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::fmt;
@@ -282,5 +291,134 @@ pub fn run(request: &SynthRequest) -> Result<SynthReport, SynthError> {
         noise_mm: spec.noise_mm,
         noise_deg: spec.noise_deg,
         visibility,
+    })
+}
+
+/// Everything a synthetic set of several-cable captures with 3-D markers
+/// needs (`synth --actuator`).
+#[derive(Debug, Clone)]
+pub struct CaptureSynthRequest {
+    /// The actuator without the hidden effect (the model a fit starts from).
+    pub actuator: Actuator,
+    /// The 3-D solver's settings.
+    pub options: SpatialOptions,
+    /// The hidden effect (put into the actuator's rod).
+    pub effect: HiddenEffect,
+    /// The captures; `None`: [`default_plan`] up to `max_tension_n`.
+    pub plan: Option<Vec<Capture>>,
+    /// The default plan's top tension, N.
+    pub max_tension_n: f64,
+    /// The default plan's dwell before each capture, s.
+    pub dwell_s: f64,
+    /// The markers; `None`: [`default_markers`].
+    pub markers: Option<Vec<MarkerSpec>>,
+    /// Noise on every marker coordinate (standard deviation), mm.
+    pub noise_mm: f64,
+    /// Seed of the noise.
+    pub seed: u64,
+    /// The captures file (CSV).
+    pub out: PathBuf,
+    /// The markers file (CSV).
+    pub markers_out: PathBuf,
+    /// Overwrite existing files.
+    pub force: bool,
+}
+
+/// What `synth --actuator` wrote.
+#[derive(Debug, Clone, Serialize)]
+pub struct CaptureSynthReport {
+    /// Captures written.
+    pub captures: usize,
+    /// Markers per capture.
+    pub markers: usize,
+    /// The captures file.
+    pub out: PathBuf,
+    /// The markers file.
+    pub markers_out: PathBuf,
+    /// The hidden effect's name.
+    pub effect: &'static str,
+    /// Its parameter.
+    pub magnitude: Option<f64>,
+    /// Noise on every marker coordinate, mm.
+    pub noise_mm: f64,
+    /// Largest move of a marker by the hidden effect (noise-free), mm; `None` without one.
+    pub max_marker_shift_mm: Option<f64>,
+}
+
+impl CaptureSynthReport {
+    /// Whether the effect moves no marker by [`VISIBLE_NOISE_SDS`] noise standard deviations.
+    pub fn hidden_by_noise(&self) -> bool {
+        self.max_marker_shift_mm.is_some_and(|m| m < VISIBLE_NOISE_SDS * self.noise_mm)
+    }
+}
+
+impl fmt::Display for CaptureSynthReport {
+    /// What `synth --actuator` says on stderr: the files, and a warning when the noise hides the effect.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(
+            f,
+            "wrote {} captures to {} and {} markers each to {} (hidden effect: {}{}; noise {} mm)",
+            self.captures,
+            self.out.display(),
+            self.markers,
+            self.markers_out.display(),
+            self.effect,
+            self.magnitude.map(|m| format!(" = {m}")).unwrap_or_default(),
+            self.noise_mm
+        )?;
+        if let (true, Some(m)) = (self.hidden_by_noise(), self.max_marker_shift_mm) {
+            writeln!(
+                f,
+                "warning: the hidden effect moves the markers by at most {} mm, less than {VISIBLE_NOISE_SDS}× the noise (sd {} mm): \
+                 the data cannot show it and a diagnosis will rightly answer `none`; raise its value or lower --noise-mm",
+                crate::io::fmt_sig(m, 2),
+                self.noise_mm
+            )?;
+        }
+        Ok(())
+    }
+}
+
+/// Generates and writes a capture set: the actuator with the hidden effect
+/// is validated, existing files are refused unless `force`, every capture
+/// of the plan is solved with it and its markers measured with noise, and
+/// the effect's size is compared with the noise.
+pub fn run_captures(request: &CaptureSynthRequest) -> Result<CaptureSynthReport, SynthError> {
+    let mut truth = request.actuator.clone();
+    truth.rod = request.effect.apply(&request.actuator.rod);
+    truth.rod.validate().map_err(SynthError::TrueActuator)?;
+    for path in [&request.out, &request.markers_out] {
+        if !request.force && path.exists() {
+            return Err(SynthError::Exists { path: path.clone() });
+        }
+    }
+    let plan = request.plan.clone().unwrap_or_else(|| default_plan(request.actuator.cables.len(), request.max_tension_n, request.dwell_s));
+    let markers = request.markers.clone().unwrap_or_else(|| default_markers(&request.actuator));
+    let set = synth_captures(&truth, &request.options, plan, &markers, request.noise_mm, request.seed, false)?;
+    let write = |path: &PathBuf, text: String| crate::io::write_atomic(path, text.as_bytes()).map_err(FileError::on("writing", path));
+    write(&request.out, captures_csv(&set.captures))?;
+    write(&request.markers_out, markers_3d_csv(&set))?;
+    let max_marker_shift_mm = match request.effect {
+        HiddenEffect::None => None,
+        _ => {
+            let with = solve_captures(&truth, &request.options, &set)?;
+            let without = solve_captures(&request.actuator, &request.options, &set)?;
+            let shift = with
+                .iter()
+                .zip(&without)
+                .flat_map(|(a, b)| a.markers_mm.iter().zip(&b.markers_mm).map(|(p, q)| p.iter().zip(q).map(|(x, y)| (x - y).powi(2)).sum::<f64>().sqrt()))
+                .fold(0.0, f64::max);
+            Some(shift)
+        }
+    };
+    Ok(CaptureSynthReport {
+        captures: set.captures.len(),
+        markers: markers.len(),
+        out: request.out.clone(),
+        markers_out: request.markers_out.clone(),
+        effect: request.effect.name(),
+        magnitude: request.effect.magnitude(),
+        noise_mm: request.noise_mm,
+        max_marker_shift_mm,
     })
 }

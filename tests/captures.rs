@@ -3,7 +3,7 @@
 //! (tests/data/soromox, MIT), and the 3-D fit's round trip on synthetic
 //! captures whose truth is known.
 
-use cablemap::calibrate::captures::synth::{one_cable_at_a_time, synth_captures, MarkerSpec};
+use cablemap::calibrate::captures::synth::{default_plan, one_cable_at_a_time, synth_captures, MarkerSpec};
 use cablemap::calibrate::captures::fit::Status;
 use cablemap::calibrate::captures::{diagnose_captures, fit_captures, Diagnose3Spec, Diagnosis3, Fit3Spec, Param};
 use cablemap::calibrate::Effect;
@@ -220,16 +220,12 @@ fn hidden(effect: impl Fn(&mut Actuator)) -> (Actuator, cablemap::calibrate::cap
     let mut truth = start.clone();
     effect(&mut truth);
     let markers = [MarkerSpec::new("p1", 129.1, 0.0, 25.0), MarkerSpec::new("p2", 219.5, 0.0, -21.0), MarkerSpec::new("p3", 280.0, 0.0, 20.0), MarkerSpec::new("p4", 368.0, 0.0, 0.0)];
-    let mut captures = one_cable_at_a_time(2, &[2.0, 4.5, 7.0], 5.0);
-    // Both tendons at once, and at rest: the pairs bend the body out of
-    // either tendon's plane, which separates effects on the cables' tension
-    // (friction) from effects on the body (stiffening, a gradient).
-    for (t1, t2) in [(0.0, 0.0), (4.0, 4.0), (7.0, 3.0), (3.0, 7.0)] {
-        let mut c = captures[0].clone();
-        c.measurement = captures.len() as i64 + 1;
-        c.actuation = vec![cablemap::calibrate::captures::Actuation::Tension(t1), cablemap::calibrate::captures::Actuation::Tension(t2)];
-        captures.push(c);
-    }
+    // Each tendon alone at 2, 4.5, 7 N, at rest, and both at (4, 4), (7, 3),
+    // (3, 7) N: the pairs bend the body out of either tendon's plane, which
+    // separates effects on the cables' tension (friction) from effects on
+    // the body (stiffening, a gradient).
+    let captures = default_plan(2, 7.0, 5.0);
+    assert_eq!(captures.len(), 10);
     let set = synth_captures(&truth, &SpatialOptions::default(), captures, &markers, 1.0, 3, false).unwrap();
     (start, set)
 }
@@ -283,13 +279,118 @@ fn diagnose_finds_nothing_in_null_data_and_no_library_effect_in_a_curved_rod() {
 }
 
 #[test]
-fn diagnose_cli_on_the_real_tentacle_prints_a_verdict() {
-    let (ok, stdout, stderr) = cablemap(&["diagnose", &soromox("captures.csv"), "--actuator", &soromox("actuator.toml"), "--markers", &soromox("markers.csv"), "--holdout-cable", "2", "--json"]);
+fn diagnose_cli_on_the_real_tentacle_prints_a_verdict_and_writes_its_report() {
+    let dir = tempfile::tempdir().unwrap();
+    let report = dir.path().join("report");
+    let (ok, stdout, stderr) = cablemap(&[
+        "diagnose",
+        &soromox("captures.csv"),
+        "--actuator",
+        &soromox("actuator.toml"),
+        "--markers",
+        &soromox("markers.csv"),
+        "--holdout-cable",
+        "2",
+        "--out",
+        report.to_str().unwrap(),
+        "--json",
+    ]);
     assert!(ok, "{stderr}");
     let v = json(&stdout);
+    // The report: the verdict, the candidates, the fits' values, the per-marker RMS.
+    let md = std::fs::read_to_string(report.join("report.md")).unwrap();
+    for part in ["## Verdict: ", "## Candidates", "| rank | effect |", "### Body fit", "`ei_n_mm2`", "## Per-marker RMS", "| p4 |", "## Held out"] {
+        assert!(md.contains(part), "{part} in {md}");
+    }
+    assert!(md.contains(&format!("## Verdict: {}", v["verdict"].as_str().unwrap())), "{md}");
+    // A picture per capture, of the captures of every cable (held out or fitted), each its own.
+    let captures = std::fs::read_to_string(soromox("captures.csv")).unwrap();
+    let mut pictures = Vec::new();
+    for line in captures.lines().skip(1) {
+        let id: i64 = line.split(',').next().unwrap().parse().unwrap();
+        let picture = report.join(format!("capture_{id}.png"));
+        let bytes = std::fs::read(&picture).unwrap_or_else(|e| panic!("{}: {e}", picture.display()));
+        assert!(bytes.starts_with(b"\x89PNG") && md.contains(&format!("](capture_{id}.png)")), "capture {id}");
+        pictures.push(bytes);
+    }
+    assert_eq!(pictures.len(), 14);
+    for cable in ["cables pulling: 1)", "cables pulling: 2)"] {
+        assert_eq!(md.matches(cable).count(), 7, "{cable} in {md}");
+    }
+    assert!(pictures[0] != pictures[7] && pictures[0] != pictures[6], "each capture's picture draws its own body");
     // What the verdict is on real data is the tool's to say; the fit is asserted.
     assert!(["none", "unexplained", "inconclusive", "ambiguous"].contains(&v["verdict"].as_str().unwrap()) || v["parameter_name"].is_string(), "{v}");
     assert_eq!(v["baseline"]["converged"], true);
     assert!(v["holdout_rms_before"].as_f64().is_some() && v["candidates"].as_array().unwrap().len() >= 5, "{v}");
     println!("diagnose on the real tentacle (fit on tendon 1, tendon 2 held out): verdict {}: {}", v["verdict"], v["reason"]);
+}
+
+/// The SoRoMoX actuator file with the authors' identified materials (the
+/// truth of the round trip through the binary), as text.
+fn truth_toml() -> String {
+    let text = std::fs::read_to_string(soromox("actuator.toml")).unwrap();
+    let mut out = String::new();
+    for line in text.lines() {
+        let replaced = match line.split(" = ").next().unwrap() {
+            "gj_n_mm2" => "gj_n_mm2 = 9624.4",
+            "ei_n_mm2" => "ei_n_mm2 = 13955.3",
+            "ea_n" => "ea_n = 235.07",
+            "ga_n" => "ga_n = 81.06",
+            "density_g_cm3" => "density_g_cm3 = 1.3177",
+            _ => line,
+        };
+        out.push_str(replaced);
+        out.push('\n');
+    }
+    out
+}
+
+#[test]
+fn synth_captures_then_calibrate_recovers_the_rigidities_through_the_binary() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = |name: &str| dir.path().join(name).display().to_string();
+    std::fs::write(path("truth.toml"), truth_toml()).unwrap();
+    let synth = |extra: &[&str], out: &str, markers: &str| {
+        let (truth, out, markers) = (path("truth.toml"), path(out), path(markers));
+        let mut args = vec!["synth", "--actuator", &truth];
+        args.extend(["--out", &out, "--markers-out", &markers, "--noise-mm", "1", "--seed", "7", "--tension-max-n", "7"]);
+        args.extend(extra);
+        cablemap(&args)
+    };
+    let (ok, _, stderr) = synth(&[], "captures.csv", "markers.csv");
+    assert!(ok, "{stderr}");
+    assert!(stderr.contains("wrote 10 captures") && stderr.contains("4 markers each"), "{stderr}");
+    // The documented format: both tendons' columns, the four default markers.
+    let captures = std::fs::read_to_string(path("captures.csv")).unwrap();
+    assert!(captures.starts_with("measurement,tension_1_n,tension_2_n,direction,step,dwell_s\n"), "{captures}");
+    assert!(captures.contains(",4,4,static,") && captures.contains(",0,0,static,"), "pairs and rest: {captures}");
+    let markers = std::fs::read_to_string(path("markers.csv")).unwrap();
+    assert_eq!(markers.lines().count(), 1 + 10 * 4, "{markers}");
+    assert!(markers.starts_with("measurement,marker,s_mm,offset_y_mm,offset_z_mm,x_mm,y_mm,z_mm"), "{markers}");
+    // An existing file is kept.
+    let (ok, _, stderr) = synth(&[], "captures.csv", "markers.csv");
+    assert!(!ok && stderr.contains("exists"), "{stderr}");
+    // Calibrate from the file's nominal materials: the truth within two standard errors.
+    let (ok, stdout, stderr) = cablemap(&["calibrate", &path("captures.csv"), "--actuator", &soromox("actuator.toml"), "--markers", &path("markers.csv"), "--noise-mm", "1", "--json"]);
+    assert!(ok, "{stderr}");
+    let fit = json(&stdout);
+    assert_eq!(fit["converged"], true, "{fit}");
+    let truth = [("ei_n_mm2", 13955.3), ("ea_n", 235.07), ("ga_n", 81.06), ("gj_n_mm2", 9624.4), ("density_g_cm3", 1.3177)];
+    let mut fitted = 0;
+    for p in fit["parameters"].as_array().unwrap() {
+        let want = truth.iter().find(|(n, _)| p["name"] == *n).unwrap().1;
+        println!("synth → calibrate: {} = {} ± {} (truth {want}, {})", p["name"], p["value"], p["se"], p["status"]);
+        if p["status"] == "fitted" {
+            let (value, se) = (p["value"].as_f64().unwrap(), p["se"].as_f64().unwrap());
+            assert!((value - want).abs() <= 2.0 * se, "{p} vs truth {want}");
+            fitted += 1;
+        }
+    }
+    assert!(fitted >= 3, "EI, EA and the weight at least: {fit}");
+    assert!((0.6..1.5).contains(&fit["reduced_chi2"].as_f64().unwrap()), "{}", fit["reduced_chi2"]);
+    // A hidden effect by NAME=VALUE, and markers where asked.
+    let (ok, _, stderr) = synth(&["--effect", "clamp_compliance=800", "--markers-at", "a:100:0:20;tip:360:0:0"], "c2.csv", "m2.csv");
+    assert!(ok && stderr.contains("hidden effect: clamp_compliance = 800") && stderr.contains("2 markers each"), "{stderr}");
+    let (ok, _, stderr) = synth(&["--routings", "a:1,1,1,1,1"], "c3.csv", "m3.csv");
+    assert!(!ok && stderr.contains("--routings"), "{stderr}");
 }

@@ -27,8 +27,8 @@ pub struct DiagnoseArgs {
     /// Routing left out of every fit; the gap on it is shown before and after.
     #[arg(long, value_name = "ROUTING")]
     pub holdout: Option<String>,
-    /// Report directory (report.md and PNG plots) [default: DATA's name with
-    /// `-diagnosis`, beside the data file: measurements.csv → measurements-diagnosis/].
+    /// Report directory (report.md and PNG plots; with --actuator a picture per capture) [default:
+    /// DATA's name with `-diagnosis`, beside the data file: measurements.csv → measurements-diagnosis/].
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
     /// Skip the report and plots.
@@ -111,8 +111,12 @@ fn run_captures(args: &DiagnoseArgs, actuator: &std::path::Path) -> anyhow::Resu
         margin: args.margin,
         max_effects: args.max_effects,
         options: super::calibrate::spatial_options(&args.actuator),
+        report_dir: (!args.no_report).then(|| args.out.clone().unwrap_or_else(|| DiagnoseRequest::default_report_dir(&args.data))),
     };
-    let report = diagnose_request(&request).map_err(|e| with_flag(e, false))?;
+    let report = diagnose_request(&request).map_err(|e| match e {
+        CalibrateError::ReportDir(_) => anyhow::Error::new(e).context("--out"),
+        e => with_flag(e, false),
+    })?;
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
     if args.json {

@@ -5,7 +5,10 @@ use super::{parse_list, ActuatorArgs};
 use cablemap::calibrate::Effect;
 use cablemap::model::routing::CONTROL_POINTS;
 use cablemap::model::SolverOptions;
-use cablemap::synth::{HiddenEffect, Markers, SynthRequest, OUT_OF_LIBRARY};
+use cablemap::calibrate::captures::files::read_captures;
+use cablemap::calibrate::captures::synth::MarkerSpec;
+use cablemap::model::Actuator;
+use cablemap::synth::{CaptureSynthRequest, HiddenEffect, Markers, SynthRequest, OUT_OF_LIBRARY};
 use anyhow::bail;
 use clap::Args;
 use std::collections::BTreeMap;
@@ -14,14 +17,30 @@ use std::path::PathBuf;
 /// Arguments of `cablemap synth`.
 #[derive(Debug, Clone, Args)]
 pub struct SynthArgs {
-    /// Output measurement file (CSV); an existing file is kept unless --force.
+    /// Output measurement file (CSV); with --actuator, the captures file; an existing file is kept unless --force.
     #[arg(long, value_name = "FILE")]
     pub out: PathBuf,
+    /// A whole actuator (rod, torsion, gravity, cables) as TOML: synthesize several-cable captures
+    /// (--out) and 3-D markers (--markers-out) with the 3-D solver, in the files calibrate,
+    /// diagnose and predict read with --actuator.
+    #[arg(long = "actuator", value_name = "FILE.toml")]
+    pub spatial_actuator: Option<PathBuf>,
+    /// With --actuator: the captures to make, as a captures file (its actuation, direction, step
+    /// and dwell columns) [default: each cable alone at 2/7, 4.5/7 and 1 of --tension-max-n, one
+    /// at rest, every pair of cables at (4, 4), (7, 3), (3, 7) sevenths].
+    #[arg(long, value_name = "FILE")]
+    pub plan: Option<PathBuf>,
+    /// With --actuator: markers as "name:s:offset_y:offset_z;…" in mm (rest arc length, body-frame
+    /// offsets) [default: SoRoMoX-like p1, p2, p3 on stalks at 0.36, 0.61, 0.78 L and p4 on the
+    /// axis 2 % of L past the tip].
+    #[arg(long, allow_hyphen_values = true, value_name = "NAME:S:Y:Z;…")]
+    pub markers_at: Option<String>,
     /// Overwrite existing output files.
     #[arg(long)]
     pub force: bool,
     /// Hidden effect: none, friction, gravity, stiffening, clamp_compliance, channel_offset or creep; or, for testing the
-    /// diagnosis, an effect outside its candidate list: rest_curvature (a rod cured bent) or glue_joint (a stiff segment at the clamp).
+    /// diagnosis, an effect outside its candidate list: rest_curvature (a rod cured bent) or glue_joint (a stiff segment at the clamp);
+    /// NAME=VALUE gives its parameter too (as --magnitude).
     #[arg(long, default_value = "none")]
     pub effect: String,
     /// The hidden effect's parameter: μ, gravity scale k, α, k_θ (N·mm/rad), δ (mm), creep fraction f; rest curvature
@@ -34,7 +53,7 @@ pub struct SynthArgs {
     /// Seed of the noise.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Noise on tip x and y (standard deviation), mm.
+    /// Noise on tip x and y (standard deviation), mm; with --actuator, on every marker coordinate.
     #[arg(long, default_value_t = 0.4, allow_hyphen_values = true)]
     pub noise_mm: f64,
     /// Noise on the tip angle (standard deviation), degrees.
@@ -45,13 +64,13 @@ pub struct SynthArgs {
     /// straight, tip_bend, arc].
     #[arg(long, allow_hyphen_values = true)]
     pub routings: Option<String>,
-    /// Top tension τ_u, N (`--max-tension` is the old name).
+    /// Top tension τ_u, N (`--max-tension` is the old name); with --actuator, the default plan's.
     #[arg(long = "tension-max-n", alias = "max-tension", value_name = "N", default_value_t = 2.0, allow_hyphen_values = true)]
     pub max_tension: f64,
     /// Loading steps from rest to τ_u (unloading uses the same levels).
     #[arg(long, default_value_t = 5)]
     pub load_steps: usize,
-    /// Dwell before each loaded reading, s.
+    /// Dwell before each loaded reading, s; with --actuator, before each capture of the default plan.
     #[arg(long, default_value_t = 5.0, allow_hyphen_values = true)]
     pub step_dwell_s: f64,
     /// Dwell before each rest reading, s.
@@ -66,7 +85,8 @@ pub struct SynthArgs {
     /// Centreline points per reading.
     #[arg(long, default_value_t = 21)]
     pub centreline_points: usize,
-    /// Also write markers (measurement,s_mm,offset_mm,x_mm,y_mm) here.
+    /// Also write markers (measurement,s_mm,offset_mm,x_mm,y_mm) here; with --actuator, the 3-D
+    /// markers (measurement,marker,s_mm,offset_y_mm,offset_z_mm,x_mm,y_mm,z_mm,sd_mm).
     #[arg(long, value_name = "FILE")]
     pub markers_out: Option<PathBuf>,
     /// Markers as "s:offset;s:offset" in mm (rest arc length, lateral body-frame offset) [default: L/4, L/2, 3L/4 and L on
@@ -125,8 +145,18 @@ fn parse_markers(text: &str) -> anyhow::Result<Vec<(f64, f64)>> {
     Ok(out)
 }
 
-/// The hidden effect `--effect` and `--magnitude` ask for.
+/// The hidden effect `--effect` (NAME or NAME=VALUE) and `--magnitude` ask for.
 fn hidden_effect(args: &SynthArgs) -> anyhow::Result<HiddenEffect> {
+    let (name, magnitude) = match args.effect.split_once('=') {
+        Some((name, value)) => {
+            anyhow::ensure!(args.magnitude.is_none(), "--effect {}: give the value once, in --effect NAME=VALUE or by --magnitude", args.effect);
+            let v = value.trim().parse::<f64>().ok().filter(|v| v.is_finite());
+            let Some(v) = v else { bail!("--effect {}: '{value}' is not a number", args.effect) };
+            (name.trim(), Some(v))
+        }
+        None => (args.effect.trim(), args.magnitude),
+    };
+    let args = &SynthArgs { effect: name.to_string(), magnitude, ..args.clone() };
     if let Some(hidden) = OUT_OF_LIBRARY.iter().find(|h| **h == args.effect) {
         let Some(m) = args.magnitude else {
             bail!("--effect {hidden} needs --magnitude ({})", if *hidden == "rest_curvature" { "the rest curvature in 1/mm, e.g. 0.004" } else { "the joint's EI factor, e.g. 5" });
@@ -189,8 +219,69 @@ fn request(args: &SynthArgs) -> anyhow::Result<SynthRequest> {
     })
 }
 
+/// Parses "name:s:y:z;…" (mm).
+fn parse_markers_at(text: &str) -> anyhow::Result<Vec<MarkerSpec>> {
+    let mut out: Vec<MarkerSpec> = Vec::new();
+    for item in text.split(';').filter(|s| !s.trim().is_empty()) {
+        let parts: Vec<&str> = item.split(':').map(str::trim).collect();
+        let numbers: Option<Vec<f64>> = parts.get(1..).map(|p| p.iter().map(|v| v.parse::<f64>().ok().filter(|v| v.is_finite())).collect()).flatten();
+        let (4, Some(v)) = (parts.len(), numbers) else {
+            bail!("--markers-at: '{item}' should look like name:s_mm:offset_y_mm:offset_z_mm, e.g. p1:129.1:0:25");
+        };
+        anyhow::ensure!(!parts[0].is_empty() && !out.iter().any(|m| m.name == parts[0]), "--markers-at: '{item}': each marker needs its own name");
+        out.push(MarkerSpec::new(parts[0], v[0], v[1], v[2]));
+    }
+    anyhow::ensure!(!out.is_empty(), "--markers-at: no marker given");
+    Ok(out)
+}
+
+/// The capture synth request the arguments describe (`--actuator`).
+fn capture_request(args: &SynthArgs, actuator: &std::path::Path) -> anyhow::Result<CaptureSynthRequest> {
+    anyhow::ensure!(!args.actuator.sets_the_rod(), "with --actuator the rod comes from FILE.toml's [rod] table; edit it instead of giving rod flags");
+    let planar_only = [
+        (args.routings.is_some(), "--routings"),
+        (args.centreline_out.is_some(), "--centreline-out"),
+        (args.markers.is_some(), "--markers (give --markers-at NAME:S:Y:Z;…)"),
+        (args.clamp_tilt_rad != 0.0, "--clamp-tilt-rad (set gravity_direction in FILE.toml)"),
+    ];
+    if let Some((_, flag)) = planar_only.iter().find(|(given, _)| *given) {
+        bail!("{flag} is for planar data; with --actuator the captures come from --plan or the default plan");
+    }
+    let Some(markers_out) = args.markers_out.clone() else {
+        bail!("with --actuator give --markers-out FILE: the 3-D markers are written there");
+    };
+    anyhow::ensure!(args.noise_mm.is_finite() && args.noise_mm >= 0.0, "--noise-mm {}: must be a standard deviation ≥ 0 mm", args.noise_mm);
+    anyhow::ensure!(args.max_tension.is_finite() && args.max_tension > 0.0, "--tension-max-n {}: must be a tension > 0 N", args.max_tension);
+    anyhow::ensure!(args.step_dwell_s.is_finite() && args.step_dwell_s >= 0.0, "--step-dwell-s {}: must be a time ≥ 0 s", args.step_dwell_s);
+    let start = Actuator::read(actuator).map_err(|e| anyhow::Error::new(e).context("--actuator"))?;
+    let plan = match &args.plan {
+        Some(path) => Some(read_captures(path, start.cables.len(), start.rod.length_mm).map_err(|e| anyhow::Error::new(e).context("--plan"))?.0),
+        None => None,
+    };
+    Ok(CaptureSynthRequest {
+        options: super::calibrate::spatial_options(&args.actuator),
+        effect: hidden_effect(args)?,
+        plan,
+        max_tension_n: args.max_tension,
+        dwell_s: args.step_dwell_s,
+        markers: args.markers_at.as_deref().map(parse_markers_at).transpose()?,
+        noise_mm: args.noise_mm,
+        seed: args.seed,
+        out: args.out.clone(),
+        markers_out,
+        force: args.force,
+        actuator: start,
+    })
+}
+
 /// Runs `cablemap synth`: what it wrote goes to stderr.
 pub fn run(args: &SynthArgs) -> anyhow::Result<()> {
+    if let Some(actuator) = &args.spatial_actuator {
+        let report = cablemap::synth::run_captures(&capture_request(args, actuator)?)?;
+        eprint!("{report}");
+        return Ok(());
+    }
+    anyhow::ensure!(args.plan.is_none() && args.markers_at.is_none(), "--plan and --markers-at make several-cable captures: give the actuator with --actuator FILE.toml");
     let report = cablemap::synth::run(&request(args)?)?;
     eprint!("{report}");
     Ok(())

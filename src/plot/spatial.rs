@@ -1,7 +1,8 @@
 //! The PNG of an actuator's simulation: two orthogonal views of the hanging
 //! rod, x–y (looking along z) and x–z (looking along y), on one scale, with
 //! the body's silhouette, the centreline, every cable's path (up to where
-//! it is knotted) and the tip.
+//! it is knotted) and the tip; with [`draw_spatial_with_points`], points in
+//! 3-D besides (a capture's measured and simulated markers).
 
 use super::canvas::{png_backend, register_fonts, PlotError, FONT};
 use super::series::{clamp_series, draw_legend, draw_series_on, legend_size, page_chart, Mark, PictureSeries};
@@ -22,8 +23,26 @@ struct View {
 /// The two views every spatial picture shows: x–y (looking along z) and x–z (looking along y).
 const VIEWS: [View; 2] = [View { axis: 1, name: "y" }, View { axis: 2, name: "z" }];
 
+/// Points in the clamp frame drawn in both views, with one legend entry.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SpatialPoints {
+    /// Legend text.
+    pub legend: String,
+    /// Colour.
+    pub colour: RGBAColor,
+    /// The points (x, y, z), mm.
+    pub points_mm: Vec<[f64; 3]>,
+    /// Crosses (measured points) or dots (simulated ones).
+    pub crosses: bool,
+}
+
 /// Draws `sim` as two side-by-side views into `path` (PNG, 1400 × 760 px).
 pub fn draw_spatial(path: &Path, title: &str, sim: &Simulation) -> Result<(), PlotError> {
+    draw_spatial_with_points(path, title, sim, &[])
+}
+
+/// [`draw_spatial`] with `points` in both views (the views' scale covers them).
+pub fn draw_spatial_with_points(path: &Path, title: &str, sim: &Simulation, points: &[SpatialPoints]) -> Result<(), PlotError> {
     let radius = sim.actuator.rod.radius_mm;
     let paths = sim.cable_paths_mm();
     // One scale for both views: the range of x and of both lateral coordinates.
@@ -33,6 +52,12 @@ pub fn draw_spatial(path: &Path, title: &str, sim: &Simulation) -> Result<(), Pl
         for i in 0..3 {
             lo[i] = lo[i].min(p[i] - radius);
             hi[i] = hi[i].max(p[i] + radius);
+        }
+    }
+    for p in points.iter().flat_map(|p| &p.points_mm) {
+        for i in 0..3 {
+            lo[i] = lo[i].min(p[i] - 2.0);
+            hi[i] = hi[i].max(p[i] + 2.0);
         }
     }
     draw_views(path, title, (lo, hi), |view| {
@@ -62,6 +87,18 @@ pub fn draw_spatial(path: &Path, title: &str, sim: &Simulation) -> Result<(), Pl
         if let Some(n) = sim.centreline.last() {
             let mark = Mark::Dot { at: in_view(n.position_mm()), radius_px: 5 };
             series.push(PictureSeries { legend: "tip".into(), colour: BLUE_800.to_rgba(), mark });
+        }
+        for p in points {
+            let at: Vec<(f64, f64)> = p.points_mm.iter().map(|&q| in_view(q)).collect();
+            if p.crosses {
+                series.push(PictureSeries { legend: p.legend.clone(), colour: p.colour, mark: Mark::Crosses { at } });
+            } else {
+                // One legend entry: the first dot carries it, the others none.
+                for (k, q) in at.into_iter().enumerate() {
+                    let legend = if k == 0 { p.legend.clone() } else { String::new() };
+                    series.push(PictureSeries { legend, colour: p.colour, mark: Mark::Dot { at: q, radius_px: 5 } });
+                }
+            }
         }
         series
     })
@@ -151,8 +188,9 @@ fn draw_views(path: &Path, title: &str, (lo, hi): ([f64; 3], [f64; 3]), series_o
         }
         // The legend in the plot's upper right corner (the rod hangs from the top centre).
         let plot = chart.plotting_area().strip_coord_spec();
-        let (w, _) = legend_size(&plot, &series);
-        draw_legend(&plot, path, &series, (plot.dim_in_pixel().0 as i32 - w - 10, 10))?;
+        let legend: Vec<PictureSeries> = series.iter().filter(|s| !s.legend.is_empty()).cloned().collect();
+        let (w, _) = legend_size(&plot, &legend);
+        draw_legend(&plot, path, &legend, (plot.dim_in_pixel().0 as i32 - w - 10, 10))?;
     }
     root.present().map_err(|e| PlotError::new(path, e))?;
     Ok(())

@@ -263,6 +263,9 @@ pub struct Diagnosis3 {
     /// The final model's actuator.
     #[serde(skip)]
     pub actuator: Actuator,
+    /// The report's files, when written (`report.md` first).
+    #[serde(skip)]
+    pub written: Vec<std::path::PathBuf>,
 }
 
 fn candidate(effect: Effect, reference_bic: f64, result: &Result<Fit3Result, CalibrateError>) -> Candidate3 {
@@ -554,6 +557,7 @@ pub fn diagnose_captures(base: &Actuator, set: &CaptureSet, spec: &Diagnose3Spec
         captures_fitted: train.captures.len(),
         elapsed_s: started.elapsed().as_secs_f64(),
         actuator: extended.actuator.clone(),
+        written: Vec::new(),
     })
 }
 
@@ -592,7 +596,11 @@ impl std::fmt::Display for Diagnosis3 {
         if let (Some(k), Some(b), Some(a)) = (self.holdout_cable, self.holdout_rms_before, self.holdout_rms_after) {
             writeln!(out, "held out (captures where cable {k} pulls): marker RMS {b:.3} mm with the body fit, {a:.3} mm with the final model")?;
         }
-        writeln!(out, "{:.1} s", self.elapsed_s)
+        writeln!(out, "{:.1} s", self.elapsed_s)?;
+        if let Some(report) = self.written.first() {
+            writeln!(out, "report: {} ({} pictures beside it)", report.display(), self.written.len() - 1)?;
+        }
+        Ok(())
     }
 }
 
@@ -623,10 +631,41 @@ pub struct Diagnose3Request {
     pub max_effects: usize,
     /// The 3-D solver's settings.
     pub options: crate::model::spatial::SpatialOptions,
+    /// Report directory (`report.md` and a picture per capture); none for no report.
+    pub report_dir: Option<std::path::PathBuf>,
 }
 
-/// Reads the request's files and runs [`diagnose_captures`].
+impl Diagnose3Request {
+    /// A request with the defaults of `diagnose --actuator`: noise 0.4 mm,
+    /// least squares, at most 200 iterations per fit, α = 1e-3, BIC
+    /// threshold and margin 10, at most two effects, no held-out cable, no report.
+    pub fn new(captures: std::path::PathBuf, markers: Option<std::path::PathBuf>, actuator: std::path::PathBuf) -> Self {
+        let spec = Diagnose3Spec::default();
+        Self {
+            captures,
+            markers,
+            actuator,
+            noise_mm: 0.4,
+            loss: crate::calibrate::fit::Loss::Squared,
+            max_iterations: 200,
+            holdout_cable: None,
+            alpha: spec.alpha,
+            threshold: spec.threshold,
+            margin: spec.margin,
+            max_effects: spec.max_effects,
+            options: crate::model::spatial::SpatialOptions::default(),
+            report_dir: None,
+        }
+    }
+}
+
+/// Reads the request's files, runs [`diagnose_captures`] and writes the
+/// report directory when asked for (refused first when inside a sweep run,
+/// before anything is read); the report's files are in `written`.
 pub fn diagnose_request(request: &Diagnose3Request) -> Result<Diagnosis3, CalibrateError> {
+    if let Some(dir) = &request.report_dir {
+        crate::io::check_outside_run_dir(dir, "the report directory")?;
+    }
     let base = Actuator::read(&request.actuator).map_err(CalibrateError::Actuator)?;
     let set = super::files::read_capture_set(&request.captures, request.markers.as_deref(), base.cables.len(), base.rod.length_mm)?;
     let mut params: Vec<Param> = Param::BODY.to_vec();
@@ -641,5 +680,10 @@ pub fn diagnose_request(request: &Diagnose3Request) -> Result<Diagnosis3, Calibr
         max_effects: request.max_effects,
         alpha: request.alpha,
     };
-    diagnose_captures(&base, &set, &spec)
+    let mut d = diagnose_captures(&base, &set, &spec)?;
+    if let Some(dir) = &request.report_dir {
+        let sources = super::report::ReportSources { captures: &request.captures, markers: request.markers.as_deref(), actuator: &request.actuator };
+        d.written = super::report::write_report(dir, sources, &set, &d, &request.options)?;
+    }
+    Ok(d)
 }

@@ -24,6 +24,7 @@ use crate::numerics::lm;
 use nalgebra::DMatrix;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Mutex;
 use serde::Serialize;
 
 /// A parameter of the 3-D fit.
@@ -232,6 +233,9 @@ struct Problem<'a> {
     /// The relative cost reduction of the last accepted step (f64 bits):
     /// below [`ENOUGH_REDUCTION`] the fit stops.
     last_reduction: &'a AtomicU64,
+    /// The last Jacobian (point, free columns, matrix): the fit's first
+    /// iteration takes the one the check of negligible columns made.
+    last_jacobian: Mutex<Option<(Vec<f64>, Vec<usize>, DMatrix<f64>)>>,
 }
 
 impl Problem<'_> {
@@ -286,7 +290,22 @@ impl Problem<'_> {
             })
             .collect();
         let columns: Vec<Vec<f64>> = columns.into_iter().collect::<Option<_>>()?;
-        Some(DMatrix::from_fn(r.len(), free.len(), |i, k| columns[k][i]))
+        let j = DMatrix::from_fn(r.len(), free.len(), |i, k| columns[k][i]);
+        *self.last_jacobian.lock().expect("not poisoned") = Some((x.to_vec(), free.to_vec(), j.clone()));
+        Some(j)
+    }
+
+    /// The Jacobian at `x` over `free`: the last one made when it was made
+    /// there (for these columns or more), else by [`Problem::differences`].
+    fn jacobian_at(&self, x: &[f64], r: &[f64], free: &[usize]) -> Option<DMatrix<f64>> {
+        let last = self.last_jacobian.lock().expect("not poisoned").clone();
+        if let Some((at, columns, j)) = last {
+            let picked: Option<Vec<usize>> = free.iter().map(|k| columns.iter().position(|c| c == k)).collect();
+            if let (true, Some(picked)) = (at.as_slice() == x, picked) {
+                return Some(DMatrix::from_fn(j.nrows(), picked.len(), |i, c| j[(i, picked[c])]));
+            }
+        }
+        self.differences(x, r, free)
     }
 }
 
@@ -300,7 +319,7 @@ impl lm::Problem for Problem<'_> {
     }
 
     fn jacobian(&mut self, x: &[f64], r: &[f64], free: &[usize]) -> Option<DMatrix<f64>> {
-        self.differences(x, r, free)
+        self.jacobian_at(x, r, free)
     }
 }
 
@@ -364,7 +383,7 @@ pub fn fit_captures(base: &Actuator, set: &CaptureSet, spec: &Fit3Spec, observe:
         })
         .collect();
     let last_reduction = AtomicU64::new(f64::INFINITY.to_bits());
-    let problem = Problem { base, set, spec, params: params.clone(), sigma, last_reduction: &last_reduction };
+    let problem = Problem { base, set, spec, params: params.clone(), sigma, last_reduction: &last_reduction, last_jacobian: Mutex::new(None) };
     let n = problem.sigma.len();
     let r0 = problem.transformed(&start)?;
     let mut free: Vec<usize> = (0..params.len()).collect();
@@ -400,7 +419,7 @@ pub fn fit_captures(base: &Actuator, set: &CaptureSet, spec: &Fit3Spec, observe:
         let p = free.len();
         let s2 = chi2 / (n - p).max(1) as f64;
         let cov = problem
-            .differences(&x, &outcome.r, &free)
+            .jacobian_at(&x, &outcome.r, &free)
             .and_then(|j| (j.transpose() * j).try_inverse())
             .map(|inv| inv * s2);
         // Which free parameters the data do not determine.

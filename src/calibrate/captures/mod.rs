@@ -10,11 +10,13 @@
 //! - [`synth`]: synthetic captures with a hidden effect and noise.
 //! - [`run`]: the `predict` and `calibrate` requests and their reports.
 //! - [`diagnose`]: the planar diagnosis's verdicts over the registry's effects in 3-D.
+//! - [`report`]: a diagnosis's report directory (`report.md`, a picture per capture).
 
 pub mod diagnose;
 pub mod errors;
 pub mod files;
 pub mod fit;
+pub mod report;
 pub mod run;
 pub mod simulate;
 pub mod synth;

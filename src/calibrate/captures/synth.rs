@@ -42,6 +42,45 @@ pub fn one_cable_at_a_time(cables: usize, levels_n: &[f64], dwell_s: f64) -> Vec
     out
 }
 
+/// The default plan of `synth --actuator` for `cables` cables up to
+/// `max_tension_n`: each cable alone at 2/7, 4.5/7 and 7/7 of it, one
+/// capture at rest, and every pair of cables at (4, 4), (7, 3) and (3, 7)
+/// sevenths of it (pairs bend the body out of either cable's plane, which
+/// separates effects on the cables' tension from effects on the body);
+/// static captures dwelling `dwell_s`, numbered from 1. At 7 N these are
+/// the SoRoMoX-like captures of `tests/captures.rs`.
+pub fn default_plan(cables: usize, max_tension_n: f64, dwell_s: f64) -> Vec<Capture> {
+    let level = |sevenths: f64| max_tension_n * sevenths / 7.0;
+    let mut out = one_cable_at_a_time(cables, &[level(2.0), level(4.5), level(7.0)], dwell_s);
+    let mut push = |tensions: Vec<f64>| {
+        let id = out.len() as i64 + 1;
+        let actuation = tensions.into_iter().map(Actuation::Tension).collect();
+        out.push(Capture { measurement: id, actuation, direction: Direction::Static, step: id - 1, dwell_s, row: id as usize });
+    };
+    push(vec![0.0; cables]);
+    for i in 0..cables {
+        for j in i + 1..cables {
+            for (a, b) in [(4.0, 4.0), (7.0, 3.0), (3.0, 7.0)] {
+                let mut t = vec![0.0; cables];
+                t[i] = level(a);
+                t[j] = level(b);
+                push(t);
+            }
+        }
+    }
+    out
+}
+
+/// The default markers of `synth --actuator`, after the SoRoMoX tentacle's:
+/// `p1`, `p2`, `p3` on stalks at 0.36 L, 0.61 L and 0.78 L, off the body
+/// along body z by twice the radius there (alternately +, −, +), and `p4`
+/// on the axis 2 % of L beyond the tip.
+pub fn default_markers(actuator: &Actuator) -> Vec<MarkerSpec> {
+    let l = actuator.rod.length_mm;
+    let stalk = |name: &str, f: f64, side: f64| MarkerSpec::new(name, f * l, 0.0, side * 2.0 * actuator.rod.radius_at(f * l));
+    vec![stalk("p1", 0.36, 1.0), stalk("p2", 0.61, -1.0), stalk("p3", 0.78, 1.0), MarkerSpec::new("p4", 1.02 * l, 0.0, 0.0)]
+}
+
 /// Solves `captures` with `truth` and measures `markers` on each with
 /// noise of standard deviation `noise_mm` per coordinate (seeded; the
 /// readings carry `sd_mm` = `noise_mm` when `state_sd` is set).

@@ -77,26 +77,36 @@ fn num(v: f64) -> String {
 }
 
 fn candidate_table(out: &mut String, cands: &[Candidate]) {
-    out.push_str("| rank | effect | parameter | value ± SE | ΔBIC | χ²/dof | p | tip RMS (mm) | counts as evidence |\n|---|---|---|---|---|---|---|---|---|\n");
+    candidate_table_head(out, "tip RMS (mm)");
     for c in cands {
-        let _ = writeln!(
-            out,
-            "| {} | {} | `{}` | {} ± {} | {} | {} | {} | {} | {} |",
-            c.rank,
-            c.effect.name(),
-            c.parameter_name,
-            num(c.parameter),
-            num(c.parameter_se),
-            num(c.delta_bic),
-            num(c.reduced_chi2),
-            crate::calibrate::stats::p_cell(c.p_value),
-            num(c.rms_mm),
-            match c.failure() {
-                None => "yes".to_string(),
-                Some(why) => format!("no: {}", why.replace('|', "/").replace('\n', " ")),
-            }
-        );
+        candidate_row(out, c.rank, c.effect, c.parameter_name, [c.parameter, c.parameter_se, c.delta_bic, c.reduced_chi2, c.p_value, c.rms_mm], c.failure());
     }
+}
+
+/// The head of a candidates table in a diagnosis report, its RMS column named `rms`.
+pub(crate) fn candidate_table_head(out: &mut String, rms: &str) {
+    let _ = writeln!(out, "| rank | effect | parameter | value ± SE | ΔBIC | χ²/dof | p | {rms} | counts as evidence |\n|---|---|---|---|---|---|---|---|---|");
+}
+
+/// One candidate's row: `values` are its parameter, SE, ΔBIC, χ²/dof, p and
+/// RMS; `failure` why it does not count (none: it counts).
+pub(crate) fn candidate_row(out: &mut String, rank: usize, effect: crate::calibrate::Effect, parameter_name: &str, values: [f64; 6], failure: Option<String>) {
+    let [parameter, se, delta_bic, reduced_chi2, p_value, rms_mm] = values;
+    let _ = writeln!(
+        out,
+        "| {rank} | {} | `{parameter_name}` | {} ± {} | {} | {} | {} | {} | {} |",
+        effect.name(),
+        num(parameter),
+        num(se),
+        num(delta_bic),
+        num(reduced_chi2),
+        crate::calibrate::stats::p_cell(p_value),
+        num(rms_mm),
+        match failure {
+            None => "yes".to_string(),
+            Some(why) => format!("no: {}", why.replace('|', "/").replace('\n', " ")),
+        }
+    );
 }
 
 /// One line on a fit's adequacy: χ², dof, χ²/dof, p, outliers, convergence.
