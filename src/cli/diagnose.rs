@@ -91,7 +91,7 @@ pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
 
 /// The 3-D route of `cablemap diagnose` (`--actuator FILE.toml`).
 fn run_captures(args: &DiagnoseArgs, actuator: &std::path::Path) -> anyhow::Result<()> {
-    use cablemap::calibrate::captures::diagnose::{diagnose_request, Diagnose3Request};
+    use cablemap::calibrate::captures::{diagnose_request, Diagnose3Request};
     anyhow::ensure!(args.holdout.is_none(), "--holdout takes a routing of planar data; with --actuator, hold out a cable's captures by --holdout-cable K");
     anyhow::ensure!(args.fit.centrelines.is_none(), "--centrelines: planar centreline points; with --actuator, give 3-D markers by --markers");
     anyhow::ensure!(!args.actuator.sets_the_rod(), "with --actuator the rod and its effects come from FILE.toml's [rod] table; edit it instead of giving rod flags");

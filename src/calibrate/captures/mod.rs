@@ -21,9 +21,9 @@ pub mod run;
 pub mod simulate;
 pub mod synth;
 
-pub use diagnose::{diagnose_captures, diagnose_request, Diagnose3Request, Diagnose3Spec, Diagnosis3};
+pub use diagnose::{diagnose_captures, Diagnose3Spec, Diagnosis3};
 pub use errors::ErrorReport;
 pub use files::{read_capture_set, Actuation, Capture, CaptureSet, MarkerReading};
 pub use fit::{fit_captures, Fit3Result, Fit3Spec, Param};
-pub use run::{calibrate, predict, Calibrate3Report, Calibrate3Request, PredictReport, PredictRequest};
+pub use run::{calibrate, diagnose_request, predict, Calibrate3Report, Calibrate3Request, Diagnose3Request, PredictReport, PredictRequest};
 pub use simulate::{solve_captures, CaptureSolution};

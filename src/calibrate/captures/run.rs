@@ -11,6 +11,7 @@ use super::errors::ErrorReport;
 use super::files::{read_capture_set, CaptureSet};
 use super::fit::{fit_captures, Fit3Result, Fit3Spec, Param, Status};
 use super::simulate::solve_captures;
+use super::diagnose::{diagnose_captures, Diagnose3Spec, Diagnosis3};
 use crate::calibrate::fit::Loss;
 use crate::calibrate::{CalibrateError, Effect};
 use crate::model::spatial::SpatialOptions;
@@ -285,4 +286,88 @@ impl fmt::Display for Calibrate3Report {
         }
         Ok(())
     }
+}
+
+/// What `diagnose --actuator` needs.
+#[derive(Debug, Clone)]
+pub struct Diagnose3Request {
+    /// The captures file.
+    pub captures: std::path::PathBuf,
+    /// The markers file.
+    pub markers: Option<std::path::PathBuf>,
+    /// The actuator file: the start and everything not fitted.
+    pub actuator: std::path::PathBuf,
+    /// The system's noise per coordinate, mm.
+    pub noise_mm: f64,
+    /// Loss on the whitened residuals.
+    pub loss: crate::calibrate::fit::Loss,
+    /// Most Levenberg–Marquardt iterations per fit.
+    pub max_iterations: usize,
+    /// Captures in which this cable pulls are held out.
+    pub holdout_cable: Option<usize>,
+    /// The noise test's level.
+    pub alpha: f64,
+    /// BIC decrease an effect needs.
+    pub threshold: f64,
+    /// BIC lead over the runner-up.
+    pub margin: f64,
+    /// Most effects added.
+    pub max_effects: usize,
+    /// The 3-D solver's settings.
+    pub options: crate::model::spatial::SpatialOptions,
+    /// Report directory (`report.md` and a picture per capture); none for no report.
+    pub report_dir: Option<std::path::PathBuf>,
+}
+
+impl Diagnose3Request {
+    /// A request with the defaults of `diagnose --actuator`: noise 0.4 mm,
+    /// least squares, at most 200 iterations per fit, α = 1e-3, BIC
+    /// threshold and margin 10, at most two effects, no held-out cable, no report.
+    pub fn new(captures: std::path::PathBuf, markers: Option<std::path::PathBuf>, actuator: std::path::PathBuf) -> Self {
+        let spec = Diagnose3Spec::default();
+        Self {
+            captures,
+            markers,
+            actuator,
+            noise_mm: 0.4,
+            loss: crate::calibrate::fit::Loss::Squared,
+            max_iterations: 200,
+            holdout_cable: None,
+            alpha: spec.alpha,
+            threshold: spec.threshold,
+            margin: spec.margin,
+            max_effects: spec.max_effects,
+            options: crate::model::spatial::SpatialOptions::default(),
+            report_dir: None,
+        }
+    }
+}
+
+/// Reads the request's files, runs [`diagnose_captures`] and writes the
+/// report directory when asked for (refused first when inside a sweep run,
+/// before anything is read); the report's files are in `written`.
+pub fn diagnose_request(request: &Diagnose3Request) -> Result<Diagnosis3, CalibrateError> {
+    if let Some(dir) = &request.report_dir {
+        crate::io::check_outside_run_dir(dir, "the report directory")?;
+    }
+    let base = Actuator::read(&request.actuator).map_err(CalibrateError::Actuator)?;
+    let set = read_capture_set(&request.captures, request.markers.as_deref(), base.cables.len(), base.rod.length_mm)?;
+    let mut params: Vec<Param> = Param::BODY.to_vec();
+    if !base.rod.gravity.enabled {
+        params.retain(|&p| p != Param::Density);
+    }
+    let spec = Diagnose3Spec {
+        fit: Fit3Spec { params, noise_mm: request.noise_mm, loss: request.loss, max_iterations: request.max_iterations, options: request.options.clone() },
+        holdout_cable: request.holdout_cable,
+        threshold: request.threshold,
+        margin: request.margin,
+        max_effects: request.max_effects,
+        alpha: request.alpha,
+    };
+    let mut d = diagnose_captures(&base, &set, &spec)?;
+    if let Some(dir) = &request.report_dir {
+        let sources = super::report::ReportSources { captures: &request.captures, markers: request.markers.as_deref(), actuator: &request.actuator };
+        d.written = super::report::write_report(dir, sources, &set, &d, &request.options)?;
+    }
+    Ok(d)
 }
