@@ -10,7 +10,7 @@
 //! library's messages.
 
 use super::{actuator_with, bad, Failure, Result, SolverRequest};
-use cablemap::calibrate::captures::diagnose::{diagnose_request, Diagnose3Request};
+use cablemap::calibrate::captures::{diagnose_request, Diagnose3Request};
 use cablemap::calibrate::captures::{self, Calibrate3Request, Param, PredictRequest};
 use cablemap::calibrate::diagnose::DiagnoseRequest;
 use cablemap::calibrate::fit::{parse_held, Held, Loss, Noise};
@@ -589,6 +589,8 @@ fn diagnose_run(r: DiagnosePy) -> Result<Finished> {
         margin,
         max_effects,
         options: spatial_options(&fit.solver)?,
+        // The library's report directory is the command's; the binding returns the report object.
+        report_dir: None,
     };
     let done = diagnose_request(&request).map_err(calibrate_failure)?;
     Ok((done.to_json_line(), done.to_string(), Vec::new()))
