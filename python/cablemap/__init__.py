@@ -26,6 +26,7 @@ from typing import Any, Dict, Iterable, List, Optional, Sequence, Union
 import numpy as np
 
 from . import _native
+from ._record import Record
 from .errors import BadInputError, CablemapError, FileFormatError, SolveError
 
 __all__ = [
@@ -168,7 +169,7 @@ def _solver(method: Optional[str], nodes_per_span: Optional[int], steps_per_span
     return solver
 
 
-class Simulation:
+class Simulation(Record):
     """One solve: the fields of ``cablemap simulate --json`` as attributes.
 
     With ``routing_mm`` (one planar cable) these are the planar record's
@@ -185,22 +186,9 @@ class Simulation:
     """
 
     def __init__(self, record: Dict[str, Any], centreline: np.ndarray, columns: Sequence[str]) -> None:
-        self._record = record
+        super().__init__(record)
         self.centreline = centreline
         self.centreline_columns = list(columns)
-
-    def __getattr__(self, name: str) -> Any:
-        record = self.__dict__.get("_record", {})
-        if name in record:
-            return record[name]
-        raise AttributeError(f"Simulation has no field {name!r}; its fields are {', '.join(sorted(record))}")
-
-    def __dir__(self) -> List[str]:
-        return sorted(set(super().__dir__()) | set(self._record))
-
-    def to_dict(self) -> Dict[str, Any]:
-        """The record: exactly ``cablemap simulate --json``'s object."""
-        return json.loads(json.dumps(self._record))
 
     def __repr__(self) -> str:
         r = self._record

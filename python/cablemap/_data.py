@@ -16,33 +16,21 @@ import os
 from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 from . import _native
+from ._record import Record
 from .errors import BadInputError
 
 PathLike = Union[str, "os.PathLike[str]"]
 Shard = Union[str, Tuple[int, int], None]
 
 
-class _Report:
+class _Report(Record):
     """A library report: its fields (the command's ``--json`` object) as
     attributes and :meth:`to_dict`, the command's text as :attr:`text`."""
 
     def __init__(self, record: Dict[str, Any], text: str) -> None:
-        self._record = record
+        super().__init__(record)
         #: What the command prints.
         self.text = text
-
-    def __getattr__(self, name: str) -> Any:
-        record = self.__dict__.get("_record", {})
-        if name in record:
-            return record[name]
-        raise AttributeError(f"{type(self).__name__} has no field {name!r}; its fields are {', '.join(sorted(record))}")
-
-    def __dir__(self) -> List[str]:
-        return sorted(set(super().__dir__()) | set(self._record))
-
-    def to_dict(self) -> Dict[str, Any]:
-        """The report as the command's ``--json`` prints it."""
-        return json.loads(json.dumps(self._record))
 
     def __str__(self) -> str:
         return self.text

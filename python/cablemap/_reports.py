@@ -19,6 +19,7 @@ import os
 from typing import Any, Dict, Iterable, List, Mapping, Optional, Sequence, Union
 
 from . import Actuator, PathLike, _actuator, _dumps, _native, _solver
+from ._record import Record
 from .errors import BadInputError
 
 __all__ = [
@@ -100,7 +101,7 @@ def _list(values: Optional[Sequence[Any]], digits: int = 4) -> str:
     return "[" + ", ".join(_num(v, digits) for v in (values or [])) + "]"
 
 
-class Report:
+class Report(Record):
     """A workflow's report.
 
     - attributes: the fields of the command's ``--json`` object
@@ -112,24 +113,11 @@ class Report:
     """
 
     def __init__(self, record: Dict[str, Any], text: str, pictures: Sequence[str]) -> None:
-        self._record = record
+        super().__init__(record)
         #: The command's text report.
         self.text = text
         #: Paths of the pictures the workflow wrote.
         self.pictures = list(pictures)
-
-    def __getattr__(self, name: str) -> Any:
-        record = self.__dict__.get("_record", {})
-        if name in record:
-            return record[name]
-        raise AttributeError(f"{type(self).__name__} has no field {name!r}; its fields are {', '.join(sorted(record))}")
-
-    def __dir__(self) -> List[str]:
-        return sorted(set(super().__dir__()) | set(self._record))
-
-    def to_dict(self) -> Dict[str, Any]:
-        """The report: exactly the command's ``--json`` object."""
-        return json.loads(json.dumps(self._record))
 
     def __str__(self) -> str:
         return self.text
