@@ -304,10 +304,7 @@ fn simulate_request(request: SimulateRequest) -> Result<(Simulation, String)> {
     if actuator.cables.is_empty() {
         return Err(bad("no cables: give cables=[...], routing_mm with tension_n, or an actuator with cables"));
     }
-    let mut spatial_options = SpatialOptions::default();
-    if let Some(steps) = solver.steps_per_span {
-        spatial_options.steps_per_span = steps;
-    }
+    let spatial_options = SpatialOptions::with_given(solver.steps_per_span, None, None);
     let sim = simulate_actuator(&actuator, &options, &spatial_options, given, Some(hold), order, basis)?;
     let json = record::simulation_json(&sim).to_string();
     Ok((sim, json))

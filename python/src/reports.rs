@@ -100,18 +100,8 @@ fn length_basis(name: &str) -> Result<LengthBasis> {
 /// The 3-D solver's settings from the solver's fields, as the commands'
 /// `spatial_options`: only those given change the defaults.
 fn spatial_options(solver: &SolverRequest) -> Result<SpatialOptions> {
-    let given = solver.options()?;
-    let mut o = SpatialOptions::default();
-    if solver.nodes_per_span.is_some() {
-        o.nodes_per_span = given.nodes_per_span;
-    }
-    if solver.steps_per_span.is_some() {
-        o.steps_per_span = given.steps_per_span;
-    }
-    if solver.method.is_some() {
-        o.method = given.method;
-    }
-    Ok(o)
+    let method = solver.method.as_ref().map(|_| solver.options().map(|o| o.method)).transpose()?;
+    Ok(SpatialOptions::with_given(solver.steps_per_span, solver.nodes_per_span, method))
 }
 
 /// The rod overrides of a planar fit (the rod flags of `calibrate` and

@@ -239,16 +239,6 @@ fn run_captures(args: &CalibrateArgs, actuator: &std::path::Path) -> anyhow::Res
 /// The 3-D solver's settings from the solver flags (--nodes-per-span,
 /// --steps-per-span for the centreline's resolution, --method).
 pub fn spatial_options(args: &ActuatorArgs) -> cablemap::model::spatial::SpatialOptions {
-    let mut o = cablemap::model::spatial::SpatialOptions::default();
-    let solver = args.solver_options(&SolverOptions::default());
-    if args.nodes_per_span.is_some() {
-        o.nodes_per_span = solver.nodes_per_span;
-    }
-    if args.steps_per_span.is_some() {
-        o.steps_per_span = solver.steps_per_span;
-    }
-    if args.method.is_some() {
-        o.method = solver.method;
-    }
-    o
+    let method = args.method.map(|_| args.solver_options(&SolverOptions::default()).method);
+    cablemap::model::spatial::SpatialOptions::with_given(args.steps_per_span, args.nodes_per_span, method)
 }

@@ -227,10 +227,7 @@ fn run_spatial(args: &SimulateArgs) -> anyhow::Result<()> {
         args.n_d
     );
     let options = args.actuator.solver_options(&SolverOptions::default());
-    let mut spatial_options = SpatialOptions::default();
-    if let Some(steps) = args.actuator.steps_per_span {
-        spatial_options.steps_per_span = steps;
-    }
+    let spatial_options = SpatialOptions::with_given(args.actuator.steps_per_span, None, None);
     let thesis = args.coefficients == CoefficientRoute::Thesis;
     let given = given_settings(args);
     // As the planar `--routing` path holds it.

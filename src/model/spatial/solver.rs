@@ -103,6 +103,20 @@ pub struct SpatialOptions {
     pub method: crate::model::SolverMethod,
 }
 
+impl SpatialOptions {
+    /// The 3-D defaults with the solver settings a user gave: a field left
+    /// `None` keeps the 3-D solver's own default (not the planar solver's).
+    pub fn with_given(steps_per_span: Option<usize>, nodes_per_span: Option<usize>, method: Option<crate::model::SolverMethod>) -> Self {
+        let d = Self::default();
+        Self {
+            steps_per_span: steps_per_span.unwrap_or(d.steps_per_span),
+            nodes_per_span: nodes_per_span.unwrap_or(d.nodes_per_span),
+            method: method.unwrap_or(d.method),
+            ..d
+        }
+    }
+}
+
 impl Default for SpatialOptions {
     fn default() -> Self {
         Self { steps_per_span: 10, moment_tolerance_n_mm: 1e-7, max_passes: 40, nodes_per_span: 10, method: crate::model::SolverMethod::Collocation }
