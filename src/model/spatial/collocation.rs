@@ -38,8 +38,10 @@
 //! solution, no shooting. With gravity or friction the sweep is a fixed-point
 //! map, accelerated by Anderson's method ([`crate::numerics::anderson`]);
 //! where it does not contract (heavy rods), Newton's method on the whole
-//! collocation system takes over, continued in the weight from a weightless
-//! rod if it fails from the warm start.
+//! collocation system takes over (Newton–Krylov: GMRES,
+//! [`crate::numerics::gmres`], on directional derivatives by one sweep
+//! each), continued in the weight from a weightless rod if it fails from
+//! the warm start.
 //!
 //! **Coefficients.** The bending curvature of the centreline is the rotation
 //! rate of its unit tangent, κ = u − (u·v̂) v̂ + v̂ × v̂' in the body frame
@@ -76,6 +78,20 @@ const NEWTON_TOLERANCE: f64 = 1e-11;
 const NEWTON_MAX_ITERATIONS: u32 = 40;
 /// Newton: the backtracking's sufficient decrease (Armijo) factor.
 const NEWTON_SUFFICIENT_DECREASE: f64 = 1e-4;
+/// Newton–Krylov: GMRES's relative tolerance on J δ = −F, and its most
+/// iterations (sweeps) before a fresh Jacobian is made instead.
+const KRYLOV_TOLERANCE: f64 = 1e-2;
+const KRYLOV_MAX_ITERATIONS: usize = 40;
+/// The kinds of Newton step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Step {
+    /// With the kept factors of an earlier Jacobian.
+    Chord,
+    /// Newton–Krylov: GMRES, preconditioned by the kept factors if any.
+    Krylov,
+    /// With a fresh Jacobian.
+    Fresh,
+}
 /// Newton: smallest damping factor tried before giving up.
 const NEWTON_MIN_DAMPING: f64 = 1.0 / 1024.0;
 /// Weight continuation: first and largest steps, smallest step (fractions of the weight).
@@ -190,6 +206,9 @@ struct Solved {
     local: Vec<[f64; 6]>,
 }
 
+/// LU factors of Newton's Jacobian on the whole collocation system.
+type Factors = nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>;
+
 /// The 3-D collocation solver for one actuator: set tensions, then solve
 /// (in a ladder, for the best warm starts).
 #[derive(Debug, Clone)]
@@ -264,8 +283,9 @@ pub struct SpatialSolver {
     speed: Vec<f64>,
     dmom: Vec<V3>,
     anderson: Anderson,
-    /// Newton's Jacobian factors on the whole system, kept for chord steps.
-    newton_factors: Option<nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>>,
+    /// Newton's Jacobian factors on the whole system, kept for chord steps
+    /// and as the Krylov steps' preconditioner.
+    newton_factors: Option<Factors>,
     /// A factor on the sweeps' and the local Newton's tolerances (1; below
     /// for displacement-driven cables, whose tensions are found by
     /// differences of solves).
@@ -744,11 +764,17 @@ impl SpatialSolver {
         Ok(iterations)
     }
 
-    /// Newton's method on F(z) = z − G(z) (G: one sweep), with the Jacobian
-    /// by finite differences of sweeps and backtracking on |F|. The
-    /// Jacobian's factors are kept across iterations and solves (chord
-    /// steps: a heavy rod's Jacobian changes slowly along a tension ladder)
-    /// and made afresh when a chord step contracts by less than half.
+    /// Newton's method on F(z) = z − G(z) (G: one sweep), with backtracking
+    /// on |F|. The steps are Newton–Krylov: GMRES on J δ = −F to
+    /// [`KRYLOV_TOLERANCE`], J v by one finite-difference sweep (the
+    /// fixed-point map's non-contracting modes, the heavy rod's low bending
+    /// modes, are few: about four sweeps a step instead of a Jacobian's one
+    /// per unknown and its LU). Only when GMRES does not reach its
+    /// tolerance in [`KRYLOV_MAX_ITERATIONS`] or a Krylov step fails its
+    /// line search is the Jacobian made by finite differences and
+    /// factored; its factors are kept across iterations and solves for
+    /// chord steps while those contract by half or better, and then serve
+    /// as GMRES's right preconditioner.
     fn newton(&mut self, tensions: &[f64]) -> Result<u32, SpatialFailure> {
         let n = self.state.len();
         let residual = |this: &mut Self| -> Result<DVector<f64>, SpatialFailure> {
@@ -758,24 +784,39 @@ impl SpatialSolver {
         let mut f = residual(self)?;
         let mut norm = f.amax();
         let mut factors = self.newton_factors.take();
+        let mut krylov = factors.is_none();
         for it in 0..NEWTON_MAX_ITERATIONS {
             if norm <= NEWTON_TOLERANCE {
                 self.newton_factors = factors;
                 return Ok(it);
             }
-            let fresh = factors.is_none();
-            if fresh {
-                factors = Some(self.jacobian(tensions)?.lu());
-            }
-            let base = self.state.clone();
             let failed = SpatialFailure::Gravity { passes: it, residual_n_mm: norm / self.m_scale };
-            let Some(delta) = factors.as_ref().and_then(|lu| lu.solve(&(-&f))) else {
-                if fresh {
+            let mut delta = None;
+            let mut step = Step::Chord;
+            if krylov {
+                step = Step::Krylov;
+                delta = self.krylov_step(tensions, &f, factors.as_ref())?;
+                if delta.is_none() {
+                    factors = None;
+                }
+            } else if let Some(lu) = factors.as_ref() {
+                delta = lu.solve(&(-&f));
+                if delta.is_none() {
+                    factors = None;
+                }
+            }
+            if delta.is_none() {
+                step = Step::Fresh;
+                let lu = self.jacobian(tensions)?.lu();
+                delta = lu.solve(&(-&f));
+                factors = Some(lu);
+                krylov = false;
+                if delta.is_none() {
                     return Err(failed);
                 }
-                factors = None;
-                continue;
-            };
+            }
+            let delta = delta.expect("set above");
+            let base = self.state.clone();
             let mut lambda = 1.0;
             let accepted = loop {
                 for i in 0..n {
@@ -785,7 +826,7 @@ impl SpatialSolver {
                     Ok(trial) if trial.amax().is_finite() && trial.amax() < (1.0 - NEWTON_SUFFICIENT_DECREASE * lambda) * norm => break Some(trial),
                     _ => {
                         lambda /= 2.0;
-                        if lambda < NEWTON_MIN_DAMPING || (!fresh && lambda < 0.25) {
+                        if lambda < NEWTON_MIN_DAMPING || (step == Step::Chord && lambda < 0.25) {
                             break None;
                         }
                     }
@@ -796,16 +837,20 @@ impl SpatialSolver {
                     let contraction = trial.amax() / norm;
                     norm = trial.amax();
                     f = trial;
-                    if !fresh && contraction > 0.5 {
-                        factors = None;
+                    if step == Step::Chord && contraction > 0.5 {
+                        krylov = true;
                     }
                 }
                 None => {
                     self.state.copy_from_slice(&base);
-                    if fresh {
-                        return Err(failed);
+                    match step {
+                        Step::Fresh => return Err(failed),
+                        Step::Chord => krylov = true,
+                        _ => {
+                            factors = None;
+                            krylov = false;
+                        }
                     }
-                    factors = None;
                     f = residual(self)?;
                     norm = f.amax();
                 }
@@ -816,6 +861,54 @@ impl SpatialSolver {
             return Ok(NEWTON_MAX_ITERATIONS);
         }
         Err(SpatialFailure::Gravity { passes: NEWTON_MAX_ITERATIONS, residual_n_mm: norm / self.m_scale })
+    }
+
+    /// A Newton–Krylov step at the current state (F(z) = `f`, G(z) in
+    /// `next`, the local solutions committed): GMRES on J δ = −F to
+    /// [`KRYLOV_TOLERANCE`], J v = (F(z + εv) − F(z))/ε by one sweep,
+    /// right-preconditioned by `factors` when given. `None` when GMRES
+    /// does not reach its tolerance.
+    fn krylov_step(&mut self, tensions: &[f64], f: &DVector<f64>, factors: Option<&Factors>) -> Result<Option<DVector<f64>>, SpatialFailure> {
+        let n = self.state.len();
+        let base = self.state.clone();
+        let g0 = self.next.clone();
+        let scale = 1e-7 * (1.0 + base.iter().fold(0.0f64, |a, v| a.max(v.abs())));
+        let b: Vec<f64> = f.iter().map(|v| -v).collect();
+        let mut x = vec![0.0; n];
+        let outcome = crate::numerics::gmres::gmres(
+            &b,
+            KRYLOV_MAX_ITERATIONS,
+            KRYLOV_TOLERANCE,
+            |v: &[f64], out: &mut [f64]| {
+                let eps = scale / v.iter().fold(0.0f64, |a, v| a.max(v.abs())).max(1e-300);
+                for i in 0..n {
+                    self.state[i] = base[i] + eps * v[i];
+                }
+                let result = self.sweep(tensions, false);
+                if result.is_ok() {
+                    for i in 0..n {
+                        out[i] = ((self.state[i] - self.next[i]) - f[i]) / eps;
+                    }
+                }
+                self.state.copy_from_slice(&base);
+                result.map(|_| ())
+            },
+            |v: &mut [f64]| {
+                if let Some(lu) = factors {
+                    let mut w = DVector::from_column_slice(v);
+                    if lu.solve_mut(&mut w) {
+                        v.copy_from_slice(w.as_slice());
+                    }
+                }
+            },
+            &mut x,
+        );
+        self.next.copy_from_slice(&g0);
+        let outcome = outcome?;
+        if outcome.relative_residual > KRYLOV_TOLERANCE {
+            return Ok(None);
+        }
+        Ok(Some(DVector::from_vec(x)))
     }
 
     /// The Jacobian of F(z) = z − G(z) at the current state by forward
