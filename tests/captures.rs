@@ -3,7 +3,7 @@
 //! (tests/data/soromox, MIT), and the 3-D fit's round trip on synthetic
 //! captures whose truth is known.
 
-use cablemap::calibrate::captures::synth::{default_plan, one_cable_at_a_time, synth_captures, MarkerSpec};
+use cablemap::calibrate::captures::synth::{default_plan, load_unload_plan, one_cable_at_a_time, synth_captures, MarkerSpec};
 use cablemap::calibrate::captures::fit::Status;
 use cablemap::calibrate::captures::{diagnose_captures, fit_captures, Diagnose3Spec, Diagnosis3, Fit3Spec, Param};
 use cablemap::calibrate::Effect;
@@ -183,7 +183,7 @@ fn tentacle_truth() -> Actuator {
 fn the_3d_fit_recovers_the_rigidities_within_their_standard_errors() {
     let truth = tentacle_truth();
     let options = SpatialOptions::default();
-    let markers = [MarkerSpec::new("p1", 129.1, 0.0, 25.0), MarkerSpec::new("p2", 219.5, 0.0, -21.0), MarkerSpec::new("p3", 280.0, 0.0, 20.0), MarkerSpec::new("p4", 368.0, 0.0, 0.0)];
+    let markers = soromox_markers();
     let captures = one_cable_at_a_time(2, &[1.5, 3.0, 4.5, 6.0, 7.5], 5.0);
     let set = synth_captures(&truth, &options, captures, &markers, 1.0, 7, false).unwrap();
     let start = Actuator::read(std::path::Path::new(&soromox("actuator.toml"))).unwrap();
@@ -212,21 +212,30 @@ fn the_3d_fit_recovers_the_rigidities_within_their_standard_errors() {
     assert!((1.2..2.3).contains(&fit.errors.rms_mm), "{}", fit.errors.rms_mm);
 }
 
+/// The SoRoMoX markers: three on stalks, one 8 mm beyond the tip.
+fn soromox_markers() -> Vec<MarkerSpec> {
+    vec![MarkerSpec::new("p1", 129.1, 0.0, 25.0), MarkerSpec::new("p2", 219.5, 0.0, -21.0), MarkerSpec::new("p3", 280.0, 0.0, 20.0), MarkerSpec::new("p4", 368.0, 0.0, 0.0)]
+}
+
 /// Synthetic captures of the tentacle (the file's materials) with `hidden`
 /// applied to the truth: each tendon alone at three levels, both at three
 /// pairs and one capture at rest, the four SoRoMoX markers, 1 mm noise.
 fn hidden(effect: impl Fn(&mut Actuator)) -> (Actuator, cablemap::calibrate::captures::CaptureSet) {
+    // Each tendon alone at 2, 4.5, 7 N, at rest, and both at (4, 4), (7, 3),
+    // (3, 7) N: the pairs bend the body out of either tendon's plane, which
+    // separates effects on the cables' tension from effects on the body
+    // (stiffening, a gradient).
+    let captures = default_plan(2, 7.0, 5.0);
+    assert_eq!(captures.len(), 10);
+    hidden_in(effect, captures, &soromox_markers())
+}
+
+/// As [`hidden`], with the given captures and markers.
+fn hidden_in(effect: impl Fn(&mut Actuator), captures: Vec<cablemap::calibrate::captures::Capture>, markers: &[MarkerSpec]) -> (Actuator, cablemap::calibrate::captures::CaptureSet) {
     let start = Actuator::read(std::path::Path::new(&soromox("actuator.toml"))).unwrap();
     let mut truth = start.clone();
     effect(&mut truth);
-    let markers = [MarkerSpec::new("p1", 129.1, 0.0, 25.0), MarkerSpec::new("p2", 219.5, 0.0, -21.0), MarkerSpec::new("p3", 280.0, 0.0, 20.0), MarkerSpec::new("p4", 368.0, 0.0, 0.0)];
-    // Each tendon alone at 2, 4.5, 7 N, at rest, and both at (4, 4), (7, 3),
-    // (3, 7) N: the pairs bend the body out of either tendon's plane, which
-    // separates effects on the cables' tension (friction) from effects on
-    // the body (stiffening, a gradient).
-    let captures = default_plan(2, 7.0, 5.0);
-    assert_eq!(captures.len(), 10);
-    let set = synth_captures(&truth, &SpatialOptions::default(), captures, &markers, 1.0, 3, false).unwrap();
+    let set = synth_captures(&truth, &SpatialOptions::default(), captures, markers, 1.0, 3, false).unwrap();
     (start, set)
 }
 
@@ -239,32 +248,37 @@ fn diagnosis(start: &Actuator, set: &cablemap::calibrate::captures::CaptureSet) 
 
 #[test]
 fn diagnose_names_a_hidden_clamp_compliance_in_3d() {
-    let k = 800.0;
+    // How precisely captures determine a clamp spring depends on how soft it
+    // is: the tendons' moment at the clamp is partly cancelled by the curled
+    // body's weight at high tension, so a stiff spring barely turns the base
+    // (800 N·mm/rad: 0.7° more tip angle at 7 N; from these ten captures,
+    // fitted 1127 ± 346, SE 30 %). At 400 N·mm/rad (a grip as soft as 56 mm
+    // of the base section) the SE is about 20 % and it is named within
+    // ±25 % (494 ± 100 with this seed: the noise's offset, not a bias —
+    // noise-free captures give back 400.000).
+    let k = 400.0;
     let (start, set) = hidden(|a| Effect::ClampCompliance.apply(&mut a.rod, k));
     let d = diagnosis(&start, &set);
     assert_eq!(d.verdict.label(), "clamp_compliance", "{}", d.reason);
-    // Named, and within two standard errors (with these ten captures at 1 mm
-    // the SE is about 30 %: the issue's ±25 % needs more captures).
     let (got, se) = (d.parameter.unwrap(), d.parameter_se.unwrap());
-    assert!((got - k).abs() <= 2.0 * se, "{got} ± {se} vs {k}");
+    println!("hidden clamp stiffness {k} N·mm/rad: named at {got:.1} ± {se:.1}");
+    assert!((got - k).abs() <= 0.25 * k, "{got} ± {se} vs {k}: not within ±25 %");
+    assert!((got - k).abs() <= 2.0 * se, "{got} ± {se} vs {k}: not within 2 SE");
 }
 
 #[test]
 fn diagnose_names_a_hidden_friction_in_3d() {
     let mu = 0.15;
-    let (start, set) = hidden(|a| Effect::Friction.apply(&mut a.rod, mu));
+    // Static captures alone leave friction's BIC lead over stiffening below
+    // the margin (both make the bend sublinear in tension); a load/unload
+    // protocol, the diagnosis's separating measurement, shows the loop
+    // only friction opens.
+    let (start, set) = hidden_in(|a| Effect::Friction.apply(&mut a.rod, mu), load_unload_plan(2, 7.0, 5.0), &soromox_markers());
     let d = diagnosis(&start, &set);
-    // Friction leads with its value within ±25 %; with ten captures at 1 mm
-    // its BIC lead over stiffening is below the margin, so the tool may say
-    // `ambiguous` (friction and another) rather than name it.
-    let top = &d.candidates[0];
-    assert_eq!(top.effect, Effect::Friction, "{}", d.reason);
-    assert!((top.parameter - mu).abs() <= 0.25 * mu, "{} vs {mu}", top.parameter);
-    match d.verdict.label() {
-        "friction" => {}
-        "ambiguous" => assert!(d.ambiguous_between.contains(&Effect::Friction), "{:?}", d.ambiguous_between),
-        other => panic!("{other}: {}", d.reason),
-    }
+    assert_eq!(d.verdict.label(), "friction", "{}", d.reason);
+    let (got, se) = (d.parameter.unwrap(), d.parameter_se.unwrap());
+    println!("hidden friction μ {mu}: named at {got:.4} ± {se:.4}");
+    assert!((got - mu).abs() <= 0.25 * mu, "{got} ± {se} vs {mu}: not within ±25 %");
 }
 
 #[test]
@@ -393,4 +407,35 @@ fn synth_captures_then_calibrate_recovers_the_rigidities_through_the_binary() {
     assert!(ok && stderr.contains("hidden effect: clamp_compliance = 800") && stderr.contains("2 markers each"), "{stderr}");
     let (ok, _, stderr) = synth(&["--routings", "a:1,1,1,1,1"], "c3.csv", "m3.csv");
     assert!(!ok && stderr.contains("--routings"), "{stderr}");
+}
+
+/// The planar projection of the tentacle (`tests/data/soromox/planar/`,
+/// written by `scripts/soromox-planar.py`: each capture in its tendon's
+/// bending plane) is what the planar `calibrate` and `diagnose` read; the
+/// committed files are the script's output, and the planar fit converges
+/// at full weight on the tapered, anchored body its header gives.
+#[test]
+fn the_planar_projection_of_the_tentacle_is_the_scripts_output_and_calibrates() {
+    let dir = tempfile::tempdir().unwrap();
+    let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scripts/soromox-planar.py");
+    let out = Command::new("python3").arg(&script).arg(soromox("")).arg(dir.path()).output().expect("python3 runs");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    for file in ["readings.csv", "markers.csv"] {
+        let committed = std::fs::read_to_string(soromox(&format!("planar/{file}"))).unwrap();
+        let made = std::fs::read_to_string(dir.path().join(file)).unwrap();
+        assert_eq!(committed, made, "planar/{file} is not scripts/soromox-planar.py's output: run the script again");
+    }
+    let (ok, stdout, stderr) = cablemap(&["calibrate", &soromox("planar/readings.csv"), "--markers", &soromox("planar/markers.csv"), "--noise-mm", "5", "--fix", "ga_n=129.9118", "--json"]);
+    assert!(ok, "{stderr}");
+    let fit = json(&stdout);
+    assert_eq!(fit["converged"], true, "{fit}");
+    let routing = &fit["per_routing"][0];
+    assert_eq!(routing["rows"], 14, "{routing}");
+    let ei = fit["parameters"].as_array().unwrap().iter().find(|p| p["name"] == "ei_n_mm2").unwrap();
+    let (value, se) = (ei["value"].as_f64().unwrap(), ei["se"].as_f64().unwrap());
+    println!("planar projection: EI {value:.0} ± {se:.0} N·mm², tip RMS {:.2} mm, angle RMS {:.2}°", routing["rms_position_mm"], routing["rms_angle_deg"]);
+    // Softer than the nominal 22 366 N·mm² (the captures bend more than the
+    // nominal model), as the 3-D fit finds.
+    assert!(value > 0.0 && se < 0.1 * value && value < 22366.18, "{ei}");
+    assert!(routing["rms_position_mm"].as_f64().unwrap() < 40.0, "{routing}");
 }

@@ -184,15 +184,7 @@ pub fn run(args: &CalibrateArgs) -> anyhow::Result<()> {
 /// and 3-D markers, the fit by the 3-D solver.
 fn run_captures(args: &CalibrateArgs, actuator: &std::path::Path) -> anyhow::Result<()> {
     use cablemap::calibrate::captures::{self, Calibrate3Request, Param};
-    if args.holdout.is_some() {
-        bail!("--holdout takes a routing of planar data; with --actuator, hold out a cable's captures by --holdout-cable K");
-    }
-    if args.fit.centrelines.is_some() {
-        bail!("--centrelines: planar centreline points; with --actuator, give 3-D markers by --markers");
-    }
-    if args.actuator.sets_the_rod() {
-        bail!("with --actuator the rod and its effects come from FILE.toml's [rod] table; edit it instead of giving rod flags");
-    }
+    check_captures_flags(args.holdout.is_some(), &args.fit, &args.actuator)?;
     let mut held = Vec::new();
     for item in &args.fit.fix {
         let Some((name, value)) = item.split_once('=') else {
@@ -206,12 +198,6 @@ fn run_captures(args: &CalibrateArgs, actuator: &std::path::Path) -> anyhow::Res
             bail!("--fix {item}: '{value}' is not a number");
         };
         held.push((p, v));
-    }
-    if !(args.fit.noise_mm.is_finite() && args.fit.noise_mm > 0.0) {
-        bail!("--noise-mm {}: the markers' noise must be a standard deviation > 0 mm", args.fit.noise_mm);
-    }
-    if args.fit.max_iterations == 0 {
-        bail!("--max-iterations must be at least 1");
     }
     let mut request = Calibrate3Request::new(args.data.clone(), args.fit.markers.clone(), actuator.to_path_buf());
     request.held = held;
@@ -232,6 +218,28 @@ fn run_captures(args: &CalibrateArgs, actuator: &std::path::Path) -> anyhow::Res
         writeln!(out, "{}", report.to_json_line())?;
     } else {
         write!(out, "{report}")?;
+    }
+    Ok(())
+}
+
+/// The flags of planar data that the captures route (`--actuator`) refuses,
+/// and the fit settings it checks, shared by `calibrate` and `diagnose`:
+/// `planar_holdout` is whether `--holdout ROUTING` was given.
+pub fn check_captures_flags(planar_holdout: bool, fit: &FitArgs, actuator: &ActuatorArgs) -> anyhow::Result<()> {
+    if planar_holdout {
+        bail!("--holdout takes a routing of planar data; with --actuator, hold out a cable's captures by --holdout-cable K");
+    }
+    if fit.centrelines.is_some() {
+        bail!("--centrelines: planar centreline points; with --actuator, give 3-D markers by --markers");
+    }
+    if actuator.sets_the_rod() {
+        bail!("with --actuator the rod and its effects come from FILE.toml's [rod] table; edit it instead of giving rod flags");
+    }
+    if !(fit.noise_mm.is_finite() && fit.noise_mm > 0.0) {
+        bail!("--noise-mm {}: the markers' noise must be a standard deviation > 0 mm", fit.noise_mm);
+    }
+    if fit.max_iterations == 0 {
+        bail!("--max-iterations must be at least 1");
     }
     Ok(())
 }

@@ -92,12 +92,8 @@ pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
 /// The 3-D route of `cablemap diagnose` (`--actuator FILE.toml`).
 fn run_captures(args: &DiagnoseArgs, actuator: &std::path::Path) -> anyhow::Result<()> {
     use cablemap::calibrate::captures::{diagnose_request, Diagnose3Request};
-    anyhow::ensure!(args.holdout.is_none(), "--holdout takes a routing of planar data; with --actuator, hold out a cable's captures by --holdout-cable K");
-    anyhow::ensure!(args.fit.centrelines.is_none(), "--centrelines: planar centreline points; with --actuator, give 3-D markers by --markers");
-    anyhow::ensure!(!args.actuator.sets_the_rod(), "with --actuator the rod and its effects come from FILE.toml's [rod] table; edit it instead of giving rod flags");
+    super::calibrate::check_captures_flags(args.holdout.is_some(), &args.fit, &args.actuator)?;
     anyhow::ensure!(args.fit.fix.is_empty(), "--fix with --actuator: set the value in FILE.toml instead (a diagnosis fits the body the data determine)");
-    anyhow::ensure!(args.fit.noise_mm.is_finite() && args.fit.noise_mm > 0.0, "--noise-mm {}: the markers' noise must be a standard deviation > 0 mm", args.fit.noise_mm);
-    anyhow::ensure!(args.fit.max_iterations > 0, "--max-iterations must be at least 1");
     let request = Diagnose3Request {
         captures: args.data.clone(),
         markers: args.fit.markers.clone(),

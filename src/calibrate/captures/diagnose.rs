@@ -25,8 +25,9 @@ use super::errors::ErrorReport;
 use super::files::CaptureSet;
 use super::fit::{fit_captures, Fit3Result, Fit3Spec, Param, Status};
 use super::simulate::solve_captures;
+use crate::calibrate::diagnose::criterion::{self, decide, rank, Candidate, Decision, NamedEffect};
 use crate::calibrate::diagnose::Verdict;
-use crate::calibrate::{stats, CalibrateError, Effect};
+use crate::calibrate::{CalibrateError, Effect};
 use crate::model::Actuator;
 use rayon::prelude::*;
 use serde::Serialize;
@@ -50,65 +51,17 @@ pub struct Diagnose3Spec {
     pub alpha: f64,
 }
 
+impl Diagnose3Spec {
+    /// The naming rule's thresholds.
+    pub fn rule(&self) -> criterion::Rule {
+        criterion::Rule { threshold: self.threshold, margin: self.margin }
+    }
+}
+
 impl Default for Diagnose3Spec {
     fn default() -> Self {
         Self { fit: Fit3Spec::default(), holdout_cable: None, threshold: 10.0, margin: 10.0, max_effects: 2, alpha: 1e-3 }
     }
-}
-
-/// One candidate effect refitted with the body.
-#[derive(Debug, Clone, Serialize)]
-pub struct Candidate3 {
-    /// Rank (1 = lowest BIC).
-    pub rank: usize,
-    /// The effect.
-    pub effect: Effect,
-    /// Parameter name with unit.
-    pub parameter_name: &'static str,
-    /// Fitted value (NaN if the fit failed).
-    pub parameter: f64,
-    /// Its standard error.
-    pub parameter_se: f64,
-    /// BIC change against the model without it (negative: better).
-    pub delta_bic: f64,
-    /// RMS of the 3-D marker errors, mm.
-    pub rms_mm: f64,
-    /// χ², dof, χ²/dof, p.
-    pub chi2: f64,
-    /// Degrees of freedom.
-    pub dof: usize,
-    /// χ²/dof.
-    pub reduced_chi2: f64,
-    /// P(χ²_dof ≥ χ²).
-    pub p_value: f64,
-    /// Whether the fit converged.
-    pub converged: bool,
-    /// Whether its value is plausible and determined.
-    pub plausible: bool,
-    /// Why the fit failed, if it did.
-    pub error: Option<String>,
-}
-
-impl Candidate3 {
-    /// Whether this fit counts as evidence.
-    pub fn counts(&self) -> bool {
-        self.error.is_none() && self.converged && self.plausible && self.delta_bic.is_finite()
-    }
-}
-
-/// An effect of the final model.
-#[derive(Debug, Clone, Serialize)]
-pub struct Named3 {
-    /// The effect.
-    pub effect: Effect,
-    /// Parameter name.
-    pub parameter_name: &'static str,
-    /// Fitted value.
-    pub parameter: f64,
-    /// Standard error.
-    pub parameter_se: f64,
-    /// BIC change that admitted it.
-    pub delta_bic: f64,
 }
 
 /// A fit in brief, for the report.
@@ -227,17 +180,17 @@ pub struct Diagnosis3 {
     /// Its SE.
     pub parameter_se: Option<f64>,
     /// The final model's effects in the order added.
-    pub effects: Vec<Named3>,
+    pub effects: Vec<NamedEffect>,
     /// With `unexplained`: effects that lower the BIC but leave the fit above the noise.
-    pub partial_effects: Vec<Named3>,
+    pub partial_effects: Vec<NamedEffect>,
     /// The two effects the data cannot tell apart, if ambiguous.
     pub ambiguous_between: Vec<Effect>,
     /// The measurement that would separate them.
     pub separating_measurement: Option<String>,
     /// Ranked candidates of the first round.
-    pub candidates: Vec<Candidate3>,
+    pub candidates: Vec<Candidate>,
     /// Of the second round.
-    pub second_round: Vec<Candidate3>,
+    pub second_round: Vec<Candidate>,
     /// Candidates left out, and why.
     pub not_candidates: Vec<String>,
     /// The body fit.
@@ -268,11 +221,22 @@ pub struct Diagnosis3 {
     pub written: Vec<std::path::PathBuf>,
 }
 
-fn candidate(effect: Effect, reference_bic: f64, result: &Result<Fit3Result, CalibrateError>) -> Candidate3 {
+fn candidate(effect: Effect, reference_bic: f64, result: &Result<Fit3Result, CalibrateError>) -> Candidate {
     match result {
         Ok(f) => {
             let p = f.parameter(Param::Effect(effect)).expect("fitted effect");
-            Candidate3 {
+            let mut flags = Vec::new();
+            match p.status {
+                Status::Fitted => {}
+                Status::Undetermined => flags.push(format!("{} is not determined by these data (held at its start)", p.name)),
+                Status::AtBound => flags.push(format!("{} is at the bound of its range", p.name)),
+            }
+            if !effect.plausible(p.value) {
+                flags.push(format!("{} = {:.4e} is outside the plausible range {}", p.name, p.value, effect.plausible_text()));
+            } else if !p.se.is_finite() {
+                flags.push(format!("{} has no finite standard error", p.name));
+            }
+            Candidate {
                 rank: 0,
                 effect,
                 parameter_name: effect.parameter_name(),
@@ -285,45 +249,12 @@ fn candidate(effect: Effect, reference_bic: f64, result: &Result<Fit3Result, Cal
                 reduced_chi2: f.reduced_chi2,
                 p_value: f.p_value,
                 converged: f.converged,
-                plausible: p.status == Status::Fitted && effect.plausible(p.value) && p.se.is_finite(),
+                plausible: flags.is_empty(),
+                flags,
                 error: None,
             }
         }
-        Err(e) => Candidate3 {
-            rank: 0,
-            effect,
-            parameter_name: effect.parameter_name(),
-            parameter: f64::NAN,
-            parameter_se: f64::NAN,
-            delta_bic: f64::INFINITY,
-            rms_mm: f64::NAN,
-            chi2: f64::NAN,
-            dof: 0,
-            reduced_chi2: f64::NAN,
-            p_value: f64::NAN,
-            converged: false,
-            plausible: false,
-            error: Some(e.to_string()),
-        },
-    }
-}
-
-#[derive(Clone, Copy)]
-enum Decision {
-    None,
-    Named(Effect),
-    Ambiguous(Effect, Effect),
-}
-
-fn decide(ranked: &[Candidate3], spec: &Diagnose3Spec) -> Decision {
-    let ok: Vec<&Candidate3> = ranked.iter().filter(|c| c.counts()).collect();
-    let Some(best) = ok.first() else { return Decision::None };
-    if best.delta_bic > -spec.threshold {
-        return Decision::None;
-    }
-    match ok.get(1) {
-        Some(runner) if runner.delta_bic - best.delta_bic < spec.margin => Decision::Ambiguous(best.effect, runner.effect),
-        _ => Decision::Named(best.effect),
+        Err(e) => Candidate::failed(effect, e.to_string()),
     }
 }
 
@@ -338,7 +269,7 @@ struct Round<'a> {
 
 impl Round<'_> {
     /// Every candidate not in `effects`, refitted with them from `reference`'s optimum.
-    fn run(&self, effects: &[Effect], reference: &Fit3Result) -> (Vec<Candidate3>, Vec<(Effect, Fit3Result)>) {
+    fn run(&self, effects: &[Effect], reference: &Fit3Result) -> (Vec<Candidate>, Vec<(Effect, Fit3Result)>) {
         let todo: Vec<Effect> = self.candidates.iter().copied().filter(|e| !effects.contains(e)).collect();
         let results: Vec<(Effect, Result<Fit3Result, CalibrateError>)> = todo
             .par_iter()
@@ -361,17 +292,10 @@ impl Round<'_> {
                 fits.push((e, f));
             }
         }
-        cands.sort_by(|a, b| a.delta_bic.total_cmp(&b.delta_bic));
-        for (k, c) in cands.iter_mut().enumerate() {
-            c.rank = k + 1;
-        }
+        rank(&mut cands);
         let _ = self.base;
         (cands, fits)
     }
-}
-
-fn named(e: Effect, c: &Candidate3) -> Named3 {
-    Named3 { effect: e, parameter_name: e.parameter_name(), parameter: c.parameter, parameter_se: c.parameter_se, delta_bic: c.delta_bic }
 }
 
 fn fit_of(fits: &[(Effect, Fit3Result)], e: Effect) -> Fit3Result {
@@ -379,7 +303,7 @@ fn fit_of(fits: &[(Effect, Fit3Result)], e: Effect) -> Fit3Result {
 }
 
 fn chi2_text(f: &Fit3Result) -> String {
-    format!("χ² = {:.1} on {} dof, χ²/dof = {:.2}, {}", f.chi2, f.dof, f.reduced_chi2, stats::p_text(f.p_value))
+    criterion::chi2_text(f.chi2, f.dof, f.reduced_chi2, f.p_value)
 }
 
 /// Runs the 3-D diagnosis of `set` from the actuator `base`.
@@ -420,7 +344,7 @@ pub fn diagnose_captures(base: &Actuator, set: &CaptureSet, spec: &Diagnose3Spec
         .collect();
     let round = Round { base, set: &train, spec, body, candidates };
     let (first, fits) = round.run(&[], &baseline);
-    let mut effects: Vec<Named3> = Vec::new();
+    let mut effects: Vec<NamedEffect> = Vec::new();
     let mut partial_effects = Vec::new();
     let mut ambiguous_between = Vec::new();
     let mut separating_measurement = None;
@@ -428,7 +352,7 @@ pub fn diagnose_captures(base: &Actuator, set: &CaptureSet, spec: &Diagnose3Spec
     let mut extended = baseline.clone();
     let mut extended_effects: Vec<Effect> = Vec::new();
     let mut verdict;
-    let decision = decide(&first, spec);
+    let decision = decide(&first, spec.rule());
     match decision {
         Decision::None => verdict = Verdict::Consistent,
         Decision::Ambiguous(a, b) => {
@@ -438,20 +362,20 @@ pub fn diagnose_captures(base: &Actuator, set: &CaptureSet, spec: &Diagnose3Spec
         }
         Decision::Named(e) => {
             let c = first.iter().find(|c| c.effect == e).expect("candidate");
-            effects.push(named(e, c));
+            effects.push(NamedEffect::of(c));
             extended = fit_of(&fits, e);
             extended_effects = vec![e];
             // A second effect only when the first leaves the fit above the noise.
             if spec.max_effects > 1 && !extended.p_value.ge(&spec.alpha) {
                 let (cands2, fits2) = round.run(&[e], &extended);
-                if let Decision::Named(e2) = decide(&cands2, spec) {
+                if let Decision::Named(e2) = decide(&cands2, spec.rule()) {
                     let f2 = fit_of(&fits2, e2);
                     let c2 = cands2.iter().find(|c| c.effect == e2).expect("candidate");
                     if let Some(p1) = f2.parameter(Param::Effect(e)) {
                         effects[0].parameter = p1.value;
                         effects[0].parameter_se = p1.se;
                     }
-                    effects.push(named(e2, c2));
+                    effects.push(NamedEffect::of(c2));
                     extended = f2;
                     extended_effects.push(e2);
                 }
@@ -464,7 +388,7 @@ pub fn diagnose_captures(base: &Actuator, set: &CaptureSet, spec: &Diagnose3Spec
         Decision::Ambiguous(a, _) => fit_of(&fits, a),
         _ => extended.clone(),
     };
-    let any_counts = first.iter().any(Candidate3::counts);
+    let any_counts = first.iter().any(Candidate::counts);
     let reason;
     let mut signature_of = None;
     if !baseline.converged {
@@ -502,7 +426,7 @@ pub fn diagnose_captures(base: &Actuator, set: &CaptureSet, spec: &Diagnose3Spec
         partial_effects = std::mem::take(&mut effects);
         if partial_effects.is_empty() {
             if let Some(c) = first.iter().find(|c| c.counts() && c.delta_bic <= -spec.threshold) {
-                partial_effects.push(named(c.effect, c));
+                partial_effects.push(NamedEffect::of(c));
             }
         }
         ambiguous_between.clear();

@@ -4,11 +4,11 @@
 //! measured and simulated markers with the final model's body in two views
 //! (x–y and x–z, [`crate::plot::spatial`]).
 
-use super::diagnose::{Candidate3, Diagnosis3, FitSummary};
+use super::diagnose::{Diagnosis3, FitSummary};
 use super::files::{Actuation, Capture, CaptureSet};
 use super::fit::Status;
 use super::simulate::solve_captures;
-use crate::calibrate::diagnose::markdown::{candidate_row, candidate_table_head};
+use crate::calibrate::diagnose::markdown::candidate_table;
 use crate::calibrate::CalibrateError;
 use crate::model::solver::simulate::simulate_spatial_held;
 use crate::model::spatial::SpatialOptions;
@@ -114,19 +114,6 @@ fn num(v: f64) -> String {
     }
 }
 
-fn candidate_table(out: &mut String, cands: &[Candidate3]) {
-    candidate_table_head(out, "marker RMS (mm)");
-    for c in cands {
-        let failure = match (&c.error, c.converged, c.plausible) {
-            (Some(e), _, _) => Some(e.clone()),
-            (None, false, _) => Some("did not converge".into()),
-            (None, true, false) => Some("implausible or undetermined value".into()),
-            _ => None,
-        };
-        candidate_row(out, c.rank, c.effect, c.parameter_name, [c.parameter, c.parameter_se, c.delta_bic, c.reduced_chi2, c.p_value, c.rms_mm], failure);
-    }
-}
-
 fn fit_section(out: &mut String, title: &str, f: &FitSummary) {
     let _ = writeln!(out, "### {title}: {}\n", f.model);
     out.push_str("| parameter | value ± SE | start | status |\n|---|---|---|---|\n");
@@ -175,13 +162,13 @@ fn markdown(sources: ReportSources<'_>, set: &CaptureSet, d: &Diagnosis3, names:
     }
     let _ = writeln!(out, "\nCriterion: {}\n", d.criterion);
     out.push_str("## Candidates (each refitted with the body)\n\n");
-    candidate_table(&mut out, &d.candidates);
+    candidate_table(&mut out, &d.candidates, "marker RMS (mm)");
     for n in &d.not_candidates {
         let _ = writeln!(out, "\nNot a candidate: {n}");
     }
     if !d.second_round.is_empty() {
         out.push_str("\n### Second round (with the first effect)\n\n");
-        candidate_table(&mut out, &d.second_round);
+        candidate_table(&mut out, &d.second_round, "marker RMS (mm)");
     }
     out.push_str("\n## Fits\n\n");
     fit_section(&mut out, "Body fit", &d.baseline);

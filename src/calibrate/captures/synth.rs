@@ -71,6 +71,24 @@ pub fn default_plan(cables: usize, max_tension_n: f64, dwell_s: f64) -> Vec<Capt
     out
 }
 
+/// A load/unload protocol for `cables` cables up to `max_tension_n`, the
+/// measurement that separates friction from the other effects (friction
+/// opens a loop between the two directions): each cable alone is loaded
+/// to 2/7, 4.5/7 and 7/7 of it, unloaded to 4.5/7 and 2/7, then released
+/// (a rest capture); one chain in step order, dwelling `dwell_s`, numbered
+/// from 1.
+pub fn load_unload_plan(cables: usize, max_tension_n: f64, dwell_s: f64) -> Vec<Capture> {
+    let mut out = Vec::new();
+    for k in 0..cables {
+        for (sevenths, direction) in [(2.0, Direction::Load), (4.5, Direction::Load), (7.0, Direction::Load), (4.5, Direction::Unload), (2.0, Direction::Unload), (0.0, Direction::Rest)] {
+            let id = out.len() as i64 + 1;
+            let actuation = (0..cables).map(|j| Actuation::Tension(if j == k { max_tension_n * sevenths / 7.0 } else { 0.0 })).collect();
+            out.push(Capture { measurement: id, actuation, direction, step: id - 1, dwell_s, row: id as usize });
+        }
+    }
+    out
+}
+
 /// The default markers of `synth --actuator`, after the SoRoMoX tentacle's:
 /// `p1`, `p2`, `p3` on stalks at 0.36 L, 0.61 L and 0.78 L, off the body
 /// along body z by twice the radius there (alternately +, −, +), and `p4`
@@ -119,4 +137,20 @@ pub fn synth_captures(
         }
     }
     Ok(set)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_load_unload_plan_loads_unloads_and_releases_each_cable_in_order() {
+        let plan = load_unload_plan(2, 7.0, 5.0);
+        assert_eq!(plan.len(), 12);
+        let first: Vec<(f64, Direction)> = plan[..6].iter().map(|c| (c.magnitude(), c.direction)).collect();
+        use Direction::*;
+        assert_eq!(first, vec![(2.0, Load), (4.5, Load), (7.0, Load), (4.5, Unload), (2.0, Unload), (0.0, Rest)]);
+        assert!(plan[6..].iter().all(|c| c.pulling_cables().iter().all(|&k| k == 2)));
+        assert!(plan.iter().enumerate().all(|(i, c)| c.step == i as i64 && c.measurement == i as i64 + 1));
+    }
 }

@@ -20,12 +20,13 @@
 //! ([`Effect::plausible`]). Effects are added forward-stepwise by the same
 //! rule (at most `max_effects`).
 
+use super::criterion::{self, decide, rank, Candidate, Decision, NamedEffect};
 use super::Verdict;
 use crate::calibrate::data::{split_holdout, Dataset, Direction, RoutingGroup};
 use crate::calibrate::effect::Effect;
 use crate::calibrate::fit::{closest_on_centreline, fit, residuals, rms_per_routing, FitResult, FitSpec, RoutingRms};
 use crate::calibrate::predict::{predict, Prediction};
-use crate::calibrate::{stats, CalibrateError};
+use crate::calibrate::CalibrateError;
 use crate::model::{Rod, SolverOptions};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -51,66 +52,16 @@ pub struct DiagnoseSpec {
     pub held_effects: Vec<Effect>,
 }
 
+impl DiagnoseSpec {
+    /// The naming rule's thresholds.
+    pub fn rule(&self) -> criterion::Rule {
+        criterion::Rule { threshold: self.threshold, margin: self.margin }
+    }
+}
+
 impl Default for DiagnoseSpec {
     fn default() -> Self {
         Self { holdout: None, fit: FitSpec::default(), threshold: 10.0, margin: 10.0, max_effects: 2, alpha: 1e-3, held_effects: Vec::new() }
-    }
-}
-
-/// One candidate effect refitted with the rigidities.
-#[derive(Debug, Clone, Serialize)]
-pub struct Candidate {
-    /// Rank (1 = lowest BIC).
-    pub rank: usize,
-    /// The effect.
-    pub effect: Effect,
-    /// Parameter name with unit.
-    pub parameter_name: &'static str,
-    /// Fitted value (NaN if the fit failed).
-    pub parameter: f64,
-    /// Its standard error.
-    pub parameter_se: f64,
-    /// BIC change against the model without the effect (negative: better).
-    pub delta_bic: f64,
-    /// RMS tip residual of the fit, mm.
-    pub rms_mm: f64,
-    /// χ² of the whitened residuals (outliers set aside).
-    pub chi2: f64,
-    /// Its degrees of freedom.
-    pub dof: usize,
-    /// χ²/dof.
-    pub reduced_chi2: f64,
-    /// P(χ²_dof ≥ χ²).
-    pub p_value: f64,
-    /// Whether the fit converged.
-    pub converged: bool,
-    /// Whether the values are physically plausible (effect and rigidities).
-    pub plausible: bool,
-    /// Implausible or undetermined values, in words.
-    pub flags: Vec<String>,
-    /// Why the fit failed, if it did.
-    pub error: Option<String>,
-}
-
-impl Candidate {
-    /// Whether this fit counts as evidence: it ran, converged and its
-    /// values are plausible.
-    pub fn counts(&self) -> bool {
-        self.error.is_none() && self.converged && self.plausible && self.delta_bic.is_finite()
-    }
-
-    /// Why it does not count, in words (None when it does).
-    pub fn failure(&self) -> Option<String> {
-        if let Some(e) = &self.error {
-            return Some(format!("fit failed: {e}"));
-        }
-        if !self.converged {
-            return Some("did not converge".into());
-        }
-        if !self.plausible {
-            return Some(if self.flags.is_empty() { "implausible value".into() } else { self.flags.join("; ") });
-        }
-        None
     }
 }
 
@@ -161,21 +112,6 @@ pub struct Signature {
     pub along_body_mm: Vec<f64>,
     /// The same in words.
     pub summary: Vec<String>,
-}
-
-/// A named effect of the final model.
-#[derive(Debug, Clone, Serialize)]
-pub struct NamedEffect {
-    /// The effect.
-    pub effect: Effect,
-    /// Parameter name.
-    pub parameter_name: &'static str,
-    /// Fitted value.
-    pub parameter: f64,
-    /// Standard error.
-    pub parameter_se: f64,
-    /// BIC change that admitted it.
-    pub delta_bic: f64,
 }
 
 /// The outcome of a diagnosis.
@@ -247,45 +183,7 @@ fn candidate(effect: Effect, reference_bic: f64, result: &Result<FitResult, Cali
                 error: None,
             }
         }
-        Err(e) => Candidate {
-            rank: 0,
-            effect,
-            parameter_name: effect.parameter_name(),
-            parameter: f64::NAN,
-            parameter_se: f64::NAN,
-            delta_bic: f64::INFINITY,
-            rms_mm: f64::NAN,
-            chi2: f64::NAN,
-            dof: 0,
-            reduced_chi2: f64::NAN,
-            p_value: f64::NAN,
-            converged: false,
-            plausible: false,
-            flags: Vec::new(),
-            error: Some(e.to_string()),
-        },
-    }
-}
-
-/// Outcome of one round of the criterion.
-enum Decision {
-    None,
-    Named(Effect),
-    Ambiguous(Effect, Effect),
-}
-
-fn decide(ranked: &[Candidate], spec: &DiagnoseSpec) -> Decision {
-    let ok: Vec<&Candidate> = ranked.iter().filter(|c| c.counts()).collect();
-    let Some(best) = ok.first() else { return Decision::None };
-    if best.delta_bic > -spec.threshold {
-        return Decision::None;
-    }
-    let e = best.effect;
-    match ok.get(1) {
-        Some(runner) if runner.delta_bic - best.delta_bic < spec.margin => {
-            Decision::Ambiguous(e, runner.effect)
-        }
-        _ => Decision::Named(e),
+        Err(e) => Candidate::failed(effect, e.to_string()),
     }
 }
 
@@ -325,15 +223,8 @@ fn round(
             fits.push((e, f));
         }
     }
-    cands.sort_by(|a, b| a.delta_bic.total_cmp(&b.delta_bic));
-    for (k, c) in cands.iter_mut().enumerate() {
-        c.rank = k + 1;
-    }
+    rank(&mut cands);
     (cands, fits)
-}
-
-fn named_effect(e: Effect, c: &Candidate) -> NamedEffect {
-    NamedEffect { effect: e, parameter_name: e.parameter_name(), parameter: c.parameter, parameter_se: c.parameter_se, delta_bic: c.delta_bic }
 }
 
 fn fit_of(fits: &[(Effect, FitResult)], e: Effect) -> FitResult {
@@ -341,7 +232,7 @@ fn fit_of(fits: &[(Effect, FitResult)], e: Effect) -> FitResult {
 }
 
 fn chi2_text(f: &FitResult) -> String {
-    format!("χ² = {:.1} on {} dof, χ²/dof = {:.2}, {}", f.chi2, f.dof, f.reduced_chi2, stats::p_text(f.p_value))
+    criterion::chi2_text(f.chi2, f.dof, f.reduced_chi2, f.p_value)
 }
 
 /// Runs the whole workflow on `data` with `base` as the starting actuator.
@@ -361,7 +252,7 @@ pub fn diagnose(base: &Rod, options: &SolverOptions, data: &Dataset, spec: &Diag
     let mut extended = baseline.clone();
     let mut verdict;
     // The naming rule on the first round (and a second effect on top).
-    let decision = decide(&candidates, spec);
+    let decision = decide(&candidates, spec.rule());
     match decision {
         Decision::None => verdict = Verdict::Consistent,
         Decision::Ambiguous(a, b) => {
@@ -371,11 +262,11 @@ pub fn diagnose(base: &Rod, options: &SolverOptions, data: &Dataset, spec: &Diag
         }
         Decision::Named(e) => {
             let c = candidates.iter().find(|c| c.effect == e).expect("candidate");
-            named.push(named_effect(e, c));
+            named.push(NamedEffect::of(c));
             extended = fit_of(&fits, e);
             if spec.max_effects > 1 {
                 let (cands2, fits2) = round(base, options, data, &train, spec, &[e], &extended);
-                if let Decision::Named(e2) = decide(&cands2, spec) {
+                if let Decision::Named(e2) = decide(&cands2, spec.rule()) {
                     let f2 = fit_of(&fits2, e2);
                     let c2 = cands2.iter().find(|c| c.effect == e2).expect("candidate");
                     // The first effect's value is re-estimated with the second.
@@ -383,7 +274,7 @@ pub fn diagnose(base: &Rod, options: &SolverOptions, data: &Dataset, spec: &Diag
                         named[0].parameter = p1.value;
                         named[0].parameter_se = p1.se;
                     }
-                    named.push(named_effect(e2, c2));
+                    named.push(NamedEffect::of(c2));
                     extended = f2;
                 }
                 second_round = cands2;
@@ -430,16 +321,16 @@ pub fn diagnose(base: &Rod, options: &SolverOptions, data: &Dataset, spec: &Diag
         };
     } else {
         // Not explained yet: the best one or two library effects.
-        let mut best_pair: Option<(Effect, Effect, FitResult, Candidate, Candidate)> = None;
+        let mut best_pair: Option<(Effect, FitResult, Candidate, Candidate)> = None;
         if !matches!(decision, Decision::Named(_)) && spec.max_effects > 1 {
             if let Some(c1) = candidates.iter().find(|c| c.counts()) {
                 let e1 = c1.effect;
                 let f1 = fit_of(&fits, e1);
                 let (cands2, fits2) = round(base, options, data, &train, spec, &[e1], &f1);
-                if let Decision::Named(e2) = decide(&cands2, spec) {
+                if let Decision::Named(e2) = decide(&cands2, spec.rule()) {
                     let f2 = fit_of(&fits2, e2);
                     let c2 = cands2.iter().find(|c| c.effect == e2).expect("candidate").clone();
-                    best_pair = Some((e1, e2, f2, c1.clone(), c2));
+                    best_pair = Some((e1, f2, c1.clone(), c2));
                 }
                 second_round = cands2;
                 if f1.chi2 < judged.chi2 {
@@ -448,13 +339,13 @@ pub fn diagnose(base: &Rod, options: &SolverOptions, data: &Dataset, spec: &Diag
             }
         }
         match best_pair {
-            Some((e1, e2, f2, c1, c2)) if f2.consistent_with_noise(spec.alpha) => {
-                let mut n1 = named_effect(e1, &c1);
+            Some((e1, f2, c1, c2)) if f2.consistent_with_noise(spec.alpha) => {
+                let mut n1 = NamedEffect::of(&c1);
                 if let Some(p1) = f2.effect_parameter(e1) {
                     n1.parameter = p1.value;
                     n1.parameter_se = p1.se;
                 }
-                named = vec![n1, named_effect(e2, &c2)];
+                named = vec![n1, NamedEffect::of(&c2)];
                 ambiguous_between.clear();
                 separating_measurement = None;
                 extended = f2;
@@ -462,7 +353,7 @@ pub fn diagnose(base: &Rod, options: &SolverOptions, data: &Dataset, spec: &Diag
                 reason = format!("the model {} explains the data to within the stated noise ({})", model_name(&extended), chi2_text(&extended));
             }
             pair => {
-                if let Some((_, _, f2, _, _)) = pair {
+                if let Some((_, f2, _, _)) = pair {
                     if f2.chi2 < judged.chi2 {
                         judged = f2;
                     }
@@ -474,7 +365,7 @@ pub fn diagnose(base: &Rod, options: &SolverOptions, data: &Dataset, spec: &Diag
                 partial_effects = std::mem::take(&mut named);
                 if partial_effects.is_empty() {
                     if let Some(c) = candidates.iter().find(|c| c.counts() && c.delta_bic <= -spec.threshold) {
-                        partial_effects.push(named_effect(c.effect, c));
+                        partial_effects.push(NamedEffect::of(c));
                     }
                 }
                 ambiguous_between.clear();
@@ -699,52 +590,5 @@ pub fn residual_diagnostics(data: &Dataset, groups: &[RoutingGroup], predictions
         loop_gap_deg: if pairs > 0 { gap / pairs as f64 } else { f64::NAN },
         rest_shift_deg: if routings_with_rests > 0 { shift / routings_with_rests as f64 } else { f64::NAN },
         per_routing: rms_per_routing(data, groups, predictions, w),
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn cand(effect: Effect, delta_bic: f64, plausible: bool) -> Candidate {
-        Candidate {
-            rank: 0,
-            effect,
-            parameter_name: effect.parameter_name(),
-            parameter: 1.0,
-            parameter_se: 0.1,
-            delta_bic,
-            rms_mm: 1.0,
-            chi2: 100.0,
-            dof: 100,
-            reduced_chi2: 1.0,
-            p_value: 0.5,
-            converged: true,
-            plausible,
-            flags: Vec::new(),
-            error: None,
-        }
-    }
-
-    #[test]
-    fn the_criterion_names_refuses_or_calls_it_ambiguous() {
-        let spec = DiagnoseSpec::default();
-        let named = |c: &[Candidate]| match decide(c, &spec) {
-            Decision::None => "none".to_string(),
-            Decision::Named(e) => e.name().to_string(),
-            Decision::Ambiguous(a, b) => format!("{}|{}", a.name(), b.name()),
-        };
-        use Effect::*;
-        assert_eq!(named(&[cand(Friction, -50.0, true), cand(Creep, -30.0, true)]), "friction");
-        assert_eq!(named(&[cand(Friction, -50.0, true), cand(Creep, -45.0, true)]), "friction|creep");
-        assert_eq!(named(&[cand(Friction, -9.0, true), cand(Creep, 3.0, true)]), "none");
-        // An implausible value is passed over, for naming and as runner-up.
-        assert_eq!(named(&[cand(Gravity, -80.0, false), cand(Friction, -50.0, true), cand(Creep, -20.0, true)]), "friction");
-        assert_eq!(named(&[cand(Friction, -50.0, true), cand(Gravity, -48.0, false)]), "friction");
-        assert_eq!(named(&[]), "none");
-        // An unconverged fit is no evidence, however good its BIC.
-        let mut stuck = cand(Creep, -90.0, true);
-        stuck.converged = false;
-        assert_eq!(named(&[stuck, cand(Friction, -50.0, true)]), "friction");
     }
 }

@@ -2,7 +2,8 @@
 //! residual diagnostics, the fitted parameters and three PNG plots
 //! (residuals before/after, load/unload loops, measured vs simulated shapes).
 
-use super::analysis::{Candidate, DiagnoseSpec, Diagnosis};
+use super::analysis::{DiagnoseSpec, Diagnosis};
+use super::criterion::Candidate;
 use super::Verdict;
 use crate::calibrate::data::{CentrelinePoints, Dataset, Direction, MarkerPoints, RoutingGroup};
 use crate::calibrate::fit::{row_residual, FitResult};
@@ -76,37 +77,31 @@ fn num(v: f64) -> String {
     }
 }
 
-fn candidate_table(out: &mut String, cands: &[Candidate]) {
-    candidate_table_head(out, "tip RMS (mm)");
-    for c in cands {
-        candidate_row(out, c.rank, c.effect, c.parameter_name, [c.parameter, c.parameter_se, c.delta_bic, c.reduced_chi2, c.p_value, c.rms_mm], c.failure());
-    }
-}
 
-/// The head of a candidates table in a diagnosis report, its RMS column named `rms`.
-pub(crate) fn candidate_table_head(out: &mut String, rms: &str) {
+/// A round's candidates as a Markdown table (planar and 3-D reports), the
+/// RMS column headed `rms`; the last column says whether each counts as
+/// evidence and, if not, why.
+pub(crate) fn candidate_table(out: &mut String, cands: &[Candidate], rms: &str) {
     let _ = writeln!(out, "| rank | effect | parameter | value ± SE | ΔBIC | χ²/dof | p | {rms} | counts as evidence |\n|---|---|---|---|---|---|---|---|---|");
-}
-
-/// One candidate's row: `values` are its parameter, SE, ΔBIC, χ²/dof, p and
-/// RMS; `failure` why it does not count (none: it counts).
-pub(crate) fn candidate_row(out: &mut String, rank: usize, effect: crate::calibrate::Effect, parameter_name: &str, values: [f64; 6], failure: Option<String>) {
-    let [parameter, se, delta_bic, reduced_chi2, p_value, rms_mm] = values;
-    let _ = writeln!(
-        out,
-        "| {rank} | {} | `{parameter_name}` | {} ± {} | {} | {} | {} | {} | {} |",
-        effect.name(),
-        num(parameter),
-        num(se),
-        num(delta_bic),
-        num(reduced_chi2),
-        crate::calibrate::stats::p_cell(p_value),
-        num(rms_mm),
-        match failure {
-            None => "yes".to_string(),
-            Some(why) => format!("no: {}", why.replace('|', "/").replace('\n', " ")),
-        }
-    );
+    for c in cands {
+        let _ = writeln!(
+            out,
+            "| {} | {} | `{}` | {} ± {} | {} | {} | {} | {} | {} |",
+            c.rank,
+            c.effect.name(),
+            c.parameter_name,
+            num(c.parameter),
+            num(c.parameter_se),
+            num(c.delta_bic),
+            num(c.reduced_chi2),
+            crate::calibrate::stats::p_cell(c.p_value),
+            num(c.rms_mm),
+            match c.failure() {
+                None => "yes".to_string(),
+                Some(why) => format!("no: {}", why.replace('|', "/").replace('\n', " ")),
+            }
+        );
+    }
 }
 
 /// One line on a fit's adequacy: χ², dof, χ²/dof, p, outliers, convergence.
@@ -239,11 +234,11 @@ fn markdown(data_path: &Path, data: &Dataset, d: &Diagnosis, after_label: Option
     let _ = writeln!(out, "Criterion: {}.\n", d.criterion);
     out.push_str("Cable stretch is not a candidate: under tension control the cable's stretch does not change the forces on the rod, so no tip reading can identify it.\n\n");
     out.push_str("## Candidates (each refitted with EA, GA, EI)\n\n");
-    candidate_table(&mut out, &d.candidates);
+    candidate_table(&mut out, &d.candidates, "tip RMS (mm)");
     if !d.second_round.is_empty() {
         let first = d.named.first().or(d.partial_effects.first()).map_or_else(|| d.candidates.first().map_or("", |c| c.effect.name()), |n| n.effect.name());
         let _ = writeln!(out, "\nSecond round (given {first}):\n");
-        candidate_table(&mut out, &d.second_round);
+        candidate_table(&mut out, &d.second_round, "tip RMS (mm)");
     }
     out.push_str("\n## Residual diagnostics of the thesis model\n\nResiduals are simulated − measured; θ is weighted so that the angle weight (mm per degree) converts it to mm.\n\n| rows | n | RMS (mm) | mean Δx (mm) | mean Δy (mm) | mean Δθ (°) |\n|---|---|---|---|---|---|\n");
     for c in &d.diagnostics.classes {

@@ -5,16 +5,19 @@
 //!
 //! [`run`] takes a [`DiagnoseRequest`] and returns a [`DiagnoseReport`],
 //! which serialises itself (the `--json` object) and displays itself (the
-//! summary). The criterion is in [`analysis`], the Markdown report and its
+//! summary). The naming rule (shared with the 3-D diagnosis of captures) is in
+//! [`criterion`], the planar workflow in [`analysis`], the Markdown report and its
 //! plots in [`markdown`].
 
 pub mod analysis;
+pub mod criterion;
 pub mod markdown;
 pub mod report;
 pub mod run;
 pub mod verdict;
 
-pub use analysis::{diagnose, model_name, Candidate, DiagnoseSpec, Diagnosis, NamedEffect};
+pub use analysis::{diagnose, model_name, DiagnoseSpec, Diagnosis};
+pub use criterion::{Candidate, NamedEffect};
 pub use report::DiagnoseReport;
 pub use run::{run, DiagnoseRequest};
 pub use verdict::Verdict;

@@ -3,7 +3,8 @@
 //!
 //! [`Display`]: std::fmt::Display
 
-use super::analysis::{model_name, Candidate, Diagnosis, NamedEffect, ResidualDiagnostics, Signature};
+use super::analysis::{model_name, Diagnosis, ResidualDiagnostics, Signature};
+use super::criterion::{Candidate, NamedEffect};
 use super::Verdict;
 use crate::calibrate::fit::FitResult;
 use crate::calibrate::Effect;
