@@ -254,7 +254,7 @@ fn diagnose_names_a_hidden_clamp_compliance_in_3d() {
     // (800 N·mm/rad: 0.7° more tip angle at 7 N; from these ten captures,
     // fitted 1127 ± 346, SE 30 %). At 400 N·mm/rad (a grip as soft as 56 mm
     // of the base section) the SE is about 20 % and it is named within
-    // ±25 % (494 ± 100 with this seed: the noise's offset, not a bias —
+    // ±25 % (492 ± 100 with this seed: the noise's offset, not a bias —
     // noise-free captures give back 400.000).
     let k = 400.0;
     let (start, set) = hidden(|a| Effect::ClampCompliance.apply(&mut a.rod, k));
