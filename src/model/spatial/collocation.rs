@@ -32,10 +32,12 @@
 //! - The positions, deformed arc length and gravity's moment are spectral
 //!   quadratures of R v, |v| and p' × W.
 //!
-//! The unknowns are the clamp's rotation θ₀ (clamp compliance), u and M_W at
-//! the nodes. Without distributed loads and friction the strains do not
-//! depend on them: one sweep (local solves → frames → positions) is the
-//! solution, no shooting. With gravity or friction the sweep is a fixed-point
+//! The unknowns are the distal weight's force and moment in the body frame
+//! at the nodes, N_b = Rᵀ W and M_b = Rᵀ M_W (what the local solves read;
+//! θ₀ of clamp compliance follows from the clamp's moment within a sweep).
+//! Without distributed loads and friction the strains do not depend on
+//! them: one sweep (local solves → frames → positions) is the solution, no
+//! shooting. With gravity or friction the sweep is a fixed-point
 //! map, accelerated by Anderson's method ([`crate::numerics::anderson`]);
 //! where it does not contract (heavy rods), Newton's method on the whole
 //! collocation system takes over (Newton–Krylov: GMRES,
@@ -259,18 +261,17 @@ pub struct SpatialSolver {
     /// span quadrature of |e₁ + r'|), and its axial stiffness EA, N.
     rest_length_mm: Vec<f64>,
     cable_ea_n: Vec<Option<f64>>,
-    // The state: θ₀ (3), u (3 per node), M_W (3 per node) in `state`, with
-    // u scaled by L and M_W by L/EI (angle units).
+    // The state: per node the distal weight's force and moment in the body
+    // frame (N_b = Rᵀ W, M_b = Rᵀ M_W, of the full weight), scaled by
+    // L²/EI and L/EI (angle units), then the friction profiles.
     state: Vec<f64>,
     next: Vec<f64>,
     /// Local solutions (warm starts) and their factors.
     local: Vec<[f64; 6]>,
     /// The inverse local Jacobian of the last fresh Newton step per node (chord steps).
     inverse: Vec<Option<Matrix6<f64>>>,
-    /// Frames of the solution, and scratch frames of a sweep's input and of
-    /// a finite-difference sweep.
+    /// Frames of the solution, and scratch frames of a finite-difference sweep.
     rot: Vec<M3>,
-    rot_in: Vec<M3>,
     rot_alt: Vec<M3>,
     /// A sweep's u, v and M_W at the nodes.
     ubuf: Vec<V3>,
@@ -295,7 +296,9 @@ pub struct SpatialSolver {
     solved: usize,
     passes: u32,
     last: Option<TipPose>,
-    u_scale: f64,
+    /// The last solve's estimated errors ([`SpatialSolver::error_estimate`]).
+    estimate: (f64, f64),
+    n_scale: f64,
     m_scale: f64,
 }
 
@@ -408,12 +411,13 @@ impl SpatialSolver {
         let has_weight = weight_factor != 0.0;
         let ei0 = section[0].ei;
         let friction = rod.effects.friction_mu > 0.0;
-        let n_state = 3 + 6 * nn + if friction { nn * nc } else { 0 };
+        let n_state = 6 * nn + if friction { nn * nc } else { 0 };
         let hold = Hold { direction: rod.effects.load_direction, dwell_s: rod.effects.creep_hold_s };
         let mut creep = Creep::new(&rod.effects, rod.ei_n_mm2, 2 * nn);
         creep.set_dwell(hold.dwell_s);
         let straight = [1.0, 0.0, 0.0, 0.0, 0.0, 0.0];
-        Ok(Self {
+        let tolerance_scale = if actuator.cables.iter().any(|c| c.is_displacement_driven()) { PRECISE_TOLERANCE_SCALE } else { 1.0 };
+        let mut solver = Self {
             options: options.clone(),
             cables: nc,
             base_tension_n: actuator.cables.iter().map(|c| c.tension_n).collect(),
@@ -425,7 +429,7 @@ impl SpatialSolver {
             stiffening: rod.effects.stiffening_alpha,
             friction,
             signed_mu: rod.effects.friction_mu * rod.effects.load_direction.slip_sign(),
-            ratio_at: 3 + 6 * nn,
+            ratio_at: 6 * nn,
             global_dir: vec![V3::x(); nn * nc],
             creep,
             hold,
@@ -442,16 +446,11 @@ impl SpatialSolver {
             chan,
             active,
             channels,
-            state: {
-                let mut z = vec![0.0; n_state];
-                z[3 + 6 * nn..].iter_mut().for_each(|r| *r = 1.0);
-                z
-            },
+            state: vec![0.0; n_state],
             next: vec![0.0; n_state],
             local: vec![straight; nn],
             inverse: vec![None; nn],
             rot: vec![M3::identity(); nn],
-            rot_in: vec![M3::identity(); nn],
             rot_alt: vec![M3::identity(); nn],
             ubuf: vec![V3::zeros(); nn],
             vbuf: vec![V3::zeros(); nn],
@@ -463,15 +462,29 @@ impl SpatialSolver {
             dmom: vec![V3::zeros(); nn],
             anderson: Anderson::new(n_state),
             newton_factors: None,
-            tolerance_scale: if actuator.cables.iter().any(|c| c.is_displacement_driven()) { PRECISE_TOLERANCE_SCALE } else { 1.0 },
+            tolerance_scale,
             history: Vec::with_capacity(3),
             solved: 0,
             passes: 0,
             last: None,
-            u_scale: length,
+            estimate: (0.0, 0.0),
+            n_scale: length * length / ei0,
             m_scale: length / ei0,
             rod,
-        })
+        };
+        solver.straight_state();
+        Ok(solver)
+    }
+
+    /// The state of the straight, unloaded rod: the full weight W(s) in the
+    /// identity frames, no moment M_W, friction profiles 1.
+    fn straight_state(&mut self) {
+        let nn = self.nodes_count();
+        for i in 0..nn {
+            let n = self.gravity_unit * (self.distal_weight[i] * self.n_scale);
+            self.state[6 * i..6 * i + 6].copy_from_slice(&[n[0], n[1], n[2], 0.0, 0.0, 0.0]);
+        }
+        self.state[self.ratio_at..].iter_mut().for_each(|r| *r = 1.0);
     }
 
     fn nodes_count(&self) -> usize {
@@ -526,6 +539,7 @@ impl SpatialSolver {
                 self.settle_outputs();
                 self.creep.end_solve();
                 self.passes = passes;
+                self.estimate = self.estimate_errors();
                 let pose = self.pose_of_state(passes, &tensions);
                 if !pose.tip_mm().iter().chain(&[pose.length_mm, pose.tip_angle_rad]).all(|v| v.is_finite()) {
                     self.forget();
@@ -603,8 +617,7 @@ impl SpatialSolver {
         self.solved = 0;
         self.newton_factors = None;
         self.anderson.clear();
-        let ratio_at = self.ratio_at;
-        self.state.iter_mut().enumerate().for_each(|(i, v)| *v = if i >= ratio_at { 1.0 } else { 0.0 });
+        self.straight_state();
         self.local.iter_mut().for_each(|l| *l = [1.0, 0.0, 0.0, 0.0, 0.0, 0.0]);
         self.inverse.iter_mut().for_each(|f| *f = None);
     }
@@ -648,11 +661,17 @@ impl SpatialSolver {
             w = [0.0; HISTORY];
             w[0] = 1.0;
         }
-        for (i, v) in self.state.iter_mut().enumerate() {
-            *v = (0..k).map(|h| w[h] * self.history[h].state[i]).sum();
-        }
-        for (i, l) in self.local.iter_mut().enumerate() {
-            *l = std::array::from_fn(|c| (0..k).map(|h| w[h] * self.history[h].local[i][c]).sum());
+        self.state.iter_mut().for_each(|v| *v = 0.0);
+        self.local.iter_mut().for_each(|l| *l = [0.0; 6]);
+        for (h, &wh) in self.history[..k].iter().zip(&w) {
+            for (v, z) in self.state.iter_mut().zip(&h.state) {
+                *v += wh * z;
+            }
+            for (l, x) in self.local.iter_mut().zip(&h.local) {
+                for c in 0..6 {
+                    l[c] += wh * x[c];
+                }
+            }
         }
     }
 
@@ -947,36 +966,24 @@ impl SpatialSolver {
         }
     }
 
-    /// One sweep G(z) of the state in `self.state` into `self.next`:
-    /// frames from u (and θ₀), local solves with those frames and M_W,
-    /// then θ₀, frames, positions and M_W from the new strains. With
-    /// `commit` the local solutions, frames and positions become the
-    /// solver's (a finite-difference sweep of Newton's Jacobian leaves them).
-    /// Returns the largest changes of the frames (rad), of M_W (in angle
-    /// units, M_W·L/EI) and of the friction profiles.
+    /// One sweep G(z) of the state in `self.state` into `self.next`: local
+    /// solves with the state's distal loads (body frame), then θ₀, the
+    /// frames, positions and M_W from the new strains, and the distal loads
+    /// in the new frames. With `commit` the local solutions, frames and
+    /// positions become the solver's (a finite-difference sweep of Newton's
+    /// Jacobian leaves them). Returns the largest changes of the distal
+    /// force and moment (in angle units: N_b·L²/EI, M_b·L/EI, at the weight
+    /// on) and of the friction profiles.
     fn sweep(&mut self, tensions: &[f64], commit: bool) -> Result<(f64, f64, f64), SpatialFailure> {
         let nn = self.nodes_count();
-        let theta0 = V3::new(self.state[0], self.state[1], self.state[2]);
         let mut ubuf = std::mem::take(&mut self.ubuf);
-        for i in 0..nn {
-            ubuf[i] = self.state_u(&self.state, i);
-        }
-        // Local solves (the frames of the input state matter only under a weight).
         let w_scale = if self.has_weight { self.weight_fraction } else { 0.0 };
-        let mut rot_in = std::mem::take(&mut self.rot_in);
-        if w_scale > 0.0 {
-            self.frames(&ubuf, exp_so3(&theta0), &mut rot_in);
-        }
         let mut clamp_moment = V3::zeros();
         let mut failed = None;
+        let mut inverse = std::mem::take(&mut self.inverse);
         for i in 0..nn {
-            let (nw, mw) = if w_scale > 0.0 {
-                let rt = rot_in[i].transpose();
-                (rt * (self.gravity_unit * (self.distal_weight[i] * w_scale)), rt * self.state_m(&self.state, i))
-            } else {
-                (V3::zeros(), V3::zeros())
-            };
-            match self.local_solve(i, tensions, nw, mw, commit) {
+            let (nw, mw) = if w_scale > 0.0 { (self.state_n(i) * w_scale, self.state_m(i) * w_scale) } else { (V3::zeros(), V3::zeros()) };
+            match self.local_solve(i, tensions, nw, mw, &mut inverse[i], commit) {
                 Ok(x) => {
                     ubuf[i] = V3::new(x[3], x[4], x[5]);
                     self.vbuf[i] = V3::new(x[0], x[1], x[2]);
@@ -993,76 +1000,69 @@ impl SpatialSolver {
                 }
             }
         }
-        self.rot_in = rot_in;
+        self.inverse = inverse;
         if let Some(e) = failed {
             self.ubuf = ubuf;
             return Err(e);
         }
         // θ₀ from the clamp's moment (a rotational spring about both bending axes).
-        let theta0_out = match self.clamp_stiffness {
+        let theta0 = match self.clamp_stiffness {
             Some(k) => V3::new(0.0, clamp_moment[1] / k, clamp_moment[2] / k),
             None => V3::zeros(),
         };
-        let mut change = (theta0_out - theta0).amax();
-        let mut rot_out = if commit { std::mem::take(&mut self.rot) } else { std::mem::take(&mut self.rot_alt) };
-        self.frames(&ubuf, exp_so3(&theta0_out), &mut rot_out);
+        let mut rot = if commit { std::mem::take(&mut self.rot) } else { std::mem::take(&mut self.rot_alt) };
+        self.frames(&ubuf, exp_so3(&theta0), &mut rot);
         for i in 0..nn {
-            self.dp[i] = rot_out[i] * self.vbuf[i];
+            self.dp[i] = rot[i] * self.vbuf[i];
         }
-        if commit {
-            self.rot = rot_out;
-        } else {
-            self.rot_alt = rot_out;
-        }
-        // M_W from the new frames and strains.
-        let mut mom = std::mem::take(&mut self.mbuf);
-        if w_scale > 0.0 {
+        // The distal loads of the full weight in the new frames: W and
+        // M_W (from its rate −p' × W, backward from M_W(L) = 0). A weightless
+        // sweep of a heavy rod (the weight continuation's start) leaves them too.
+        let (mut change_n, mut change_m) = (0.0f64, 0.0f64);
+        if self.has_weight {
+            let mut mom = std::mem::take(&mut self.mbuf);
             for i in 0..nn {
-                self.dmom[i] = -self.dp[i].cross(&(self.gravity_unit * (self.distal_weight[i] * w_scale)));
+                self.dmom[i] = -self.dp[i].cross(&(self.gravity_unit * self.distal_weight[i]));
             }
             self.integrate_backward(&mut mom);
-        } else {
-            mom.iter_mut().for_each(|m| *m = V3::zeros());
-        }
-        self.next[0..3].copy_from_slice(theta0_out.as_slice());
-        let mut change_m = 0.0f64;
-        // The frames' change (as the planar solver's change of φ): under a
-        // weight, between the input's and the output's frames; without one
-        // a single sweep is the solution.
-        if w_scale > 0.0 {
-            let out = if commit { &self.rot } else { &self.rot_alt };
-            for (a, b) in self.rot_in.iter().zip(out) {
-                let d = a.transpose() * b;
-                let skew = V3::new(d[(2, 1)] - d[(1, 2)], d[(0, 2)] - d[(2, 0)], d[(1, 0)] - d[(0, 1)]);
-                change = change.max(0.5 * skew.amax());
+            for i in 0..nn {
+                let rt = rot[i].transpose();
+                let n = rt * (self.gravity_unit * (self.distal_weight[i] * self.n_scale));
+                let m = rt * (mom[i] * self.m_scale);
+                let at = 6 * i;
+                change_n = change_n.max((n - V3::new(self.state[at], self.state[at + 1], self.state[at + 2])).amax());
+                change_m = change_m.max((m - V3::new(self.state[at + 3], self.state[at + 4], self.state[at + 5])).amax());
+                self.next[at..at + 3].copy_from_slice(n.as_slice());
+                self.next[at + 3..at + 6].copy_from_slice(m.as_slice());
             }
+            self.mbuf = mom;
+        } else {
+            self.next[..6 * nn].iter_mut().for_each(|z| *z = 0.0);
         }
-        for i in 0..nn {
-            let uo = ubuf[i] * self.u_scale;
-            self.next[3 + 3 * i..6 + 3 * i].copy_from_slice(uo.as_slice());
-            let at = 3 + 3 * nn + 3 * i;
-            let mo = mom[i] * self.m_scale;
-            change_m = change_m.max((mo - V3::new(self.state[at], self.state[at + 1], self.state[at + 2])).amax());
-            self.next[at..at + 3].copy_from_slice(mo.as_slice());
+        if commit {
+            self.rot = rot;
+        } else {
+            self.rot_alt = rot;
         }
         self.ubuf = ubuf;
-        self.mbuf = mom;
         let change_ratio = if self.friction { self.friction_profiles(commit) } else { 0.0 };
-        if !(change + change_m + change_ratio).is_finite() {
+        let (change_n, change_m) = (change_n * w_scale, change_m * w_scale);
+        if !(change_n + change_m + change_ratio).is_finite() {
             return Err(SpatialFailure::NonFinite);
         }
-        Ok((change, change_m, change_ratio))
+        Ok((change_n, change_m, change_ratio))
     }
 
+    /// The distal weight's force at node `i` in the state (body frame, full weight), N.
     #[inline]
-    fn state_u(&self, state: &[f64], i: usize) -> V3 {
-        V3::new(state[3 + 3 * i], state[4 + 3 * i], state[5 + 3 * i]) / self.u_scale
+    fn state_n(&self, i: usize) -> V3 {
+        V3::new(self.state[6 * i], self.state[6 * i + 1], self.state[6 * i + 2]) / self.n_scale
     }
 
+    /// The distal weight's moment at node `i` in the state (body frame, full weight), N·mm.
     #[inline]
-    fn state_m(&self, state: &[f64], i: usize) -> V3 {
-        let at = 3 + 3 * self.nodes_count() + 3 * i;
-        V3::new(state[at], state[at + 1], state[at + 2]) / self.m_scale
+    fn state_m(&self, i: usize) -> V3 {
+        V3::new(self.state[6 * i + 3], self.state[6 * i + 4], self.state[6 * i + 5]) / self.m_scale
     }
 
     /// Frames at the nodes from the curvatures `u` and the clamp frame `r0`:
@@ -1182,9 +1182,17 @@ impl SpatialSolver {
     /// solve (chord steps) while they contract fast, and a fresh one
     /// otherwise; a step below [`LOCAL_STEP_TOLERANCE`] ends it (what is
     /// left is about the contraction factor times that step).
-    fn local_solve(&mut self, i: usize, tensions: &[f64], nw: V3, mw: V3, commit: bool) -> Result<[f64; 6], SpatialFailure> {
+    fn local_solve(&self, i: usize, tensions: &[f64], nw: V3, mw: V3, kept: &mut Option<Matrix6<f64>>, commit: bool) -> Result<[f64; 6], SpatialFailure> {
         let mut x = self.local[i];
-        let mut inverse = self.inverse[i];
+        // The kept inverse is updated in place by a committed sweep, on a
+        // copy by a finite-difference sweep.
+        let mut copy;
+        let inverse = if commit {
+            kept
+        } else {
+            copy = *kept;
+            &mut copy
+        };
         let mut previous = f64::INFINITY;
         // The last step taken and the residual before it (Broyden's update).
         let mut last: Option<(Vector6<f64>, Vector6<f64>)> = None;
@@ -1193,7 +1201,7 @@ impl SpatialSolver {
             let (f, jacobian) = self.residual(i, tensions, &x, nw, mw, fresh);
             let f = Vector6::from(f);
             if let Some(j) = jacobian {
-                inverse = j.try_inverse();
+                *inverse = j.try_inverse();
                 if inverse.is_none() {
                     break;
                 }
@@ -1215,7 +1223,7 @@ impl SpatialSolver {
                 if fresh {
                     break;
                 }
-                inverse = None;
+                *inverse = None;
                 last = None;
                 continue;
             }
@@ -1244,22 +1252,17 @@ impl SpatialSolver {
                 x[k] += lambda * dx[k];
             }
             if big < self.tolerance_scale * LOCAL_STEP_TOLERANCE && lambda == 1.0 && x[0] > 0.0 {
-                if commit {
-                    self.inverse[i] = inverse;
-                }
                 return Ok(x);
             }
             last = Some((dx * lambda, f));
             // Steps that contract slowly: take a fresh Jacobian.
             if !fresh && big > CHORD_CONTRACTION * previous {
-                inverse = None;
+                *inverse = None;
                 last = None;
             }
             previous = big;
         }
-        if commit {
-            self.inverse[i] = None;
-        }
+        *inverse = None;
         Err(SpatialFailure::Local { s_mm: self.s[i] })
     }
 
@@ -1418,7 +1421,7 @@ impl SpatialSolver {
         let rot = if commit { &self.rot } else { &self.rot_alt };
         for i in 0..nn {
             let v = self.vbuf[i];
-            let u = self.next_u(i);
+            let u = self.ubuf[i];
             for c in 0..nc {
                 let ch = &self.chan[i * nc + c];
                 let q = v + u.cross(&ch.r) + ch.dr;
@@ -1457,12 +1460,6 @@ impl SpatialSolver {
             }
         }
         change
-    }
-
-    /// u at node `i` of the sweep's output (in `self.next`).
-    #[inline]
-    fn next_u(&self, i: usize) -> V3 {
-        V3::new(self.next[3 + 3 * i], self.next[4 + 3 * i], self.next[5 + 3 * i]) / self.u_scale
     }
 
     /// The pose of the converged state.
@@ -1507,7 +1504,7 @@ impl SpatialSolver {
             );
             return Err(self.unresolved(what, reach - pose.length_mm, tolerance, "mm"));
         }
-        let (_, tip_error) = self.error_estimate();
+        let (_, tip_error) = self.estimate;
         if !(tip_error <= tolerance) {
             return Err(self.unresolved("the tip position".into(), tip_error, tolerance, "mm"));
         }
@@ -1528,8 +1525,14 @@ impl SpatialSolver {
 
     /// The tangent angle's and the tip's estimated errors of the last
     /// solve (rad, mm): what the interpolants of u, p' and M_W' miss on each
-    /// span, about the size of their highest Chebyshev coefficients.
+    /// span, about the size of their highest Chebyshev coefficients
+    /// (computed once per solve).
     pub fn error_estimate(&self) -> (f64, f64) {
+        self.estimate
+    }
+
+    /// [`SpatialSolver::error_estimate`] of the state just solved.
+    fn estimate_errors(&self) -> (f64, f64) {
         let np = self.np;
         let (mut angle, mut moment, mut position) = (0.0, 0.0, 0.0);
         let mut comps = [0.0; 9 * (MAX_NODES + 1)];
