@@ -258,9 +258,9 @@ fn candidate(effect: Effect, reference_bic: f64, result: &Result<Fit3Result, Cal
     }
 }
 
-/// The state a round starts from: the reference fit and its effects.
+/// What every round shares: the fitted captures, the settings, the body
+/// parameters the baseline determined and the candidate effects.
 struct Round<'a> {
-    base: &'a Actuator,
     set: &'a CaptureSet,
     spec: &'a Diagnose3Spec,
     body: Vec<Param>,
@@ -293,7 +293,6 @@ impl Round<'_> {
             }
         }
         rank(&mut cands);
-        let _ = self.base;
         (cands, fits)
     }
 }
@@ -342,7 +341,7 @@ pub fn diagnose_captures(base: &Actuator, set: &CaptureSet, spec: &Diagnose3Spec
         })
         .filter(|e| spec.fit.params.iter().all(|p| *p != Param::Effect(*e)))
         .collect();
-    let round = Round { base, set: &train, spec, body, candidates };
+    let round = Round { set: &train, spec, body, candidates };
     let (first, fits) = round.run(&[], &baseline);
     let mut effects: Vec<NamedEffect> = Vec::new();
     let mut partial_effects = Vec::new();
