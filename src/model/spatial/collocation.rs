@@ -65,7 +65,7 @@ use crate::numerics::anderson::Anderson;
 use crate::numerics::chebyshev::{self, next_coefficient, ESTIMATE_SAFETY};
 use crate::shape::{LegendreSeries, LengthBasis};
 use std::sync::Arc;
-use nalgebra::{DMatrix, DVector, Matrix3, Matrix6, Quaternion, Rotation3, UnitQuaternion, Vector3, Vector6};
+use nalgebra::{DMatrix, DVector, Matrix3, Matrix6, Quaternion, Rotation3, UnitQuaternion, Vector3};
 
 type V3 = Vector3<f64>;
 type M3 = Matrix3<f64>;
@@ -186,11 +186,14 @@ impl Grid {
 /// The cross-section at a node.
 #[derive(Debug, Clone, Copy)]
 struct Section {
-    ea: f64,
-    ga: f64,
     gj: f64,
     ei: f64,
     radius: f64,
+    /// 1/EA, 1/GA, 1/GJ, 1/EI (the residual multiplies: no divisions in the hot loop).
+    inv_ea: f64,
+    inv_ga: f64,
+    inv_gj: f64,
+    inv_ei: f64,
 }
 
 /// A cable's channel at a node, body frame.
@@ -370,7 +373,7 @@ impl SpatialSolver {
                     ei *= f;
                     gj *= f;
                 }
-                section.push(Section { ea, ga, gj, ei, radius });
+                section.push(Section { gj, ei, radius, inv_ea: 1.0 / ea, inv_ga: 1.0 / ga, inv_gj: 1.0 / gj, inv_ei: 1.0 / ei });
                 distal_weight.push(match &body {
                     None => weight_factor * (length - sj),
                     Some(b) => weight_factor * b.distal_density_area(sj),
@@ -1195,30 +1198,24 @@ impl SpatialSolver {
         };
         let mut previous = f64::INFINITY;
         // The last step taken and the residual before it (Broyden's update).
-        let mut last: Option<(Vector6<f64>, Vector6<f64>)> = None;
+        let mut last: Option<([f64; 6], [f64; 6])> = None;
         for _ in 0..LOCAL_MAX_ITERATIONS {
             let fresh = inverse.is_none();
-            let (f, jacobian) = self.residual(i, tensions, &x, nw, mw, fresh);
-            let f = Vector6::from(f);
-            if let Some(j) = jacobian {
+            let f = if fresh {
+                let (f, j) = self.residual_and_jacobian(i, tensions, &x, nw, mw);
                 *inverse = j.try_inverse();
-                if inverse.is_none() {
-                    break;
+                f
+            } else {
+                let f = self.residual(i, tensions, &x, nw, mw);
+                if let (Some((step, f_old)), Some(h)) = (&last, inverse.as_mut()) {
+                    broyden_update(h, step, &f, f_old);
                 }
-            } else if let (Some((step, f_old)), Some(h)) = (last, inverse.as_mut()) {
-                // Broyden's ("good") update of the inverse Jacobian with the
-                // step just taken: chord steps then converge superlinearly,
-                // and the kept inverse follows the Jacobian from solve to solve.
-                let df = f - f_old;
-                let h_df = *h * df;
-                let denominator = step.dot(&h_df);
-                if denominator.abs() > 1e-300 {
-                    *h += (step - h_df) * (step.transpose() * *h) / denominator;
-                }
-            }
-            let inv = inverse.expect("set above");
-            let dx = -(inv * f);
-            let big = dx.amax();
+                f
+            };
+            let Some(h) = inverse.as_ref() else { break };
+            let mut dx = mul6(h, &f);
+            dx.iter_mut().for_each(|d| *d = -*d);
+            let big = dx.iter().fold(0.0f64, |a, d| a.max(d.abs()));
             if !big.is_finite() {
                 if fresh {
                     break;
@@ -1237,11 +1234,10 @@ impl SpatialSolver {
             // backtrack until the residual falls, so that Newton cannot
             // jump to another branch of t = q/|q|.
             if big > 0.02 {
-                let f0 = f.norm_squared();
+                let f0 = norm_squared6(&f);
                 while lambda > 1e-3 {
                     let trial: [f64; 6] = std::array::from_fn(|k| x[k] + lambda * dx[k]);
-                    let (ft, _) = self.residual(i, tensions, &trial, nw, mw, false);
-                    let ft = Vector6::from(ft).norm_squared();
+                    let ft = norm_squared6(&self.residual(i, tensions, &trial, nw, mw));
                     if ft.is_finite() && ft < f0 {
                         break;
                     }
@@ -1249,12 +1245,13 @@ impl SpatialSolver {
                 }
             }
             for k in 0..6 {
-                x[k] += lambda * dx[k];
+                dx[k] *= lambda;
+                x[k] += dx[k];
             }
             if big < self.tolerance_scale * LOCAL_STEP_TOLERANCE && lambda == 1.0 && x[0] > 0.0 {
                 return Ok(x);
             }
-            last = Some((dx * lambda, f));
+            last = Some((dx, f));
             // Steps that contract slowly: take a fresh Jacobian.
             if !fresh && big > CHORD_CONTRACTION * previous {
                 *inverse = None;
@@ -1266,10 +1263,47 @@ impl SpatialSolver {
         Err(SpatialFailure::Local { s_mm: self.s[i] })
     }
 
+    /// The internal force and moment (body frame) at node `i` for the
+    /// strains `x` and the distal loads `nw`, `mw`: n = N_b − Σ τ t,
+    /// m = M_b − Σ τ r × t.
+    #[inline(always)]
+    fn cut_loads(&self, i: usize, tensions: &[f64], x: &[f64; 6], nw: V3, mw: V3) -> (V3, V3) {
+        let v = V3::new(x[0], x[1], x[2]);
+        let u = V3::new(x[3], x[4], x[5]);
+        let (mut n, mut m) = (nw, mw);
+        let nc = self.cables;
+        for c in 0..nc {
+            let tau = self.tension_at(tensions, i, c);
+            if tau == 0.0 {
+                continue;
+            }
+            let ch = &self.chan[i * nc + c];
+            let q = v + u.cross(&ch.r) + ch.dr;
+            let pull = q * (tau / q.norm());
+            n -= pull;
+            m -= ch.r.cross(&pull);
+        }
+        (n, m)
+    }
+
     /// The residual F(x) = x − x* − C(f(x)) of the cut equations at node `i`
     /// (compliance form: f the internal force and moment, C the
-    /// constitutive law) and, when asked, its Jacobian.
-    fn residual(&self, i: usize, tensions: &[f64], x: &[f64; 6], nw: V3, mw: V3, jacobian: bool) -> ([f64; 6], Option<Matrix6<f64>>) {
+    /// constitutive law).
+    #[inline]
+    fn residual(&self, i: usize, tensions: &[f64], x: &[f64; 6], nw: V3, mw: V3) -> [f64; 6] {
+        let sec = &self.section[i];
+        let (n, m) = self.cut_loads(i, tensions, x, nw, mw);
+        let u = if self.stiffening == 0.0 && !self.creep.is_on() {
+            // The linear law, inline (most solves).
+            V3::new(m[0] * sec.inv_gj, m[1] * sec.inv_ei, m[2] * sec.inv_ei + self.rod.rest_curvature_per_mm)
+        } else {
+            self.curvature_law(i, &m, sec, false).0
+        };
+        [x[0] - 1.0 - n[0] * sec.inv_ea, x[1] - n[1] * sec.inv_ga, x[2] - n[2] * sec.inv_ga, x[3] - u[0], x[4] - u[1], x[5] - u[2]]
+    }
+
+    /// [`SpatialSolver::residual`] and its Jacobian.
+    fn residual_and_jacobian(&self, i: usize, tensions: &[f64], x: &[f64; 6], nw: V3, mw: V3) -> ([f64; 6], Matrix6<f64>) {
         let sec = self.section[i];
         let v = V3::new(x[0], x[1], x[2]);
         let u = V3::new(x[3], x[4], x[5]);
@@ -1288,35 +1322,30 @@ impl SpatialSolver {
             let t = q / len;
             n -= t * tau;
             m -= ch.r.cross(&t) * tau;
-            if jacobian {
-                let p = (M3::identity() - t * t.transpose()) * (tau / len);
-                let rh = ch.r.cross_matrix();
-                let rp = rh * p;
-                svv += p;
-                svu -= p * rh;
-                suv += rp;
-                suu -= rp * rh;
-            }
+            let p = (M3::identity() - t * t.transpose()) * (tau / len);
+            let rh = ch.r.cross_matrix();
+            let rp = rh * p;
+            svv += p;
+            svu -= p * rh;
+            suv += rp;
+            suu -= rp * rh;
         }
         // The constitutive law: v − v* = K_se⁻¹ n; u = c(m).
-        let fv = V3::new(v[0] - 1.0 - n[0] / sec.ea, v[1] - n[1] / sec.ga, v[2] - n[2] / sec.ga);
-        let (u_law, c_prime) = self.curvature_law(i, &m, &sec, jacobian);
+        let fv = V3::new(v[0] - 1.0 - n[0] * sec.inv_ea, v[1] - n[1] * sec.inv_ga, v[2] - n[2] * sec.inv_ga);
+        let (u_law, c_prime) = self.curvature_law(i, &m, &sec, true);
         let fu = u - u_law;
         let f = [fv[0], fv[1], fv[2], fu[0], fu[1], fu[2]];
-        let jac = jacobian.then(|| {
-            let kv = M3::from_diagonal(&V3::new(1.0 / sec.ea, 1.0 / sec.ga, 1.0 / sec.ga));
-            let mut j = Matrix6::identity();
-            let jvv = M3::identity() + kv * svv;
-            let jvu = kv * svu;
-            let juv = c_prime * suv;
-            let juu = M3::identity() + c_prime * suu;
-            j.fixed_view_mut::<3, 3>(0, 0).copy_from(&jvv);
-            j.fixed_view_mut::<3, 3>(0, 3).copy_from(&jvu);
-            j.fixed_view_mut::<3, 3>(3, 0).copy_from(&juv);
-            j.fixed_view_mut::<3, 3>(3, 3).copy_from(&juu);
-            j
-        });
-        (f, jac)
+        let kv = M3::from_diagonal(&V3::new(sec.inv_ea, sec.inv_ga, sec.inv_ga));
+        let mut j = Matrix6::identity();
+        let jvv = M3::identity() + kv * svv;
+        let jvu = kv * svu;
+        let juv = c_prime * suv;
+        let juu = M3::identity() + c_prime * suu;
+        j.fixed_view_mut::<3, 3>(0, 0).copy_from(&jvv);
+        j.fixed_view_mut::<3, 3>(0, 3).copy_from(&jvu);
+        j.fixed_view_mut::<3, 3>(3, 0).copy_from(&juv);
+        j.fixed_view_mut::<3, 3>(3, 3).copy_from(&juu);
+        (f, j)
     }
 
     /// The curvature u from the internal moment `m` (body frame) and, when
@@ -1329,9 +1358,9 @@ impl SpatialSolver {
         let rest = self.rod.rest_curvature_per_mm;
         let (gain, off) = self.creep_terms(i, sec);
         if alpha == 0.0 {
-            let b = 1.0 / sec.ei + gain;
-            let u = V3::new(m[0] / sec.gj, m[1] * b + off[1], m[2] * b + rest + off[2]);
-            let d = if derivative { M3::from_diagonal(&V3::new(1.0 / sec.gj, b, b)) } else { M3::zeros() };
+            let b = sec.inv_ei + gain;
+            let u = V3::new(m[0] * sec.inv_gj, m[1] * b + off[1], m[2] * b + rest + off[2]);
+            let d = if derivative { M3::from_diagonal(&V3::new(sec.inv_gj, b, b)) } else { M3::zeros() };
             return (u, d);
         }
         let mb = (m[1] * m[1] + m[2] * m[2]).sqrt();
@@ -1873,6 +1902,48 @@ fn exp_so3(w: &V3) -> M3 {
         (theta.sin() / theta, (1.0 - theta.cos()) / t2)
     };
     M3::identity() + k * a + k * k * b
+}
+
+/// H f for a 6×6 matrix (column-major, as nalgebra stores it), written
+/// out: nalgebra's generic product builds temporaries in this hot loop.
+#[inline(always)]
+fn mul6(h: &Matrix6<f64>, f: &[f64; 6]) -> [f64; 6] {
+    let a = h.as_slice();
+    let mut y = [0.0; 6];
+    for (k, fk) in f.iter().enumerate() {
+        for (r, yr) in y.iter_mut().enumerate() {
+            *yr += a[6 * k + r] * fk;
+        }
+    }
+    y
+}
+
+/// |f|² of a 6-vector.
+#[inline(always)]
+fn norm_squared6(f: &[f64; 6]) -> f64 {
+    f.iter().map(|v| v * v).sum()
+}
+
+/// Broyden's ("good") update of an inverse Jacobian `h` with the step just
+/// taken and the residuals after and before it: h += (s − h δf)(sᵀ h)/(sᵀ h δf).
+/// Chord steps then converge superlinearly, and the kept inverse follows
+/// the Jacobian from solve to solve. Written out (one pass per column, no
+/// 6×6 temporaries).
+#[inline(always)]
+fn broyden_update(h: &mut Matrix6<f64>, step: &[f64; 6], f: &[f64; 6], f_old: &[f64; 6]) {
+    let df: [f64; 6] = std::array::from_fn(|k| f[k] - f_old[k]);
+    let h_df = mul6(h, &df);
+    let denominator: f64 = step.iter().zip(&h_df).map(|(a, b)| a * b).sum();
+    if denominator.abs() > 1e-300 {
+        let inv = 1.0 / denominator;
+        let w: [f64; 6] = std::array::from_fn(|r| (step[r] - h_df[r]) * inv);
+        for column in h.as_mut_slice().chunks_exact_mut(6) {
+            let z: f64 = step.iter().zip(column.iter()).map(|(a, b)| a * b).sum();
+            for (a, wr) in column.iter_mut().zip(&w) {
+                *a += wr * z;
+            }
+        }
+    }
 }
 
 /// Checks every cable's channel against the body's radius r(s) along s:
