@@ -1629,64 +1629,63 @@ impl SpatialSolver {
         let length = self.rod.length_mm;
         let ell = self.sigma[nn - 1];
         let (theta_error, _) = self.error_estimate();
-        // κ at the nodes (body frame): u − (u·v̂) v̂ + v̂ × v̂'.
-        let mut kappa = vec![V3::zeros(); nn];
-        let mut vhat = vec![V3::zeros(); nn];
-        for i in 0..nn {
+        let unit_v = |i: usize| {
             let x = &self.local[i];
-            vhat[i] = V3::new(x[0], x[1], x[2]).normalize();
-        }
-        for span in 0..self.spans() {
-            let base = span * np;
-            for j in 0..np {
-                let row = &self.grid.diff[j * np..(j + 1) * np];
-                let mut d = V3::zeros();
-                for k in 0..np {
-                    d += vhat[base + k] * row[k];
-                }
-                let dv = d / self.half[span];
-                let x = &self.local[base + j];
-                let u = V3::new(x[3], x[4], x[5]);
-                let vh = vhat[base + j];
-                let mut k = u - vh * u.dot(&vh) + vh.cross(&dv);
-                k[0] = u[0];
-                kappa[base + j] = k;
-            }
-        }
+            V3::new(x[0], x[1], x[2]).normalize()
+        };
         let mut out: [Vec<f64>; 3] = std::array::from_fn(|_| vec![0.0; order + 1]);
-        let mut quadrature_error = vec![0.0f64; order + 1];
-        let mut values = vec![0.0; (order + 1) * 3 * np];
+        let mut quadrature_error = [0.0f64; MAX_SPATIAL_ORDER + 1];
+        // Per span (stack buffers: this runs once per solve of a sweep):
+        // v̂ at its nodes, and the highest Chebyshev coefficients of each
+        // P_n κ_k, accumulated node by node.
+        let mut vhat = [V3::zeros(); MAX_NODES + 1];
+        let tail_rows = self.grid.tail.len() / np;
+        let to_legendre = 2.0 / ell;
         for span in 0..self.spans() {
             let base = span * np;
             let h = self.half[span];
+            let inv_h = 1.0 / h;
+            for (j, v) in vhat[..np].iter_mut().enumerate() {
+                *v = unit_v(base + j);
+            }
+            let mut tails = [[[0.0f64; chebyshev::TAIL_COEFFICIENTS]; 3]; MAX_SPATIAL_ORDER + 1];
             for j in 0..np {
-                let i = base + j;
-                let t = 2.0 * self.sigma[i] / ell - 1.0;
+                // κ at the node (body frame): u − (u·v̂) v̂ + v̂ × v̂'.
+                let row = &self.grid.diff[j * np..(j + 1) * np];
+                let mut d = V3::zeros();
+                for k in 0..np {
+                    d += vhat[k] * row[k];
+                }
+                let dv = d * inv_h;
+                let x = &self.local[base + j];
+                let u = V3::new(x[3], x[4], x[5]);
+                let vh = vhat[j];
+                let mut kappa = u - vh * u.dot(&vh) + vh.cross(&dv);
+                kappa[0] = u[0];
+                let t = to_legendre * self.sigma[base + j] - 1.0;
                 let mut legendre = LegendreSeries::new(t);
                 let w = h * self.grid.q[(np - 1) * np + j];
-                for n in 0..=order {
+                for (n, tail) in tails[..=order].iter_mut().enumerate() {
                     if n > 0 {
                         legendre.advance();
                     }
                     let p = legendre.value();
                     for k in 0..3 {
-                        out[k][n] += w * p * kappa[i][k];
-                        values[(n * 3 + k) * np + j] = p * kappa[i][k];
+                        let value = p * kappa[k];
+                        out[k][n] += w * value;
+                        for r in 0..tail_rows {
+                            tail[k][r] += self.grid.tail[r * np + j] * value;
+                        }
                     }
                 }
             }
-            for n in 0..=order {
-                let worst = (0..3)
-                    .map(|k| {
-                        let [tail] = chebyshev::tails_of(&self.grid.tail, np, [&values[(n * 3 + k) * np..(n * 3 + k + 1) * np]]);
-                        next_coefficient(tail)
-                    })
-                    .fold(0.0, f64::max);
+            for (n, tail) in tails[..=order].iter().enumerate() {
+                let worst = tail.iter().map(|t| next_coefficient(*t)).fold(0.0, f64::max);
                 quadrature_error[n] += 2.0 * h * worst;
             }
             // The tangent's jump to the next span (where v jumps).
             if span + 1 < self.spans() {
-                let (a, b) = (vhat[base + np - 1], vhat[base + np]);
+                let (a, b) = (vhat[np - 1], unit_v(base + np));
                 let axis = a.cross(&b);
                 let sin = axis.norm();
                 if sin > 0.0 {
