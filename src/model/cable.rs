@@ -215,9 +215,10 @@ impl Channel {
 ///
 /// Errors: no cables or more than [`MAX_CABLES`]; a tension that is negative
 /// or not finite; a control point that is not finite or not below the radius;
-/// a channel that reaches |r_c| ≥ r anywhere along s (checked at
-/// 2·512 + 1 points; the convex hull of the control points bounds each
-/// coordinate, not the distance); an anchor outside (0, L]; two cables on
+/// a channel that reaches |r_c| ≥ r anywhere along s (none can when every
+/// control point (y_i, z_i) lies inside the disc: the convex hull of the
+/// control points holds the channel; otherwise checked at 2·512 + 1
+/// points); an anchor outside (0, L]; two cables on
 /// the same path (identical control points: the spline is linear in them, so
 /// this is exactly "the same curve").
 pub fn validate(actuator: &Rod, cables: &[Cable]) -> Result<Vec<Channel>, SpatialError> {
@@ -244,11 +245,18 @@ pub fn validate(actuator: &Rod, cables: &[Cable]) -> Result<Vec<Channel>, Spatia
         let z = Routing::new(&cable.z_mm, span, radius)
             .map_err(|source| SpatialError::Routing { cable: cable_no, axis: 'z', source })?;
         let channel = Channel { y, z };
-        let n = 2 * RADIUS_CHECK_POINTS_PER_SPAN;
-        for k in 0..=n {
-            let (s, dist) = channel.radius_at_parameter(k as f64 / n as f64);
-            if dist >= radius {
-                return Err(SpatialError::OutsideBody { cable: cable_no, s_mm: s, distance_mm: dist, radius_mm: radius });
+        // y and z share the parameter ζ and the basis (non-negative, summing
+        // to one), so the channel lies in the convex hull of its control
+        // points (y_i, z_i): with all of them inside the disc of radius r,
+        // so is every point of it, and the samples are not needed.
+        let hull_inside = cable.y_mm.iter().zip(&cable.z_mm).all(|(y, z)| y * y + z * z < radius * radius);
+        if !hull_inside {
+            let n = 2 * RADIUS_CHECK_POINTS_PER_SPAN;
+            for k in 0..=n {
+                let (s, dist) = channel.radius_at_parameter(k as f64 / n as f64);
+                if dist >= radius {
+                    return Err(SpatialError::OutsideBody { cable: cable_no, s_mm: s, distance_mm: dist, radius_mm: radius });
+                }
             }
         }
         if let Some(ea) = cable.cable_ea_n {

@@ -142,8 +142,9 @@ struct Grid {
     /// Per interval [x_{j−1}, x_j], the rows its Magnus step reads: the exact
     /// integral of the interpolant over the interval, and at its Gauss points
     /// c = ½ − √15/10, ½, ½ + √15/10 the combinations u(c₂), u(c₃) − u(c₁),
-    /// u(c₃) − 2u(c₂) + u(c₁) (4 m rows of m + 1).
-    magnus: Vec<f64>,
+    /// u(c₃) − 2u(c₂) + u(c₁): m (m + 1) entries, node by node, each the
+    /// four rows' weights of that node.
+    magnus: Vec<[f64; 4]>,
     /// Interpolation rows onto the friction grid of each interval
     /// (m (FRICTION_SUBSTEPS − 1) rows of m + 1).
     fine: Vec<f64>,
@@ -162,16 +163,13 @@ impl Grid {
         let np = m + 1;
         let xn = chebyshev::lobatto_nodes(m);
         let q = chebyshev::integration_matrix(m);
-        let mut magnus = Vec::with_capacity(4 * m * np);
+        let mut magnus = Vec::with_capacity(m * np);
         let mut g = [vec![0.0; np], vec![0.0; np], vec![0.0; np]];
         for j in 1..np {
             for (row, c) in g.iter_mut().zip([0.5 - 15f64.sqrt() / 10.0, 0.5, 0.5 + 15f64.sqrt() / 10.0]) {
                 chebyshev::interpolation_weights(&xn, xn[j - 1] + c * (xn[j] - xn[j - 1]), row);
             }
-            magnus.extend((0..np).map(|k| q[j * np + k] - q[(j - 1) * np + k]));
-            magnus.extend_from_slice(&g[1]);
-            magnus.extend((0..np).map(|k| g[2][k] - g[0][k]));
-            magnus.extend((0..np).map(|k| g[2][k] - 2.0 * g[1][k] + g[0][k]));
+            magnus.extend((0..np).map(|k| [q[j * np + k] - q[(j - 1) * np + k], g[1][k], g[2][k] - g[0][k], g[2][k] - 2.0 * g[1][k] + g[0][k]]));
         }
         let mut fine = Vec::with_capacity(m * (FRICTION_SUBSTEPS - 1) * np);
         let mut row = vec![0.0; np];
@@ -666,11 +664,18 @@ impl SpatialSolver {
             w = [0.0; HISTORY];
             w[0] = 1.0;
         }
-        self.state.iter_mut().for_each(|v| *v = 0.0);
+        // Without weight or friction no sweep reads the state: its
+        // prediction is skipped.
+        let state_read = self.has_weight || self.friction;
+        if state_read {
+            self.state.iter_mut().for_each(|v| *v = 0.0);
+        }
         self.local.iter_mut().for_each(|l| *l = [0.0; 6]);
         for (h, &wh) in self.history[..k].iter().zip(&w) {
-            for (v, z) in self.state.iter_mut().zip(&h.state) {
-                *v += wh * z;
+            if state_read {
+                for (v, z) in self.state.iter_mut().zip(&h.state) {
+                    *v += wh * z;
+                }
             }
             for (l, x) in self.local.iter_mut().zip(&h.local) {
                 for c in 0..6 {
@@ -1078,29 +1083,20 @@ impl SpatialSolver {
         let np = self.np;
         let sqrt15 = 15f64.sqrt();
         let mut r = r0;
-        // One span's u by component (contiguous rows for the dot products).
-        let mut comp = [[0.0f64; MAX_NODES + 1]; 3];
         for span in 0..self.spans() {
             let base = span * np;
             let h = self.half[span];
             out[base] = r;
-            for (k, uk) in u[base..base + np].iter().enumerate() {
-                comp[0][k] = uk[0];
-                comp[1][k] = uk[1];
-                comp[2][k] = uk[2];
-            }
+            let us = &u[base..base + np];
             for j in 1..np {
-                let rows = &self.grid.magnus[4 * (j - 1) * np..4 * j * np];
-                // The four functionals of each component in one pass (twelve
+                // The four functionals of u, node by node (twelve
                 // independent sums).
                 let mut acc = [[0.0f64; 3]; 4];
-                for k in 0..np {
-                    let (a, b, c) = (comp[0][k], comp[1][k], comp[2][k]);
-                    for (r, sum) in acc.iter_mut().enumerate() {
-                        let w = rows[r * np + k];
-                        sum[0] += w * a;
-                        sum[1] += w * b;
-                        sum[2] += w * c;
+                for (w, uk) in self.grid.magnus[(j - 1) * np..j * np].iter().zip(us) {
+                    for (sum, wr) in acc.iter_mut().zip(w) {
+                        sum[0] += wr * uk[0];
+                        sum[1] += wr * uk[1];
+                        sum[2] += wr * uk[2];
                     }
                 }
                 let g = acc.map(V3::from);
@@ -1885,7 +1881,6 @@ impl crate::model::solver::actuation::TensionSolve for SpatialSolver {
 #[inline]
 fn exp_so3(w: &V3) -> M3 {
     let t2 = w.norm_squared();
-    let k = w.cross_matrix();
     let (a, b) = if t2 < 0.25 {
         // sin θ/θ = Σ (−θ²)^n/(2n+1)!, (1 − cos θ)/θ² = Σ (−θ²)^n/(2n+2)!,
         // by Horner with the coefficients' ratios as products (a division
@@ -1902,7 +1897,12 @@ fn exp_so3(w: &V3) -> M3 {
         let theta = t2.sqrt();
         (theta.sin() / theta, (1.0 - theta.cos()) / t2)
     };
-    M3::identity() + k * a + k * k * b
+    // I + a K + b K² with K² = w wᵀ − θ² I (no matrix product).
+    let c = 1.0 - b * t2;
+    let (x, y, z) = (w[0], w[1], w[2]);
+    let (bx, by, bz) = (b * x, b * y, b * z);
+    let (ax, ay, az) = (a * x, a * y, a * z);
+    M3::new(c + bx * x, bx * y - az, bx * z + ay, bx * y + az, c + by * y, by * z - ax, bx * z - ay, by * z + ax, c + bz * z)
 }
 
 /// H f for a 6×6 matrix (column-major, as nalgebra stores it), written
@@ -2054,6 +2054,16 @@ mod tests {
 
     fn same_shape(p: &crate::model::Simulation, q: &crate::model::Simulation) -> f64 {
         p.centreline.iter().zip(&q.centreline).map(|(a, b)| dist(a.position_mm(), b.position_mm())).fold(0.0, f64::max)
+    }
+
+    #[test]
+    fn exp_so3_is_the_rotation_about_its_vector() {
+        for w in [V3::new(1e-9, -2e-9, 0.5e-9), V3::new(0.01, -0.02, 0.03), V3::new(0.3, 0.2, -0.1), V3::new(-0.9, 1.2, 0.4)] {
+            let r = exp_so3(&w);
+            let expected = Rotation3::new(w);
+            assert!((r - expected.matrix()).amax() < 1e-15, "{w:?}: {r} against {}", expected.matrix());
+            assert!((r.transpose() * r - M3::identity()).amax() < 1e-15);
+        }
     }
 
     #[test]
