@@ -634,22 +634,31 @@ impl SpatialSolver {
         }
         let newest = &self.history[0];
         let origin = &newest.tensions;
-        let step: Vec<f64> = tensions.iter().zip(origin).map(|(a, b)| a - b).collect();
+        // Differences of tension vectors, on the stack (at most MAX_CABLES).
+        let difference = |a: &[f64]| -> [f64; super::cable::MAX_CABLES] {
+            let mut d = [0.0; super::cable::MAX_CABLES];
+            for ((d, x), o) in d.iter_mut().zip(a).zip(origin) {
+                *d = x - o;
+            }
+            d
+        };
+        let step = difference(tensions);
         let norm = step.iter().map(|d| d * d).sum::<f64>().sqrt();
         // Parameter λ along `step` of each earlier solve, if it lies on the line.
-        let mut params = vec![0.0];
+        let mut params = [0.0; HISTORY];
+        let mut k = 1;
         if norm > 0.0 {
             for h in &self.history[1..self.solved] {
-                let d: Vec<f64> = h.tensions.iter().zip(origin).map(|(a, b)| a - b).collect();
+                let d = difference(&h.tensions);
                 let lambda = d.iter().zip(&step).map(|(a, b)| a * b).sum::<f64>() / (norm * norm);
                 let off = d.iter().zip(&step).map(|(a, b)| (a - lambda * b).powi(2)).sum::<f64>().sqrt();
-                if off > 1e-9 * (1.0 + norm) || params.iter().any(|p: &f64| (p - lambda).abs() < 1e-12) {
+                if off > 1e-9 * (1.0 + norm) || params[..k].iter().any(|p: &f64| (p - lambda).abs() < 1e-12) {
                     break;
                 }
-                params.push(lambda);
+                params[k] = lambda;
+                k += 1;
             }
         }
-        let k = params.len();
         let mut w = [0.0; HISTORY];
         for i in 0..k {
             let mut weight = 1.0;
@@ -1577,11 +1586,15 @@ impl SpatialSolver {
                 }
             }
             let slice = |k: usize| &comps[k * np..(k + 1) * np];
-            let tails = chebyshev::tails_of(&self.grid.tail, np, [slice(0), slice(1), slice(2), slice(3), slice(4), slice(5), slice(6), slice(7), slice(8)]);
+            let tails = chebyshev::tails_of(&self.grid.tail, np, [slice(0), slice(1), slice(2), slice(3), slice(4), slice(5)]);
             let next = tails.map(next_coefficient);
             angle += length * next[0].max(next[1]).max(next[2]);
             position += length * next[3].max(next[4]).max(next[5]);
-            moment += length * next[6].max(next[7]).max(next[8]);
+            if self.has_weight {
+                // M_W' (zero without weight).
+                let next = chebyshev::tails_of(&self.grid.tail, np, [slice(6), slice(7), slice(8)]).map(next_coefficient);
+                moment += length * next[0].max(next[1]).max(next[2]);
+            }
         }
         let ei_min = self.section.iter().map(|s| s.ei.min(s.gj)).fold(f64::INFINITY, f64::min);
         let scale = ESTIMATE_SAFETY / (self.m * self.m) as f64;
