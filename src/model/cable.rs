@@ -397,6 +397,22 @@ mod tests {
     }
 
     #[test]
+    fn a_channel_whose_control_points_lie_inside_the_disc_lies_inside_everywhere() {
+        // The convex hull property that lets validate skip its samples.
+        let r = rod().radius_mm;
+        let k = 0.99 * r / 2f64.sqrt();
+        for (y, z) in [([k, -k, k, -k, k], [k, k, -k, -k, k]), ([0.0, 4.9, -4.9, 0.0, 3.0], [4.9, 0.0, 0.0, -4.9, 3.9])] {
+            let channels = validate(&rod(), &[Cable::spatial(y, z, 1.0)]).unwrap();
+            for k in 0..=4096 {
+                let (s, d) = channels[0].radius_at_parameter(k as f64 / 4096.0);
+                assert!(d < r, "{y:?} {z:?}: {d} mm from the axis at s = {s} mm");
+            }
+        }
+        // A control point outside the disc, the channel inside: the samples accept it.
+        assert!(validate(&rod(), &[Cable::spatial([0.0, 4.0, 0.0, 0.0, 0.0], [0.0, 3.5, 0.0, 0.0, 0.0], 1.0)]).is_ok());
+    }
+
+    #[test]
     fn bad_cables_get_named_errors() {
         let ok = Cable::spatial([1.0; 5], [1.0; 5], 1.0);
         let e = validate(&rod(), &[]).unwrap_err();
