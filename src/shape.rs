@@ -146,25 +146,30 @@ impl ShapeCoefficients {
     }
 }
 
+/// ((2k + 1)/(k + 1), k/(k + 1)): the factors of
+/// [`LegendreSeries::advance`]'s recurrence at order k.
+const fn legendre_factors(k: usize) -> (f64, f64) {
+    let kf = k as f64;
+    ((2.0 * kf + 1.0) / (kf + 1.0), kf / (kf + 1.0))
+}
+
+/// [`legendre_factors`] for k = 0 … 15, the orders in use.
+const LEGENDRE_FACTORS: [(f64, f64); 16] = {
+    let mut table = [(0.0, 0.0); 16];
+    let mut k = 0;
+    while k < 16 {
+        table[k] = legendre_factors(k);
+        k += 1;
+    }
+    table
+};
+
 /// Legendre polynomials P_0, P_1, … and their derivatives at one point t,
 /// one order after the other by the three-term recurrence
 /// (k + 1) P_{k+1} = (2k + 1) t P_k − k P_{k−1} and
 /// P'_{k+1} = P'_{k−1} + (2k + 1) P_k. The one Legendre recurrence of the
 /// crate: quadratures over all orders at a sample advance it in their loop
 /// over orders (no allocation), [`legendre`] runs it to one order.
-/// ((2k + 1)/(k + 1), k/(k + 1)) for k = 0 … 15: the factors of
-/// [`LegendreSeries::advance`]'s recurrence.
-const LEGENDRE_FACTORS: [(f64, f64); 16] = {
-    let mut table = [(0.0, 0.0); 16];
-    let mut k = 0;
-    while k < 16 {
-        let kf = k as f64;
-        table[k] = ((2.0 * kf + 1.0) / (kf + 1.0), kf / (kf + 1.0));
-        k += 1;
-    }
-    table
-};
-
 #[derive(Debug, Clone, Copy)]
 pub struct LegendreSeries {
     t: f64,
@@ -190,10 +195,7 @@ impl LegendreSeries {
         // The recurrence's factors (2k + 1)/(k + 1) and k/(k + 1) from a
         // table for the orders in use: a division per order is the
         // quadratures' slowest step.
-        let (a, b) = match LEGENDRE_FACTORS.get(self.order) {
-            Some(&f) => f,
-            None => ((2.0 * kf + 1.0) / (kf + 1.0), kf / (kf + 1.0)),
-        };
+        let (a, b) = LEGENDRE_FACTORS.get(self.order).copied().unwrap_or_else(|| legendre_factors(self.order));
         let p_next = a * self.t * self.p - b * self.p_prev;
         let dp_next = self.dp_prev + (2.0 * kf + 1.0) * self.p;
         (self.p_prev, self.p, self.dp_prev, self.dp) = (self.p, p_next, self.dp, dp_next);
