@@ -1,0 +1,73 @@
+#!/usr/bin/env bash
+# Runs a fixed set of user commands with one cablemap binary and keeps what
+# they print (JSON) and the tables they write, so that two binaries (before
+# and after a change of structure) can be compared with
+# scripts/behaviour-compare.py. Usage:
+#   scripts/behaviour.sh BIN OUT_DIR
+# Takes about 2 minutes on 2 cores (the SoRoMoX diagnosis is most of it).
+set -euo pipefail
+bin=$(realpath "$1")
+out=$2
+cd "$(dirname "$0")/.."
+mkdir -p "$out"
+out=$(realpath "$out")
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+
+run() { # NAME ARGS...: the command's stdout into OUT/NAME.json
+    local name=$1
+    shift
+    if ! "$bin" "$@" > "$out/$name.json" 2> "$out/$name.err"; then
+        echo "exit $?" >> "$out/$name.err"
+    fi
+}
+
+# simulate: planar, tapered, anchored, two-cable spatial, displacement-driven
+run simulate-planar simulate --routing 1,-2,3,0.5,-3 --tension-n 1.5 --json
+run simulate-tapered simulate --routing 1,-2,3,0.5,-3 --tension-n 1.5 --radius-profile-mm 0:5,65:4 --json
+run simulate-anchored simulate --routing 1,-2,3,0.5,-3 --tension-n 1.5 --cable-anchor-mm 50 --stiffening-alpha 2 --json
+run simulate-cable simulate --cable "y=1,-2,3,0.5,-3 tension=1.5" --json
+run simulate-spatial simulate --actuator tests/data/spatial/antagonistic.toml --json
+run simulate-spatial-rk4 simulate --cable "y=2,3,1,-1,2 z=1,-1,2,2,0 tension=1.4" --cable "y=-2,-2,-2,-2,-2 tension=0.5" --method rk4 --json
+run simulate-displaced simulate --routing 1,-2,3,0.5,-3 --displacement-mm 2 --json
+run simulate-displaced-cables simulate --cable "y=2,3,1,-1,2 z=1,-1,2,2,0 displacement=2" --cable "y=-2,-2,-2,-2,-2 tension=0.5" --json
+run simulate-planar-rk4 simulate --routing 1,-2,3,0.5,-3 --tension-n 1.5 --method rk4 --json
+run simulate-tentacle simulate --actuator tests/data/soromox/actuator.toml --json
+
+# design: Table 5.1 I and II, a two-cable two-target sequence
+run design-5.1-I design --target x=50,y=5,a0=-0.025,a1=-0.06,a2=0.015 --json
+run design-5.1-II design --target x=10,y=50,a0=0.015,a1=-0.07,a2=-0.03 --json
+run design-targets design --actuator tests/data/design/two-free-cables.toml --targets tests/data/design/two-targets.toml --json
+
+# a sweep and map, feasible on it; a cable sweep and its map
+"$bin" map jobs/quick.toml --out "$work/quick" --quiet > /dev/null 2>&1 || echo "map quick failed" >> "$out/errors"
+run feasible-I feasible --map "$work/quick/map" --target x=50,y=5,a0=-0.025,a1=-0.06 --json
+run feasible-xy feasible --map "$work/quick/map" --target x=40,y=20 --json
+"$bin" map jobs/antagonistic-pair.toml --out "$work/pair" > /dev/null 2>&1 || echo "map antagonistic-pair failed" >> "$out/errors"
+"$bin" map jobs/spatial-pair.toml --out "$work/spatial" > /dev/null 2>&1 || echo "map spatial-pair failed" >> "$out/errors"
+
+# calibrate and diagnose on three synth files, and on the tentacle
+"$bin" synth --out "$work/none.csv" --seed 1 > /dev/null
+"$bin" synth --out "$work/friction.csv" --effect friction --magnitude 0.08 --seed 3 > /dev/null
+"$bin" synth --out "$work/clamp.csv" --effect clamp_compliance --magnitude 400 --seed 5 > /dev/null
+for f in none friction clamp; do
+    cp "$work/$f.csv" "$out/synth-$f.csv"
+    run "calibrate-$f" calibrate "$work/$f.csv" --json
+    run "diagnose-$f" diagnose "$work/$f.csv" --no-report --json
+done
+run predict-soromox predict tests/data/soromox/captures.csv --actuator tests/data/soromox/actuator.toml --markers tests/data/soromox/markers.csv --json
+run calibrate-soromox calibrate tests/data/soromox/captures.csv --actuator tests/data/soromox/actuator.toml --markers tests/data/soromox/markers.csv --out "$work/fit" --json
+run diagnose-soromox diagnose tests/data/soromox/captures.csv --actuator tests/data/soromox/actuator.toml --markers tests/data/soromox/markers.csv --json
+
+# the tables the maps wrote, as CSV (the Parquet files' bytes carry writer metadata)
+python=${PYTHON:-python3}
+for m in quick/map pair/map pair/map/planar spatial/map; do
+    [ -d "$work/$m" ] || continue
+    for t in "$work/$m"/*.parquet; do
+        [ -e "$t" ] || continue
+        name=$(echo "$m/$(basename "$t" .parquet)" | tr '/' '_')
+        "$python" -c 'import sys, pyarrow.parquet as pq; pq.read_table(sys.argv[1]).to_pandas().to_csv(sys.argv[2], index=False, float_format="%.17g")' "$t" "$out/table-$name.csv"
+    done
+    [ ! -e "$work/$m/summary.json" ] || cp "$work/$m/summary.json" "$out/summary-$(echo "$m" | tr '/' '_').json"
+done
+echo "behaviour: $(ls "$out" | wc -l) files in $out"
