@@ -17,9 +17,9 @@ trap 'rm -rf "$work"' EXIT
 run() { # NAME ARGS...: the command's stdout into OUT/NAME.json
     local name=$1
     shift
-    if ! "$bin" "$@" > "$out/$name.json" 2> "$out/$name.err"; then
-        echo "exit $?" >> "$out/$name.err"
-    fi
+    local rc=0
+    "$bin" "$@" > "$out/$name.json" 2> "$work/$name.err" || rc=$?
+    [ "$rc" = 0 ] || echo "exit $rc" >> "$out/$name.json.rc"
 }
 
 # simulate: planar, tapered, anchored, two-cable spatial, displacement-driven
@@ -40,7 +40,7 @@ run design-5.1-II design --target x=10,y=50,a0=0.015,a1=-0.07,a2=-0.03 --json
 run design-targets design --actuator tests/data/design/two-free-cables.toml --targets tests/data/design/two-targets.toml --json
 
 # a sweep and map, feasible on it; a cable sweep and its map
-"$bin" map jobs/quick.toml --out "$work/quick" --quiet > /dev/null 2>&1 || echo "map quick failed" >> "$out/errors"
+"$bin" map jobs/quick.toml --out "$work/quick" > /dev/null 2>&1 || echo "map quick failed" >> "$out/errors"
 run feasible-I feasible --map "$work/quick/map" --target x=50,y=5,a0=-0.025,a1=-0.06 --json
 run feasible-xy feasible --map "$work/quick/map" --target x=40,y=20 --json
 "$bin" map jobs/antagonistic-pair.toml --out "$work/pair" > /dev/null 2>&1 || echo "map antagonistic-pair failed" >> "$out/errors"
@@ -49,7 +49,7 @@ run feasible-xy feasible --map "$work/quick/map" --target x=40,y=20 --json
 # calibrate and diagnose on three synth files, and on the tentacle
 "$bin" synth --out "$work/none.csv" --seed 1 > /dev/null
 "$bin" synth --out "$work/friction.csv" --effect friction --magnitude 0.08 --seed 3 > /dev/null
-"$bin" synth --out "$work/clamp.csv" --effect clamp_compliance --magnitude 400 --seed 5 > /dev/null
+"$bin" synth --out "$work/clamp.csv" --effect clamp_compliance --magnitude 100 --seed 5 > /dev/null
 for f in none friction clamp; do
     cp "$work/$f.csv" "$out/synth-$f.csv"
     run "calibrate-$f" calibrate "$work/$f.csv" --json
@@ -61,7 +61,7 @@ run diagnose-soromox diagnose tests/data/soromox/captures.csv --actuator tests/d
 
 # the tables the maps wrote, as CSV (the Parquet files' bytes carry writer metadata)
 python=${PYTHON:-python3}
-for m in quick/map pair/map pair/map/planar spatial/map; do
+for m in quick/map pair/map pair/map/planar spatial/map spatial/map/planar; do
     [ -d "$work/$m" ] || continue
     for t in "$work/$m"/*.parquet; do
         [ -e "$t" ] || continue
@@ -70,4 +70,13 @@ for m in quick/map pair/map pair/map/planar spatial/map; do
     done
     [ ! -e "$work/$m/summary.json" ] || cp "$work/$m/summary.json" "$out/summary-$(echo "$m" | tr '/' '_').json"
 done
+# every sweep's rows, sorted (shards and chunks may be laid out differently)
+for r in quick pair spatial; do
+    [ -d "$work/$r/run" ] || continue
+    "$python" -c 'import sys, pyarrow.dataset as ds; t = ds.dataset(sys.argv[1], format="parquet").to_table().to_pandas(); t.sort_values(list(t.columns)).to_csv(sys.argv[2], index=False, float_format="%.17g")' "$work/$r/run/shards" "$out/rows-$r.csv"
+done
+# the pictures and pages, by their bytes (the scratch folder's name left out)
+grep -rlF "$work" "$work" --include='*.js' --include='*.html' --include='*.json' | xargs -r sed -i "s#$work#WORK#g"
+(cd "$work" && find . -name '*.png' -o -name '*.html' -o -name 'cables.json' | sort | xargs sha256sum) > "$out/pictures.txt"
+grep -rlF "$work" "$out" | xargs -r sed -i "s#$work#WORK#g"
 echo "behaviour: $(ls "$out" | wc -l) files in $out"
