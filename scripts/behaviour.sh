@@ -13,6 +13,8 @@ mkdir -p "$out"
 out=$(realpath "$out")
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
+# the tentacle's files in scratch: diagnose writes its report beside its input
+cp tests/data/soromox/captures.csv tests/data/soromox/markers.csv tests/data/soromox/actuator.toml "$work/"
 
 run() { # NAME ARGS...: the command's stdout into OUT/NAME.json
     local name=$1
@@ -32,7 +34,7 @@ run simulate-spatial-rk4 simulate --cable "y=2,3,1,-1,2 z=1,-1,2,2,0 tension=1.4
 run simulate-displaced simulate --routing 1,-2,3,0.5,-3 --displacement-mm 2 --json
 run simulate-displaced-cables simulate --cable "y=2,3,1,-1,2 z=1,-1,2,2,0 displacement=2" --cable "y=-2,-2,-2,-2,-2 tension=0.5" --json
 run simulate-planar-rk4 simulate --routing 1,-2,3,0.5,-3 --tension-n 1.5 --method rk4 --json
-run simulate-tentacle simulate --actuator tests/data/soromox/actuator.toml --json
+run simulate-tentacle simulate --actuator "$work/actuator.toml" --json
 
 # design: Table 5.1 I and II, a two-cable two-target sequence
 run design-5.1-I design --target x=50,y=5,a0=-0.025,a1=-0.06,a2=0.015 --json
@@ -55,9 +57,9 @@ for f in none friction clamp; do
     run "calibrate-$f" calibrate "$work/$f.csv" --json
     run "diagnose-$f" diagnose "$work/$f.csv" --no-report --json
 done
-run predict-soromox predict tests/data/soromox/captures.csv --actuator tests/data/soromox/actuator.toml --markers tests/data/soromox/markers.csv --json
-run calibrate-soromox calibrate tests/data/soromox/captures.csv --actuator tests/data/soromox/actuator.toml --markers tests/data/soromox/markers.csv --out "$work/fit" --json
-run diagnose-soromox diagnose tests/data/soromox/captures.csv --actuator tests/data/soromox/actuator.toml --markers tests/data/soromox/markers.csv --json
+run predict-soromox predict "$work/captures.csv" --actuator "$work/actuator.toml" --markers "$work/markers.csv" --json
+run calibrate-soromox calibrate "$work/captures.csv" --actuator "$work/actuator.toml" --markers "$work/markers.csv" --out "$work/fit" --json
+run diagnose-soromox diagnose "$work/captures.csv" --actuator "$work/actuator.toml" --markers "$work/markers.csv" --json
 
 # the tables the maps wrote, as CSV (the Parquet files' bytes carry writer metadata)
 python=${PYTHON:-python3}
