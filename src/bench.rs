@@ -10,7 +10,8 @@
 //! steps per span and secant shooting, [`SolverMethod::Rk4`]) in the same
 //! run, so the speed-up is measured under the same load.
 
-use crate::model::{Rod, ControlPoints, Routing, Simulator, SolverMethod, SolverOptions};
+use crate::model::{Rod, ControlPoints, Routing};
+use crate::solver::{Simulator, SolverMethod, SolverOptions};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -144,7 +145,7 @@ fn bench_ladder(
     by_displacement: bool,
     label: &str,
 ) -> Result<BenchFigures, crate::Error> {
-    use crate::model::solver::actuation::meet_displacements;
+    use crate::solver::actuation::meet_displacements;
     let mut sim = Simulator::new(actuator, options)?;
     let mut per_solve = Vec::with_capacity(routings.len());
     let mut a = [0.0; 4];
@@ -197,8 +198,8 @@ fn figures(label: &str, mut per_solve: Vec<f64>, tensions: usize, mean_passes: f
 /// Deterministic two-cable spatial actuators for [`bench_spatial`]: each
 /// cable's y and z control points from the thesis grid scaled by 0.7, so
 /// that every channel stays within 0.8 r of the axis.
-pub fn sample_spatial_pairs(count: usize, radius_mm: f64) -> Vec<[crate::model::spatial::Cable; 2]> {
-    use crate::model::spatial::Cable;
+pub fn sample_spatial_pairs(count: usize, radius_mm: f64) -> Vec<[crate::solver::spatial::Cable; 2]> {
+    use crate::solver::spatial::Cable;
     let grid = sample_thesis_routings(4 * count + 3, radius_mm);
     let scaled = |k: usize| grid[k].map(|v| 0.7 * v);
     (0..count)
@@ -219,14 +220,14 @@ pub fn sample_spatial_pairs(count: usize, radius_mm: f64) -> Vec<[crate::model::
 /// three series included. `gravity` is the direction (None: off).
 pub fn bench_spatial(
     rod: &Rod,
-    options: &crate::model::spatial::SpatialOptions,
-    pairs: &[[crate::model::spatial::Cable; 2]],
+    options: &crate::solver::spatial::SpatialOptions,
+    pairs: &[[crate::solver::spatial::Cable; 2]],
     tensions: usize,
     gravity: Option<[f64; 3]>,
     label: &str,
 ) -> Result<BenchFigures, crate::Error> {
-    use crate::model::spatial::{Actuator, SpatialRk4Solver, SpatialSolver};
-    use crate::model::SolverMethod;
+    use crate::solver::spatial::{Actuator, SpatialRk4Solver, SpatialSolver};
+    use crate::solver::SolverMethod;
     let mut rod = rod.clone();
     rod.gravity.enabled = gravity.is_some();
     let mut per_solve = Vec::with_capacity(pairs.len());
@@ -274,8 +275,8 @@ pub fn bench_spatial(
     }
     std::hint::black_box(sink);
     let method = match options.method {
-        crate::model::SolverMethod::Collocation => format!("spatial-collocation-{}", options.nodes_per_span),
-        crate::model::SolverMethod::Rk4 => format!("spatial-rk4-{}", options.steps_per_span),
+        crate::solver::SolverMethod::Collocation => format!("spatial-collocation-{}", options.nodes_per_span),
+        crate::solver::SolverMethod::Rk4 => format!("spatial-rk4-{}", options.steps_per_span),
     };
     Ok(figures(label, per_solve, tensions, passes as f64 / solves.max(1) as f64, failures, method))
 }

@@ -22,6 +22,7 @@ pub mod numerics;
 pub mod plot;
 pub mod reduce;
 pub mod shape;
+pub mod solver;
 pub mod study;
 pub mod sweep;
 pub mod synth;
@@ -37,13 +38,13 @@ pub enum Error {
     Parameter(#[from] model::ParameterError),
     /// A solve failed.
     #[error(transparent)]
-    Solve(#[from] model::SolveFailure),
+    Solve(#[from] crate::solver::SolveFailure),
     /// A single simulation (parameters or a solve) failed.
     #[error(transparent)]
-    Simulate(#[from] model::SimulateError),
+    Simulate(#[from] crate::solver::SimulateError),
     /// Spatial (several-cable) actuator or solve.
     #[error(transparent)]
-    Spatial(#[from] model::spatial::SpatialError),
+    Spatial(#[from] crate::solver::spatial::SpatialError),
     /// Shape coefficients could not be computed.
     #[error(transparent)]
     Shape(#[from] shape::ShapeError),

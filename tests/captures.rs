@@ -7,7 +7,7 @@ use cablemap::calibrate::captures::synth::{default_plan, load_unload_plan, one_c
 use cablemap::calibrate::captures::fit::Status;
 use cablemap::calibrate::captures::{diagnose_captures, fit_captures, Diagnose3Spec, Diagnosis3, Fit3Spec, Param};
 use cablemap::calibrate::Effect;
-use cablemap::model::spatial::SpatialOptions;
+use cablemap::solver::spatial::SpatialOptions;
 use cablemap::model::Actuator;
 use std::path::PathBuf;
 use std::process::Command;

@@ -5,7 +5,7 @@
 mod process;
 
 use cablemap::model::effects::{fittable, Section, REGISTRY};
-use cablemap::model::Backend;
+use cablemap::solver::Backend;
 use cablemap::model::{Effects, Rod};
 use std::collections::BTreeSet;
 
@@ -84,7 +84,7 @@ fn the_docs_effects_table_is_the_registry() {
     assert_eq!(rows.len(), REGISTRY.len(), "one row per registry entry");
     for (row, info) in rows.iter().zip(REGISTRY.iter()) {
         let fit = info.fit.map_or("—".to_string(), |f| format!("`{}`", f.name));
-        let solvers: Vec<&str> = Backend::ALL.iter().filter(|b| info.supported_by(**b)).map(|b| b.name()).collect();
+        let solvers: Vec<&str> = Backend::ALL.iter().filter(|b| b.models(info)).map(|b| b.name()).collect();
         let expected = [
             info.effect.to_string(),
             format!("`{}` ({})", info.path, info.symbol),

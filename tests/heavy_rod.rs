@@ -5,7 +5,8 @@
 //! own: refinement, the equilibrium of the distal free body evaluated from
 //! the output shape alone, and the previous RK4 method where it converges.
 
-use cablemap::model::{simulate, Rod, Routing, Simulation, SolverMethod, SolverOptions};
+use cablemap::model::{Rod, Routing};
+use cablemap::solver::{simulate, Simulation, SolverMethod, SolverOptions};
 use cablemap::shape::LengthBasis;
 use std::process::Command;
 

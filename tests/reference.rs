@@ -3,7 +3,8 @@
 //! `tests/data/reference/`, see its README) and against the straight-routing
 //! analytic solution (model-notes §3).
 
-use cablemap::model::{simulate, Rod, Routing, SolverOptions};
+use cablemap::model::{Rod, Routing};
+use cablemap::solver::{simulate, SolverOptions};
 use cablemap::shape::LengthBasis;
 use proptest::prelude::*;
 use serde_json::Value;

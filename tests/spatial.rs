@@ -3,9 +3,10 @@
 //! shooting solver), analytic solutions, symmetries and agreement with the
 //! planar solver.
 
-use cablemap::model::spatial::{simulate_spatial, Cable, Actuator, SpatialError, SpatialOptions};
-use cablemap::model::Simulation;
-use cablemap::model::{simulate, Rod, Routing, SolverOptions};
+use cablemap::solver::spatial::{simulate_spatial, Cable, Actuator, SpatialError, SpatialOptions};
+use cablemap::solver::Simulation;
+use cablemap::model::{ActuatorError, Rod, Routing};
+use cablemap::solver::{simulate, SolverOptions};
 use cablemap::shape::LengthBasis;
 use serde_json::Value;
 use std::path::PathBuf;
@@ -69,7 +70,7 @@ fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
 /// 1e-3 mm and 1e-5 rad.
 #[test]
 fn every_reference_case_agrees() {
-    let rk4 = SpatialOptions { method: cablemap::model::SolverMethod::Rk4, ..SpatialOptions::default() };
+    let rk4 = SpatialOptions { method: cablemap::solver::SolverMethod::Rk4, ..SpatialOptions::default() };
     for (options, tip_mm, angle_rad) in [(SpatialOptions::default(), 1e-6, 1e-7), (rk4, 1e-3, 1e-5)] {
         reference_cases_agree(&options, tip_mm, angle_rad);
     }
@@ -286,18 +287,18 @@ fn bad_input_gets_clear_errors() {
     let err = |cables: Vec<Cable>| simulate_spatial(&Actuator::with_cables(rod.clone(), cables), &SpatialOptions::default(), 3, LengthBasis::Rest).unwrap_err();
     // Each coordinate below r, the distance √2·3.6 = 5.09 mm above it.
     let e = err(vec![Cable::spatial([3.6; 5], [3.6; 5], 1.0)]);
-    assert!(matches!(e, SpatialError::OutsideBody { cable: 1, .. }), "{e}");
+    assert!(matches!(e, SpatialError::Actuator(ActuatorError::OutsideBody { cable: 1, .. })), "{e}");
     let e = err(vec![Cable::planar([1.0; 5], 1.0), Cable::planar([1.0; 5], 0.5)]);
-    assert!(matches!(e, SpatialError::SamePath { first: 1, second: 2 }), "{e}");
+    assert!(matches!(e, SpatialError::Actuator(ActuatorError::SamePath { first: 1, second: 2 })), "{e}");
     let e = err(vec![Cable::planar([1.0; 5], 1.0), Cable::planar([-1.0; 5], -0.5)]);
     assert!(e.to_string().contains("cable 2") && e.to_string().contains("-0.5"), "{e}");
     let mut a = Actuator::with_cables(rod.clone(), vec![Cable::planar([1.0; 5], 1.0)]);
     a.gravity_direction = Some([0.0, 0.0, 0.0]);
-    assert!(matches!(simulate_spatial(&a, &SpatialOptions::default(), 3, LengthBasis::Rest), Err(SpatialError::GravityDirection(_))));
+    assert!(matches!(simulate_spatial(&a, &SpatialOptions::default(), 3, LengthBasis::Rest), Err(SpatialError::Actuator(ActuatorError::GravityDirection(_)))));
     a.gravity_direction = None;
     a.rod.effects.friction_mu = 0.1;
     // The RK4 reference models the thesis's rod without effects; the default collocation models friction.
-    let rk4 = SpatialOptions { method: cablemap::model::SolverMethod::Rk4, ..SpatialOptions::default() };
+    let rk4 = SpatialOptions { method: cablemap::solver::SolverMethod::Rk4, ..SpatialOptions::default() };
     let e = simulate_spatial(&a, &rk4, 3, LengthBasis::Rest).unwrap_err();
     assert!(e.to_string().contains("friction_mu") && e.to_string().contains("spatial RK4"), "{e}");
     assert!(simulate_spatial(&a, &SpatialOptions::default(), 3, LengthBasis::Rest).is_ok());

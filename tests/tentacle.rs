@@ -5,8 +5,8 @@
 //! per tendon converge, and converged shapes are in equilibrium, checked
 //! from the output centreline alone.
 
-use cablemap::model::spatial::{simulate_spatial, Actuator, SpatialOptions};
-use cablemap::model::Simulation;
+use cablemap::solver::spatial::{simulate_spatial, Actuator, SpatialOptions};
+use cablemap::solver::Simulation;
 use cablemap::shape::LengthBasis;
 use std::path::PathBuf;
 

@@ -9,12 +9,10 @@
 //! (`cablemap.errors`): bad input, a failed solve (with its status), or a
 //! file that cannot be read.
 
-use cablemap::model::record::{self, SimulationRecord};
-use cablemap::model::spatial::{SpatialError, SpatialOptions};
-use cablemap::model::{
-    simulate_actuator, simulate_held, Actuator, Backend, Cable, Given, Hold, LoadDirection, Rod, Routing, SimulateError, Simulation, Simulator,
-    SolverMethod, SolverOptions, REGISTRY,
-};
+use cablemap::solver::record::{self, SimulationRecord};
+use cablemap::solver::spatial::{SpatialError, SpatialOptions};
+use cablemap::model::{Actuator, ActuatorError, Cable, LoadDirection, Rod, Routing, REGISTRY};
+use cablemap::solver::{simulate_actuator, simulate_held, Backend, Given, Hold, SimulateError, Simulation, Simulator, SolverMethod, SolverOptions};
 use cablemap::shape::LengthBasis;
 use cablemap::sweep::solve::{planar_routing, Stored};
 use cablemap::sweep::spec::Ladder;
@@ -59,9 +57,15 @@ impl From<SpatialError> for Failure {
     fn from(e: SpatialError) -> Self {
         match (&e, e.failure_status()) {
             (_, Some(status)) => Failure::Solve { status: status.to_string(), message: e.to_string() },
-            (SpatialError::Read { .. } | SpatialError::Toml { .. }, None) => Failure::File(e.to_string()),
+            (SpatialError::Actuator(ActuatorError::Read { .. } | ActuatorError::Toml { .. }), None) => Failure::File(e.to_string()),
             _ => Failure::BadInput(e.to_string()),
         }
+    }
+}
+
+impl From<ActuatorError> for Failure {
+    fn from(e: ActuatorError) -> Self {
+        SpatialError::from(e).into()
     }
 }
 
@@ -69,7 +73,7 @@ impl From<SimulateError> for Failure {
     fn from(e: SimulateError) -> Self {
         match &e {
             SimulateError::Solve(f) => Failure::Solve { status: f.status().to_string(), message: e.to_string() },
-            SimulateError::Parameter(_) => Failure::BadInput(e.to_string()),
+            SimulateError::Parameter(_) | SimulateError::Unresolved(_) | SimulateError::Unsupported(_) => Failure::BadInput(e.to_string()),
         }
     }
 }
@@ -368,9 +372,9 @@ fn solve_batch<'py>(
                 return Err(bad(format!("tensions_n[{j}] = {t}: a cable pulls with a finite tension ≥ 0 N")));
             }
         }
-        cablemap::model::solver::simulate::check_ladder_tension("tensions_n", tensions_n.iter().copied().fold(0.0, f64::max))
+        cablemap::solver::simulate::check_ladder_tension("tensions_n", tensions_n.iter().copied().fold(0.0, f64::max))
             .map_err(|e| bad(e.to_string()))?;
-        cablemap::model::resolution::check_order(order, &options).map_err(|e| bad(e.to_string()))?;
+        cablemap::solver::resolution::check_order(order, &options).map_err(|e| bad(e.to_string()))?;
         let rod = actuator.rod;
         Backend::check_planar(&rod, &options, Given::default()).map_err(|e| bad(e.to_string()))?;
         // Checks the rod once, before the threads start.

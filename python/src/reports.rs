@@ -22,7 +22,7 @@ use cablemap::design::cables::CableDesignRequest;
 use cablemap::design::feasible::{FeasibleRequest, MapSource};
 use cablemap::design::run::DesignRequest;
 use cablemap::design::{DesignError, SearchOptions, Target, Weights};
-use cablemap::model::spatial::SpatialOptions;
+use cablemap::solver::spatial::SpatialOptions;
 use cablemap::model::{Actuator, Rod, RodOverrides, REGISTRY};
 use cablemap::mould::{MouldOptions, MouldParams};
 use cablemap::shape::LengthBasis;

@@ -34,7 +34,8 @@ use super::effect::Effect;
 use super::predict::{predict, Prediction};
 use super::stats;
 use super::CalibrateError;
-use crate::model::{Rod, CentrelinePoint, SolverOptions};
+use crate::model::Rod;
+use crate::solver::{CentrelinePoint, SolverOptions};
 use crate::numerics::lm;
 use nalgebra::DMatrix;
 use rayon::prelude::*;
@@ -285,7 +286,7 @@ pub fn residuals(
 }
 
 /// Residual of one row: Δx, Δy (mm) and weighted Δθ (mm-equivalent).
-pub fn row_residual(m: &super::Measurement, p: &crate::model::TipPose, angle_weight_mm_per_deg: f64) -> [f64; 3] {
+pub fn row_residual(m: &super::Measurement, p: &crate::solver::TipPose, angle_weight_mm_per_deg: f64) -> [f64; 3] {
     [
         p.tip_x_mm - m.tip_x_mm,
         p.tip_y_mm - m.tip_y_mm,
@@ -1010,7 +1011,7 @@ mod tests {
         // A straight centreline along +x from the clamp to 65 mm, frame angle 0.
         let mut a = Rod::default();
         a.gravity.enabled = false;
-        let mut sim = crate::model::Simulator::new(&a, &SolverOptions::default()).unwrap();
+        let mut sim = crate::solver::Simulator::new(&a, &SolverOptions::default()).unwrap();
         sim.set_routing_mm(&[0.0; 5]).unwrap();
         sim.solve(0.0).unwrap();
         let template = sim.centreline()[0];

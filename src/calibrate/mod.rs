@@ -51,10 +51,13 @@ pub enum CalibrateError {
     // The failure is part of the message, not the error's source, so that
     // `{:#}` (cause chains) does not print it twice on one line.
     #[error("routing '{routing}', row {row} ({tension_n} N): {failure}")]
-    Solve { routing: String, row: usize, tension_n: f64, failure: crate::model::SolveFailure },
+    Solve { routing: String, row: usize, tension_n: f64, failure: crate::solver::SolveFailure },
     /// Invalid actuator or fit settings.
     #[error(transparent)]
     Parameter(#[from] crate::model::ParameterError),
+    /// The solver refused the rod or its settings.
+    #[error(transparent)]
+    Simulate(#[from] crate::solver::SimulateError),
     /// The request cannot be carried out on this data.
     #[error("{0}")]
     Invalid(String),
@@ -81,8 +84,8 @@ pub enum CalibrateError {
     Plot(#[from] crate::plot::PlotError),
     /// The actuator of a 3-D calibration cannot be used.
     #[error("the actuator: {0}")]
-    Actuator(crate::model::spatial::SpatialError),
+    Actuator(crate::solver::spatial::SpatialError),
     /// The 3-D model could not be solved for a capture.
     #[error("capture {measurement} (row {row} of the captures file): {failure}")]
-    Capture { measurement: i64, row: usize, failure: crate::model::spatial::SpatialError },
+    Capture { measurement: i64, row: usize, failure: crate::solver::spatial::SpatialError },
 }

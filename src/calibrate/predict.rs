@@ -4,7 +4,8 @@
 
 use super::data::{Dataset, Direction, RoutingGroup};
 use super::CalibrateError;
-use crate::model::{Rod, CentrelinePoint, Hold, LoadDirection, Routing, Simulator, SolverOptions, TipPose};
+use crate::model::{Rod, LoadDirection, Routing};
+use crate::solver::{CentrelinePoint, Hold, Simulator, SolverOptions, TipPose};
 use rayon::prelude::*;
 
 /// The model's answer for one row.

@@ -11,7 +11,8 @@ use super::data::{read_centrelines, read_markers, read_measurements, split_holdo
 use super::fit::{apply_held, fit_observed, rms_per_routing, FitProgress, FitResult, FitSpec, Held, Loss, Noise, RoutingRms, ShapeData};
 use super::predict::predict;
 use super::{CalibrateError, Effect};
-use crate::model::{Rod, RodOverrides, SolverOptions};
+use crate::model::{Rod, RodOverrides};
+use crate::solver::SolverOptions;
 use serde::{Serialize, Serializer};
 use std::fmt;
 use std::path::PathBuf;

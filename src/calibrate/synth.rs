@@ -11,7 +11,8 @@ use super::predict::predict_group;
 use super::rng::Rng;
 use super::CalibrateError;
 use crate::model::routing::CONTROL_POINTS;
-use crate::model::{Rod, Segment, SolverOptions};
+use crate::model::{Rod, Segment};
+use crate::solver::SolverOptions;
 use super::Effect;
 
 /// Effects `synth` can hide that are deliberately not diagnosis candidates

@@ -2,7 +2,8 @@
 //! decisions they make: the rod's overrides (a library
 //! [`RodOverrides`]) and the solver options.
 
-use cablemap::model::{EffectInfo, Rod, RodOverrides, SolverMethod, SolverOptions, REGISTRY};
+use cablemap::model::{EffectInfo, Rod, RodOverrides, REGISTRY};
+use cablemap::solver::{SolverMethod, SolverOptions};
 use clap::Args;
 use std::path::PathBuf;
 

@@ -7,7 +7,7 @@ use anyhow::bail;
 use cablemap::calibrate::fit::{parse_held, Held, Loss, Noise};
 use cablemap::calibrate::run::run_observed;
 use cablemap::calibrate::{CalibrateError, CalibrateRequest, Effect, FitSettings};
-use cablemap::model::SolverOptions;
+use cablemap::solver::SolverOptions;
 use clap::Args;
 use std::io::Write;
 use std::path::PathBuf;
@@ -246,7 +246,7 @@ pub fn check_captures_flags(planar_holdout: bool, fit: &FitArgs, actuator: &Actu
 
 /// The 3-D solver's settings from the solver flags (--nodes-per-span,
 /// --steps-per-span for the centreline's resolution, --method).
-pub fn spatial_options(args: &ActuatorArgs) -> cablemap::model::spatial::SpatialOptions {
+pub fn spatial_options(args: &ActuatorArgs) -> cablemap::solver::spatial::SpatialOptions {
     let method = args.method.map(|_| args.solver_options(&SolverOptions::default()).method);
-    cablemap::model::spatial::SpatialOptions::with_given(args.steps_per_span, args.nodes_per_span, method)
+    cablemap::solver::spatial::SpatialOptions::with_given(args.steps_per_span, args.nodes_per_span, method)
 }

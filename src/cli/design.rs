@@ -8,7 +8,7 @@ use cablemap::design::cables::targets::TargetSet;
 use cablemap::design::cables::CableDesignRequest;
 use cablemap::design::run::DesignRequest;
 use cablemap::design::{self, DesignError, SearchOptions, Target, Weights};
-use cablemap::model::SolverOptions;
+use cablemap::solver::SolverOptions;
 use clap::Args;
 use std::path::PathBuf;
 

@@ -5,7 +5,7 @@ use super::calibrate::{with_flag, FitArgs};
 use super::ActuatorArgs;
 use cablemap::calibrate::diagnose::{self, DiagnoseRequest};
 use cablemap::calibrate::CalibrateError;
-use cablemap::model::SolverOptions;
+use cablemap::solver::SolverOptions;
 use clap::Args;
 use std::io::Write;
 use std::path::PathBuf;

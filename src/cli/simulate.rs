@@ -1,8 +1,9 @@
 //! `cablemap simulate`: one actuator, one tension.
 
 use super::{parse_list, ActuatorArgs, LengthBasisArgs};
-use cablemap::model::record::{self, SimulationRecord};
-use cablemap::model::{simulate_actuator, simulate_held, Actuator, Backend, Cable, Given, Hold, LoadDirection, Routing, SimulateError, SolverOptions};
+use cablemap::solver::record::{self, SimulationRecord};
+use cablemap::model::{Actuator, Cable, LoadDirection, Routing};
+use cablemap::solver::{simulate_actuator, simulate_held, Backend, Given, Hold, SimulateError, SolverOptions};
 use cablemap::plot::{draw_bodies, BodyDrawing};
 use anyhow::Context;
 use clap::Args;
@@ -115,7 +116,7 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     // ones are only needed up to what the steps resolve.
     let exact_order = match args.coefficients {
         CoefficientRoute::Exact => args.order,
-        CoefficientRoute::Thesis => args.order.min(cablemap::model::resolution::max_order(&options)),
+        CoefficientRoute::Thesis => args.order.min(cablemap::solver::resolution::max_order(&options)),
     };
     let basis = args.basis.length_basis;
     let mut sim = match actuation {
@@ -130,7 +131,7 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         // and solved as every actuator's (the same planar backend).
         _ => {
             let one = Actuator::with_cables(actuator.clone(), vec![actuation.cable(routing.control_points_mm().0, args.cable_ea_n)]);
-            let spatial_options = cablemap::model::spatial::SpatialOptions::default();
+            let spatial_options = cablemap::solver::spatial::SpatialOptions::default();
             let solved = simulate_actuator(&one, &options, &spatial_options, given_settings(args), Some(hold), exact_order, basis);
             if let (Err(e), true) = (&solved, args.json) {
                 if let Some(status) = e.failure_status() {
@@ -184,12 +185,12 @@ fn report_png(args: &SimulateArgs) {
 
 /// An actuator given by its cables (`--cable`, `--actuator`, or a routing
 /// with spatial flags): solved by the backend that serves it
-/// ([`cablemap::model::Backend::serving`]: the planar fast path for one
+/// ([`cablemap::solver::Backend::serving`]: the planar fast path for one
 /// in-plane cable with gravity in the plane, else the 3-D solver) and
 /// reported in the actuator's terms (the spatial record).
 fn run_spatial(args: &SimulateArgs) -> anyhow::Result<()> {
-    use cablemap::model::spatial::SpatialOptions;
-    use cablemap::model::Hold;
+    use cablemap::solver::spatial::SpatialOptions;
+    use cablemap::solver::Hold;
     // The rod: the spatial file's [rod], else an --actuator-file, else the
     // thesis's; rod flags override either.
     let mut spatial = match &args.spatial_actuator {
@@ -233,7 +234,7 @@ fn run_spatial(args: &SimulateArgs) -> anyhow::Result<()> {
     // As the planar `--routing` path holds it.
     let direction = if args.direction == "unload" { LoadDirection::Unload } else { LoadDirection::Load };
     let hold = Hold { direction, dwell_s: args.dwell_s.unwrap_or(spatial.rod.effects.creep_hold_s) };
-    let order = if thesis { args.order.min(cablemap::model::resolution::max_order(&options)) } else { args.order };
+    let order = if thesis { args.order.min(cablemap::solver::resolution::max_order(&options)) } else { args.order };
     let basis = args.basis.length_basis;
     let solved = simulate_actuator(&spatial, &options, &spatial_options, given, Some(hold), order, basis);
     if let (Err(e), true) = (&solved, args.json) {

@@ -4,7 +4,7 @@
 use super::{parse_list, ActuatorArgs};
 use cablemap::calibrate::Effect;
 use cablemap::model::routing::CONTROL_POINTS;
-use cablemap::model::SolverOptions;
+use cablemap::solver::SolverOptions;
 use cablemap::calibrate::captures::files::read_captures;
 use cablemap::calibrate::captures::synth::MarkerSpec;
 use cablemap::model::Actuator;

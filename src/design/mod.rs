@@ -54,7 +54,7 @@ pub enum DesignError {
     },
     /// Re-simulating a design (for its drawing) failed.
     #[error("re-simulating the design: {0}")]
-    Simulate(#[from] crate::model::SimulateError),
+    Simulate(#[from] crate::solver::SimulateError),
     /// The designed routing is not a valid channel.
     #[error(transparent)]
     Routing(#[from] crate::model::RoutingError),

@@ -3,7 +3,8 @@
 
 use super::target::{Component, Target, Weights};
 use super::DesignError;
-use crate::model::{Rod, ControlPoints, Routing, Simulator, SolveFailure, SolverOptions, TipPose};
+use crate::model::{Rod, ControlPoints, Routing};
+use crate::solver::{Simulator, SolveFailure, SolverOptions, TipPose};
 use crate::shape::LengthBasis;
 use serde::Serialize;
 
@@ -102,7 +103,7 @@ pub struct Objective {
 }
 
 /// Largest tension step of the continuation ladder used when a cold solve
-/// fails, N (the same as `model::simulate`: keeps Newton and the shooting in
+/// fails, N (the same as `crate::solver::simulate`: keeps Newton and the shooting in
 /// their basin for strongly curled shapes).
 pub const LADDER_STEP_N: f64 = 0.25;
 
@@ -113,7 +114,7 @@ impl Objective {
         // The solver settings and the target's coefficient order, before any
         // search: every a_k compared must be resolved by the steps.
         Simulator::new(&actuator, &options)?;
-        crate::model::resolution::check_order(target.order(), &options).map_err(|e| DesignError::BadTarget(e.to_string()))?;
+        crate::solver::resolution::check_order(target.order(), &options).map_err(|e| DesignError::BadTarget(e.to_string()))?;
         weights.check_against(&target)?;
         bounds.validate(actuator.channel_radius_mm())?;
         Ok(Self { actuator, options, target, weights, bounds, length_basis: LengthBasis::default() })
@@ -142,7 +143,7 @@ impl Objective {
     /// tension converges for routings inside the body at the design
     /// tensions (checked on thousands of random routings, agreeing with the
     /// ladder to 3e-7 mm) and is 4× cheaper, so it is tried first; if it
-    /// fails, a continuation ladder from low tension (as `model::simulate`)
+    /// fails, a continuation ladder from low tension (as `crate::solver::simulate`)
     /// takes over.
     pub fn evaluate(&self, sim: &mut Simulator, routing_mm: &ControlPoints, tension_n: f64) -> Result<Evaluation, SolveFailure> {
         let routing = Routing::for_actuator(routing_mm, &self.actuator)

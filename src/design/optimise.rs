@@ -18,7 +18,8 @@
 use super::objective::{Evaluation, Objective};
 use super::target::Component;
 use super::DesignError;
-use crate::model::{ControlPoints, Routing, Simulator, SolveFailure};
+use crate::model::{ControlPoints, Routing};
+use crate::solver::{Simulator, SolveFailure};
 use crate::numerics::lm;
 use nalgebra::DMatrix;
 use rayon::prelude::*;
@@ -546,7 +547,8 @@ pub fn compare(objective: &Objective, eval: &Evaluation, tolerance_pct: f64) -> 
 mod tests {
     use super::*;
     use crate::design::{Bounds, Target, Weights};
-    use crate::model::{Rod, SolverOptions};
+    use crate::model::Rod;
+    use crate::solver::SolverOptions;
 
     fn objective() -> Objective {
         let act = Rod::default();

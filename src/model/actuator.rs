@@ -5,8 +5,7 @@
 //! (docs/schema.md).
 
 use crate::model::cable::{self, Cable};
-use crate::model::spatial::SpatialError;
-use crate::model::{Backend, Given, SolverOptions};
+use crate::model::ActuatorError;
 use crate::model::{ParameterError, Rod};
 use serde::{Deserialize, Serialize};
 
@@ -47,7 +46,7 @@ impl Actuator {
     }
 
     /// Unit gravity direction (global).
-    pub fn gravity_unit(&self) -> Result<[f64; 3], SpatialError> {
+    pub fn gravity_unit(&self) -> Result<[f64; 3], ActuatorError> {
         let g = match self.gravity_direction {
             Some(g) => g,
             None => {
@@ -57,29 +56,14 @@ impl Actuator {
         };
         let n = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
         if !(n.is_finite() && n > 0.0) {
-            return Err(SpatialError::GravityDirection(g));
+            return Err(ActuatorError::GravityDirection(g));
         }
         Ok(g.map(|c| c / n))
     }
 
-    /// [`Actuator::validate_for`] the 3-D solver (collocation), which serves
-    /// every actuator the spatial RK4 reference does and more.
-    pub fn validate(&self) -> Result<Vec<cable::Channel>, SpatialError> {
-        self.validate_for(Backend::Spatial)
-    }
-
-    /// Checks everything for a 3-D solver: the actuator
-    /// ([`Actuator::channels`]) and that `backend` models it
-    /// ([`Backend::check`]); builds the cables' channels.
-    pub fn validate_for(&self, backend: Backend) -> Result<Vec<cable::Channel>, SpatialError> {
-        let channels = self.channels()?;
-        backend.check(self, &SolverOptions::default(), Given::default())?;
-        Ok(channels)
-    }
-
     /// Checks the actuator itself, whichever backend solves it (the rod's
     /// parameters, torsion, gravity and cables), and builds the cables' channels.
-    pub fn channels(&self) -> Result<Vec<cable::Channel>, SpatialError> {
+    pub fn channels(&self) -> Result<Vec<cable::Channel>, ActuatorError> {
         self.rod.validate()?;
         if let Some(gj) = self.gj_n_mm2 {
             if !(gj.is_finite() && gj > 0.0) {
@@ -92,15 +76,15 @@ impl Actuator {
     }
 
     /// Reads the TOML format (docs/schema.md); `source` names the file in errors.
-    pub fn from_toml(text: &str, source: &str) -> Result<Self, SpatialError> {
-        toml::from_str(text).map_err(|e| SpatialError::Toml { source_name: source.to_string(), message: e.to_string() })
+    pub fn from_toml(text: &str, source: &str) -> Result<Self, ActuatorError> {
+        toml::from_str(text).map_err(|e| ActuatorError::Toml { source_name: source.to_string(), message: e.to_string() })
     }
 
     /// Reads and checks an actuator file ([`Actuator::channels`]; which
     /// backend serves it is decided when it is solved).
-    pub fn read(path: &std::path::Path) -> Result<Self, SpatialError> {
+    pub fn read(path: &std::path::Path) -> Result<Self, ActuatorError> {
         let text = std::fs::read_to_string(path)
-            .map_err(|e| SpatialError::Read { path: path.display().to_string(), message: e.to_string() })?;
+            .map_err(|e| ActuatorError::Read { path: path.display().to_string(), message: e.to_string() })?;
         let a = Self::from_toml(&text, &path.display().to_string())?;
         a.channels()?;
         Ok(a)

@@ -6,7 +6,7 @@
 //! is one parametric space curve r_c(s) = (0, y_c(s), z_c(s)) in the body
 //! frame. z ≡ 0 is today's planar routing.
 
-use crate::model::spatial::SpatialError;
+use crate::model::ActuatorError;
 use crate::model::routing::{ChannelPoint, Routing, CHANNEL_STEP_MM, CONTROL_POINTS};
 use crate::model::Rod;
 use serde::{Deserialize, Serialize};
@@ -221,29 +221,29 @@ impl Channel {
 /// points); an anchor outside (0, L]; two cables on
 /// the same path (identical control points: the spline is linear in them, so
 /// this is exactly "the same curve").
-pub fn validate(actuator: &Rod, cables: &[Cable]) -> Result<Vec<Channel>, SpatialError> {
+pub fn validate(actuator: &Rod, cables: &[Cable]) -> Result<Vec<Channel>, ActuatorError> {
     if cables.is_empty() || cables.len() > MAX_CABLES {
-        return Err(SpatialError::CableCount(cables.len()));
+        return Err(ActuatorError::CableCount { count: cables.len(), max: MAX_CABLES });
     }
     let (length, radius) = (actuator.length_mm, actuator.radius_mm);
     let mut channels = Vec::with_capacity(cables.len());
     for (index, cable) in cables.iter().enumerate() {
         let cable_no = index + 1;
         if !(cable.tension_n.is_finite() && cable.tension_n >= 0.0) {
-            return Err(SpatialError::Tension { cable: cable_no, tension_n: cable.tension_n });
+            return Err(ActuatorError::Tension { cable: cable_no, tension_n: cable.tension_n });
         }
         if let Some(anchor) = cable.anchor_mm {
             if !(anchor.is_finite() && anchor > 0.0 && anchor <= length) {
-                return Err(SpatialError::Anchor { cable: cable_no, anchor_mm: anchor, length_mm: length });
+                return Err(ActuatorError::Anchor { cable: cable_no, anchor_mm: anchor, length_mm: length });
             }
         }
         // The control points span the cable, [0, anchor] (docs/model.md,
         // "Cables"), as the planar solver's `cable_anchor_mm` does.
         let span = cable.anchor_or_tip_mm(length);
         let y = Routing::new(&cable.y_mm, span, radius)
-            .map_err(|source| SpatialError::Routing { cable: cable_no, axis: 'y', source })?;
+            .map_err(|source| ActuatorError::Routing { cable: cable_no, axis: 'y', source })?;
         let z = Routing::new(&cable.z_mm, span, radius)
-            .map_err(|source| SpatialError::Routing { cable: cable_no, axis: 'z', source })?;
+            .map_err(|source| ActuatorError::Routing { cable: cable_no, axis: 'z', source })?;
         let channel = Channel { y, z };
         // y and z share the parameter ζ and the basis (non-negative, summing
         // to one), so the channel lies in the convex hull of its control
@@ -255,17 +255,17 @@ pub fn validate(actuator: &Rod, cables: &[Cable]) -> Result<Vec<Channel>, Spatia
             for k in 0..=n {
                 let (s, dist) = channel.radius_at_parameter(k as f64 / n as f64);
                 if dist >= radius {
-                    return Err(SpatialError::OutsideBody { cable: cable_no, s_mm: s, distance_mm: dist, radius_mm: radius });
+                    return Err(ActuatorError::OutsideBody { cable: cable_no, s_mm: s, distance_mm: dist, radius_mm: radius });
                 }
             }
         }
         if let Some(ea) = cable.cable_ea_n {
             if !(ea.is_finite() && ea > 0.0) {
-                return Err(SpatialError::CableStiffness { cable: cable_no, cable_ea_n: ea });
+                return Err(ActuatorError::CableStiffness { cable: cable_no, cable_ea_n: ea });
             }
         }
         if let Some(d) = cable.displacement_mm {
-            let bad = |why: String| Err(SpatialError::Displacement { cable: cable_no, displacement_mm: d, why });
+            let bad = |why: String| Err(ActuatorError::Displacement { cable: cable_no, displacement_mm: d, why });
             if !d.is_finite() {
                 return bad("give a finite pulled-in length, mm".into());
             }
@@ -282,7 +282,7 @@ pub fn validate(actuator: &Rod, cables: &[Cable]) -> Result<Vec<Channel>, Spatia
         }
         for (other, earlier) in cables[..index].iter().enumerate() {
             if earlier.y_mm == cable.y_mm && earlier.z_mm == cable.z_mm {
-                return Err(SpatialError::SamePath { first: other + 1, second: cable_no });
+                return Err(ActuatorError::SamePath { first: other + 1, second: cable_no });
             }
         }
         channels.push(channel);
@@ -294,18 +294,18 @@ pub fn validate(actuator: &Rod, cables: &[Cable]) -> Result<Vec<Channel>, Spatia
 /// (whitespace-separated `key=value` fields; `z=` may be left out for a
 /// planar cable; `anchor=S` knots it at s = S mm instead of the tip).
 impl std::str::FromStr for Cable {
-    type Err = SpatialError;
+    type Err = ActuatorError;
 
     fn from_str(text: &str) -> Result<Self, Self::Err> {
-        let bad = |why: String| SpatialError::CableSpec { text: text.to_string(), why };
-        let points = |key: &str, value: &str| -> Result<[f64; CONTROL_POINTS], SpatialError> {
+        let bad = |why: String| ActuatorError::CableSpec { text: text.to_string(), why };
+        let points = |key: &str, value: &str| -> Result<[f64; CONTROL_POINTS], ActuatorError> {
             let v: Vec<f64> = value
                 .split(',')
                 .map(|x| x.trim().parse::<f64>().map_err(|_| bad(format!("{key}: '{}' is not a number", x.trim()))))
                 .collect::<Result<_, _>>()?;
             v.try_into().map_err(|v: Vec<f64>| bad(format!("{key} needs {CONTROL_POINTS} control points, got {}", v.len())))
         };
-        let number = |key: &str, value: &str| -> Result<f64, SpatialError> {
+        let number = |key: &str, value: &str| -> Result<f64, ActuatorError> {
             value.trim().parse::<f64>().map_err(|_| bad(format!("{key}: '{value}' is not a number")))
         };
         let (mut y, mut z, mut tension, mut anchor, mut displacement, mut ea) = (None, None, None, None, None, None);
@@ -416,27 +416,27 @@ mod tests {
     fn bad_cables_get_named_errors() {
         let ok = Cable::spatial([1.0; 5], [1.0; 5], 1.0);
         let e = validate(&rod(), &[]).unwrap_err();
-        assert!(matches!(e, SpatialError::CableCount(0)), "{e}");
+        assert!(matches!(e, ActuatorError::CableCount { count: 0, .. }), "{e}");
         let e = validate(&rod(), &vec![ok.clone(); 9]).unwrap_err();
-        assert!(matches!(e, SpatialError::CableCount(9)), "{e}");
+        assert!(matches!(e, ActuatorError::CableCount { count: 9, .. }), "{e}");
         let mut neg = ok.clone();
         neg.tension_n = -0.1;
         let e = validate(&rod(), &[neg]).unwrap_err();
-        assert!(matches!(e, SpatialError::Tension { cable: 1, .. }), "{e}");
+        assert!(matches!(e, ActuatorError::Tension { cable: 1, .. }), "{e}");
         assert!(e.to_string().contains("cable 1"), "{e}");
         // Each coordinate inside, the distance outside: (4, 4) is 5.66 mm from the axis.
         let e = validate(&rod(), &[Cable::spatial([4.0; 5], [4.0; 5], 1.0)]).unwrap_err();
-        assert!(matches!(e, SpatialError::OutsideBody { cable: 1, .. }), "{e}");
+        assert!(matches!(e, ActuatorError::OutsideBody { cable: 1, .. }), "{e}");
         assert!(e.to_string().contains("radius"), "{e}");
         let e = validate(&rod(), &[Cable::spatial([1.0; 5], [0.0, 0.0, 5.5, 0.0, 0.0], 1.0)]).unwrap_err();
-        assert!(matches!(e, SpatialError::Routing { cable: 1, axis: 'z', .. }), "{e}");
+        assert!(matches!(e, ActuatorError::Routing { cable: 1, axis: 'z', .. }), "{e}");
         assert!(e.to_string().contains("z"), "{e}");
         let e = validate(&rod(), &[ok.clone(), Cable::planar([-1.0; 5], 1.0), ok.clone()]).unwrap_err();
-        assert!(matches!(e, SpatialError::SamePath { first: 1, second: 3 }), "{e}");
+        assert!(matches!(e, ActuatorError::SamePath { first: 1, second: 3 }), "{e}");
         let mut anchored = ok.clone();
         anchored.anchor_mm = Some(70.0);
         let e = validate(&rod(), &[anchored]).unwrap_err();
-        assert!(matches!(e, SpatialError::Anchor { cable: 1, .. }), "{e}");
+        assert!(matches!(e, ActuatorError::Anchor { cable: 1, .. }), "{e}");
     }
 
     #[test]

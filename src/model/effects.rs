@@ -1,25 +1,25 @@
 //! The effect registry: every physical effect beyond the thesis model
 //! (model-notes §6), each parameter described once — its spec key, unit,
 //! default, valid and plausible ranges, command-line flag, whether
-//! calibrate and diagnose can fit it, and which solver backends model it.
+//! and how calibrate and diagnose fit it. Which backends model an effect
+//! is declared with the backends, in the solver layer.
 //!
 //! Everything else that knows an effect reads it from here: the command
 //! line's effect flags are generated from [`REGISTRY`], [`Rod::validate`]
 //! checks each entry's [`Bounds`], the calibration candidates
 //! (`calibrate::Effect`) are a view of the entries with a [`Fit`], the
-//! solvers ask [`unsupported_by`] what they cannot serve, and tests check
+//! solvers' capability check walks the entries, and tests check
 //! docs/model.md's effects table against it. The spec keys are spelled
 //! here and in the [`Effects`] struct only (`effect_parameters.rs`;
 //! tests/layering.rs checks it).
 //!
 //! To add an effect: a field in [`Effects`] (or a parameter of the rod), an
 //! entry in [`REGISTRY`] and a row in docs/model.md's table; then its term
-//! in the solvers that model it.
+//! in the solver backends that model it.
 
 use super::effect_parameters::DEFAULT_CREEP_TIME_S;
 use super::parameter::{ParameterError, PlausibleRange};
 use super::rod::Rod;
-use crate::model::solver::Backend;
 #[cfg(doc)]
 use super::Effects;
 
@@ -175,8 +175,6 @@ pub struct EffectInfo {
     pub help: &'static str,
     /// How calibrate and diagnose fit it; `None`: not a fit candidate.
     pub fit: Option<Fit>,
-    /// The backends that model it.
-    pub backends: &'static [Backend],
     /// The parameter it qualifies (creep's time constant acts only when
     /// creep's fraction does); `None` for a main parameter.
     pub qualifies: Option<&'static EffectInfo>,
@@ -185,11 +183,6 @@ pub struct EffectInfo {
     /// Sets the parameter on a rod (∞ gives the rigid clamp).
     pub set: fn(&mut Rod, f64),
 }
-
-const ALL_BACKENDS: &[Backend] = &Backend::ALL;
-/// The collocation and planar backends: every effect's term is in each of
-/// them; the 3-D RK4 reference models the thesis's rod without effects.
-const MODELLING_EFFECTS: &[Backend] = &[Backend::PlanarCollocation, Backend::PlanarRk4, Backend::Spatial];
 
 fn always_on(_: &Rod) -> bool {
     true
@@ -219,7 +212,6 @@ pub static GRAVITY_DIRECTION: EffectInfo = EffectInfo {
     value_name: "RAD",
     help: "Gravity direction from the clamp axis, rad (clamp tilt)",
     fit: None,
-    backends: ALL_BACKENDS,
     qualifies: None,
     get: |a| a.gravity.direction_rad,
     set: |a, v| a.gravity.direction_rad = v,
@@ -248,7 +240,6 @@ pub static GRAVITY_SCALE: EffectInfo = EffectInfo {
         switch_on: |a| a.gravity.enabled = true,
         ..Fit::new("gravity", 1.0, Domain::Positive, (0.0, 10.0), "0 < k ≤ 10")
     }),
-    backends: ALL_BACKENDS,
     qualifies: None,
     get: |a| a.gravity.scale,
     set: |a, v| a.gravity.scale = v,
@@ -272,7 +263,6 @@ pub static STIFFENING: EffectInfo = EffectInfo {
     value_name: "ALPHA",
     help: "Material stiffening α: moment EI·u·(1 + α (r u)²)",
     fit: Some(Fit::new("stiffening", 0.2, Domain::Positive, (0.0, 100.0), "0 < α ≤ 100")),
-    backends: MODELLING_EFFECTS,
     qualifies: None,
     get: |a| a.effects.stiffening_alpha,
     set: |a, v| a.effects.stiffening_alpha = v,
@@ -296,7 +286,6 @@ pub static CLAMP_COMPLIANCE: EffectInfo = EffectInfo {
     value_name: "N_MM_PER_RAD",
     help: "Clamp rotational stiffness k_θ, N·mm/rad: the effect `clamp_compliance` (`--clamp-stiffness` is the old name)",
     fit: Some(Fit::new("clamp_compliance", 300.0, Domain::Positive, (1.0, 1e5), "1 ≤ k_θ ≤ 1e5 N·mm/rad")),
-    backends: MODELLING_EFFECTS,
     qualifies: None,
     get: |a| a.effects.clamp_stiffness_n_mm_per_rad.unwrap_or(f64::INFINITY),
     set: |a, v| a.effects.clamp_stiffness_n_mm_per_rad = (v != f64::INFINITY).then_some(v),
@@ -320,7 +309,6 @@ pub static CHANNEL_OFFSET: EffectInfo = EffectInfo {
     value_name: "MM",
     help: "Channel offset δ added to every y_i, mm",
     fit: Some(Fit::new("channel_offset", 0.0, Domain::Signed, (-2.0, 2.0), "|δ| ≤ 2 mm")),
-    backends: MODELLING_EFFECTS,
     qualifies: None,
     get: |a| a.effects.channel_offset_mm,
     set: |a, v| a.effects.channel_offset_mm = v,
@@ -344,7 +332,6 @@ pub static STIFFNESS_GRADIENT: EffectInfo = EffectInfo {
     value_name: "BETA",
     help: "Stiffness gradient β: EI(s) = EI·exp(β (s/L − ½)), β = ln(EI(L)/EI(0))",
     fit: Some(Fit::new("stiffness_gradient", 0.0, Domain::Signed, (-5.0, 5.0), "|β| ≤ 5 (EI(L)/EI(0) between 1/150 and 150)")),
-    backends: MODELLING_EFFECTS,
     qualifies: None,
     get: |a| a.effects.stiffness_gradient_beta,
     set: |a, v| a.effects.stiffness_gradient_beta = v,
@@ -368,7 +355,6 @@ pub static FRICTION: EffectInfo = EffectInfo {
     value_name: "MU",
     help: "Cable–channel friction coefficient μ (capstan law)",
     fit: Some(Fit::new("friction", 0.02, Domain::Positive, (0.0, 1.0), "0 < μ ≤ 1")),
-    backends: MODELLING_EFFECTS,
     qualifies: None,
     get: |a| a.effects.friction_mu,
     set: |a, v| a.effects.friction_mu = v,
@@ -397,7 +383,6 @@ pub static CREEP_FRACTION: EffectInfo = EffectInfo {
     value_name: "F",
     help: "Creep: fraction f of the bending rigidity that relaxes (0 ≤ f < 1)",
     fit: Some(Fit::new("creep", 0.05, Domain::Fraction, (0.0, 0.9), "0 < f ≤ 0.9")),
-    backends: MODELLING_EFFECTS,
     qualifies: None,
     get: |a| a.effects.creep_fraction,
     set: |a, v| a.effects.creep_fraction = v,
@@ -421,7 +406,6 @@ pub static CREEP_TIME: EffectInfo = EffectInfo {
     value_name: "S",
     help: "Creep time constant T, s",
     fit: None,
-    backends: MODELLING_EFFECTS,
     qualifies: Some(&CREEP_FRACTION),
     get: |a| a.effects.creep_time_s,
     set: |a, v| a.effects.creep_time_s = v,
@@ -445,7 +429,6 @@ pub static CREEP_HOLD: EffectInfo = EffectInfo {
     value_name: "S",
     help: "Creep: seconds each tension is held on a fresh rod in sweeps and design",
     fit: None,
-    backends: MODELLING_EFFECTS,
     qualifies: Some(&CREEP_FRACTION),
     get: |a| a.effects.creep_hold_s,
     set: |a, v| a.effects.creep_hold_s = v,
@@ -482,11 +465,6 @@ impl EffectInfo {
     /// parameter set too.
     pub fn acts(&self, rod: &Rod) -> bool {
         self.is_set(rod) && self.qualifies.is_none_or(|main| main.is_set(rod))
-    }
-
-    /// Whether `backend` models the parameter.
-    pub fn supported_by(&self, backend: Backend) -> bool {
-        self.backends.contains(&backend)
     }
 
     /// Refuses a value outside [`EffectInfo::bounds`] for `rod` (whose
@@ -545,13 +523,6 @@ pub fn fittable() -> impl Iterator<Item = (&'static EffectInfo, &'static Fit)> {
     REGISTRY.iter().copied().filter_map(|e| e.fit.as_ref().map(|f| (e, f)))
 }
 
-/// The first effect acting on `rod` that `backend` does not model, `None`
-/// when it models all of them: the solvers' one capability check for
-/// effects. [`EffectInfo::backends`] names the backends that would serve it.
-pub fn unsupported_by(backend: Backend, rod: &Rod) -> Option<&'static EffectInfo> {
-    REGISTRY.iter().copied().find(|e| !e.supported_by(backend) && e.acts(rod))
-}
-
 /// Checks every effect parameter of `rod` against its bounds.
 pub fn validate(rod: &Rod) -> Result<(), ParameterError> {
     REGISTRY.iter().try_for_each(|e| e.check(rod))
@@ -585,26 +556,6 @@ mod tests {
             assert_eq!(find(e.path).map(|f| f.key), Some(e.key));
             assert_eq!(find_flag(e.flag).map(|f| f.key), Some(e.key));
         }
-    }
-
-    #[test]
-    fn the_spatial_rk4_reference_refuses_each_effect_and_a_qualifier_alone_does_not_act() {
-        let mut a = Rod::default();
-        assert!(Backend::ALL.iter().all(|&b| unsupported_by(b, &a).is_none()));
-        a.effects.creep_time_s = 3.0;
-        a.effects.creep_hold_s = 5.0;
-        assert!(unsupported_by(Backend::SpatialRk4, &a).is_none(), "creep's time and hold act only with a creep fraction");
-        a.effects.creep_fraction = 0.2;
-        assert_eq!(unsupported_by(Backend::SpatialRk4, &a).map(|e| e.key), Some("creep_fraction"));
-        assert!(unsupported_by(Backend::PlanarRk4, &a).is_none());
-        assert!(unsupported_by(Backend::Spatial, &a).is_none());
-        let mut b = Rod::default();
-        b.effects.clamp_stiffness_n_mm_per_rad = Some(40.0);
-        assert_eq!(unsupported_by(Backend::SpatialRk4, &b).map(|e| e.key), Some("clamp_stiffness_n_mm_per_rad"));
-        assert!(unsupported_by(Backend::Spatial, &b).is_none());
-        b = Rod::default();
-        b.gravity.scale = 2.0;
-        assert!(unsupported_by(Backend::SpatialRk4, &b).is_none());
     }
 
     #[test]

@@ -1,9 +1,8 @@
-//! Why a rod, a solver setting or a coefficient order was refused, and the
+//! Why a rod's parameter or a numerical setting was refused, and the
 //! plausible ranges parameters are checked against. Every file of the
 //! model that checks a parameter uses these; this file uses none of them.
 
 use super::body::BodyError;
-use super::resolution::OrderError;
 
 /// A plausible range of a parameter: far beyond any rod cablemap models,
 /// yet refusing values whose products in the solver overflow or vanish.
@@ -37,15 +36,7 @@ pub enum ParameterError {
     /// A parameter that must be finite is not, or lies outside its range.
     #[error("parameter {name} = {} is out of range: {expected}", crate::io::fmt_num(*value))]
     OutOfRange { name: &'static str, value: f64, expected: &'static str },
-    /// A coefficient order the discretisation does not resolve
-    /// ([`crate::model::resolution`]).
-    #[error(transparent)]
-    Unresolved(#[from] OrderError),
     /// The body along s (radius profile, segments, cable anchor) is invalid.
     #[error(transparent)]
     Body(#[from] BodyError),
-    /// The solver backend asked for does not model this rod
-    /// ([`crate::model::solver::Backend::check`]).
-    #[error(transparent)]
-    Unsupported(#[from] crate::model::solver::Unsupported),
 }

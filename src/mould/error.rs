@@ -60,7 +60,7 @@ pub enum MouldError {
     NonUniformBody(String),
     /// The actuator's cables are invalid.
     #[error(transparent)]
-    Actuator(#[from] crate::model::spatial::SpatialError),
+    Actuator(#[from] crate::solver::spatial::SpatialError),
     /// The rod's parameters are invalid.
     #[error(transparent)]
     Rod(#[from] crate::model::ParameterError),

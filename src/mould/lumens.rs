@@ -143,7 +143,7 @@ impl Lumens {
         let p = params;
         let bad = |name: &'static str, message: String| Err(MouldError::BadParameter { name, message });
         super::request::check_body(actuator, super::MouldStyle::Lumens)?;
-        let channels = crate::model::cable::validate(&actuator.rod, &actuator.cables)?;
+        let channels = crate::model::cable::validate(&actuator.rod, &actuator.cables).map_err(crate::solver::spatial::SpatialError::from)?;
         actuator.rod.validate()?;
         let (length_mm, radius_mm) = (actuator.rod.length_mm, actuator.rod.radius_mm);
         let profile_mm = actuator.rod.radius_profile_mm.as_slice();

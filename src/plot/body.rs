@@ -4,7 +4,8 @@
 
 use super::canvas::{png_backend, register_fonts, PlotError};
 use super::series::{bounds, clamp_series, draw_legend, draw_series_on, hanging_chart, series_points, Mark, PictureSeries, LEGEND_PAD_PX, LEGEND_ROW_PX};
-use crate::model::{Rod, Simulation};
+use crate::model::Rod;
+use crate::solver::Simulation;
 use plotters::prelude::*;
 use std::path::Path;
 

@@ -6,7 +6,7 @@
 
 use super::canvas::{png_backend, register_fonts, PlotError, FONT};
 use super::series::{clamp_series, draw_legend, draw_series_on, legend_size, page_chart, Mark, PictureSeries};
-use crate::model::Simulation;
+use crate::solver::Simulation;
 use plotters::prelude::*;
 use plotters::style::full_palette::{BLUE_800, BROWN, ORANGE, PURPLE};
 use std::path::Path;

@@ -78,7 +78,7 @@ impl RowColumns {
     /// Whether row `i` converged and has every value the reducer needs.
     pub fn converged(&self, i: usize) -> bool {
         !self.status.is_null(i)
-            && self.status.value(i) == crate::model::STATUS_OK
+            && self.status.value(i) == crate::solver::STATUS_OK
             && !self.tension_n.is_null(i)
             && !self.tip_x_mm.is_null(i)
             && !self.tip_y_mm.is_null(i)

@@ -5,8 +5,9 @@
 //! ([`ModeDrawings::of_cables`]).
 
 use super::{Design, MapCables, MapData};
-use crate::model::spatial::simulate_spatial;
-use crate::model::{Rod, SolverOptions};
+use crate::solver::spatial::simulate_spatial;
+use crate::model::Rod;
+use crate::solver::SolverOptions;
 use crate::plot::BodyDrawing;
 
 /// Why a representative could not be drawn.
@@ -109,7 +110,7 @@ impl ModeDrawings {
 fn draw(mode: usize, d: &Design, actuator: &Rod, solver: &SolverOptions) -> Result<BodyDrawing, DrawingError> {
     let routing = crate::model::Routing::for_actuator(d.routing_mm, actuator)
         .map_err(|source| DrawingError::Routing { mode, source })?;
-    let sim = crate::model::simulate(actuator, solver, &routing, d.tension_n, 1, crate::shape::LengthBasis::default())
+    let sim = crate::solver::simulate(actuator, solver, &routing, d.tension_n, 1, crate::shape::LengthBasis::default())
         .map_err(|e| DrawingError::Simulation { mode, source: Box::new(e) })?;
     Ok(BodyDrawing::of_body(&sim, actuator, format!("mode {mode}"), plotters::style::full_palette::BLUE_800))
 }

@@ -10,7 +10,7 @@
 
 use super::ReduceError;
 use crate::model::routing::CONTROL_POINTS;
-use crate::model::record::{simulate_command, SimulateCommand};
+use crate::solver::record::{simulate_command, SimulateCommand};
 use crate::model::Actuator;
 use crate::sweep::schema::Axis;
 use crate::sweep::CableSweepSpec;

@@ -24,7 +24,7 @@ pub fn write_map_replacing(
     dir: &Path,
     map: &MapData,
     actuator: &crate::model::Rod,
-    solver: &crate::model::SolverOptions,
+    solver: &crate::solver::SolverOptions,
 ) -> Result<Vec<Picture>, ReduceError> {
     write_dir_replacing(dir, |staging| write_map(staging, map, actuator, solver))
 }
@@ -111,7 +111,7 @@ pub fn write_map(
     dir: &Path,
     map: &MapData,
     actuator: &crate::model::Rod,
-    solver: &crate::model::SolverOptions,
+    solver: &crate::solver::SolverOptions,
 ) -> Result<Vec<Picture>, ReduceError> {
     write_map_drawn(dir, map, actuator, &ModeDrawings::of_map(map, actuator, solver), None)
 }
@@ -241,7 +241,8 @@ mod tests {
     use crate::reduce::{reduce_batches, MapBody, ReduceOptions, RunInfo};
     use crate::shape::LengthBasis;
     use arrow::record_batch::RecordBatch;
-    use crate::model::{Rod, Routing, Simulator, SolverOptions};
+    use crate::model::{Rod, Routing};
+    use crate::solver::{Simulator, SolverOptions};
     use arrow::array::{ArrayRef, Float64Array, Int64Array, StringArray};
     use arrow::datatypes::{DataType, Field, Schema};
     use std::sync::Arc;

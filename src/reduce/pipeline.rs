@@ -17,7 +17,7 @@ use super::source::{PlanarSource, RunInfo};
 use super::spill;
 use super::tables::{self, PLANAR_MAP_DIR};
 use super::{fetch, CableMapSummary, Design, MapCables, MapData, MapSummary, ReduceError, ReduceOptions, CELL_STATS_ORDER, MODES};
-use crate::model::STATUS_OK;
+use crate::solver::STATUS_OK;
 use crate::sweep::schema::STATUS_INVALID_ROUTING;
 use crate::sweep::{open_run_of, CableSweepSpec, Completeness, RunSpec, SweepError, SweepRun, SweepSpec};
 use arrow::record_batch::RecordBatch;
@@ -466,7 +466,7 @@ mod tests {
         let m = map.modes.iter().position(|m| m.representative.is_some()).unwrap();
         // Outside the body: the routing is refused, and the drawing says so.
         map.modes[m].representative.as_mut().unwrap().routing_mm[2] = 2.0 * actuator.radius_mm;
-        let drawings = drawings::ModeDrawings::of_map(&map, &actuator, &crate::model::SolverOptions::default());
+        let drawings = drawings::ModeDrawings::of_map(&map, &actuator, &crate::solver::SolverOptions::default());
         assert_eq!(drawings.shapes.len(), MODES);
         assert!(drawings.shapes[m].is_none());
         assert_eq!(drawings.failures.len(), 1);

@@ -125,6 +125,9 @@ pub enum SweepError {
     /// The solver rejected the actuator.
     #[error(transparent)]
     Parameter(#[from] crate::model::ParameterError),
+    /// The solver refused the rod or its settings.
+    #[error(transparent)]
+    Simulate(#[from] crate::solver::SimulateError),
     /// A routing of the grid was rejected.
     #[error(transparent)]
     Routing(#[from] crate::model::RoutingError),

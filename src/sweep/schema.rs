@@ -13,7 +13,7 @@
 //! NaN), and `status` says why.
 
 use crate::model::routing::{ControlPoints, CONTROL_POINTS};
-use crate::model::TipPose;
+use crate::solver::TipPose;
 use arrow::array::{ArrayRef, Float64Array, Float64Builder, Int32Array, Int32Builder, Int64Array, Int64Builder, ListBuilder, StringArray, StringBuilder};
 use arrow::datatypes::{DataType, Field, Schema, SchemaRef};
 use arrow::record_batch::RecordBatch;

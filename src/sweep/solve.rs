@@ -7,9 +7,10 @@
 
 use super::schema::{CableRow, SolvedRouting, SolvedRow, STATUS_FAILED, STATUS_INVALID_ROUTING};
 use crate::model::routing::ControlPoints;
-use crate::model::spatial::{Actuator, SpatialError, SpatialOptions, SpatialSolver};
-use crate::model::solver::actuation;
-use crate::model::{Routing, Simulator, SolveFailure, TipPose, STATUS_OK};
+use crate::solver::spatial::{Actuator, SpatialError, SpatialOptions, SpatialSolver};
+use crate::solver::actuation;
+use crate::model::Routing;
+use crate::solver::{Simulator, SolveFailure, TipPose, STATUS_OK};
 use crate::sweep::spec::Ladder;
 use crate::shape::LengthBasis;
 
@@ -203,7 +204,7 @@ pub fn cable_routing(id: u64, mut actuator: Actuator, options: &SpatialOptions, 
     let mut tensions = vec![0.0; first.len()];
     // Continuation from zero to the first combination (rungs of ≤ 0.25 N
     // and ≤ 0.5 mm).
-    let rung = |(&v, &d): (&f64, &bool)| if d { v / crate::model::solver::simulate::DISPLACEMENT_RUNG_MM } else { v / 0.25 };
+    let rung = |(&v, &d): (&f64, &bool)| if d { v / crate::solver::simulate::DISPLACEMENT_RUNG_MM } else { v / 0.25 };
     let top = first.iter().zip(&combinations.by_displacement).map(rung).fold(0.0, f64::max);
     let rungs = (top.ceil() as usize).max(1);
     for k in 1..rungs {

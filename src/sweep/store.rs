@@ -220,7 +220,7 @@ pub fn total_status_counts<'a>(chunks: impl IntoIterator<Item = &'a ChunkInfo>) 
 
 /// Rows of failed solves (status other than `ok`) in a status count.
 pub fn failures(counts: &BTreeMap<String, u64>) -> u64 {
-    counts.iter().filter(|(s, _)| s.as_str() != crate::model::STATUS_OK).map(|(_, n)| n).sum()
+    counts.iter().filter(|(s, _)| s.as_str() != crate::solver::STATUS_OK).map(|(_, n)| n).sum()
 }
 
 /// Paths of a run directory.

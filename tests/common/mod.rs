@@ -4,7 +4,8 @@
 //! layout and writes the map tables (`docs/maps.md`).
 
 use arrow::array::{ArrayRef, Float64Array, Int64Array, RecordBatch, StringArray};
-use cablemap::model::{Rod, Routing, Simulator, SolverOptions, STATUS_OK};
+use cablemap::model::{Rod, Routing};
+use cablemap::solver::{Simulator, SolverOptions, STATUS_OK};
 use cablemap::reduce::{reduce_batches, tables::write_tables, ReduceOptions, RunInfo};
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, OnceLock};

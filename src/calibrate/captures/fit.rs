@@ -18,7 +18,7 @@ use super::simulate::{solve_captures, CaptureSolution};
 use crate::calibrate::fit::Loss;
 use crate::calibrate::{stats, CalibrateError, Effect};
 use crate::model::effects::Domain;
-use crate::model::spatial::SpatialOptions;
+use crate::solver::spatial::SpatialOptions;
 use crate::model::Actuator;
 use crate::numerics::lm;
 use nalgebra::DMatrix;
@@ -349,7 +349,7 @@ pub fn fit_captures(base: &Actuator, set: &CaptureSet, spec: &Fit3Spec, observe:
     if !(spec.noise_mm.is_finite() && spec.noise_mm > 0.0) {
         return Err(CalibrateError::Noise(format!("noise_mm = {}: the markers' noise must be a standard deviation > 0", spec.noise_mm)));
     }
-    base.channels().map_err(CalibrateError::Actuator)?;
+    base.channels().map_err(|e| CalibrateError::Actuator(e.into()))?;
     let mut params: Vec<Param> = Vec::new();
     for &p in &spec.params {
         if p == Param::Density && !base.rod.gravity.enabled {

@@ -1,7 +1,7 @@
 //! Calibration, prediction and diagnosis with several cables and 3-D
 //! markers (issue 26): captures with one actuation column per cable,
 //! body-fixed markers measured in the clamp frame, an actuator file, and
-//! the 3-D solver ([`crate::model::spatial::SpatialSolver`]).
+//! the 3-D solver ([`crate::solver::spatial::SpatialSolver`]).
 //!
 //! - [`files`]: reading the captures and markers files (CSV, Parquet).
 //! - [`simulate`]: solving captures in warm-started chains; markers on the body.

@@ -14,7 +14,7 @@ use super::simulate::solve_captures;
 use super::diagnose::{diagnose_captures, Diagnose3Spec, Diagnosis3};
 use crate::calibrate::fit::Loss;
 use crate::calibrate::{CalibrateError, Effect};
-use crate::model::spatial::SpatialOptions;
+use crate::solver::spatial::SpatialOptions;
 use crate::model::Actuator;
 use serde::Serialize;
 use std::fmt;
@@ -44,7 +44,7 @@ pub struct PredictReport {
 }
 
 fn read_actuator(path: &Path) -> Result<Actuator, CalibrateError> {
-    Actuator::read(path).map_err(CalibrateError::Actuator)
+    Actuator::read(path).map_err(|e| CalibrateError::Actuator(e.into()))
 }
 
 fn read_set(captures: &Path, markers: Option<&Path>, actuator: &Actuator) -> Result<CaptureSet, CalibrateError> {
@@ -314,7 +314,7 @@ pub struct Diagnose3Request {
     /// Most effects added.
     pub max_effects: usize,
     /// The 3-D solver's settings.
-    pub options: crate::model::spatial::SpatialOptions,
+    pub options: crate::solver::spatial::SpatialOptions,
     /// Report directory (`report.md` and a picture per capture); none for no report.
     pub report_dir: Option<std::path::PathBuf>,
 }
@@ -337,7 +337,7 @@ impl Diagnose3Request {
             threshold: spec.threshold,
             margin: spec.margin,
             max_effects: spec.max_effects,
-            options: crate::model::spatial::SpatialOptions::default(),
+            options: crate::solver::spatial::SpatialOptions::default(),
             report_dir: None,
         }
     }
@@ -350,7 +350,7 @@ pub fn diagnose_request(request: &Diagnose3Request) -> Result<Diagnosis3, Calibr
     if let Some(dir) = &request.report_dir {
         crate::io::check_outside_run_dir(dir, "the report directory")?;
     }
-    let base = Actuator::read(&request.actuator).map_err(CalibrateError::Actuator)?;
+    let base = Actuator::read(&request.actuator).map_err(|e| CalibrateError::Actuator(e.into()))?;
     let set = read_capture_set(&request.captures, request.markers.as_deref(), base.cables.len(), base.rod.length_mm)?;
     let mut params: Vec<Param> = Param::BODY.to_vec();
     if !base.rod.gravity.enabled {

@@ -14,9 +14,10 @@
 use super::files::{Actuation, Capture, CaptureSet, MarkerReading};
 use crate::calibrate::data::Direction;
 use crate::calibrate::CalibrateError;
-use crate::model::solver::actuation;
-use crate::model::spatial::{SpatialError, SpatialFailure, SpatialOptions, SpatialSolver};
-use crate::model::{Actuator, CentrelinePoint, Hold, LoadDirection, TipPose};
+use crate::solver::actuation;
+use crate::solver::spatial::{SpatialError, SpatialFailure, SpatialOptions, SpatialSolver};
+use crate::model::{Actuator, LoadDirection};
+use crate::solver::{CentrelinePoint, Hold, TipPose};
 use rayon::prelude::*;
 
 /// The model's answer for one capture.
@@ -194,9 +195,9 @@ pub fn solve_captures(actuator: &Actuator, options: &SpatialOptions, set: &Captu
             loop {
                 match solve_chain(actuator, &options, set, chain) {
                     Err(CalibrateError::Capture { failure: SpatialError::Solve(SpatialFailure::Unresolved(_)), .. })
-                        if options.nodes_per_span < crate::model::solver::MAX_NODES_PER_SPAN =>
+                        if options.nodes_per_span < crate::solver::MAX_NODES_PER_SPAN =>
                     {
-                        options.nodes_per_span = (2 * options.nodes_per_span).min(crate::model::solver::MAX_NODES_PER_SPAN);
+                        options.nodes_per_span = (2 * options.nodes_per_span).min(crate::solver::MAX_NODES_PER_SPAN);
                     }
                     result => return result,
                 }

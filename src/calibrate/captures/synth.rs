@@ -7,7 +7,7 @@ use super::simulate::solve_captures;
 use crate::calibrate::data::Direction;
 use crate::calibrate::rng::Rng;
 use crate::calibrate::CalibrateError;
-use crate::model::spatial::SpatialOptions;
+use crate::solver::spatial::SpatialOptions;
 use crate::model::Actuator;
 
 /// A body-fixed marker to place on every capture.

@@ -27,7 +27,8 @@ use crate::calibrate::effect::Effect;
 use crate::calibrate::fit::{closest_on_centreline, fit, residuals, rms_per_routing, FitResult, FitSpec, RoutingRms};
 use crate::calibrate::predict::{predict, Prediction};
 use crate::calibrate::CalibrateError;
-use crate::model::{Rod, SolverOptions};
+use crate::model::Rod;
+use crate::solver::SolverOptions;
 use rayon::prelude::*;
 use serde::Serialize;
 

@@ -9,7 +9,8 @@ use super::report::DiagnoseReport;
 use crate::calibrate::data::read_measurements;
 use crate::calibrate::run::FitSettings;
 use crate::calibrate::CalibrateError;
-use crate::model::{RodOverrides, SolverOptions};
+use crate::model::RodOverrides;
+use crate::solver::SolverOptions;
 use std::path::{Path, PathBuf};
 
 /// Everything a diagnosis needs.

@@ -25,7 +25,8 @@ use super::optimise::SearchOptions;
 use super::run::DesignRequest;
 use super::target::{error_pct, Target, Weights};
 use super::DesignError;
-use crate::model::{Actuator, SolverOptions};
+use crate::model::Actuator;
+use crate::solver::SolverOptions;
 use crate::shape::LengthBasis;
 use search::{Achieved, CableSearch, Channel, Setup, StartReport};
 use serde_json::json;
@@ -368,7 +369,7 @@ fn command_of(actuator: &Actuator, file: Option<&std::path::Path>) -> String {
     match file {
         Some(p) => format!("cablemap simulate --actuator {} --json", super::feasible::shell_word(&p.display().to_string())),
         None => {
-            let c = crate::model::record::simulate_command(actuator, &crate::model::spatial::SpatialOptions::default());
+            let c = crate::solver::record::simulate_command(actuator, &crate::solver::spatial::SpatialOptions::default());
             if c.missing.is_empty() {
                 c.text
             } else {
@@ -387,7 +388,7 @@ fn planar_case(r: &CableDesignRequest) -> bool {
     let d = &r.design;
     let [f] = d.freedom.as_slice() else { return false };
     let cable = &d.actuator.cables[0];
-    let in_plane = crate::model::solver::backend::is_planar(&d.actuator);
+    let in_plane = crate::solver::backend::is_planar(&d.actuator);
     let [t] = r.targets.targets.as_slice() else { return false };
     let planar_target = t.components.iter().all(|(q, v, _)| match q {
         Quantity::TipX | Quantity::TipY | Quantity::BendZ(_) => true,
@@ -488,7 +489,7 @@ pub fn run(request: &CableDesignRequest) -> Result<CableDesignRun, DesignError> 
                 let sim = setup.simulate(&setup.actuator(&found.channels, &actuation))?;
                 Ok((actuation, Achieved::of(&sim)))
             })
-            .collect::<Result<Vec<_>, crate::model::spatial::SpatialError>>()
+            .collect::<Result<Vec<_>, crate::solver::spatial::SpatialError>>()
             .map_err(|e| DesignError::BadSearch(format!("re-simulating the design found: {e}")))?;
         (found.channels, achieved, found.cost, found.starts, found.seeds_simulated, "cables")
     };

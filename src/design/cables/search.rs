@@ -12,7 +12,7 @@
 //! √(R² − z_i²). Each actuation is its range scaled to [0, 1].
 //!
 //! Every evaluation solves each target's actuator with
-//! [`crate::model::simulate_actuator`], the path `cablemap simulate` takes,
+//! [`crate::solver::simulate_actuator`], the path `cablemap simulate` takes,
 //! so a design's reported values are what its `simulate` command prints.
 //! Starts come from a coarse grid (straight channels in 8 directions, or
 //! 5 levels and ramps for one free coordinate, × 3 actuation levels per
@@ -23,8 +23,9 @@
 use super::spec::{ActuationBounds, CableFreedom, DesignActuator};
 use super::targets::{Quantity, ShapeTarget};
 use super::super::DesignError;
-use crate::model::spatial::{SpatialError, SpatialOptions, SpatialSolver};
-use crate::model::{simulate_actuator, Actuator, Given, Simulation, SolverOptions, TipPose};
+use crate::solver::spatial::{SpatialError, SpatialOptions, SpatialSolver};
+use crate::model::Actuator;
+use crate::solver::{simulate_actuator, Given, Simulation, SolverOptions, TipPose};
 use crate::numerics::lm;
 use crate::shape::LengthBasis;
 use nalgebra::DMatrix;
@@ -300,9 +301,9 @@ impl Setup {
     /// where that fails, and for every other actuator, [`Setup::simulate`].
     /// The design's reported values are [`Setup::simulate`]'s.
     pub fn quick(&self, actuator: &Actuator) -> Result<Achieved, SpatialError> {
-        let spatial = !crate::model::solver::backend::is_planar(actuator)
+        let spatial = !crate::solver::backend::is_planar(actuator)
             && !actuator.cables.iter().any(|c| c.is_displacement_driven())
-            && self.options.method == crate::model::SolverMethod::Collocation;
+            && self.options.method == crate::solver::SolverMethod::Collocation;
         if spatial {
             let options = SpatialOptions { nodes_per_span: self.options.nodes_per_span, ..SpatialOptions::default() };
             if let Ok(mut solver) = SpatialSolver::new(actuator, &options) {

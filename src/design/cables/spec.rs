@@ -189,7 +189,7 @@ impl DesignActuator {
                 }
             };
             let (lo, hi) = actuation.range();
-            if !(lo >= 0.0 && lo <= hi && hi <= crate::model::solver::simulate::MAX_LADDER_TENSION_N) {
+            if !(lo >= 0.0 && lo <= hi && hi <= crate::solver::simulate::MAX_LADDER_TENSION_N) {
                 return Err(bad(source, format!("cable {no}: actuation bounds {lo} … {hi} must satisfy 0 ≤ min ≤ max")));
             }
             pending.push((free_y, free_z, number("max_offset_mm")?, actuation));

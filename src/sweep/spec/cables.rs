@@ -40,7 +40,7 @@
 //! holds `output.chunk_routings` routings.
 
 use crate::model::routing::CONTROL_POINTS;
-use crate::model::spatial::{SpatialError, SpatialOptions};
+use crate::solver::spatial::{SpatialError, SpatialOptions};
 use crate::model::{Actuator, Cable, Rod, MAX_CABLES};
 use crate::shape::LengthBasis;
 use crate::sweep::kind::{ChunkLayout, InvalidSpec, RunSpec, MAX_CHUNK_ROWS, MAX_ROWS};
@@ -298,7 +298,7 @@ impl CableSweepSpec {
             if let Some(ea) = c.cable_ea_n.filter(|ea| !(ea.is_finite() && *ea > 0.0)) {
                 return Err(bad(format!("cable {n}: cable_ea_n = {ea} must be a finite stiffness > 0 N (leave it out for an inextensible cable)")));
             }
-            if g.by_displacement && self.solver.method == crate::model::SolverMethod::Rk4 {
+            if g.by_displacement && self.solver.method == crate::solver::SolverMethod::Rk4 {
                 return Err(bad(format!("cable {n} is driven by its displacement: [solver] method = \"rk4\" does not integrate the cables' paths; use the default collocation")));
             }
             // The anchor is not swept: outside the rod, every routing's rows
@@ -331,7 +331,7 @@ impl CableSweepSpec {
                 }
             }
         }
-        crate::model::spatial::check_order(self.output.order, &self.solver).map_err(|e| bad(e.to_string()))?;
+        crate::solver::spatial::check_order(self.output.order, &self.solver).map_err(|e| bad(e.to_string()))?;
         if !(self.output.cell_mm.is_finite() && self.output.cell_mm > 0.0) {
             return Err(bad(format!("output.cell_mm = {} must be a positive length", self.output.cell_mm)));
         }
@@ -354,10 +354,10 @@ impl CableSweepSpec {
         // The base actuator (swept points at their first level) must be a
         // rod the 3-D solver models; a routing's own faults are its rows' status.
         let base = self.actuator_for(0, &self.dimensions());
-        match base.validate_for(crate::model::Backend::spatial(self.solver.method)) {
-            Err(SpatialError::Parameter(e)) => return Err(bad(e.to_string())),
+        match crate::solver::spatial::validated_channels(&base, crate::solver::Backend::spatial(self.solver.method)) {
+            Err(SpatialError::Actuator(crate::model::ActuatorError::Parameter(e))) => return Err(bad(e.to_string())),
             Err(e @ SpatialError::Unsupported(_)) => return Err(bad(format!("[rod] {e}"))),
-            Err(e @ SpatialError::GravityDirection(_)) => return Err(bad(e.to_string())),
+            Err(e @ SpatialError::Actuator(crate::model::ActuatorError::GravityDirection(_))) => return Err(bad(e.to_string())),
             _ => {}
         }
         Ok(())

@@ -9,7 +9,7 @@
 //! [actuator]            # model::Rod; omitted fields keep the thesis values
 //! [actuator.gravity]
 //! enabled = true
-//! [solver]              # model::SolverOptions
+//! [solver]              # crate::solver::SolverOptions
 //! steps_per_span = 24
 //! [grid]
 //! levels = 9            # levels per control point
@@ -32,7 +32,8 @@
 //! chunk_routings = 256  # routings per Parquet chunk file
 //! ```
 
-use crate::model::{Rod, Routing, Simulator, SolverOptions};
+use crate::model::{Rod, Routing};
+use crate::solver::{Simulator, SolverOptions};
 use crate::shape::LengthBasis;
 use crate::sweep::enumerate::SweepPlan;
 use crate::sweep::kind::{ChunkLayout, InvalidSpec, RunSpec, MAX_CHUNK_ROWS, MAX_ROWS};
@@ -248,7 +249,7 @@ impl SweepSpec {
             return Err(SpecError::setting("solver", format!("steps_per_span = {} is more than {MAX_STEPS_PER_SPAN}: the solver would need more memory than a \
                  machine has, and {} steps already resolve every supported order",
                 self.solver.steps_per_span,
-                crate::model::resolution::REQUIRED_STEPS_PER_SPAN[crate::model::resolution::MAX_RESOLVED_ORDER]
+                crate::solver::resolution::REQUIRED_STEPS_PER_SPAN[crate::solver::resolution::MAX_RESOLVED_ORDER]
             )));
         }
         if self.tension.count > MAX_TENSIONS {
@@ -271,11 +272,11 @@ impl SweepSpec {
             if let Some(ea) = d.cable_ea_n.filter(|ea| !(ea.is_finite() && *ea > 0.0)) {
                 return bad(format!("cable_ea_n = {ea} must be a finite stiffness > 0 N (leave it out for an inextensible cable)"));
             }
-            if self.solver.method == crate::model::SolverMethod::Rk4 {
+            if self.solver.method == crate::solver::SolverMethod::Rk4 {
                 return bad("[solver] method = \"rk4\" does not integrate the cable's path, so it cannot meet a displacement: use the default collocation".into());
             }
         }
-        crate::model::Simulator::new(&self.actuator, &self.solver).map_err(|e| SpecError::setting("solver", e.to_string()))?;
+        crate::solver::Simulator::new(&self.actuator, &self.solver).map_err(|e| SpecError::setting("solver", e.to_string()))?;
         let g = &self.grid;
         if g.levels == 0 || g.levels > MAX_LEVELS {
             return Err(SpecError::setting("grid", format!("levels = {} must be between 1 and {MAX_LEVELS}", g.levels)));
@@ -318,7 +319,7 @@ impl SweepSpec {
         if o.order > MAX_ORDER {
             return Err(SpecError::setting("output", format!("order = {} is above the supported {MAX_ORDER}", o.order)));
         }
-        crate::model::resolution::check_order(o.order, &self.solver).map_err(|e| SpecError::setting("output", e.to_string()))?;
+        crate::solver::resolution::check_order(o.order, &self.solver).map_err(|e| SpecError::setting("output", e.to_string()))?;
         if o.chunk_routings == 0 {
             return Err(SpecError::setting("output", "chunk_routings = 0: a chunk needs at least one routing"));
         }
@@ -605,7 +606,7 @@ mod tests {
             let spec =
                 SweepSpec::from_toml(&format!("[solver]\nmethod = \"{method}\"\nsteps_per_span = 30\n[output]\ncentreline = true\n"), "t")
                     .unwrap();
-            let mut sim = crate::model::Simulator::new(&spec.actuator, &spec.solver).unwrap();
+            let mut sim = crate::solver::Simulator::new(&spec.actuator, &spec.solver).unwrap();
             sim.set_routing_mm(&[1.0, 2.0, 0.0, -1.0, 1.0]).unwrap();
             sim.solve(1.5).unwrap();
             assert_eq!(sim.centreline().len() as u64, spec.centreline_points(), "{method}");

@@ -47,15 +47,19 @@
 //! allocated once per [`Simulator`]; solving allocates nothing, except in
 //! collocation's Newton fallback for heavy rods (a dense Jacobian).
 
-use super::parameter::ParameterError;
-use super::rod::{LoadDirection, Rod};
-use super::body::{merge_sorted, Body};
-use super::routing::Routing;
+use crate::model::parameter::ParameterError;
+use crate::model::rod::{LoadDirection, Rod};
+use crate::model::body::{merge_sorted, Body};
+use crate::model::routing::Routing;
 use crate::shape::LengthBasis;
 use serde::{Deserialize, Serialize};
 
 pub mod actuation;
 pub mod backend;
+mod error;
+pub mod record;
+pub mod resolution;
+pub mod spatial;
 pub(crate) mod collocation;
 mod continuation;
 pub(crate) mod creep;
@@ -66,9 +70,10 @@ mod rk4;
 pub mod simulate;
 
 pub use backend::{Backend, Given, Support, Unsupported};
+pub use error::SimulateError;
 pub use result::{CableAtNode, CentrelinePoint, PerCable, Simulation, TipFrame, TipPose};
 pub use simulate::{
-    check_ladder_tension, planar_problem, simulate, simulate_actuator, simulate_held, simulate_spatial, SimulateError, MAX_AUTO_SPATIAL_STEPS_PER_SPAN,
+    check_ladder_tension, planar_problem, simulate, simulate_actuator, simulate_held, simulate_spatial, MAX_AUTO_SPATIAL_STEPS_PER_SPAN,
     MAX_AUTO_STEPS_PER_SPAN, MAX_LADDER_TENSION_N,
 };
 use creep::Creep;
@@ -353,22 +358,22 @@ pub struct Hold {
 
 impl Simulator {
     /// Creates a solver for `actuator`; fails on invalid parameters.
-    pub fn new(actuator: &Rod, options: &SolverOptions) -> Result<Self, ParameterError> {
-        actuator.validate()?;
+    pub fn new(actuator: &Rod, options: &SolverOptions) -> Result<Self, SimulateError> {
+        actuator.validate().map_err(ParameterError::from)?;
         // The upper bound keeps a typo (2e9 steps) from exhausting memory.
         if options.steps_per_span < 2 || options.steps_per_span % 2 != 0 || options.steps_per_span > MAX_STEPS_PER_SPAN {
             return Err(ParameterError::OutOfRange {
                 name: "steps_per_span",
                 value: options.steps_per_span as f64,
                 expected: "an even number from 2 to 100000",
-            });
+            }.into());
         }
         if options.method == SolverMethod::Collocation && !(4..=MAX_NODES_PER_SPAN).contains(&options.nodes_per_span) {
             return Err(ParameterError::OutOfRange {
                 name: "nodes_per_span",
                 value: options.nodes_per_span as f64,
                 expected: "between 4 and 64",
-            });
+            }.into());
         }
         let n = options.steps_per_span;
         // Material stiffening's curvature law u(m) has complex branch points
@@ -379,7 +384,7 @@ impl Simulator {
         } else {
             options.nodes_per_span
         };
-        let body = actuator.body()?;
+        let body = actuator.body().map_err(ParameterError::from)?;
         Backend::check_planar(actuator, options, Given::default())?;
         let spans = span_boundaries(actuator, body.as_ref(), 0.5 * actuator.cable_length_mm()).len() - 1;
         // Per-point buffers: RK4 stage points, or collocation nodes.
@@ -434,7 +439,7 @@ impl Simulator {
     }
 
     /// Validates `y_mm` against the actuator and sets it as the routing.
-    pub fn set_routing_mm(&mut self, y_mm: &[f64]) -> Result<(), super::routing::RoutingError> {
+    pub fn set_routing_mm(&mut self, y_mm: &[f64]) -> Result<(), crate::model::routing::RoutingError> {
         let routing = Routing::for_actuator(y_mm, &self.actuator)?;
         self.set_routing(&routing);
         Ok(())
@@ -768,7 +773,7 @@ impl Simulator {
     pub fn coefficients_into(&mut self, basis: LengthBasis, out: &mut [f64]) {
         assert!(self.last_tension_n.is_some(), "coefficients_into needs a successful solve");
         let estimate = if self.col.is_some() { self.colloc_coefficients(basis, out) } else { self.rk4_coefficients(basis, out) };
-        self.coefficient_error = if estimate.0 <= super::resolution::ORDER_TOLERANCE_PER_MM || self.is_probe {
+        self.coefficient_error = if estimate.0 <= resolution::ORDER_TOLERANCE_PER_MM || self.is_probe {
             estimate
         } else {
             // As for the tip: a solve at twice the intervals tells.
@@ -784,7 +789,7 @@ impl Simulator {
     }
 
     /// [`Simulator::coefficients_into`], refusing coefficients whose
-    /// estimated error is above [`super::resolution::ORDER_TOLERANCE_PER_MM`]
+    /// estimated error is above [`resolution::ORDER_TOLERANCE_PER_MM`]
     /// or that are not finite.
     pub fn coefficients_checked(&mut self, basis: LengthBasis, out: &mut [f64]) -> Result<(), SolveFailure> {
         self.coefficients_into(basis, out);
@@ -792,7 +797,7 @@ impl Simulator {
             return Err(SolveFailure::NonFinite { s_mm: self.actuator.length_mm });
         }
         let (error, k) = self.coefficient_error;
-        let tolerance = super::resolution::ORDER_TOLERANCE_PER_MM;
+        let tolerance = resolution::ORDER_TOLERANCE_PER_MM;
         if !(error <= tolerance) {
             return Err(self.unresolved(format!("a_{k}"), error, tolerance, "mm⁻¹"));
         }

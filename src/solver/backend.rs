@@ -9,19 +9,20 @@
 //!   with z ≡ 0 — with every effect, tapered and segmented bodies and anchors;
 //! - [`Backend::PlanarRk4`], the planar reference: classical RK4 with
 //!   shooting (`rk4`), the same model with the cable knotted at the tip;
-//! - [`Backend::Spatial`], the 3-D solver (`crate::model::spatial::collocation`):
+//! - [`Backend::Spatial`], the 3-D solver (`crate::solver::spatial::collocation`):
 //!   several cables, out-of-plane channels and gravity, spectral collocation
 //!   with every effect, tapered and segmented bodies and anchors;
 //! - [`Backend::SpatialRk4`], the 3-D reference: RK4 along s with Broyden on
-//!   gravity's moment (`crate::model::spatial::solver`), the thesis's uniform
+//!   gravity's moment (`crate::solver::spatial::solver`), the thesis's uniform
 //!   rod without effects (`--method rk4` with several or spatial cables).
 //!
 //! What a request needs is listed once ([`needs`]) and what a backend
 //! models once ([`Backend::support`]); the check compares the two, so a
 //! new feature or backend is one line in each.
 
+use crate::model::effects::{EffectInfo, GRAVITY_DIRECTION, GRAVITY_SCALE, REGISTRY};
 use crate::model::{Actuator, Cable, Rod};
-use crate::model::solver::{SolverMethod, SolverOptions};
+use crate::solver::{SolverMethod, SolverOptions};
 
 /// A way to solve an actuator's statics.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize)]
@@ -121,7 +122,33 @@ pub struct Support {
     pub nodes_per_span: bool,
     /// Whether it reads `steps_per_span` (RK4 steps; collocation's centreline points).
     pub steps_per_span: bool,
+    /// The effects of the registry it models.
+    pub effects: EffectSupport,
 }
+
+/// Which effects of the registry ([`crate::model::effects`]) a backend models.
+#[derive(Debug, Clone, Copy)]
+pub enum EffectSupport {
+    /// Every effect: each entry's term is in the backend.
+    All,
+    /// Only these (the thesis's rod: gravity's direction and scale).
+    Only(&'static [&'static EffectInfo]),
+}
+
+impl PartialEq for EffectSupport {
+    fn eq(&self, other: &Self) -> bool {
+        match (self, other) {
+            (EffectSupport::All, EffectSupport::All) => true,
+            (EffectSupport::Only(a), EffectSupport::Only(b)) => a.len() == b.len() && a.iter().zip(*b).all(|(x, y)| std::ptr::eq(*x, *y)),
+            _ => false,
+        }
+    }
+}
+
+impl Eq for EffectSupport {}
+
+/// The effects of the thesis's rod, which every backend models.
+const THESIS_EFFECTS: &[&EffectInfo] = &[&GRAVITY_DIRECTION, &GRAVITY_SCALE];
 
 impl Backend {
     /// Every backend, in the order a request is offered to them.
@@ -158,6 +185,7 @@ impl Backend {
             method: SolverMethod::Collocation,
             nodes_per_span: true,
             steps_per_span: true,
+            effects: EffectSupport::All,
         };
         match self {
             Backend::PlanarCollocation => planar,
@@ -177,6 +205,7 @@ impl Backend {
                 nodes_per_span: true,
                 // The centreline's points.
                 steps_per_span: true,
+                effects: EffectSupport::All,
             },
             Backend::SpatialRk4 => Support {
                 several_cables: true,
@@ -191,8 +220,23 @@ impl Backend {
                 method: SolverMethod::Rk4,
                 nodes_per_span: false,
                 steps_per_span: true,
+                effects: EffectSupport::Only(THESIS_EFFECTS),
             },
         }
+    }
+
+    /// Whether this backend models the registry's effect `info`.
+    pub fn models(self, info: &EffectInfo) -> bool {
+        match self.support().effects {
+            EffectSupport::All => true,
+            EffectSupport::Only(list) => list.iter().any(|e| std::ptr::eq(*e, info)),
+        }
+    }
+
+    /// The first effect acting on `rod` that this backend does not model,
+    /// `None` when it models all of them.
+    pub fn unmodelled_effect(self, rod: &Rod) -> Option<&'static EffectInfo> {
+        REGISTRY.iter().copied().find(|e| !self.models(e) && e.acts(rod))
     }
 
     /// Whether this backend serves `need`.
@@ -206,7 +250,7 @@ impl Backend {
             Need::AnchorBeforeTip => s.anchors,
             Need::RodAnchor => s.rod_anchor,
             Need::Displacement => s.displacement,
-            Need::Effect(info) => info.supported_by(self),
+            Need::Effect(info) => self.models(info),
             Need::Hold => s.hold,
             Need::ThesisCoefficients => s.thesis_coefficients,
             Need::Collocation => s.method == SolverMethod::Collocation,
@@ -308,7 +352,7 @@ fn needs(request: Request<'_>, options: &SolverOptions, given: Given) -> Vec<(Ne
     if anchored {
         need(Need::AnchorBeforeTip, "a cable anchored before the tip (it knots the cable at the tip only)".into());
     }
-    for info in crate::model::effects::REGISTRY.iter().copied().filter(|info| info.acts(rod)) {
+    for info in REGISTRY.iter().copied().filter(|info| info.acts(rod)) {
         need(Need::Effect(info), format!("effects.{} (leave it at its default)", info.key));
     }
     if given.hold {
@@ -389,5 +433,25 @@ mod tests {
             }
         }
         assert!(refused > 0, "some of these the planar backends refuse");
+    }
+
+    #[test]
+    fn the_spatial_rk4_reference_refuses_each_effect_and_a_qualifier_alone_does_not_act() {
+        let mut a = Rod::default();
+        assert!(Backend::ALL.iter().all(|b| b.unmodelled_effect(&a).is_none()));
+        a.effects.creep_time_s = 3.0;
+        a.effects.creep_hold_s = 5.0;
+        assert!(Backend::SpatialRk4.unmodelled_effect(&a).is_none(), "creep's time and hold act only with a creep fraction");
+        a.effects.creep_fraction = 0.2;
+        assert_eq!(Backend::SpatialRk4.unmodelled_effect(&a).map(|e| e.key), Some("creep_fraction"));
+        assert!(Backend::PlanarRk4.unmodelled_effect(&a).is_none());
+        assert!(Backend::Spatial.unmodelled_effect(&a).is_none());
+        let mut b = Rod::default();
+        b.effects.clamp_stiffness_n_mm_per_rad = Some(40.0);
+        assert_eq!(Backend::SpatialRk4.unmodelled_effect(&b).map(|e| e.key), Some("clamp_stiffness_n_mm_per_rad"));
+        assert!(Backend::Spatial.unmodelled_effect(&b).is_none());
+        b = Rod::default();
+        b.gravity.scale = 2.0;
+        assert!(Backend::SpatialRk4.unmodelled_effect(&b).is_none());
     }
 }

@@ -125,7 +125,7 @@ pub fn meet_displacements<S: TensionSolve>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::solver::result::PerCable;
+    use crate::solver::result::PerCable;
 
     /// A toy solver: Δ_i = a_i τ_i + b_i τ_j − c_i (c: the rest state's give).
     struct Toy {

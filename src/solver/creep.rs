@@ -10,7 +10,7 @@
 //! ([`Creep::record_moment`]), and q is advanced in closed form after the
 //! solve ([`Creep::end_solve`]).
 
-use super::super::rod::Effects;
+use crate::model::rod::Effects;
 
 /// The creep state of a simulator: the material law, the current hold and
 /// the history q(s) at every point of the integrator.

@@ -6,23 +6,13 @@
 //! the spatial one's; both return the one [`Simulation`].
 
 use super::actuation;
+use super::error::SimulateError;
 use super::result::Simulation;
 use super::{tip_tolerance_mm, Backend, Given, Hold, SolveFailure, SolverMethod, SolverOptions, Simulator, Unresolved, MAX_NODES_PER_SPAN};
 use crate::model::parameter::ParameterError;
-use crate::model::spatial::{check_order, SpatialError, SpatialFailure, SpatialOptions, SpatialRk4Solver, SpatialSolver};
+use crate::solver::spatial::{check_order, SpatialError, SpatialFailure, SpatialOptions, SpatialRk4Solver, SpatialSolver};
 use crate::model::{Actuator, Cable, Rod, Routing};
 use crate::shape::LengthBasis;
-
-/// Why [`simulate`] or [`simulate_held`] produced no result.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum SimulateError {
-    /// The actuator, solver options, hold or coefficient order are invalid.
-    #[error(transparent)]
-    Parameter(#[from] ParameterError),
-    /// A solve of the tension ladder failed.
-    #[error(transparent)]
-    Solve(#[from] SolveFailure),
-}
 
 /// Solves one actuator at `tension_n`, stepping up from a low tension by
 /// continuation so that large deformations start from a nearby solution.
@@ -85,7 +75,7 @@ fn simulate_planar_cable(
     basis: LengthBasis,
     hold: Hold,
 ) -> Result<Simulation, SimulateError> {
-    crate::model::resolution::check_order(order, options).map_err(ParameterError::from)?;
+    crate::solver::resolution::check_order(order, options)?;
     // A solve the discretisation does not resolve is repeated, from the
     // bottom of the ladder, at a finer one, up to the most there is.
     let attempt = |options: &SolverOptions| -> Result<Simulation, SimulateError> {
@@ -189,7 +179,7 @@ pub const MAX_AUTO_STEPS_PER_SPAN: usize = 6144;
 ///
 /// - collocation (the default, [`SpatialSolver`]): every solve estimates its
 ///   own error (the tip within [`tip_tolerance_mm`], every coefficient within
-///   [`crate::model::resolution::ORDER_TOLERANCE_PER_MM`]); where it is above,
+///   [`crate::solver::resolution::ORDER_TOLERANCE_PER_MM`]); where it is above,
 ///   the ladder is solved again at twice the intervals, up to
 ///   [`MAX_NODES_PER_SPAN`], beyond which the solve is refused as unresolved;
 /// - RK4 (the reference, [`SpatialRk4Solver`]): the result is checked against
@@ -331,7 +321,7 @@ fn unresolved_part(fine: &Simulation, coarse: &Simulation, steps: usize) -> Opti
         return unresolved("the tip position".into(), tip_difference, tolerance, "mm");
     }
     let series = [("a_twist", &fine.a_twist, &coarse.a_twist), ("a_bend_y", &fine.a_bend_y, &coarse.a_bend_y), ("a_bend_z", &fine.a_bend_z, &coarse.a_bend_z)];
-    let a_tolerance = crate::model::resolution::ORDER_TOLERANCE_PER_MM;
+    let a_tolerance = crate::solver::resolution::ORDER_TOLERANCE_PER_MM;
     for (name, f, c) in series {
         for (k, (p, q)) in f.iter().zip(c.iter()).enumerate() {
             if !((p - q).abs() <= a_tolerance) {
@@ -420,6 +410,6 @@ pub fn planar_problem(actuator: &Actuator) -> Result<(Rod, Routing), SpatialErro
         rod.gravity.direction_rad = g[1].atan2(g[0]);
     }
     let routing = Routing::for_actuator(cable.y_mm, &rod)
-        .map_err(|source| SpatialError::Routing { cable: 1, axis: 'y', source })?;
+        .map_err(|source| crate::model::ActuatorError::Routing { cable: 1, axis: 'y', source })?;
     Ok((rod, routing))
 }

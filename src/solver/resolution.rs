@@ -100,7 +100,8 @@ pub fn check_order(order: usize, options: &SolverOptions) -> Result<(), OrderErr
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::{Rod, Routing, Simulator};
+    use crate::model::{Rod, Routing};
+    use crate::solver::Simulator;
 
     fn rk4(steps: usize) -> SolverOptions {
         SolverOptions { method: SolverMethod::Rk4, steps_per_span: steps, ..SolverOptions::default() }
@@ -138,7 +139,7 @@ mod tests {
         for t in [0.5, 1.0, 1.5, 2.0] {
             match sim.solve(t) {
                 Ok(_) => {}
-                Err(crate::model::SolveFailure::Unresolved(_)) => return None,
+                Err(crate::solver::SolveFailure::Unresolved(_)) => return None,
                 Err(e) => panic!("{e}"),
             }
         }
@@ -167,7 +168,7 @@ mod tests {
         }
     }
 
-    use crate::model::{simulate, SolveFailure, SimulateError};
+    use crate::solver::{simulate, SolveFailure, SimulateError};
     use proptest::prelude::*;
 
     /// A random rod, far from the thesis's: length, radius, rigidities, a
@@ -216,7 +217,7 @@ mod tests {
                         prop_assert!((sim.a_bend_z[k] - fine.a_bend_z[k]).abs() <= ORDER_TOLERANCE_PER_MM, "a_{k}: {} vs {} at 64 intervals", sim.a_bend_z[k], fine.a_bend_z[k]);
                     }
                     let tip = (sim.pose.tip_x_mm - fine.pose.tip_x_mm).hypot(sim.pose.tip_y_mm - fine.pose.tip_y_mm);
-                    prop_assert!(tip <= crate::model::solver::tip_tolerance_mm(length_mm), "tip off by {tip} mm");
+                    prop_assert!(tip <= crate::solver::tip_tolerance_mm(length_mm), "tip off by {tip} mm");
                 }
                 Err(SimulateError::Solve(SolveFailure::Unresolved(_))) => {}
                 // A solve that does not converge is another matter (the fine one did).

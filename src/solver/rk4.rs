@@ -412,7 +412,8 @@ impl Simulator {
 
 #[cfg(test)]
 mod tests {
-    use crate::model::{simulate, Routing, Simulator, SolverMethod, SolverOptions};
+    use crate::model::Routing;
+    use crate::solver::{simulate, Simulator, SolverMethod, SolverOptions};
     use crate::shape::LengthBasis;
 
     /// RK4's estimates (the differences to a pass at twice the step) bound

@@ -1,5 +1,5 @@
 //! The 3-D solver by spectral collocation per knot span: the planar
-//! collocation ([`crate::model::solver`]) generalised to several cables,
+//! collocation ([`crate::solver`]) generalised to several cables,
 //! spatial channels, torsion and gravity in any direction.
 //!
 //! Cutting the rod at s and taking the distal part, rod and cables together,
@@ -56,11 +56,12 @@
 use super::cable::Channel;
 use super::solver::{SpatialOptions, MAX_SPATIAL_ORDER};
 use super::{Actuator, SpatialError, SpatialFailure};
-use crate::model::solver::result::{CableAtNode, CentrelinePoint, PerCable, TipFrame, TipPose};
-use crate::model::solver::collocation::FRICTION_SUBSTEPS;
-use crate::model::solver::creep::Creep;
-use crate::model::solver::friction::{MAX_PASSES as FRICTION_MAX_PASSES, TOLERANCE as FRICTION_TOLERANCE};
-use crate::model::{Body, Hold, Rod};
+use crate::solver::result::{CableAtNode, CentrelinePoint, PerCable, TipFrame, TipPose};
+use crate::solver::collocation::FRICTION_SUBSTEPS;
+use crate::solver::creep::Creep;
+use crate::solver::friction::{MAX_PASSES as FRICTION_MAX_PASSES, TOLERANCE as FRICTION_TOLERANCE};
+use crate::model::{Body, Rod};
+use crate::solver::Hold;
 use crate::numerics::anderson::Anderson;
 use crate::numerics::chebyshev::{self, next_coefficient, ESTIMATE_SAFETY};
 use crate::shape::{LegendreSeries, LengthBasis};
@@ -128,7 +129,7 @@ const STIFFENING_MAX_ITERATIONS: usize = 50;
 /// points near the real axis, which slows the spectral convergence).
 const MIN_NODES_WITH_STIFFENING: usize = 16;
 /// Most collocation intervals per span (the buffers of a span are this + 1 long).
-const MAX_NODES: usize = crate::model::solver::MAX_NODES_PER_SPAN;
+const MAX_NODES: usize = crate::solver::MAX_NODES_PER_SPAN;
 
 /// The Chebyshev–Lobatto matrices of one span at m intervals, with the
 /// rows this solver's Magnus steps and friction grid read: built once per m
@@ -312,7 +313,7 @@ pub struct SpatialSolver {
 impl SpatialSolver {
     /// A solver for `actuator` (its cables, rod, body, torsion and gravity).
     pub fn new(actuator: &Actuator, options: &SpatialOptions) -> Result<Self, SpatialError> {
-        let channels = actuator.validate_for(crate::model::Backend::Spatial)?;
+        let channels = super::solver::validated_channels(actuator, crate::solver::Backend::Spatial)?;
         options.check()?;
         let rod = actuator.rod.clone();
         let body = rod.body().map_err(|e| SpatialError::Option(e.to_string()))?;
@@ -1545,10 +1546,10 @@ impl SpatialSolver {
     }
 
     /// Refuses a pose whose estimated tip error is above
-    /// [`crate::model::solver::tip_tolerance_mm`], or whose tip lies farther
+    /// [`crate::solver::tip_tolerance_mm`], or whose tip lies farther
     /// from the clamp than the stretched rod is long (no curve can).
-    fn check_resolved(&self, pose: &TipPose) -> Result<(), crate::model::solver::Unresolved> {
-        let tolerance = crate::model::solver::tip_tolerance_mm(self.rod.length_mm);
+    fn check_resolved(&self, pose: &TipPose) -> Result<(), crate::solver::Unresolved> {
+        let tolerance = crate::solver::tip_tolerance_mm(self.rod.length_mm);
         let [x, y, z] = pose.tip_mm();
         let reach = (x * x + y * y + z * z).sqrt();
         if reach > pose.length_mm + tolerance {
@@ -1626,11 +1627,11 @@ impl SpatialSolver {
     /// `[twist, bending about body y, bending about body z]`, each
     /// a_0 … a_order in 1/mm (see the module comment). Refused as unresolved
     /// when their estimated error is above
-    /// [`crate::model::resolution::ORDER_TOLERANCE_PER_MM`] (the message
+    /// [`crate::solver::resolution::ORDER_TOLERANCE_PER_MM`] (the message
     /// names the setting to raise).
     pub fn coefficients(&self, order: usize, basis: LengthBasis) -> Result<[Vec<f64>; 3], SpatialError> {
         let (a, error) = self.coefficients_with_error(order, basis)?;
-        let tolerance = crate::model::resolution::ORDER_TOLERANCE_PER_MM;
+        let tolerance = crate::solver::resolution::ORDER_TOLERANCE_PER_MM;
         if !(error <= tolerance) {
             return Err(SpatialFailure::Unresolved(self.unresolved(format!("a_0 … a_{order}"), error, tolerance, "mm⁻¹")).into());
         }
@@ -1638,13 +1639,13 @@ impl SpatialSolver {
     }
 
     /// [`SpatialSolver::unresolved`]'s failure at this solver's resolution.
-    fn unresolved(&self, what: String, estimate: f64, tolerance: f64, unit: &'static str) -> crate::model::solver::Unresolved {
+    fn unresolved(&self, what: String, estimate: f64, tolerance: f64, unit: &'static str) -> crate::solver::Unresolved {
         let advice = format!(
             "raise --nodes-per-span above {} (spec: [solver] nodes_per_span; at most {}), or lower the tensions",
             self.m,
-            crate::model::solver::MAX_NODES_PER_SPAN
+            crate::solver::MAX_NODES_PER_SPAN
         );
-        crate::model::solver::Unresolved { what, estimate, tolerance, unit, advice }
+        crate::solver::Unresolved { what, estimate, tolerance, unit, advice }
     }
 
     /// [`SpatialSolver::coefficients`] without the check, with the estimated
@@ -1896,13 +1897,13 @@ impl SpatialSolver {
     }
 }
 
-/// The 3-D solver as a [`crate::model::solver::actuation::TensionSolve`].
-impl crate::model::solver::actuation::TensionSolve for SpatialSolver {
+/// The 3-D solver as a [`crate::solver::actuation::TensionSolve`].
+impl crate::solver::actuation::TensionSolve for SpatialSolver {
     type Error = SpatialError;
     fn solve_tensions(&mut self, tensions_n: &[f64]) -> Result<TipPose, SpatialError> {
         self.solve(tensions_n)
     }
-    fn not_met(e: crate::model::solver::actuation::DisplacementNotMet) -> SpatialError {
+    fn not_met(e: crate::solver::actuation::DisplacementNotMet) -> SpatialError {
         SpatialFailure::DisplacementNotMet(e).into()
     }
 }
@@ -1992,7 +1993,7 @@ fn check_channels_inside(actuator: &Actuator, channels: &[Channel], body: &Body,
             let distance = (p.r_mm[0] + offset_y_mm).hypot(p.r_mm[1]);
             let radius = body.radius_at(s);
             if distance >= radius {
-                return Err(SpatialError::OutsideBody { cable: index + 1, s_mm: s, distance_mm: distance, radius_mm: radius });
+                return Err(crate::model::ActuatorError::OutsideBody { cable: index + 1, s_mm: s, distance_mm: distance, radius_mm: radius }.into());
             }
         }
     }
@@ -2002,7 +2003,7 @@ fn check_channels_inside(actuator: &Actuator, channels: &[Channel], body: &Body,
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::spatial::Cable;
+    use crate::solver::spatial::Cable;
 
     fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
         ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
@@ -2016,13 +2017,13 @@ mod tests {
         let mut planar_rod = rod.clone();
         planar_rod.cable_anchor_mm = anchor;
         let routing = crate::model::Routing::for_actuator(y, &planar_rod).unwrap();
-        let options = crate::model::SolverOptions { nodes_per_span: 24, ..Default::default() };
-        let p = crate::model::simulate(&planar_rod, &options, &routing, tau, 3, LengthBasis::Rest).unwrap();
+        let options = crate::solver::SolverOptions { nodes_per_span: 24, ..Default::default() };
+        let p = crate::solver::simulate(&planar_rod, &options, &routing, tau, 3, LengthBasis::Rest).unwrap();
         let mut cable = Cable::planar(y, tau);
         cable.anchor_mm = anchor;
         let a = Actuator::with_cables(rod.clone(), vec![cable]);
         let options = SpatialOptions { nodes_per_span: 24, ..Default::default() };
-        let sp = crate::model::spatial::simulate_spatial(&a, &options, 3, LengthBasis::Rest).unwrap();
+        let sp = crate::solver::spatial::simulate_spatial(&a, &options, 3, LengthBasis::Rest).unwrap();
         let tip = dist(sp.pose.tip_mm(), [p.pose.tip_x_mm, p.pose.tip_y_mm, 0.0]);
         let angle = (sp.pose.tip_angle_rad - p.pose.tip_angle_rad).abs();
         let da = sp.a_bend_z.iter().zip(&p.a_bend_z).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
@@ -2079,12 +2080,12 @@ mod tests {
         eprintln!("worst: {worst:?}");
     }
 
-    fn simulate(a: &Actuator) -> crate::model::Simulation {
-        let options = crate::model::SolverOptions::default();
-        crate::model::simulate_actuator(a, &options, &SpatialOptions::default(), Default::default(), None, 3, LengthBasis::Rest).unwrap()
+    fn simulate(a: &Actuator) -> crate::solver::Simulation {
+        let options = crate::solver::SolverOptions::default();
+        crate::solver::simulate_actuator(a, &options, &SpatialOptions::default(), Default::default(), None, 3, LengthBasis::Rest).unwrap()
     }
 
-    fn same_shape(p: &crate::model::Simulation, q: &crate::model::Simulation) -> f64 {
+    fn same_shape(p: &crate::solver::Simulation, q: &crate::solver::Simulation) -> f64 {
         p.centreline.iter().zip(&q.centreline).map(|(a, b)| dist(a.position_mm(), b.position_mm())).fold(0.0, f64::max)
     }
 
@@ -2159,14 +2160,14 @@ mod tests {
         for (d, ea, needle) in [(-1.0, None, "negative"), (f64::NAN, None, "finite"), (80.0, None, "cannot be pulled in"), (1.0, Some(0.0), "cable_ea_n")] {
             let cable = Cable { displacement_mm: Some(d), cable_ea_n: ea, ..Cable::planar(y, 0.0) };
             let a = Actuator::with_cables(Rod::default(), vec![cable]);
-            let e = crate::model::simulate_actuator(&a, &Default::default(), &SpatialOptions::default(), Default::default(), None, 3, LengthBasis::Rest).unwrap_err();
+            let e = crate::solver::simulate_actuator(&a, &Default::default(), &SpatialOptions::default(), Default::default(), None, 3, LengthBasis::Rest).unwrap_err();
             assert!(e.to_string().contains(needle) && e.to_string().contains("cable 1"), "{e}");
         }
         // The RK4 references do not integrate the cables' paths.
         let cable = Cable { displacement_mm: Some(1.0), ..Cable::planar(y, 0.0) };
         let a = Actuator::with_cables(Rod::default(), vec![cable]);
-        let rk4 = crate::model::SolverOptions { method: crate::model::SolverMethod::Rk4, ..Default::default() };
-        let e = crate::model::simulate_actuator(&a, &rk4, &SpatialOptions::default(), Default::default(), None, 3, LengthBasis::Rest).unwrap_err();
+        let rk4 = crate::solver::SolverOptions { method: crate::solver::SolverMethod::Rk4, ..Default::default() };
+        let e = crate::solver::simulate_actuator(&a, &rk4, &SpatialOptions::default(), Default::default(), None, 3, LengthBasis::Rest).unwrap_err();
         assert!(e.to_string().contains("displacement"), "{e}");
         // A file gives one actuation.
         let both = "[[cable]]\ny_mm = [1, 1, 1, 1, 1]\ntension_n = 1\ndisplacement_mm = 1\n";

@@ -50,7 +50,8 @@
 use super::cable::{Channel, ChannelPoint3};
 use super::error::{SpatialError, SpatialFailure};
 use super::Actuator;
-use crate::model::solver::result::{CableAtNode, CentrelinePoint, PerCable, TipFrame, TipPose};
+use crate::solver::Backend;
+use crate::solver::result::{CableAtNode, CentrelinePoint, PerCable, TipFrame, TipPose};
 use crate::model::Rod;
 use crate::numerics::{rk4_step, Rk4Scratch};
 use crate::shape::{self, LengthBasis};
@@ -76,7 +77,7 @@ const ANCHOR_TOLERANCE_MM: f64 = 1e-9;
 pub const MAX_SPATIAL_ORDER: usize = 8;
 
 /// Fewest RK4 steps per span at which a_0 … a_k of every series lie within
-/// [`crate::model::resolution::ORDER_TOLERANCE_PER_MM`] of a 128-step solve,
+/// [`crate::solver::resolution::ORDER_TOLERANCE_PER_MM`] of a 128-step solve,
 /// indexed by k. Measured on a two-cable spatial actuator at 2 N and 1 N
 /// (±4 mm S-shaped routings) on the grid 4, 6, 8, 10, 12, 16, 24; an entry
 /// within a factor 1.5 of the tolerance was moved to the next grid point,
@@ -99,14 +100,14 @@ pub struct SpatialOptions {
     /// Collocation intervals per span of the 3-D collocation (4 … 64).
     pub nodes_per_span: usize,
     /// The 3-D method: spectral collocation (the default,
-    /// [`crate::model::spatial::collocation`]) or the RK4 reference (`rk4`).
-    pub method: crate::model::SolverMethod,
+    /// [`crate::solver::spatial::collocation`]) or the RK4 reference (`rk4`).
+    pub method: crate::solver::SolverMethod,
 }
 
 impl SpatialOptions {
     /// The 3-D defaults with the solver settings a user gave: a field left
     /// `None` keeps the 3-D solver's own default (not the planar solver's).
-    pub fn with_given(steps_per_span: Option<usize>, nodes_per_span: Option<usize>, method: Option<crate::model::SolverMethod>) -> Self {
+    pub fn with_given(steps_per_span: Option<usize>, nodes_per_span: Option<usize>, method: Option<crate::solver::SolverMethod>) -> Self {
         let d = Self::default();
         Self {
             steps_per_span: steps_per_span.unwrap_or(d.steps_per_span),
@@ -119,7 +120,7 @@ impl SpatialOptions {
 
 impl Default for SpatialOptions {
     fn default() -> Self {
-        Self { steps_per_span: 10, moment_tolerance_n_mm: 1e-7, max_passes: 40, nodes_per_span: 10, method: crate::model::SolverMethod::Collocation }
+        Self { steps_per_span: 10, moment_tolerance_n_mm: 1e-7, max_passes: 40, nodes_per_span: 10, method: crate::solver::SolverMethod::Collocation }
     }
 }
 
@@ -129,11 +130,11 @@ impl SpatialOptions {
         if self.steps_per_span < 2 {
             return Err(SpatialError::Option(format!("steps_per_span = {} must be at least 2", self.steps_per_span)));
         }
-        if !(4..=crate::model::solver::MAX_NODES_PER_SPAN).contains(&self.nodes_per_span) {
+        if !(4..=crate::solver::MAX_NODES_PER_SPAN).contains(&self.nodes_per_span) {
             return Err(SpatialError::Option(format!(
                 "nodes_per_span = {} must be between 4 and {}",
                 self.nodes_per_span,
-                crate::model::solver::MAX_NODES_PER_SPAN
+                crate::solver::MAX_NODES_PER_SPAN
             )));
         }
         if !(self.moment_tolerance_n_mm.is_finite() && self.moment_tolerance_n_mm > 0.0) {
@@ -273,7 +274,7 @@ pub struct SpatialRk4Solver {
 impl SpatialRk4Solver {
     /// A solver for `actuator` (its cables, rod, torsion and gravity).
     pub fn new(actuator: &Actuator, options: &SpatialOptions) -> Result<Self, SpatialError> {
-        let channels = actuator.validate_for(crate::model::Backend::SpatialRk4)?;
+        let channels = validated_channels(actuator, Backend::SpatialRk4)?;
         if options.steps_per_span < 2 {
             return Err(SpatialError::Option(format!("steps_per_span = {} must be at least 2", options.steps_per_span)));
         }
@@ -916,6 +917,15 @@ impl SpatialRk4Solver {
     }
 }
 
+/// Checks `actuator` itself ([`Actuator::channels`]) and that `backend`
+/// models it with the default settings ([`Backend::check`]); builds the
+/// cables' channels.
+pub fn validated_channels(actuator: &Actuator, backend: Backend) -> Result<Vec<Channel>, SpatialError> {
+    let channels = actuator.channels()?;
+    backend.check(actuator, &crate::solver::SolverOptions::default(), crate::solver::Given::default())?;
+    Ok(channels)
+}
+
 /// Checks that `order` is resolved with `options` (the message names the
 /// fix): the collocation estimates its coefficients' error at every solve
 /// (up to [`MAX_SPATIAL_ORDER`]); the RK4 reference needs the steps of
@@ -926,7 +936,7 @@ pub fn check_order(order: usize, options: &SpatialOptions) -> Result<(), Spatial
             "order {order} is above the spatial solver's highest order {MAX_SPATIAL_ORDER}"
         )));
     }
-    if options.method == crate::model::SolverMethod::Collocation {
+    if options.method == crate::solver::SolverMethod::Collocation {
         return Ok(());
     }
     let need = REQUIRED_SPATIAL_STEPS_PER_SPAN[order];

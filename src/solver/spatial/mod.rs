@@ -4,7 +4,7 @@
 //! EI/1.5: ν = 0.5, incompressible silicone) and gravity along any global
 //! direction, solved by the equilibrium-at-a-cut form generalised to three
 //! dimensions ([`solver`]). Single solves and the result type are the
-//! solver interface's ([`crate::model::solver`]: `simulate_spatial`,
+//! solver interface's ([`crate::solver`]: `simulate_spatial`,
 //! `simulate_actuator`, `Simulation`); the planar backends are the fast path
 //! for one in-plane cable, and the two agree on planar cases.
 
@@ -14,7 +14,7 @@ pub mod solver;
 
 pub use crate::model::actuator::{Actuator, EI_OVER_GJ};
 pub use crate::model::cable::{self, Cable, MAX_CABLES};
-pub use crate::model::solver::simulate_spatial;
+pub use crate::solver::simulate_spatial;
 pub use error::{SpatialError, SpatialFailure};
 pub use collocation::SpatialSolver;
-pub use solver::{check_order, SpatialOptions, SpatialRk4Solver, MAX_SPATIAL_ORDER};
+pub use solver::{check_order, validated_channels, SpatialOptions, SpatialRk4Solver, MAX_SPATIAL_ORDER};

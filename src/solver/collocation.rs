@@ -1094,7 +1094,8 @@ impl Simulator {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::{Rod, SolverOptions};
+    use crate::model::Rod;
+    use crate::solver::SolverOptions;
 
     /// The tip, tip angle and a_0 … a_order of a ladder up to `tension` at
     /// `m` intervals, with the tip's and the coefficients' error estimates.
@@ -1128,7 +1129,7 @@ mod tests {
             let (a, y, tension) = super::super::random_case(&mut rng);
             let Some((fine, fine_a, _, _)) = estimated(&a, 64, &y, tension, 12) else { continue };
             for m in [6, 8, 10, 12, 16] {
-                let order = crate::model::resolution::REQUIRED_NODES_PER_SPAN.iter().rposition(|&n| n <= m).unwrap().min(12);
+                let order = crate::solver::resolution::REQUIRED_NODES_PER_SPAN.iter().rposition(|&n| n <= m).unwrap().min(12);
                 let Some((tip, c, tip_error, a_error)) = estimated(&a, m, &y, tension, order) else { continue };
                 let off = (tip[0] - fine[0]).hypot(tip[1] - fine[1]);
                 assert!(off <= tip_error + 1e-7, "m {m}: tip off by {off:e} mm, estimated {tip_error:e}");
@@ -1144,8 +1145,8 @@ mod tests {
             a.gravity.enabled = gravity;
             for y in crate::bench::sample_thesis_routings(40, 5.0) {
                 let (_, _, tip_error, a_error) = estimated(&a, 10, &y.0, 2.0, 3).unwrap();
-                assert!(tip_error < 0.25 * crate::model::solver::tip_tolerance_mm(a.length_mm), "{y:?}: {tip_error:e} mm");
-                assert!(a_error < 0.1 * crate::model::resolution::ORDER_TOLERANCE_PER_MM, "{y:?}: {a_error:e} mm⁻¹");
+                assert!(tip_error < 0.25 * crate::solver::tip_tolerance_mm(a.length_mm), "{y:?}: {tip_error:e} mm");
+                assert!(a_error < 0.1 * crate::solver::resolution::ORDER_TOLERANCE_PER_MM, "{y:?}: {a_error:e} mm⁻¹");
             }
         }
     }

@@ -8,7 +8,7 @@
 
 use crate::model::cable::MAX_CABLES;
 use crate::model::routing::ControlPoints;
-use crate::model::solver::Backend;
+use crate::solver::Backend;
 use crate::model::Actuator;
 use crate::shape::LengthBasis;
 

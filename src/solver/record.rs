@@ -16,10 +16,11 @@
 //! - The `cablemap simulate` command that solves an actuator again
 //!   ([`simulate_command`]).
 
-use super::routing::ControlPoints;
+use crate::model::routing::ControlPoints;
 use super::spatial::SpatialOptions;
-use super::{Actuator, CentrelinePoint, Simulation, STATUS_OK};
-use crate::model::solver::result::PlanarPoint;
+use crate::model::Actuator;
+use super::{CentrelinePoint, Simulation, STATUS_OK};
+use crate::solver::result::PlanarPoint;
 use crate::shape::LengthBasis;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
@@ -310,7 +311,7 @@ pub fn simulate_command(actuator: &Actuator, options: &SpatialOptions) -> Simula
 /// The actuator record: the JSON object of a simulation given by its
 /// cables (names in docs/schema.md). Keys shared with the planar record mean
 /// the same, except `tip_angle_rad`, here the unsigned angle of the tip
-/// tangent from the clamp axis ([`crate::model::TipPose::angle_from_clamp_axis_rad`]);
+/// tangent from the clamp axis ([`crate::solver::TipPose::angle_from_clamp_axis_rad`]);
 /// `a` is the in-plane series (`a_bend_z`), the planar record's `a` for a
 /// planar rod.
 pub fn simulation_json(sim: &Simulation) -> serde_json::Value {
@@ -458,7 +459,8 @@ pub fn write_actuator_centreline_csv(path: &Path, sim: &Simulation) -> std::io::
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::{simulate, Cable, Rod, Routing, SolverOptions};
+    use crate::model::{Cable, Rod, Routing};
+    use crate::solver::{simulate, SolverOptions};
 
     fn solve() -> Simulation {
         let a = Rod::default();
@@ -554,11 +556,11 @@ mod tests {
         let mut two = planar.clone();
         two.cables.push(Cable::planar([-1.0; 5], 0.5));
         for actuator in [planar, two] {
-            let sim = crate::model::simulate_actuator(
+            let sim = crate::solver::simulate_actuator(
                 &actuator,
                 &SolverOptions::default(),
                 &SpatialOptions::default(),
-                crate::model::Given::default(),
+                crate::solver::Given::default(),
                 None,
                 3,
                 LengthBasis::Rest,
