@@ -10,8 +10,9 @@
 //! generates them).
 
 use crate::calibrate::data::{centrelines_csv, markers_csv, measurements_csv};
-use crate::calibrate::synth::{default_routings, hidden_effect_size, synthesize_with_markers, Planted, SynthSpec, VISIBLE_NOISE_SDS};
-use crate::calibrate::{CalibrateError, Effect};
+use crate::calibrate::synth::{default_routings, hidden_effect_size, synthesize_with_markers, SynthSpec, VISIBLE_NOISE_SDS};
+pub use crate::calibrate::synth::{HiddenEffect, HiddenEffectError, OUT_OF_LIBRARY};
+use crate::calibrate::CalibrateError;
 use crate::io::FileError;
 use crate::model::routing::CONTROL_POINTS;
 use crate::calibrate::captures::files::{captures_csv, markers_3d_csv, Capture};
@@ -24,72 +25,6 @@ use serde::Serialize;
 use std::collections::BTreeMap;
 use std::fmt;
 use std::path::PathBuf;
-
-/// The effect the data hide from the model that fits them.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum HiddenEffect {
-    /// None: the data are the model's plus noise.
-    None,
-    /// An effect of the diagnosis's candidate list, with its parameter.
-    Candidate {
-        /// The effect.
-        effect: Effect,
-        /// Its parameter ([`Effect::parameter_name`]).
-        magnitude: f64,
-    },
-    /// A rod cured bent (outside the candidate list, so that a diagnosis
-    /// must answer `unexplained`).
-    RestCurvature {
-        /// The rest curvature, 1/mm.
-        per_mm: f64,
-    },
-    /// A stiff glue joint at the clamp (outside the candidate list).
-    GlueJoint {
-        /// The joint's EI factor.
-        ei_factor: f64,
-        /// Its length from the clamp, mm.
-        length_mm: f64,
-    },
-}
-
-/// Effects `synth` can hide that are deliberately not diagnosis candidates,
-/// so that tests can check the diagnosis answers `unexplained` for them.
-pub const OUT_OF_LIBRARY: [&str; 2] = ["rest_curvature", "glue_joint"];
-
-impl HiddenEffect {
-    /// Its name, as `--effect` takes it.
-    pub fn name(&self) -> &'static str {
-        match self {
-            HiddenEffect::None => "none",
-            HiddenEffect::Candidate { effect, .. } => effect.name(),
-            HiddenEffect::RestCurvature { .. } => OUT_OF_LIBRARY[0],
-            HiddenEffect::GlueJoint { .. } => OUT_OF_LIBRARY[1],
-        }
-    }
-
-    /// Its parameter, as `--magnitude` takes it; `None` for no effect.
-    pub fn magnitude(&self) -> Option<f64> {
-        match *self {
-            HiddenEffect::None => None,
-            HiddenEffect::Candidate { magnitude, .. } => Some(magnitude),
-            HiddenEffect::RestCurvature { per_mm } => Some(per_mm),
-            HiddenEffect::GlueJoint { ei_factor, .. } => Some(ei_factor),
-        }
-    }
-
-    /// `actuator` with the effect in it ([`Planted::plant`]).
-    pub fn apply(&self, actuator: &Rod) -> Rod {
-        let planted = match *self {
-            HiddenEffect::None => Planted::None,
-            HiddenEffect::Candidate { effect, magnitude } => Planted::Candidate { effect, value: magnitude },
-            HiddenEffect::RestCurvature { per_mm } => Planted::RestCurvature { per_mm },
-            HiddenEffect::GlueJoint { ei_factor, length_mm } => Planted::GlueJoint { ei_factor, length_mm },
-        };
-        let mut a = actuator.clone();
-        planted.plant(&mut a);
-        a
-    }
-}
 
 /// Where the markers sit.
 #[derive(Debug, Clone, PartialEq)]

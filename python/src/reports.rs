@@ -72,10 +72,7 @@ fn calibrate_failure(e: CalibrateError) -> Failure {
             Failure::Solve { status, .. } => Failure::Solve { status, message },
             Failure::BadInput(_) => Failure::BadInput(message),
         },
-        CalibrateError::Held(inner) => match calibrate_failure(*inner) {
-            Failure::BadInput(m) => Failure::BadInput(format!("fix: {m}")),
-            other => other,
-        },
+        CalibrateError::Held(_) => Failure::BadInput(format!("fix: {message}")),
         _ => Failure::BadInput(message),
     }
 }

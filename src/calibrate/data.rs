@@ -5,7 +5,7 @@
 //! columns, malformed or impossible values, inconsistent routings) is the
 //! same and every error names the file, the row and the column.
 
-use super::CalibrateError;
+use super::{CalibrateError, HoldoutError};
 use crate::model::routing::{ControlPoints, CONTROL_POINTS};
 use std::collections::{BTreeMap, HashMap};
 use std::path::Path;
@@ -137,11 +137,6 @@ impl Dataset {
                 RoutingGroup { routing: id, routing_mm: first.routing_mm, clamp_tilt_rad: first.clamp_tilt_rad, rows }
             })
             .collect()
-    }
-
-    /// Routing ids in order of first appearance.
-    pub fn routing_ids(&self) -> Vec<String> {
-        self.groups().into_iter().map(|g| g.routing).collect()
     }
 }
 
@@ -715,12 +710,12 @@ pub fn split_holdout(data: &Dataset, holdout: Option<&str>) -> Result<(Vec<Routi
     };
     let ids: Vec<&str> = groups.iter().map(|g| g.routing.as_str()).collect();
     let Some(pos) = groups.iter().position(|g| g.routing == id) else {
-        return Err(CalibrateError::Holdout(format!("no routing '{id}' in the data to hold out (routings: {})", ids.join(", "))));
+        return Err(HoldoutError::UnknownRouting { routing: id.to_string(), routings: ids.iter().map(|r| r.to_string()).collect() }.into());
     };
     let mut train = groups;
     let held = train.remove(pos);
     if train.is_empty() {
-        return Err(CalibrateError::Holdout(format!("routing {id} is the only routing; holding it out would leave nothing to fit")));
+        return Err(HoldoutError::OnlyRouting { routing: id.to_string() }.into());
     }
     Ok((train, Some(held)))
 }

@@ -33,7 +33,7 @@ use super::data::{CentrelinePoints, Dataset, Marker, MarkerPoints, Measurement, 
 use super::effect::Effect;
 use super::predict::{predict, Prediction};
 use super::stats;
-use super::CalibrateError;
+use super::{CalibrateError, HeldError, InvalidRequest, NoiseError};
 use crate::model::Rod;
 use crate::solver::{CentrelinePoint, SolverOptions};
 use crate::numerics::lm;
@@ -73,7 +73,7 @@ impl Noise {
     pub fn validate(&self) -> Result<(), CalibrateError> {
         for (name, v) in [("noise_mm", self.mm), ("noise_deg", self.deg)] {
             if !(v.is_finite() && v > 0.0) {
-                return Err(CalibrateError::Noise(format!("{name} = {v}: the measurement noise must be a standard deviation > 0")));
+                return Err(NoiseError::Measurement { name, value: v }.into());
             }
         }
         Ok(())
@@ -634,18 +634,7 @@ fn check_tips_within_reach(data: &Dataset, base: &Rod) -> Result<(), CalibrateEr
     if reach <= MAX_TIP_REACH_PER_LENGTH * length {
         return Ok(());
     }
-    let ratio = reach / length;
-    let unit = if (300.0..3000.0).contains(&ratio) { " — are they in µm?" } else { "" };
-    Err(CalibrateError::Invalid(format!(
-        "the measurements are absurdly far from any shape the rod can take: the tips are up to {}× farther from the clamp than \
-         the rod is long (tip_x_mm = {}, tip_y_mm = {} on row {}; L = {} mm){unit}; give the tips in mm (check the units, the \
-         column order and the rod length)",
-        crate::io::fmt_sig(ratio, 3),
-        crate::io::fmt_num(far.tip_x_mm),
-        crate::io::fmt_num(far.tip_y_mm),
-        far.row,
-        crate::io::fmt_num(length)
-    )))
+    Err(InvalidRequest::TipsOutOfReach { ratio: reach / length, tip_x_mm: far.tip_x_mm, tip_y_mm: far.tip_y_mm, row: far.row, length_mm: length }.into())
 }
 
 /// Where a running fit is: reported after every accepted step.
@@ -668,10 +657,7 @@ pub fn fit_observed(
     observe: &mut dyn FnMut(FitProgress),
 ) -> Result<FitResult, CalibrateError> {
     if !(spec.angle_weight_mm_per_deg.is_finite() && spec.angle_weight_mm_per_deg >= 0.0) {
-        return Err(CalibrateError::Invalid(format!(
-            "the angle weight must be a finite number ≥ 0 mm per degree, got {}",
-            spec.angle_weight_mm_per_deg
-        )));
+        return Err(InvalidRequest::AngleWeight { value: spec.angle_weight_mm_per_deg }.into());
     }
     spec.noise.validate()?;
     base.validate()?;
@@ -690,10 +676,7 @@ pub fn fit_observed(
     let r = problem.transformed_residuals(&x)?;
     let n = r.len();
     if n <= p {
-        return Err(CalibrateError::Invalid(format!(
-            "{n} residuals ({} readings) cannot determine {p} parameters; measure more steps or routings, or hold parameters fixed (--fix)",
-            data.rows.len()
-        )));
+        return Err(InvalidRequest::TooFewResiduals { residuals: n, readings: data.rows.len(), parameters: p }.into());
     }
     let cost: f64 = r.iter().map(|v| v * v).sum();
     // Residuals are in units of the noise (and the robust loss compresses
@@ -704,12 +687,7 @@ pub fn fit_observed(
     let worst = r.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     if !cost.is_finite() || !(worst < ABSURD_RESIDUAL) {
         let farthest = data.rows.iter().map(|m| m.tip_x_mm.abs().max(m.tip_y_mm.abs())).fold(0.0, f64::max);
-        return Err(CalibrateError::Invalid(format!(
-            "the measurements are absurdly far from any shape the actuator can take (a tip coordinate of {} mm, a \
-             residual of {} noise widths): check the units (mm and degrees) and the column order of the data",
-            crate::io::fmt_num(farthest),
-            crate::io::fmt_num(worst)
-        )));
+        return Err(InvalidRequest::AbsurdResiduals { farthest_mm: farthest, worst_noise_widths: worst }.into());
     }
     let settings = lm::Settings { bounds: bounds.clone(), free: problem.free.clone(), max_iterations: spec.max_iterations };
     let outcome = lm::minimise(&mut problem, x, r, &settings, &mut |step| {
@@ -868,7 +846,7 @@ pub fn apply_held(base: &Rod, held: &[(Held, f64)]) -> Result<(Rod, [bool; 3], V
     let mut effects = Vec::new();
     for &(h, v) in held {
         if !v.is_finite() {
-            return Err(CalibrateError::Held(Box::new(CalibrateError::Invalid(format!("held value {v} is not a finite number")))));
+            return Err(CalibrateError::Held(HeldError::NotFinite { value: v }));
         }
         match h {
             Held::Rigidity(k) => {
@@ -881,7 +859,7 @@ pub fn apply_held(base: &Rod, held: &[(Held, f64)]) -> Result<(Rod, [bool; 3], V
             }
         }
     }
-    a.validate().map_err(|e| CalibrateError::Held(Box::new(e.into())))?;
+    a.validate().map_err(|e| CalibrateError::Held(e.into()))?;
     Ok((a, fixed, effects))
 }
 

@@ -9,7 +9,7 @@ use crate::model::ControlPoints;
 use super::data::{CentrelinePoints, Dataset, Direction, Marker, MarkerPoints, Measurement, RoutingGroup};
 use super::predict::predict_group;
 use super::rng::Rng;
-use super::CalibrateError;
+use super::{CalibrateError, InvalidRequest};
 use crate::model::routing::CONTROL_POINTS;
 use crate::model::{Rod, Segment};
 use crate::solver::SolverOptions;
@@ -26,17 +26,18 @@ pub fn effect_names() -> Vec<&'static str> {
     Effect::ALL.iter().map(|e| e.name()).chain(OUT_OF_LIBRARY).collect()
 }
 
-/// The effect hidden in synthetic data.
+/// The effect hidden in synthetic data (planar readings and 3-D captures
+/// alike): the data's model, which the fit does not know of.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Planted {
+pub enum HiddenEffect {
     /// The thesis model.
     None,
     /// A calibration candidate at a value of its parameter.
     Candidate {
         /// The effect.
         effect: Effect,
-        /// Its parameter's value.
-        value: f64,
+        /// Its parameter's value ([`Effect::parameter_name`]).
+        magnitude: f64,
     },
     /// A rod cured bent (outside the library: no candidate names it).
     RestCurvature {
@@ -54,7 +55,7 @@ pub enum Planted {
 
 /// Why the effect to hide was not understood.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum PlantError {
+pub enum HiddenEffectError {
     /// No effect of that name.
     #[error("--effect {name}: unknown effect; use none or one of {}", effect_names().join(", "))]
     Unknown {
@@ -62,39 +63,80 @@ pub enum PlantError {
         name: String,
     },
     /// An effect without its size.
-    #[error("--effect {name} needs --magnitude ({what})")]
+    #[error("--effect {name} needs --magnitude ({})", .size.describe())]
     NoMagnitude {
         /// The effect.
         name: String,
-        /// What the magnitude is, in words.
-        what: String,
+        /// What the magnitude is.
+        size: MagnitudeOf,
     },
     /// A size without an effect.
     #[error("--magnitude needs --effect")]
     NoEffect,
 }
 
-impl Planted {
+/// What an effect's magnitude measures (for the message asking for it).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum MagnitudeOf {
+    /// A candidate's parameter.
+    Parameter(Effect),
+    /// A rest curvature.
+    RestCurvature,
+    /// A glue joint's EI factor.
+    GlueJoint,
+}
+
+impl MagnitudeOf {
+    fn describe(self) -> String {
+        match self {
+            MagnitudeOf::Parameter(e) => format!("its parameter {}", e.parameter_name()),
+            MagnitudeOf::RestCurvature => "the rest curvature in 1/mm, e.g. 0.004".into(),
+            MagnitudeOf::GlueJoint => "the joint's EI factor, e.g. 5".into(),
+        }
+    }
+}
+
+impl HiddenEffect {
     /// The effect named `name` (`none`, a candidate or one of
     /// [`OUT_OF_LIBRARY`]) of size `magnitude`; a glue joint is
     /// `glue_length_mm` long.
-    pub fn parse(name: &str, magnitude: Option<f64>, glue_length_mm: f64) -> Result<Planted, PlantError> {
-        let needs = |what: String| PlantError::NoMagnitude { name: name.to_string(), what };
+    pub fn parse(name: &str, magnitude: Option<f64>, glue_length_mm: f64) -> Result<HiddenEffect, HiddenEffectError> {
+        let needs = |size: MagnitudeOf| HiddenEffectError::NoMagnitude { name: name.to_string(), size };
         match name {
-            "none" => magnitude.map_or(Ok(Planted::None), |_| Err(PlantError::NoEffect)),
+            "none" => magnitude.map_or(Ok(HiddenEffect::None), |_| Err(HiddenEffectError::NoEffect)),
             "rest_curvature" => {
-                let per_mm = magnitude.ok_or_else(|| needs("the rest curvature in 1/mm, e.g. 0.004".into()))?;
-                Ok(Planted::RestCurvature { per_mm })
+                let per_mm = magnitude.ok_or_else(|| needs(MagnitudeOf::RestCurvature))?;
+                Ok(HiddenEffect::RestCurvature { per_mm })
             }
             "glue_joint" => {
-                let ei_factor = magnitude.ok_or_else(|| needs("the joint's EI factor, e.g. 5".into()))?;
-                Ok(Planted::GlueJoint { ei_factor, length_mm: glue_length_mm })
+                let ei_factor = magnitude.ok_or_else(|| needs(MagnitudeOf::GlueJoint))?;
+                Ok(HiddenEffect::GlueJoint { ei_factor, length_mm: glue_length_mm })
             }
             _ => {
-                let effect = Effect::parse(name).ok_or_else(|| PlantError::Unknown { name: name.to_string() })?;
-                let value = magnitude.ok_or_else(|| needs(format!("its parameter {}", effect.parameter_name())))?;
-                Ok(Planted::Candidate { effect, value })
+                let effect = Effect::parse(name).ok_or_else(|| HiddenEffectError::Unknown { name: name.to_string() })?;
+                let magnitude = magnitude.ok_or_else(|| needs(MagnitudeOf::Parameter(effect)))?;
+                Ok(HiddenEffect::Candidate { effect, magnitude })
             }
+        }
+    }
+
+    /// Its name, as `--effect` takes it.
+    pub fn name(&self) -> &'static str {
+        match self {
+            HiddenEffect::None => "none",
+            HiddenEffect::Candidate { effect, .. } => effect.name(),
+            HiddenEffect::RestCurvature { .. } => OUT_OF_LIBRARY[0],
+            HiddenEffect::GlueJoint { .. } => OUT_OF_LIBRARY[1],
+        }
+    }
+
+    /// Its parameter, as `--magnitude` takes it; `None` for no effect.
+    pub fn magnitude(&self) -> Option<f64> {
+        match *self {
+            HiddenEffect::None => None,
+            HiddenEffect::Candidate { magnitude, .. } => Some(magnitude),
+            HiddenEffect::RestCurvature { per_mm } => Some(per_mm),
+            HiddenEffect::GlueJoint { ei_factor, .. } => Some(ei_factor),
         }
     }
 
@@ -104,11 +146,18 @@ impl Planted {
     /// the rod without the effect, so that no file carries them.
     pub fn plant(&self, rod: &mut Rod) {
         match *self {
-            Planted::None => {}
-            Planted::Candidate { effect, value } => effect.apply(rod, value),
-            Planted::RestCurvature { per_mm } => rod.rest_curvature_per_mm = per_mm,
-            Planted::GlueJoint { ei_factor, length_mm } => stiffen_base(rod, ei_factor, length_mm),
+            HiddenEffect::None => {}
+            HiddenEffect::Candidate { effect, magnitude } => effect.apply(rod, magnitude),
+            HiddenEffect::RestCurvature { per_mm } => rod.rest_curvature_per_mm = per_mm,
+            HiddenEffect::GlueJoint { ei_factor, length_mm } => stiffen_base(rod, ei_factor, length_mm),
         }
+    }
+
+    /// `rod` with the effect in it ([`HiddenEffect::plant`]).
+    pub fn apply(&self, rod: &Rod) -> Rod {
+        let mut with = rod.clone();
+        self.plant(&mut with);
+        with
     }
 }
 
@@ -222,38 +271,27 @@ pub fn synthesize(spec: &SynthSpec, points: usize) -> Result<(Dataset, Centrelin
 pub fn synthesize_with_markers(spec: &SynthSpec, points: usize) -> Result<(Dataset, CentrelinePoints, MarkerPoints), CalibrateError> {
     for &(s_mm, offset_mm) in &spec.markers {
         if !(s_mm.is_finite() && offset_mm.is_finite() && (0.0..=spec.actuator.length_mm).contains(&s_mm)) {
-            return Err(CalibrateError::Invalid(format!(
-                "marker at s = {s_mm} mm, offset {offset_mm} mm: s must lie on the rod (0 … {} mm) and both must be finite",
-                spec.actuator.length_mm
-            )));
+            return Err(InvalidRequest::MarkerOffRod { s_mm, offset_mm, length_mm: spec.actuator.length_mm }.into());
         }
     }
     if !(spec.max_tension_n.is_finite() && spec.max_tension_n > 0.0) || spec.load_steps == 0 {
-        return Err(CalibrateError::Invalid(format!(
-            "the protocol needs a top tension > 0 N and at least one load step (got {} N, {} steps)",
-            spec.max_tension_n, spec.load_steps
-        )));
+        return Err(InvalidRequest::Protocol { max_tension_n: spec.max_tension_n, load_steps: spec.load_steps }.into());
     }
     for (name, v) in [("noise_mm", spec.noise_mm), ("noise_deg", spec.noise_deg), ("step_dwell_s", spec.step_dwell_s), ("rest_dwell_s", spec.rest_dwell_s)] {
         if !(v.is_finite() && v >= 0.0) {
-            return Err(CalibrateError::Invalid(format!("{name} = {v} must be a finite number ≥ 0")));
+            return Err(InvalidRequest::Negative { name, value: v }.into());
         }
     }
     if spec.routings.is_empty() {
-        return Err(CalibrateError::Invalid("give at least one routing".into()));
+        return Err(InvalidRequest::NoRoutings.into());
     }
     // Sizes are checked up front: a typo like 1000000 steps would otherwise
     // run for hours (every step is a chain of solves) before writing anything.
     if spec.load_steps > MAX_LOAD_STEPS {
-        return Err(CalibrateError::Invalid(format!(
-            "load_steps = {} is more than the {MAX_LOAD_STEPS} a bench protocol uses: give --load-steps ≤ {MAX_LOAD_STEPS}",
-            spec.load_steps
-        )));
+        return Err(InvalidRequest::TooManyLoadSteps { load_steps: spec.load_steps, max: MAX_LOAD_STEPS }.into());
     }
     if points > MAX_CENTRELINE_POINTS {
-        return Err(CalibrateError::Invalid(format!(
-            "{points} centreline points per reading is more than {MAX_CENTRELINE_POINTS}: give --centreline-points ≤ {MAX_CENTRELINE_POINTS}"
-        )));
+        return Err(InvalidRequest::TooManyCentrelinePoints { points, max: MAX_CENTRELINE_POINTS }.into());
     }
     spec.actuator.validate()?;
     // Noise-free rows first (the measured fields are filled below).
@@ -303,7 +341,7 @@ fn protocol_rows(spec: &SynthSpec) -> Result<Dataset, CalibrateError> {
     for (id, y) in &spec.routings {
         let clamp_tilt_rad = spec.routing_tilts_rad.get(id).copied().unwrap_or(spec.clamp_tilt_rad);
         if !clamp_tilt_rad.is_finite() {
-            return Err(CalibrateError::Invalid(format!("routing {id}: clamp tilt {clamp_tilt_rad} must be finite")));
+            return Err(InvalidRequest::ClampTilt { routing: id.clone(), tilt_rad: clamp_tilt_rad }.into());
         }
         for (k, &(tension_n, direction, dwell_s)) in steps.iter().enumerate() {
             let measurement = data.rows.len() as i64 + 1;
@@ -393,14 +431,14 @@ mod tests {
     #[test]
     fn every_candidate_and_unmodelled_effect_can_be_planted() {
         for name in effect_names() {
-            let planted = Planted::parse(name, Some(0.3), 5.0).unwrap();
+            let planted = HiddenEffect::parse(name, Some(0.3), 5.0).unwrap();
             let mut rod = Rod::default();
             planted.plant(&mut rod);
             assert_ne!(rod, Rod::default(), "{name} changes the rod");
-            assert!(Planted::parse(name, None, 5.0).unwrap_err().to_string().contains("needs --magnitude"));
+            assert!(HiddenEffect::parse(name, None, 5.0).unwrap_err().to_string().contains("needs --magnitude"));
         }
-        assert_eq!(Planted::parse("none", None, 5.0).unwrap(), Planted::None);
-        assert!(Planted::parse("bogus", Some(1.0), 5.0).unwrap_err().to_string().contains("stiffness_gradient, rest_curvature, glue_joint"));
+        assert_eq!(HiddenEffect::parse("none", None, 5.0).unwrap(), HiddenEffect::None);
+        assert!(HiddenEffect::parse("bogus", Some(1.0), 5.0).unwrap_err().to_string().contains("stiffness_gradient, rest_curvature, glue_joint"));
     }
 
     #[test]

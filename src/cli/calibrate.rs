@@ -96,7 +96,7 @@ impl FitArgs {
 /// Names the flag behind a fit's setting errors (`--holdout` too, with `holdout_flag`).
 pub fn with_flag(e: CalibrateError, holdout_flag: bool) -> anyhow::Error {
     match e {
-        CalibrateError::Held(inner) => anyhow::Error::new(*inner).context("--fix"),
+        CalibrateError::Held(inner) => anyhow::Error::new(inner).context("--fix"),
         CalibrateError::ActuatorFile(_) => anyhow::Error::new(e).context("--actuator-file"),
         CalibrateError::Noise(_) => anyhow::Error::new(e).context("--noise-mm / --noise-deg"),
         CalibrateError::Holdout(_) if holdout_flag => anyhow::Error::new(e).context("--holdout"),

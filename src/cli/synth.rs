@@ -2,13 +2,12 @@
 //! hidden effect and noise.
 
 use super::{parse_list, ActuatorArgs};
-use cablemap::calibrate::Effect;
 use cablemap::model::routing::CONTROL_POINTS;
 use cablemap::solver::SolverOptions;
 use cablemap::calibrate::captures::files::read_captures;
 use cablemap::calibrate::captures::synth::MarkerSpec;
 use cablemap::model::Actuator;
-use cablemap::synth::{CaptureSynthRequest, HiddenEffect, Markers, SynthRequest, OUT_OF_LIBRARY};
+use cablemap::synth::{CaptureSynthRequest, HiddenEffect, Markers, SynthRequest};
 use anyhow::bail;
 use clap::Args;
 use std::collections::BTreeMap;
@@ -156,29 +155,7 @@ fn hidden_effect(args: &SynthArgs) -> anyhow::Result<HiddenEffect> {
         }
         None => (args.effect.trim(), args.magnitude),
     };
-    let args = &SynthArgs { effect: name.to_string(), magnitude, ..args.clone() };
-    if let Some(hidden) = OUT_OF_LIBRARY.iter().find(|h| **h == args.effect) {
-        let Some(m) = args.magnitude else {
-            bail!("--effect {hidden} needs --magnitude ({})", if *hidden == "rest_curvature" { "the rest curvature in 1/mm, e.g. 0.004" } else { "the joint's EI factor, e.g. 5" });
-        };
-        return Ok(if *hidden == "rest_curvature" {
-            HiddenEffect::RestCurvature { per_mm: m }
-        } else {
-            HiddenEffect::GlueJoint { ei_factor: m, length_mm: args.glue_length_mm }
-        });
-    }
-    if args.effect == "none" {
-        anyhow::ensure!(args.magnitude.is_none(), "--magnitude needs --effect");
-        return Ok(HiddenEffect::None);
-    }
-    let Some(effect) = Effect::parse(&args.effect) else {
-        let names: Vec<&str> = Effect::ALL.iter().map(|e| e.name()).chain(OUT_OF_LIBRARY).collect();
-        bail!("--effect {}: unknown effect; use none or one of {}", args.effect, names.join(", "));
-    };
-    let Some(magnitude) = args.magnitude else {
-        bail!("--effect {} needs --magnitude (its parameter {})", args.effect, effect.parameter_name());
-    };
-    Ok(HiddenEffect::Candidate { effect, magnitude })
+    Ok(HiddenEffect::parse(name, magnitude, args.glue_length_mm)?)
 }
 
 /// The synth request the arguments describe.

@@ -309,18 +309,18 @@ fn chi2_text(f: &Fit3Result) -> String {
 pub fn diagnose_captures(base: &Actuator, set: &CaptureSet, spec: &Diagnose3Spec) -> Result<Diagnosis3, CalibrateError> {
     let started = std::time::Instant::now();
     if !(spec.alpha > 0.0 && spec.alpha < 1.0) {
-        return Err(CalibrateError::Invalid(format!("the noise test's level must lie in (0, 1), got {}", spec.alpha)));
+        return Err(crate::calibrate::InvalidRequest::Alpha { alpha: spec.alpha }.into());
     }
     let (train, test) = match spec.holdout_cable {
         None => (set.clone(), None),
         Some(k) => {
             if k == 0 || k > base.cables.len() {
-                return Err(CalibrateError::Holdout(format!("cable {k}: the actuator has cables 1 to {}", base.cables.len())));
+                return Err(crate::calibrate::HoldoutError::NoSuchCable { cable: k, cables: base.cables.len() }.into());
             }
             let train = set.subset(|c| !c.pulling_cables().contains(&k));
             let test = set.subset(|c| c.pulling_cables().contains(&k));
             if train.captures.is_empty() || test.captures.is_empty() {
-                return Err(CalibrateError::Holdout(format!("cable {k}: {} captures pull it and {} do not; holding it out needs both", test.captures.len(), train.captures.len())));
+                return Err(crate::calibrate::HoldoutError::NotSeparable { cable: k, pulling: test.captures.len(), others: train.captures.len() }.into());
             }
             (train, Some(test))
         }

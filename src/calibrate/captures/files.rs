@@ -147,10 +147,7 @@ pub fn read_captures(path: &Path, cables: usize, length_mm: f64) -> Result<(Vec<
     for k in cables + 1..=MAX_CABLE_COLUMNS {
         for name in [format!("tension_{k}_n"), format!("displacement_{k}_mm")] {
             if has(&name) {
-                return Err(CalibrateError::Invalid(format!(
-                    "{}: column '{name}' names cable {k}, but the actuator has {cables} cable(s); give one [[cable]] table per cable in the actuator file, in the columns' order",
-                    path.display()
-                )));
+                return Err(crate::calibrate::InvalidRequest::CableColumnBeyond { path: path.to_path_buf(), column: name, cable: k, cables }.into());
             }
         }
     }
@@ -161,10 +158,7 @@ pub fn read_captures(path: &Path, cables: usize, length_mm: f64) -> Result<(Vec<
             (true, false) => (column_index(path, &table, &t)?, t, true),
             (false, true) => (column_index(path, &table, &d)?, d, false),
             (true, true) => {
-                return Err(CalibrateError::Invalid(format!(
-                    "{}: both '{t}' and '{d}' are given; cable {k} is driven either by its tension or by its displacement",
-                    path.display()
-                )))
+                return Err(crate::calibrate::InvalidRequest::BothDrives { path: path.to_path_buf(), tension: t, displacement: d, cable: k }.into())
             }
             (false, false) => {
                 return Err(CalibrateError::MissingColumn { path: path.display().to_string(), column: format!("{t}' (or '{d}"), found: table.header.join(",") })

@@ -347,13 +347,13 @@ const NEGLIGIBLE_COLUMN: f64 = 1e-6;
 /// Fits `spec.params` of `base` to the markers of `set`.
 pub fn fit_captures(base: &Actuator, set: &CaptureSet, spec: &Fit3Spec, observe: &mut dyn FnMut(lm::Step)) -> Result<Fit3Result, CalibrateError> {
     if !(spec.noise_mm.is_finite() && spec.noise_mm > 0.0) {
-        return Err(CalibrateError::Noise(format!("noise_mm = {}: the markers' noise must be a standard deviation > 0", spec.noise_mm)));
+        return Err(crate::calibrate::NoiseError::Markers { value: spec.noise_mm }.into());
     }
     base.channels().map_err(|e| CalibrateError::Actuator(e.into()))?;
     let mut params: Vec<Param> = Vec::new();
     for &p in &spec.params {
         if p == Param::Density && !base.rod.gravity.enabled {
-            return Err(CalibrateError::Invalid("the density is fitted through the weight, but the actuator's gravity is off; hold it or switch gravity on".into()));
+            return Err(crate::calibrate::InvalidRequest::DensityWithoutGravity.into());
         }
         if !params.contains(&p) {
             params.push(p);
@@ -394,10 +394,7 @@ pub fn fit_captures(base: &Actuator, set: &CaptureSet, spec: &Fit3Spec, observe:
         free.retain(|&k| norms[k] > NEGLIGIBLE_COLUMN * top);
     }
     if n <= free.len() {
-        return Err(CalibrateError::Invalid(format!(
-            "{n} marker coordinates cannot determine {} parameters; measure more markers or captures, or hold parameters (--fix)",
-            free.len()
-        )));
+        return Err(crate::calibrate::InvalidRequest::TooFewMarkerCoordinates { coordinates: n, parameters: free.len() }.into());
     }
     let mut problem = problem;
     let mut iterations = 0;

@@ -158,7 +158,7 @@ impl Calibrate3Report {
 /// The actuator file of a fit: the start with the fitted values, and a
 /// header saying where they came from.
 pub fn calibrated_toml(report: &Calibrate3Report, source: &Path) -> Result<String, CalibrateError> {
-    let body = toml::to_string(&report.fit.actuator).map_err(|e| CalibrateError::Invalid(format!("writing the calibrated actuator: {e}")))?;
+    let body = toml::to_string(&report.fit.actuator).map_err(crate::calibrate::InvalidRequest::CalibratedToml)?;
     let mut head = format!("# cablemap calibrate: {} fitted to {} captures, starting from {}\n", fitted_names(&report.fit), report.captures_fitted, source.display());
     for p in &report.fit.parameters {
         match p.status {
@@ -187,7 +187,7 @@ pub fn calibrate(request: &Calibrate3Request, observe: &mut dyn FnMut(crate::num
     let set = read_set(&request.captures, request.markers.as_deref(), &base)?;
     for &(p, v) in &request.held {
         if !(v.is_finite() && (matches!(p, Param::Effect(_)) || v > 0.0)) {
-            return Err(CalibrateError::Held(Box::new(CalibrateError::Invalid(format!("{} = {v}: a held value must be a finite number (> 0 for a rigidity or the density)", p.name())))));
+            return Err(CalibrateError::Held(crate::calibrate::HeldError::NotPositive { name: p.name(), value: v }));
         }
         p.set(&mut base, v);
     }
@@ -204,16 +204,12 @@ pub fn calibrate(request: &Calibrate3Request, observe: &mut dyn FnMut(crate::num
         None => (set, None),
         Some(k) => {
             if k == 0 || k > base.cables.len() {
-                return Err(CalibrateError::Holdout(format!("cable {k}: the actuator has cables 1 to {}", base.cables.len())));
+                return Err(crate::calibrate::HoldoutError::NoSuchCable { cable: k, cables: base.cables.len() }.into());
             }
             let train = set.subset(|c| !c.pulling_cables().contains(&k));
             let test = set.subset(|c| c.pulling_cables().contains(&k));
             if train.captures.is_empty() || test.captures.is_empty() {
-                return Err(CalibrateError::Holdout(format!(
-                    "cable {k}: {} captures pull it and {} do not; holding it out needs both",
-                    test.captures.len(),
-                    train.captures.len()
-                )));
+                return Err(crate::calibrate::HoldoutError::NotSeparable { cable: k, pulling: test.captures.len(), others: train.captures.len() }.into());
             }
             (train, Some(test))
         }

@@ -112,7 +112,7 @@ pub fn synth_captures(
     state_sd: bool,
 ) -> Result<CaptureSet, CalibrateError> {
     if !(noise_mm.is_finite() && noise_mm >= 0.0) {
-        return Err(CalibrateError::Noise(format!("noise_mm = {noise_mm}: the noise must be a standard deviation ≥ 0")));
+        return Err(crate::calibrate::NoiseError::Synthetic { value: noise_mm }.into());
     }
     let readings = |c: &Capture| -> Vec<MarkerReading> {
         markers

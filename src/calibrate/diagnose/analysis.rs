@@ -239,7 +239,7 @@ fn chi2_text(f: &FitResult) -> String {
 /// Runs the whole workflow on `data` with `base` as the starting actuator.
 pub fn diagnose(base: &Rod, options: &SolverOptions, data: &Dataset, spec: &DiagnoseSpec) -> Result<Diagnosis, CalibrateError> {
     if !(spec.alpha > 0.0 && spec.alpha < 1.0) {
-        return Err(CalibrateError::Invalid(format!("the noise test's level must lie in (0, 1), got {}", spec.alpha)));
+        return Err(crate::calibrate::InvalidRequest::Alpha { alpha: spec.alpha }.into());
     }
     let (train, held) = split_holdout(data, spec.holdout.as_deref())?;
     let w = spec.fit.angle_weight_mm_per_deg;

@@ -1,0 +1,190 @@
+//! The calibration layer's errors: each variant carries typed fields, the
+//! sentence is made by `Display`.
+
+use super::Effect;
+
+/// Errors of the calibration layer.
+#[derive(Debug, thiserror::Error)]
+pub enum CalibrateError {
+    /// A file could not be read or written.
+    #[error("{context}: {source}")]
+    Io { context: String, source: std::io::Error },
+    /// The file has no data rows.
+    #[error("{path}: the file has no data rows; give a header line and at least one measurement")]
+    Empty { path: String },
+    /// A required column is missing.
+    #[error("{path}: missing column '{column}' (found: {found}); see docs/measurements.md for the required columns")]
+    MissingColumn { path: String, column: String, found: String },
+    /// A cell does not hold what its column needs.
+    #[error("{path}: row {row}, column '{column}': '{value}' is not valid, expected {expected}")]
+    BadValue { path: String, row: usize, column: String, value: String, expected: String },
+    /// A row cannot be split into fields (or the file cannot be decoded).
+    #[error("{path}: row {row}: {message}")]
+    Malformed { path: String, row: usize, message: String },
+    /// The file's geometry header (`# key = value` lines before the CSV
+    /// header) is invalid.
+    #[error("{path}: the geometry header (the '#' lines before the column names): {message}; see docs/measurements.md")]
+    Geometry { path: String, message: String },
+    /// Rows contradict each other.
+    #[error("{path}: row {row}: {message}")]
+    Inconsistent { path: String, row: usize, message: String },
+    /// A routing in the data is not a valid routing for the actuator.
+    #[error("routing '{routing}' (first on row {row}): {source}")]
+    Routing { routing: String, row: usize, source: crate::model::RoutingError },
+    /// The model could not be solved for a measurement.
+    // The failure is part of the message, not the error's source, so that
+    // `{:#}` (cause chains) does not print it twice on one line.
+    #[error("routing '{routing}', row {row} ({tension_n} N): {failure}")]
+    Solve { routing: String, row: usize, tension_n: f64, failure: crate::solver::SolveFailure },
+    /// Invalid actuator or fit settings.
+    #[error(transparent)]
+    Parameter(#[from] crate::model::ParameterError),
+    /// The solver refused the rod or its settings.
+    #[error(transparent)]
+    Simulate(#[from] crate::solver::SimulateError),
+    /// The request cannot be carried out on this data.
+    #[error(transparent)]
+    Invalid(#[from] InvalidRequest),
+    /// The routing or cable to hold out is not one the data can spare.
+    #[error(transparent)]
+    Holdout(#[from] HoldoutError),
+    /// The measurement noise is not a standard deviation.
+    #[error(transparent)]
+    Noise(#[from] NoiseError),
+    /// A value to hold a parameter at is not valid.
+    #[error(transparent)]
+    Held(HeldError),
+    /// An effect is both fitted and held.
+    #[error("--effect {0} and --fix {1}=…: an effect is either fitted or held, not both", .effect.name(), .effect.parameter_name())]
+    FittedAndHeld { effect: Effect },
+    /// The report directory is, or lies inside, a sweep's run directory.
+    #[error(transparent)]
+    ReportDir(#[from] crate::io::InsideRunDir),
+    /// The actuator file to start from cannot be used.
+    #[error(transparent)]
+    ActuatorFile(#[from] crate::model::rod::ActuatorFileError),
+    /// Drawing a plot.
+    #[error(transparent)]
+    Plot(#[from] crate::plot::PlotError),
+    /// The actuator of a 3-D calibration cannot be used.
+    #[error("the actuator: {0}")]
+    Actuator(crate::solver::spatial::SpatialError),
+    /// The 3-D model could not be solved for a capture.
+    #[error("capture {measurement} (row {row} of the captures file): {failure}")]
+    Capture { measurement: i64, row: usize, failure: crate::solver::spatial::SpatialError },
+}
+
+/// A request the data or the settings cannot carry out.
+#[derive(Debug, thiserror::Error)]
+pub enum InvalidRequest {
+    /// A synthetic marker off the rod, or not finite.
+    #[error("marker at s = {s_mm} mm, offset {offset_mm} mm: s must lie on the rod (0 … {length_mm} mm) and both must be finite")]
+    MarkerOffRod { s_mm: f64, offset_mm: f64, length_mm: f64 },
+    /// A loading protocol without a tension or a step.
+    #[error("the protocol needs a top tension > 0 N and at least one load step (got {max_tension_n} N, {load_steps} steps)")]
+    Protocol { max_tension_n: f64, load_steps: usize },
+    /// A setting that must be finite and ≥ 0.
+    #[error("{name} = {value} must be a finite number ≥ 0")]
+    Negative { name: &'static str, value: f64 },
+    /// A synthetic data set without routings.
+    #[error("give at least one routing")]
+    NoRoutings,
+    /// More load steps than a bench protocol uses.
+    #[error("load_steps = {load_steps} is more than the {max} a bench protocol uses: give --load-steps ≤ {max}")]
+    TooManyLoadSteps { load_steps: usize, max: usize },
+    /// More centreline points per reading than the files take.
+    #[error("{points} centreline points per reading is more than {max}: give --centreline-points ≤ {max}")]
+    TooManyCentrelinePoints { points: usize, max: usize },
+    /// A clamp tilt that is not finite.
+    #[error("routing {routing}: clamp tilt {tilt_rad} must be finite")]
+    ClampTilt { routing: String, tilt_rad: f64 },
+    /// Measured tips farther from the clamp than the rod can reach.
+    #[error(
+        "the measurements are absurdly far from any shape the rod can take: the tips are up to {}× farther from the clamp than \
+         the rod is long (tip_x_mm = {}, tip_y_mm = {} on row {row}; L = {} mm){}; give the tips in mm (check the units, the \
+         column order and the rod length)",
+        crate::io::fmt_sig(*.ratio, 3),
+        crate::io::fmt_num(*.tip_x_mm),
+        crate::io::fmt_num(*.tip_y_mm),
+        crate::io::fmt_num(*.length_mm),
+        if (300.0..3000.0).contains(.ratio) { " — are they in µm?" } else { "" }
+    )]
+    TipsOutOfReach { ratio: f64, tip_x_mm: f64, tip_y_mm: f64, row: usize, length_mm: f64 },
+    /// An angle weight that is negative or not finite.
+    #[error("the angle weight must be a finite number ≥ 0 mm per degree, got {value}")]
+    AngleWeight { value: f64 },
+    /// Fewer tip residuals than parameters.
+    #[error("{residuals} residuals ({readings} readings) cannot determine {parameters} parameters; measure more steps or routings, or hold parameters fixed (--fix)")]
+    TooFewResiduals { residuals: usize, readings: usize, parameters: usize },
+    /// Fewer marker coordinates than parameters.
+    #[error("{coordinates} marker coordinates cannot determine {parameters} parameters; measure more markers or captures, or hold parameters (--fix)")]
+    TooFewMarkerCoordinates { coordinates: usize, parameters: usize },
+    /// Residuals so large that no step can lower them.
+    #[error(
+        "the measurements are absurdly far from any shape the actuator can take (a tip coordinate of {} mm, a \
+         residual of {} noise widths): check the units (mm and degrees) and the column order of the data",
+        crate::io::fmt_num(*.farthest_mm),
+        crate::io::fmt_num(*.worst_noise_widths)
+    )]
+    AbsurdResiduals { farthest_mm: f64, worst_noise_widths: f64 },
+    /// The noise test's level outside (0, 1).
+    #[error("the noise test's level must lie in (0, 1), got {alpha}")]
+    Alpha { alpha: f64 },
+    /// The density fitted while gravity is off.
+    #[error("the density is fitted through the weight, but the actuator's gravity is off; hold it or switch gravity on")]
+    DensityWithoutGravity,
+    /// A captures file with a column for a cable the actuator does not have.
+    #[error("{}: column '{column}' names cable {cable}, but the actuator has {cables} cable(s); give one [[cable]] table per cable in the actuator file, in the columns' order", .path.display())]
+    CableColumnBeyond { path: std::path::PathBuf, column: String, cable: usize, cables: usize },
+    /// A cable driven both by its tension and by its displacement.
+    #[error("{}: both '{tension}' and '{displacement}' are given; cable {cable} is driven either by its tension or by its displacement", .path.display())]
+    BothDrives { path: std::path::PathBuf, tension: String, displacement: String, cable: usize },
+    /// The fitted actuator cannot be written as TOML.
+    #[error("writing the calibrated actuator: {0}")]
+    CalibratedToml(#[source] toml::ser::Error),
+}
+
+/// A routing or cable to hold out that the data cannot spare.
+#[derive(Debug, thiserror::Error)]
+pub enum HoldoutError {
+    /// No routing of that id.
+    #[error("no routing '{routing}' in the data to hold out (routings: {})", .routings.join(", "))]
+    UnknownRouting { routing: String, routings: Vec<String> },
+    /// The only routing.
+    #[error("routing {routing} is the only routing; holding it out would leave nothing to fit")]
+    OnlyRouting { routing: String },
+    /// No cable of that number.
+    #[error("cable {cable}: the actuator has cables 1 to {cables}")]
+    NoSuchCable { cable: usize, cables: usize },
+    /// Every capture, or none, pulls the cable.
+    #[error("cable {cable}: {pulling} captures pull it and {others} do not; holding it out needs both")]
+    NotSeparable { cable: usize, pulling: usize, others: usize },
+}
+
+/// A noise level that is not a standard deviation.
+#[derive(Debug, thiserror::Error)]
+pub enum NoiseError {
+    /// The measurement noise of a fit (`noise_mm`, `noise_deg`).
+    #[error("{name} = {value}: the measurement noise must be a standard deviation > 0")]
+    Measurement { name: &'static str, value: f64 },
+    /// The markers' noise of a 3-D fit.
+    #[error("noise_mm = {value}: the markers' noise must be a standard deviation > 0")]
+    Markers { value: f64 },
+    /// The noise of synthetic captures.
+    #[error("noise_mm = {value}: the noise must be a standard deviation ≥ 0")]
+    Synthetic { value: f64 },
+}
+
+/// A value to hold a parameter at (`--fix`) that cannot be used.
+#[derive(Debug, thiserror::Error)]
+pub enum HeldError {
+    /// Not a finite number.
+    #[error("held value {value} is not a finite number")]
+    NotFinite { value: f64 },
+    /// A rigidity or density that is not a finite number > 0.
+    #[error("{name} = {value}: a held value must be a finite number (> 0 for a rigidity or the density)")]
+    NotPositive { name: &'static str, value: f64 },
+    /// The rod with the held values is not valid.
+    #[error(transparent)]
+    Rod(#[from] crate::model::ParameterError),
+}
