@@ -8,7 +8,7 @@
 //! Workflows are requests in, reports out (each report serialises to the
 //! JSON `--json` prints and displays as the text the command prints):
 //! [`map::run`] (sweep and reduce of any [`job::Job`]), [`study::run`],
-//! [`design::run::run`], [`design::feasible::run`], [`synth::run`].
+//! [`design::run`], [`design::feasible_request::run`], [`synth::run`].
 
 pub mod bench;
 pub mod calibrate;

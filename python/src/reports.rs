@@ -15,13 +15,10 @@ use cablemap::calibrate::captures::{self, Calibrate3Request, Param, PredictReque
 use cablemap::calibrate::diagnose::DiagnoseRequest;
 use cablemap::calibrate::fit::{parse_held, Held, Loss, Noise};
 use cablemap::calibrate::{CalibrateError, CalibrateRequest, Effect, FitSettings};
-use cablemap::design::cables::search::CableSearch;
-use cablemap::design::cables::spec::{self, DesignActuator, DEFAULT_TENSION_MAX_N};
-use cablemap::design::cables::targets::TargetSet;
-use cablemap::design::cables::CableDesignRequest;
-use cablemap::design::feasible::{FeasibleRequest, MapSource};
-use cablemap::design::run::DesignRequest;
-use cablemap::design::{DesignError, SearchOptions, Target, Weights};
+use cablemap::design::actuator::DesignActuator;
+use cablemap::design::feasible_request::{FeasibleRequest, MapSource};
+use cablemap::design::targets::TargetSet;
+use cablemap::design::{DesignError, DesignRequest, SearchOptions, Target, Weights};
 use cablemap::solver::spatial::SpatialOptions;
 use cablemap::model::{Actuator, Rod, RodOverrides, REGISTRY};
 use cablemap::mould::{MouldOptions, MouldParams};
@@ -44,6 +41,10 @@ fn design_failure(e: DesignError) -> Failure {
         DesignError::File(_) | DesignError::MapTable(_) | DesignError::Map { .. } | DesignError::Study(_) | DesignError::Plot(_) => {
             Failure::File(message)
         }
+        // The keyword, not the flag: the Python package's words.
+        DesignError::TargetOnly { setting } => Failure::BadInput(format!("{} does not apply to targets=: give {}", setting.key(), setting.instead().replace("--actuator", "the actuator file"))),
+        DesignError::TargetOrTargets => Failure::BadInput("give either target=… or targets=FILE.toml".into()),
+        DesignError::TargetsNeedMap => Failure::BadInput("targets= needs map=: the map of a cable sweep".into()),
         DesignError::Variant { source, .. } => match design_failure(*source) {
             Failure::File(_) => Failure::File(message),
             Failure::Solve { status, .. } => Failure::Solve { status, message },
@@ -207,51 +208,9 @@ struct DesignPy {
     solver: SolverRequest,
 }
 
-/// The planar design (`design --target`).
-fn design_planar(r: DesignPy) -> Result<Finished> {
-    let weights = r.weights.as_deref().map(Weights::parse).transpose().map_err(|e| bad(format!("weights: {e}")))?.unwrap_or_default();
-    if !r.actuator.cables.is_empty() || r.actuator.gj_n_mm2.is_some() || r.actuator.gravity_direction.is_some() {
-        return Err(bad(
-            "design(target=…) designs one planar cable on a rod: give the rod alone (no cables, gj_n_mm2 or gravity_direction), or targets=FILE.toml with actuator=FILE.toml for several cables",
-        ));
-    }
-    let request = DesignRequest {
-        actuator: r.actuator.rod,
-        options: r.solver.options()?,
-        target: Target::parse(r.target.as_deref().unwrap_or_default()).map_err(|e| bad(format!("target: {e}")))?,
-        weights,
-        tension_min_n: r.tension_min_n,
-        tension_max_n: r.tension_max_n,
-        max_offset_mm: r.max_offset_mm,
-        length_basis: length_basis(&r.length_basis)?,
-        map: r.map,
-        search: SearchOptions {
-            starts: r.starts.unwrap_or(8),
-            max_evaluations: r.max_evaluations.unwrap_or(SearchOptions::default().max_evaluations),
-            ..SearchOptions::default()
-        },
-        tolerance_pct: r.tolerance_pct.unwrap_or(5.0),
-        out: r.out,
-        mould: r.mould.params(),
-        write_moulds: r.moulds,
-    };
-    let done = cablemap::design::run::run(&request).map_err(design_failure)?;
-    Ok((done.record.to_json_line(), done.to_string(), pictures(done.out.as_deref(), &done.exported)))
-}
-
-/// The several-cable design (`design --targets FILE.toml [--actuator FILE.toml]`).
-fn design_cables(r: DesignPy, targets: &Path) -> Result<Finished> {
-    for (given, name, instead) in [
-        (r.weights.is_some(), "weights", "weights = { … } in each [[target]]"),
-        (r.tension_min_n.is_some(), "tension_min_n", "tension_min_n in each [[cable]] of the actuator file"),
-        (r.tension_max_n.is_some(), "tension_max_n", "tension_max_n in each [[cable]] of the actuator file"),
-        (r.max_offset_mm.is_some(), "max_offset_mm", "max_offset_mm in each [[cable]] of the actuator file"),
-    ] {
-        if given {
-            return Err(bad(format!("{name} does not apply to targets=: give {instead}")));
-        }
-    }
-    let design = match &r.design_actuator {
+/// The design request of `cablemap.design`'s keywords (the flags of `cablemap design`).
+fn design_request(r: DesignPy) -> Result<DesignRequest> {
+    let actuator = match &r.design_actuator {
         Some(path) => {
             // The rod fields apply to the file's rod; the first refusal is kept.
             let refused = std::cell::RefCell::new(None);
@@ -266,39 +225,51 @@ fn design_cables(r: DesignPy, targets: &Path) -> Result<Finished> {
             if let Some(e) = refused.into_inner() {
                 return Err(e);
             }
-            design?
+            Some(design?)
         }
-        None => DesignActuator::planar(r.actuator.rod.clone(), spec::default_tension_min_n(1), DEFAULT_TENSION_MAX_N, None),
+        None => None,
     };
-    let mut targets = TargetSet::read(targets, design.actuator.rod.length_mm).map_err(design_failure)?;
-    if let Some(tol) = r.tolerance_pct {
-        targets.targets.iter_mut().for_each(|t| t.tolerance_pct = tol);
+    if r.targets.is_none() && (!r.actuator.cables.is_empty() || r.actuator.gj_n_mm2.is_some() || r.actuator.gravity_direction.is_some()) {
+        return Err(bad(
+            "design(target=…) designs one planar cable on a rod: give the rod alone (no cables, gj_n_mm2 or gravity_direction), or targets=FILE.toml with actuator=FILE.toml for several cables",
+        ));
     }
-    let request = CableDesignRequest {
-        design,
-        targets,
-        options: r.solver.options()?,
-        length_basis: length_basis(&r.length_basis)?,
-        search: CableSearch {
-            starts: r.starts.unwrap_or(CableSearch::default().starts),
-            max_evaluations: r.max_evaluations.unwrap_or(SearchOptions::default().max_evaluations),
-        },
-        map: r.map,
-        out: r.out,
-        moulds: r.moulds.then(|| MouldOptions { params: r.mould.params(), ..Default::default() }),
+    let targets = match &r.targets {
+        // The rod's length sets the targets' default weights.
+        Some(path) => Some(TargetSet::read(path, actuator.as_ref().map_or(r.actuator.rod.length_mm, |a| a.actuator.rod.length_mm)).map_err(design_failure)?),
+        None => None,
     };
-    let done = cablemap::design::cables::run(&request).map_err(design_failure)?;
-    Ok((done.to_json().to_string(), done.to_string(), pictures(done.out.as_deref(), &done.exported)))
+    Ok(DesignRequest {
+        rod: r.actuator.rod,
+        actuator,
+        options: r.solver.options()?,
+        target: r.target.as_deref().map(Target::parse).transpose().map_err(|e| bad(format!("target: {e}")))?,
+        targets,
+        weights: r.weights.as_deref().map(Weights::parse).transpose().map_err(|e| bad(format!("weights: {e}")))?,
+        tension_min_n: r.tension_min_n,
+        tension_max_n: r.tension_max_n,
+        max_offset_mm: r.max_offset_mm,
+        length_basis: length_basis(&r.length_basis)?,
+        map: r.map,
+        starts: r.starts,
+        max_evaluations: r.max_evaluations.unwrap_or(SearchOptions::default().max_evaluations),
+        tolerance_pct: r.tolerance_pct,
+        out: r.out,
+        mould: r.mould.params(),
+        write_moulds: r.moulds,
+    })
 }
 
-/// `cablemap design`: with `targets` the several-cable design, else the
-/// planar one of `target`.
+/// `cablemap design`: the request of the keywords, run by the library.
 #[pyfunction]
 pub(crate) fn design(py: Python<'_>, request_json: &str) -> PyResult<Finished> {
     let request: DesignPy = super::from_json(request_json, "design").map_err(|e| e.into_py(py))?;
-    detached(py, move || match request.targets.clone() {
-        Some(targets) => design_cables(request, &targets),
-        None => design_planar(request),
+    detached(py, move || {
+        let request = design_request(request)?;
+        let done = cablemap::design::run(&request).map_err(design_failure)?;
+        let (out, exported) = done.exported();
+        let pictures = pictures(out, exported);
+        Ok((done.to_json().to_string(), done.to_string(), pictures))
     })
 }
 
@@ -319,26 +290,18 @@ struct FeasiblePy {
 
 fn feasible_run(r: FeasiblePy) -> Result<Finished> {
     let basis = length_basis(&r.length_basis)?;
-    if let Some(file) = &r.targets {
-        let Some(map) = &r.map else { return Err(bad("targets= needs map=: the map of a cable sweep")) };
-        if r.weights.is_some() {
-            return Err(bad("weights does not apply to targets=: give weights = { … } in each [[target]]"));
-        }
-        // As the command: the rod's length only sets the targets' default weights.
-        let targets = TargetSet::read(file, Rod::default().length_mm).map_err(design_failure)?;
-        let report = cablemap::design::cables::feasible::check(map, &targets, basis, r.nearest).map_err(design_failure)?;
-        return Ok((super::to_json(&report), report.to_string(), Vec::new()));
-    }
-    let target = Target::parse(r.target.as_deref().ok_or_else(|| bad("give target= (or targets= with map=)"))?).map_err(|e| bad(format!("target: {e}")))?;
-    let weights = r.weights.as_deref().map(Weights::parse).transpose().map_err(|e| bad(format!("weights: {e}")))?.unwrap_or_default();
+    // As the command: the rod's length only sets the targets' default weights.
+    let targets = r.targets.as_deref().map(|file| TargetSet::read(file, Rod::default().length_mm)).transpose().map_err(design_failure)?;
+    let target = r.target.as_deref().map(Target::parse).transpose().map_err(|e| bad(format!("target: {e}")))?;
+    let weights = r.weights.as_deref().map(Weights::parse).transpose().map_err(|e| bad(format!("weights: {e}")))?;
     let source = match (r.map, r.study) {
         (Some(_), Some(_)) => return Err(bad("give map= or study=, not both")),
         (Some(map), None) => MapSource::Map(map),
         (None, Some(study)) => MapSource::Study(study),
         (None, None) => return Err(bad("give map=MAP_DIR (a `cablemap reduce` output) or study=DIR (a `cablemap study` output)")),
     };
-    let request = FeasibleRequest { source, target, weights, length_basis: basis, nearest: r.nearest };
-    let report = cablemap::design::feasible::run(&request).map_err(design_failure)?;
+    let request = FeasibleRequest { source, target, targets, weights, length_basis: basis, nearest: r.nearest };
+    let report = cablemap::design::feasible_request::run(&request).map_err(design_failure)?;
     Ok((super::to_json(&report), report.to_string(), Vec::new()))
 }
 

@@ -2,12 +2,9 @@
 
 use super::{ActuatorArgs, LengthBasisArgs};
 use anyhow::Context;
-use cablemap::design::cables::search::CableSearch;
-use cablemap::design::cables::spec::{self, DesignActuator};
-use cablemap::design::cables::targets::TargetSet;
-use cablemap::design::cables::CableDesignRequest;
-use cablemap::design::run::DesignRequest;
-use cablemap::design::{self, DesignError, SearchOptions, Target, Weights};
+use cablemap::design::actuator::DesignActuator;
+use cablemap::design::targets::TargetSet;
+use cablemap::design::{self, DesignError, DesignRequest, SearchOptions, Target, Weights};
 use cablemap::solver::SolverOptions;
 use clap::Args;
 use std::path::PathBuf;
@@ -80,90 +77,56 @@ pub struct DesignArgs {
 
 /// The design request the arguments describe.
 fn request(args: &DesignArgs) -> anyhow::Result<DesignRequest> {
-    let weights = match &args.weights {
-        Some(w) => Weights::parse(w).context("--weights")?,
-        None => Weights::default(),
+    let rod = args.actuator.resolve()?;
+    let actuator = match &args.design_actuator {
+        Some(path) => {
+            anyhow::ensure!(args.actuator.actuator_file.is_none(), "give the rod either in --actuator FILE's [rod] table or by --actuator-file, not both");
+            Some(DesignActuator::read(path, |rod| args.actuator.apply(rod)).context("--actuator")?)
+        }
+        None => None,
+    };
+    let targets = match &args.targets {
+        // The rod's length sets the targets' default weights.
+        Some(path) => Some(TargetSet::read(path, actuator.as_ref().map_or(rod.length_mm, |a| a.actuator.rod.length_mm)).context("--targets")?),
+        None => None,
     };
     Ok(DesignRequest {
-        actuator: args.actuator.resolve()?,
+        rod,
+        actuator,
         options: args.actuator.solver_options(&SolverOptions::default()),
-        target: Target::parse(args.target.as_deref().unwrap_or_default()).context("--target")?,
-        weights,
+        target: args.target.as_deref().map(Target::parse).transpose().context("--target")?,
+        targets,
+        weights: args.weights.as_deref().map(Weights::parse).transpose().context("--weights")?,
         tension_min_n: args.tension_min_n,
         tension_max_n: args.tension_max_n,
         max_offset_mm: args.max_offset_mm,
         length_basis: args.basis.length_basis,
         map: args.map.clone(),
-        search: SearchOptions { starts: args.starts.unwrap_or(8), max_evaluations: args.max_evaluations, ..SearchOptions::default() },
-        tolerance_pct: args.tolerance_pct.unwrap_or(5.0),
+        starts: args.starts,
+        max_evaluations: args.max_evaluations,
+        tolerance_pct: args.tolerance_pct,
         out: args.out.clone(),
         mould: args.mould.params(),
         write_moulds: args.moulds,
     })
 }
 
-/// The several-cable request of `--targets` (with `--actuator`).
-fn cables_request(args: &DesignArgs, targets: &std::path::Path) -> anyhow::Result<CableDesignRequest> {
-    for (given, flag, instead) in [
-        (args.weights.is_some(), "--weights", "weights = { … } in each [[target]]"),
-        (args.tension_min_n.is_some(), "--tension-min-n", "tension_min_n in each [[cable]] of --actuator"),
-        (args.tension_max_n.is_some(), "--tension-max-n", "tension_max_n in each [[cable]] of --actuator"),
-        (args.max_offset_mm.is_some(), "--max-offset-mm", "max_offset_mm in each [[cable]] of --actuator"),
-    ] {
-        anyhow::ensure!(!given, "{flag} does not apply to --targets: give {instead}");
-    }
-    let design = match &args.design_actuator {
-        Some(path) => {
-            anyhow::ensure!(args.actuator.actuator_file.is_none(), "give the rod either in --actuator FILE's [rod] table or by --actuator-file, not both");
-            DesignActuator::read(path, |rod| args.actuator.apply(rod)).context("--actuator")?
-        }
-        None => DesignActuator::planar(args.actuator.resolve()?, spec::default_tension_min_n(1), spec::DEFAULT_TENSION_MAX_N, None),
-    };
-    let mut targets = TargetSet::read(targets, design.actuator.rod.length_mm).context("--targets")?;
-    if let Some(tol) = args.tolerance_pct {
-        targets.targets.iter_mut().for_each(|t| t.tolerance_pct = tol);
-    }
-    Ok(CableDesignRequest {
-        design,
-        targets,
-        options: args.actuator.solver_options(&SolverOptions::default()),
-        length_basis: args.basis.length_basis,
-        search: CableSearch { starts: args.starts.unwrap_or(CableSearch::default().starts), max_evaluations: args.max_evaluations },
-        map: args.map.clone(),
-        out: args.out.clone(),
-        moulds: args.moulds.then(|| cablemap::mould::MouldOptions { params: args.mould.params(), ..Default::default() }),
-    })
-}
-
 /// Runs `cablemap design`.
 pub fn run(args: &DesignArgs) -> anyhow::Result<()> {
-    if let Some(targets) = &args.targets {
-        let request = cables_request(args, targets)?;
-        let done = cablemap::design::cables::run(&request).map_err(|e| match e {
-            DesignError::ExportDir { .. } => anyhow::Error::new(e).context("--out"),
-            DesignError::BadSearch(_) => anyhow::Error::new(e).context("--starts"),
-            e => anyhow::Error::new(e),
-        })?;
-        if args.json {
-            println!("{}", done.to_json());
-        } else {
-            print!("{done}");
-        }
-        return Ok(());
-    }
     let request = request(args)?;
     if let Some(bound) = request.mould_bound_exceeded() {
         // Before the search, on stderr (stdout may be --json).
         eprintln!("note: {bound}");
     }
-    let done = design::run::run(&request).map_err(|e| match e {
+    let done = design::run(&request).map_err(|e| match e {
         DesignError::ExportDir { .. } => anyhow::Error::new(e).context("--out"),
-        DesignError::BadSearch(_) => anyhow::Error::new(e).context("--starts / --tolerance-pct"),
+        DesignError::NoStarts => anyhow::Error::new(e).context("--starts"),
+        DesignError::Tolerance { .. } => anyhow::Error::new(e).context("--tolerance-pct"),
         DesignError::Mould(m) => super::mould::with_flag(m),
         e => anyhow::Error::new(e),
     })?;
     if args.json {
-        println!("{}", done.record.to_json_line());
+        println!("{}", done.to_json());
     } else {
         print!("{done}");
     }

@@ -1,6 +1,7 @@
 //! `cablemap feasible`: the map's verdict on a target (thesis §4.2).
 
-use cablemap::design::feasible::{FeasibleRequest, MapSource};
+use cablemap::design::feasible_request::{FeasibleRequest, MapSource};
+use cablemap::design::targets::TargetSet;
 use cablemap::design::{Target, Weights};
 use clap::Args;
 use std::io::Write;
@@ -40,33 +41,23 @@ pub struct FeasibleArgs {
 
 /// Runs `cablemap feasible`.
 pub fn run(args: &FeasibleArgs) -> anyhow::Result<()> {
-    if let (Some(file), Some(map)) = (&args.targets, &args.map) {
-        anyhow::ensure!(args.weights.is_none(), "--weights does not apply to --targets: give weights = {{ … }} in each [[target]]");
-        // The rod's length only sets default weights; the map's own rod is the thesis's unless its spec says otherwise.
-        let length_mm = cablemap::model::Rod::default().length_mm;
-        let targets = cablemap::design::cables::targets::TargetSet::read(file, length_mm).map_err(|e| anyhow::Error::new(e).context("--targets"))?;
-        let report = cablemap::design::cables::feasible::check(map, &targets, args.basis.length_basis, args.nearest)?;
-        let stdout = std::io::stdout();
-        let mut out = stdout.lock();
-        if args.json {
-            writeln!(out, "{}", serde_json::to_value(&report)?)?;
-        } else {
-            write!(out, "{report}")?;
-        }
-        return Ok(());
-    }
-    let target = Target::parse(args.target.as_deref().unwrap_or_default())?;
-    let weights = match &args.weights {
-        Some(w) => Weights::parse(w)?,
-        None => Weights::default(),
-    };
+    // The rod's length only sets the targets' default weights; the map's own rod is the thesis's unless its spec says otherwise.
+    let length_mm = cablemap::model::Rod::default().length_mm;
+    let targets = args.targets.as_deref().map(|file| TargetSet::read(file, length_mm)).transpose().map_err(|e| anyhow::Error::new(e).context("--targets"))?;
     let source = match (&args.map, &args.study) {
         (Some(map), _) => MapSource::Map(map.clone()),
         (None, Some(study)) => MapSource::Study(study.clone()),
         (None, None) => anyhow::bail!("give --map MAP_DIR or --study DIR"),
     };
-    let request = FeasibleRequest { source, target, weights, length_basis: args.basis.length_basis, nearest: args.nearest };
-    let report = cablemap::design::feasible::run(&request)?;
+    let request = FeasibleRequest {
+        source,
+        target: args.target.as_deref().map(Target::parse).transpose()?,
+        targets,
+        weights: args.weights.as_deref().map(Weights::parse).transpose()?,
+        length_basis: args.basis.length_basis,
+        nearest: args.nearest,
+    };
+    let report = cablemap::design::feasible_request::run(&request)?;
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
     if args.json {

@@ -9,9 +9,7 @@ use super::DesignError;
 use crate::io::FileError;
 use crate::model::Routing;
 use crate::solver::simulate;
-use crate::plot::{draw_bodies, BodyDrawing};
 use crate::shape::centreline_from_coefficients;
-use plotters::style::full_palette::{BLUE_800, GREEN_700};
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -151,7 +149,7 @@ pub fn write_all(
         Ok::<_, DesignError>(())
     };
     write("design.json", record.to_file_text().as_bytes())?;
-    let act = &objective.actuator;
+    let act = &objective.rod;
     let routing = Routing::for_actuator(&eval.routing_mm, act)?;
     write("channel.csv", routing.channel_csv().as_bytes())?;
     if act.is_uniform_body() {
@@ -167,42 +165,24 @@ pub fn write_all(
 /// states no length or base angle, so its shape is drawn with the achieved
 /// design's ℓ and θ_0 (coefficients the target omits are the achieved ones).
 pub fn shape_png(path: &Path, objective: &Objective, eval: &Evaluation) -> Result<(), DesignError> {
-    let act = &objective.actuator;
+    let act = &objective.rod;
     let routing = Routing::for_actuator(&eval.routing_mm, act)?;
     let sim = simulate(act, &objective.options, &routing, eval.tension_n, objective.target.order(), objective.length_basis)?;
-    let mut bodies =
-        vec![crate::plot::BodyDrawing::of_body(&sim, act, "achieved body (outline at ±r), cable in red".into(), BLUE_800)];
     let target = &objective.target;
-    if target.highest_order().is_some() {
+    // Drawing needs the coefficients over the drawn (deformed) length ℓ.
+    let target_centreline = target.highest_order().map(|_| {
         let pose = &eval.pose;
-        // Drawing needs the coefficients over the drawn (deformed) length ℓ.
         let to_deformed = 1.0 / objective.length_basis.factor_from_deformed(pose.length_mm, act.length_mm);
         let a: Vec<f64> = (0..eval.a.len()).map(|k| to_deformed * target.get(Component::A(k)).unwrap_or(eval.a[k])).collect();
-        let pts = centreline_from_coefficients(&a, pose.length_mm, pose.base_angle_rad, 121);
-        let angles: Vec<f64> = pts.windows(2).map(|w| (w[1][1] - w[0][1]).atan2(w[1][0] - w[0][0])).collect();
-        let mut frame = angles.clone();
-        frame.push(*angles.last().unwrap_or(&0.0));
-        bodies.push(BodyDrawing {
-            centreline: pts.iter().map(|p| (p[0], p[1])).collect(),
-            frame_angle_rad: frame,
-            cable: Vec::new(),
-            further_cables: Vec::new(),
-            radius_mm: 0.0,
-            radii_mm: Vec::new(),
-            label: "target shape (target a_i; achieved ℓ and base angle)".into(),
-            colour: GREEN_700,
-        });
-    }
-    let tips: Vec<(f64, f64)> = match (target.get(Component::TipX), target.get(Component::TipY)) {
-        (Some(x), Some(y)) => vec![(x, y)],
-        _ => Vec::new(),
-    };
+        centreline_from_coefficients(&a, pose.length_mm, pose.base_angle_rad, 121)
+    });
+    let tip = target.get(Component::TipX).zip(target.get(Component::TipY));
     let title = format!(
         "design: y = [{}] mm, τ = {:.3} N",
         eval.routing_mm.iter().map(|y| format!("{y:.2}")).collect::<Vec<_>>().join(", "),
         eval.tension_n
     );
-    draw_bodies(path, &title, &bodies, &tips)?;
+    crate::plot::draw_design_shape(path, &title, &sim, act, target_centreline.as_deref(), tip)?;
     Ok(())
 }
 
@@ -222,23 +202,6 @@ mod tests {
         assert!((rows.first().unwrap()[1] - 1.0).abs() < 1e-9);
         assert!((rows.last().unwrap()[1] + 4.0).abs() < 1e-9);
         assert!(rows.iter().all(|row| row[1].abs() <= 4.0 + 1e-9));
-    }
-
-    /// The pictures (design's shape.png, simulate --png) draw a cable knotted
-    /// before the tip from the clamp to its anchor, not on to the tip.
-    #[test]
-    fn the_drawn_cable_ends_at_its_anchor() {
-        let anchor_mm = 41.7;
-        let act = crate::model::Rod { cable_anchor_mm: Some(anchor_mm), ..Default::default() };
-        let routing = Routing::for_actuator([3.0, 1.0, -2.0, 3.0, 4.0], &act).unwrap();
-        let sim = simulate(&act, &Default::default(), &routing, 1.5, 2, crate::shape::LengthBasis::Rest).unwrap();
-        let drawing = BodyDrawing::of_body(&sim, &act, "body".into(), BLUE_800);
-        let knot = sim.centreline.iter().find(|c| c.s_mm == anchor_mm).expect("a centreline point at the anchor");
-        assert_eq!(drawing.cable.last(), Some(&(knot.cables[0].position_mm[0], knot.cables[0].position_mm[1])));
-        assert_eq!(drawing.cable.len(), sim.centreline.iter().filter(|c| c.s_mm <= anchor_mm).count());
-        // The channel's offset there (y_4 = 4 mm at the anchor): the path does not fall back onto the centreline.
-        assert!((knot.cables[0].channel_mm[0] - 4.0).abs() < 1e-9, "{knot:?}");
-        assert!(drawing.cable.iter().all(|p| p.0.is_finite() && p.1.is_finite()));
     }
 
     #[test]

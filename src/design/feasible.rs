@@ -4,14 +4,15 @@
 //! which simulated designs are nearest.
 
 use super::map::{map_error, Cell, MapDesign, MapDir, CELL_STATS_ORDER, MODES};
-use super::optimise::{Seed, SeedSource};
+use super::search::routing::Design;
+use super::search::SeedSource;
 use super::target::{Component, Target, Weights};
 use super::DesignError;
 use crate::model::Cable;
 use crate::shape::LengthBasis;
 use serde::Serialize;
 use std::fmt;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// The three verdicts.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -32,6 +33,9 @@ pub enum Verdict {
     /// grid points (Table 5.1's Target I on the thesis map). Serialised
     /// `unreachable`, the key JSON outputs have always used.
     Unreachable,
+    /// Not judged: the target asks for too little of what the map holds
+    /// (a cable sweep's reach: fewer than two tip components).
+    Unchecked,
 }
 
 impl Verdict {
@@ -41,6 +45,18 @@ impl Verdict {
             Verdict::Feasible => "feasible",
             Verdict::Borderline => "borderline",
             Verdict::Unreachable => "unreachable",
+            Verdict::Unchecked => "unchecked",
+        }
+    }
+
+    /// The reach tables' word for a tip (`reached`, `borderline`,
+    /// `not_reached`, `unchecked`): what a tip verdict has always been called.
+    pub fn reach_word(&self) -> &'static str {
+        match self {
+            Verdict::Feasible => "reached",
+            Verdict::Borderline => "borderline",
+            Verdict::Unreachable => "not_reached",
+            Verdict::Unchecked => "unchecked",
         }
     }
 
@@ -51,6 +67,7 @@ impl Verdict {
             Verdict::Feasible => "feasible",
             Verdict::Borderline => "borderline",
             Verdict::Unreachable => "not reached by any of the map's designs",
+            Verdict::Unchecked => "unchecked",
         }
     }
 }
@@ -124,8 +141,8 @@ pub struct DesignCables {
 
 impl NearDesign {
     /// As a starting design for the optimiser (a one-cable design's).
-    pub fn seed(&self) -> Seed {
-        Seed { routing_mm: self.design.routing_mm, tension_n: self.design.tension_n, source: SeedSource::Map }
+    pub fn seed(&self) -> Design {
+        Design { routing_mm: self.design.routing_mm, tension_n: self.design.tension_n, source: SeedSource::Map }
     }
 }
 
@@ -392,112 +409,6 @@ fn mode_check(map: &MapDir, target: &Target, cell: Option<&Cell>) -> ModeCheck {
     ModeCheck { mode, candidates, count_in_cell }
 }
 
-/// What `feasible` judges the target against.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub enum MapSource {
-    /// One feasibility map directory (`cablemap reduce` output).
-    Map(PathBuf),
-    /// A study directory (`cablemap study` output): every variant's map.
-    Study(PathBuf),
-}
-
-/// Everything a feasibility check needs.
-#[derive(Debug, Clone)]
-pub struct FeasibleRequest {
-    /// The map, or the study's maps.
-    pub source: MapSource,
-    /// The target.
-    pub target: Target,
-    /// Weights of the distance to the nearest designs (checked against the target here).
-    pub weights: Weights,
-    /// The length the target's coefficients are per unit of.
-    pub length_basis: LengthBasis,
-    /// Nearest simulated designs to list.
-    pub nearest: usize,
-}
-
-/// One study variant's verdict.
-#[derive(Debug, Clone)]
-pub struct VariantVerdict {
-    /// Variant number.
-    pub index: usize,
-    /// Its settings, `axis=value, …`.
-    pub label: String,
-    /// Its map's verdict.
-    pub report: FeasibilityReport,
-}
-
-/// The answer of `feasible`.
-#[derive(Debug, Clone)]
-pub enum FeasibleReport {
-    /// One map's verdict.
-    Map {
-        /// The verdict and its evidence.
-        report: FeasibilityReport,
-        /// The command that designs for the target with the map's designs as seeds.
-        next: String,
-    },
-    /// Every variant's verdict of a study.
-    Study {
-        /// The study directory.
-        dir: PathBuf,
-        /// One verdict per variant.
-        variants: Vec<VariantVerdict>,
-    },
-}
-
-impl FeasibleReport {
-    /// The variants of a study whose maps reach the target feasibly (`v0`, …).
-    pub fn feasible_variants(&self) -> Vec<String> {
-        match self {
-            FeasibleReport::Map { .. } => Vec::new(),
-            FeasibleReport::Study { variants, .. } => {
-                variants.iter().filter(|v| v.report.verdict == Verdict::Feasible).map(|v| format!("v{}", v.index)).collect()
-            }
-        }
-    }
-}
-
-impl Serialize for FeasibleReport {
-    /// The JSON `feasible --json` prints.
-    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        match self {
-            FeasibleReport::Map { report, .. } => report.serialize(serializer),
-            FeasibleReport::Study { dir, variants } => {
-                let rows: Vec<_> = variants
-                    .iter()
-                    .map(|v| serde_json::json!({ "variant": v.index, "label": v.label, "verdict": v.report.verdict, "report": v.report }))
-                    .collect();
-                serde_json::json!({ "study": dir, "feasible_variants": self.feasible_variants(), "variants": rows }).serialize(serializer)
-            }
-        }
-    }
-}
-
-impl fmt::Display for FeasibleReport {
-    /// The text `feasible` prints.
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            FeasibleReport::Map { report, next } => {
-                write!(f, "{report}")?;
-                writeln!(f, "next      {next}")
-            }
-            FeasibleReport::Study { variants, .. } => {
-                for v in variants {
-                    let first = v.report.reasons.first().map_or(String::new(), |s| format!(": {s}"));
-                    writeln!(f, "v{:<3} {}: {}{first}", v.index, v.label, v.report.verdict.label())?;
-                }
-                let reach = self.feasible_variants();
-                if reach.is_empty() {
-                    writeln!(f, "no variant reaches the target feasibly (see the borderline ones, or widen the study)")
-                } else {
-                    writeln!(f, "reach the target: {} of {} variants ({})", reach.len(), variants.len(), reach.join(", "))
-                }
-            }
-        }
-    }
-}
-
 impl fmt::Display for FeasibilityReport {
     /// The verdict, its reasons, the tip cell, the coefficients, the mode and the nearest designs.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
@@ -570,24 +481,3 @@ pub(crate) fn shell_word(text: &str) -> String {
     }
 }
 
-/// Runs `feasible`: the map's verdict on the target, or every study variant's.
-pub fn run(request: &FeasibleRequest) -> Result<FeasibleReport, DesignError> {
-    let FeasibleRequest { source, target, weights, length_basis, nearest } = request;
-    weights.check_against(target)?;
-    match source {
-        MapSource::Map(dir) => {
-            let map = MapDir::open(dir)?;
-            let report = check(&map, target, *length_basis, weights, *nearest)?;
-            Ok(FeasibleReport::Map { report, next: design_command(target, dir) })
-        }
-        MapSource::Study(dir) => {
-            let mut variants = Vec::new();
-            for (index, label, map_dir) in crate::study::mapped_variants(dir).map_err(Box::new)? {
-                let map = MapDir::open(&map_dir).map_err(|e| DesignError::Variant { index, label: label.clone(), source: Box::new(e) })?;
-                let report = check(&map, target, *length_basis, weights, *nearest)?;
-                variants.push(VariantVerdict { index, label, report });
-            }
-            Ok(FeasibleReport::Study { dir: dir.clone(), variants })
-        }
-    }
-}

@@ -64,9 +64,9 @@ impl MapDir {
         Ok(Self { path: dir.to_path_buf(), summary, cells, designs, cables, index })
     }
 
-    /// Refuses to use a map made for another actuator than `actuator` (a
+    /// Refuses to use a map made for another actuator than `rod` (a
     /// rod with its one planar cable): another rod or body, or several cables.
-    pub fn check_actuator(&self, actuator: &Rod) -> Result<(), DesignError> {
+    pub fn check_actuator(&self, rod: &Rod) -> Result<(), DesignError> {
         if let Some(cables) = &self.cables {
             return Err(map_error(
                 &self.path,
@@ -80,16 +80,16 @@ impl MapDir {
             ));
         }
         let s = &self.summary;
-        if (s.length_mm - actuator.length_mm).abs() > 1e-9 || (s.radius_mm - actuator.radius_mm).abs() > 1e-9 {
+        if (s.length_mm - rod.length_mm).abs() > 1e-9 || (s.radius_mm - rod.radius_mm).abs() > 1e-9 {
             return Err(map_error(
                 &self.path,
                 format!(
                     "the map was made for a rod of L = {} mm, r = {} mm but the actuator has L = {} mm, r = {} mm; use a matching map or --length-mm/--radius-mm",
-                    s.length_mm, s.radius_mm, actuator.length_mm, actuator.radius_mm
+                    s.length_mm, s.radius_mm, rod.length_mm, rod.radius_mm
                 ),
             ));
         }
-        let body = crate::reduce::MapBody::of(actuator);
+        let body = crate::reduce::MapBody::of(rod);
         if s.body != body {
             let describe = |b: &crate::reduce::MapBody| {
                 if *b == crate::reduce::MapBody::default() {

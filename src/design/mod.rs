@@ -1,28 +1,50 @@
-//! Feasibility check and cable-routing design (thesis §3.4, Ch. 5; eq. 3.17).
+//! Feasibility check and cable-routing design (thesis §3.4, Ch. 5; eq. 3.17)
+//! of an actuator with 1–8 cables: one search for the thesis's one planar
+//! cable and one target (`design --target`) and for several cables, targets
+//! or a trajectory (`design --targets`, docs/design.md).
 //!
-//! - [`target`]: what the designer asks for (tip, curvature coefficients, weights).
-//! - [`objective`]: eq. 3.17 as weighted residuals, and the bounds.
-//! - [`optimise`]: multi-start bounded Levenberg–Marquardt.
-//! - [`map`]: reading a feasibility map directory (`docs/maps.md`).
-//! - [`feasible`]: the map's verdict on a target before any optimisation.
-//! - [`record`]: design.json, its fields, writer and reader.
-//! - [`export`]: the design's files: design.json, channel CSV, 1:1 mould SVG, achieved-vs-target PNG.
-//! - [`run`]: the whole workflow of `cablemap design` (its request);
-//!   [`report`]: what it returns and the text it prints.
+//! - [`target`]: the thesis's target (tip, curvature coefficients, weights);
+//!   [`targets`]: a targets file (`[[target]]`, `[trajectory]`).
+//! - [`actuator`]: the actuator file with what each cable may change.
+//! - [`objective`]: eq. 3.17 of one planar cable as weighted residuals, and
+//!   its bounds; [`sequence`]: eq. 3.17 summed over targets, for 1–N cables.
+//! - [`search`]: the one multi-start bounded Levenberg–Marquardt, over
+//!   either problem.
+//! - [`map`], [`map_channels`]: reading a feasibility map directory
+//!   (`docs/maps.md`) and its designs as seeds; [`feasible`], [`reach`]:
+//!   the map's verdict on a target before any optimisation;
+//!   [`feasible_request`]: the request of `cablemap feasible`.
+//! - [`record`]: design.json, its fields, writer and reader;
+//!   [`export`], [`sequence_export`]: the design's files.
+//! - [`trajectory`]: the tip path between waypoints.
+//! - [`request`]: the one request of `cablemap design` and its check;
+//!   [`run`], [`sequence_run`]: its workflow; [`report`]: what the
+//!   one-target design returns.
 
-pub mod cables;
+pub mod actuator;
 pub mod export;
 pub mod feasible;
+pub mod feasible_request;
 pub mod map;
+pub mod map_channels;
 pub mod objective;
-pub mod optimise;
+pub mod reach;
 pub mod record;
 pub mod report;
+pub mod request;
 pub mod run;
+pub mod search;
+pub mod sequence;
+pub mod sequence_export;
+pub mod sequence_run;
 pub mod target;
+pub mod targets;
+pub mod trajectory;
 
-pub use objective::{Bounds, Evaluation, Objective};
-pub use optimise::{compare, design, ComponentResult, DesignOutcome, SearchOptions, Seed, SeedSource};
+pub use objective::{compare, Bounds, ComponentResult, Evaluation, Objective};
+pub use search::{SearchOptions, SeedSource, StartReport, Termination};
+pub use request::DesignRequest;
+pub use run::{run, DesignReport};
 pub use target::{Component, Target, Weights};
 
 /// Why a feasibility check or a design could not be made.
@@ -34,9 +56,60 @@ pub enum DesignError {
     /// The weights are malformed or inconsistent with the target.
     #[error("bad weights: {0}")]
     BadWeights(String),
-    /// A search setting is unusable (tolerance, number of starts).
-    #[error("bad search setting: {0}")]
-    BadSearch(String),
+    /// Both or neither of a target and a targets file.
+    #[error("give either a target (--target) or a targets file (--targets)")]
+    TargetOrTargets,
+    /// An actuator file with the one-target design, which designs one planar cable on a rod.
+    #[error("--target designs one planar cable on a rod: give the rod alone, or --targets FILE.toml with --actuator FILE.toml for several cables")]
+    ActuatorWithTarget,
+    /// A setting of the one-target design given with a targets file.
+    #[error("{} does not apply to --targets: give {}", setting.flag(), setting.instead())]
+    TargetOnly {
+        /// Which.
+        setting: request::TargetOnly,
+    },
+    /// A targets file needs one map, a cable sweep's.
+    #[error("--targets needs --map: the map of a cable sweep")]
+    TargetsNeedMap,
+    /// The tolerance is not a finite percentage ≥ 0.
+    #[error("bad search setting: the tolerance must be a finite number ≥ 0 %, got {tolerance_pct}")]
+    Tolerance {
+        /// The tolerance given, %.
+        tolerance_pct: f64,
+    },
+    /// No start to refine.
+    #[error("bad search setting: the number of starts must be at least 1")]
+    NoStarts,
+    /// The largest control-point offset is outside the body.
+    #[error("bad bounds: the largest control-point offset must lie in (0, r) = (0, {radius_mm}) mm, got {max_offset_mm} mm")]
+    MaxOffset {
+        /// The offset asked, mm.
+        max_offset_mm: f64,
+        /// The channel radius r, mm.
+        radius_mm: f64,
+    },
+    /// The tension bounds are unusable for the one-cable search.
+    #[error("bad bounds: tension bounds must satisfy 0 < τ_l ≤ τ_u (finite), got τ_l = {tension_min_n} N, τ_u = {tension_max_n} N")]
+    TensionBounds {
+        /// τ_l, N.
+        tension_min_n: f64,
+        /// τ_u, N.
+        tension_max_n: f64,
+    },
+    /// The target asks for coefficients the solver's steps cannot resolve.
+    #[error("bad target: {source}")]
+    Resolution {
+        /// What the solver settings resolve.
+        #[source]
+        source: crate::solver::resolution::OrderError,
+    },
+    /// Re-solving the design found by `simulate`'s own path failed.
+    #[error("bad search setting: re-simulating the design found: {source}")]
+    Resimulate {
+        /// Why.
+        #[source]
+        source: crate::solver::spatial::SpatialError,
+    },
     /// The export directory lies in a sweep's run directory.
     #[error(transparent)]
     ExportDir {

@@ -3,7 +3,7 @@
 
 use super::target::{Component, Target, Weights};
 use super::DesignError;
-use crate::model::{Rod, ControlPoints, Routing};
+use crate::model::{ControlPoints, Rod, Routing};
 use crate::solver::{Simulator, SolveFailure, SolverOptions, TipPose};
 use crate::shape::LengthBasis;
 use serde::Serialize;
@@ -38,14 +38,10 @@ impl Bounds {
     pub fn validate(&self, radius_mm: f64) -> Result<(), DesignError> {
         let Bounds { max_offset_mm: y, tension_min_n: lo, tension_max_n: hi } = *self;
         if !(y.is_finite() && y > 0.0 && y < radius_mm) {
-            return Err(DesignError::BadBounds(format!(
-                "the largest control-point offset must lie in (0, r) = (0, {radius_mm}) mm, got {y} mm"
-            )));
+            return Err(DesignError::MaxOffset { max_offset_mm: y, radius_mm });
         }
         if !(lo.is_finite() && hi.is_finite() && lo > 0.0 && lo <= hi) {
-            return Err(DesignError::BadBounds(format!(
-                "tension bounds must satisfy 0 < τ_l ≤ τ_u (finite), got τ_l = {lo} N, τ_u = {hi} N"
-            )));
+            return Err(DesignError::TensionBounds { tension_min_n: lo, tension_max_n: hi });
         }
         Ok(())
     }
@@ -87,8 +83,8 @@ impl Evaluation {
 /// the bounds.
 #[derive(Debug, Clone)]
 pub struct Objective {
-    /// The actuator being designed.
-    pub actuator: Rod,
+    /// The rod being designed (its one cable is the design).
+    pub rod: Rod,
     /// Solver settings.
     pub options: SolverOptions,
     /// What to achieve.
@@ -103,21 +99,21 @@ pub struct Objective {
 }
 
 /// Largest tension step of the continuation ladder used when a cold solve
-/// fails, N (the same as `crate::solver::simulate`: keeps Newton and the shooting in
+/// fails, N (the same as `model::simulate`: keeps Newton and the shooting in
 /// their basin for strongly curled shapes).
 pub const LADDER_STEP_N: f64 = 0.25;
 
 impl Objective {
     /// Builds and checks an objective.
-    pub fn new(actuator: Rod, options: SolverOptions, target: Target, weights: Weights, bounds: Bounds) -> Result<Self, DesignError> {
-        actuator.validate()?;
+    pub fn new(rod: Rod, options: SolverOptions, target: Target, weights: Weights, bounds: Bounds) -> Result<Self, DesignError> {
+        rod.validate()?;
         // The solver settings and the target's coefficient order, before any
         // search: every a_k compared must be resolved by the steps.
-        Simulator::new(&actuator, &options)?;
-        crate::solver::resolution::check_order(target.order(), &options).map_err(|e| DesignError::BadTarget(e.to_string()))?;
+        Simulator::new(&rod, &options)?;
+        crate::solver::resolution::check_order(target.order(), &options).map_err(|source| DesignError::Resolution { source })?;
         weights.check_against(&target)?;
-        bounds.validate(actuator.channel_radius_mm())?;
-        Ok(Self { actuator, options, target, weights, bounds, length_basis: LengthBasis::default() })
+        bounds.validate(rod.channel_radius_mm())?;
+        Ok(Self { rod, options, target, weights, bounds, length_basis: LengthBasis::default() })
     }
 
     /// The same objective with coefficients in `basis`.
@@ -128,7 +124,7 @@ impl Objective {
 
     /// A fresh simulator for this objective's actuator (one per thread).
     pub fn simulator(&self) -> Simulator {
-        Simulator::new(&self.actuator, &self.options).expect("actuator validated in Objective::new")
+        Simulator::new(&self.rod, &self.options).expect("actuator validated in Objective::new")
     }
 
     /// Number of residuals (one per target component).
@@ -143,10 +139,10 @@ impl Objective {
     /// tension converges for routings inside the body at the design
     /// tensions (checked on thousands of random routings, agreeing with the
     /// ladder to 3e-7 mm) and is 4× cheaper, so it is tried first; if it
-    /// fails, a continuation ladder from low tension (as `crate::solver::simulate`)
+    /// fails, a continuation ladder from low tension (as `model::simulate`)
     /// takes over.
     pub fn evaluate(&self, sim: &mut Simulator, routing_mm: &ControlPoints, tension_n: f64) -> Result<Evaluation, SolveFailure> {
-        let routing = Routing::for_actuator(routing_mm, &self.actuator)
+        let routing = Routing::for_actuator(routing_mm, &self.rod)
             .expect("design variables are kept inside the body by the bounds");
         sim.set_routing(&routing);
         let pose = match sim.solve(tension_n) {
@@ -181,6 +177,46 @@ impl Objective {
         self.residuals_into(eval, &mut r);
         r.iter().map(|v| v * v).sum()
     }
+}
+
+/// Per-component comparison of a design with its target.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ComponentResult {
+    /// Which component.
+    pub component: Component,
+    /// Requested value.
+    pub target: f64,
+    /// Achieved value.
+    pub achieved: f64,
+    /// 100 (achieved − target)/|target|, % (None for a zero target).
+    pub error_pct: Option<f64>,
+    /// Whether the component is met within the tolerance.
+    pub met: bool,
+}
+
+/// Compares `eval` with the objective's target. A component is met when its
+/// relative error is within `tolerance_pct`; a zero target is judged against
+/// a natural scale instead (the rod length L for positions, 1/L for
+/// curvature coefficients: one radian of bending over the rod).
+pub fn compare(objective: &Objective, eval: &Evaluation, tolerance_pct: f64) -> Vec<ComponentResult> {
+    let length = objective.rod.length_mm;
+    objective
+        .target
+        .components
+        .iter()
+        .map(|&(component, target)| {
+            let achieved = eval.value(component).expect("order covers the target");
+            let error_pct = super::target::error_pct(achieved, target);
+            let met = match error_pct {
+                Some(e) => e.abs() <= tolerance_pct,
+                None => {
+                    let scale = if matches!(component, Component::A(_)) { 1.0 / length } else { length };
+                    (achieved - target).abs() <= tolerance_pct / 100.0 * scale
+                }
+            };
+            ComponentResult { component, target, achieved, error_pct, met }
+        })
+        .collect()
 }
 
 #[cfg(test)]

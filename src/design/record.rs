@@ -4,7 +4,8 @@
 
 use super::feasible::{FeasibilityReport, Verdict};
 use super::objective::{Bounds, Objective};
-use super::optimise::{ComponentResult, DesignOutcome, StartReport};
+use super::objective::{ComponentResult, Evaluation};
+use super::search::{routing, Found};
 use super::DesignError;
 use crate::model::routing::ControlPoints;
 use crate::model::Rod;
@@ -46,7 +47,7 @@ pub struct DesignRecord {
     /// Seed designs simulated before refining.
     pub seeds_simulated: usize,
     /// Each refined start.
-    pub starts: Vec<StartReport>,
+    pub starts: Vec<serde_json::Value>,
     /// The target as given.
     pub target: serde_json::Value,
     /// Cable tension, N.
@@ -76,13 +77,13 @@ pub struct FeasibilityRecord {
 
 impl DesignRecord {
     /// The record of `outcome` for `objective`, with each component's result.
-    pub fn new(objective: &Objective, outcome: &DesignOutcome, results: &[ComponentResult]) -> Self {
-        let e = &outcome.best;
+    pub fn new(objective: &Objective, outcome: &Found<Evaluation>, results: &[ComponentResult]) -> Self {
+        let e = &outcome.solution;
         let key_values = |f: &dyn Fn(&ComponentResult) -> f64| results.iter().map(|r| (r.component.key(), f(r))).collect();
         DesignRecord {
             a: e.a.clone(),
             achieved: key_values(&|r| r.achieved),
-            actuator: objective.actuator.clone(),
+            actuator: objective.rod.clone(),
             base_angle_rad: e.pose.base_angle_rad,
             bounds: objective.bounds.clone(),
             cost: outcome.cost,
@@ -94,7 +95,20 @@ impl DesignRecord {
             routing_mm: e.routing_mm,
             seconds: outcome.seconds,
             seeds_simulated: outcome.seeds_simulated,
-            starts: outcome.starts.clone(),
+            starts: outcome
+                .starts
+                .iter()
+                .map(|s| {
+                    let (routing_mm, tension_n) = routing::design_at(&objective.bounds, &s.seed);
+                    serde_json::json!({
+                        "cost": s.cost,
+                        "evaluations": s.evaluations,
+                        "seed": { "routing_mm": routing_mm, "source": s.source, "tension_n": tension_n },
+                        "seed_cost": s.seed_cost,
+                        "termination": s.termination,
+                    })
+                })
+                .collect(),
             target: objective.target.to_json(),
             tension_n: e.tension_n,
             tip_angle_rad: e.pose.tip_angle_rad,

@@ -5,7 +5,8 @@
 
 use super::feasible::FeasibilityReport;
 use super::objective::Objective;
-use super::optimise::{ComponentResult, DesignOutcome};
+use super::objective::{ComponentResult, Evaluation};
+use super::search::Found;
 use super::record::DesignRecord;
 use super::target::Component;
 use crate::mould::MouldSummary;
@@ -18,7 +19,7 @@ pub struct DesignRun {
     /// The objective searched.
     pub objective: Objective,
     /// The search's result.
-    pub outcome: DesignOutcome,
+    pub outcome: Found<Evaluation>,
     /// Each target component, achieved vs asked.
     pub results: Vec<ComponentResult>,
     /// A component counts as met within this many percent.
@@ -89,7 +90,7 @@ impl DesignRun {
     /// search and the verdict.
     fn write_design(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let (objective, outcome, tolerance_pct) = (&self.objective, &self.outcome, self.tolerance_pct);
-        let e = &outcome.best;
+        let e = &outcome.solution;
         writeln!(f)?;
         // Pasteable into `simulate` and `design`: --routing takes a plain comma list.
         writeln!(

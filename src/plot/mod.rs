@@ -5,11 +5,13 @@
 
 mod body;
 mod canvas;
+mod design_shape;
 mod reach;
 mod series;
 pub mod spatial;
 
 pub use body::{body_series, draw_bodies, BodyDrawing};
+pub use design_shape::draw_design_shape;
 pub use canvas::{png_backend, register_fonts, PlotError, FONT};
 pub use series::{
     clamp_half_width_mm, clamp_series, draw_legend, draw_series_on, hanging_chart, legend_size, series_points, Mark, PageChart, PictureSeries,

@@ -4,9 +4,9 @@
 //! its picture (`target_N.png`); for a trajectory, the sampled path
 //! (`trajectory.csv`) and its picture (`trajectory.png`).
 
-use super::search::Setup;
-use super::CableDesignRun;
-use super::super::DesignError;
+use super::sequence::Setup;
+use super::sequence_run::SequenceRun;
+use super::DesignError;
 use crate::io::FileError;
 use crate::model::cable;
 use std::fmt::Write as _;
@@ -18,8 +18,8 @@ pub fn actuator_file_name(index: usize) -> String {
 }
 
 /// Writes the design's files into `dir` and returns their names, in order.
-pub fn write_all(dir: &Path, run: &CableDesignRun, setup: &Setup) -> Result<Vec<String>, DesignError> {
-    super::super::export::check_export_dir(dir)?;
+pub fn write_all(dir: &Path, run: &SequenceRun, setup: &Setup) -> Result<Vec<String>, DesignError> {
+    super::export::check_export_dir(dir)?;
     std::fs::create_dir_all(dir).map_err(FileError::on("creating", dir))?;
     let mut written = Vec::new();
     let mut write = |name: &str, bytes: &[u8]| {
@@ -54,7 +54,7 @@ pub fn write_all(dir: &Path, run: &CableDesignRun, setup: &Setup) -> Result<Vec<
             }
         }
         write("trajectory.csv", csv.as_bytes())?;
-        let waypoint = |t: &super::TargetOutcome| t.target.tip_mm().map(|v| v.unwrap_or(f64::NAN));
+        let waypoint = |t: &super::sequence_run::TargetOutcome| t.target.tip_mm().map(|v| v.unwrap_or(f64::NAN));
         let drawing = crate::plot::spatial::TrajectoryDrawing {
             waypoints: run.targets.iter().map(waypoint).collect(),
             legs: tr.legs.iter().map(|l| l.samples.iter().map(|s| s.tip_mm).collect()).collect(),

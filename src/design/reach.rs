@@ -6,10 +6,10 @@
 //! in-plane tip and `a_bend_z` (the map's coefficient ranges) with the
 //! nearest stored designs, every cable of each.
 
-use super::super::feasible::{self as planar, FeasibilityReport};
-use super::super::map::MapDir;
-use super::super::target::{Target, Weights};
-use super::super::DesignError;
+use super::feasible::{self as planar, FeasibilityReport, Verdict};
+use super::map::MapDir;
+use super::target::{Target, Weights};
+use super::DesignError;
 use super::targets::{Quantity, ShapeTarget, TargetSet};
 use crate::reduce::tables::{read_reach, ReachTables};
 use crate::shape::LengthBasis;
@@ -17,25 +17,17 @@ use serde::Serialize;
 use std::fmt;
 use std::path::{Path, PathBuf};
 
-/// Whether the sweep put a tip where the target asks.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Reached {
-    /// Tips in the target's voxel or cell.
-    Reached,
-    /// None there, some in a neighbour.
-    Borderline,
-    /// None there or next to it (not proof: the sweep samples a grid; `design` will tell).
-    NotReached,
-    /// The target asks for no tip, or only one component of it.
-    Unchecked,
-}
-
 /// One target's tip against the reach tables.
 #[derive(Debug, Clone, Serialize)]
 pub struct TipReach {
-    /// The verdict.
-    pub verdict: Reached,
+    /// The verdict: `feasible` for tips in the target's voxel or cell,
+    /// `borderline` for none there and some in a neighbour, `unreachable`
+    /// for none there or next to it (not proof: the sweep samples a grid;
+    /// `design` will tell), `unchecked` when the target asks for fewer
+    /// than two tip components. Written in the reach tables' words
+    /// ([`Verdict::reach_word`]).
+    #[serde(serialize_with = "reach_word")]
+    pub verdict: Verdict,
     /// Which table: `3d` (voxels), `xy`, `xz` or `yz` (plane cells).
     pub table: Option<&'static str>,
     /// The voxel or cell indices of the tip.
@@ -71,12 +63,16 @@ pub struct TargetsFeasibility {
     pub targets: Vec<TargetFeasibility>,
 }
 
+fn reach_word<S: serde::Serializer>(verdict: &Verdict, s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_str(verdict.reach_word())
+}
+
 fn tip_reach(reach: &ReachTables, t: &ShapeTarget) -> TipReach {
     let cell = reach.summary.cell_mm;
     let index = |v: f64| (v / cell).floor() as i32;
     let tip = t.tip_mm();
     let given: Vec<usize> = (0..3).filter(|&i| tip[i].is_some()).collect();
-    let unchecked = TipReach { verdict: Reached::Unchecked, table: None, cell: Vec::new(), count: 0, neighbours: 0 };
+    let unchecked = TipReach { verdict: Verdict::Unchecked, table: None, cell: Vec::new(), count: 0, neighbours: 0 };
     let (table, idx, count, neighbours) = match given.as_slice() {
         [0, 1, 2] => {
             let c = [0, 1, 2].map(|i| index(tip[i].expect("given")));
@@ -114,11 +110,11 @@ fn tip_reach(reach: &ReachTables, t: &ShapeTarget) -> TipReach {
         _ => return unchecked,
     };
     let verdict = if count > 0 {
-        Reached::Reached
+        Verdict::Feasible
     } else if neighbours > 0 {
-        Reached::Borderline
+        Verdict::Borderline
     } else {
-        Reached::NotReached
+        Verdict::Unreachable
     };
     TipReach { verdict, table: Some(table), cell: idx, count, neighbours }
 }
@@ -129,7 +125,7 @@ fn planar_target(t: &ShapeTarget) -> Option<(Target, Weights)> {
     let key = |q: &Quantity| match q {
         Quantity::TipX => Some("x".to_string()),
         Quantity::TipY => Some("y".to_string()),
-        Quantity::BendZ(k) if *k <= super::super::target::MAX_ORDER => Some(format!("a{k}")),
+        Quantity::BendZ(k) if *k <= super::target::MAX_ORDER => Some(format!("a{k}")),
         _ => None,
     };
     let pairs: Vec<(String, f64, f64)> = t.components.iter().filter_map(|(q, v, w)| key(q).map(|k| (k, *v, *w))).collect();
@@ -169,14 +165,14 @@ impl fmt::Display for TargetsFeasibility {
             writeln!(f)?;
             let r = &t.tip;
             let what = match r.verdict {
-                Reached::Reached => format!("reached: {} tips in the tip's {} cell {:?}", r.count, r.table.unwrap_or(""), r.cell),
-                Reached::Borderline => format!("borderline: no tip in the {} cell {:?}, {} in its neighbours", r.table.unwrap_or(""), r.cell, r.neighbours),
-                Reached::NotReached => format!(
+                Verdict::Feasible => format!("reached: {} tips in the tip's {} cell {:?}", r.count, r.table.unwrap_or(""), r.cell),
+                Verdict::Borderline => format!("borderline: no tip in the {} cell {:?}, {} in its neighbours", r.table.unwrap_or(""), r.cell, r.neighbours),
+                Verdict::Unreachable => format!(
                     "not reached by the sweep: no tip in or next to the {} cell {:?} (the sweep samples a grid: `design` will tell)",
                     r.table.unwrap_or(""),
                     r.cell
                 ),
-                Reached::Unchecked => "tip unchecked (the target asks for fewer than two tip components)".to_string(),
+                Verdict::Unchecked => "tip unchecked (the target asks for fewer than two tip components)".to_string(),
             };
             writeln!(f, "{}   {what}", t.name)?;
             if let Some(p) = &t.planar {

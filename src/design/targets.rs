@@ -6,8 +6,8 @@
 //! solver (`a_bend_z`, `a_bend_y`, `a_twist`, the names `simulate --json`
 //! uses), with weights and a tolerance.
 
-use super::super::target::MAX_ORDER;
-use super::super::DesignError;
+use super::target::MAX_ORDER;
+use super::DesignError;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 

@@ -1,60 +1,37 @@
-//! Designing an actuator with 1–8 cables (planar or spatial) for a sequence
-//! of target shapes or a tip trajectory: one set of channels, one actuation
-//! (tension, or displacement) per target (docs/design.md, "Several cables").
+//! The design of an actuator with 1–8 cables (planar or spatial) for a
+//! sequence of target shapes or a tip trajectory (`design --targets`): one
+//! set of channels, one actuation (tension, or displacement) per target
+//! (docs/design.md, "Several cables"); its report, [`SequenceRun`].
 //!
-//! - [`spec`]: the actuator file with what each cable may change.
-//! - [`targets`]: the targets file (`[[target]]`, `[trajectory]`).
-//! - [`search`]: the multi-start bounded Levenberg–Marquardt over channels and actuations.
-//! - [`trajectory`]: the tip path between waypoints.
-//! - [`export`]: design.json, each cable's channel CSV, each target's picture and actuator file.
-//!
-//! [`run`] takes a [`CableDesignRequest`] and returns a [`CableDesignRun`].
-//! One planar cable free in y with one in-plane target is the thesis's
-//! design: it is searched by the planar design's own search
-//! ([`super::optimise::design`], the same answers as `design --target`).
+//! The search is the one multi-start ([`super::search`]) over the channels
+//! problem; one tension-driven planar cable free in y with one in-plane
+//! target is the thesis's design, and its problem is the thesis's unknowns
+//! (the routing problem, the same answers as `design --target`).
 
-pub mod export;
-pub mod feasible;
-pub mod map;
-pub mod search;
-pub mod spec;
-pub mod targets;
-pub mod trajectory;
-
-use super::optimise::SearchOptions;
-use super::run::DesignRequest;
+use super::actuator::{ActuationBounds, DesignActuator};
+use super::objective::{Bounds, Objective};
+use super::search::channels::ChannelsProblem;
+use super::search::routing::RoutingProblem;
+use super::request::DesignRequest;
+use super::search::{self, SearchOptions, StartReport, ROUTING_STARTS, SEQUENCE_STARTS};
+use super::sequence::{Achieved, Channel, Setup};
 use super::target::{error_pct, Target, Weights};
-use super::DesignError;
+use super::targets::{Quantity, ShapeTarget, TargetSet};
+use super::{map_channels as map, sequence_export as export, trajectory, DesignError};
 use crate::model::Actuator;
-use crate::solver::SolverOptions;
 use crate::shape::LengthBasis;
-use search::{Achieved, CableSearch, Channel, Setup, StartReport};
 use serde_json::json;
-use spec::{ActuationBounds, DesignActuator};
 use std::fmt;
 use std::path::PathBuf;
-use targets::{Quantity, ShapeTarget, TargetSet};
 
-/// Everything a several-cable design needs.
+/// What a sequence design designs: the actuator with what each cable may
+/// change, and the targets (a sequence, or a trajectory's waypoints).
 #[derive(Debug, Clone)]
-pub struct CableDesignRequest {
+pub struct Sequence {
     /// The actuator and what may change of each cable.
     pub design: DesignActuator,
-    /// The targets (a sequence, or a trajectory's waypoints).
+    /// The targets.
     pub targets: TargetSet,
-    /// Solver settings.
-    pub options: SolverOptions,
-    /// The length the coefficients are per unit of.
-    pub length_basis: LengthBasis,
-    /// Search settings.
-    pub search: CableSearch,
-    /// A feasibility map of several cables: its nearest designs seed the search.
-    pub map: Option<PathBuf>,
-    /// Export directory.
-    pub out: Option<PathBuf>,
-    /// With `out`: also write every channel's moulds ([`crate::mould::for_actuator`]);
-    /// the free channels are then kept within what the moulds cast.
-    pub moulds: Option<crate::mould::MouldOptions>,
 }
 
 /// One target component, asked vs achieved.
@@ -141,7 +118,7 @@ fn fmt6(v: f64) -> String {
 
 /// A finished several-cable design.
 #[derive(Debug, Clone)]
-pub struct CableDesignRun {
+pub struct SequenceRun {
     /// The actuator designed for.
     pub design: DesignActuator,
     /// Each cable's designed channel (y, z control points, mm).
@@ -170,7 +147,7 @@ pub struct CableDesignRun {
     pub moulds: Option<crate::mould::MouldReport>,
 }
 
-impl CableDesignRun {
+impl SequenceRun {
     /// Every target met (and, for a trajectory, every intermediate solve and, with `smooth`, no reversal).
     pub fn met(&self) -> bool {
         self.targets.iter().all(TargetOutcome::met) && self.trajectory.as_ref().is_none_or(|t| t.ok())
@@ -263,7 +240,7 @@ impl CableDesignRun {
     }
 }
 
-impl fmt::Display for CableDesignRun {
+impl fmt::Display for SequenceRun {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         for (i, (y, z)) in self.channels.iter().enumerate() {
             let list = |v: &[f64; 5]| v.iter().map(|x| format!("{x:.4}")).collect::<Vec<_>>().join(",");
@@ -384,7 +361,7 @@ fn command_of(actuator: &Actuator, file: Option<&std::path::Path>) -> String {
 /// cable free in y with a positive lower tension bound (the planar search's
 /// τ_l > 0; `tension_min_n = 0` goes to the general search), gravity in its
 /// plane, one target asking only for the in-plane tip and a_bend_z.
-fn planar_case(r: &CableDesignRequest) -> bool {
+fn planar_case(r: &Sequence, map: Option<&std::path::Path>) -> bool {
     let d = &r.design;
     let [f] = d.freedom.as_slice() else { return false };
     let cable = &d.actuator.cables[0];
@@ -395,13 +372,14 @@ fn planar_case(r: &CableDesignRequest) -> bool {
         Quantity::TipZ => *v == 0.0,
         _ => false,
     });
-    f.free_y && !f.free_z && cable.is_planar() && matches!(f.actuation, ActuationBounds::Tension { min_n, .. } if min_n > 0.0) && in_plane && planar_target && r.targets.trajectory.is_none() && r.map.is_none()
+    f.free_y && !f.free_z && cable.is_planar() && matches!(f.actuation, ActuationBounds::Tension { min_n, .. } if min_n > 0.0) && in_plane && planar_target && r.targets.trajectory.is_none() && map.is_none()
 }
 
-/// The planar request of the thesis's case ([`planar_case`]).
-fn planar_request(r: &CableDesignRequest) -> Result<DesignRequest, DesignError> {
-    let t = &r.targets.targets[0];
-    let f = &r.design.freedom[0];
+/// The thesis's objective (eq. 3.17) of the one-cable case ([`planar_case`]):
+/// the rod with the cable's anchor and gravity's direction in the plane,
+/// the target's in-plane components and weights, the cable's bounds.
+fn routing_objective(design: &DesignActuator, r: &DesignRequest, t: &ShapeTarget) -> Result<Objective, DesignError> {
+    let f = &design.freedom[0];
     let key = |q: &Quantity| match q {
         Quantity::TipX => Some("x".to_string()),
         Quantity::TipY => Some("y".to_string()),
@@ -411,89 +389,73 @@ fn planar_request(r: &CableDesignRequest) -> Result<DesignRequest, DesignError> 
     let target = Target::parse(&t.components.iter().filter_map(|(q, v, _)| key(q).map(|k| format!("{k}={v}"))).collect::<Vec<_>>().join(","))?;
     let weights = Weights::parse(&t.components.iter().filter_map(|(q, _, w)| key(q).map(|k| format!("{k}={w}"))).collect::<Vec<_>>().join(","))?;
     let (lo, hi) = f.actuation.range();
-    let mut rod = r.design.actuator.rod.clone();
-    if let Some(g) = r.design.actuator.gravity_direction {
+    let mut rod = design.actuator.rod.clone();
+    if let Some(g) = design.actuator.gravity_direction {
         rod.gravity.direction_rad = g[1].atan2(g[0]);
     }
-    if let Some(anchor) = r.design.actuator.cables[0].anchor_mm {
+    if let Some(anchor) = design.actuator.cables[0].anchor_mm {
         rod.cable_anchor_mm = Some(anchor);
     }
-    Ok(DesignRequest {
-        actuator: rod,
-        options: r.options.clone(),
-        target,
-        weights,
-        tension_min_n: Some(lo),
-        tension_max_n: Some(hi),
-        max_offset_mm: Some(f.max_offset_mm),
-        length_basis: r.length_basis,
-        map: None,
-        search: SearchOptions { starts: 8, max_evaluations: r.search.max_evaluations, ..SearchOptions::default() },
-        tolerance_pct: t.tolerance_pct,
-        out: None,
-        mould: Default::default(),
-        write_moulds: false,
-    })
+    rod.validate()?;
+    let mut bounds = Bounds::thesis(rod.channel_radius_mm(), lo, hi);
+    bounds.max_offset_mm = f.max_offset_mm;
+    Ok(Objective::new(rod, r.options.clone(), target, weights, bounds)?.with_length_basis(r.length_basis))
 }
 
 /// Runs a several-cable design: refuses what no design reaches, searches
 /// (the planar search for the thesis's case), compares each target,
 /// reports a trajectory's path, and exports.
-pub fn run(request: &CableDesignRequest) -> Result<CableDesignRun, DesignError> {
+pub fn run(request: &DesignRequest, sequence: &Sequence) -> Result<SequenceRun, DesignError> {
+    let moulds = request.write_moulds.then(|| crate::mould::MouldOptions { params: request.mould.clone(), ..Default::default() });
+    let search = request.search_options(SEQUENCE_STARTS);
     let started = std::time::Instant::now();
     if let Some(dir) = &request.out {
         super::export::check_export_dir(dir)?;
     }
-    check_reachable(&request.design, &request.targets)?;
-    let mut design = request.design.clone();
-    if let (Some(m), true) = (&request.moulds, request.out.is_some()) {
-        // The moulds' rule (tube and skin inside r), a hair inside it.
-        let limit = m.params.max_channel_offset_mm(design.actuator.rod.radius_mm) - 1e-9;
+    check_reachable(&sequence.design, &sequence.targets)?;
+    let mut design = sequence.design.clone();
+    if let (Some(m), true) = (&moulds, request.out.is_some()) {
+        let limit = super::request::mould_offset_limit_mm(&m.params, design.actuator.rod.radius_mm);
         for f in design.freedom.iter_mut().filter(|f| f.free_y || f.free_z) {
             f.max_offset_mm = f.max_offset_mm.min(limit);
         }
     }
     let setup = Setup {
         design: design.clone(),
-        targets: request.targets.targets.clone(),
+        targets: sequence.targets.targets.clone(),
         options: request.options.clone(),
         basis: request.length_basis,
-        smooth_steps: request.targets.trajectory.as_ref().filter(|t| t.smooth).map(|t| t.steps_per_leg),
+        smooth_steps: sequence.targets.trajectory.as_ref().filter(|t| t.smooth).map(|t| t.steps_per_leg),
     };
-    let length = request.design.actuator.rod.length_mm;
-    let (channels, achieved, cost, starts, seeds_simulated, method) = if planar_case(request) {
-        let done = super::run::run(&planar_request(request)?)?;
-        let e = &done.outcome.best;
+    let length = sequence.design.actuator.rod.length_mm;
+    let (channels, achieved, cost, starts, seeds_simulated, method) = if planar_case(sequence, request.map.as_deref()) {
+        let objective = routing_objective(&design, request, &sequence.targets.targets[0])?;
+        let options = SearchOptions { starts: ROUTING_STARTS, max_evaluations: search.max_evaluations, ..SearchOptions::default() };
+        let found = search::search(&RoutingProblem { objective: &objective, grid: &options, map_designs: Vec::new() }, &options)?;
+        let e = found.solution;
         let zeros = vec![0.0; e.a.len()];
-        let achieved = Achieved { pose: e.pose, a_bend_z: e.a.clone(), a_bend_y: zeros.clone(), a_twist: zeros };
-        let starts = done
-            .outcome
-            .starts
-            .iter()
-            .map(|s| StartReport { seed_cost: s.seed_cost, cost: s.cost, evaluations: s.evaluations, source: match s.seed.source { super::SeedSource::Grid => "grid", super::SeedSource::Map => "map" }, termination: s.termination.clone() })
-            .collect();
+        let achieved = Achieved { pose: e.pose, a_bend_z: e.a, a_bend_y: zeros.clone(), a_twist: zeros };
         let channel: Channel = ((*e.routing_mm).try_into().expect("five control points"), [0.0; 5]);
-        (vec![channel], vec![(vec![e.tension_n], achieved)], done.outcome.cost, starts, done.outcome.seeds_simulated, "planar")
+        (vec![channel], vec![(vec![e.tension_n], achieved)], found.cost, found.starts, found.seeds_simulated, "planar")
     } else {
-        let extra = match &request.map {
-            Some(dir) => map::channels(dir, &setup, 2 * request.search.starts)?,
+        let map_channels = match &request.map {
+            Some(dir) => map::channels(dir, &setup, 2 * search.starts)?,
             None => Vec::new(),
         };
-        let found = search::search(&setup, &request.search, &extra)?;
+        let found = search::search(&ChannelsProblem { setup: &setup, map_channels }, &search)?;
         // Reported as `simulate` solves the design (the search may have
         // solved it without the ladder).
-        let achieved = found
-            .achieved
-            .into_iter()
-            .map(|(actuation, _)| {
-                let sim = setup.simulate(&setup.actuator(&found.channels, &actuation))?;
+        let channels = setup.channels(&found.x);
+        let achieved = (0..setup.targets.len())
+            .map(|t| {
+                let actuation = setup.actuation(&found.x, t);
+                let sim = setup.simulate(&setup.actuator(&channels, &actuation)).map_err(|source| DesignError::Resimulate { source })?;
                 Ok((actuation, Achieved::of(&sim)))
             })
-            .collect::<Result<Vec<_>, crate::solver::spatial::SpatialError>>()
-            .map_err(|e| DesignError::BadSearch(format!("re-simulating the design found: {e}")))?;
-        (found.channels, achieved, found.cost, found.starts, found.seeds_simulated, "cables")
+            .collect::<Result<Vec<_>, DesignError>>()?;
+        (channels, achieved, found.cost, found.starts, found.seeds_simulated, "cables")
     };
-    let mut targets: Vec<TargetOutcome> = request
+    let mut targets: Vec<TargetOutcome> = sequence
         .targets
         .targets
         .iter()
@@ -503,11 +465,11 @@ pub fn run(request: &CableDesignRequest) -> Result<CableDesignRun, DesignError> 
             TargetOutcome { components: compare(t, &a, length), target: t.clone(), actuation, achieved: a, command: command_of(&actuator, None), actuator }
         })
         .collect();
-    let trajectory = match &request.targets.trajectory {
+    let trajectory = match &sequence.targets.trajectory {
         Some(tr) => Some(trajectory::path(&setup, &channels, &targets, tr)?),
         None => None,
     };
-    let mut run = CableDesignRun {
+    let mut run = SequenceRun {
         design,
         channels,
         targets: Vec::new(),
@@ -530,7 +492,7 @@ pub fn run(request: &CableDesignRequest) -> Result<CableDesignRun, DesignError> 
     run.targets = targets;
     run.seconds = started.elapsed().as_secs_f64();
     if let Some(dir) = &request.out {
-        if let Some(m) = &request.moulds {
+        if let Some(m) = &moulds {
             run.moulds = Some(crate::mould::for_actuator(&run.targets[0].actuator, m, dir)?);
         }
         run.exported = export::write_all(dir, &run, &setup)?;

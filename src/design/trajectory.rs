@@ -6,10 +6,10 @@
 //! solve fails, and (with `smooth = true`) any cable whose tension reverses
 //! inside a leg.
 
-use super::search::{Channel, Setup};
+use super::sequence::{Channel, Setup};
 use super::targets::Trajectory;
-use super::TargetOutcome;
-use super::super::DesignError;
+use super::sequence_run::TargetOutcome;
+use super::DesignError;
 use serde::Serialize;
 use std::fmt;
 

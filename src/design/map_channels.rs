@@ -2,10 +2,10 @@
 //! (`design --map MAP` with `--targets`): the map's simulated designs
 //! nearest to the targets, every cable's channel.
 
-use super::search::{Channel, Setup};
+use super::sequence::{Channel, Setup};
 use super::targets::Quantity;
-use super::super::map::{map_error, MapDir};
-use super::super::DesignError;
+use super::map::{map_error, MapDir};
+use super::DesignError;
 use std::path::Path;
 
 /// Opens the planar map of a cable sweep's map `dir` (its `planar/` folder, which
@@ -33,7 +33,7 @@ pub fn channels(dir: &Path, setup: &Setup, count: usize) -> Result<Vec<Vec<Chann
     let mut out: Vec<Vec<Channel>> = Vec::new();
     let per_target = count.div_ceil(setup.targets.len().max(1));
     for t in &setup.targets {
-        let score = |d: &super::super::map::MapDesign| -> f64 {
+        let score = |d: &super::map::MapDesign| -> f64 {
             t.components
                 .iter()
                 .map(|(q, v, w)| {

@@ -20,17 +20,14 @@
 //! parallel, each deterministically, and the least cost wins (ties to the
 //! earlier start): the same answer on every run and thread count.
 
-use super::spec::{ActuationBounds, CableFreedom, DesignActuator};
+use super::actuator::{ActuationBounds, CableFreedom, DesignActuator};
 use super::targets::{Quantity, ShapeTarget};
-use super::super::DesignError;
 use crate::solver::spatial::{SpatialError, SpatialOptions, SpatialSolver};
 use crate::model::Actuator;
 use crate::solver::{simulate_actuator, Given, Simulation, SolverOptions, TipPose};
 use crate::numerics::lm;
 use crate::shape::LengthBasis;
-use nalgebra::DMatrix;
 use rayon::prelude::*;
-use serde::Serialize;
 
 /// What one solve of one target's actuator achieved.
 #[derive(Debug, Clone, PartialEq)]
@@ -66,21 +63,6 @@ impl Achieved {
     }
 }
 
-/// Search settings of a several-cable design.
-#[derive(Debug, Clone, Serialize)]
-pub struct CableSearch {
-    /// Starts refined to convergence.
-    pub starts: usize,
-    /// Most target solves per start, per target.
-    pub max_evaluations: usize,
-}
-
-impl Default for CableSearch {
-    fn default() -> Self {
-        Self { starts: 4, max_evaluations: 1500 }
-    }
-}
-
 /// The problem: actuator, freedoms, targets and solver settings.
 #[derive(Debug, Clone)]
 pub struct Setup {
@@ -105,7 +87,7 @@ pub struct Setup {
 pub const REVERSAL_WEIGHT: f64 = 1e8;
 
 /// A point of the search: the unit-box coordinates.
-type Point = Vec<f64>;
+pub type Point = Vec<f64>;
 
 /// Control points (y, z) of one cable.
 pub type Channel = ([f64; 5], [f64; 5]);
@@ -149,7 +131,7 @@ impl Setup {
     }
 
     /// Index of target `t`'s first actuation variable.
-    fn actuation_start(&self, t: usize) -> usize {
+    pub fn actuation_start(&self, t: usize) -> usize {
         self.channel_var_count() + t * self.cables()
     }
 
@@ -170,7 +152,7 @@ impl Setup {
     }
 
     /// The cables whose tension may reverse inside a leg: the displacement-driven ones.
-    fn reversal_cables(&self) -> Vec<usize> {
+    pub fn reversal_cables(&self) -> Vec<usize> {
         self.design.freedom.iter().enumerate().filter(|(_, f)| matches!(f.actuation, ActuationBounds::Displacement { .. })).map(|(c, _)| c).collect()
     }
 
@@ -291,7 +273,7 @@ impl Setup {
     }
 
     /// Solves target `t` at `x` ([`Setup::quick`]).
-    fn solve(&self, channels: &[Channel], x: &[f64], t: usize) -> Result<Achieved, SpatialError> {
+    pub fn solve(&self, channels: &[Channel], x: &[f64], t: usize) -> Result<Achieved, SpatialError> {
         self.quick(&self.actuator(channels, &self.actuation(x, t)))
     }
 
@@ -331,7 +313,7 @@ impl Setup {
     }
 
     /// The unit box and the free variables (an actuation whose bounds coincide is held).
-    fn settings(&self) -> lm::Settings {
+    pub fn settings(&self) -> lm::Settings {
         let nc = self.channel_var_count();
         let bounds: Vec<(f64, f64)> = (0..self.var_count()).map(|i| if i < nc { (-1.0, 1.0) } else { (0.0, 1.0) }).collect();
         let free = (0..self.var_count())
@@ -344,177 +326,6 @@ impl Setup {
             })
             .collect();
         lm::Settings { bounds, free, max_iterations: usize::MAX }
-    }
-}
-
-/// One start's refinement.
-#[derive(Debug, Clone, Serialize)]
-pub struct StartReport {
-    /// Cost at the start.
-    pub seed_cost: f64,
-    /// Cost at the end (inf when the start could not be solved).
-    pub cost: f64,
-    /// Target solves used.
-    pub evaluations: usize,
-    /// Where the start came from (`grid` or `map`).
-    pub source: &'static str,
-    /// Why it stopped.
-    pub termination: String,
-}
-
-/// The search's best design.
-#[derive(Debug, Clone)]
-pub struct Found {
-    /// Its unit coordinates.
-    pub x: Vec<f64>,
-    /// The channels.
-    pub channels: Vec<Channel>,
-    /// Per target: its actuation and what it achieved.
-    pub achieved: Vec<(Vec<f64>, Achieved)>,
-    /// The summed cost.
-    pub cost: f64,
-    /// Every refined start, in start order.
-    pub starts: Vec<StartReport>,
-    /// Designs simulated to seed the search.
-    pub seeds_simulated: usize,
-}
-
-/// Finite-difference step in the unit box (about 1e-5 mm on the thesis
-/// rod): large against the solver's convergence noise, small against curvature.
-const FD_STEP: f64 = 2e-6;
-
-/// Below this summed cost the fit is exact to the solver's noise.
-const COST_FLOOR: f64 = 1e-20;
-
-struct Problem<'a> {
-    setup: &'a Setup,
-    /// The last point solved and every target's solve there (a smooth
-    /// trajectory's Jacobian needs the neighbours of a moved target).
-    last: Option<(Point, Vec<Achieved>)>,
-    best: Option<(f64, Point, Vec<Achieved>)>,
-    evaluations: usize,
-    max_evaluations: usize,
-    /// The best cost at each Jacobian.
-    history: Vec<f64>,
-}
-
-/// A start stops when its best cost fell by less than [`STALL_FRACTION`]
-/// over this many iterations: a flat valley, where the remaining gain is
-/// below what any target's tolerance resolves.
-const STALL_ITERATIONS: usize = 10;
-
-/// See [`STALL_ITERATIONS`].
-const STALL_FRACTION: f64 = 0.01;
-
-impl Problem<'_> {
-    fn stalled(&self) -> bool {
-        let h = &self.history;
-        h.len() > STALL_ITERATIONS && h[h.len() - 1] > (1.0 - STALL_FRACTION) * h[h.len() - 1 - STALL_ITERATIONS]
-    }
-}
-
-impl Problem<'_> {
-    fn solve_all(&mut self, x: &[f64]) -> Option<(Vec<f64>, Vec<Achieved>)> {
-        let channels = self.setup.channels(x);
-        let mut r = Vec::new();
-        let mut all = Vec::with_capacity(self.setup.targets.len());
-        for t in 0..self.setup.targets.len() {
-            self.evaluations += 1;
-            let a = self.setup.solve(&channels, x, t).ok()?;
-            r.extend(self.setup.residuals_of(t, &a));
-            all.push(a);
-        }
-        if self.setup.enforces_smooth() {
-            for k in 0..all.len() - 1 {
-                self.evaluations += self.setup.smooth_samples();
-                let leg = self.setup.leg_residuals(&channels, (&self.setup.actuation(x, k), &self.setup.actuation(x, k + 1)), (&all[k], &all[k + 1]))?;
-                r.extend(leg);
-            }
-        }
-        self.last = Some((x.to_vec(), all.clone()));
-        let cost: f64 = r.iter().map(|v| v * v).sum();
-        if cost.is_finite() && self.best.as_ref().is_none_or(|b| cost < b.0) {
-            self.best = Some((cost, x.to_vec(), all.clone()));
-        }
-        Some((r, all))
-    }
-
-    /// Rows of target `t` in the residual vector.
-    fn rows(&self, t: usize) -> std::ops::Range<usize> {
-        let start: usize = self.setup.targets[..t].iter().map(|g| g.components.len()).sum();
-        start..start + self.setup.targets[t].components.len()
-    }
-
-    /// Rows of leg `k`'s reversal residuals (after every target's rows).
-    fn leg_rows(&self, k: usize) -> std::ops::Range<usize> {
-        let n = self.setup.reversal_cables().len();
-        let start = self.rows(self.setup.targets.len() - 1).end + k * n;
-        start..start + n
-    }
-
-    /// Every target's solve at `x` (the last solve's, when it was at `x`).
-    fn solved_at(&mut self, x: &[f64]) -> Option<Vec<Achieved>> {
-        match &self.last {
-            Some((at, all)) if at.as_slice() == x => Some(all.clone()),
-            _ => self.solve_all(x).map(|r| r.1),
-        }
-    }
-}
-
-impl lm::Problem for Problem<'_> {
-    fn residuals(&mut self, x: &[f64]) -> Option<Vec<f64>> {
-        self.solve_all(x).map(|r| r.0)
-    }
-
-    /// Forward differences, inward at an upper bound; a channel variable
-    /// moves every target, an actuation variable only its own target.
-    fn jacobian(&mut self, x: &[f64], r: &[f64], free: &[usize]) -> Option<DMatrix<f64>> {
-        let setup = self.setup;
-        self.history.push(self.best.as_ref().map_or(f64::INFINITY, |b| b.0));
-        let mut jac = DMatrix::zeros(r.len(), free.len());
-        let nc = setup.channel_var_count();
-        let channels = setup.channels(x);
-        for (k, &j) in free.iter().enumerate() {
-            let (lo, hi) = if j < nc { (-1.0, 1.0) } else { (0.0, 1.0) };
-            let mut h = if x[j] + FD_STEP > hi { -FD_STEP } else { FD_STEP };
-            let mut at = x.to_vec();
-            at[j] += h;
-            if at[j] < lo {
-                h = -h;
-                at[j] = x[j] + h;
-            }
-            if j < nc {
-                let (rh, _) = self.solve_all(&at)?;
-                for i in 0..r.len() {
-                    jac[(i, k)] = (rh[i] - r[i]) / h;
-                }
-            } else {
-                let t = (j - nc) / setup.cables();
-                self.evaluations += 1;
-                let a = setup.solve(&channels, &at, t).ok()?;
-                let rh = setup.residuals_of(t, &a);
-                for (i, row) in self.rows(t).enumerate() {
-                    jac[(row, k)] = (rh[i] - r[row]) / h;
-                }
-                if setup.enforces_smooth() {
-                    // The legs into and out of target t move with it.
-                    let base = self.solved_at(x)?;
-                    for leg in t.saturating_sub(1)..(t + 1).min(setup.targets.len() - 1) {
-                        let ends = if leg == t { (&a, &base[t + 1]) } else { (&base[leg], &a) };
-                        self.evaluations += setup.smooth_samples();
-                        let lh = setup.leg_residuals(&channels, (&setup.actuation(&at, leg), &setup.actuation(&at, leg + 1)), ends)?;
-                        for (i, row) in self.leg_rows(leg).enumerate() {
-                            jac[(row, k)] = (lh[i] - r[row]) / h;
-                        }
-                    }
-                }
-            }
-        }
-        Some(jac)
-    }
-
-    fn stop(&mut self) -> bool {
-        self.best.as_ref().is_some_and(|b| b.0 <= COST_FLOOR) || self.evaluations >= self.max_evaluations || self.stalled()
     }
 }
 
@@ -547,7 +358,7 @@ const MAX_SEED_SOLVES: usize = 1500;
 /// actuation level vector; a combination's cost is the sum over targets
 /// of the least cost over its levels. Returns (cost, start point), best
 /// first (ties in combination order), and the number of solves.
-fn grid_seeds(setup: &Setup) -> (Vec<(f64, Point)>, usize) {
+pub fn grid_seeds(setup: &Setup) -> (Vec<(f64, Point)>, usize) {
     let n = setup.cables();
     let per_cable: Vec<Vec<Vec<f64>>> = setup.design.freedom.iter().map(candidates).collect();
     let levels: Vec<f64> = if n <= 3 { vec![0.0, 0.5, 1.0] } else { vec![0.0, 1.0] };
@@ -623,82 +434,6 @@ pub fn point_of(setup: &Setup, channels: &[Channel]) -> Point {
     let mut x: Point = (0..setup.cables()).flat_map(|c| setup.unit_channel(c, &channels[c])).collect();
     x.resize(setup.var_count(), 0.5);
     x
-}
-
-/// Refines one start; returns the best point seen with its cost and solves.
-fn refine(setup: &Setup, x0: &[f64], max_evaluations: usize, source: &'static str) -> (Option<(f64, Point, Vec<Achieved>)>, StartReport) {
-    let mut p = Problem { setup, last: None, best: None, evaluations: 0, max_evaluations, history: Vec::new() };
-    let start = p.solve_all(x0);
-    let seed_cost = start.as_ref().map_or(f64::INFINITY, |s| s.0.iter().map(|v| v * v).sum());
-    let termination = match start {
-        Some((r, _)) => lm::minimise(&mut p, x0.to_vec(), r, &setup.settings(), &mut |_| {}).termination.to_string(),
-        None => "the start could not be solved".into(),
-    };
-    let cost = p.best.as_ref().map_or(f64::INFINITY, |b| b.0);
-    let termination = if cost <= COST_FLOOR {
-        "exact fit (objective at the noise floor)".into()
-    } else if p.evaluations >= max_evaluations {
-        "evaluation budget reached".into()
-    } else if p.stalled() {
-        format!("stalled: the cost fell by less than {} % over {STALL_ITERATIONS} iterations", 100.0 * STALL_FRACTION)
-    } else {
-        termination
-    };
-    let report = StartReport { seed_cost, cost, evaluations: p.evaluations, source, termination };
-    (p.best, report)
-}
-
-/// Designs: seeds from the grid (and `extra`, e.g. a map's designs' channels,
-/// which come first), the best `search.starts` refined in parallel, the
-/// least cost kept (ties to the earlier start).
-pub fn search(setup: &Setup, search: &CableSearch, extra: &[Vec<Channel>]) -> Result<Found, DesignError> {
-    if search.starts == 0 {
-        return Err(DesignError::BadSearch("the number of starts must be at least 1".into()));
-    }
-    let (grid, mut seeds_simulated) = grid_seeds(setup);
-    let mut starts: Vec<(Point, &'static str)> = Vec::new();
-    // A map's designs take up to half of the starts, ahead of the grid's.
-    for channels in extra.iter().take(search.starts.div_ceil(2)) {
-        seeds_simulated += 1;
-        let mut x = point_of(setup, channels);
-        // Their actuation: the best grid combination's levels, per target.
-        if let Some((_, g)) = grid.first() {
-            let s = setup.channel_var_count();
-            x[s..].copy_from_slice(&g[s..]);
-        }
-        starts.push((x, "map"));
-    }
-    // Seeds of equal cost are one design twice (two interchangeable cables
-    // swapped): one of them is refined.
-    let mut last_cost = f64::NAN;
-    for (cost, x) in &grid {
-        if starts.len() >= search.starts {
-            break;
-        }
-        if (cost - last_cost).abs() <= 1e-9 * cost.abs() {
-            continue;
-        }
-        last_cost = *cost;
-        starts.push((x.clone(), "grid"));
-    }
-    if starts.is_empty() {
-        return Err(DesignError::NoSeed);
-    }
-    // Per target, and per leg its samples when the trajectory is smooth.
-    let legs = if setup.enforces_smooth() { setup.targets.len() - 1 } else { 0 };
-    let budget = search.max_evaluations * (setup.targets.len() + legs * setup.smooth_samples());
-    let results: Vec<_> = starts.par_iter().map(|(x, source)| refine(setup, x, budget, source)).collect();
-    let mut best: Option<(f64, Point, Vec<Achieved>)> = None;
-    for (b, _) in &results {
-        if let Some(b) = b {
-            if best.as_ref().is_none_or(|c| b.0 < c.0) {
-                best = Some(b.clone());
-            }
-        }
-    }
-    let (cost, x, achieved) = best.ok_or(DesignError::NoSeed)?;
-    let achieved = achieved.into_iter().enumerate().map(|(t, a)| (setup.actuation(&x, t), a)).collect();
-    Ok(Found { channels: setup.channels(&x), x, achieved, cost, starts: results.into_iter().map(|r| r.1).collect(), seeds_simulated })
 }
 
 /// How steeply `values` (a cable's tension at evenly spaced samples of a

@@ -10,8 +10,8 @@
 //! A free coordinate stays within `max_offset_mm` of the axis (default the
 //! thesis's 0.999 r: the radius less a skin of 0.1 %).
 
-use super::super::objective::Bounds;
-use super::super::DesignError;
+use super::objective::Bounds;
+use super::DesignError;
 use crate::model::{Actuator, Rod};
 use serde::Serialize;
 use std::path::Path;
@@ -26,7 +26,7 @@ pub const DEFAULT_TENSION_MAX_N: f64 = 2.0;
 /// its answers; for several, 0 N (an antagonist must be able to go slack).
 pub fn default_tension_min_n(cables: usize) -> f64 {
     if cables == 1 {
-        crate::design::run::DEFAULT_TENSION_RANGE_N[0]
+        crate::design::request::DEFAULT_TENSION_RANGE_N[0]
     } else {
         0.0
     }
