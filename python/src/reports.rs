@@ -21,7 +21,7 @@ use cablemap::design::targets::TargetSet;
 use cablemap::design::{DesignError, DesignRequest, SearchOptions, Target, Weights};
 use cablemap::solver::spatial::SpatialOptions;
 use cablemap::model::{Actuator, Rod, RodOverrides, REGISTRY};
-use cablemap::mould::{MouldOptions, MouldParams};
+use cablemap::mould::MouldParams;
 use cablemap::shape::LengthBasis;
 use pyo3::prelude::*;
 use serde::Deserialize;

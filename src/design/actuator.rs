@@ -17,6 +17,9 @@ use serde::Serialize;
 use std::path::Path;
 
 /// Default upper tension bound of a designed cable, N (the thesis's τ_u).
+/// Tension bounds without a map, N (the thesis's design range, §5).
+pub const DEFAULT_TENSION_RANGE_N: [f64; 2] = [1.0, 2.0];
+
 pub const DEFAULT_TENSION_MAX_N: f64 = 2.0;
 
 /// Default lower tension bound of a designed cable of an actuator with
@@ -26,7 +29,7 @@ pub const DEFAULT_TENSION_MAX_N: f64 = 2.0;
 /// its answers; for several, 0 N (an antagonist must be able to go slack).
 pub fn default_tension_min_n(cables: usize) -> f64 {
     if cables == 1 {
-        crate::design::request::DEFAULT_TENSION_RANGE_N[0]
+        DEFAULT_TENSION_RANGE_N[0]
     } else {
         0.0
     }
@@ -100,7 +103,7 @@ pub struct DesignActuator {
 const DESIGN_KEYS: [&str; 6] = ["free", "tension_min_n", "tension_max_n", "displacement_max_mm", "max_offset_mm", "displacement_min_mm"];
 
 fn bad(source: &str, message: String) -> DesignError {
-    DesignError::BadBounds(format!("{source}: {message}"))
+    DesignError::ActuatorFile { file: source.to_string(), message }
 }
 
 impl DesignActuator {

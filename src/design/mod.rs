@@ -36,6 +36,7 @@ pub mod run;
 pub mod search;
 pub mod sequence;
 pub mod sequence_export;
+pub mod sequence_report;
 pub mod sequence_run;
 pub mod target;
 pub mod targets;
@@ -50,12 +51,18 @@ pub use target::{Component, Target, Weights};
 /// Why a feasibility check or a design could not be made.
 #[derive(Debug, thiserror::Error)]
 pub enum DesignError {
-    /// The target is malformed or asks for what the solver cannot resolve.
-    #[error("bad target: {0}")]
-    BadTarget(String),
+    /// The target is malformed.
+    #[error("bad target: {problem}")]
+    BadTarget {
+        /// What is wrong.
+        problem: target::ListProblem,
+    },
     /// The weights are malformed or inconsistent with the target.
-    #[error("bad weights: {0}")]
-    BadWeights(String),
+    #[error("bad weights: {problem}")]
+    BadWeights {
+        /// What is wrong.
+        problem: target::ListProblem,
+    },
     /// Both or neither of a target and a targets file.
     #[error("give either a target (--target) or a targets file (--targets)")]
     TargetOrTargets,
@@ -137,9 +144,44 @@ pub enum DesignError {
     /// No design can reach the targets (found before any search).
     #[error("unreachable: {0}")]
     Unreachable(String),
-    /// Tension or offset bounds are unusable.
-    #[error("bad bounds: {0}")]
-    BadBounds(String),
+    /// A targets file that cannot be read or breaks its format (docs/design.md).
+    #[error("bad target: {}{message}", path.as_ref().map_or(String::new(), |p| format!("{}: ", p.display())))]
+    TargetsFile {
+        /// The file, when read from one.
+        path: Option<std::path::PathBuf>,
+        /// What the file gets wrong, in the file's own terms.
+        message: String,
+    },
+    /// An actuator file of a design that cannot be read or breaks its format.
+    #[error("bad bounds: {file}: {message}")]
+    ActuatorFile {
+        /// The file (or the text's name).
+        file: String,
+        /// What the file gets wrong, in the file's own terms.
+        message: String,
+    },
+    /// The designed channels are no channels (written to the design's files).
+    #[error("bad bounds: the designed channels: {source}")]
+    Channels {
+        /// Why.
+        source: crate::model::ActuatorError,
+    },
+    /// Writing a target's actuator file.
+    #[error("bad bounds: writing the actuator of {target}: {source}")]
+    ActuatorToml {
+        /// The target's name.
+        target: String,
+        /// Why.
+        source: toml::ser::Error,
+    },
+    /// Re-solving a target's design for its picture.
+    #[error("bad bounds: re-simulating {target}: {source}")]
+    ResimulateTarget {
+        /// The target's name.
+        target: String,
+        /// Why.
+        source: crate::solver::spatial::SpatialError,
+    },
     /// Invalid actuator parameters.
     #[error(transparent)]
     Parameter(#[from] crate::model::ParameterError),

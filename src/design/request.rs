@@ -2,7 +2,7 @@
 //! of one planar cable for one target, or an actuator of 1–8 cables for a
 //! sequence of targets, decided from its input.
 
-use super::actuator::DesignActuator;
+use super::actuator::{DesignActuator, DEFAULT_TENSION_RANGE_N};
 use super::map::MapDir;
 use super::objective::{Bounds, Objective};
 use super::search::SearchOptions;
@@ -14,9 +14,6 @@ use crate::solver::SolverOptions;
 use crate::mould::MouldParams;
 use crate::shape::LengthBasis;
 use std::path::PathBuf;
-
-/// Tension bounds without a map, N (the thesis's design range, §5).
-pub const DEFAULT_TENSION_RANGE_N: [f64; 2] = [1.0, 2.0];
 
 /// Everything a design needs: the thesis's design of one planar cable for
 /// one target (`target`), or an actuator of 1–8 cables for a sequence of

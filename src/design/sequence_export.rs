@@ -5,7 +5,7 @@
 //! (`trajectory.csv`) and its picture (`trajectory.png`).
 
 use super::sequence::Setup;
-use super::sequence_run::SequenceRun;
+use super::sequence_report::SequenceRun;
 use super::DesignError;
 use crate::io::FileError;
 use crate::model::cable;
@@ -32,13 +32,13 @@ pub fn write_all(dir: &Path, run: &SequenceRun, setup: &Setup) -> Result<Vec<Str
     text.push('\n');
     write("design.json", text.as_bytes())?;
     let first = &run.targets[0].actuator;
-    let channels = first.channels().map_err(|e| DesignError::BadBounds(format!("the designed channels: {e}")))?;
+    let channels = first.channels().map_err(|source| DesignError::Channels { source })?;
     for (i, ch) in channels.iter().enumerate() {
         let end = first.cables[i].anchor_or_tip_mm(first.rod.length_mm);
         write(&cable::channel_file_name(i), ch.csv(end).as_bytes())?;
     }
     for (i, t) in run.targets.iter().enumerate() {
-        let toml = toml::to_string(&t.actuator).map_err(|e| DesignError::BadBounds(format!("writing the actuator of {}: {e}", t.target.name)))?;
+        let toml = toml::to_string(&t.actuator).map_err(|source| DesignError::ActuatorToml { target: t.target.name.clone(), source })?;
         let head = format!("# {}: the actuator of this design at this target; cablemap simulate --actuator FILE solves it again\n", t.target.name);
         write(&actuator_file_name(i), format!("{head}{toml}").as_bytes())?;
     }
@@ -54,7 +54,7 @@ pub fn write_all(dir: &Path, run: &SequenceRun, setup: &Setup) -> Result<Vec<Str
             }
         }
         write("trajectory.csv", csv.as_bytes())?;
-        let waypoint = |t: &super::sequence_run::TargetOutcome| t.target.tip_mm().map(|v| v.unwrap_or(f64::NAN));
+        let waypoint = |t: &super::sequence_report::TargetOutcome| t.target.tip_mm().map(|v| v.unwrap_or(f64::NAN));
         let drawing = crate::plot::spatial::TrajectoryDrawing {
             waypoints: run.targets.iter().map(waypoint).collect(),
             legs: tr.legs.iter().map(|l| l.samples.iter().map(|s| s.tip_mm).collect()).collect(),
@@ -65,7 +65,7 @@ pub fn write_all(dir: &Path, run: &SequenceRun, setup: &Setup) -> Result<Vec<Str
         written.push("trajectory.png".to_string());
     }
     for (i, t) in run.targets.iter().enumerate() {
-        let sim = setup.simulate(&t.actuator).map_err(|e| DesignError::BadBounds(format!("re-simulating {}: {e}", t.target.name)))?;
+        let sim = setup.simulate(&t.actuator).map_err(|source| DesignError::ResimulateTarget { target: t.target.name.clone(), source })?;
         let name = format!("target_{}.png", i + 1);
         let tensions: Vec<String> = sim.pose.tensions_n.iter().map(|v| format!("{v:.3}")).collect();
         crate::plot::spatial::draw_spatial(&dir.join(&name), &format!("{}: tensions [{}] N", t.target.name, tensions.join(", ")), &sim)?;

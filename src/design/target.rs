@@ -88,19 +88,18 @@ impl Target {
     /// Parses `x=50,y=5,a0=-0.025,a1=-0.06,a2=0.015` (any subset, any order).
     pub fn parse(text: &str) -> Result<Self, DesignError> {
         let mut components = Vec::new();
-        for (key, component, value) in parse_pairs(text, "e.g. --target x=50,y=5,a0=-0.025,a1=-0.06,a2=0.015", DesignError::BadTarget)? {
+        let bad = |problem| DesignError::BadTarget { problem };
+        for (key, component, value) in parse_pairs(text, List::Target).map_err(bad)? {
             if !value.is_finite() {
-                return Err(DesignError::BadTarget(format!("{key}: '{value}' is not a finite number")));
+                return Err(bad(ListProblem::NotFinite { key, value }));
             }
             if components.iter().any(|(c, _)| *c == component) {
-                return Err(DesignError::BadTarget(format!("{key} is given twice")));
+                return Err(bad(ListProblem::Twice { key }));
             }
             components.push((component, value));
         }
         if components.is_empty() {
-            return Err(DesignError::BadTarget(
-                "the target is empty; give at least one of x, y, a0, a1, … e.g. --target x=50,y=5".into(),
-            ));
+            return Err(bad(ListProblem::EmptyTarget));
         }
         components.sort_by_key(|c| c.0);
         Ok(Self { components })
@@ -140,11 +139,10 @@ impl Weights {
     /// thesis defaults). Weights must be finite and ≥ 0.
     pub fn parse(text: &str) -> Result<Self, DesignError> {
         let mut overrides: Vec<(Component, f64)> = Vec::new();
-        for (key, component, value) in
-            parse_pairs(text, "e.g. --weights x=1,y=1,a0=100,a1=50,a2=25", DesignError::BadWeights)?
-        {
+        let bad = |problem| DesignError::BadWeights { problem };
+        for (key, component, value) in parse_pairs(text, List::Weights).map_err(bad)? {
             if !(value.is_finite() && value >= 0.0) {
-                return Err(DesignError::BadWeights(format!("{key}: '{value}' is not a finite weight ≥ 0")));
+                return Err(bad(ListProblem::NotAWeight { key, value }));
             }
             overrides.retain(|(c, _)| *c != component);
             overrides.push((component, value));
@@ -162,38 +160,108 @@ impl Weights {
     pub fn check_against(&self, target: &Target) -> Result<(), DesignError> {
         for (c, _) in &self.overrides {
             if target.get(*c).is_none() {
-                return Err(DesignError::BadWeights(format!(
-                    "a weight is given for {} but the target does not ask for it; add {}=… to --target or drop the weight",
-                    c.key(),
-                    c.key()
-                )));
+                return Err(DesignError::BadWeights { problem: ListProblem::NotInTarget { key: c.key() } });
             }
         }
         if target.components.iter().all(|(c, _)| self.get(*c) == 0.0) {
-            return Err(DesignError::BadWeights("every weight is zero: nothing to fit".into()));
+            return Err(DesignError::BadWeights { problem: ListProblem::AllZero });
         }
         Ok(())
     }
 }
 
-/// Splits `KEY=VALUE,…` into (key, component, number); `example` completes
-/// the error messages, `error` says which kind of list is wrong.
-fn parse_pairs(text: &str, example: &str, error: fn(String) -> DesignError) -> Result<Vec<(String, Component, f64)>, DesignError> {
+/// Which list of `KEY=VALUE` pairs: a target or its weights.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum List {
+    /// `--target`.
+    Target,
+    /// `--weights`.
+    Weights,
+}
+
+impl List {
+    /// An example of the list, completing the error messages.
+    pub fn example(self) -> &'static str {
+        match self {
+            List::Target => "e.g. --target x=50,y=5,a0=-0.025,a1=-0.06,a2=0.015",
+            List::Weights => "e.g. --weights x=1,y=1,a0=100,a1=50,a2=25",
+        }
+    }
+}
+
+/// What is wrong with a target's or its weights' list.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ListProblem {
+    /// An item without `=`.
+    #[error("'{item}' is not KEY=VALUE; write {}", list.example())]
+    NotKeyValue {
+        /// The item.
+        item: String,
+        /// Which list.
+        list: List,
+    },
+    /// A key that names no component.
+    #[error("unknown component '{key}'; use x, y (tip, mm) or a0 … a{MAX_ORDER} (curvature coefficients, 1/mm)")]
+    UnknownComponent {
+        /// The key.
+        key: String,
+    },
+    /// A value that is no number.
+    #[error("{key}: '{value}' is not a finite number; {}{}", if value.contains(['=', ' ', ';', '\t']) { "separate components with commas, " } else { "" }, list.example())]
+    NotANumber {
+        /// The key.
+        key: String,
+        /// The value as written.
+        value: String,
+        /// Which list.
+        list: List,
+    },
+    /// A target value that is not finite.
+    #[error("{key}: '{value}' is not a finite number")]
+    NotFinite {
+        /// The key.
+        key: String,
+        /// The value.
+        value: f64,
+    },
+    /// A component given twice.
+    #[error("{key} is given twice")]
+    Twice {
+        /// The key.
+        key: String,
+    },
+    /// No component.
+    #[error("the target is empty; give at least one of x, y, a0, a1, … e.g. --target x=50,y=5")]
+    EmptyTarget,
+    /// A weight that is negative or not finite.
+    #[error("{key}: '{value}' is not a finite weight ≥ 0")]
+    NotAWeight {
+        /// The key.
+        key: String,
+        /// The value.
+        value: f64,
+    },
+    /// A weight for a component the target does not ask for.
+    #[error("a weight is given for {key} but the target does not ask for it; add {key}=… to --target or drop the weight")]
+    NotInTarget {
+        /// The component's key.
+        key: String,
+    },
+    /// Every weight zero.
+    #[error("every weight is zero: nothing to fit")]
+    AllZero,
+}
+
+/// Splits `KEY=VALUE,…` into (key, component, number).
+fn parse_pairs(text: &str, list: List) -> Result<Vec<(String, Component, f64)>, ListProblem> {
     text.split(',')
         .map(str::trim)
         .filter(|s| !s.is_empty())
         .map(|item| {
-            let (key, value) = item.split_once('=').ok_or_else(|| error(format!("'{item}' is not KEY=VALUE; write {example}")))?;
+            let (key, value) = item.split_once('=').ok_or_else(|| ListProblem::NotKeyValue { item: item.to_string(), list })?;
             let key = key.trim();
-            let component = Component::parse(key).ok_or_else(|| {
-                error(format!("unknown component '{key}'; use x, y (tip, mm) or a0 … a{MAX_ORDER} (curvature coefficients, 1/mm)"))
-            })?;
-            let number: f64 = value.trim().parse().map_err(|_| {
-                let value = value.trim();
-                // "x=50 y=5" or "x=50;y=5": another component written into this one's value.
-                let separator = if value.contains(['=', ' ', ';', '\t']) { "; separate components with commas, " } else { "; " };
-                error(format!("{key}: '{value}' is not a finite number{separator}{example}"))
-            })?;
+            let component = Component::parse(key).ok_or_else(|| ListProblem::UnknownComponent { key: key.to_string() })?;
+            let number: f64 = value.trim().parse().map_err(|_| ListProblem::NotANumber { key: key.to_string(), value: value.trim().to_string(), list })?;
             Ok((key.to_string(), component, number))
         })
         .collect()

@@ -218,15 +218,16 @@ struct TrajectoryTable {
 }
 
 fn bad(message: String) -> DesignError {
-    DesignError::BadTarget(message)
+    DesignError::TargetsFile { path: None, message }
 }
 
 impl TargetSet {
     /// Reads a targets file; `length_mm` (the rod's) sets the default weights.
     pub fn read(path: &Path, length_mm: f64) -> Result<Self, DesignError> {
-        let text = std::fs::read_to_string(path).map_err(|e| bad(format!("{}: {e}", path.display())))?;
+        let in_file = |message| DesignError::TargetsFile { path: Some(path.to_path_buf()), message };
+        let text = std::fs::read_to_string(path).map_err(|e| in_file(e.to_string()))?;
         Self::parse(&text, length_mm).map_err(|e| match e {
-            DesignError::BadTarget(m) => bad(format!("{}: {m}", path.display())),
+            DesignError::TargetsFile { path: None, message } => in_file(message),
             e => e,
         })
     }

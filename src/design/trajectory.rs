@@ -8,7 +8,7 @@
 
 use super::sequence::{Channel, Setup};
 use super::targets::Trajectory;
-use super::sequence_run::TargetOutcome;
+use super::targets::ShapeTarget;
 use super::DesignError;
 use serde::Serialize;
 use std::fmt;
@@ -120,11 +120,11 @@ fn reverses(values: &[f64]) -> bool {
 }
 
 /// Samples the path of the designed `channels` through the waypoints' `targets`.
-pub fn path(setup: &Setup, channels: &[Channel], targets: &[TargetOutcome], trajectory: &Trajectory) -> Result<PathReport, DesignError> {
+pub fn path(setup: &Setup, channels: &[Channel], targets: &[(&ShapeTarget, &[f64])], trajectory: &Trajectory) -> Result<PathReport, DesignError> {
     use rayon::prelude::*;
     let n = trajectory.steps_per_leg;
-    let waypoint = |t: &TargetOutcome| -> [f64; 3] {
-        let tip = t.target.tip_mm();
+    let waypoint = |t: &(&ShapeTarget, &[f64])| -> [f64; 3] {
+        let tip = t.0.tip_mm();
         [tip[0].unwrap_or(f64::NAN), tip[1].unwrap_or(f64::NAN), tip[2].unwrap_or(f64::NAN)]
     };
     let legs: Vec<Leg> = targets
@@ -136,7 +136,7 @@ pub fn path(setup: &Setup, channels: &[Channel], targets: &[TargetOutcome], traj
                 .into_par_iter()
                 .map(|j| {
                     let f = j as f64 / n as f64;
-                    let actuation: Vec<f64> = w[0].actuation.iter().zip(&w[1].actuation).map(|(p, q)| p + f * (q - p)).collect();
+                    let actuation: Vec<f64> = w[0].1.iter().zip(w[1].1).map(|(p, q)| p + f * (q - p)).collect();
                     match setup.simulate(&setup.actuator(channels, &actuation)) {
                         Ok(sim) => {
                             let tip = sim.pose.tip_mm();
