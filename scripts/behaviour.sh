@@ -40,12 +40,17 @@ run simulate-tentacle simulate --actuator "$work/actuator.toml" --json
 run design-5.1-I design --target x=50,y=5,a0=-0.025,a1=-0.06,a2=0.015 --json
 run design-5.1-II design --target x=10,y=50,a0=0.015,a1=-0.07,a2=-0.03 --json
 run design-targets design --actuator tests/data/design/two-free-cables.toml --targets tests/data/design/two-targets.toml --json
+# the same one-cable design by a targets file, and designs within the moulds
+run design-targets-one-cable design --targets tests/data/design/table-5-1-I.toml --json
+run design-5.1-I-moulds design --target x=50,y=5,a0=-0.025,a1=-0.06,a2=0.015 --out "$work/moulds-I" --moulds --json
 
 # a sweep and map, feasible on it; a cable sweep and its map
 "$bin" map jobs/quick.toml --out "$work/quick" > /dev/null 2>&1 || echo "map quick failed" >> "$out/errors"
 run feasible-I feasible --map "$work/quick/map" --target x=50,y=5,a0=-0.025,a1=-0.06 --json
 run feasible-xy feasible --map "$work/quick/map" --target x=40,y=20 --json
 "$bin" map jobs/antagonistic-pair.toml --out "$work/pair" > /dev/null 2>&1 || echo "map antagonistic-pair failed" >> "$out/errors"
+run feasible-targets feasible --map "$work/pair/map" --targets tests/data/design/two-targets.toml --json
+run design-targets-map design --actuator tests/data/spatial/antagonistic.toml --targets tests/data/design/two-targets.toml --map "$work/pair/map" --json --starts 2 --max-evaluations 200
 "$bin" map jobs/spatial-pair.toml --out "$work/spatial" > /dev/null 2>&1 || echo "map spatial-pair failed" >> "$out/errors"
 
 # calibrate and diagnose on three synth files, and on the tentacle
