@@ -145,7 +145,7 @@ fn bench_ladder(
     by_displacement: bool,
     label: &str,
 ) -> Result<BenchFigures, crate::Error> {
-    use crate::solver::actuation::meet_displacements;
+    use crate::solver::Solver;
     let mut sim = Simulator::new(actuator, options)?;
     let mut per_solve = Vec::with_capacity(routings.len());
     let mut a = [0.0; 4];
@@ -156,7 +156,7 @@ fn bench_ladder(
         sim.set_routing(&routing);
         let mut tension = [0.0];
         for &v in ladder {
-            let solved = if by_displacement { meet_displacements(&mut sim, &[Some(v)], &mut tension) } else { sim.solve(v) };
+            let solved = if by_displacement { Solver::solve(&mut sim, &[crate::model::Actuation::Displacement(v)], &mut tension) } else { sim.solve(v) };
             match solved {
                 Ok(pose) => {
                     sim.coefficients_into(crate::shape::LengthBasis::default(), &mut a);

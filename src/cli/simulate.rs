@@ -2,7 +2,7 @@
 
 use super::{parse_list, ActuatorArgs, LengthBasisArgs};
 use cablemap::solver::record::{self, SimulationRecord};
-use cablemap::model::{Actuator, Cable, LoadDirection, Routing};
+use cablemap::model::{Actuation, Actuator, Cable, LoadDirection, Routing};
 use cablemap::solver::{simulate_actuator, simulate_held, Backend, Given, Hold, SimulateError, SolverOptions};
 use cablemap::plot::{draw_bodies, BodyDrawing};
 use anyhow::Context;
@@ -125,12 +125,12 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
             if let (Err(SimulateError::Solve(failure)), true) = (&solved, args.json) {
                 print_failure_json(failure.status(), &failure.to_string())?;
             }
-            solved.with_context(|| format!("simulating routing {y:?} at {actuation}"))?
+            solved.with_context(|| format!("simulating routing {y:?} at {}", describe(actuation)))?
         }
         // A displacement, or a stiffness: the actuator's one cable, checked
         // and solved as every actuator's (the same planar backend).
         _ => {
-            let one = Actuator::with_cables(actuator.clone(), vec![actuation.cable(routing.control_points_mm().0, args.cable_ea_n)]);
+            let one = Actuator::with_cables(actuator.clone(), vec![routing_cable(actuation, routing.control_points_mm().0, args.cable_ea_n)]);
             let spatial_options = cablemap::solver::spatial::SpatialOptions::default();
             let solved = simulate_actuator(&one, &options, &spatial_options, given_settings(args), Some(hold), exact_order, basis);
             if let (Err(e), true) = (&solved, args.json) {
@@ -138,7 +138,7 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
                     print_failure_json(status, &e.to_string())?;
                 }
             }
-            solved.with_context(|| format!("simulating routing {y:?} at {actuation}"))?
+            solved.with_context(|| format!("simulating routing {y:?} at {}", describe(actuation)))?
         }
     };
     if args.coefficients == CoefficientRoute::Thesis {
@@ -211,7 +211,7 @@ fn run_spatial(args: &SimulateArgs) -> anyhow::Result<()> {
     if let (Some(routing), Some(actuation)) = (&args.routing, planar_actuation(args)?) {
         let y = parse_list(routing, "--routing")?;
         let y: [f64; 5] = y.try_into().map_err(|y: Vec<f64>| anyhow::anyhow!("--routing: a routing needs exactly 5 control points y0..y4 (mm), got {}", y.len()))?;
-        spatial.cables = vec![actuation.cable(y, args.cable_ea_n)];
+        spatial.cables = vec![routing_cable(actuation, y, args.cable_ea_n)];
     }
     anyhow::ensure!(
         !spatial.cables.is_empty(),
@@ -273,32 +273,16 @@ fn run_spatial(args: &SimulateArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// How `--routing`'s one cable is driven.
-#[derive(Debug, Clone, Copy)]
-enum Actuation {
-    /// By its tension, N.
-    Tension(f64),
-    /// By its displacement, mm.
-    Displacement(f64),
+/// `--routing`'s one cable on routing `y_mm`, driven by `actuation`, with stiffness `cable_ea_n`.
+fn routing_cable(actuation: Actuation, y_mm: [f64; 5], cable_ea_n: Option<f64>) -> Cable {
+    Cable { cable_ea_n, ..Cable::planar(y_mm, 0.0) }.actuated(actuation)
 }
 
-impl Actuation {
-    /// The planar cable on routing `y_mm` driven so, with stiffness `cable_ea_n`.
-    fn cable(self, y_mm: [f64; 5], cable_ea_n: Option<f64>) -> Cable {
-        let cable = Cable { cable_ea_n, ..Cable::planar(y_mm, 0.0) };
-        match self {
-            Actuation::Tension(t) => Cable { tension_n: t, ..cable },
-            Actuation::Displacement(d) => Cable { displacement_mm: Some(d), ..cable },
-        }
-    }
-}
-
-impl std::fmt::Display for Actuation {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            Actuation::Tension(t) => write!(f, "{} N", cablemap::io::fmt_num(*t)),
-            Actuation::Displacement(d) => write!(f, "a displacement of {} mm", cablemap::io::fmt_num(*d)),
-        }
+/// An actuation in words, for messages.
+fn describe(actuation: Actuation) -> String {
+    match actuation {
+        Actuation::Tension(t) => format!("{} N", cablemap::io::fmt_num(t)),
+        Actuation::Displacement(d) => format!("a displacement of {} mm", cablemap::io::fmt_num(d)),
     }
 }
 

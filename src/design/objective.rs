@@ -98,11 +98,6 @@ pub struct Objective {
     pub length_basis: LengthBasis,
 }
 
-/// Largest tension step of the continuation ladder used when a cold solve
-/// fails, N (the same as `model::simulate`: keeps Newton and the shooting in
-/// their basin for strongly curled shapes).
-pub const LADDER_STEP_N: f64 = 0.25;
-
 impl Objective {
     /// Builds and checks an objective.
     pub fn new(rod: Rod, options: SolverOptions, target: Target, weights: Weights, bounds: Bounds) -> Result<Self, DesignError> {
@@ -149,7 +144,7 @@ impl Objective {
             Ok(pose) => pose,
             Err(_) => {
                 sim.set_routing(&routing);
-                let rungs = ((tension_n / LADDER_STEP_N).ceil() as usize).max(1);
+                let rungs = crate::solver::ladder::tension_rungs(tension_n);
                 let mut pose = None;
                 for k in 1..=rungs {
                     pose = Some(sim.solve(tension_n * k as f64 / rungs as f64)?);

@@ -54,6 +54,27 @@ pub struct Cable {
     pub anchor_mm: Option<f64>,
 }
 
+/// How a cable is driven at the base: the one actuation type of every
+/// solve, ladder, capture and sweep row.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Actuation {
+    /// Pulled with this tension, N.
+    Tension(f64),
+    /// Pulled in by this length, mm (its tension is found by the solve).
+    Displacement(f64),
+}
+
+impl Actuation {
+    /// The same actuation scaled by `fraction` (a continuation ladder's rung).
+    pub fn scaled(self, fraction: f64) -> Actuation {
+        match self {
+            Actuation::Tension(t) => Actuation::Tension(t * fraction),
+            Actuation::Displacement(d) => Actuation::Displacement(d * fraction),
+        }
+    }
+}
+
 /// A cable as the actuator file writes it (exactly one actuation).
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -123,6 +144,24 @@ impl Cable {
     pub fn is_displacement_driven(&self) -> bool {
         self.displacement_mm.is_some()
     }
+
+    /// How the cable is driven: its displacement if it has one, else its tension.
+    pub fn actuation(&self) -> Actuation {
+        match self.displacement_mm {
+            Some(d) => Actuation::Displacement(d),
+            None => Actuation::Tension(self.tension_n),
+        }
+    }
+
+    /// The cable driven by `actuation` (a displacement-driven cable's
+    /// tension starts at zero).
+    pub fn actuated(&self, actuation: Actuation) -> Cable {
+        match actuation {
+            Actuation::Tension(t) => Cable { tension_n: t, displacement_mm: None, ..self.clone() },
+            Actuation::Displacement(d) => Cable { tension_n: 0.0, displacement_mm: Some(d), ..self.clone() },
+        }
+    }
+
 
     /// Whether the channel lies in the body's x–y plane (every z_i = 0).
     pub fn is_planar(&self) -> bool {

@@ -16,7 +16,7 @@ mod validation;
 
 pub use actuator::Actuator;
 pub use body::{Body, BodyError, Segment};
-pub use cable::{Cable, MAX_CABLES};
+pub use cable::{Actuation, Cable, MAX_CABLES};
 pub use effect_parameters::{Effects, LoadDirection};
 pub use parameter::{ParameterError, PlausibleRange};
 pub use rod::{Gravity, Rod};

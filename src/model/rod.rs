@@ -204,11 +204,6 @@ impl Rod {
         }
     }
 
-    /// The largest radius along the rod, mm.
-    pub fn max_radius_mm(&self) -> f64 {
-        self.radius_profile_mm.iter().map(|p| p.1).fold(if self.radius_profile_mm.is_empty() { self.radius_mm } else { 0.0 }, f64::max)
-    }
-
     /// Reads an actuator TOML file (the fields of [`Rod`], as in a sweep
     /// spec's `[actuator]` section; missing fields are the thesis's), checked
     /// with [`Rod::validate`]. This module owns the actuator file format.

@@ -23,19 +23,9 @@ use crate::model::cable::MAX_CABLES;
 /// the tension within ~1e-11 N and the shape within ~1e-9 mm.
 pub const DISPLACEMENT_TOLERANCE_MM: f64 = 1e-11;
 /// Largest tension change of one Newton step, N (the tension ladder's rung).
-const MAX_TENSION_STEP_N: f64 = 0.25;
+const MAX_TENSION_STEP_N: f64 = super::ladder::TENSION_RUNG_N;
 /// Newton steps before giving up.
 const MAX_ITERATIONS: usize = 400;
-
-/// A solver of the statics at given cable tensions.
-pub trait TensionSolve {
-    /// Why a solve failed.
-    type Error;
-    /// Solves at `tensions_n` (one per cable), warm-started from the last solve.
-    fn solve_tensions(&mut self, tensions_n: &[f64]) -> Result<TipPose, Self::Error>;
-    /// The failure of displacements that could not be met.
-    fn not_met(e: DisplacementNotMet) -> Self::Error;
-}
 
 /// Newton's method did not meet a cable's displacement.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -51,27 +41,24 @@ pub struct DisplacementNotMet {
     pub iterations: usize,
 }
 
-impl DisplacementNotMet {
-    fn into_error<S: TensionSolve>(self) -> S::Error {
-        S::not_met(self)
-    }
-}
-
 /// Meets each cable's actuation: `displacements_mm[i]` = Some(D) drives cable
 /// i to the displacement D (its tension found), None keeps its tension at
 /// `tensions_n[i]`. `tensions_n` holds the start (and, for displacement-driven
 /// cables, receives the tensions found). Returns the pose of the last solve,
 /// which is at the tensions returned.
-pub fn meet_displacements<S: TensionSolve>(
-    solver: &mut S,
+/// `solve_tensions` is the solver's warm-started solve at given tensions
+/// ([`super::Solver::solve_tensions`]); [`super::Solver::solve`] is the
+/// entry.
+pub(crate) fn meet_displacements<E: From<DisplacementNotMet>>(
+    mut solve_tensions: impl FnMut(&[f64]) -> Result<TipPose, E>,
     displacements_mm: &[Option<f64>],
     tensions_n: &mut [f64],
-) -> Result<TipPose, S::Error> {
+) -> Result<TipPose, E> {
     let n = tensions_n.len();
     assert!(n <= MAX_CABLES && displacements_mm.len() == n);
     let driven: Vec<usize> = (0..n).filter(|&i| displacements_mm[i].is_some()).collect();
     let off = |pose: &TipPose, i: usize| pose.displacements_mm[i] - displacements_mm[i].expect("driven");
-    let mut pose = solver.solve_tensions(tensions_n)?;
+    let mut pose = solve_tensions(tensions_n)?;
     if driven.is_empty() {
         return Ok(pose);
     }
@@ -98,7 +85,7 @@ pub fn meet_displacements<S: TensionSolve>(
             let eps = 1e-6 * (1.0 + base[j]);
             tensions_n.copy_from_slice(&base);
             tensions_n[j] += eps;
-            let probe = solver.solve_tensions(tensions_n)?;
+            let probe = solve_tensions(tensions_n)?;
             for (row, &i) in active.iter().enumerate() {
                 jacobian[(row, col)] = (off(&probe, i) - residual[row]) / eps;
             }
@@ -108,7 +95,7 @@ pub fn meet_displacements<S: TensionSolve>(
         tensions_n.copy_from_slice(&base);
         let Some(step) = step else {
             let (i, r) = active.iter().zip(&residual).max_by(|a, b| a.1.abs().total_cmp(&b.1.abs())).map(|(&i, &r)| (i, r)).expect("active");
-            return Err(DisplacementNotMet { cable: i + 1, off_mm: r, tension_n: base[i], iterations: iteration }.into_error::<S>());
+            return Err(DisplacementNotMet { cable: i + 1, off_mm: r, tension_n: base[i], iterations: iteration }.into());
         };
         // Capped like a ladder rung; projected onto τ ≥ 0.
         let largest = step.amax();
@@ -116,15 +103,17 @@ pub fn meet_displacements<S: TensionSolve>(
         for (row, &i) in active.iter().enumerate() {
             tensions_n[i] = (base[i] + scale * step[row]).max(0.0);
         }
-        pose = solver.solve_tensions(tensions_n)?;
+        pose = solve_tensions(tensions_n)?;
     }
     let (i, r) = driven.iter().map(|&i| (i, off(&pose, i))).max_by(|a, b| a.1.abs().total_cmp(&b.1.abs())).expect("driven");
-    Err(DisplacementNotMet { cable: i + 1, off_mm: r, tension_n: tensions_n[i], iterations: MAX_ITERATIONS }.into_error::<S>())
+    Err(DisplacementNotMet { cable: i + 1, off_mm: r, tension_n: tensions_n[i], iterations: MAX_ITERATIONS }.into())
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::Actuation;
+    use crate::solver::Solver;
     use crate::solver::result::PerCable;
 
     /// A toy solver: Δ_i = a_i τ_i + b_i τ_j − c_i (c: the rest state's give).
@@ -135,8 +124,24 @@ mod tests {
     #[derive(Debug)]
     struct ToyError;
 
-    impl TensionSolve for Toy {
+    impl From<DisplacementNotMet> for ToyError {
+        fn from(_: DisplacementNotMet) -> Self {
+            ToyError
+        }
+    }
+
+    impl Solver for Toy {
         type Error = ToyError;
+        fn backend(&self) -> crate::solver::Backend {
+            crate::solver::Backend::Spatial
+        }
+        fn hold_next(&mut self, _: crate::solver::Hold) {}
+        fn centreline(&self) -> Vec<crate::solver::CentrelinePoint> {
+            Vec::new()
+        }
+        fn coefficients(&mut self, order: usize, _: crate::shape::LengthBasis) -> Result<[Vec<f64>; 3], ToyError> {
+            Ok(std::array::from_fn(|_| vec![0.0; order + 1]))
+        }
         fn solve_tensions(&mut self, t: &[f64]) -> Result<TipPose, ToyError> {
             self.solves += 1;
             let mut d = PerCable::filled(2, 0.0);
@@ -158,26 +163,31 @@ mod tests {
                 frame_3d: None,
             })
         }
-        fn not_met(_: DisplacementNotMet) -> ToyError {
-            ToyError
-        }
     }
 
     #[test]
     fn meets_displacements_and_leaves_a_long_cable_slack() {
         let mut toy = Toy { solves: 0 };
         let mut t = [0.0, 0.0];
-        let pose = meet_displacements(&mut toy, &[Some(3.0), Some(0.5)], &mut t).unwrap();
+        let pose = meet_displacements(|t| toy.solve_tensions(t), &[Some(3.0), Some(0.5)], &mut t).unwrap();
         assert!((pose.displacements_mm[0] - 3.0).abs() < 1e-11 && (pose.displacements_mm[1] - 0.5).abs() < 1e-11, "{:?}", pose.displacements_mm);
         assert!(t[0] > 0.0 && t[1] > 0.0);
         // Cable 2 commanded less than its path needs even at zero tension: slack.
         let mut t = [0.0, 0.0];
-        let pose = meet_displacements(&mut toy, &[Some(3.0), Some(0.0)], &mut t).unwrap();
+        let pose = meet_displacements(|t| toy.solve_tensions(t), &[Some(3.0), Some(0.0)], &mut t).unwrap();
         assert_eq!(t[1], 0.0);
         assert!(pose.displacements_mm[1] >= 0.0 && (pose.displacements_mm[0] - 3.0).abs() < 1e-11);
         // A tension-driven cable keeps its tension.
         let mut t = [0.0, 0.7];
-        meet_displacements(&mut toy, &[Some(3.0), None], &mut t).unwrap();
+        meet_displacements(|t| toy.solve_tensions(t), &[Some(3.0), None], &mut t).unwrap();
         assert_eq!(t[1], 0.7);
+        // The same through the interface's one actuation, and up its ladder.
+        let mut t = [0.0, 0.0];
+        let pose = toy.solve(&[Actuation::Displacement(3.0), Actuation::Tension(0.7)], &mut t).unwrap();
+        assert!((pose.displacements_mm[0] - 3.0).abs() < 1e-11 && t[1] == 0.7, "{t:?}");
+        let before = toy.solves;
+        let pose = toy.climb(&[Actuation::Displacement(3.0), Actuation::Tension(0.7)], None).unwrap();
+        assert!((pose.displacements_mm[0] - 3.0).abs() < 1e-11 && pose.tensions_n[1] == 0.7);
+        assert!(toy.solves - before >= crate::solver::ladder::rungs(&[Actuation::Displacement(3.0)]), "one solve per rung at least");
     }
 }

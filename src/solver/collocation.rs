@@ -1102,7 +1102,7 @@ mod tests {
     fn estimated(a: &Rod, m: usize, y: &[f64], tension: f64, order: usize) -> Option<([f64; 3], Vec<f64>, f64, f64)> {
         let mut sim = Simulator::new(a, &SolverOptions { nodes_per_span: m, ..SolverOptions::default() }).ok()?;
         sim.set_routing_mm(y).ok()?;
-        let rungs = ((tension / 0.25).ceil() as usize).max(1);
+        let rungs = crate::solver::ladder::tension_rungs(tension);
         let mut pose = None;
         for k in 1..=rungs {
             let t = tension * k as f64 / rungs as f64;
@@ -1126,7 +1126,7 @@ mod tests {
         let mut rng = crate::calibrate::rng::Rng::new(7);
         let mut checked = 0;
         for _ in 0..12 {
-            let (a, y, tension) = super::super::random_case(&mut rng);
+            let (a, y, tension) = super::super::tests::random_case(&mut rng);
             let Some((fine, fine_a, _, _)) = estimated(&a, 64, &y, tension, 12) else { continue };
             for m in [6, 8, 10, 12, 16] {
                 let order = crate::solver::resolution::REQUIRED_NODES_PER_SPAN.iter().rposition(|&n| n <= m).unwrap().min(12);

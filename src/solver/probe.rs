@@ -59,7 +59,7 @@ impl Simulator {
         let result = (|| {
             if !probe.current {
                 probe.sim.set_routing(self.given_routing.as_ref()?);
-                probe.sim.apply_hold(self.hold).ok()?;
+                probe.sim.apply_hold(self.hold);
                 probe.current = true;
             }
             let (fine, coarse) = (probe.sim.col.as_mut()?, self.col.as_ref()?);

@@ -235,7 +235,7 @@ impl Simulator {
                         }
                     }
                     *dy = d.to_array();
-                    Ok(())
+                    Ok::<(), SolveFailure>(())
                 })?;
                 st = State::from_array(y);
                 if !st.is_finite() {
@@ -424,13 +424,13 @@ mod tests {
         let mut rng = crate::calibrate::rng::Rng::new(11);
         let mut checked = 0;
         for _ in 0..12 {
-            let (a, y, tension) = super::super::random_case(&mut rng);
+            let (a, y, tension) = super::super::tests::random_case(&mut rng);
             let fine = SolverOptions { nodes_per_span: 64, ..SolverOptions::default() };
             let Ok(reference) = simulate(&a, &fine, &Routing::for_actuator(&y, &a).unwrap(), tension, 5, LengthBasis::Rest) else { continue };
             for n in [8, 16, 24] {
                 let mut sim = Simulator::new(&a, &SolverOptions { method: SolverMethod::Rk4, steps_per_span: n, ..SolverOptions::default() }).unwrap();
                 sim.set_routing_mm(&y).unwrap();
-                let rungs = ((tension / 0.25).ceil() as usize).max(1);
+                let rungs = crate::solver::ladder::tension_rungs(tension);
                 let mut solved = None;
                 for k in 1..=rungs {
                     let t = tension * k as f64 / rungs as f64;

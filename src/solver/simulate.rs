@@ -5,11 +5,11 @@
 //! result. [`simulate`] is the planar backends' ladder, [`simulate_spatial`]
 //! the spatial one's; both return the one [`Simulation`].
 
-use super::actuation;
 use super::error::SimulateError;
 use super::result::Simulation;
-use super::{tip_tolerance_mm, Backend, Given, Hold, SolveFailure, SolverMethod, SolverOptions, Simulator, Unresolved, MAX_NODES_PER_SPAN};
+use super::{tip_tolerance_mm, until_resolved, Backend, Given, Hold, SolveFailure, Solver, SolverMethod, SolverOptions, Simulator, Unresolved, MAX_NODES_PER_SPAN};
 use crate::model::parameter::ParameterError;
+use crate::solver::spatial::collocation::check_dwell;
 use crate::solver::spatial::{check_order, SpatialError, SpatialFailure, SpatialOptions, SpatialRk4Solver, SpatialSolver};
 use crate::model::{Actuator, Cable, Rod, Routing};
 use crate::shape::LengthBasis;
@@ -44,26 +44,6 @@ pub fn simulate_held(
     simulate_planar_cable(actuator, options, &Cable::planar(routing.control_points_mm().0, tension_n), routing, order, basis, hold)
 }
 
-/// Like [`simulate_held`] for a cable driven by its displacement: the
-/// cable is pulled in by `displacement_mm` (its stiffness `cable_ea_n`,
-/// `None` inextensible) in rungs of at most [`DISPLACEMENT_RUNG_MM`], each
-/// rung's tension found by [`actuation::meet_displacements`]; the result's
-/// cable carries the tension found.
-#[allow(clippy::too_many_arguments)]
-pub fn simulate_displaced(
-    actuator: &Rod,
-    options: &SolverOptions,
-    routing: &Routing,
-    displacement_mm: f64,
-    cable_ea_n: Option<f64>,
-    order: usize,
-    basis: LengthBasis,
-    hold: Hold,
-) -> Result<Simulation, SimulateError> {
-    let cable = Cable { displacement_mm: Some(displacement_mm), cable_ea_n, ..Cable::planar(routing.control_points_mm().0, 0.0) };
-    simulate_planar_cable(actuator, options, &cable, routing, order, basis, hold)
-}
-
 /// The planar ladder of one `cable` (its routing `routing`, built for the
 /// rod): up its tension, or its displacement; then the coefficients.
 fn simulate_planar_cable(
@@ -76,66 +56,25 @@ fn simulate_planar_cable(
     hold: Hold,
 ) -> Result<Simulation, SimulateError> {
     crate::solver::resolution::check_order(order, options)?;
+    hold.check()?;
+    let actuator = Actuator::with_cables(actuator.clone(), vec![cable.clone()]);
     // A solve the discretisation does not resolve is repeated, from the
     // bottom of the ladder, at a finer one, up to the most there is.
-    let attempt = |options: &SolverOptions| -> Result<Simulation, SimulateError> {
-        let mut sim = Simulator::new(actuator, options)?;
-        sim.set_routing(routing);
-        sim.set_cable_stiffness(cable.cable_ea_n);
-        // A ladder: cheap, and it keeps Newton and the shooting in their
-        // basin for curled-up shapes.
-        let rungs = match cable.displacement_mm {
-            Some(d) => displacement_rungs(d),
-            None if cable.tension_n.is_finite() => ((cable.tension_n / 0.25).ceil() as usize).max(1),
-            None => 1,
-        };
-        let mut tension = [0.0];
-        let mut pose = None;
-        for k in 1..=rungs {
-            if k == rungs {
-                sim.set_hold(hold)?;
-            }
-            let f = k as f64 / rungs as f64;
-            pose = Some(match cable.displacement_mm {
-                Some(d) => actuation::meet_displacements(&mut sim, &[Some(d * f)], &mut tension)?,
-                None => sim.solve(cable.tension_n * f)?,
-            });
-        }
-        let pose = pose.expect("at least one rung");
-        let mut a = vec![0.0; order + 1];
-        sim.coefficients_checked(basis, &mut a)?;
-        let cable = Cable { tension_n: pose.tension_n(), ..cable.clone() };
-        Ok(Simulation {
-            actuator: Actuator::with_cables(actuator.clone(), vec![cable]),
-            backend: Backend::planar(options.method),
-            pose,
-            a_bend_z: a,
-            a_bend_y: vec![0.0; order + 1],
-            a_twist: vec![0.0; order + 1],
-            length_basis: basis,
-            centreline: sim.centreline(),
-        })
-    };
-    let mut options = options.clone();
-    loop {
-        match attempt(&options) {
-            Err(SimulateError::Solve(SolveFailure::Unresolved(_))) if refined(&mut options) => continue,
-            result => return result,
-        }
-    }
-}
-
-/// Largest displacement step of a displacement ladder, mm (at the thesis
-/// rod's ≈ 2.5 mm/N about a 0.25 N tension rung).
-pub const DISPLACEMENT_RUNG_MM: f64 = 0.5;
-
-/// The rungs of a ladder up to `displacement_mm`.
-fn displacement_rungs(displacement_mm: f64) -> usize {
-    ((displacement_mm / DISPLACEMENT_RUNG_MM).ceil() as usize).max(1)
+    until_resolved(
+        options,
+        |options| {
+            let mut sim = Simulator::new(&actuator.rod, options)?;
+            sim.set_routing(routing);
+            sim.set_cable_stiffness(cable.cable_ea_n);
+            Ok(sim.simulate(&actuator, Some(hold), order, basis)?)
+        },
+        |e| matches!(e, SimulateError::Solve(SolveFailure::Unresolved(_))),
+        refined,
+    )
 }
 
 /// Highest tension the continuation ladders of [`simulate`] and
-/// [`simulate_spatial`] climb to, N: 10⁵ rungs of 0.25 N
+/// [`simulate_spatial`] climb to, N: 10⁵ rungs of [`ladder::TENSION_RUNG_N`]
 /// (a few seconds); an absurd tension is refused rather than climbed for hours.
 pub const MAX_LADDER_TENSION_N: f64 = 25_000.0;
 
@@ -214,80 +153,52 @@ pub fn simulate_spatial_held(
     if options.method == SolverMethod::Rk4 {
         return simulate_spatial_rk4(actuator, options, order, basis);
     }
-    let mut options = options.clone();
-    loop {
-        match solve_collocation_ladder(actuator, &options, order, basis, hold) {
-            Err(SpatialError::Solve(SpatialFailure::Unresolved(_))) if options.nodes_per_span < MAX_NODES_PER_SPAN => {
-                options.nodes_per_span = (2 * options.nodes_per_span).min(MAX_NODES_PER_SPAN);
-            }
-            result => return result,
-        }
+    if let Some(h) = hold {
+        check_dwell(h)?;
     }
-}
-
-/// One ladder of the collocation solver at `options`, with its checks.
-fn solve_collocation_ladder(actuator: &Actuator, options: &SpatialOptions, order: usize, basis: LengthBasis, hold: Option<Hold>) -> Result<Simulation, SpatialError> {
-    let mut solver = SpatialSolver::new(actuator, options)?;
-    // One ladder for both actuations: the tensions of tension-driven cables
-    // and the displacements of the others climb together.
-    let top = actuator.cables.iter().filter(|c| !c.is_displacement_driven()).map(|c| c.tension_n).fold(0.0, f64::max);
-    let pull = actuator.cables.iter().filter_map(|c| c.displacement_mm).fold(0.0, f64::max);
-    let rungs = ((top / 0.25).ceil() as usize).max(displacement_rungs(pull));
-    let displaced = actuator.cables.iter().any(|c| c.is_displacement_driven());
-    let mut tensions: Vec<f64> = actuator.cables.iter().map(|c| if c.is_displacement_driven() { 0.0 } else { c.tension_n }).collect();
-    let mut pose = None;
-    for k in 1..=rungs {
-        if let (true, Some(h)) = (k == rungs, hold) {
-            solver.set_hold(h)?;
-        }
-        let f = k as f64 / rungs as f64;
-        pose = Some(if displaced {
-            let targets: Vec<Option<f64>> = actuator.cables.iter().map(|c| c.displacement_mm.map(|d| d * f)).collect();
-            for (t, c) in tensions.iter_mut().zip(&actuator.cables) {
-                if !c.is_displacement_driven() {
-                    *t = c.tension_n * f;
-                }
-            }
-            actuation::meet_displacements(&mut solver, &targets, &mut tensions)?
-        } else {
-            solver.solve_scaled(f)?
-        });
-    }
-    let pose = pose.expect("at least one rung");
-    let mut actuator = actuator.clone();
-    for (c, t) in actuator.cables.iter_mut().zip(pose.tensions_n.iter()) {
-        c.tension_n = *t;
-    }
-    let [a_twist, a_bend_y, a_bend_z] = solver.coefficients(order, basis)?;
-    if !a_twist.iter().chain(&a_bend_y).chain(&a_bend_z).all(|v| v.is_finite()) {
-        return Err(SpatialFailure::NonFinite.into());
-    }
-    Ok(Simulation { actuator, backend: Backend::Spatial, pose, a_bend_z, a_bend_y, a_twist, length_basis: basis, centreline: solver.centreline() })
+    until_resolved(
+        options,
+        |options| SpatialSolver::new(actuator, options)?.simulate(actuator, hold, order, basis),
+        |e| matches!(e, SpatialError::Solve(SpatialFailure::Unresolved(_))),
+        |options| {
+            let finer = options.nodes_per_span < MAX_NODES_PER_SPAN;
+            options.nodes_per_span = (2 * options.nodes_per_span).min(MAX_NODES_PER_SPAN);
+            finer
+        },
+    )
 }
 
 /// [`simulate_spatial`] by the RK4 reference, refining by comparison with half the steps.
 fn simulate_spatial_rk4(actuator: &Actuator, options: &SpatialOptions, order: usize, basis: LengthBasis) -> Result<Simulation, SpatialError> {
+    let ladder = |options: &SpatialOptions| SpatialRk4Solver::new(actuator, options)?.simulate(actuator, None, order, basis);
     let half = SpatialOptions { steps_per_span: (options.steps_per_span / 2).max(2), ..options.clone() };
     // A coarse solve that fails says nothing about the fine one: the
     // comparison then moves one level up.
-    let mut coarse = solve_ladder(actuator, &half, order, basis).ok();
-    let mut options = options.clone();
-    loop {
-        let fine = solve_ladder(actuator, &options, order, basis)?;
-        let steps = options.steps_per_span;
-        let failure = match &coarse {
-            Some(c) => unresolved_part(&fine, c, steps),
-            None => Some(unresolved("the tip position".into(), f64::INFINITY, 0.0, "mm", steps)),
-        };
-        let Some(failure) = failure else {
-            return Ok(fine);
-        };
-        if steps >= MAX_AUTO_SPATIAL_STEPS_PER_SPAN {
-            return Err(failure.into());
-        }
-        options.steps_per_span = (2 * steps).min(MAX_AUTO_SPATIAL_STEPS_PER_SPAN);
-        coarse = Some(fine);
-    }
+    let mut coarse = ladder(&half).ok();
+    until_resolved(
+        options,
+        |options| {
+            let fine = ladder(options)?;
+            let steps = options.steps_per_span;
+            let failure = match &coarse {
+                Some(c) => unresolved_part(&fine, c, steps),
+                None => Some(unresolved("the tip position".into(), f64::INFINITY, 0.0, "mm", steps)),
+            };
+            match failure {
+                None => Ok(fine),
+                Some(failure) => {
+                    coarse = Some(fine);
+                    Err(failure.into())
+                }
+            }
+        },
+        |e| matches!(e, SpatialError::Solve(SpatialFailure::Unresolved(_))),
+        |options| {
+            let finer = options.steps_per_span < MAX_AUTO_SPATIAL_STEPS_PER_SPAN;
+            options.steps_per_span = (2 * options.steps_per_span).min(MAX_AUTO_SPATIAL_STEPS_PER_SPAN);
+            finer
+        },
+    )
 }
 
 /// Most RK4 steps per span [`simulate_spatial`] refines to by itself.
@@ -330,26 +241,6 @@ fn unresolved_part(fine: &Simulation, coarse: &Simulation, steps: usize) -> Opti
         }
     }
     None
-}
-
-/// One ladder of [`simulate_spatial_rk4`] at `options`' steps, without the
-/// resolution check (but refusing non-finite results).
-fn solve_ladder(actuator: &Actuator, options: &SpatialOptions, order: usize, basis: LengthBasis) -> Result<Simulation, SpatialError> {
-    let mut solver = SpatialRk4Solver::new(actuator, options)?;
-    let top = actuator.cables.iter().map(|c| c.tension_n).fold(0.0, f64::max);
-    let rungs = ((top / 0.25).ceil() as usize).max(1);
-    let mut pose = None;
-    for k in 1..=rungs {
-        pose = Some(solver.solve_scaled(k as f64 / rungs as f64)?);
-    }
-    let pose = pose.expect("at least one rung");
-    solver.settle_moments()?;
-    let [a_twist, a_bend_y, a_bend_z] = solver.coefficients_unchecked(order, basis);
-    let finite = pose.tip_mm().iter().chain(&[pose.length_mm, pose.angle_from_clamp_axis_rad()]).chain(&a_twist).chain(&a_bend_y).chain(&a_bend_z).all(|v| v.is_finite());
-    if !finite {
-        return Err(SpatialFailure::NonFinite.into());
-    }
-    Ok(Simulation { actuator: actuator.clone(), backend: Backend::SpatialRk4, pose, a_bend_z, a_bend_y, a_twist, length_basis: basis, centreline: solver.centreline() })
 }
 
 /// Solves `actuator` with the backend that serves it ([`Backend::serving`]):

@@ -8,8 +8,8 @@
 use super::schema::{CableRow, SolvedRouting, SolvedRow, STATUS_FAILED, STATUS_INVALID_ROUTING};
 use crate::model::routing::ControlPoints;
 use crate::solver::spatial::{Actuator, SpatialError, SpatialOptions, SpatialSolver};
-use crate::solver::actuation;
-use crate::model::Routing;
+use crate::solver::{ladder, Solver};
+use crate::model::{Actuation, Routing};
 use crate::solver::{Simulator, SolveFailure, TipPose, STATUS_OK};
 use crate::sweep::spec::Ladder;
 use crate::shape::LengthBasis;
@@ -33,32 +33,25 @@ pub struct Stored {
 pub fn planar_routing(sim: &mut Simulator, id: u64, routing_mm: ControlPoints, routing: &Routing, ladder: &Ladder, stored: Stored) -> SolvedRouting {
     sim.set_routing(routing);
     let rows = match ladder {
-        Ladder::TensionN(tensions) => tensions.iter().map(|&t| planar_row(sim, Actuation::TensionN(t), stored)).collect(),
+        Ladder::TensionN(tensions) => tensions.iter().map(|&t| planar_row(sim, Actuation::Tension(t), &mut [t], stored)).collect(),
         Ladder::DisplacementMm(displacements) => {
             // The tension found at one displacement starts the next.
             let mut tension = [0.0];
-            displacements.iter().map(|&d| planar_row(sim, Actuation::DisplacementMm(d, &mut tension), stored)).collect()
+            displacements.iter().map(|&d| planar_row(sim, Actuation::Displacement(d), &mut tension, stored)).collect()
         }
     };
     SolvedRouting { id, routing_mm, rows }
 }
 
-/// One rung of a planar ladder.
-enum Actuation<'a> {
-    /// At this tension, N.
-    TensionN(f64),
-    /// At this displacement, mm, from (and into) this tension.
-    DisplacementMm(f64, &'a mut [f64; 1]),
-}
-
 /// One planar solve as a row: outputs only for a successful, finite solve.
 /// The row's tension and displacement are the command and what it produced
 /// (a tension's displacement; a displacement's tension, unknown when it failed).
-fn planar_row(sim: &mut Simulator, actuation: Actuation, stored: Stored) -> SolvedRow {
+/// A displacement's solve starts from (and leaves its tension in) `tension`.
+fn planar_row(sim: &mut Simulator, actuation: Actuation, tension: &mut [f64; 1], stored: Stored) -> SolvedRow {
     let (solved, command) = match actuation {
-        Actuation::TensionN(t) => (sim.solve(t), (t, f64::NAN)),
-        Actuation::DisplacementMm(d, tension) => {
-            let solved = actuation::meet_displacements(sim, &[Some(d)], tension);
+        Actuation::Tension(t) => (sim.solve(t), (t, f64::NAN)),
+        Actuation::Displacement(d) => {
+            let solved = Solver::solve(sim, &[Actuation::Displacement(d)], &mut tension[..]);
             if solved.is_err() {
                 // A failed rung leaves no tension to start from: the next starts from zero.
                 tension[0] = 0.0;
@@ -129,15 +122,11 @@ impl TensionCombinations {
             let t: Vec<f64> = values.iter().map(|v| v * scale).collect();
             return solver.solve(&t);
         }
-        let mut targets = [None; crate::model::MAX_CABLES];
+        let mut rung = [Actuation::Tension(0.0); crate::model::MAX_CABLES];
         for (i, (&v, &d)) in values.iter().zip(&self.by_displacement).enumerate() {
-            if d {
-                targets[i] = Some(v * scale);
-            } else {
-                tensions_n[i] = v * scale;
-            }
+            rung[i] = if d { Actuation::Displacement(v * scale) } else { Actuation::Tension(v * scale) };
         }
-        actuation::meet_displacements(solver, &targets[..values.len()], tensions_n)
+        Solver::solve(solver, &rung[..values.len()], tensions_n)
     }
 }
 
@@ -204,7 +193,7 @@ pub fn cable_routing(id: u64, mut actuator: Actuator, options: &SpatialOptions, 
     let mut tensions = vec![0.0; first.len()];
     // Continuation from zero to the first combination (rungs of ≤ 0.25 N
     // and ≤ 0.5 mm).
-    let rung = |(&v, &d): (&f64, &bool)| if d { v / crate::solver::simulate::DISPLACEMENT_RUNG_MM } else { v / 0.25 };
+    let rung = |(&v, &d): (&f64, &bool)| if d { v / ladder::DISPLACEMENT_RUNG_MM } else { v / ladder::TENSION_RUNG_N };
     let top = first.iter().zip(&combinations.by_displacement).map(rung).fold(0.0, f64::max);
     let rungs = (top.ceil() as usize).max(1);
     for k in 1..rungs {

@@ -10,15 +10,7 @@ use crate::calibrate::CalibrateError;
 use std::collections::BTreeMap;
 use std::path::Path;
 
-/// How one cable is actuated in a capture.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Actuation {
-    /// Pulled with this tension at the base, N (`tension_K_n`).
-    Tension(f64),
-    /// Pulled in by this length at the base, mm (`displacement_K_mm`).
-    Displacement(f64),
-}
+pub use crate::model::Actuation;
 
 /// One capture: a static (or protocol) reading with every cable's actuation.
 #[derive(Debug, Clone, PartialEq)]

@@ -14,7 +14,7 @@
 use super::files::{Actuation, Capture, CaptureSet, MarkerReading};
 use crate::calibrate::data::Direction;
 use crate::calibrate::CalibrateError;
-use crate::solver::actuation;
+use crate::solver::Solver;
 use crate::solver::spatial::{SpatialError, SpatialFailure, SpatialOptions, SpatialSolver};
 use crate::model::{Actuator, LoadDirection};
 use crate::solver::{CentrelinePoint, Hold, TipPose};
@@ -106,24 +106,10 @@ fn solve_at(solver: &mut SpatialSolver, c: &Capture, fraction: f64, tensions: &m
         let t: Vec<f64> = c.tensions_n().iter().map(|t| t * fraction).collect();
         return solver.solve(&t);
     }
-    let targets: Vec<Option<f64>> = c.actuation.iter().map(|a| if let Actuation::Displacement(d) = a { Some(d * fraction) } else { None }).collect();
-    for (t, a) in tensions.iter_mut().zip(&c.actuation) {
-        if let Actuation::Tension(v) = a {
-            *t = v * fraction;
-        }
-    }
-    actuation::meet_displacements(solver, &targets, tensions)
+    let rung: Vec<Actuation> = c.actuation.iter().map(|a| a.scaled(fraction)).collect();
+    Solver::solve(solver, &rung, tensions)
 }
 
-/// Rungs of a ladder from the straight rod: 0.25 N of the largest tension
-/// (or 0.5 mm of the largest displacement) each, as the single solves take.
-fn rungs(c: &Capture) -> usize {
-    let n = c.actuation.iter().map(|a| match a {
-        Actuation::Tension(t) => (t / 0.25).ceil(),
-        Actuation::Displacement(d) => (d / 0.5).ceil(),
-    });
-    n.fold(1.0, f64::max) as usize
-}
 
 /// Solves one chain with one solver at `options`.
 fn solve_chain(actuator: &Actuator, options: &SpatialOptions, set: &CaptureSet, chain: &[usize]) -> Result<Vec<(usize, CaptureSolution)>, CalibrateError> {
@@ -167,7 +153,7 @@ fn solve_chain(actuator: &Actuator, options: &SpatialOptions, set: &CaptureSet, 
             Err(_) => {
                 // Out of the warm start's basin: climb from the straight rod
                 // in small rungs without dwell (which leaves creep's history alone).
-                let n = rungs(c);
+                let n = crate::solver::ladder::rungs(&c.actuation);
                 set_hold(&mut solver, Hold { direction: hold.direction, dwell_s: 0.0 }).map_err(fail)?;
                 for k in 1..n {
                     solve_at(&mut solver, c, k as f64 / n as f64, &mut tensions).map_err(fail)?;

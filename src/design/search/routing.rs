@@ -16,7 +16,7 @@
 //! are explored briefly, no two within one grid step.
 
 use super::{Exploration, Problem, SearchOptions, Seed, SeedSource, Seeds, Start, FD_STEP};
-use crate::design::objective::{Bounds, Evaluation, Objective, LADDER_STEP_N};
+use crate::design::objective::{Bounds, Evaluation, Objective};
 use crate::design::DesignError;
 use crate::model::{ControlPoints, Routing};
 use crate::solver::Simulator;
@@ -144,7 +144,7 @@ impl RoutingProblem<'_> {
                     let mut ladder: Vec<f64> = tensions.clone();
                     if sim.solve(first).is_err() {
                         sim.set_routing(&routing);
-                        let rungs = ((first / LADDER_STEP_N).ceil() as usize).max(1);
+                        let rungs = crate::solver::ladder::tension_rungs(first);
                         ladder.splice(0..0, (1..rungs).map(|k| first * k as f64 / rungs as f64));
                     }
                     // (After a cold success the first rung repeats as a converged warm start.)

@@ -574,14 +574,17 @@ impl SpatialSolver {
     /// solve. Without this call every solve is held `effects.creep_hold_s`
     /// on a rod with no load history, in `effects.load_direction`.
     pub fn set_hold(&mut self, hold: Hold) -> Result<(), SpatialError> {
-        if !(hold.dwell_s.is_finite() && hold.dwell_s >= 0.0) {
-            return Err(SpatialError::Option(format!("dwell_s = {} must be a finite time ≥ 0 s", hold.dwell_s)));
-        }
+        check_dwell(hold)?;
+        self.follow_hold(hold);
+        Ok(())
+    }
+
+    /// [`SpatialSolver::set_hold`] of a checked `hold`.
+    fn follow_hold(&mut self, hold: Hold) {
         self.creep.follow_protocol();
         self.creep.set_dwell(hold.dwell_s);
         self.signed_mu = self.rod.effects.friction_mu * hold.direction.slip_sign();
         self.hold = hold;
-        Ok(())
     }
 
     /// Like [`SpatialSolver::set_hold`] for independent captures: each of
@@ -589,9 +592,7 @@ impl SpatialSolver {
     /// from a rod with no load history (creep's history does not carry
     /// over from solve to solve; the warm start does).
     pub fn set_independent_hold(&mut self, hold: Hold) -> Result<(), SpatialError> {
-        if !(hold.dwell_s.is_finite() && hold.dwell_s >= 0.0) {
-            return Err(SpatialError::Option(format!("dwell_s = {} must be a finite time ≥ 0 s", hold.dwell_s)));
-        }
+        check_dwell(hold)?;
         self.creep.start_each_solve_virgin();
         self.creep.set_dwell(hold.dwell_s);
         self.signed_mu = self.rod.effects.friction_mu * hold.direction.slip_sign();
@@ -1871,41 +1872,45 @@ impl SpatialSolver {
             *d = self.rest_length_mm[c] - path + self.cable_ea_n[c].map_or(0.0, |ea| pulled / ea);
         }
     }
-
-    /// Each cable's deformed path length from the clamp to its anchor, mm
-    /// (∫ |q_i| ds over the nodes where it pulls, by the span quadrature).
-    pub fn cable_path_lengths_mm(&self) -> Vec<f64> {
-        let np = self.np;
-        let nc = self.cables;
-        let mut out = vec![0.0; nc];
-        for span in 0..self.spans() {
-            let base = span * np;
-            let h = self.half[span];
-            for c in 0..nc {
-                if !self.active[base * nc + c] {
-                    continue;
-                }
-                for j in 0..np {
-                    let x = &self.local[base + j];
-                    let ch = &self.chan[(base + j) * nc + c];
-                    let q = V3::new(x[0], x[1], x[2]) + V3::new(x[3], x[4], x[5]).cross(&ch.r) + ch.dr;
-                    out[c] += h * self.grid.q[(np - 1) * np + j] * q.norm();
-                }
-            }
-        }
-        out
-    }
 }
 
-/// The 3-D solver as a [`crate::solver::actuation::TensionSolve`].
-impl crate::solver::actuation::TensionSolve for SpatialSolver {
+/// The spatial backend: several and out-of-plane cables by collocation.
+impl crate::solver::Solver for SpatialSolver {
     type Error = SpatialError;
+    fn backend(&self) -> crate::solver::Backend {
+        crate::solver::Backend::Spatial
+    }
     fn solve_tensions(&mut self, tensions_n: &[f64]) -> Result<TipPose, SpatialError> {
         self.solve(tensions_n)
     }
-    fn not_met(e: crate::solver::actuation::DisplacementNotMet) -> SpatialError {
+    fn hold_next(&mut self, hold: Hold) {
+        self.follow_hold(hold);
+    }
+    fn centreline(&self) -> Vec<CentrelinePoint> {
+        SpatialSolver::centreline(self)
+    }
+    /// Refuses coefficients that are not finite.
+    fn coefficients(&mut self, order: usize, basis: LengthBasis) -> Result<[Vec<f64>; 3], SpatialError> {
+        let a = SpatialSolver::coefficients(self, order, basis)?;
+        if !a.iter().flatten().all(|v| v.is_finite()) {
+            return Err(SpatialFailure::NonFinite.into());
+        }
+        Ok(a)
+    }
+}
+
+impl From<crate::solver::actuation::DisplacementNotMet> for SpatialError {
+    fn from(e: crate::solver::actuation::DisplacementNotMet) -> Self {
         SpatialFailure::DisplacementNotMet(e).into()
     }
+}
+
+/// Refuses a hold whose dwell is not a finite time ≥ 0 s.
+pub(crate) fn check_dwell(hold: Hold) -> Result<(), SpatialError> {
+    if !(hold.dwell_s.is_finite() && hold.dwell_s >= 0.0) {
+        return Err(SpatialError::Option(format!("dwell_s = {} must be a finite time ≥ 0 s", hold.dwell_s)));
+    }
+    Ok(())
 }
 
 /// exp of the skew matrix of `w` (Rodrigues). Below 0.5 rad, as a Magnus

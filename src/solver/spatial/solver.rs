@@ -917,6 +917,35 @@ impl SpatialRk4Solver {
     }
 }
 
+/// The spatial RK4 reference: the thesis's uniform rod without effects.
+impl crate::solver::Solver for SpatialRk4Solver {
+    type Error = SpatialError;
+    fn backend(&self) -> Backend {
+        Backend::SpatialRk4
+    }
+    fn solve_tensions(&mut self, tensions_n: &[f64]) -> Result<TipPose, SpatialError> {
+        self.solve(tensions_n)
+    }
+    /// It models no effect a hold acts on (friction, creep).
+    fn hold_next(&mut self, _hold: crate::solver::Hold) {}
+    fn centreline(&self) -> Vec<CentrelinePoint> {
+        SpatialRk4Solver::centreline(self)
+    }
+    /// Without the order check (a refinement's coarse solve computes the
+    /// same orders at half the steps); refuses a pose or coefficients that
+    /// are not finite.
+    fn coefficients(&mut self, order: usize, basis: LengthBasis) -> Result<[Vec<f64>; 3], SpatialError> {
+        let pose = self.last.expect("coefficients needs a successful solve");
+        self.settle_moments()?;
+        let a = self.coefficients_unchecked(order, basis);
+        let finite = pose.tip_mm().iter().chain(&[pose.length_mm, pose.angle_from_clamp_axis_rad()]).chain(a.iter().flatten()).all(|v| v.is_finite());
+        if !finite {
+            return Err(SpatialFailure::NonFinite.into());
+        }
+        Ok(a)
+    }
+}
+
 /// Checks `actuator` itself ([`Actuator::channels`]) and that `backend`
 /// models it with the default settings ([`Backend::check`]); builds the
 /// cables' channels.
