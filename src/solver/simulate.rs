@@ -289,11 +289,7 @@ pub fn planar_problem(actuator: &Actuator) -> Result<(Rod, Routing), SpatialErro
     let mut rod = actuator.rod.clone();
     if let Some(anchor) = cable.anchor_mm {
         if rod.cable_anchor_mm.is_some_and(|k| k != anchor) {
-            return Err(SpatialError::Option(format!(
-                "cable 1 has anchor={} mm and the rod cable_anchor_mm = {} mm: give the anchor once",
-                crate::io::fmt_num(anchor),
-                crate::io::fmt_num(rod.cable_anchor_mm.unwrap_or(anchor))
-            )));
+            return Err(SpatialError::AnchorTwice { cable_mm: anchor, rod_mm: rod.cable_anchor_mm.unwrap_or(anchor) });
         }
         rod.cable_anchor_mm = Some(anchor);
     }

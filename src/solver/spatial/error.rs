@@ -19,9 +19,40 @@ pub enum SpatialError {
     /// A planar solve (the fast path of a one-cable in-plane actuator) failed.
     #[error(transparent)]
     Planar(#[from] crate::solver::error::SimulateError),
-    /// A numerical setting is bad.
+    /// Too few RK4 steps per span.
+    #[error("spatial solver: steps_per_span = {0} must be at least 2")]
+    StepsPerSpan(usize),
+    /// Collocation intervals per span outside 4 … `max`.
+    #[error("spatial solver: nodes_per_span = {nodes} must be between 4 and {max}")]
+    NodesPerSpan { nodes: usize, max: usize },
+    /// A moment tolerance that is not a positive number.
+    #[error("spatial solver: moment_tolerance_n_mm must be a positive number")]
+    MomentTolerance,
+    /// A tension scale that is negative or not finite.
+    #[error("spatial solver: tension scale {0} must be finite and ≥ 0")]
+    TensionScale(f64),
+    /// Not one tension per cable.
+    #[error("spatial solver: {given} tensions given for {cables} cables")]
+    TensionCount { given: usize, cables: usize },
+    /// The body along s (radius profile, segments) is invalid.
     #[error("spatial solver: {0}")]
-    Option(String),
+    Body(crate::model::BodyError),
+    /// A dwell that is not a finite time ≥ 0 s.
+    #[error("spatial solver: dwell_s = {0} must be a finite time ≥ 0 s")]
+    Dwell(f64),
+    /// A coefficient order above every the solver resolves.
+    #[error("spatial solver: order {order} is above the spatial solver's highest order {max}")]
+    OrderAbove { order: usize, max: usize },
+    /// A coefficient order the RK4 reference's steps do not resolve.
+    #[error("spatial solver: order {order} needs at least {need} RK4 steps per span to be resolved (have {have}); raise --steps-per-span (spec: steps_per_span) or lower the order")]
+    OrderSteps { order: usize, need: usize, have: usize },
+    /// A planar cable's anchor given both on the cable and on the rod, differently.
+    #[error(
+        "spatial solver: cable 1 has anchor={} mm and the rod cable_anchor_mm = {} mm: give the anchor once",
+        crate::io::fmt_num(*cable_mm),
+        crate::io::fmt_num(*rod_mm)
+    )]
+    AnchorTwice { cable_mm: f64, rod_mm: f64 },
     /// The solve failed.
     #[error(transparent)]
     Solve(#[from] SpatialFailure),
@@ -69,7 +100,7 @@ impl SpatialError {
     /// Checks a solve's tensions: one per cable, each finite and ≥ 0.
     pub fn check_tensions(tensions_n: &[f64], cables: usize) -> Result<(), SpatialError> {
         if tensions_n.len() != cables {
-            return Err(SpatialError::Option(format!("{} tensions given for {cables} cables", tensions_n.len())));
+            return Err(SpatialError::TensionCount { given: tensions_n.len(), cables });
         }
         for (i, &t) in tensions_n.iter().enumerate() {
             if !(t.is_finite() && t >= 0.0) {

@@ -128,17 +128,13 @@ impl SpatialOptions {
     /// Checks the settings (the message names the setting and its range).
     pub fn check(&self) -> Result<(), SpatialError> {
         if self.steps_per_span < 2 {
-            return Err(SpatialError::Option(format!("steps_per_span = {} must be at least 2", self.steps_per_span)));
+            return Err(SpatialError::StepsPerSpan(self.steps_per_span));
         }
         if !(4..=crate::solver::MAX_NODES_PER_SPAN).contains(&self.nodes_per_span) {
-            return Err(SpatialError::Option(format!(
-                "nodes_per_span = {} must be between 4 and {}",
-                self.nodes_per_span,
-                crate::solver::MAX_NODES_PER_SPAN
-            )));
+            return Err(SpatialError::NodesPerSpan { nodes: self.nodes_per_span, max: crate::solver::MAX_NODES_PER_SPAN });
         }
         if !(self.moment_tolerance_n_mm.is_finite() && self.moment_tolerance_n_mm > 0.0) {
-            return Err(SpatialError::Option("moment_tolerance_n_mm must be a positive number".into()));
+            return Err(SpatialError::MomentTolerance);
         }
         Ok(())
     }
@@ -276,10 +272,10 @@ impl SpatialRk4Solver {
     pub fn new(actuator: &Actuator, options: &SpatialOptions) -> Result<Self, SpatialError> {
         let channels = validated_channels(actuator, Backend::SpatialRk4)?;
         if options.steps_per_span < 2 {
-            return Err(SpatialError::Option(format!("steps_per_span = {} must be at least 2", options.steps_per_span)));
+            return Err(SpatialError::StepsPerSpan(options.steps_per_span));
         }
         if !(options.moment_tolerance_n_mm.is_finite() && options.moment_tolerance_n_mm > 0.0) {
-            return Err(SpatialError::Option("moment_tolerance_n_mm must be a positive number".into()));
+            return Err(SpatialError::MomentTolerance);
         }
         let rod = actuator.rod.clone();
         let gj = actuator.torsional_rigidity_n_mm2();
@@ -366,7 +362,7 @@ impl SpatialRk4Solver {
     /// warm-started from the previous solve.
     pub fn solve_scaled(&mut self, scale: f64) -> Result<TipPose, SpatialError> {
         if !(scale.is_finite() && scale >= 0.0) {
-            return Err(SpatialError::Option(format!("tension scale {scale} must be finite and ≥ 0")));
+            return Err(SpatialError::TensionScale(scale));
         }
         self.scale = scale;
         self.last = None;
@@ -961,19 +957,14 @@ pub fn validated_channels(actuator: &Actuator, backend: Backend) -> Result<Vec<C
 /// [`REQUIRED_SPATIAL_STEPS_PER_SPAN`].
 pub fn check_order(order: usize, options: &SpatialOptions) -> Result<(), SpatialError> {
     if order > MAX_SPATIAL_ORDER {
-        return Err(SpatialError::Option(format!(
-            "order {order} is above the spatial solver's highest order {MAX_SPATIAL_ORDER}"
-        )));
+        return Err(SpatialError::OrderAbove { order, max: MAX_SPATIAL_ORDER });
     }
     if options.method == crate::solver::SolverMethod::Collocation {
         return Ok(());
     }
     let need = REQUIRED_SPATIAL_STEPS_PER_SPAN[order];
     if options.steps_per_span < need {
-        return Err(SpatialError::Option(format!(
-            "order {order} needs at least {need} RK4 steps per span to be resolved (have {}); raise --steps-per-span (spec: steps_per_span) or lower the order",
-            options.steps_per_span
-        )));
+        return Err(SpatialError::OrderSteps { order, need, have: options.steps_per_span });
     }
     Ok(())
 }

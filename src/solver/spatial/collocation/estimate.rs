@@ -137,7 +137,7 @@ impl SpatialSolver {
     /// error of the largest coefficient, 1/mm.
     pub fn coefficients_with_error(&self, order: usize, basis: LengthBasis) -> Result<([Vec<f64>; 3], f64), SpatialError> {
         if order > MAX_SPATIAL_ORDER {
-            return Err(SpatialError::Option(format!("order {order} is above the spatial solver's highest order {MAX_SPATIAL_ORDER}")));
+            return Err(SpatialError::OrderAbove { order, max: MAX_SPATIAL_ORDER });
         }
         assert!(self.last.is_some(), "coefficients needs a successful solve");
         let np = self.np;

@@ -327,7 +327,7 @@ impl SpatialSolver {
         let channels = super::solver::validated_channels(actuator, crate::solver::Backend::Spatial)?;
         options.check()?;
         let rod = actuator.rod.clone();
-        let body = rod.body().map_err(|e| SpatialError::Option(e.to_string()))?;
+        let body = rod.body().map_err(SpatialError::Body)?;
         let length = rod.length_mm;
         let m = if rod.effects.stiffening_alpha > 0.0 { options.nodes_per_span.max(MIN_NODES_WITH_STIFFENING) } else { options.nodes_per_span };
         let np = m + 1;
@@ -546,7 +546,7 @@ impl SpatialSolver {
     /// warm-started from the previous solves.
     pub fn solve_scaled(&mut self, scale: f64) -> Result<TipPose, SpatialError> {
         if !(scale.is_finite() && scale >= 0.0) {
-            return Err(SpatialError::Option(format!("tension scale {scale} must be finite and ≥ 0")));
+            return Err(SpatialError::TensionScale(scale));
         }
         self.scale = scale;
         self.last = None;
@@ -747,7 +747,7 @@ impl From<crate::solver::actuation::DisplacementNotMet> for SpatialError {
 /// Refuses a hold whose dwell is not a finite time ≥ 0 s.
 pub(crate) fn check_dwell(hold: Hold) -> Result<(), SpatialError> {
     if !(hold.dwell_s.is_finite() && hold.dwell_s >= 0.0) {
-        return Err(SpatialError::Option(format!("dwell_s = {} must be a finite time ≥ 0 s", hold.dwell_s)));
+        return Err(SpatialError::Dwell(hold.dwell_s));
     }
     Ok(())
 }
