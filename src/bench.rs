@@ -6,7 +6,7 @@
 //! and off. Timing is by wall clock on a shared machine: the median over
 //! many routings keeps one noisy neighbour from moving the figure.
 //!
-//! [`bench_with_reference`] also times the previous method (RK4 with 24
+//! [`bench_with_reference`] also times the reference method (RK4 with 24
 //! steps per span and secant shooting, [`SolverMethod::Rk4`]) in the same
 //! run, so the speed-up is measured under the same load.
 
@@ -36,7 +36,7 @@ pub struct BenchFigures {
     pub failures: usize,
     /// The method measured: "collocation-N" (N intervals per span) or "rk4-N" (N steps per span).
     pub method: String,
-    /// The previous method measured in the same run, if asked for.
+    /// The reference method measured in the same run, if asked for.
     pub reference: Option<Box<BenchFigures>>,
     /// Reference median over this median.
     pub speedup: Option<f64>,
@@ -50,7 +50,7 @@ pub fn method_label(options: &SolverOptions) -> String {
     }
 }
 
-/// The previous method as the reference: RK4, 24 steps per span, secant shooting.
+/// The reference method: RK4, 24 steps per span, secant shooting.
 pub fn reference_options() -> SolverOptions {
     SolverOptions { method: SolverMethod::Rk4, steps_per_span: 24, ..SolverOptions::default() }
 }

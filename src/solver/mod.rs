@@ -10,8 +10,8 @@
 //! where the routing is a polynomial: by default with spectral collocation
 //! on Chebyshev–Lobatto nodes ([`SolverMethod::Collocation`], in the
 //! `collocation` submodule, which also replaces the shooting below by
-//! fixed-point sweeps and Newton's method), or with the previous classical
-//! RK4 ([`SolverMethod::Rk4`], kept as the reference, in `rk4`).
+//! fixed-point sweeps and Newton's method), or with classical RK4
+//! ([`SolverMethod::Rk4`], the reference the collocation is checked against, in `rk4`).
 //!
 //! One file per piece: this file holds the cut equations shared by both
 //! integrators ([`Simulator::strains_at`]) and the public API; `collocation`
@@ -213,7 +213,7 @@ pub enum SolverMethod {
     /// method and continuation in the weight as the fallback for heavy rods.
     #[default]
     Collocation,
-    /// The previous method, kept as the reference: classical RK4 with
+    /// The reference method, a plain scheme to check against: classical RK4 with
     /// `steps_per_span` steps per span and secant shooting on gravity's
     /// base moment.
     Rk4,
@@ -371,8 +371,8 @@ impl Hold {
 
 impl Simulator {
     /// Creates a solver for `actuator`; fails on invalid parameters.
-    pub fn new(actuator: &Rod, options: &SolverOptions) -> Result<Self, SimulateError> {
-        actuator.validate().map_err(ParameterError::from)?;
+    pub fn new(rod: &Rod, options: &SolverOptions) -> Result<Self, SimulateError> {
+        rod.validate().map_err(ParameterError::from)?;
         // The upper bound keeps a typo (2e9 steps) from exhausting memory.
         if options.steps_per_span < 2 || options.steps_per_span % 2 != 0 || options.steps_per_span > MAX_STEPS_PER_SPAN {
             return Err(ParameterError::OutOfRange {
@@ -392,29 +392,29 @@ impl Simulator {
         // Material stiffening's curvature law u(m) has complex branch points
         // near the real axis (1 + 3 α r² u² = 0), which slows the spectral
         // convergence: 10 intervals leave 2e-6 rad there, 16 leave 1e-8.
-        let m = if actuator.effects.stiffening_alpha > 0.0 {
+        let m = if rod.effects.stiffening_alpha > 0.0 {
             options.nodes_per_span.max(MIN_NODES_WITH_STIFFENING)
         } else {
             options.nodes_per_span
         };
-        let body = actuator.body().map_err(ParameterError::from)?;
-        Backend::check_planar(actuator, options, Given::default())?;
-        let spans = span_boundaries(actuator, body.as_ref(), 0.5 * actuator.cable_length_mm()).len() - 1;
+        let body = rod.body().map_err(ParameterError::from)?;
+        Backend::check_planar(rod, options, Given::default())?;
+        let spans = span_boundaries(rod, body.as_ref(), 0.5 * rod.cable_length_mm()).len() - 1;
         // Per-point buffers: RK4 stage points, or collocation nodes.
         let points = match options.method {
             SolverMethod::Rk4 => 2 * (2 * n + 1),
             SolverMethod::Collocation => spans * (m + 1),
         };
         let col = (options.method == SolverMethod::Collocation).then(|| Box::new(collocation::Colloc::new(m, spans)));
-        let beta = actuator.gravity.direction_rad;
+        let beta = rod.gravity.direction_rad;
         // A non-uniform body's weight is this factor times ∫ ρ r² (Body).
         let weight_n_per_mm = match &body {
-            None => actuator.weight_n_per_mm(),
-            Some(_) if !actuator.gravity.enabled => 0.0,
-            Some(_) => actuator.gravity.scale * 1e-6 * std::f64::consts::PI * actuator.gravity.g_m_s2,
+            None => rod.weight_n_per_mm(),
+            Some(_) if !rod.gravity.enabled => 0.0,
+            Some(_) => rod.gravity.scale * 1e-6 * std::f64::consts::PI * rod.gravity.g_m_s2,
         };
         Ok(Self {
-            actuator: actuator.clone(),
+            actuator: rod.clone(),
             options: options.clone(),
             weight_n_per_mm,
             gravity_cos: beta.cos(),
@@ -423,8 +423,8 @@ impl Simulator {
             channel: vec![ChannelSample::default(); points],
             cable_dir: vec![(1.0, 0.0); points],
             last_tension_n: None,
-            friction: Friction::new(actuator.effects.friction_mu, actuator.effects.load_direction.slip_sign(), points),
-            creep: Creep::new(&actuator.effects, actuator.ei_n_mm2, points),
+            friction: Friction::new(rod.effects.friction_mu, rod.effects.load_direction.slip_sign(), points),
+            creep: Creep::new(&rod.effects, rod.ei_n_mm2, points),
             col,
             rk4: rk4::Rk4::new(n),
             body,
@@ -440,7 +440,7 @@ impl Simulator {
         })
         .and_then(|mut sim: Simulator| {
             // Outside a protocol every solve is held like this from a virgin rod.
-            let hold = Hold { direction: actuator.effects.load_direction, dwell_s: actuator.effects.creep_hold_s };
+            let hold = Hold { direction: rod.effects.load_direction, dwell_s: rod.effects.creep_hold_s };
             hold.check()?;
             sim.apply_hold(hold);
             Ok(sim)

@@ -11,7 +11,7 @@
 //! - RK4 ([`REQUIRED_STEPS_PER_SPAN`]), measured with `cablemap simulate
 //!   --json`: seven routings (straight to fully alternating, ±4 mm) at
 //!   0.5–2 N against a 2048-step solve (on a grid of 4, then 16 steps). At
-//!   the old default of 24 steps a_5 is resolved, a_9 is off by ~3e-3.
+//!   24 steps a_5 is resolved, a_9 is off by ~3e-3.
 //! - Collocation, the default ([`REQUIRED_NODES_PER_SPAN`]): five routings
 //!   (±4 mm, straight to alternating) at 0.5 and 2 N against 64 intervals
 //!   per span, on the grid 4, 6, 8, 10, 12, 16; an entry within a factor 1.5

@@ -1,5 +1,5 @@
-//! The previous integration method, kept as the reference
-//! ([`super::SolverMethod::Rk4`]): classical RK4 forward from the clamp with
+//! The reference integration method ([`super::SolverMethod::Rk4`]), a
+//! plain scheme the collocation is checked against: classical RK4 forward from the clamp with
 //! `steps_per_span` steps on each knot span, and secant shooting on
 //! gravity's base moment M(0), warm-started across the continuation in
 //! tension (`continuation`). Per-point buffers are indexed by stage point,

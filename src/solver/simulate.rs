@@ -17,22 +17,22 @@ use crate::shape::LengthBasis;
 /// Solves one actuator at `tension_n`, stepping up from a low tension by
 /// continuation so that large deformations start from a nearby solution.
 pub fn simulate(
-    actuator: &Rod,
+    rod: &Rod,
     options: &SolverOptions,
     routing: &Routing,
     tension_n: f64,
     order: usize,
     basis: LengthBasis,
 ) -> Result<Simulation, SimulateError> {
-    let hold = Hold { direction: actuator.effects.load_direction, dwell_s: actuator.effects.creep_hold_s };
-    simulate_held(actuator, options, routing, tension_n, order, basis, hold)
+    let hold = Hold { direction: rod.effects.load_direction, dwell_s: rod.effects.creep_hold_s };
+    simulate_held(rod, options, routing, tension_n, order, basis, hold)
 }
 
 /// Like [`simulate`], with the final tension reached in direction
 /// `hold.direction` (friction) and held for `hold.dwell_s` from a virgin
 /// rod (creep); the ladder below it is loaded without dwell.
 pub fn simulate_held(
-    actuator: &Rod,
+    rod: &Rod,
     options: &SolverOptions,
     routing: &Routing,
     tension_n: f64,
@@ -41,13 +41,13 @@ pub fn simulate_held(
     hold: Hold,
 ) -> Result<Simulation, SimulateError> {
     check_ladder_tension("tension_n", tension_n)?;
-    simulate_planar_cable(actuator, options, &Cable::planar(routing.control_points_mm().0, tension_n), routing, order, basis, hold)
+    simulate_planar_cable(rod, options, &Cable::planar(routing.control_points_mm().0, tension_n), routing, order, basis, hold)
 }
 
 /// The planar ladder of one `cable` (its routing `routing`, built for the
 /// rod): up its tension, or its displacement; then the coefficients.
 fn simulate_planar_cable(
-    actuator: &Rod,
+    rod: &Rod,
     options: &SolverOptions,
     cable: &Cable,
     routing: &Routing,
@@ -57,13 +57,13 @@ fn simulate_planar_cable(
 ) -> Result<Simulation, SimulateError> {
     crate::solver::resolution::check_order(order, options)?;
     hold.check()?;
-    let actuator = Actuator::with_cables(actuator.clone(), vec![cable.clone()]);
+    let actuator = Actuator::with_cables(rod.clone(), vec![cable.clone()]);
     // A solve the discretisation does not resolve is repeated, from the
     // bottom of the ladder, at a finer one, up to the most there is.
     until_resolved(
         options,
         |options| {
-            let mut sim = Simulator::new(&actuator.rod, options)?;
+            let mut sim = Simulator::new(rod, options)?;
             sim.set_routing(routing);
             sim.set_cable_stiffness(cable.cable_ea_n);
             Ok(sim.simulate(&actuator, Some(hold), order, basis)?)

@@ -40,7 +40,7 @@ mod tests {
         pose.unwrap()
     }
 
-    /// Every effect, collocation against the previous RK4 method (at 192
+    /// Every effect, collocation against the RK4 reference (at 192
     /// steps per span, well converged), on a curved routing with gravity:
     /// a tension ladder up and down, with creep holds.
     #[test]

@@ -1,4 +1,4 @@
-//! The spatial (3-D) backend (issue 16, the thesis's future work): the
+//! The spatial (3-D) backends (the thesis's future work): the
 //! thesis's rod ([`crate::model::Rod`]) with 1–8 cables, each routed along
 //! r_c,i(s) = (0, y_i(s), z_i(s)) in the body frame, torsion (GJ, default
 //! EI/1.5: ν = 0.5, incompressible silicone) and gravity along any global
