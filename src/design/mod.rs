@@ -48,6 +48,35 @@ pub use request::DesignRequest;
 pub use run::{run, DesignReport};
 pub use target::{Component, Target, Weights};
 
+/// A target's tip farther from the clamp than the rod is long (its asked
+/// components alone): no design reaches it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TipBeyondReach {
+    /// The target's name.
+    pub target: String,
+    /// The tip's asked components (x, y, z), mm.
+    pub tip_mm: [Option<f64>; 3],
+    /// Their distance from the clamp, mm.
+    pub distance_mm: f64,
+    /// The rod's length L, mm.
+    pub length_mm: f64,
+}
+
+impl std::fmt::Display for TipBeyondReach {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let given: Vec<String> = ["x", "y", "z"].iter().zip(self.tip_mm).filter_map(|(k, v)| v.map(|v| format!("{k} = {v}"))).collect();
+        write!(
+            f,
+            "{}: the tip ({}) is {} mm from the clamp, beyond the rod's length L = {} mm: it misses by at least {} mm",
+            self.target,
+            given.join(", "),
+            sequence_report::fmt6(self.distance_mm),
+            self.length_mm,
+            sequence_report::fmt6(self.distance_mm - self.length_mm)
+        )
+    }
+}
+
 /// Why a feasibility check or a design could not be made.
 #[derive(Debug, thiserror::Error)]
 pub enum DesignError {
@@ -142,8 +171,11 @@ pub enum DesignError {
     #[error(transparent)]
     Mould(#[from] crate::mould::MouldError),
     /// No design can reach the targets (found before any search).
-    #[error("unreachable: {0}")]
-    Unreachable(String),
+    #[error("unreachable: {}", tips.iter().map(ToString::to_string).collect::<Vec<_>>().join("; "))]
+    Unreachable {
+        /// Each target whose tip lies beyond the rod's length.
+        tips: Vec<TipBeyondReach>,
+    },
     /// A targets file that cannot be read or breaks its format (docs/design.md).
     #[error("bad target: {}{message}", path.as_ref().map_or(String::new(), |p| format!("{}: ", p.display())))]
     TargetsFile {

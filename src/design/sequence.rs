@@ -1,6 +1,7 @@
-//! The search of a several-cable design: one set of channels and one
-//! actuation vector per target, minimising the weighted squared errors of
-//! every target together (eq. 3.17 summed over the targets).
+//! The unknowns and objective of a design for a sequence of targets
+//! ([`Setup`]): one set of channels and one actuation vector per target,
+//! the weighted squared errors of every target together (eq. 3.17 summed
+//! over the targets), searched by [`super::search::channels`].
 //!
 //! Variables live in a unit box for the library's one bounded
 //! Levenberg–Marquardt ([`crate::numerics::lm`]): a control point free in
@@ -14,11 +15,9 @@
 //! Every evaluation solves each target's actuator with
 //! [`crate::solver::simulate_actuator`], the path `cablemap simulate` takes,
 //! so a design's reported values are what its `simulate` command prints.
-//! Starts come from a coarse grid (straight channels in 8 directions, or
+//! The seed grid ([`grid_seeds`]): straight channels in 8 directions, or
 //! 5 levels and ramps for one free coordinate, × 3 actuation levels per
-//! cable) or from a map's nearest designs; the best few are refined in
-//! parallel, each deterministically, and the least cost wins (ties to the
-//! earlier start): the same answer on every run and thread count.
+//! cable.
 
 use super::actuator::{ActuationBounds, CableFreedom, DesignActuator};
 use super::targets::{Quantity, ShapeTarget};

@@ -17,7 +17,8 @@ use super::search::{self, SearchOptions, ROUTING_STARTS, SEQUENCE_STARTS};
 use super::sequence::{Achieved, Channel, Setup};
 use super::target::{error_pct, Target, Weights};
 use super::targets::{Quantity, ShapeTarget, TargetSet};
-use super::sequence_report::{fmt6, ComponentOutcome, SequenceRun, TargetOutcome};
+use super::sequence_report::{ComponentOutcome, SequenceRun, TargetOutcome};
+use super::TipBeyondReach;
 use super::{map_channels as map, sequence_export as export, trajectory, DesignError};
 use crate::model::Actuator;
 
@@ -37,26 +38,19 @@ pub fn check_reachable(design: &DesignActuator, targets: &TargetSet) -> Result<(
     let length = design.actuator.rod.length_mm;
     // The rod stretches under its weight by far less than this.
     let reach = length * (1.0 + 1e-3);
-    let mut reasons = Vec::new();
-    for t in &targets.targets {
-        let tip = t.tip_mm();
-        let d = tip.iter().flatten().map(|v| v * v).sum::<f64>().sqrt();
-        if d > reach {
-            let given: Vec<String> = ["x", "y", "z"].iter().zip(tip).filter_map(|(k, v)| v.map(|v| format!("{k} = {v}"))).collect();
-            reasons.push(format!(
-                "{}: the tip ({}) is {} mm from the clamp, beyond the rod's length L = {} mm: it misses by at least {} mm",
-                t.name,
-                given.join(", "),
-                fmt6(d),
-                length,
-                fmt6(d - length)
-            ));
-        }
-    }
-    if reasons.is_empty() {
+    let tips: Vec<TipBeyondReach> = targets
+        .targets
+        .iter()
+        .filter_map(|t| {
+            let tip_mm = t.tip_mm();
+            let distance_mm = tip_mm.iter().flatten().map(|v| v * v).sum::<f64>().sqrt();
+            (distance_mm > reach).then(|| TipBeyondReach { target: t.name.clone(), tip_mm, distance_mm, length_mm: length })
+        })
+        .collect();
+    if tips.is_empty() {
         Ok(())
     } else {
-        Err(DesignError::Unreachable(reasons.join("; ")))
+        Err(DesignError::Unreachable { tips })
     }
 }
 
