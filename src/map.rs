@@ -11,7 +11,7 @@
 use crate::job::{Job, JobError, JobSpec};
 use crate::reduce::parts::PartReport;
 use crate::reduce::tables::PLANAR_MAP_DIR;
-use crate::reduce::{reduce_cable_run, reduce_run, write_map_replacing, CableMapSummary, MapSummary, ModeBoundaries, ReduceError, ReduceOptions};
+use crate::reduce::{reduce_cable_run, reduce_run, write_map_replacing, CableMapSummary, MapSummary, ReduceError};
 use crate::study::{StudyError, StudyProgress, StudyReport, StudyRequest};
 use crate::sweep::progress::ProgressMode;
 use crate::sweep::{
@@ -22,8 +22,7 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-/// Cell size of a planar map when none is asked for, mm.
-pub const DEFAULT_CELL_MM: f64 = 1.0;
+pub use crate::reduce::{MapSettings, DEFAULT_CELL_MM};
 
 /// Why a map could not be made.
 #[derive(Debug, thiserror::Error)]
@@ -55,38 +54,6 @@ pub enum MapError {
     /// A study spec's study.
     #[error(transparent)]
     Study(#[from] StudyError),
-}
-
-/// The map settings shared by `reduce`, `map` and `study`.
-#[derive(Debug, Clone, PartialEq)]
-pub struct MapSettings {
-    /// Cell size, mm; `None`: [`DEFAULT_CELL_MM`], a cable sweep its spec's `output.cell_mm`.
-    pub cell_mm: Option<f64>,
-    /// Explicit mode boundaries; `None` takes quantiles of the data.
-    pub mode_boundaries: Option<ModeBoundaries>,
-    /// Designs kept per cell in designs.parquet.
-    pub designs_per_cell: usize,
-    /// Samples held in memory at once (bounds the reduce's memory).
-    pub memory_samples: usize,
-}
-
-impl MapSettings {
-    /// The reduce options of a planar map (scratch beside the map: on the
-    /// same disk as the results, not a RAM-backed /tmp).
-    pub fn options(&self, out: &Path) -> ReduceOptions {
-        ReduceOptions {
-            cell_mm: self.cell_mm.unwrap_or(DEFAULT_CELL_MM),
-            mode_boundaries: self.mode_boundaries,
-            designs_per_cell: self.designs_per_cell,
-            memory_samples: self.memory_samples,
-            scratch_dir: Some(scratch_beside(out)),
-        }
-    }
-}
-
-/// The directory `out` lies in (`.` for a bare name).
-fn scratch_beside(out: &Path) -> PathBuf {
-    out.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new(".")).to_path_buf()
 }
 
 /// Where a reduce takes its rows from.
@@ -275,7 +242,7 @@ impl MapKind for SweepSpec {
         let reduce_s = start.elapsed().as_secs_f64();
         let pictures = write_map_replacing(out, &map, &spec.actuator, &spec.solver).map_err(MapError::Write)?;
         let total_s = start.elapsed().as_secs_f64();
-        let sparse_note = crate::reduce::plots::Density::sparse_note(&map.summary, &map.cells);
+        let sparse_note = crate::reduce::Density::sparse_note(&map.summary, &map.cells);
         Ok(ReduceReport::Planar(PlanarMapReport {
             summary: map.summary,
             map_dir: out.clone(),

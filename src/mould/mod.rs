@@ -43,7 +43,6 @@ pub mod mesh;
 pub mod moulds;
 pub mod params;
 pub mod polygon;
-pub mod preview;
 pub mod request;
 pub mod set;
 pub mod stl;

@@ -39,7 +39,7 @@ impl PartKind {
     }
 
     /// The letter engraved on the part.
-    pub(super) fn letter(self) -> &'static str {
+    pub fn letter(self) -> &'static str {
         match self {
             PartKind::Tray => "T",
             PartKind::Lid => "1",

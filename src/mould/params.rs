@@ -35,16 +35,6 @@ impl MouldParams {
     pub fn max_channel_offset_mm(&self, radius_mm: f64) -> f64 {
         radius_mm - self.tube_diameter_mm / 2.0 - self.min_skin_mm
     }
-
-    /// The least distance between two channels' centrelines these moulds
-    /// can cast: two tube radii and `min_skin_mm` of silicone between, mm.
-    /// [`Moulds::planar`] and [`super::Lumens::new`] refuse channels closer
-    /// than this ([`MouldError::ChannelsTooClose`]).
-    ///
-    /// [`Moulds::planar`]: super::Moulds::planar
-    pub fn min_channel_spacing_mm(&self) -> f64 {
-        self.tube_diameter_mm + self.min_skin_mm
-    }
 }
 
 /// Largest size accepted for any mould dimension (body length and radius,

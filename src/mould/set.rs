@@ -2,7 +2,7 @@
 //! mould1.stl, mould2.stl, previews and mould.json.
 
 use super::mesh::Mesh;
-use super::{preview, stl, volume_below_face_mm3, MouldError, MouldParams, Moulds, Part, PartKind, SUMMARY_FILE};
+use super::{stl, volume_below_face_mm3, MouldError, MouldParams, Moulds, Part, PartKind, SUMMARY_FILE};
 use crate::io::FileError;
 use crate::model::Routing;
 use serde::Serialize;
@@ -235,7 +235,7 @@ impl MouldSet {
             let name = format!("mould{number}.stl");
             let path = dir.join(&name);
             crate::io::write_atomic(&path, &stl::to_bytes(&mesh, &title)).map_err(FileError::on("writing", &path))?;
-            preview::write_png(&dir.join(format!("mould{number}.png")), self, number)?;
+            crate::plot::draw_mould(&dir.join(format!("mould{number}.png")), self, number)?;
             files.push(MouldFile { file: name, parts: placed });
         }
         let mut channel_files = Vec::new();

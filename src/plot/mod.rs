@@ -1,11 +1,15 @@
-//! Pictures: every PNG cablemap draws of actuators and maps, shared by
-//! `simulate`, reduce and design. One file per kind of picture; the
-//! surface (font, backend, error) and the series of a hanging-rod picture
-//! are shared.
+//! Pictures: every PNG cablemap draws of actuators, maps and moulds,
+//! shared by `simulate`, reduce, study, mould and design. One file per
+//! kind of picture; the surface (font, backend, error), the series of a
+//! hanging-rod picture and the frame of a map picture are shared.
 
 mod body;
 mod canvas;
 mod design_shape;
+pub mod heatmap;
+pub mod map_frame;
+pub mod modes;
+pub mod mould;
 mod reach;
 mod series;
 pub mod spatial;
@@ -18,8 +22,24 @@ pub use series::{
     CLAMP_HALF_WIDTH_PER_RADIUS,
 };
 
+pub use heatmap::{draw_heatmap, draw_heatmap_laid_out, HeatmapLayout};
+pub use map_frame::{MapFrame, Scale};
+pub use modes::{draw_modes, ModesLayout};
+pub use mould::draw_mould;
+
 /// Reach maps, as the cable map draws them.
 pub use reach::{draw_reach_maps, ReachPlane};
+
+/// One picture with the explanation the index page shows.
+#[derive(Debug, Clone)]
+pub struct Picture {
+    /// File name in the map directory.
+    pub file: String,
+    /// Title.
+    pub title: String,
+    /// One line of explanation.
+    pub explanation: String,
+}
 
 #[cfg(test)]
 pub(crate) use body::tests;

@@ -9,7 +9,8 @@
 //! representative shapes of the modes. Numbers keep 7 significant digits,
 //! enough for every value a person reads off the page (the tables keep all).
 
-use super::plots::Picture;
+use super::density::Density;
+use crate::plot::Picture;
 use super::{MapCables, MapData, ReduceError, MODES};
 use crate::model::Rod;
 use crate::plot::BodyDrawing;
@@ -119,7 +120,7 @@ fn data(
     let mut value = json!({
         "summary": map.summary,
         "length_basis_description": map.summary.length_basis.describe(),
-        "sparse_note": super::plots::Density::sparse_note(&map.summary, &map.cells),
+        "sparse_note": Density::sparse_note(&map.summary, &map.cells),
         "actuator": actuator,
         "effects_in_use": effects_in_use(actuator),
         "written_utc": written_utc,

@@ -27,6 +27,7 @@
 //! [`map_cables`] a several-cable map's cables.
 
 mod cells;
+mod density;
 mod columns;
 pub mod drawings;
 mod error;
@@ -37,12 +38,12 @@ pub mod map_cables;
 mod map_data;
 mod mirror;
 mod modes;
-mod options;
+pub mod options;
 pub mod output;
 pub mod parts;
 mod partition;
 pub mod pipeline;
-pub mod plots;
+
 mod reach;
 mod sample;
 mod samples;
@@ -52,13 +53,14 @@ mod spill;
 pub mod stats;
 pub mod tables;
 
+pub use density::Density;
 pub use error::ReduceError;
 pub use map_cables::{design_actuation, MapCables};
 pub use map_data::{
     CableMapSummary, CellStats, CoefficientStats, Design, MapBody, MapData, MapSummary, ModeStats, CELL_STATS_ORDER, COEFFICIENT_UNIT,
     MAX_CELLS_PER_AXIS, MODES,
 };
-pub use options::{ModeBoundaries, ReduceOptions, DEFAULT_MEMORY_SAMPLES};
+pub use options::{MapSettings, ModeBoundaries, ReduceOptions, DEFAULT_CELL_MM, DEFAULT_MEMORY_SAMPLES};
 pub use output::{check_map_out, write_map, write_map_replacing};
 pub use pipeline::{map_given_as_run, reduce_batches, reduce_cable_run, reduce_run, run_open_error, CableMap};
 pub use source::RunInfo;

@@ -3,7 +3,7 @@
 
 use super::ReduceError;
 use serde::{Deserialize, Serialize};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Boundaries of the characteristic modes: a_0 split into 4 ranges by three
 /// values, a_1 into 3 by two (both mm⁻¹, in the run's length basis).
@@ -77,4 +77,39 @@ impl ReduceOptions {
     pub(crate) fn scratch_parent(&self) -> PathBuf {
         self.scratch_dir.clone().unwrap_or_else(std::env::temp_dir)
     }
+}
+
+/// Cell size of a planar map when none is asked for, mm.
+pub const DEFAULT_CELL_MM: f64 = 1.0;
+
+/// The map settings shared by `reduce`, `map` and `study`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MapSettings {
+    /// Cell size, mm; `None`: [`DEFAULT_CELL_MM`], a cable sweep its spec's `output.cell_mm`.
+    pub cell_mm: Option<f64>,
+    /// Explicit mode boundaries; `None` takes quantiles of the data.
+    pub mode_boundaries: Option<ModeBoundaries>,
+    /// Designs kept per cell in designs.parquet.
+    pub designs_per_cell: usize,
+    /// Samples held in memory at once (bounds the reduce's memory).
+    pub memory_samples: usize,
+}
+
+impl MapSettings {
+    /// The reduce options of a planar map (scratch beside the map: on the
+    /// same disk as the results, not a RAM-backed /tmp).
+    pub fn options(&self, out: &Path) -> ReduceOptions {
+        ReduceOptions {
+            cell_mm: self.cell_mm.unwrap_or(DEFAULT_CELL_MM),
+            mode_boundaries: self.mode_boundaries,
+            designs_per_cell: self.designs_per_cell,
+            memory_samples: self.memory_samples,
+            scratch_dir: Some(scratch_beside(out)),
+        }
+    }
+}
+
+/// The directory `out` lies in (`.` for a bare name).
+fn scratch_beside(out: &Path) -> PathBuf {
+    out.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new(".")).to_path_buf()
 }

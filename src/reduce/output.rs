@@ -3,7 +3,7 @@
 //! and picture and, for a planar run, its feasibility map.
 
 use super::drawings::ModeDrawings;
-use super::plots::{self, draw_heatmap, Picture, Scale};
+use crate::plot::{draw_heatmap, draw_modes, Picture, Scale};
 use super::reach::{Reach, PLANES};
 use super::tables::PLANAR_MAP_DIR;
 use super::{explorer, tables, CableMapSummary, CoefficientStats, MapCables, MapData, ReduceError, COEFFICIENT_UNIT};
@@ -133,7 +133,7 @@ pub fn write_map_drawn(
         cables.write(dir)?;
     }
     let mut pictures = coefficient_pictures(dir, map)?;
-    plots::draw_modes(&dir.join("modes.png"), map, &drawings.shapes, cables)?;
+    draw_modes(&dir.join("modes.png"), map, &drawings.shapes, cables)?;
     pictures.push(Picture {
         file: "modes.png".into(),
         title: "Characteristic modes (thesis Fig. 4.4)".into(),
@@ -309,7 +309,7 @@ mod tests {
         assert_eq!(pictures.len(), 1 + 3 * 3 + 1);
         for p in &pictures {
             let img = image::open(dir.join(&p.file)).unwrap().to_rgb8();
-            // Sized from the map's extent at equal aspect (plots.rs checks the aspect).
+            // Sized from the map's extent at equal aspect (plot/heatmap.rs checks the aspect).
             let (w, h) = img.dimensions();
             assert!(w >= 600 && h >= 400 && w <= 2400 && h <= 4000, "{}: {w}×{h}", p.file);
             // Not blank: many distinct colours and a good share of non-white pixels.

@@ -10,7 +10,7 @@ use super::grid;
 use super::modes;
 use super::output::{check_map_out, write_cable_map};
 use super::partition;
-use super::plots::Picture;
+use crate::plot::Picture;
 use super::reach::Reach;
 use super::samples;
 use super::source::{PlanarSource, RunInfo};

@@ -3,7 +3,7 @@
 //! ([`NUMBER_AXES`]), the tension range (`tension_n`), tables of
 //! `[actuator.effects]` settings (`effects`), and every effect parameter of
 //! the registry by its path ([`crate::model::effects::REGISTRY`]:
-//! `effects.friction_mu`, `gravity.scale`, …), set through the registry's
+//! `effects.KEY`, `gravity.scale`, …), set through the registry's
 //! own setter.
 
 use crate::model::effects::Section;

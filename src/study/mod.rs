@@ -21,8 +21,7 @@
 //! `density_g_cm3` (numbers, or `scale`), `tension_n` (pairs [min, max] in
 //! N), `effects` (tables of `[actuator.effects]` settings, laid over the
 //! base spec's), and each effect parameter of the registry by its path
-//! (`effects.friction_mu`, `gravity.scale`: numbers; see
-//! [`crate::model::effects`]). Variants are numbered with the first axis
+//! (`effects.KEY`, `gravity.scale`: numbers; see [`crate::model::effects`]). Variants are numbered with the first axis
 //! slowest.
 //!
 //! A study directory holds `study.json` (the study and its variants),

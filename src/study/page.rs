@@ -141,7 +141,7 @@ impl Comparison {
     /// on common axes (the union of their frames at one mm per pixel) and
     /// one colour scale; and sizes their modes.png to one scale.
     pub fn draw_pictures(&self, dir: &Path, maps: &[(MapSummary, Vec<CellStats>)]) -> Result<PagePictures, StudyError> {
-        use crate::reduce::plots::{draw_heatmap_laid_out, HeatmapLayout, MapFrame, ModesLayout, Scale};
+        use crate::plot::{draw_heatmap_laid_out, HeatmapLayout, MapFrame, ModesLayout, Scale};
         let frame = maps.iter().map(|(s, _)| MapFrame::of(s)).reduce(MapFrame::union);
         let most = maps.iter().flat_map(|(_, cells)| cells.iter().map(|c| c.count)).max().unwrap_or(1);
         let mut reach = Vec::new();
@@ -185,7 +185,7 @@ mod tests {
 
     #[test]
     fn the_page_draws_every_reach_on_common_axes_and_modes_at_one_scale() {
-        use crate::reduce::plots::tests::{bounding_box, cell, pixels_of, summary};
+        use crate::plot::map_frame::tests::{bounding_box, cell, pixels_of, summary};
         let small = summary();
         // A reach twice as large each way, from a rod twice as long.
         let large = MapSummary { nx: 20, ny: 32, y_min_mm: -80.0, length_mm: 130.0, ..summary() };
@@ -225,7 +225,7 @@ mod tests {
             assert!(w.abs_diff(expected) <= 1 && h.abs_diff(expected) <= 1, "busiest cells {cell_px:?} px, {expected} px expected in both");
         }
         // modes.png keeps each map's frame: shown widths follow the maps' mm extents.
-        let layouts: Vec<_> = maps.iter().map(|(s, _)| crate::reduce::plots::ModesLayout::of(s)).collect();
+        let layouts: Vec<_> = maps.iter().map(|(s, _)| crate::plot::ModesLayout::of(s)).collect();
         for (p, l) in pictures.modes.iter().zip(&layouts) {
             let shown_px_per_mm = f64::from(p.shown_px.0) / f64::from(l.size_px.0) * l.px_per_mm;
             assert!((shown_px_per_mm - pictures.modes_px_per_mm).abs() < 0.01, "{p:?}");

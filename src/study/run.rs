@@ -9,7 +9,7 @@ use super::error::StudyError;
 use super::page::PAGE_FILE;
 use super::spec::{StudySpec, Variant};
 use crate::io::FileError;
-use crate::map::MapSettings;
+use crate::reduce::MapSettings;
 use crate::reduce::tables::{read_cells, read_summary};
 use crate::reduce::ReduceOptions;
 use crate::sweep::progress::ProgressMode;

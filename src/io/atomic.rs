@@ -1,5 +1,10 @@
-//! Small file helpers shared by every stage.
+//! Files and directories written atomically: a writer's uniquely named,
+//! locked temporary, renamed into place and synced, so a reader never sees
+//! a half-written file and a killed writer's leftovers are told from a live
+//! writer's.
 
+use super::parent_dir;
+use super::run_dir::check_outside_run_dir;
 use std::fs::File;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -129,13 +134,6 @@ pub fn is_stale(path: &Path) -> bool {
         .is_some_and(|age| age.as_secs() > STALE_TEMP_S)
 }
 
-fn parent_dir(path: &Path) -> &Path {
-    match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    }
-}
-
 /// Writes `bytes` to `path` atomically: a temporary file in the same
 /// directory (named uniquely per writer), fsync, rename into place, fsync
 /// the directory. A reader never sees a half-written file, a crash never
@@ -238,252 +236,6 @@ pub fn sync_dir(dir: &Path) {
     if let Ok(d) = File::open(dir) {
         let _ = d.sync_all();
     }
-}
-
-/// What marks a directory as a sweep run: its manifest's file name and
-/// each kind's format tag. The one owner of these markers: the sweep engine
-/// writes them from here ([`crate::sweep::store`], [`crate::sweep::spec`])
-/// and [`is_run_dir`] recognises them from here, so a new kind of run is
-/// protected from stray outputs as soon as its tag is added.
-pub mod run_markers {
-    /// Manifest file name in a run directory.
-    pub const MANIFEST: &str = "manifest.json";
-    /// Format tag of planar single-cable sweep runs. Version 2: the a_i
-    /// columns are in the basis the manifest names (`length_basis`, the
-    /// thesis's rest-length basis by default); version 1 runs had
-    /// deformed-length a_i and no such field.
-    pub const PLANAR_FORMAT: &str = "cablemap-sweep/2";
-    /// Format tag of sweeps of several or spatial cables.
-    pub const CABLES_FORMAT: &str = "cablemap-cables/1";
-    /// Every kind's current tag.
-    pub const FORMATS: [&str; 2] = [PLANAR_FORMAT, CABLES_FORMAT];
-
-    /// The family of a format tag: its text up to and including the `/`
-    /// before the version (`cablemap-sweep/`), so runs of every version of
-    /// a kind are recognised.
-    pub fn family(format: &str) -> &str {
-        format.find('/').map_or(format, |k| &format[..=k])
-    }
-}
-
-/// Bytes of a manifest read to find its format tag: the tag is its first
-/// key, so a user's huge file named `manifest.json` is never read whole.
-const MANIFEST_HEAD_BYTES: u64 = 64 << 10;
-
-/// Whether `dir` is a sweep run directory of any kind: its manifest's
-/// `format` names a run kind of [`run_markers::FORMATS`] (any version).
-/// The tag is found in the text rather than by parsing the JSON, so a
-/// damaged (truncated) manifest still marks the run; a `manifest.json` of
-/// something else that only mentions a tag elsewhere does not.
-pub fn is_run_dir(dir: &Path) -> bool {
-    use std::io::Read;
-    let Ok(file) = File::open(dir.join(run_markers::MANIFEST)) else { return false };
-    let mut head = Vec::new();
-    if file.take(MANIFEST_HEAD_BYTES).read_to_end(&mut head).is_err() {
-        return false;
-    }
-    manifest_format(&String::from_utf8_lossy(&head)).is_some_and(|format| {
-        run_markers::FORMATS.iter().any(|kind| format.starts_with(run_markers::family(kind)))
-    })
-}
-
-/// The string value of the first `"format"` key of a JSON text
-/// (`"format": "cablemap-sweep/2"` → `cablemap-sweep/2`), whatever follows.
-fn manifest_format(text: &str) -> Option<&str> {
-    let mut rest = text;
-    while let Some(k) = rest.find("\"format\"") {
-        rest = rest[k + "\"format\"".len()..].trim_start();
-        if let Some(value) = rest.strip_prefix(':').map(str::trim_start).and_then(|v| v.strip_prefix('"')) {
-            return value.find('"').map(|end| &value[..end]);
-        }
-    }
-    None
-}
-
-/// The sweep run directory that `path` is, or lies inside at any depth,
-/// if any. The path is resolved through its deepest existing ancestor
-/// (symbolic links and `..` included), so `RUN/shards/new/map`,
-/// `RUN/../RUN/x` and a relative path from inside the run are all found.
-pub fn enclosing_run_dir(path: &Path) -> Option<PathBuf> {
-    let mut existing = path;
-    let resolved = loop {
-        if let Ok(p) = std::fs::canonicalize(existing) {
-            break p;
-        }
-        let parent = parent_dir(existing);
-        if parent == existing {
-            return None;
-        }
-        existing = parent;
-    };
-    resolved.ancestors().find(|d| is_run_dir(d)).map(Path::to_path_buf)
-}
-
-/// An output that is, or lies inside, a sweep run directory
-/// ([`check_outside_run_dir`]).
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error(
-    "{what} {} {} the sweep run directory {}; writing there would make the run unusable: give a path outside the run",
-    out.display(),
-    if *is_the_run { "is" } else { "is inside" },
-    run.display()
-)]
-pub struct InsideRunDir {
-    /// What the output is, for the message (e.g. "the map directory").
-    pub what: String,
-    /// The output asked for.
-    pub out: PathBuf,
-    /// The run directory it is or lies in.
-    pub run: PathBuf,
-    /// The output is the run directory itself.
-    pub is_the_run: bool,
-}
-
-/// Refuses an output (a directory or a file) that is a sweep run
-/// directory or lies inside one at any depth: the run would then hold
-/// files cablemap's checks reject, or lose its own, and be unusable until
-/// cleaned by hand. `what` names the output in the message (the command
-/// line adds its flag).
-pub fn check_outside_run_dir(out: &Path, what: &str) -> Result<(), InsideRunDir> {
-    let Some(run) = enclosing_run_dir(out) else { return Ok(()) };
-    let is_the_run = std::fs::canonicalize(out).is_ok_and(|o| o == run);
-    Err(InsideRunDir { what: what.to_string(), out: out.to_path_buf(), run, is_the_run })
-}
-
-/// A file operation that failed: which file, what was being done, and why.
-/// The one I/O error of every layer, so each names the path the same way
-/// (as a path, not a pre-formatted string) and keeps the cause.
-#[derive(Debug, thiserror::Error)]
-#[error("{op} {}: {source}", path.display())]
-pub struct FileError {
-    /// The file or directory.
-    pub path: PathBuf,
-    /// What was being done, as a verb phrase before the path ("reading", "writing", "creating").
-    pub op: &'static str,
-    /// The cause.
-    pub source: std::io::Error,
-}
-
-impl FileError {
-    /// The error of `op` on `path`.
-    pub fn new(op: &'static str, path: impl Into<PathBuf>, source: std::io::Error) -> Self {
-        Self { path: path.into(), op, source }
-    }
-
-    /// A closure for `map_err`: `std::fs::read(p).map_err(FileError::on("reading", p))`.
-    pub fn on(op: &'static str, path: &Path) -> impl FnOnce(std::io::Error) -> Self {
-        let path = path.to_path_buf();
-        move |source| Self { path, op, source }
-    }
-
-    /// Whether the cause is a missing file.
-    pub fn is_not_found(&self) -> bool {
-        self.source.kind() == std::io::ErrorKind::NotFound
-    }
-}
-
-/// [`read_utf8`] with the path in the error.
-pub fn read_text(path: &Path, op: &'static str) -> Result<String, FileError> {
-    read_utf8(path).map_err(FileError::on(op, path))
-}
-
-/// A number for a message: plain for ordinary magnitudes, scientific for
-/// extreme ones (1e308 is not printed as 309 digits).
-pub fn fmt_num(v: f64) -> String {
-    if v != 0.0 && v.is_finite() && !(1e-4..1e9).contains(&v.abs()) {
-        format!("{v:e}")
-    } else {
-        format!("{v}")
-    }
-}
-
-/// A byte count for a message, in binary units: `512 B`, `3.2 MiB`, `236.7 GiB`.
-pub fn fmt_bytes(bytes: u64) -> String {
-    const UNITS: [&str; 6] = ["B", "KiB", "MiB", "GiB", "TiB", "PiB"];
-    let mut value = bytes as f64;
-    let mut unit = 0;
-    while value >= 1024.0 && unit + 1 < UNITS.len() {
-        value /= 1024.0;
-        unit += 1;
-    }
-    if unit == 0 {
-        format!("{bytes} B")
-    } else {
-        format!("{value:.1} {}", UNITS[unit])
-    }
-}
-
-/// Memory this process may still use, bytes: the kernel's estimate of
-/// available memory (`MemAvailable`), or less where a cgroup (a container,
-/// a SLURM job) limits the process more. `None` where neither can be read
-/// (then no size is refused for memory alone).
-pub fn available_memory_bytes() -> Option<u64> {
-    let meminfo = std::fs::read_to_string("/proc/meminfo").ok().and_then(|text| {
-        let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
-        let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-        Some(kib.saturating_mul(1024))
-    });
-    let read_u64 = |path: &str| std::fs::read_to_string(path).ok().and_then(|t| t.trim().parse::<u64>().ok());
-    // cgroup v2, then v1 (whose "no limit" is a huge number, harmless here).
-    let cgroup = match (read_u64("/sys/fs/cgroup/memory.max"), read_u64("/sys/fs/cgroup/memory.current")) {
-        (Some(max), Some(current)) => Some(max.saturating_sub(current)),
-        _ => match (read_u64("/sys/fs/cgroup/memory/memory.limit_in_bytes"), read_u64("/sys/fs/cgroup/memory/memory.usage_in_bytes")) {
-            (Some(max), Some(current)) => Some(max.saturating_sub(current)),
-            _ => None,
-        },
-    };
-    match (meminfo, cgroup) {
-        (Some(a), Some(b)) => Some(a.min(b)),
-        (a, b) => a.or(b),
-    }
-}
-
-/// A number rounded to `digits` significant digits for people to read (whole
-/// numbers keep their integer digits: 1234, not 1230):
-/// plain decimal for ordinary magnitudes (1e-4 ≤ |v| < 1e6), scientific
-/// otherwise, trailing zeros dropped (`1.54`, `-0.01235`, `3.2e-7`, not
-/// `1.5400e0` or `-0.012345678901234567`). Files keep full precision.
-pub fn fmt_sig(v: f64, digits: usize) -> String {
-    if v == 0.0 || !v.is_finite() {
-        return format!("{v}");
-    }
-    let digits = digits.max(1);
-    let trim = |m: &str| if m.contains('.') { m.trim_end_matches('0').trim_end_matches('.').to_string() } else { m.to_string() };
-    if !(1e-4..1e6).contains(&v.abs()) {
-        let text = format!("{v:.prec$e}", prec = digits - 1);
-        let (mantissa, exponent) = text.split_once('e').expect("scientific format has an exponent");
-        return format!("{}e{exponent}", trim(mantissa));
-    }
-    let decimals = (digits as i32 - 1 - v.abs().log10().floor() as i32).max(0) as usize;
-    trim(&format!("{v:.decimals$}"))
-}
-
-/// The subdirectories of `dir` that hold a file named `file` (sorted; none
-/// when `dir` is unreadable): where a user who gave the parent of a run or a
-/// map meant to point.
-pub fn subdirs_holding(dir: &Path, file: &str) -> Vec<PathBuf> {
-    let Ok(entries) = std::fs::read_dir(dir) else { return Vec::new() };
-    let mut found: Vec<PathBuf> = entries.filter_map(|e| e.ok()).map(|e| e.path()).filter(|p| p.join(file).is_file()).collect();
-    found.sort();
-    found
-}
-
-/// Reads a UTF-8 text file. A file in another encoding (Latin-1, UTF-16
-/// from a spreadsheet) is an error saying so and how to fix it, instead of
-/// the bare "stream did not contain valid UTF-8".
-pub fn read_utf8(path: &Path) -> std::io::Result<String> {
-    let bytes = std::fs::read(path)?;
-    String::from_utf8(bytes).map_err(|e| {
-        let at = e.utf8_error().valid_up_to();
-        std::io::Error::new(
-            std::io::ErrorKind::InvalidData,
-            format!(
-                "the file is not UTF-8 text (invalid byte 0x{:02x} at offset {at}): save it as UTF-8, e.g. \
-                 `iconv -f latin1 -t utf-8 FILE > FILE.utf8`",
-                e.as_bytes()[at]
-            ),
-        )
-    })
 }
 
 /// Swaps two existing paths atomically (Linux `renameat2` with
@@ -601,37 +353,10 @@ fn remove_abandoned_staging(parent: &Path, name: &str) {
     }
 }
 
-/// SHA-256 of a file's bytes, hex.
-pub fn sha256_file(path: &Path) -> std::io::Result<String> {
-    use sha2::{Digest, Sha256};
-    let mut file = File::open(path)?;
-    let mut hasher = Sha256::new();
-    std::io::copy(&mut file, &mut hasher)?;
-    Ok(hex(&hasher.finalize()))
-}
-
-/// Lower-case hex of `bytes`.
-pub fn hex(bytes: &[u8]) -> String {
-    bytes.iter().map(|b| format!("{b:02x}")).collect()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn numbers_for_people_have_the_significant_digits_asked_for() {
-        assert_eq!(fmt_sig(1.54, 3), "1.54");
-        assert_eq!(fmt_sig(1.5400000001, 5), "1.54");
-        assert_eq!(fmt_sig(-0.012345678901234567, 4), "-0.01235");
-        assert_eq!(fmt_sig(115.1172, 5), "115.12");
-        assert_eq!(fmt_sig(12345.67, 5), "12346");
-        assert_eq!(fmt_sig(9.99996, 5), "10");
-        assert_eq!(fmt_sig(3.2e-7, 3), "3.2e-7");
-        assert_eq!(fmt_sig(-4.56789e8, 3), "-4.57e8");
-        assert_eq!(fmt_sig(0.0, 3), "0");
-        assert_eq!(fmt_sig(f64::NAN, 3), "NaN");
-    }
+    use crate::io::sha256_file;
 
     #[test]
     fn tokens_are_unique_and_temp_names_recognised() {
@@ -688,58 +413,6 @@ mod tests {
         assert_eq!(std::fs::read(&regular).unwrap(), b"new");
         let names: Vec<_> = std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
         assert_eq!(names.len(), 5, "no temporaries left: {names:?}");
-    }
-
-    #[test]
-    fn run_directories_of_either_kind_are_found_at_any_depth() {
-        let dir = tempfile::tempdir().unwrap();
-        for (name, format) in [("planar", run_markers::PLANAR_FORMAT), ("cables", run_markers::CABLES_FORMAT)] {
-            let run = dir.path().join(name);
-            std::fs::create_dir_all(run.join("shards")).unwrap();
-            std::fs::write(run.join("manifest.json"), format!("{{\"format\": \"{format}\"}}")).unwrap();
-            let run = std::fs::canonicalize(&run).unwrap();
-            for inside in ["", "manifest.json", "shards/map", "shards/new/deeper/map", "shards/../x"] {
-                let path = run.join(inside);
-                assert_eq!(enclosing_run_dir(&path), Some(run.clone()), "{}", path.display());
-                let e = check_outside_run_dir(&path, "the map directory").unwrap_err().to_string();
-                assert!(
-                    e.contains("sweep run directory") && e.contains(if inside.is_empty() { " is the " } else { " is inside the " }),
-                    "{e}"
-                );
-            }
-            assert!(write_atomic(&run.join("shards/x.csv"), b"x").is_err());
-            write_atomic_in_run(&run.join("shards/x.csv"), b"x").unwrap();
-        }
-        assert_eq!(enclosing_run_dir(&dir.path().join("elsewhere/map")), None);
-        assert!(check_outside_run_dir(Path::new("relative/new/map"), "x").is_ok());
-    }
-
-    /// A run is told by its manifest's `format`, of any version and even
-    /// when the manifest is cut short; a `manifest.json` of something else
-    /// is not a run for mentioning a tag in another field.
-    #[test]
-    fn a_run_is_told_by_its_manifests_format_key() {
-        let dir = tempfile::tempdir().unwrap();
-        for (manifest, is_run) in [
-            (r#"{"format": "cablemap-cables/1", "tool_version": "0.1.0"}"#, true),
-            ("{\n  \"format\" : \"cablemap-sweep/1\",\n  \"spec\": {", true),
-            (r#"{"format":"cablemap-cables/7"}"#, true),
-            (r#"{"format": "cablemap-map/1"}"#, false),
-            (r#"{"format": "photos/3", "note": "made from cablemap-sweep/2 and cablemap-cables/1 runs"}"#, false),
-            (r#"{"name": "cablemap-cables/1"}"#, false),
-            ("", false),
-        ] {
-            std::fs::write(dir.path().join(run_markers::MANIFEST), manifest).unwrap();
-            assert_eq!(is_run_dir(dir.path()), is_run, "{manifest}");
-        }
-    }
-
-    #[test]
-    fn byte_counts_read_in_binary_units() {
-        assert_eq!(fmt_bytes(512), "512 B");
-        assert_eq!(fmt_bytes(512 << 20), "512.0 MiB");
-        assert_eq!(fmt_bytes(u64::MAX), "16384.0 PiB");
-        assert!(available_memory_bytes().is_none_or(|b| b > 0));
     }
 
     #[test]

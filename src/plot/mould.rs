@@ -1,19 +1,19 @@
 //! Preview pictures of the moulds: the print plate from above (colour =
 //! height) and the assembled mould's cross-section at mid-length.
 
-use super::MouldSet;
-use crate::plot::{register_fonts, PlotError, FONT};
+use super::canvas::{png_backend, register_fonts, PlotError, FONT};
+use crate::mould::MouldSet;
 use plotters::prelude::*;
 use std::path::Path;
 
 /// Draws mould `number` (1 or 2) to `path`.
-pub fn write_png(path: &Path, set: &MouldSet, number: u8) -> Result<(), PlotError> {
+pub fn draw_mould(path: &Path, set: &MouldSet, number: u8) -> Result<(), PlotError> {
     register_fonts();
     let err = |e: &dyn std::fmt::Display| PlotError::new(path, e);
     let m = &set.moulds;
     let kinds = MouldSet::kinds(number);
     let (_, placed) = set.plate(number);
-    let root = crate::plot::png_backend(path, (1400, 1100))?.into_drawing_area();
+    let root = png_backend(path, (1400, 1100))?.into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(&e))?;
     let (top, bottom) = root.split_vertically(620);
     // The section at true aspect on the left, notes on the right.
