@@ -64,7 +64,8 @@ fn lower_layers_never_import_upward() {
         ("job.rs", &["reduce", "map", "design", "calibrate", "mould", "bench", "plot"]),
         ("map.rs", &["design", "calibrate", "mould", "bench"]),
         ("mould/", &["design", "calibrate", "reduce", "sweep", "study", "map", "job", "bench"]),
-        ("plot/", &["sweep", "study", "map", "job", "design", "calibrate", "mould", "bench"]),
+        // Pictures draw what the stages computed; no workflow runs from them.
+        ("plot/", &["sweep", "study", "map", "job", "bench"]),
     ];
     for (file, code) in library_sources() {
         for (layer, upper) in above {
@@ -573,9 +574,11 @@ fn string_sentence_variants(code: &str) -> Vec<String> {
         };
         let fields = squeezed(fields);
         let lone = fields == "(String)" || fields == "(pubString)";
-        let sentence = ["message", "reason", "why", "detail", "list", "text"]
-            .iter()
-            .any(|f| fields.contains(&format!("{f}:String")) || fields.contains(&format!("{f}:pubString")));
+        let sentence = ["message", "reason", "why", "detail", "list", "text"].iter().any(|f| {
+            ["{", ","].iter().any(|before| {
+                fields.contains(&format!("{before}{f}:String")) || fields.contains(&format!("{before}pub{f}:String"))
+            })
+        });
         if lone || sentence {
             found.push(name);
         }
@@ -618,7 +621,9 @@ fn errors_carry_typed_fields_not_sentences() {
 
 /// Error variants in the library still carrying a pre-formatted `String`
 /// ([`errors_carry_typed_fields_not_sentences`]); lowered as they are typed.
-const LIBRARY_STRING_SENTENCES: usize = 1000;
+/// `plot::PlotError` is one of them: plotters' errors are generic over the
+/// backend, so a drawing's failure is kept as its text.
+const LIBRARY_STRING_SENTENCES: usize = 22;
 
 #[test]
 fn the_detector_of_sentence_errors_sees_each_form() {
@@ -632,6 +637,10 @@ fn the_detector_of_sentence_errors_sees_each_form() {
             #[error("cannot read {}", path.display())]
             #[non_exhaustive]
             Read { path: PathBuf, name: String },
+            #[error("{context}: {source}")]
+            Parquet { context: String, source: ParquetError },
+            #[error("{why}")]
+            Why { origin: String, pub why: String },
             #[error("{count} rows")]
             Rows { count: u64 },
         }
@@ -639,7 +648,7 @@ fn the_detector_of_sentence_errors_sees_each_form() {
         #[error("{0}")]
         pub struct Invalid(pub String);
     "#;
-    assert_eq!(string_sentence_variants(code), ["Lone", "Setting", "Invalid"]);
+    assert_eq!(string_sentence_variants(code), ["Lone", "Setting", "Why", "Invalid"]);
 }
 
 #[test]

@@ -21,7 +21,7 @@
 
 use super::mesh::{Mesh, MeshBuilder, Point};
 use super::polygon::{self, P2};
-use super::{MouldError, MouldParams, MAX_SIZE_MM, MAX_TRIANGLES};
+use super::{MouldError, MouldParams, ParameterProblem, MAX_SIZE_MM, MAX_TRIANGLES};
 use crate::model::cable::Channel;
 use crate::model::routing::CONTROL_POINTS;
 use crate::model::Actuator;
@@ -141,7 +141,7 @@ impl Lumens {
     /// ([`super::check_body`]).
     pub fn new(actuator: &Actuator, params: &MouldParams) -> Result<Self, MouldError> {
         let p = params;
-        let bad = |name: &'static str, message: String| Err(MouldError::BadParameter { name, message });
+        let bad = |name: &'static str, problem| Err(MouldError::BadParameter { name, problem });
         super::request::check_body(actuator, super::MouldStyle::Lumens)?;
         let channels = crate::model::cable::validate(&actuator.rod, &actuator.cables).map_err(crate::solver::spatial::SpatialError::from)?;
         actuator.rod.validate()?;
@@ -157,26 +157,26 @@ impl Lumens {
             ("length_mm", length_mm),
         ] {
             if !value.is_finite() {
-                return bad(name, format!("{value} is not a number of mm: give a finite size"));
+                return bad(name, ParameterProblem::NotFinite { value });
             }
             if value.abs() > MAX_SIZE_MM {
-                return bad(name, format!("{} mm is larger than {MAX_SIZE_MM} mm, beyond any printer: give the size in mm", crate::io::fmt_num(value)));
+                return bad(name, ParameterProblem::TooLarge { value });
             }
         }
         if p.tube_diameter_mm <= 0.0 || p.tube_diameter_mm > radius_mm {
-            return bad("tube_diameter_mm", format!("{} mm must be positive and at most the radius {radius_mm} mm", p.tube_diameter_mm));
+            return bad("tube_diameter_mm", ParameterProblem::Tube { tube_mm: p.tube_diameter_mm, radius_mm, pour: false });
         }
         if p.wall_mm <= 0.0 {
-            return bad("wall_mm", format!("{} mm must be positive (the cores reach that far beyond the body)", p.wall_mm));
+            return bad("wall_mm", ParameterProblem::WallNotPositive { wall_mm: p.wall_mm });
         }
         if p.clamp_mm < 0.0 {
-            return bad("clamp_mm", format!("{} mm must be ≥ 0", p.clamp_mm));
+            return bad("clamp_mm", ParameterProblem::Negative { value: p.clamp_mm });
         }
         if p.min_skin_mm < 0.0 {
-            return bad("min_skin_mm", format!("{} mm must be ≥ 0", p.min_skin_mm));
+            return bad("min_skin_mm", ParameterProblem::Negative { value: p.min_skin_mm });
         }
         if !(0.01..=2.0).contains(&p.station_step_mm) {
-            return bad("station_step_mm", format!("{} mm must be between 0.01 and 2", p.station_step_mm));
+            return bad("station_step_mm", ParameterProblem::StationStep { step_mm: p.station_step_mm });
         }
         let step = p.station_step_mm.min(MAX_STATION_STEP_MM);
         // Stations: the clamp block's end, the clamp face, the body at the
@@ -395,7 +395,7 @@ impl Lumens {
         for (i, outward_x) in [(0, false), (self.stations.len() - 1, true)] {
             let x = self.stations[i];
             let holes: Vec<Vec<P2>> = lumens.iter().map(|rings| rings[i].clone()).collect();
-            let tris = polygon::triangulate(&outlines[i], &holes).map_err(|e| MouldError::Unsupported(format!("the end face at x = {x} mm: {e}")))?;
+            let tris = polygon::triangulate(&outlines[i], &holes).map_err(|source| MouldError::EndFace { x_mm: x, source })?;
             let mut pts = outlines[i].clone();
             holes.iter().for_each(|h| pts.extend_from_slice(h));
             for t in tris {

@@ -47,7 +47,7 @@ pub mod request;
 pub mod set;
 pub mod stl;
 
-pub use error::MouldError;
+pub use error::{BodyFeature, MouldError, ParameterProblem};
 pub use moulds::{volume_below_face_mm3, Moulds, Part, PartKind};
 pub use params::{check_uniform_body, MouldParams, MAX_SIZE_MM, MAX_TRIANGLES};
 pub use lumens::{LumenSummary, Lumens};

@@ -3,7 +3,7 @@
 
 use super::font::{text_pixels, text_width_mm};
 use super::mesh::{heightfield_solid, sided, Mesh, Sided};
-use super::{MouldError, MouldParams, MAX_SIZE_MM, MAX_TRIANGLES};
+use super::{MouldError, MouldParams, ParameterProblem, MAX_SIZE_MM, MAX_TRIANGLES};
 use crate::model::Routing;
 use serde::Serialize;
 
@@ -119,18 +119,13 @@ impl Moulds {
     /// y_c(s) in the cutting plane, in cable order, all of one length.
     pub fn planar(channels: &[Routing], radius_mm: f64, params: &MouldParams) -> Result<Self, MouldError> {
         let p = params;
-        let bad = |name: &'static str, message: String| Err(MouldError::BadParameter { name, message });
+        let bad = |name: &'static str, problem| Err(MouldError::BadParameter { name, problem });
         let Some(first) = channels.first() else {
-            return bad("channels", "no channel given: the moulds need at least one cable".into());
+            return bad("channels", ParameterProblem::NoChannel);
         };
         let length = first.length_mm();
         if let Some(k) = channels.iter().position(|c| c.length_mm() != length) {
-            return bad("channels", format!(
-                "cable {} spans {} mm, cable 1 {} mm: every channel must run from the clamp to the tip (no cable_anchor_mm before the tip)",
-                k + 1,
-                crate::io::fmt_num(channels[k].length_mm()),
-                crate::io::fmt_num(length)
-            ));
+            return bad("channels", ParameterProblem::ChannelLengths { cable: k + 1, length_mm: channels[k].length_mm(), first_mm: length });
         }
         let sizes = [
             ("wall_mm", p.wall_mm),
@@ -144,46 +139,41 @@ impl Moulds {
         ];
         for (name, value) in sizes {
             if !value.is_finite() {
-                return bad(name, format!("{value} is not a number of mm: give a finite size"));
+                return bad(name, ParameterProblem::NotFinite { value });
             }
             // Beyond any printer's bed; the meshes of such moulds would not fit in memory.
             if value.abs() > MAX_SIZE_MM {
-                return bad(name, format!("{} mm is larger than {MAX_SIZE_MM} mm, beyond any printer: give the size in mm", crate::io::fmt_num(value)));
+                return bad(name, ParameterProblem::TooLarge { value });
             }
         }
         if p.tube_diameter_mm <= 0.0 || p.tube_diameter_mm > radius_mm {
-            return bad("tube_diameter_mm", format!(
-                "{} mm must be positive and at most the radius {radius_mm} mm (the pour opening is r/2 deep)",
-                p.tube_diameter_mm
-            ));
+            return bad("tube_diameter_mm", ParameterProblem::Tube { tube_mm: p.tube_diameter_mm, radius_mm, pour: true });
         }
         if !(0.0..=0.5).contains(&p.clearance_mm) {
-            return bad("clearance_mm", format!("{} mm must be between 0 and 0.5", p.clearance_mm));
+            return bad("clearance_mm", ParameterProblem::Clearance { clearance_mm: p.clearance_mm });
         }
         if p.wall_mm < PIN_HEIGHT_MM + p.clearance_mm + 0.8 {
-            return bad("wall_mm", format!(
-                "{} mm is too thin: the lid's pin holes are {} mm deep; use at least {} mm",
-                p.wall_mm,
-                PIN_HEIGHT_MM + p.clearance_mm,
-                PIN_HEIGHT_MM + p.clearance_mm + 0.8
-            ));
+            return bad(
+                "wall_mm",
+                ParameterProblem::WallTooThin {
+                    wall_mm: p.wall_mm,
+                    holes_mm: PIN_HEIGHT_MM + p.clearance_mm,
+                    least_mm: PIN_HEIGHT_MM + p.clearance_mm + 0.8,
+                },
+            );
         }
         if p.clamp_mm < 0.0 {
-            return bad("clamp_mm", format!("{} mm must be ≥ 0", p.clamp_mm));
+            return bad("clamp_mm", ParameterProblem::Negative { value: p.clamp_mm });
         }
         if p.min_skin_mm < 0.0 {
-            return bad("min_skin_mm", format!("{} mm must be ≥ 0", p.min_skin_mm));
+            return bad("min_skin_mm", ParameterProblem::Negative { value: p.min_skin_mm });
         }
         if !(0.01..=2.0).contains(&p.station_step_mm) {
-            return bad("station_step_mm", format!("{} mm must be between 0.01 and 2", p.station_step_mm));
+            return bad("station_step_mm", ParameterProblem::StationStep { step_mm: p.station_step_mm });
         }
         let text_mm = text_width_mm("CL ^+Y");
         if length + p.clamp_mm < text_mm + 12.0 {
-            return bad("clamp_mm", format!(
-                "body of {length} mm plus clamp block {} mm is too short for the marks and pins (needs {} mm)",
-                p.clamp_mm,
-                text_mm + 12.0
-            ));
+            return bad("clamp_mm", ParameterProblem::ClampTooShort { length_mm: length, clamp_mm: p.clamp_mm, needed_mm: text_mm + 12.0 });
         }
         let rho = p.tube_diameter_mm / 2.0;
         // The channel must keep min_skin of silicone to the surface everywhere.
@@ -239,12 +229,10 @@ impl Moulds {
                 let w = moulds.ridge_half_width_max_mm[k].max(notch);
                 let y = channels[k].channel_at(s).y_mm;
                 if y.abs() + w >= radius_mm {
-                    return bad("tube_diameter_mm", format!(
-                        "the protrusion of cable {} (half-width {w:.3} mm in x-sections) at |y_c| = {:.3} mm reaches the body surface r = {radius_mm} mm at s = {s:.2} mm; \
-                         use a routing further from the surface or a thinner tube",
-                        k + 1,
-                        y.abs()
-                    ));
+                    return bad(
+                        "tube_diameter_mm",
+                        ParameterProblem::Protrusion { cable: k + 1, half_width_mm: w, y_mm: y.abs(), radius_mm, s_mm: s },
+                    );
                 }
                 if let Some((j, yj, wj, _)) = prev {
                     if y - w <= yj + wj {

@@ -1,6 +1,6 @@
 //! The moulds' parameters and the bodies they can cast.
 
-use super::MouldError;
+use super::{BodyFeature, MouldError};
 use serde::Serialize;
 
 /// Parameters of the moulds, mm.
@@ -48,20 +48,20 @@ pub const MAX_TRIANGLES: f64 = 4e6;
 /// Refuses a body the moulds cannot cast: a radius profile, segments or a
 /// cable knotted before the tip ([`MouldError::NonUniformBody`]).
 pub fn check_uniform_body(a: &crate::model::Rod) -> Result<(), MouldError> {
-    let mut what = Vec::new();
+    let mut features = Vec::new();
     if !a.radius_profile_mm.is_empty() {
-        what.push("a radius profile (radius_profile_mm)");
+        features.push(BodyFeature::RadiusProfile { lumens: false });
     }
     if !a.segments.is_empty() {
-        what.push("segments of their own material");
+        features.push(BodyFeature::Segments);
     }
     if a.cable_length_mm() < a.length_mm {
-        what.push("a cable anchored before the tip (cable_anchor_mm)");
+        features.push(BodyFeature::CableAnchored);
     }
-    if what.is_empty() {
+    if features.is_empty() {
         Ok(())
     } else {
-        Err(MouldError::NonUniformBody(what.join(" and ")))
+        Err(MouldError::NonUniformBody { features })
     }
 }
 

@@ -7,7 +7,7 @@
 //! cover; [`MouldSet`]); channels in space, or a tapered body, get a printed
 //! body with lumens and its castable cores ([`Lumens`]).
 
-use super::{Lumens, LumenSummary, MouldError, MouldParams, MouldSet, MouldSummary};
+use super::{BodyFeature, Lumens, LumenSummary, MouldError, MouldParams, MouldSet, MouldSummary};
 use crate::model::{Actuator, Routing};
 use serde::Serialize;
 use std::path::Path;
@@ -90,25 +90,26 @@ impl MouldReport {
 /// ([`MouldError::NonUniformBody`]).
 pub fn check_body(actuator: &Actuator, style: MouldStyle) -> Result<(), MouldError> {
     let rod = &actuator.rod;
-    let mut what = Vec::new();
+    let mut features = Vec::new();
     if style == MouldStyle::TwoPart && !rod.radius_profile_mm.is_empty() {
-        what.push("a radius profile (radius_profile_mm; a printed body with lumens follows it: --style lumens)".to_string());
+        features.push(BodyFeature::RadiusProfile { lumens: true });
     }
     if !rod.segments.is_empty() {
-        what.push("segments of their own material".to_string());
+        features.push(BodyFeature::Segments);
     }
     if rod.cable_length_mm() < rod.length_mm {
-        what.push("a cable anchored before the tip (cable_anchor_mm)".to_string());
+        features.push(BodyFeature::CableAnchored);
     }
     for (k, c) in actuator.cables.iter().enumerate() {
-        if c.anchor_or_tip_mm(rod.length_mm) < rod.length_mm {
-            what.push(format!("cable {} knotted before the tip (anchor_mm = {} mm; its tube must leave through the tip)", k + 1, crate::io::fmt_num(c.anchor_or_tip_mm(rod.length_mm))));
+        let anchor_mm = c.anchor_or_tip_mm(rod.length_mm);
+        if anchor_mm < rod.length_mm {
+            features.push(BodyFeature::CableKnotted { cable: k + 1, anchor_mm });
         }
     }
-    if what.is_empty() {
+    if features.is_empty() {
         Ok(())
     } else {
-        Err(MouldError::NonUniformBody(what.join(" and ")))
+        Err(MouldError::NonUniformBody { features })
     }
 }
 
@@ -132,13 +133,9 @@ fn planar_channels(actuator: &Actuator) -> Result<Vec<Routing>, MouldError> {
         .enumerate()
         .map(|(k, c)| {
             if !c.is_planar() {
-                return Err(MouldError::Unsupported(format!(
-                    "cable {} leaves the bending plane (z0..z4 = {:?} mm): the two-part mould casts channels in one plane only; print the body with lumens instead (--style lumens)",
-                    k + 1,
-                    c.z_mm
-                )));
+                return Err(MouldError::CableOutOfPlane { cable: k + 1, z_mm: c.z_mm });
             }
-            Routing::new(c.y_mm, rod.length_mm, rod.radius_mm).map_err(|e| MouldError::Unsupported(format!("cable {}: {e}", k + 1)))
+            Routing::new(c.y_mm, rod.length_mm, rod.radius_mm).map_err(|source| MouldError::CableRouting { cable: k + 1, source })
         })
         .collect()
 }
@@ -147,7 +144,7 @@ fn planar_channels(actuator: &Actuator) -> Result<Vec<Routing>, MouldError> {
 /// the style `options` ask for; nothing is written.
 pub fn build(actuator: &Actuator, options: &MouldOptions) -> Result<ActuatorMoulds, MouldError> {
     if actuator.cables.is_empty() {
-        return Err(MouldError::Unsupported("the actuator has no cables: give [[cable]] tables (or --cable)".into()));
+        return Err(MouldError::NoCables);
     }
     match resolve_style(actuator, options) {
         MouldStyle::Lumens => Ok(ActuatorMoulds::Lumens(Lumens::new(actuator, &options.params)?)),
@@ -165,7 +162,7 @@ pub fn build(actuator: &Actuator, options: &MouldOptions) -> Result<ActuatorMoul
 /// before it starts (`design --moulds`).
 pub fn check(actuator: &Actuator, options: &MouldOptions) -> Result<MouldStyle, MouldError> {
     if actuator.cables.is_empty() {
-        return Err(MouldError::Unsupported("the actuator has no cables: give [[cable]] tables (or --cable)".into()));
+        return Err(MouldError::NoCables);
     }
     let style = resolve_style(actuator, options);
     match style {

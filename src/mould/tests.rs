@@ -232,7 +232,7 @@ fn channels_near_the_surface_and_bad_parameters_are_refused() {
         (MouldParams { clamp_mm: 1e7, ..p.clone() }, "clamp_mm"),
     ] {
         match Moulds::new(&ok, 5.0, &bad).unwrap_err() {
-            MouldError::BadParameter { name: got, message } => assert_eq!(got, name, "{message}"),
+            MouldError::BadParameter { name: got, problem } => assert_eq!(got, name, "{problem}"),
             e => panic!("{e}"),
         }
     }

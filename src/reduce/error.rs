@@ -107,7 +107,7 @@ pub enum ReduceError {
     },
     /// The map directory is, or lies inside, a sweep run directory.
     #[error("{0}")]
-    MapInRun(String),
+    MapInRun(#[source] crate::io::InsideRunDir),
     /// A map directory was given where a sweep run is read.
     #[error(
         "{} is a map (written by `cablemap reduce`), not a sweep run; it was made from the run {run_dir}: give that run directory",

@@ -43,7 +43,7 @@ pub fn write_dir_replacing<T>(dir: &Path, write: impl FnOnce(&Path) -> Result<T,
 /// Checks that `dir` can take a map (see [`write_map_replacing`]) before
 /// any work is done; returns its file name.
 pub fn check_map_out(dir: &Path) -> Result<String, ReduceError> {
-    crate::io::check_outside_run_dir(dir, "the map directory").map_err(|e| ReduceError::MapInRun(e.to_string()))?;
+    crate::io::check_outside_run_dir(dir, "the map directory").map_err(ReduceError::MapInRun)?;
     let name = dir.file_name().map(|n| n.to_string_lossy().into_owned()).filter(|n| n != "." && n != "..");
     let Some(name) = name else {
         return Err(ReduceError::MapDirUnnamed { path: dir.to_path_buf() });

@@ -278,68 +278,202 @@ pub(crate) fn write_cable_summary(dir: &Path, summary: &CableMapSummary) -> Resu
 }
 
 /// A map table that cannot be read, or breaks the map format.
-#[derive(Debug, Clone, thiserror::Error)]
-#[error("map {}: {message}", path.display())]
+#[derive(Debug, thiserror::Error)]
+#[error("map {}: {problem}", path.display())]
 pub struct ReadError {
     /// The file.
     pub path: PathBuf,
     /// What is wrong, and what to do.
-    pub message: String,
+    pub problem: MapProblem,
 }
 
-fn read_error(path: &Path, message: impl Into<String>) -> ReadError {
-    ReadError { path: path.to_path_buf(), message: message.into() }
+fn read_error(path: &Path, problem: MapProblem) -> ReadError {
+    ReadError { path: path.to_path_buf(), problem }
+}
+
+/// What is wrong with a map file.
+#[derive(Debug, thiserror::Error)]
+pub enum MapProblem {
+    /// The directory has no `summary.json`.
+    #[error("{0}")]
+    NoSummary(MissingSummary),
+    /// `summary.json` cannot be read.
+    #[error("cannot read ({0}); give a map directory written by `cablemap reduce`")]
+    Unreadable(#[source] std::io::Error),
+    /// A cable sweep's map with a planar map inside, given as a feasibility map.
+    #[error("is the map of a cable sweep (reach counts); its planar feasibility map is {}", planar.display())]
+    CableMapWithPlanar {
+        /// Its planar map's folder.
+        planar: PathBuf,
+    },
+    /// A spatial cable sweep's map, given as a feasibility map.
+    #[error("is the map of a spatial cable sweep (reach counts only): it has no feasibility map")]
+    SpatialCableMap,
+    /// `summary.json` breaks the map contract.
+    #[error("does not match the map contract: {0}")]
+    Contract(#[source] serde_json::Error),
+    /// Its mode boundaries are not boundaries.
+    #[error("mode_boundaries: {0}")]
+    ModeBoundaries(#[source] Box<super::ReduceError>),
+    /// Its cell size is not a length.
+    #[error("cell_mm must be positive, got {cell_mm}")]
+    CellSize {
+        /// The cell size recorded, mm.
+        cell_mm: f64,
+    },
+    /// Its tension range is not a range.
+    #[error("tension_range_n [{lo}, {hi}] is not a range")]
+    TensionRange {
+        /// Lowest tension recorded, N.
+        lo: f64,
+        /// Highest, N.
+        hi: f64,
+    },
+    /// A table cannot be opened.
+    #[error("cannot open ({0}); is this a `cablemap reduce` output directory?")]
+    CannotOpen(#[source] std::io::Error),
+    /// A table is not Parquet.
+    #[error("not a readable parquet file: {0}")]
+    NotParquet(#[source] parquet::errors::ParquetError),
+    /// A table's rows cannot be decoded.
+    #[error("reading: {0}")]
+    Reading(#[source] arrow::error::ArrowError),
+    /// A column is missing.
+    #[error("column `{name}` is missing (see docs/maps.md)")]
+    ColumnMissing {
+        /// The column.
+        name: String,
+    },
+    /// A column has nulls.
+    #[error("column `{name}` has nulls")]
+    ColumnNulls {
+        /// The column.
+        name: String,
+    },
+    /// A column has another type.
+    #[error("column `{name}` should be {wanted}, is {found}")]
+    ColumnType {
+        /// The column.
+        name: String,
+        /// The type the format gives it.
+        wanted: &'static str,
+        /// Its type in the file.
+        found: arrow::datatypes::DataType,
+    },
+    /// A cell off the grid.
+    #[error("cell ({ix}, {iy}) lies off the grid 0..{end}: the file is damaged; reduce the run again")]
+    CellOffGrid {
+        /// Its column.
+        ix: i32,
+        /// Its row.
+        iy: i32,
+        /// The grid's end along either axis.
+        end: i32,
+    },
+    /// A cable sweep map's summary cannot be read.
+    #[error("cannot read ({0}); give the map directory of a cable sweep (`cablemap map` of a spec with [[cable]] tables)")]
+    CableMapUnreadable(#[source] std::io::Error),
+    /// Not a cable sweep's map.
+    #[error("is not the summary of a cable sweep's map (kind = \"cables\"): give the map of a cable sweep")]
+    NotCableMap,
+    /// A cable sweep map's summary, unreadable where its kind was already read.
+    #[error("cannot read ({0})")]
+    CannotRead(#[source] std::io::Error),
+    /// A cable sweep map's summary breaks its contract.
+    #[error("does not match the cable map contract: {0}")]
+    CableContract(#[source] serde_json::Error),
+}
+
+/// Why a directory has no `summary.json`, pointing at the map the user
+/// meant: the `map` folder of `cablemap map --out DIR`, maps inside it, or
+/// the map still to be made of a run.
+#[derive(Debug)]
+pub enum MissingSummary {
+    /// The directory does not exist.
+    NoDir {
+        /// The directory.
+        dir: PathBuf,
+    },
+    /// The directory is a sweep run.
+    RunNotMap {
+        /// The directory.
+        dir: PathBuf,
+    },
+    /// Nothing map-like inside it.
+    NoMap,
+    /// Maps inside it.
+    MapsInside {
+        /// The directory.
+        dir: PathBuf,
+        /// The maps inside it.
+        maps: Vec<PathBuf>,
+    },
+}
+
+impl MissingSummary {
+    /// What `dir` holds instead of a map.
+    fn of(dir: &Path) -> Self {
+        if !dir.exists() {
+            MissingSummary::NoDir { dir: dir.to_path_buf() }
+        } else if crate::io::is_run_dir(dir) {
+            MissingSummary::RunNotMap { dir: dir.to_path_buf() }
+        } else {
+            match crate::io::subdirs_holding(dir, SUMMARY_FILE) {
+                maps if maps.is_empty() => MissingSummary::NoMap,
+                maps => MissingSummary::MapsInside { dir: dir.to_path_buf(), maps },
+            }
+        }
+    }
+}
+
+impl std::fmt::Display for MissingSummary {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            MissingSummary::NoDir { dir } => write!(f, "{} does not exist; give a map directory written by `cablemap reduce`", dir.display()),
+            MissingSummary::RunNotMap { dir } => {
+                let d = dir.display();
+                write!(f, "is missing: {d} is a sweep run, not a map; reduce it first (`cablemap reduce {d} --out MAP_DIR`)")
+            }
+            MissingSummary::NoMap => write!(f, "is missing; give a map directory written by `cablemap reduce`"),
+            MissingSummary::MapsInside { dir, maps } => match maps.as_slice() {
+                [one] => {
+                    let (d, one) = (dir.display(), one.display());
+                    write!(f, "is missing: {d} holds no map itself, but {one} inside it does (the map `cablemap map --out {d}` writes); give {one}")
+                }
+                _ => {
+                    let names: Vec<String> = maps.iter().map(|p| p.display().to_string()).collect();
+                    write!(f, "is missing: {} holds no map itself; the maps inside it: {}; give one of them", dir.display(), names.join(", "))
+                }
+            },
+        }
+    }
 }
 
 /// Reads and checks `summary.json` of map directory `dir`.
 pub fn read_summary(dir: &Path) -> Result<MapSummary, ReadError> {
     let path = dir.join(SUMMARY_FILE);
     let text = crate::io::read_utf8(&path).map_err(|e| match e.kind() {
-        std::io::ErrorKind::NotFound => read_error(&path, missing_summary_text(dir)),
-        _ => read_error(&path, format!("cannot read ({e}); give a map directory written by `cablemap reduce`")),
+        std::io::ErrorKind::NotFound => read_error(&path, MapProblem::NoSummary(MissingSummary::of(dir))),
+        _ => read_error(&path, MapProblem::Unreadable(e)),
     })?;
     let summary: MapSummary = serde_json::from_str(&text).map_err(|e| {
         // A cable sweep's map is not a feasibility map; a
         // planar one holds one in its `planar` folder.
         match serde_json::from_str::<serde_json::Value>(&text).ok().filter(|v| v["kind"] == "cables") {
-            Some(v) if v["planar_map"].is_string() => read_error(&path, format!(
-                "is the map of a cable sweep (reach counts); its planar feasibility map is {}",
-                dir.join(PLANAR_MAP_DIR).display()
-            )),
-            Some(_) => read_error(&path, "is the map of a spatial cable sweep (reach counts only): it has no feasibility map"),
-            None => read_error(&path, format!("does not match the map contract: {e}")),
+            Some(v) if v["planar_map"].is_string() => read_error(&path, MapProblem::CableMapWithPlanar { planar: dir.join(PLANAR_MAP_DIR) }),
+            Some(_) => read_error(&path, MapProblem::SpatialCableMap),
+            None => read_error(&path, MapProblem::Contract(e)),
         }
     })?;
-    summary.mode_boundaries.validate().map_err(|e| read_error(&path, format!("mode_boundaries: {e}")))?;
+    summary.mode_boundaries.validate().map_err(|e| read_error(&path, MapProblem::ModeBoundaries(Box::new(e))))?;
     if !(summary.cell_mm > 0.0 && summary.cell_mm.is_finite()) {
-        return Err(read_error(&path, format!("cell_mm must be positive, got {}", summary.cell_mm)));
+        return Err(read_error(&path, MapProblem::CellSize { cell_mm: summary.cell_mm }));
     }
     let [lo, hi] = summary.tension_range_n;
     if !(lo.is_finite() && hi.is_finite() && lo <= hi) {
-        return Err(read_error(&path, format!("tension_range_n [{lo}, {hi}] is not a range")));
+        return Err(read_error(&path, MapProblem::TensionRange { lo, hi }));
     }
     Ok(summary)
-}
-
-/// Why a directory has no `summary.json`, pointing at the map the user
-/// meant: the `map` folder of `cablemap map --out DIR`, maps inside it, or
-/// the map still to be made of a run.
-fn missing_summary_text(dir: &Path) -> String {
-    let maps = crate::io::subdirs_holding(dir, SUMMARY_FILE);
-    let names: Vec<String> = maps.iter().map(|p| p.display().to_string()).collect();
-    match names.as_slice() {
-        _ if !dir.exists() => format!("{} does not exist; give a map directory written by `cablemap reduce`", dir.display()),
-        _ if crate::io::is_run_dir(dir) => {
-            let d = dir.display();
-            format!("is missing: {d} is a sweep run, not a map; reduce it first (`cablemap reduce {d} --out MAP_DIR`)")
-        }
-        [] => "is missing; give a map directory written by `cablemap reduce`".into(),
-        [one] => {
-            let d = dir.display();
-            format!("is missing: {d} holds no map itself, but {one} inside it does (the map `cablemap map --out {d}` writes); give {one}")
-        }
-        _ => format!("is missing: {} holds no map itself; the maps inside it: {}; give one of them", dir.display(), names.join(", ")),
-    }
 }
 
 /// The run directory a map directory records it was made from (planar or
@@ -354,11 +488,11 @@ pub fn recorded_run_dir(dir: &Path) -> Option<String> {
 /// Reads every record batch of a parquet file.
 fn read_batches(path: &Path) -> Result<Vec<RecordBatch>, ReadError> {
     let file = std::fs::File::open(path)
-        .map_err(|e| read_error(path, format!("cannot open ({e}); is this a `cablemap reduce` output directory?")))?;
+        .map_err(|e| read_error(path, MapProblem::CannotOpen(e)))?;
     let reader = ParquetRecordBatchReaderBuilder::try_new(file)
         .and_then(|b| b.build())
-        .map_err(|e| read_error(path, format!("not a readable parquet file: {e}")))?;
-    reader.collect::<Result<Vec<_>, _>>().map_err(|e| read_error(path, format!("reading: {e}")))
+        .map_err(|e| read_error(path, MapProblem::NotParquet(e)))?;
+    reader.collect::<Result<Vec<_>, _>>().map_err(|e| read_error(path, MapProblem::Reading(e)))
 }
 
 /// Typed column access with errors that name the column.
@@ -372,9 +506,9 @@ impl<'a> Columns<'a> {
         let c = self
             .batch
             .column_by_name(name)
-            .ok_or_else(|| read_error(self.path, format!("column `{name}` is missing (see docs/maps.md)")))?;
+            .ok_or_else(|| read_error(self.path, MapProblem::ColumnMissing { name: name.to_string() }))?;
         if c.null_count() > 0 {
-            return Err(read_error(self.path, format!("column `{name}` has nulls")));
+            return Err(read_error(self.path, MapProblem::ColumnNulls { name: name.to_string() }));
         }
         Ok(c.as_ref())
     }
@@ -383,28 +517,28 @@ impl<'a> Columns<'a> {
         let c = self.column(name)?;
         c.as_primitive_opt::<Float64Type>()
             .map(|a| a.values().as_ref())
-            .ok_or_else(|| read_error(self.path, format!("column `{name}` should be f64, is {}", c.data_type())))
+            .ok_or_else(|| read_error(self.path, MapProblem::ColumnType { name: name.to_string(), wanted: "f64", found: c.data_type().clone() }))
     }
 
     fn i32(&self, name: &str) -> Result<&'a [i32], ReadError> {
         let c = self.column(name)?;
         c.as_primitive_opt::<Int32Type>()
             .map(|a| a.values().as_ref())
-            .ok_or_else(|| read_error(self.path, format!("column `{name}` should be i32, is {}", c.data_type())))
+            .ok_or_else(|| read_error(self.path, MapProblem::ColumnType { name: name.to_string(), wanted: "i32", found: c.data_type().clone() }))
     }
 
     fn i64(&self, name: &str) -> Result<&'a [i64], ReadError> {
         let c = self.column(name)?;
         c.as_primitive_opt::<Int64Type>()
             .map(|a| a.values().as_ref())
-            .ok_or_else(|| read_error(self.path, format!("column `{name}` should be i64, is {}", c.data_type())))
+            .ok_or_else(|| read_error(self.path, MapProblem::ColumnType { name: name.to_string(), wanted: "i64", found: c.data_type().clone() }))
     }
 
     fn bool(&self, name: &str) -> Result<Vec<bool>, ReadError> {
         let c = self.column(name)?;
         c.as_boolean_opt()
             .map(|a| a.iter().map(|v| v.unwrap_or(false)).collect())
-            .ok_or_else(|| read_error(self.path, format!("column `{name}` should be bool, is {}", c.data_type())))
+            .ok_or_else(|| read_error(self.path, MapProblem::ColumnType { name: name.to_string(), wanted: "bool", found: c.data_type().clone() }))
     }
 }
 
@@ -438,10 +572,7 @@ pub fn read_cells(dir: &Path, order: usize) -> Result<Vec<CellStats>, ReadError>
     }
     let grid = 0..MAX_CELLS_PER_AXIS as i32;
     if let Some(c) = cells.iter().find(|c| !grid.contains(&c.ix) || !grid.contains(&c.iy)) {
-        return Err(read_error(
-            &path,
-            format!("cell ({}, {}) lies off the grid 0..{}: the file is damaged; reduce the run again", c.ix, c.iy, grid.end),
-        ));
+        return Err(read_error(&path, MapProblem::CellOffGrid { ix: c.ix, iy: c.iy, end: grid.end }));
     }
     Ok(cells)
 }
@@ -491,13 +622,13 @@ pub struct ReachTables {
 /// Reads a cable sweep map's `summary.json` and reach tables ([`REACH_FILES`]).
 pub fn read_reach(dir: &Path) -> Result<ReachTables, ReadError> {
     let path = dir.join(SUMMARY_FILE);
-    let text = crate::io::read_utf8(&path).map_err(|e| read_error(&path, format!("cannot read ({e}); give the map directory of a cable sweep (`cablemap map` of a spec with [[cable]] tables)")))?;
+    let text = crate::io::read_utf8(&path).map_err(|e| read_error(&path, MapProblem::CableMapUnreadable(e)))?;
     let summary: CableMapSummary = serde_json::from_str(&text)
         .ok()
         .filter(|s: &CableMapSummary| s.kind == "cables")
-        .ok_or_else(|| read_error(&path, "is not the summary of a cable sweep's map (kind = \"cables\"): give the map of a cable sweep"))?;
+        .ok_or_else(|| read_error(&path, MapProblem::NotCableMap))?;
     if !(summary.cell_mm > 0.0 && summary.cell_mm.is_finite()) {
-        return Err(read_error(&path, format!("cell_mm must be positive, got {}", summary.cell_mm)));
+        return Err(read_error(&path, MapProblem::CellSize { cell_mm: summary.cell_mm }));
     }
     let mut planes: [std::collections::BTreeMap<[i32; 2], i64>; 3] = Default::default();
     for (k, ((_, axes), file)) in PLANES.iter().zip(REACH_FILES.iter()).enumerate() {
@@ -552,8 +683,8 @@ pub fn map_tables(dir: &Path) -> Result<Vec<MapTable>, ReadError> {
         return feasibility(dir);
     }
     let path = dir.join(SUMMARY_FILE);
-    let text = crate::io::read_utf8(&path).map_err(|e| read_error(&path, format!("cannot read ({e})")))?;
-    let summary: CableMapSummary = serde_json::from_str(&text).map_err(|e| read_error(&path, format!("does not match the cable map contract: {e}")))?;
+    let text = crate::io::read_utf8(&path).map_err(|e| read_error(&path, MapProblem::CannotRead(e)))?;
+    let summary: CableMapSummary = serde_json::from_str(&text).map_err(|e| read_error(&path, MapProblem::CableContract(e)))?;
     let mut tables: Vec<MapTable> = REACH_FILES.iter().map(|f| table(dir, f)).collect();
     if let Some(planar) = &summary.planar_map {
         tables.extend(feasibility(&dir.join(planar))?);

@@ -48,8 +48,11 @@ pub enum AxisError {
     #[error("give either values or scale, not both")]
     ValuesAndScale,
     /// A value that must be a number.
-    #[error("value {0} is not a number")]
-    NotANumber(String),
+    #[error("value {value} is not a number")]
+    NotANumber {
+        /// The value as written.
+        value: String,
+    },
     /// A scale factor that is not positive.
     #[error("scale {0} must be a positive factor")]
     BadFactor(f64),
@@ -60,17 +63,26 @@ pub enum AxisError {
     #[error("give values = [[min_n, max_n], ...] (no scale)")]
     TensionScale,
     /// A tension value that is not a pair.
-    #[error("value {0} is not a pair [min_n, max_n] of tensions")]
-    NotAPair(String),
+    #[error("value {value} is not a pair [min_n, max_n] of tensions")]
+    NotAPair {
+        /// The value as written.
+        value: String,
+    },
     /// A scale on the effects axis.
     #[error("give values = [{{...}}, ...] (tables of [actuator.effects] settings; no scale)")]
     EffectsScale,
     /// An effects value that is not a table.
-    #[error("value {0} is not a table of [actuator.effects] settings")]
-    NotATable(String),
-    /// A table of settings that has no JSON form.
-    #[error("{0}")]
-    Settings(String),
+    #[error("value {value} is not a table of [actuator.effects] settings")]
+    NotATable {
+        /// The value as written.
+        value: String,
+    },
+    /// A table of settings that has no JSON form (a TOML date, say).
+    #[error("value {value} holds a setting that is not a number, a string or a table")]
+    Settings {
+        /// The value as written.
+        value: String,
+    },
     /// An axis of no known name.
     #[error("unknown axis '{name}': use one of {}, {TENSION_AXIS}, {}, or an effect parameter ({})", NUMBER_AXES.join(", "), effects_axis(), effect_paths())]
     Unknown {
@@ -99,7 +111,7 @@ pub(super) enum Change {
 
 /// An axis value as a number (TOML integers count).
 fn number(v: &toml::Value) -> Result<f64, AxisError> {
-    v.as_float().or_else(|| v.as_integer().map(|i| i as f64)).ok_or_else(|| AxisError::NotANumber(v.to_string()))
+    v.as_float().or_else(|| v.as_integer().map(|i| i as f64)).ok_or_else(|| AxisError::NotANumber { value: v.to_string() })
 }
 
 fn fmt(v: f64) -> String {
@@ -163,14 +175,14 @@ fn tension_pair(v: &toml::Value) -> Result<(String, Change), AxisError> {
         Some(&[lo, hi]) if v.as_array().is_some_and(|p| p.len() == 2) => {
             Ok((format!("{}–{} N", fmt(lo), fmt(hi)), Change::Tension { min_n: lo, max_n: hi }))
         }
-        _ => Err(AxisError::NotAPair(v.to_string())),
+        _ => Err(AxisError::NotAPair { value: v.to_string() }),
     }
 }
 
 /// An effects axis value: a table of `[actuator.effects]` settings.
 fn effect_settings(v: &toml::Value) -> Result<(String, Change), AxisError> {
-    let t = v.as_table().ok_or_else(|| AxisError::NotATable(v.to_string()))?;
-    let json = serde_json::to_value(t).map_err(|e| AxisError::Settings(e.to_string()))?;
+    let t = v.as_table().ok_or_else(|| AxisError::NotATable { value: v.to_string() })?;
+    let json = serde_json::to_value(t).map_err(|_| AxisError::Settings { value: v.to_string() })?;
     let label = if t.is_empty() { "none".to_string() } else { t.iter().map(|(k, v)| format!("{k}:{v}")).collect::<Vec<_>>().join(" ") };
     Ok((format!("{{{label}}}"), Change::Effects(json.as_object().cloned().unwrap_or_default())))
 }

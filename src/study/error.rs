@@ -7,12 +7,12 @@ use std::path::PathBuf;
 #[derive(Debug, thiserror::Error)]
 pub enum StudyError {
     /// The spec text or its `[study]` section.
-    #[error("bad study spec {origin}: {message}")]
+    #[error("bad study spec {origin}: {problem}")]
     Spec {
         /// The spec file.
         origin: String,
         /// What is wrong and what to do.
-        message: String,
+        problem: SpecProblem,
     },
     /// One of the spec's axes.
     #[error("bad study spec {origin}: [[study.axis]] {axis}: {source}")]
@@ -95,12 +95,12 @@ pub enum StudyError {
     #[error(transparent)]
     File(#[from] crate::io::FileError),
     /// `study.json` is not a study's record.
-    #[error("{}: not a study record: {message}", path.display())]
+    #[error("{}: not a study record: {source}", path.display())]
     NotARecord {
         /// The file.
         path: PathBuf,
         /// What is wrong.
-        message: String,
+        source: serde_json::Error,
     },
     /// A task index outside the split.
     #[error("task {shard} is not below the {shards} tasks of the split: tasks are numbered 0 to shards − 1 (shards ≥ 1)")]
@@ -117,5 +117,59 @@ pub enum StudyError {
         dir: PathBuf,
         /// What went wrong.
         source: Box<StudyError>,
+    },
+}
+
+/// What is wrong with a study spec as a whole.
+#[derive(Debug, thiserror::Error)]
+pub enum SpecProblem {
+    /// The text is not TOML.
+    #[error("{0}")]
+    Toml(#[source] toml::de::Error),
+    /// No `[study]` section.
+    #[error("no [study] section: a study spec is a sweep spec with a [study] section naming its axes")]
+    NoStudySection,
+    /// The `[study]` section is malformed.
+    #[error("[study] {0}")]
+    StudySection(#[source] toml::de::Error),
+    /// The base spec has no TOML text.
+    #[error("{0}")]
+    BaseText(#[source] toml::ser::Error),
+    /// The base sweep spec is refused.
+    #[error("the base sweep spec: {0}")]
+    Base(#[source] Box<crate::sweep::SweepError>),
+    /// No axes.
+    #[error("[study] has no [[study.axis]]: give at least one axis (name and values or scale)")]
+    NoAxes,
+    /// An axis given twice.
+    #[error("[[study.axis]] {axis} is given twice: give each axis once, with all its values")]
+    AxisTwice {
+        /// The axis's name.
+        axis: String,
+    },
+    /// A tension axis over a base spec driven by displacement.
+    #[error(
+        "[[study.axis]] {axis} varies the tension ladder, but the base spec drives the cable by its displacement ([displacement]): \
+         vary its displacements in the base spec, or give the base spec a [tension] ladder"
+    )]
+    TensionOfDisplacement {
+        /// The axis's name.
+        axis: String,
+    },
+    /// Too many variants.
+    #[error("the axes give more than {most} variants: use fewer values")]
+    TooManyVariants {
+        /// The most variants a study may have.
+        most: usize,
+    },
+    /// A variant's settings do not make a sweep spec.
+    #[error("variant {index} ({label}): {source}")]
+    VariantSettings {
+        /// Variant number.
+        index: usize,
+        /// Its settings.
+        label: String,
+        /// Why they do not make a spec.
+        source: serde_json::Error,
     },
 }

@@ -49,7 +49,7 @@ pub mod spec;
 
 pub use axes::{AxisError, NUMBER_AXES};
 pub use comparison::{compare, Comparison, VariantRow, COMPARISON_CSV, COMPARISON_JSON};
-pub use error::StudyError;
+pub use error::{SpecProblem, StudyError};
 pub use page::{reach_picture_file, PagePicture, PagePictures, MODES_SHOWN_MAX_W, PAGE_FILE, STUDY_REACH_PLOT_W};
 pub use record::{mapped_variants, STUDY_FILE, STUDY_FORMAT};
 pub use run::{run, run_variant, StudyProgress, StudyReport, StudyRequest, StudyTask, VariantRun};

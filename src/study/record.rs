@@ -74,7 +74,7 @@ pub fn mapped_variants(dir: &Path) -> Result<Vec<(usize, String, PathBuf)>, Stud
         Err(source) => return Err(FileError::new("reading", path, source).into()),
     };
     let v: serde_json::Value =
-        serde_json::from_slice(&bytes).map_err(|e| StudyError::NotARecord { path: path.clone(), message: e.to_string() })?;
+        serde_json::from_slice(&bytes).map_err(|source| StudyError::NotARecord { path: path.clone(), source })?;
     Ok(v["variants"]
         .as_array()
         .into_iter()

@@ -3,7 +3,7 @@
 //! each with its complete sweep spec.
 
 use super::axes::{AxisSection, Change};
-use super::error::StudyError;
+use super::error::{SpecProblem, StudyError};
 use crate::sweep::SweepSpec;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -88,43 +88,37 @@ impl StudySpec {
     /// Parses a study spec; `origin` names it in errors.
     pub fn from_toml(text: &str, origin: &str) -> Result<Self, StudyError> {
         let table: toml::Table =
-            text.parse().map_err(|e: toml::de::Error| StudyError::Spec { origin: origin.to_string(), message: e.to_string() })?;
+            text.parse().map_err(|e| StudyError::Spec { origin: origin.to_string(), problem: SpecProblem::Toml(e) })?;
         Self::from_table(table, origin)
     }
 
     /// A study spec from its parsed TOML (see [`crate::job::Job::load`],
     /// which parses a spec once to tell its kind); `origin` names it in errors.
     pub fn from_table(mut table: toml::Table, origin: &str) -> Result<Self, StudyError> {
-        let bad = |message: String| StudyError::Spec { origin: origin.to_string(), message };
-        let section = table
-            .remove("study")
-            .ok_or_else(|| bad("no [study] section: a study spec is a sweep spec with a [study] section naming its axes".into()))?;
-        let section: StudySection = section.try_into().map_err(|e: toml::de::Error| bad(format!("[study] {e}")))?;
-        let base_text = toml::to_string(&table).map_err(|e| bad(e.to_string()))?;
-        let base = SweepSpec::from_toml(&base_text, origin).map_err(|e| bad(format!("the base sweep spec: {e}")))?;
+        let bad = |problem| StudyError::Spec { origin: origin.to_string(), problem };
+        let section = table.remove("study").ok_or_else(|| bad(SpecProblem::NoStudySection))?;
+        let section: StudySection = section.try_into().map_err(|e| bad(SpecProblem::StudySection(e)))?;
+        let base_text = toml::to_string(&table).map_err(|e| bad(SpecProblem::BaseText(e)))?;
+        let base = SweepSpec::from_toml(&base_text, origin).map_err(|e| bad(SpecProblem::Base(Box::new(e))))?;
         if section.axis.is_empty() {
-            return Err(bad("[study] has no [[study.axis]]: give at least one axis (name and values or scale)".into()));
+            return Err(bad(SpecProblem::NoAxes));
         }
         let mut axes: Vec<(String, Vec<(String, Change)>)> = Vec::new();
         for a in &section.axis {
             let changes =
                 a.changes().map_err(|source| StudyError::Axis { origin: origin.to_string(), axis: a.name.clone(), source })?;
             if axes.iter().any(|(n, _)| *n == a.name) {
-                return Err(bad(format!("[[study.axis]] {} is given twice: give each axis once, with all its values", a.name)));
+                return Err(bad(SpecProblem::AxisTwice { axis: a.name.clone() }));
             }
             // The tension ladder of a cable driven by its displacement is unused.
             if base.displacement.is_some() && changes.iter().any(|(_, c)| matches!(c, Change::Tension { .. })) {
-                return Err(bad(format!(
-                    "[[study.axis]] {} varies the tension ladder, but the base spec drives the cable by its displacement ([displacement]): \
-                     vary its displacements in the base spec, or give the base spec a [tension] ladder",
-                    a.name
-                )));
+                return Err(bad(SpecProblem::TensionOfDisplacement { axis: a.name.clone() }));
             }
             axes.push((a.name.clone(), changes));
         }
         let count = axes.iter().try_fold(1usize, |n, (_, v)| n.checked_mul(v.len())).filter(|&n| n <= MAX_VARIANTS);
         let Some(count) = count else {
-            return Err(bad(format!("the axes give more than {MAX_VARIANTS} variants: use fewer values")));
+            return Err(bad(SpecProblem::TooManyVariants { most: MAX_VARIANTS }));
         };
         let base_json: serde_json::Value = serde_json::from_str(&base.canonical_json()).expect("the spec's canonical JSON parses");
         let mut variants = Vec::with_capacity(count);
@@ -144,7 +138,8 @@ impl StudySpec {
                 settings.push(Setting { axis: name.clone(), value: value.clone() });
             }
             let label = label(&settings);
-            let spec: SweepSpec = serde_json::from_value(json).map_err(|e| bad(format!("variant {index} ({label}): {e}")))?;
+            let spec: SweepSpec =
+                serde_json::from_value(json).map_err(|source| bad(SpecProblem::VariantSettings { index, label: label.clone(), source }))?;
             spec.validate().map_err(|source| StudyError::Variant {
                 origin: origin.to_string(),
                 index,

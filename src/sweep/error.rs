@@ -1,6 +1,7 @@
 //! Why a sweep, a status query or a read failed.
 
 use super::{kind, run, spec, status, store};
+use crate::io::fmt_bytes;
 use std::path::PathBuf;
 
 /// Why a sweep, a status query or a read failed. Messages name the file or
@@ -21,16 +22,34 @@ pub enum SweepError {
         /// The spec file, or where an in-memory spec came from.
         origin: String,
         /// What is wrong.
-        source: kind::InvalidSpec,
+        source: spec::CableSpecError,
     },
     /// A spec the engine refuses ([`super::RunSpec::check`] of an in-memory
-    /// spec of any kind), or a cable sweep larger than a sweep may be by default.
-    #[error("bad sweep spec {origin}: {message}")]
+    /// spec of any kind).
+    #[error("bad sweep spec {origin}: {source}")]
     InvalidSpec {
         /// The spec file, or where an in-memory spec came from.
         origin: String,
         /// What is wrong.
-        message: String,
+        source: kind::InvalidSpec,
+    },
+    /// The whole sweep is larger than a sweep may be without `--allow-large`.
+    #[error(
+        "bad sweep spec (size): the sweep has {rows} rows ({routings} routings × {per_routing} {}), more than {}: check {}, or pass \
+         --allow-large if the job is meant to be this big",
+        counted.per_routing(),
+        kind::MAX_ROWS,
+        counted.settings()
+    )]
+    TooLarge {
+        /// Rows of the sweep.
+        rows: u64,
+        /// Routings.
+        routings: u64,
+        /// Rows per routing.
+        per_routing: u64,
+        /// What the kind of sweep counts per routing, and where it is set.
+        counted: kind::RowsCounted,
     },
     /// Shard index or count out of range.
     #[error("shard {shard} of {shards} is out of range: use 0 ≤ shard < shards (shards ≥ 1)")]
@@ -48,8 +67,32 @@ pub enum SweepError {
         chunks: u64,
     },
     /// The sweep would need more memory than the machine has free.
-    #[error("{0}")]
-    TooMuchMemory(String),
+    #[error(
+        "the sweep would need about {} of memory, more than the {} available: {in_flight} chunk(s) of {chunk_rows} rows built at \
+         once ({} each) and the tables of its {chunks} chunk files ({}): {advice}, or pass --allow-large to run it anyway",
+        fmt_bytes(*needed_bytes),
+        fmt_bytes(*available_bytes),
+        fmt_bytes(*chunk_bytes),
+        fmt_bytes(*tables_bytes)
+    )]
+    TooMuchMemory {
+        /// Memory the sweep would take, bytes.
+        needed_bytes: u64,
+        /// Memory available, bytes.
+        available_bytes: u64,
+        /// Chunks built at once.
+        in_flight: u64,
+        /// Rows per chunk.
+        chunk_rows: u64,
+        /// Memory of one chunk while it is built, bytes.
+        chunk_bytes: u64,
+        /// Chunk files of the run.
+        chunks: u64,
+        /// Memory of the run's chunk and shard tables, bytes.
+        tables_bytes: u64,
+        /// What to lower or raise.
+        advice: run::MemoryAdvice,
+    },
     /// The run directory would lie inside another run directory.
     #[error(
         "{} is inside the sweep run directory {}; a run there would make that run unusable: give a directory outside the run",
@@ -62,9 +105,12 @@ pub enum SweepError {
         /// The run directory it lies in.
         run: PathBuf,
     },
-    /// A thread count of 0 or unparsable.
+    /// A thread count of 0.
+    #[error("invalid thread count: 0: use at least 1 thread")]
+    NoThreads,
+    /// The thread pool could not be built with the thread count asked for.
     #[error("invalid thread count: {0}")]
-    BadThreads(String),
+    ThreadPool(#[from] rayon::ThreadPoolBuildError),
     /// DIR exists, has no manifest and is not empty.
     #[error("{} is not a cablemap sweep directory (it has no manifest.json but holds '{entry}'): give a new or empty directory to --out", dir.display())]
     NotARunDir { dir: PathBuf, entry: String },
@@ -95,8 +141,8 @@ pub enum SweepError {
         wanted: String,
     },
     /// The manifest is unreadable.
-    #[error("manifest {} is damaged: {message}. Restore it, or start the sweep in a new directory", path.display())]
-    CorruptManifest { path: PathBuf, message: String },
+    #[error("manifest {} is damaged: {problem}. Restore it, or start the sweep in a new directory", path.display())]
+    CorruptManifest { path: PathBuf, problem: store::ManifestProblem },
     /// DIR belongs to a run of another spec.
     #[error("{} holds a sweep of a different spec (sha256 {existing}; this spec is {wanted}): use another --out directory, or the spec that run was started with", dir.display())]
     SpecMismatch { dir: PathBuf, existing: String, wanted: String },
@@ -111,14 +157,21 @@ pub enum SweepError {
     ForeignFile { path: PathBuf },
     /// A chunk-named file from another job.
     #[error("{} does not belong to this sweep ({reason}): move it out of the run directory, then rerun", path.display())]
-    ForeignChunk { path: PathBuf, reason: String },
+    ForeignChunk { path: PathBuf, reason: store::ForeignReason },
     /// A chunk file that cannot be read.
-    #[error("chunk file {} is damaged ({message}): delete it and rerun the sweep to recompute that chunk", path.display())]
-    CorruptChunk { path: PathBuf, message: String },
+    #[error("chunk file {} is damaged ({problem}): delete it and rerun the sweep to recompute that chunk", path.display())]
+    CorruptChunk { path: PathBuf, problem: store::ChunkProblem },
     /// Chunk files whose bytes changed since they were written (checksum
     /// mismatch) or whose footer is unreadable.
-    #[error("{} holds damaged chunk files: {list}. Rerun the sweep command of each named shard (same SPEC, --out, --shards): it moves damaged chunks to {} and recomputes them", dir.display(), dir.join(store::DAMAGED_DIR).display())]
-    DamagedChunks { dir: PathBuf, list: String },
+    #[error("{} holds damaged chunk files: {}. Rerun the sweep command of each named shard (same SPEC, --out, --shards): it moves damaged chunks to {} and recomputes them", dir.display(), store::damaged_text(damaged, *shards), dir.join(store::DAMAGED_DIR).display())]
+    DamagedChunks {
+        /// The run directory.
+        dir: PathBuf,
+        /// The damaged chunk files.
+        damaged: Vec<store::DamagedChunk>,
+        /// The run's shard count (each chunk belongs to one shard).
+        shards: u64,
+    },
     /// The run is not complete and the caller asked for a complete one.
     #[error("sweep in {} is incomplete ({done} of {total} rows): rerun the sweep command to finish it, or read it as partial", dir.display())]
     Incomplete { dir: PathBuf, done: u64, total: u64 },

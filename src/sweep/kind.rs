@@ -121,9 +121,46 @@ pub trait RunSpec: Clone + PartialEq + std::fmt::Debug + serde::Serialize + serd
 
 /// Why [`RunSpec::check`] refuses a spec: the setting and what to do, in
 /// the kind's own words (without the spec's origin, which the caller knows).
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("{0}")]
-pub struct InvalidSpec(pub String);
+#[derive(Debug, thiserror::Error)]
+pub enum InvalidSpec {
+    /// A planar sweep spec's setting.
+    #[error("{0}")]
+    Planar(#[source] super::spec::SpecError),
+    /// A cable sweep spec's setting.
+    #[error("{0}")]
+    Cables(#[source] super::spec::CableSpecError),
+}
+
+/// What a kind of sweep counts per routing, and where the counts are set
+/// (for [`super::SweepError::TooLarge`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RowsCounted {
+    /// A planar sweep's actuations, set by the grid and the ladder's table.
+    Actuations {
+        /// `[tension]` or `[displacement]`.
+        ladder_table: &'static str,
+    },
+    /// A cable sweep's tension combinations.
+    TensionCombinations,
+}
+
+impl RowsCounted {
+    /// What a row of a routing is.
+    pub fn per_routing(&self) -> &'static str {
+        match self {
+            RowsCounted::Actuations { .. } => "actuations",
+            RowsCounted::TensionCombinations => "tension combinations",
+        }
+    }
+
+    /// The settings that set the count.
+    pub fn settings(&self) -> String {
+        match self {
+            RowsCounted::Actuations { ladder_table } => format!("[grid] levels and {ladder_table} count"),
+            RowsCounted::TensionCombinations => "the levels and tension counts".to_string(),
+        }
+    }
+}
 
 /// The kind of sweep a run directory holds, from its manifest's format tag
 /// ([`crate::sweep::store::run_kind`] reads it).

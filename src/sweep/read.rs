@@ -24,7 +24,7 @@
 
 use super::kind::RunSpec;
 use super::spec::SweepSpec;
-use super::store::{ChunkInfo, Manifest, RunDir};
+use super::store::{ChunkInfo, ChunkProblem, Manifest, RunDir};
 use super::SweepError;
 use arrow::datatypes::SchemaRef;
 use arrow::record_batch::RecordBatch;
@@ -69,14 +69,7 @@ pub fn open_run_of<S: RunSpec>(dir: &Path, completeness: Completeness) -> Result
     let manifest: Manifest<S> = run.read_manifest()?.ok_or_else(|| SweepError::no_run(dir))?;
     let scan = run.scan(&manifest)?;
     if !scan.damaged.is_empty() {
-        let plan = manifest.spec.layout();
-        let list = scan
-            .damaged
-            .iter()
-            .map(|d| format!("{} (shard {}: {})", d.path.display(), plan.chunk_shard(d.chunk, manifest.shards.max(1)), d.reason))
-            .collect::<Vec<_>>()
-            .join("; ");
-        return Err(SweepError::DamagedChunks { dir: dir.to_path_buf(), list });
+        return Err(SweepError::DamagedChunks { dir: dir.to_path_buf(), damaged: scan.damaged, shards: manifest.shards });
     }
     let chunks: Vec<ChunkInfo> = scan.chunks.into_values().collect();
     let sweep = SweepRun { dir: dir.to_path_buf(), manifest, chunks };
@@ -214,13 +207,13 @@ fn open_chunk(
     projection: Option<&[usize]>,
 ) -> Result<parquet::arrow::arrow_reader::ParquetRecordBatchReader, SweepError> {
     let file = File::open(path).map_err(crate::io::FileError::on("opening", path))?;
-    let corrupt = |message: String| SweepError::CorruptChunk { path: path.to_path_buf(), message };
-    let builder = ParquetRecordBatchReaderBuilder::try_new(file).map_err(|e| corrupt(e.to_string()))?;
+    let corrupt = |problem| SweepError::CorruptChunk { path: path.to_path_buf(), problem };
+    let builder = ParquetRecordBatchReaderBuilder::try_new(file).map_err(|e| corrupt(ChunkProblem::parquet(e)))?;
     let found = builder.schema();
     let same = found.fields().len() == expected.fields().len()
         && found.fields().iter().zip(expected.fields()).all(|(a, b)| a.name() == b.name() && a.data_type() == b.data_type());
     if !same {
-        return Err(corrupt("its columns differ from the run's schema".into()));
+        return Err(corrupt(ChunkProblem::Columns));
     }
     let builder = match projection {
         Some(indices) => {
@@ -229,5 +222,5 @@ fn open_chunk(
         }
         None => builder,
     };
-    builder.with_batch_size(BATCH_ROWS).build().map_err(|e| corrupt(e.to_string()))
+    builder.with_batch_size(BATCH_ROWS).build().map_err(|e| corrupt(ChunkProblem::parquet(e)))
 }

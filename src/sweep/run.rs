@@ -79,21 +79,31 @@ fn check_memory<S: RunSpec>(spec: &S, shards: u64, threads: usize, allow_large: 
     if needed <= available || allow_large {
         return Ok(());
     }
-    let fmt = crate::io::fmt_bytes;
-    let advice = if tables >= building {
-        format!("raise output.chunk_routings (now {}) for fewer, larger chunk files", layout.chunk_routings)
-    } else {
-        "lower output.chunk_routings or the thread count (--threads)".to_string()
-    };
-    Err(SweepError::TooMuchMemory(format!(
-        "the sweep would need about {} of memory, more than the {} available: {in_flight} chunk(s) of {chunk_rows} rows built at once \
-         ({} each) and the tables of its {} chunk files ({}): {advice}, or pass --allow-large to run it anyway",
-        fmt(needed),
-        fmt(available),
-        fmt(chunk_bytes),
-        layout.chunks,
-        fmt(tables)
-    )))
+    let advice = if tables >= building { MemoryAdvice::FewerChunks { chunk_routings: layout.chunk_routings } } else { MemoryAdvice::SmallerChunks };
+    Err(SweepError::TooMuchMemory {
+        needed_bytes: needed,
+        available_bytes: available,
+        in_flight,
+        chunk_rows,
+        chunk_bytes,
+        chunks: layout.chunks,
+        tables_bytes: tables,
+        advice,
+    })
+}
+
+/// What to change when a sweep needs more memory than is free.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+pub enum MemoryAdvice {
+    /// The chunk and shard tables dominate: fewer, larger chunks.
+    #[error("raise output.chunk_routings (now {chunk_routings}) for fewer, larger chunk files")]
+    FewerChunks {
+        /// The spec's routings per chunk.
+        chunk_routings: u64,
+    },
+    /// The chunks being built dominate: smaller chunks or fewer threads.
+    #[error("lower output.chunk_routings or the thread count (--threads)")]
+    SmallerChunks,
 }
 
 /// The thread count to use for a request of `requested` threads (`None`:
@@ -157,7 +167,7 @@ pub fn run_sweep(spec: &SweepSpec, dir: &Path, options: &SweepOptions) -> Result
 /// ([`RunSpec`]: planar, or several/spatial cables) into `dir`.
 pub fn run_sweep_of<S: RunSpec>(spec: &S, dir: &Path, options: &SweepOptions) -> Result<SweepSummary, SweepError> {
     let started = Instant::now();
-    spec.check().map_err(|e| SweepError::InvalidSpec { origin: "(in memory)".into(), message: e.0 })?;
+    spec.check().map_err(|source| SweepError::InvalidSpec { origin: "(in memory)".into(), source })?;
     let (shard, shards) = (options.shard, options.shards);
     if shards == 0 || shard >= shards {
         return Err(SweepError::BadShard { shard, shards });
@@ -166,7 +176,7 @@ pub fn run_sweep_of<S: RunSpec>(spec: &S, dir: &Path, options: &SweepOptions) ->
         return Err(SweepError::TooManyShards { shards, chunks: spec.layout().chunks });
     }
     if options.threads == Some(0) {
-        return Err(SweepError::BadThreads("0: use at least 1 thread".into()));
+        return Err(SweepError::NoThreads);
     }
     spec.check_run_size(options.allow_large)?;
     let (threads_wanted, capped) = capped_threads(options.threads);
@@ -236,7 +246,7 @@ pub fn run_sweep_of<S: RunSpec>(spec: &S, dir: &Path, options: &SweepOptions) ->
     if let Some(n) = threads_wanted {
         builder = builder.num_threads(n);
     }
-    let pool = builder.build().map_err(|e| SweepError::BadThreads(e.to_string()))?;
+    let pool = builder.build()?;
     let threads = pool.current_num_threads();
 
     let label = format!("sweep shard {shard}/{shards}");

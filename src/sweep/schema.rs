@@ -194,10 +194,20 @@ pub enum Axis {
     Z,
 }
 
+impl Axis {
+    /// The axis's name in specs and columns: `y` or `z`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Axis::Y => "y",
+            Axis::Z => "z",
+        }
+    }
+}
+
 /// Name of a cable's control-point column (f64, mm), e.g. `cable2_z3_mm`
 /// (cables from 1).
 pub fn control_point_column(cable: usize, axis: Axis, point: usize) -> String {
-    format!("cable{cable}_{}{point}_mm", if axis == Axis::Y { "y" } else { "z" })
+    format!("cable{cable}_{}{point}_mm", axis.name())
 }
 
 /// Name of a cable's tension column (f64, N), e.g. `tension1_n` (cables from

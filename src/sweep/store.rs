@@ -149,7 +149,7 @@ impl<S: RunSpec> Manifest<S> {
 }
 
 /// How a manifest disagrees with itself ([`Manifest::verify`]).
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[derive(Debug, thiserror::Error)]
 pub enum ManifestMismatch {
     /// The spec it holds is refused.
     #[error("its spec is invalid ({0})")]
@@ -190,8 +190,135 @@ pub struct DamagedChunk {
     pub chunk: u64,
     /// Path of the file.
     pub path: PathBuf,
-    /// What is wrong.
-    pub reason: String,
+    /// What is wrong (written as its sentence).
+    #[serde(serialize_with = "serialize_display")]
+    pub reason: ChunkProblem,
+}
+
+/// Serialises a value as the sentence its `Display` makes.
+fn serialize_display<T: std::fmt::Display, Z: serde::Serializer>(value: &T, serializer: Z) -> Result<Z::Ok, Z::Error> {
+    serializer.collect_str(value)
+}
+
+/// The damaged chunk files of a run split into `shards` shards, each with
+/// its shard and problem, for a message.
+pub fn damaged_text(damaged: &[DamagedChunk], shards: u64) -> String {
+    damaged.iter().map(|d| format!("{} (shard {}: {})", d.path.display(), d.chunk % shards.max(1), d.reason)).collect::<Vec<_>>().join("; ")
+}
+
+/// Why a manifest cannot be used.
+#[derive(Debug, thiserror::Error)]
+pub enum ManifestProblem {
+    /// It is not the JSON of a manifest.
+    #[error("{0}")]
+    Json(#[source] serde_json::Error),
+    /// Its format tag is another than this kind's.
+    #[error(
+        "format '{found}' is not '{wanted}' (a run made by another cablemap version; version 1 runs stored a_i per unit deformed \
+         length: sweep again into a new directory)"
+    )]
+    Format {
+        /// The manifest's tag.
+        found: String,
+        /// This kind's tag.
+        wanted: &'static str,
+    },
+    /// Its length basis is not its spec's.
+    #[error("length_basis '{manifest}' disagrees with the spec's output.length_basis '{spec}'")]
+    LengthBasis {
+        /// As recorded beside the spec.
+        manifest: LengthBasis,
+        /// As the spec says.
+        spec: LengthBasis,
+    },
+    /// It disagrees with itself.
+    #[error("{0}")]
+    Mismatch(#[source] ManifestMismatch),
+    /// It was there, then gone (another process removed it).
+    #[error("vanished while being read")]
+    Vanished,
+}
+
+/// Why a chunk file is damaged.
+#[derive(Debug, Clone, thiserror::Error)]
+pub enum ChunkProblem {
+    /// No checksum was recorded for it.
+    #[error("no checksum recorded in {}", sum_path.display())]
+    NoChecksum {
+        /// Where the checksum should be.
+        sum_path: PathBuf,
+    },
+    /// Its bytes changed since it was written.
+    #[error("its SHA-256 is {actual}, not the {recorded} recorded when it was written")]
+    Checksum {
+        /// The file's digest, hex.
+        actual: String,
+        /// The digest recorded when it was written, hex.
+        recorded: String,
+    },
+    /// Parquet cannot read it.
+    #[error("{0}")]
+    Parquet(#[source] std::sync::Arc<parquet::errors::ParquetError>),
+    /// Its columns are not the run's.
+    #[error("its columns differ from the run's schema")]
+    Columns,
+    /// It holds another number of rows than its chunk.
+    #[error("it holds {found} rows where chunk {chunk} has {rows}")]
+    Rows {
+        /// Rows in the file.
+        found: i64,
+        /// The chunk.
+        chunk: u64,
+        /// Rows of the chunk.
+        rows: u64,
+    },
+    /// Its status counts metadata is missing or not JSON.
+    #[error("status counts unreadable")]
+    StatusCounts,
+}
+
+impl ChunkProblem {
+    /// The problem of a Parquet error.
+    pub fn parquet(e: parquet::errors::ParquetError) -> Self {
+        Self::Parquet(std::sync::Arc::new(e))
+    }
+}
+
+/// Two problems are the same when they say the same (a Parquet error has
+/// no equality of its own).
+impl PartialEq for ChunkProblem {
+    fn eq(&self, other: &Self) -> bool {
+        self.to_string() == other.to_string()
+    }
+}
+
+/// Why a chunk-named file belongs to another job.
+#[derive(Debug, thiserror::Error)]
+pub enum ForeignReason {
+    /// It has no format tag of this kind.
+    #[error("it has no '{key}' = '{format}' metadata")]
+    NoFormat {
+        /// The metadata key.
+        key: &'static str,
+        /// This kind's format tag.
+        format: &'static str,
+    },
+    /// It was written for another spec.
+    #[error("it was written for spec {found} but this run's spec is {wanted}")]
+    OtherSpec {
+        /// The spec hash in its metadata (`(none)` when missing).
+        found: String,
+        /// This run's spec hash.
+        wanted: String,
+    },
+    /// It names another chunk.
+    #[error("its metadata names chunk '{found}', not {chunk}")]
+    OtherChunk {
+        /// The chunk in its metadata (`(none)` when missing).
+        found: String,
+        /// The chunk its name says.
+        chunk: u64,
+    },
 }
 
 /// What a chunk file's footer says.
@@ -307,32 +434,20 @@ impl RunDir {
                     Some(f) if f != S::FORMAT && crate::io::run_markers::FORMATS.contains(&f.as_str()) => {
                         SweepError::OtherKind { dir: self.root.clone(), found: f, wanted: S::FORMAT.into() }
                     }
-                    _ => SweepError::CorruptManifest { path, message: e.to_string() },
+                    _ => SweepError::CorruptManifest { path, problem: ManifestProblem::Json(e) },
                 });
             }
         };
         if manifest.format != S::FORMAT {
-            return Err(SweepError::CorruptManifest {
-                path,
-                message: format!(
-                    "format '{}' is not '{}' (a run made by another cablemap version; version 1 runs stored a_i \
-                     per unit deformed length: sweep again into a new directory)",
-                    manifest.format,
-                    S::FORMAT
-                ),
-            });
+            return Err(SweepError::CorruptManifest { path, problem: ManifestProblem::Format { found: manifest.format, wanted: S::FORMAT } });
         }
         if manifest.length_basis != manifest.spec.length_basis() {
             return Err(SweepError::CorruptManifest {
                 path,
-                message: format!(
-                    "length_basis '{}' disagrees with the spec's output.length_basis '{}'",
-                    manifest.length_basis,
-                    manifest.spec.length_basis()
-                ),
+                problem: ManifestProblem::LengthBasis { manifest: manifest.length_basis, spec: manifest.spec.length_basis() },
             });
         }
-        manifest.verify().map_err(|e| SweepError::CorruptManifest { path, message: e.to_string() })?;
+        manifest.verify().map_err(|e| SweepError::CorruptManifest { path, problem: ManifestProblem::Mismatch(e) })?;
         Ok(Some(manifest))
     }
 
@@ -352,7 +467,7 @@ impl RunDir {
                     // Another process created it between our look and our link.
                     false => self.read_manifest()?.ok_or_else(|| SweepError::CorruptManifest {
                         path: self.manifest_path(),
-                        message: "vanished while being read".into(),
+                        problem: ManifestProblem::Vanished,
                     })?,
                 }
             }
@@ -467,8 +582,8 @@ impl RunDir {
                         Ok(info) => {
                             scan.chunks.insert(chunk, info);
                         }
-                        Err(SweepError::CorruptChunk { path, message }) => {
-                            scan.damaged.push(DamagedChunk { chunk, path, reason: message })
+                        Err(SweepError::CorruptChunk { path, problem }) => {
+                            scan.damaged.push(DamagedChunk { chunk, path, reason: problem })
                         }
                         Err(e) => return Err(e),
                     }
@@ -482,19 +597,19 @@ impl RunDir {
     /// Compares a chunk file's SHA-256 with the one recorded when it was
     /// committed; a mismatch or a missing record is [`SweepError::CorruptChunk`].
     fn verify_checksum(&self, chunk: u64, path: &Path) -> Result<(), SweepError> {
-        let corrupt = |message: String| SweepError::CorruptChunk { path: path.to_path_buf(), message };
+        let corrupt = |problem| SweepError::CorruptChunk { path: path.to_path_buf(), problem };
         let sum_path = self.checksum_path(chunk);
         let recorded = match std::fs::read_to_string(&sum_path) {
             Ok(text) => text.trim().to_string(),
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-                return Err(corrupt(format!("no checksum recorded in {}", sum_path.display())))
+                return Err(corrupt(ChunkProblem::NoChecksum { sum_path }))
             }
             Err(e) => return Err(FileError::new("reading", sum_path, e).into()),
         };
         let actual = crate::io::sha256_file(path)
             .map_err(FileError::on("reading", path))?;
         if actual != recorded {
-            return Err(corrupt(format!("its SHA-256 is {actual}, not the {recorded} recorded when it was written")));
+            return Err(corrupt(ChunkProblem::Checksum { actual, recorded }));
         }
         Ok(())
     }
@@ -566,7 +681,7 @@ pub fn run_kind(dir: &Path) -> Result<RunKind, SweepError> {
         Err(source) => return Err(FileError::new("reading", path, source).into()),
     };
     let value: serde_json::Value =
-        serde_json::from_str(&text).map_err(|e| SweepError::CorruptManifest { path: path.clone(), message: e.to_string() })?;
+        serde_json::from_str(&text).map_err(|e| SweepError::CorruptManifest { path: path.clone(), problem: ManifestProblem::Json(e) })?;
     Ok(match value.get("format").and_then(|f| f.as_str()) {
         Some(crate::io::run_markers::CABLES_FORMAT) => RunKind::Cables,
         _ => RunKind::Planar,
@@ -629,40 +744,31 @@ pub fn check_chunk<S: RunSpec>(path: &Path, chunk: u64, manifest: &Manifest<S>, 
         File::open(path).map_err(FileError::on("opening", path))?;
     let meta = ParquetMetaDataReader::new()
         .parse_and_finish(&file)
-        .map_err(|e| SweepError::CorruptChunk { path: path.to_path_buf(), message: e.to_string() })?;
+        .map_err(|e| SweepError::CorruptChunk { path: path.to_path_buf(), problem: ChunkProblem::parquet(e) })?;
     let kv: BTreeMap<&str, &str> = meta
         .file_metadata()
         .key_value_metadata()
         .map(|v| v.iter().filter_map(|k| Some((k.key.as_str(), k.value.as_deref()?))).collect())
         .unwrap_or_default();
-    let foreign = |reason: String| SweepError::ForeignChunk { path: path.to_path_buf(), reason };
+    let foreign = |reason| SweepError::ForeignChunk { path: path.to_path_buf(), reason };
     if kv.get(keys::FORMAT) != Some(&S::FORMAT) {
-        return Err(foreign(format!("it has no '{}' = '{}' metadata", keys::FORMAT, S::FORMAT)));
+        return Err(foreign(ForeignReason::NoFormat { key: keys::FORMAT, format: S::FORMAT }));
     }
     if kv.get(keys::SPEC_SHA256) != Some(&manifest.spec_sha256.as_str()) {
-        return Err(foreign(format!(
-            "it was written for spec {} but this run's spec is {}",
-            kv.get(keys::SPEC_SHA256).unwrap_or(&"(none)"),
-            manifest.spec_sha256
-        )));
+        let found = kv.get(keys::SPEC_SHA256).unwrap_or(&"(none)").to_string();
+        return Err(foreign(ForeignReason::OtherSpec { found, wanted: manifest.spec_sha256.clone() }));
     }
     if kv.get(keys::CHUNK).and_then(|c| c.parse::<u64>().ok()) != Some(chunk) {
-        return Err(foreign(format!(
-            "its metadata names chunk '{}', not {chunk}",
-            kv.get(keys::CHUNK).unwrap_or(&"(none)")
-        )));
+        return Err(foreign(ForeignReason::OtherChunk { found: kv.get(keys::CHUNK).unwrap_or(&"(none)").to_string(), chunk }));
     }
     let file_rows = meta.file_metadata().num_rows();
     if file_rows != rows as i64 {
-        return Err(SweepError::CorruptChunk {
-            path: path.to_path_buf(),
-            message: format!("it holds {file_rows} rows where chunk {chunk} has {rows}"),
-        });
+        return Err(SweepError::CorruptChunk { path: path.to_path_buf(), problem: ChunkProblem::Rows { found: file_rows, chunk, rows } });
     }
     let status_counts = kv
         .get(keys::STATUS_COUNTS)
         .and_then(|s| serde_json::from_str(s).ok())
-        .ok_or_else(|| SweepError::CorruptChunk { path: path.to_path_buf(), message: "status counts unreadable".into() })?;
+        .ok_or_else(|| SweepError::CorruptChunk { path: path.to_path_buf(), problem: ChunkProblem::StatusCounts })?;
     Ok(ChunkInfo { chunk, path: path.to_path_buf(), rows, status_counts })
 }
 

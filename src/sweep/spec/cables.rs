@@ -43,7 +43,7 @@ use crate::model::routing::CONTROL_POINTS;
 use crate::solver::spatial::{SpatialError, SpatialOptions};
 use crate::model::{Actuator, Cable, Rod, MAX_CABLES};
 use crate::shape::LengthBasis;
-use crate::sweep::kind::{ChunkLayout, InvalidSpec, RunSpec, MAX_CHUNK_ROWS, MAX_ROWS};
+use crate::sweep::kind::{ChunkLayout, InvalidSpec, RowsCounted, RunSpec, MAX_CHUNK_ROWS, MAX_ROWS};
 use crate::sweep::schema::{cable_batch, cable_schema, Axis, CableRow};
 use crate::sweep::solve::{self, Stored, TensionCombinations};
 use crate::sweep::SweepError;
@@ -188,9 +188,9 @@ struct CableFile {
 }
 
 impl TryFrom<SpecFile> for CableSweepSpec {
-    type Error = InvalidSpec;
+    type Error = CableSpecError;
 
-    fn try_from(file: SpecFile) -> Result<Self, InvalidSpec> {
+    fn try_from(file: SpecFile) -> Result<Self, CableSpecError> {
         let SpecFile { rod, gj_n_mm2, gravity_direction, solver, output, cables } = file;
         let (cables, grids) = cables
             .into_iter()
@@ -200,17 +200,11 @@ impl TryFrom<SpecFile> for CableSweepSpec {
                 let (actuation, by_displacement) = match (tension_n, displacement_mm) {
                     (Some(t), None) => (t, false),
                     (None, Some(d)) => (d, true),
-                    (t, _) => {
-                        return Err(InvalidSpec(format!(
-                            "cable {}: give {} of tension_n = {{ min, max, count }} (N) and displacement_mm = {{ min, max, count }} (mm)",
-                            i + 1,
-                            if t.is_some() { "only one" } else { "one" }
-                        )))
-                    }
+                    (t, _) => return Err(CableSpecError::Actuation { cable: i + 1, both: t.is_some() }),
                 };
                 Ok((Cable { anchor_mm, cable_ea_n, ..Cable::spatial(y_mm, z_mm, 0.0) }, CableGrid { actuation, by_displacement, sweeps }))
             })
-            .collect::<Result<Vec<_>, InvalidSpec>>()?
+            .collect::<Result<Vec<_>, CableSpecError>>()?
             .into_iter()
             .unzip();
         Ok(Self { actuator: Actuator { rod, gj_n_mm2, gravity_direction, cables }, grids, solver, output })
@@ -235,6 +229,169 @@ impl From<CableSweepSpec> for SpecFile {
     }
 }
 
+/// What is wrong with a cable sweep spec: the cable and setting, and what
+/// to do.
+#[derive(Debug, thiserror::Error)]
+pub enum CableSpecError {
+    /// The TOML text does not parse, has unknown keys or a bad `[[cable]]`.
+    #[error("{0}")]
+    Toml(#[from] toml::de::Error),
+    /// A cable with neither or both of a tension grid and a displacement grid.
+    #[error(
+        "cable {cable}: give {} of tension_n = {{ min, max, count }} (N) and displacement_mm = {{ min, max, count }} (mm)",
+        if *both { "only one" } else { "one" }
+    )]
+    Actuation {
+        /// The cable, from 1.
+        cable: usize,
+        /// Whether both were given (else neither).
+        both: bool,
+    },
+    /// Too few or too many cables.
+    #[error("give 1 to {MAX_CABLES} [[cable]] tables, got {count}")]
+    CableCount {
+        /// The cables given.
+        count: usize,
+    },
+    /// A grid's range.
+    #[error("cable {cable}: {key} needs 0 ≤ min ≤ max (finite), got min = {min}, max = {max}")]
+    GridRange {
+        /// The cable, from 1.
+        cable: usize,
+        /// `tension_n` or `displacement_mm`.
+        key: &'static str,
+        /// Its first value.
+        min: f64,
+        /// Its last value.
+        max: f64,
+    },
+    /// A grid's count.
+    #[error("cable {cable}: {key}.count = {count} must be 1 … {MAX_TENSION_COUNT}")]
+    GridCount {
+        /// The cable, from 1.
+        cable: usize,
+        /// `tension_n` or `displacement_mm`.
+        key: &'static str,
+        /// The count given.
+        count: u32,
+    },
+    /// A displacement as long as the rod.
+    #[error("cable {cable}: displacement_mm.max = {max_mm} is not shorter than the rod ({length_mm} mm): a cable cannot be pulled in by its length")]
+    DisplacementBeyondRod {
+        /// The cable, from 1.
+        cable: usize,
+        /// The largest displacement, mm.
+        max_mm: f64,
+        /// The rod's length, mm.
+        length_mm: f64,
+    },
+    /// A cable stiffness that is not a stiffness.
+    #[error("cable {cable}: cable_ea_n = {ea_n} must be a finite stiffness > 0 N (leave it out for an inextensible cable)")]
+    CableStiffness {
+        /// The cable, from 1.
+        cable: usize,
+        /// The stiffness given, N.
+        ea_n: f64,
+    },
+    /// Displacement driving with the method that cannot meet it.
+    #[error(
+        "cable {cable} is driven by its displacement: [solver] method = \"rk4\" does not integrate the cables' paths; use the default \
+         collocation"
+    )]
+    DisplacementWithRk4 {
+        /// The cable, from 1.
+        cable: usize,
+    },
+    /// An anchor off the rod.
+    #[error(
+        "cable {cable}: anchor_mm = {} must lie on the rod, in (0, {length_mm}] mm (the rod's length_mm; leave anchor_mm out for the tip)",
+        crate::io::fmt_num(*anchor_mm)
+    )]
+    Anchor {
+        /// The cable, from 1.
+        cable: usize,
+        /// The anchor given, mm.
+        anchor_mm: f64,
+        /// The rod's length, mm.
+        length_mm: f64,
+    },
+    /// A sweep without finite levels.
+    #[error("cable {cable}: a sweep needs at least one finite level in levels_mm")]
+    NoLevels {
+        /// The cable, from 1.
+        cable: usize,
+    },
+    /// A sweep without control points.
+    #[error("cable {cable}: a sweep needs at least one control point in points (0 … 4)")]
+    NoPoints {
+        /// The cable, from 1.
+        cable: usize,
+    },
+    /// A control point that does not exist.
+    #[error("cable {cable}: control point {point} does not exist (points are 0 … 4)")]
+    NoSuchPoint {
+        /// The cable, from 1.
+        cable: usize,
+        /// The point given.
+        point: usize,
+    },
+    /// A control point swept twice.
+    #[error("cable {cable}: {} control point {point} is swept twice", axis.name())]
+    SweptTwice {
+        /// The cable, from 1.
+        cable: usize,
+        /// The axis.
+        axis: Axis,
+        /// The point.
+        point: usize,
+    },
+    /// An order the 3-D solver's settings do not resolve.
+    #[error("{0}")]
+    Order(#[source] SpatialError),
+    /// A cell size that is not a length.
+    #[error("output.cell_mm = {cell_mm} must be a positive length")]
+    CellSize {
+        /// The cell size given, mm.
+        cell_mm: f64,
+    },
+    /// `chunk_routings = 0`.
+    #[error("output.chunk_routings = 0: a chunk needs at least one routing")]
+    NoChunkRoutings,
+    /// More rows per routing than a chunk may hold.
+    #[error(
+        "{combinations} tension combinations per routing (the product of the cables' tension_n.count) is more than {MAX_CHUNK_ROWS} \
+         rows per chunk: use fewer tensions"
+    )]
+    TooManyCombinations {
+        /// Rows per routing.
+        combinations: u64,
+    },
+    /// More rows per chunk than a chunk may hold.
+    #[error(
+        "output.chunk_routings = {chunk_routings} × {combinations} tension combinations gives {chunk_rows} rows per chunk, more than \
+         {MAX_CHUNK_ROWS} (each chunk is built in memory): lower chunk_routings to ≤ {most}"
+    )]
+    ChunkRows {
+        /// Routings per chunk.
+        chunk_routings: u32,
+        /// Rows per routing.
+        combinations: u64,
+        /// Rows per chunk.
+        chunk_rows: u64,
+        /// The most routings per chunk.
+        most: u64,
+    },
+    /// The rod's parameters.
+    #[error("{0}")]
+    Rod(#[source] crate::model::ParameterError),
+    /// A rod the 3-D solver does not model.
+    #[error("[rod] {0}")]
+    RodUnsupported(#[source] SpatialError),
+    /// The gravity direction.
+    #[error("{0}")]
+    Gravity(#[source] SpatialError),
+}
+
 /// One swept dimension: cable, axis, control point, levels.
 #[derive(Debug, Clone, PartialEq)]
 struct Dimension {
@@ -248,7 +405,7 @@ impl CableSweepSpec {
     /// Reads and checks a spec; `origin` names it in errors.
     pub fn from_toml(text: &str, origin: &str) -> Result<Self, SweepError> {
         let bad = |source| SweepError::BadCableSpec { origin: origin.into(), source };
-        let spec: Self = toml::from_str(text).map_err(|e| bad(InvalidSpec(e.to_string())))?;
+        let spec: Self = toml::from_str(text).map_err(|e| bad(CableSpecError::Toml(e)))?;
         spec.validate().map_err(bad)?;
         Ok(spec)
     }
@@ -276,88 +433,84 @@ impl CableSweepSpec {
     }
 
     /// Checks the spec; messages name the field.
-    pub fn validate(&self) -> Result<(), InvalidSpec> {
-        let bad = |message: String| InvalidSpec(message);
+    pub fn validate(&self) -> Result<(), CableSpecError> {
         let cables = &self.actuator.cables;
         if cables.is_empty() || cables.len() > MAX_CABLES {
-            return Err(bad(format!("give 1 to {MAX_CABLES} [[cable]] tables, got {}", cables.len())));
+            return Err(CableSpecError::CableCount { count: cables.len() });
         }
+        let length_mm = self.actuator.rod.length_mm;
         for (i, (c, g)) in cables.iter().zip(&self.grids).enumerate() {
-            let n = i + 1;
+            let cable = i + 1;
             let t = &g.actuation;
             let key = if g.by_displacement { "displacement_mm" } else { "tension_n" };
             if !(t.min.is_finite() && t.max.is_finite() && t.min >= 0.0 && t.max >= t.min) {
-                return Err(bad(format!("cable {n}: {key} needs 0 ≤ min ≤ max (finite), got min = {}, max = {}", t.min, t.max)));
+                return Err(CableSpecError::GridRange { cable, key, min: t.min, max: t.max });
             }
             if t.count == 0 || t.count > MAX_TENSION_COUNT {
-                return Err(bad(format!("cable {n}: {key}.count = {} must be 1 … {MAX_TENSION_COUNT}", t.count)));
+                return Err(CableSpecError::GridCount { cable, key, count: t.count });
             }
-            if g.by_displacement && t.max >= self.actuator.rod.length_mm {
-                return Err(bad(format!("cable {n}: displacement_mm.max = {} is not shorter than the rod ({} mm): a cable cannot be pulled in by its length", t.max, self.actuator.rod.length_mm)));
+            if g.by_displacement && t.max >= length_mm {
+                return Err(CableSpecError::DisplacementBeyondRod { cable, max_mm: t.max, length_mm });
             }
-            if let Some(ea) = c.cable_ea_n.filter(|ea| !(ea.is_finite() && *ea > 0.0)) {
-                return Err(bad(format!("cable {n}: cable_ea_n = {ea} must be a finite stiffness > 0 N (leave it out for an inextensible cable)")));
+            if let Some(ea_n) = c.cable_ea_n.filter(|ea| !(ea.is_finite() && *ea > 0.0)) {
+                return Err(CableSpecError::CableStiffness { cable, ea_n });
             }
             if g.by_displacement && self.solver.method == crate::solver::SolverMethod::Rk4 {
-                return Err(bad(format!("cable {n} is driven by its displacement: [solver] method = \"rk4\" does not integrate the cables' paths; use the default collocation")));
+                return Err(CableSpecError::DisplacementWithRk4 { cable });
             }
             // The anchor is not swept: outside the rod, every routing's rows
             // would be invalid_routing.
-            if let Some(anchor) = c.anchor_mm {
-                let length = self.actuator.rod.length_mm;
-                if !(anchor.is_finite() && anchor > 0.0 && anchor <= length) {
-                    return Err(bad(format!(
-                        "cable {n}: anchor_mm = {} must lie on the rod, in (0, {length}] mm (the rod's length_mm; leave \
-                         anchor_mm out for the tip)",
-                        crate::io::fmt_num(anchor)
-                    )));
+            if let Some(anchor_mm) = c.anchor_mm {
+                if !(anchor_mm.is_finite() && anchor_mm > 0.0 && anchor_mm <= length_mm) {
+                    return Err(CableSpecError::Anchor { cable, anchor_mm, length_mm });
                 }
             }
             let mut seen = std::collections::BTreeSet::new();
             for s in &g.sweeps {
                 if s.levels_mm.is_empty() || s.levels_mm.iter().any(|v| !v.is_finite()) {
-                    return Err(bad(format!("cable {n}: a sweep needs at least one finite level in levels_mm")));
+                    return Err(CableSpecError::NoLevels { cable });
                 }
                 if s.points.is_empty() {
-                    return Err(bad(format!("cable {n}: a sweep needs at least one control point in points (0 … 4)")));
+                    return Err(CableSpecError::NoPoints { cable });
                 }
-                for &p in &s.points {
-                    if p >= CONTROL_POINTS {
-                        return Err(bad(format!("cable {n}: control point {p} does not exist (points are 0 … 4)")));
+                for &point in &s.points {
+                    if point >= CONTROL_POINTS {
+                        return Err(CableSpecError::NoSuchPoint { cable, point });
                     }
-                    if !seen.insert((s.axis, p)) {
-                        return Err(bad(format!("cable {n}: {:?} control point {p} is swept twice", s.axis).to_lowercase()));
+                    if !seen.insert((s.axis, point)) {
+                        return Err(CableSpecError::SweptTwice { cable, axis: s.axis, point });
                     }
                 }
             }
         }
-        crate::solver::spatial::check_order(self.output.order, &self.solver).map_err(|e| bad(e.to_string()))?;
+        crate::solver::spatial::check_order(self.output.order, &self.solver).map_err(CableSpecError::Order)?;
         if !(self.output.cell_mm.is_finite() && self.output.cell_mm > 0.0) {
-            return Err(bad(format!("output.cell_mm = {} must be a positive length", self.output.cell_mm)));
+            return Err(CableSpecError::CellSize { cell_mm: self.output.cell_mm });
         }
         if self.output.chunk_routings == 0 {
-            return Err(bad("output.chunk_routings = 0: a chunk needs at least one routing".into()));
+            return Err(CableSpecError::NoChunkRoutings);
         }
-        let combos = self.actuation_combinations();
-        let chunk_rows = u64::from(self.output.chunk_routings).saturating_mul(combos);
+        let combinations = self.actuation_combinations();
+        let chunk_rows = u64::from(self.output.chunk_routings).saturating_mul(combinations);
         if chunk_rows > MAX_CHUNK_ROWS {
-            return Err(bad(if combos > MAX_CHUNK_ROWS {
-                format!("{combos} tension combinations per routing (the product of the cables' tension_n.count) is more than {MAX_CHUNK_ROWS} rows per chunk: use fewer tensions")
+            return Err(if combinations > MAX_CHUNK_ROWS {
+                CableSpecError::TooManyCombinations { combinations }
             } else {
-                format!(
-                    "output.chunk_routings = {} × {combos} tension combinations gives {chunk_rows} rows per chunk, more than {MAX_CHUNK_ROWS} (each chunk is built in memory): lower chunk_routings to ≤ {}",
-                    self.output.chunk_routings,
-                    MAX_CHUNK_ROWS / combos
-                )
-            }));
+                CableSpecError::ChunkRows {
+                    chunk_routings: self.output.chunk_routings,
+                    combinations,
+                    chunk_rows,
+                    most: MAX_CHUNK_ROWS / combinations,
+                }
+            });
         }
         // The base actuator (swept points at their first level) must be a
         // rod the 3-D solver models; a routing's own faults are its rows' status.
         let base = self.actuator_for(0, &self.dimensions());
         match crate::solver::spatial::validated_channels(&base, crate::solver::Backend::spatial(self.solver.method)) {
-            Err(SpatialError::Actuator(crate::model::ActuatorError::Parameter(e))) => return Err(bad(e.to_string())),
-            Err(e @ SpatialError::Unsupported(_)) => return Err(bad(format!("[rod] {e}"))),
-            Err(e @ SpatialError::Actuator(crate::model::ActuatorError::GravityDirection(_))) => return Err(bad(e.to_string())),
+            Err(SpatialError::Actuator(crate::model::ActuatorError::Parameter(e))) => return Err(CableSpecError::Rod(e)),
+            Err(e @ SpatialError::Unsupported(_)) => return Err(CableSpecError::RodUnsupported(e)),
+            Err(e @ SpatialError::Actuator(crate::model::ActuatorError::GravityDirection(_))) => return Err(CableSpecError::Gravity(e)),
             _ => {}
         }
         Ok(())
@@ -437,21 +590,14 @@ impl RunSpec for CableSweepSpec {
     type Solved = Vec<CableRow>;
 
     fn check(&self) -> Result<(), InvalidSpec> {
-        self.validate()
+        self.validate().map_err(InvalidSpec::Cables)
     }
 
     fn check_run_size(&self, allow_large: bool) -> Result<(), SweepError> {
-        let rows = self.routings().saturating_mul(self.actuation_combinations());
+        let (routings, per_routing) = (self.routings(), self.actuation_combinations());
+        let rows = routings.saturating_mul(per_routing);
         if rows > MAX_ROWS && !allow_large {
-            return Err(SweepError::InvalidSpec {
-                origin: "(size)".into(),
-                message: format!(
-                    "the sweep has {rows} rows ({} routings × {} tension combinations), more than {MAX_ROWS}: check the levels and tension counts, \
-                     or pass --allow-large if the job is meant to be this big",
-                    self.routings(),
-                    self.actuation_combinations(),
-                ),
-            });
+            return Err(SweepError::TooLarge { rows, routings, per_routing, counted: RowsCounted::TensionCombinations });
         }
         Ok(())
     }

@@ -14,8 +14,8 @@ pub mod cables;
 pub mod planar;
 
 pub use super::kind::{MAX_CHUNK_ROWS, MAX_ROWS};
-pub use cables::{CableGrid, CableOutputSpec, CableSweepSpec, CableWorker, PointSweep, ValueGrid, MAX_TENSION_COUNT};
+pub use cables::{CableGrid, CableOutputSpec, CableSpecError, CableSweepSpec, CableWorker, PointSweep, ValueGrid, MAX_TENSION_COUNT};
 pub use planar::{
-    DisplacementSpec, GridSpec, Ladder, OutputSpec, SpecError, SweepSpec, TensionSpec, MAX_CHUNK_BYTES, MAX_LEVELS, MAX_ORDER, MAX_STEPS_PER_SPAN, MAX_TENSIONS,
+    ChunkBytesFix, DisplacementSpec, GridSpec, Ladder, OutputSpec, SpecError, SweepSpec, TensionSpec, MAX_CHUNK_BYTES, MAX_LEVELS, MAX_ORDER, MAX_STEPS_PER_SPAN, MAX_TENSIONS,
     THESIS_SPEC_TOML,
 };

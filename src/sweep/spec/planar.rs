@@ -36,7 +36,7 @@ use crate::model::{Rod, Routing};
 use crate::solver::{Simulator, SolverOptions};
 use crate::shape::LengthBasis;
 use crate::sweep::enumerate::SweepPlan;
-use crate::sweep::kind::{ChunkLayout, InvalidSpec, RunSpec, MAX_CHUNK_ROWS, MAX_ROWS};
+use crate::sweep::kind::{ChunkLayout, InvalidSpec, RowsCounted, RunSpec, MAX_CHUNK_ROWS, MAX_ROWS};
 use crate::sweep::schema::{arrow_schema, build_batch, SolvedRouting};
 use crate::sweep::solve::{self, Stored};
 use crate::sweep::SweepError;
@@ -191,26 +191,210 @@ pub enum SpecError {
     /// The actuator's parameters.
     #[error("[actuator] {0}")]
     Rod(#[source] crate::model::ParameterError),
-    /// Another setting, in its section.
-    #[error("[{section}] {message}")]
-    Setting {
-        /// TOML section, e.g. `grid`.
-        section: &'static str,
-        /// The setting, its value and what to do.
-        message: String,
-    },
     /// The TOML text does not parse or has unknown keys.
     #[error("{0}")]
     Toml(#[from] toml::de::Error),
-    /// The whole sweep is larger than a sweep is allowed to be by default.
-    #[error("{0}")]
-    TooLarge(String),
+    /// Both ladders given.
+    #[error("[displacement] give either [tension] or [displacement], not both: the cable is driven by one of them")]
+    TensionAndDisplacement,
+    /// More steps per span than memory allows.
+    #[error(
+        "[solver] steps_per_span = {steps} is more than {MAX_STEPS_PER_SPAN}: the solver would need more memory than a machine has, \
+         and {resolving} steps already resolve every supported order"
+    )]
+    StepsPerSpan {
+        /// The steps asked for.
+        steps: usize,
+        /// Steps that resolve the highest supported order.
+        resolving: usize,
+    },
+    /// The solver refuses the settings for this actuator.
+    #[error("[solver] {0}")]
+    Solver(#[source] crate::solver::SimulateError),
+    /// More tensions than a routing may have.
+    #[error("[tension] count = {count} is more than {MAX_TENSIONS} tensions per routing")]
+    TooManyTensions {
+        /// The count asked for.
+        count: u32,
+    },
+    /// No tension, or a lowest tension below 0.
+    #[error("[tension] min_n = {min_n} must be a finite tension ≥ 0 N")]
+    TensionMin {
+        /// The lowest tension, N.
+        min_n: f64,
+    },
+    /// A highest tension below the lowest.
+    #[error("[tension] max_n = {max_n} must be finite and ≥ min_n = {min_n}")]
+    TensionMax {
+        /// The highest tension, N.
+        max_n: f64,
+        /// The lowest, N.
+        min_n: f64,
+    },
+    /// `count = 0`.
+    #[error("[tension] count = 0: at least one tension is needed")]
+    NoTensions,
+    /// One tension over a range.
+    #[error("[tension] count = 1 needs min_n = max_n (or give count ≥ 2)")]
+    OneTensionOverARange,
+    /// A displacement count out of range.
+    #[error("[displacement] count = {count} must be 1 … {MAX_TENSIONS} displacements per routing")]
+    DisplacementCount {
+        /// The count asked for.
+        count: u32,
+    },
+    /// A smallest displacement below 0.
+    #[error("[displacement] min_mm = {min_mm} must be a finite displacement ≥ 0 mm (the length pulled in at the base)")]
+    DisplacementMin {
+        /// The smallest displacement, mm.
+        min_mm: f64,
+    },
+    /// A largest displacement below the smallest.
+    #[error("[displacement] max_mm = {max_mm} must be finite and ≥ min_mm = {min_mm} (equal when count = 1)")]
+    DisplacementMax {
+        /// The largest displacement, mm.
+        max_mm: f64,
+        /// The smallest, mm.
+        min_mm: f64,
+    },
+    /// A displacement as long as the rod.
+    #[error("[displacement] max_mm = {max_mm} is not shorter than the rod ({length_mm} mm): a cable cannot be pulled in by its length")]
+    DisplacementBeyondRod {
+        /// The largest displacement, mm.
+        max_mm: f64,
+        /// The rod's length, mm.
+        length_mm: f64,
+    },
+    /// A cable stiffness that is not a stiffness.
+    #[error("[displacement] cable_ea_n = {ea_n} must be a finite stiffness > 0 N (leave it out for an inextensible cable)")]
+    CableStiffness {
+        /// The stiffness given, N.
+        ea_n: f64,
+    },
+    /// Displacement driving with the method that cannot meet it.
+    #[error(
+        "[displacement] [solver] method = \"rk4\" does not integrate the cable's path, so it cannot meet a displacement: use the default \
+         collocation"
+    )]
+    DisplacementWithRk4,
+    /// A level count out of range.
+    #[error("[grid] levels = {levels} must be between 1 and {MAX_LEVELS}")]
+    Levels {
+        /// The levels asked for.
+        levels: u32,
+    },
+    /// Levels beyond the body.
+    #[error("[grid] extent_r = {extent_r} puts levels beyond ±r (outside the body): use a fraction 0 ≤ extent_r < 1")]
+    ExtentR {
+        /// The half-width of the levels over r.
+        extent_r: f64,
+    },
+    /// Levels and channel offset together beyond the body.
+    #[error("[grid] extent_r = {extent_r} with {} = {offset_mm} puts the channel beyond ±r: reduce one of them", crate::model::effects::CHANNEL_OFFSET.key)]
+    ChannelBeyondBody {
+        /// The half-width of the levels over r.
+        extent_r: f64,
+        /// The channel offset, mm.
+        offset_mm: f64,
+    },
+    /// Mirror de-duplication of an actuator that is not mirror-symmetric.
+    #[error(
+        "[grid] mirror_dedup = true needs a mirror-symmetric actuator ({} = 0 and gravity along the clamp axis): set mirror_dedup = false",
+        crate::model::effects::CHANNEL_OFFSET.key
+    )]
+    MirrorAsymmetric,
+    /// An order above the highest stored.
+    #[error("[output] order = {order} is above the supported {MAX_ORDER}")]
+    Order {
+        /// The order asked for.
+        order: usize,
+    },
+    /// An order the solver settings do not resolve.
+    #[error("[output] {0}")]
+    Resolution(#[source] crate::solver::resolution::OrderError),
+    /// `chunk_routings = 0`.
+    #[error("[output] chunk_routings = 0: a chunk needs at least one routing")]
+    NoChunkRoutings,
+    /// More rows per chunk than a chunk may hold.
+    #[error(
+        "[output] chunk_routings = {chunk_routings} × {ladder_table} count = {count} gives {chunk_rows} rows per chunk, more than \
+         {MAX_CHUNK_ROWS} (each chunk is built in memory): lower chunk_routings to ≤ {most}"
+    )]
+    ChunkRows {
+        /// Routings per chunk.
+        chunk_routings: u32,
+        /// The ladder's table, `[tension]` or `[displacement]`.
+        ladder_table: &'static str,
+        /// Rows per routing.
+        count: u32,
+        /// Rows per chunk.
+        chunk_rows: u64,
+        /// The most routings per chunk.
+        most: u64,
+    },
+    /// A chunk would take more memory than a chunk may.
+    #[error(
+        "[output] chunk_routings = {chunk_routings} × {ladder_table} count = {count} gives {chunk_rows} rows per chunk taking about {} \
+         of memory while it is built, more than {} ({}): {fix}",
+        crate::io::fmt_bytes(*chunk_bytes),
+        crate::io::fmt_bytes(MAX_CHUNK_BYTES),
+        centreline_text(*centreline)
+    )]
+    ChunkBytes {
+        /// Routings per chunk.
+        chunk_routings: u32,
+        /// The ladder's table, `[tension]` or `[displacement]`.
+        ladder_table: &'static str,
+        /// Rows per routing.
+        count: u32,
+        /// Rows per chunk.
+        chunk_rows: u64,
+        /// Memory of a chunk while it is built, bytes.
+        chunk_bytes: u64,
+        /// With a stored centreline: its points per row and the solver's steps per span.
+        centreline: Option<(u64, usize)>,
+        /// What to change.
+        fix: ChunkBytesFix,
+    },
 }
 
-impl SpecError {
-    fn setting(section: &'static str, message: impl Into<String>) -> Self {
-        SpecError::Setting { section, message: message.into() }
+/// Why a chunk is built in memory as large as it is, for
+/// [`SpecError::ChunkBytes`].
+fn centreline_text(centreline: Option<(u64, usize)>) -> String {
+    match centreline {
+        Some((points, steps)) => format!("with centreline = true each row holds {points} centreline points ([solver] steps_per_span = {steps})"),
+        None => "each chunk is built in memory".to_string(),
     }
+}
+
+/// What to change when a chunk would take too much memory.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+pub enum ChunkBytesFix {
+    /// One routing's rows alone are too many.
+    #[error(
+        "one routing's {count} rows alone take {}: lower [solver] steps_per_span or {ladder_table} count, or set centreline = false",
+        crate::io::fmt_bytes(*routing_bytes)
+    )]
+    OneRouting {
+        /// Rows per routing.
+        count: u32,
+        /// Memory of one routing's rows, bytes.
+        routing_bytes: u64,
+        /// The ladder's table.
+        ladder_table: &'static str,
+    },
+    /// Fewer routings per chunk, with a centreline stored.
+    #[error("lower chunk_routings to ≤ {most} (or [solver] steps_per_span, or set centreline = false)")]
+    FewerRoutingsOrCentreline {
+        /// The most routings per chunk.
+        most: u64,
+    },
+    /// Fewer routings per chunk.
+    #[error("lower chunk_routings to ≤ {most}")]
+    FewerRoutings {
+        /// The most routings per chunk.
+        most: u64,
+    },
 }
 
 impl SweepSpec {
@@ -227,7 +411,7 @@ impl SweepSpec {
         if spec.displacement.is_some() && toml::from_str::<toml::Table>(text).is_ok_and(|t| t.contains_key("tension")) {
             return Err(SweepError::BadSpec {
                 origin: origin.to_string(),
-                source: SpecError::setting("displacement", "give either [tension] or [displacement], not both: the cable is driven by one of them"),
+                source: SpecError::TensionAndDisplacement,
             });
         }
         spec.validate().map_err(|source| SweepError::BadSpec { origin: origin.to_string(), source })?;
@@ -246,97 +430,88 @@ impl SweepSpec {
         self.actuator.validate().map_err(SpecError::Rod)?;
         // Sizes before anything is allocated for them.
         if self.solver.steps_per_span > MAX_STEPS_PER_SPAN {
-            return Err(SpecError::setting("solver", format!("steps_per_span = {} is more than {MAX_STEPS_PER_SPAN}: the solver would need more memory than a \
-                 machine has, and {} steps already resolve every supported order",
-                self.solver.steps_per_span,
-                crate::solver::resolution::REQUIRED_STEPS_PER_SPAN[crate::solver::resolution::MAX_RESOLVED_ORDER]
-            )));
+            let resolving = crate::solver::resolution::REQUIRED_STEPS_PER_SPAN[crate::solver::resolution::MAX_RESOLVED_ORDER];
+            return Err(SpecError::StepsPerSpan { steps: self.solver.steps_per_span, resolving });
         }
         if self.tension.count > MAX_TENSIONS {
-            return Err(SpecError::setting("tension", format!("count = {} is more than {MAX_TENSIONS} tensions per routing", self.tension.count)));
+            return Err(SpecError::TooManyTensions { count: self.tension.count });
         }
         if let Some(d) = &self.displacement {
-            let bad = |why: String| Err(SpecError::setting("displacement", why));
             if d.count == 0 || d.count > MAX_TENSIONS {
-                return bad(format!("count = {} must be 1 … {MAX_TENSIONS} displacements per routing", d.count));
+                return Err(SpecError::DisplacementCount { count: d.count });
             }
             if !(d.min_mm.is_finite() && d.min_mm >= 0.0) {
-                return bad(format!("min_mm = {} must be a finite displacement ≥ 0 mm (the length pulled in at the base)", d.min_mm));
+                return Err(SpecError::DisplacementMin { min_mm: d.min_mm });
             }
             if !(d.max_mm.is_finite() && d.max_mm >= d.min_mm) || (d.count == 1 && d.max_mm != d.min_mm) {
-                return bad(format!("max_mm = {} must be finite and ≥ min_mm = {} (equal when count = 1)", d.max_mm, d.min_mm));
+                return Err(SpecError::DisplacementMax { max_mm: d.max_mm, min_mm: d.min_mm });
             }
             if d.max_mm >= self.actuator.length_mm {
-                return bad(format!("max_mm = {} is not shorter than the rod ({} mm): a cable cannot be pulled in by its length", d.max_mm, self.actuator.length_mm));
+                return Err(SpecError::DisplacementBeyondRod { max_mm: d.max_mm, length_mm: self.actuator.length_mm });
             }
-            if let Some(ea) = d.cable_ea_n.filter(|ea| !(ea.is_finite() && *ea > 0.0)) {
-                return bad(format!("cable_ea_n = {ea} must be a finite stiffness > 0 N (leave it out for an inextensible cable)"));
+            if let Some(ea_n) = d.cable_ea_n.filter(|ea| !(ea.is_finite() && *ea > 0.0)) {
+                return Err(SpecError::CableStiffness { ea_n });
             }
             if self.solver.method == crate::solver::SolverMethod::Rk4 {
-                return bad("[solver] method = \"rk4\" does not integrate the cable's path, so it cannot meet a displacement: use the default collocation".into());
+                return Err(SpecError::DisplacementWithRk4);
             }
         }
-        crate::solver::Simulator::new(&self.actuator, &self.solver).map_err(|e| SpecError::setting("solver", e.to_string()))?;
+        crate::solver::Simulator::new(&self.actuator, &self.solver).map_err(SpecError::Solver)?;
         let g = &self.grid;
         if g.levels == 0 || g.levels > MAX_LEVELS {
-            return Err(SpecError::setting("grid", format!("levels = {} must be between 1 and {MAX_LEVELS}", g.levels)));
+            return Err(SpecError::Levels { levels: g.levels });
         }
         if !(g.extent_r.is_finite() && g.extent_r >= 0.0 && g.extent_r < 1.0) {
-            return Err(SpecError::setting("grid", format!("extent_r = {} puts levels beyond ±r (outside the body): use a fraction 0 ≤ extent_r < 1",
-                g.extent_r
-            )));
+            return Err(SpecError::ExtentR { extent_r: g.extent_r });
         }
         let delta = self.actuator.effects.channel_offset_mm;
         // A tapered body's levels are fractions of its narrowest radius along the cable.
         let r = self.actuator.channel_radius_mm();
         if (g.extent_r * r).abs() + delta.abs() >= r {
-            return Err(SpecError::setting("grid", format!("extent_r = {} with {} = {delta} puts the channel beyond ±r: reduce one of them",
-                g.extent_r, crate::model::effects::CHANNEL_OFFSET.key
-            )));
+            return Err(SpecError::ChannelBeyondBody { extent_r: g.extent_r, offset_mm: delta });
         }
         if g.mirror_dedup {
             let gravity = &self.actuator.gravity;
             let tilted = gravity.enabled && gravity.scale != 0.0 && gravity.direction_rad.sin().abs() > 1e-12;
             if delta != 0.0 || tilted {
-                return Err(SpecError::setting("grid", format!("mirror_dedup = true needs a mirror-symmetric actuator ({} = 0 and \
-                            gravity along the clamp axis): set mirror_dedup = false", crate::model::effects::CHANNEL_OFFSET.key)));
+                return Err(SpecError::MirrorAsymmetric);
             }
         }
         let t = &self.tension;
         if !(t.min_n.is_finite() && t.min_n >= 0.0) {
-            return Err(SpecError::setting("tension", format!("min_n = {} must be a finite tension ≥ 0 N", t.min_n)));
+            return Err(SpecError::TensionMin { min_n: t.min_n });
         }
         if !(t.max_n.is_finite() && t.max_n >= t.min_n) {
-            return Err(SpecError::setting("tension", format!("max_n = {} must be finite and ≥ min_n = {}", t.max_n, t.min_n)));
+            return Err(SpecError::TensionMax { max_n: t.max_n, min_n: t.min_n });
         }
         if t.count == 0 {
-            return Err(SpecError::setting("tension", "count = 0: at least one tension is needed"));
+            return Err(SpecError::NoTensions);
         }
         if t.count == 1 && t.max_n != t.min_n {
-            return Err(SpecError::setting("tension", "count = 1 needs min_n = max_n (or give count ≥ 2)"));
+            return Err(SpecError::OneTensionOverARange);
         }
         let o = &self.output;
         if o.order > MAX_ORDER {
-            return Err(SpecError::setting("output", format!("order = {} is above the supported {MAX_ORDER}", o.order)));
+            return Err(SpecError::Order { order: o.order });
         }
-        crate::solver::resolution::check_order(o.order, &self.solver).map_err(|e| SpecError::setting("output", e.to_string()))?;
+        crate::solver::resolution::check_order(o.order, &self.solver).map_err(SpecError::Resolution)?;
         if o.chunk_routings == 0 {
-            return Err(SpecError::setting("output", "chunk_routings = 0: a chunk needs at least one routing"));
+            return Err(SpecError::NoChunkRoutings);
         }
         let count = self.ladder_count();
         let chunk_rows = u64::from(o.chunk_routings) * u64::from(count);
         let chunk_bytes = chunk_rows.saturating_mul(self.row_bytes());
         if chunk_rows <= MAX_CHUNK_ROWS && chunk_bytes > MAX_CHUNK_BYTES {
-            return Err(SpecError::setting("output", self.chunk_bytes_advice(chunk_rows, chunk_bytes)));
+            return Err(self.chunk_bytes_error(chunk_rows, chunk_bytes));
         }
         if chunk_rows > MAX_CHUNK_ROWS {
-            return Err(SpecError::setting("output", format!("chunk_routings = {} × {} count = {} gives {chunk_rows} rows per chunk, more than \
-                 {MAX_CHUNK_ROWS} (each chunk is built in memory): lower chunk_routings to ≤ {}",
-                o.chunk_routings,
-                self.ladder_table(),
+            return Err(SpecError::ChunkRows {
+                chunk_routings: o.chunk_routings,
+                ladder_table: self.ladder_table(),
                 count,
-                (MAX_CHUNK_ROWS / u64::from(count)).max(1)
-            )));
+                chunk_rows,
+                most: (MAX_CHUNK_ROWS / u64::from(count)).max(1),
+            });
         }
         Ok(())
     }
@@ -360,55 +535,35 @@ impl SweepSpec {
         ROW_COPIES * per_copy
     }
 
-    /// What to change when a chunk of `chunk_rows` rows would take
-    /// `chunk_bytes` (more than [`MAX_CHUNK_BYTES`]).
-    fn chunk_bytes_advice(&self, chunk_rows: u64, chunk_bytes: u64) -> String {
+    /// The refusal of a chunk of `chunk_rows` rows that would take
+    /// `chunk_bytes` (more than [`MAX_CHUNK_BYTES`]), with what to change.
+    fn chunk_bytes_error(&self, chunk_rows: u64, chunk_bytes: u64) -> SpecError {
         let o = &self.output;
-        let routing_bytes = u64::from(self.ladder_count()) * self.row_bytes();
-        let what = if o.centreline {
-            format!(
-                "with centreline = true each row holds {} centreline points ([solver] steps_per_span = {})",
-                self.centreline_points(),
-                self.solver.steps_per_span
-            )
-        } else {
-            "each chunk is built in memory".to_string()
-        };
+        let count = self.ladder_count();
+        let routing_bytes = u64::from(count) * self.row_bytes();
+        let ladder_table = self.ladder_table();
         let fix = match MAX_CHUNK_BYTES / routing_bytes.max(1) {
-            0 => format!(
-                "one routing's {} rows alone take {}: lower [solver] steps_per_span or {} count, or set centreline = false",
-                self.ladder_count(),
-                crate::io::fmt_bytes(routing_bytes),
-                self.ladder_table()
-            ),
-            most if o.centreline => {
-                format!("lower chunk_routings to ≤ {most} (or [solver] steps_per_span, or set centreline = false)")
-            }
-            most => format!("lower chunk_routings to ≤ {most}"),
+            0 => ChunkBytesFix::OneRouting { count, routing_bytes, ladder_table },
+            most if o.centreline => ChunkBytesFix::FewerRoutingsOrCentreline { most },
+            most => ChunkBytesFix::FewerRoutings { most },
         };
-        format!(
-            "chunk_routings = {} × {} count = {} gives {chunk_rows} rows per chunk taking about {} of memory while it is \
-             built, more than {} ({what}): {fix}",
-            o.chunk_routings,
-            self.ladder_table(),
-            self.ladder_count(),
-            crate::io::fmt_bytes(chunk_bytes),
-            crate::io::fmt_bytes(MAX_CHUNK_BYTES)
-        )
+        let centreline = o.centreline.then(|| (self.centreline_points(), self.solver.steps_per_span));
+        SpecError::ChunkBytes { chunk_routings: o.chunk_routings, ladder_table, count, chunk_rows, chunk_bytes, centreline, fix }
     }
 
     /// Checks the size of the whole sweep: more than [`MAX_ROWS`] rows is
     /// refused (a typo like `levels = 99` means 10¹¹ rows) unless
     /// `allow_large`, for a deliberate huge job.
-    pub fn check_size(&self, allow_large: bool) -> Result<(), SpecError> {
+    pub fn check_size(&self, allow_large: bool) -> Result<(), SweepError> {
         let plan = SweepPlan::new(self);
         let rows = plan.total_rows();
         if rows > MAX_ROWS && !allow_large {
-            return Err(SpecError::TooLarge(format!(
-                "the sweep has {rows} rows ({} routings × {} actuations), more than {MAX_ROWS}: check [grid] levels and \
-                 {} count, or pass --allow-large if the job is meant to be this big",
-                plan.routings, plan.tensions, self.ladder_table()
-            )));
+            return Err(SweepError::TooLarge {
+                rows,
+                routings: plan.routings,
+                per_routing: plan.tensions,
+                counted: RowsCounted::Actuations { ladder_table: self.ladder_table() },
+            });
         }
         Ok(())
     }
@@ -490,11 +645,11 @@ impl RunSpec for SweepSpec {
     type Solved = SolvedRouting;
 
     fn check(&self) -> Result<(), InvalidSpec> {
-        self.validate().map_err(|e| InvalidSpec(e.to_string()))
+        self.validate().map_err(InvalidSpec::Planar)
     }
 
     fn check_run_size(&self, allow_large: bool) -> Result<(), SweepError> {
-        self.check_size(allow_large).map_err(|source| SweepError::BadSpec { origin: "(size)".into(), source })
+        self.check_size(allow_large)
     }
 
     fn canonical_json(&self) -> String {
