@@ -47,15 +47,15 @@ pub const MAX_TRIANGLES: f64 = 4e6;
 
 /// Refuses a body the moulds cannot cast: a radius profile, segments or a
 /// cable knotted before the tip ([`MouldError::NonUniformBody`]).
-pub fn check_uniform_body(a: &crate::model::Rod) -> Result<(), MouldError> {
+pub fn check_uniform_body(rod: &crate::model::Rod) -> Result<(), MouldError> {
     let mut features = Vec::new();
-    if !a.radius_profile_mm.is_empty() {
+    if !rod.radius_profile_mm.is_empty() {
         features.push(BodyFeature::RadiusProfile { lumens: false });
     }
-    if !a.segments.is_empty() {
+    if !rod.segments.is_empty() {
         features.push(BodyFeature::Segments);
     }
-    if a.cable_length_mm() < a.length_mm {
+    if rod.cable_length_mm() < rod.length_mm {
         features.push(BodyFeature::CableAnchored);
     }
     if features.is_empty() {

@@ -10,7 +10,7 @@ use std::path::Path;
 
 /// The drawn clamp's half-width per unit of the body's radius at the clamp
 /// r(0): the clamp grips the whole base with a margin of 0.6·r(0) on each
-/// side (16 mm for the thesis's r = 5 mm rod, as before).
+/// side (16 mm for the thesis's r = 5 mm rod).
 pub const CLAMP_HALF_WIDTH_PER_RADIUS: f64 = 1.6;
 
 /// Half the width of the drawn clamp, mm, for a body of radius

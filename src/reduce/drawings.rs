@@ -43,10 +43,10 @@ pub struct ModeDrawings {
 
 impl ModeDrawings {
     /// Simulates every mode's representative of `map` again and draws it.
-    pub fn of_map(map: &MapData, actuator: &Rod, solver: &SolverOptions) -> Self {
+    pub fn of_map(map: &MapData, rod: &Rod, solver: &SolverOptions) -> Self {
         let mut drawings = Self::default();
         for m in &map.modes {
-            let shape = m.representative.as_ref().map(|d| draw(m.mode, d, actuator, solver)).transpose();
+            let shape = m.representative.as_ref().map(|d| draw(m.mode, d, rod, solver)).transpose();
             match shape {
                 Ok(shape) => drawings.shapes.push(shape),
                 Err(e) => {
@@ -107,12 +107,12 @@ impl ModeDrawings {
     }
 }
 
-fn draw(mode: usize, d: &Design, actuator: &Rod, solver: &SolverOptions) -> Result<BodyDrawing, DrawingError> {
-    let routing = crate::model::Routing::for_actuator(d.routing_mm, actuator)
+fn draw(mode: usize, d: &Design, rod: &Rod, solver: &SolverOptions) -> Result<BodyDrawing, DrawingError> {
+    let routing = crate::model::Routing::for_actuator(d.routing_mm, rod)
         .map_err(|source| DrawingError::Routing { mode, source })?;
-    let sim = crate::solver::simulate(actuator, solver, &routing, d.tension_n, 1, crate::shape::LengthBasis::default())
+    let sim = crate::solver::simulate(rod, solver, &routing, d.tension_n, 1, crate::shape::LengthBasis::default())
         .map_err(|e| DrawingError::Simulation { mode, source: Box::new(e) })?;
-    Ok(BodyDrawing::of_body(&sim, actuator, format!("mode {mode}"), plotters::style::full_palette::BLUE_800))
+    Ok(BodyDrawing::of_body(&sim, rod, format!("mode {mode}"), plotters::style::full_palette::BLUE_800))
 }
 
 /// Largest distance, mm, between a representative's stored tip and the tip

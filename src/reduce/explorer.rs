@@ -62,7 +62,7 @@ fn design_cables(cables: &MapCables, routing_id: i64) -> Value {
 /// and tension and the `cablemap simulate` command that solves it again.
 fn data(
     map: &MapData,
-    actuator: &Rod,
+    rod: &Rod,
     shapes: &[Option<BodyDrawing>],
     pictures: &[Picture],
     written_utc: &str,
@@ -121,8 +121,8 @@ fn data(
         "summary": map.summary,
         "length_basis_description": map.summary.length_basis.describe(),
         "sparse_note": Density::sparse_note(&map.summary, &map.cells),
-        "actuator": actuator,
-        "effects_in_use": effects_in_use(actuator),
+        "actuator": rod,
+        "effects_in_use": effects_in_use(rod),
         "written_utc": written_utc,
         "pictures": pictures.iter().map(|p| json!({"file": p.file, "title": p.title, "explanation": p.explanation})).collect::<Vec<_>>(),
         "cells": {
@@ -156,8 +156,8 @@ fn data(
 }
 
 /// The effects whose settings differ from the thesis model's (name, value).
-fn effects_in_use(actuator: &Rod) -> Vec<(String, Value)> {
-    let used = serde_json::to_value(&actuator.effects).expect("effects serialise");
+fn effects_in_use(rod: &Rod) -> Vec<(String, Value)> {
+    let used = serde_json::to_value(&rod.effects).expect("effects serialise");
     let default = serde_json::to_value(crate::model::Effects::default()).expect("effects serialise");
     let (Some(used), Some(default)) = (used.as_object(), default.as_object()) else { return Vec::new() };
     used.iter().filter(|(k, v)| default.get(*k) != Some(v)).map(|(k, v)| (k.clone(), v.clone())).collect()
@@ -186,13 +186,13 @@ pub fn utc_now() -> String {
 pub fn write_explorer(
     dir: &Path,
     map: &MapData,
-    actuator: &Rod,
+    rod: &Rod,
     shapes: &[Option<BodyDrawing>],
     pictures: &[Picture],
     cables: Option<&MapCables>,
 ) -> Result<(), ReduceError> {
     let write = |name: &str, bytes: &[u8]| super::tables::write_file(&dir.join(name), bytes);
-    let value = data(map, actuator, shapes, pictures, &utc_now(), cables);
+    let value = data(map, rod, shapes, pictures, &utc_now(), cables);
     let script = format!("// Written by `cablemap reduce`: the map explorer's data (index.html).\nwindow.CABLEMAP_MAP = {value};\n");
     write(DATA_FILE, script.as_bytes())?;
     write("index.html", PAGE.as_bytes())

@@ -85,7 +85,8 @@ fn basis_of_maps_without_the_field() -> LengthBasis {
 
 /// What a map records of its actuator's body beyond L and r: the radius
 /// profile, segments and cable anchor. Empty for the thesis's uniform rod,
-/// whose summary.json then has none of these fields (as before they existed).
+/// whose summary.json then has none of these fields (a reader of the
+/// thesis's maps sees no new keys).
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct MapBody {
     /// Radius profile (s, r) points, mm.
@@ -101,11 +102,11 @@ pub struct MapBody {
 
 impl MapBody {
     /// The body of `actuator`.
-    pub fn of(actuator: &crate::model::Rod) -> Self {
+    pub fn of(rod: &crate::model::Rod) -> Self {
         MapBody {
-            radius_profile_mm: actuator.radius_profile_mm.clone(),
-            segments: actuator.segments.clone(),
-            cable_anchor_mm: actuator.cable_anchor_mm.filter(|&k| k != actuator.length_mm),
+            radius_profile_mm: rod.radius_profile_mm.clone(),
+            segments: rod.segments.clone(),
+            cable_anchor_mm: rod.cable_anchor_mm.filter(|&k| k != rod.length_mm),
         }
     }
 }

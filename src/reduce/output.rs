@@ -23,10 +23,10 @@ pub const REACH_PICTURE: &str = "reach.png";
 pub fn write_map_replacing(
     dir: &Path,
     map: &MapData,
-    actuator: &crate::model::Rod,
+    rod: &crate::model::Rod,
     solver: &crate::solver::SolverOptions,
 ) -> Result<Vec<Picture>, ReduceError> {
-    write_dir_replacing(dir, |staging| write_map(staging, map, actuator, solver))
+    write_dir_replacing(dir, |staging| write_map(staging, map, rod, solver))
 }
 
 /// Writes the map directory `dir` as a whole by `write` (given the staging
@@ -104,16 +104,16 @@ fn holds_only_map_files(dir: &Path, depth: usize) -> bool {
 }
 
 /// Writes the whole map directory: tables, pictures and index.html.
-/// `actuator` and `solver` re-simulate the mode representatives for drawing
+/// `rod` and `solver` re-simulate the mode representatives for drawing
 /// ([`ModeDrawings`]). Writes in place; [`write_map_replacing`] is what the
 /// commands use.
 pub fn write_map(
     dir: &Path,
     map: &MapData,
-    actuator: &crate::model::Rod,
+    rod: &crate::model::Rod,
     solver: &crate::solver::SolverOptions,
 ) -> Result<Vec<Picture>, ReduceError> {
-    write_map_drawn(dir, map, actuator, &ModeDrawings::of_map(map, actuator, solver), None)
+    write_map_drawn(dir, map, rod, &ModeDrawings::of_map(map, rod, solver), None)
 }
 
 /// [`write_map`] with the mode representatives' bodies already drawn (a
@@ -123,7 +123,7 @@ pub fn write_map(
 pub fn write_map_drawn(
     dir: &Path,
     map: &MapData,
-    actuator: &crate::model::Rod,
+    rod: &crate::model::Rod,
     drawings: &ModeDrawings,
     cables: Option<&MapCables>,
 ) -> Result<Vec<Picture>, ReduceError> {
@@ -143,7 +143,7 @@ pub fn write_map_drawn(
             drawings.failure_note()
         ),
     });
-    explorer::write_explorer(dir, map, actuator, &drawings.shapes, &pictures, cables)?;
+    explorer::write_explorer(dir, map, rod, &drawings.shapes, &pictures, cables)?;
     Ok(pictures)
 }
 

@@ -21,7 +21,7 @@ pub struct StatusReport {
     pub kind: &'static str,
     /// The run's format tag ([`RunSpec::FORMAT`]).
     pub format: &'static str,
-    /// A planar single-cable run (its lines stay as they always were).
+    /// A planar single-cable run: its status names no kind (the thesis's runs) and counts tensions.
     pub planar: bool,
     /// SHA-256 of the spec.
     pub spec_sha256: String,

@@ -1,5 +1,5 @@
-//! The spec of a sweep of several or spatial cables (issue 16;
-//! `cablemap-cables/1` runs): the actuator file's settings, each cable's
+//! The spec of a sweep of several or spatial cables
+//! (`cablemap-cables/1` runs): the actuator file's settings, each cable's
 //! tension grid and which of its control points (y or z) are swept over
 //! which levels. Every routing is solved through the product of the tension
 //! grids by the 3-D solver; the rows carry one tension column per cable and
