@@ -46,6 +46,7 @@ pub mod polygon;
 pub mod request;
 pub mod set;
 pub mod stl;
+mod write;
 
 pub use error::{BodyFeature, MouldError, ParameterProblem};
 pub use moulds::{volume_below_face_mm3, Moulds, Part, PartKind};

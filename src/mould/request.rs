@@ -205,6 +205,6 @@ impl ActuatorMoulds {
     /// Writes the mould directory `dir` as a whole (new, empty or an
     /// earlier mould directory; a killed run leaves nothing partial).
     pub fn write_dir(&self, dir: &Path) -> Result<MouldReport, MouldError> {
-        super::set::write_mould_dir(dir, |staging| self.write_all(staging))
+        super::write::write_mould_dir(dir, |staging| self.write_all(staging))
     }
 }
