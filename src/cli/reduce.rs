@@ -90,7 +90,7 @@ fn with_flags(e: MapError, run: &Path, out: &Path) -> anyhow::Error {
 
 /// A reduce error, with the flag that fixes it where there is one.
 fn flagged(e: ReduceError, run: &Path, out: &Path) -> anyhow::Error {
-    use cablemap::reduce::parts::PartsError;
+    use cablemap::reduce::PartsError;
     let part = |i: String, n: String| format!("cablemap reduce {} --out {} --shard {i} --shards {n}", run.display(), out.display());
     match &e {
         ReduceError::CellTooSmall { smallest_cell_mm, .. } => anyhow::anyhow!("{e} (use --cell-mm ≥ {})", cablemap::io::fmt_num(*smallest_cell_mm)),

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 /// What marks a directory as a sweep run: its manifest's file name and
 /// each kind's format tag. The one owner of these markers: the sweep engine
-/// writes them from here ([`crate::sweep::store`], [`crate::sweep::spec`])
+/// writes them from here (`sweep::store`, `sweep::spec`)
 /// and [`is_run_dir`] recognises them from here, so a new kind of run is
 /// protected from stray outputs as soon as its tag is added.
 pub mod run_markers {

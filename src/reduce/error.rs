@@ -1,7 +1,7 @@
 //! Why a reduction failed: one enum for every stage and both kinds of run;
 //! messages name the file or setting and what to do.
 
-use super::{parts, tables, MAX_CELLS_PER_AXIS};
+use super::{tables, MAX_CELLS_PER_AXIS};
 use std::path::PathBuf;
 
 /// Why a reduction failed.
@@ -205,7 +205,7 @@ pub enum ReduceError {
     },
     /// The parts of a split reduction do not make one map.
     #[error("{0}")]
-    Parts(#[from] parts::PartsError),
+    Parts(#[from] PartsError),
     /// A several-cable map's cable spec ([`CABLES_FILE`](super::map_cables::CABLES_FILE)) cannot be read.
     #[error(
         "reading {}: {source} (`cablemap reduce` writes it beside the tables of a map of several cables: reduce the run again)",
@@ -217,4 +217,95 @@ pub enum ReduceError {
         /// Why it cannot be read or parsed.
         source: Box<dyn std::error::Error + Send + Sync>,
     },
+}
+
+/// Why a split reduction's parts do not make a map.
+#[derive(Debug, thiserror::Error)]
+pub enum PartsError {
+    /// The part number is not below the number of parts, or there are
+    /// more parts than a reduce may be split into.
+    #[error(
+        "part {shard} of {shards}: parts are numbered 0 to N-1, and the number of parts N must be 1 … {}",
+        crate::sweep::MAX_SHARDS
+    )]
+    BadShard {
+        /// The part asked for.
+        shard: u64,
+        /// The number of parts.
+        shards: u64,
+    },
+    /// No part has been written.
+    #[error("{}: no reduce parts found: run the parts first (part I of N for every I from 0 to N-1)", dir.display())]
+    NoParts {
+        /// The parts directory.
+        dir: PathBuf,
+    },
+    /// Some parts are missing.
+    #[error("{}: {} of {shards} parts missing (part {}): run those parts (again) before merging", dir.display(), missing.len(), list(missing))]
+    Missing {
+        /// The parts directory.
+        dir: PathBuf,
+        /// The number of parts.
+        shards: u64,
+        /// The missing parts.
+        missing: Vec<u64>,
+    },
+    /// Parts of different splits are mixed.
+    #[error("{}: holds parts of different splits (of {}): remove the directory and run the parts of one split", dir.display(), list(counts))]
+    Mixed {
+        /// The parts directory.
+        dir: PathBuf,
+        /// The numbers of parts found.
+        counts: Vec<u64>,
+    },
+    /// A part does not belong to this run or is damaged.
+    #[error("{}: {problem}: run this part again", path.display())]
+    Mismatch {
+        /// The part's file.
+        path: PathBuf,
+        /// What is wrong.
+        problem: String,
+    },
+    /// A part's files changed after they were written (a checksum differs).
+    #[error("{}: {problem}: the part was damaged or edited after it was written; run part {shard} of {shards} again", path.display())]
+    Damaged {
+        /// The part's file that failed its check.
+        path: PathBuf,
+        /// The part.
+        shard: u64,
+        /// The number of parts.
+        shards: u64,
+        /// What differs.
+        problem: String,
+    },
+    /// Part records of a split into more parts than a reduce may have.
+    #[error(
+        "{}: holds parts of a split into {shards} parts, more than {}: remove the directory and split into fewer parts",
+        dir.display(),
+        crate::sweep::MAX_SHARDS
+    )]
+    TooMany {
+        /// The parts directory.
+        dir: PathBuf,
+        /// The number of parts the records name.
+        shards: u64,
+    },
+    /// A part's record cannot be read or written.
+    #[error("{}: {source}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The error.
+        source: std::io::Error,
+    },
+}
+
+/// The numbers of `v` for a message: the first few, then how many more.
+fn list(v: &[u64]) -> String {
+    const SHOWN: usize = 20;
+    let mut text = v.iter().take(SHOWN).map(u64::to_string).collect::<Vec<_>>().join(", ");
+    if v.len() > SHOWN {
+        text.push_str(&format!(", … ({} more)", v.len() - SHOWN));
+    }
+    text
 }

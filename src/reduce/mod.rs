@@ -54,7 +54,7 @@ pub mod stats;
 pub mod tables;
 
 pub use density::Density;
-pub use error::ReduceError;
+pub use error::{PartsError, ReduceError};
 pub use map_cables::{design_actuation, MapCables};
 pub use map_data::{
     CableMapSummary, CellStats, CoefficientStats, Design, MapBody, MapData, MapSummary, ModeStats, CELL_STATS_ORDER, COEFFICIENT_UNIT,
