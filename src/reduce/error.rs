@@ -264,7 +264,7 @@ pub enum PartsError {
         /// The part's file.
         path: PathBuf,
         /// What is wrong.
-        problem: String,
+        problem: PartMismatch,
     },
     /// A part's files changed after they were written (a checksum differs).
     #[error("{}: {problem}: the part was damaged or edited after it was written; run part {shard} of {shards} again", path.display())]
@@ -276,7 +276,7 @@ pub enum PartsError {
         /// The number of parts.
         shards: u64,
         /// What differs.
-        problem: String,
+        problem: PartDamage,
     },
     /// Part records of a split into more parts than a reduce may have.
     #[error(
@@ -297,6 +297,73 @@ pub enum PartsError {
         path: PathBuf,
         /// The error.
         source: std::io::Error,
+    },
+}
+
+/// How a part does not belong to the run it is merged into.
+#[derive(Debug, thiserror::Error)]
+pub enum PartMismatch {
+    /// A part numbered beyond the split.
+    #[error("part {part} is beyond the {shards} parts: remove it")]
+    BeyondParts {
+        /// The part.
+        part: u64,
+        /// The number of parts.
+        shards: u64,
+    },
+    /// Not a part record.
+    #[error("not a reduce part record ({0})")]
+    NotARecord(#[source] serde_json::Error),
+    /// A record of another format.
+    #[error("format '{found}', expected '{wanted}'")]
+    Format {
+        /// Its format tag.
+        found: String,
+        /// The tag this version writes.
+        wanted: &'static str,
+    },
+    /// A record of another part.
+    #[error("it records part {shard} of {shards}")]
+    OtherPart {
+        /// The part it records.
+        shard: u64,
+        /// Of so many parts.
+        shards: u64,
+    },
+    /// A part of another run.
+    #[error("it is a part of another run (its spec hash differs)")]
+    OtherRun,
+    /// A part of the run as it was before it changed.
+    #[error("it covers other chunks or rows than the run has now")]
+    OtherCoverage,
+    /// A samples file of another length than its record says.
+    #[error("{bytes} bytes where the part's record says {samples} samples")]
+    SamplesLength {
+        /// The file's length.
+        bytes: u64,
+        /// Samples in the record.
+        samples: u64,
+    },
+}
+
+/// What differs in a part changed after it was written.
+#[derive(Debug, thiserror::Error)]
+pub enum PartDamage {
+    /// The record's content.
+    #[error("its content hashes to {content}, not the recorded record_sha256 {recorded}")]
+    Record {
+        /// The content's digest, hex.
+        content: String,
+        /// The digest recorded, hex.
+        recorded: String,
+    },
+    /// The samples file's bytes.
+    #[error("its SHA-256 is {actual}, not the {recorded} recorded when it was written")]
+    Samples {
+        /// The file's digest, hex.
+        actual: String,
+        /// The digest recorded, hex.
+        recorded: String,
     },
 }
 

@@ -22,6 +22,7 @@ use super::pipeline::{check_options, reduce_spilled, run_open_error};
 use super::samples::Pass1;
 use super::source::PlanarSource;
 use super::spill::{self, SpillWriter, RECORD_BYTES};
+use super::error::{PartDamage, PartMismatch};
 use super::{columns, MapData, PartsError, ReduceError, ReduceOptions};
 use crate::sweep::{open_run, Completeness, SweepRun, SweepSpec};
 use serde::{Deserialize, Serialize};
@@ -252,14 +253,14 @@ fn read_parts(dir: &Path, run: &SweepRun) -> Result<(Vec<PathBuf>, Pass1), Parts
         let path = dir.join(part_name(i, shards, "json"));
         return Err(PartsError::Mismatch {
             path,
-            problem: format!("part {i} is beyond the {shards} parts: remove it"),
+            problem: PartMismatch::BeyondParts { part: i, shards },
         });
     }
     let mut files = Vec::new();
     let mut pass1 = Pass1::default();
     for shard in 0..shards {
         let path = dir.join(part_name(shard, shards, "json"));
-        let mismatch = |problem: String| PartsError::Mismatch {
+        let mismatch = |problem| PartsError::Mismatch {
             path: path.clone(),
             problem,
         };
@@ -267,17 +268,17 @@ fn read_parts(dir: &Path, run: &SweepRun) -> Result<(Vec<PathBuf>, Pass1), Parts
             path: path.clone(),
             source,
         })?;
-        let record: PartRecord = serde_json::from_slice(&text).map_err(|e| mismatch(format!("not a reduce part record ({e})")))?;
+        let record: PartRecord = serde_json::from_slice(&text).map_err(|e| mismatch(PartMismatch::NotARecord(e)))?;
         if record.format != PART_FORMAT {
-            return Err(mismatch(format!("format '{}', expected '{PART_FORMAT}'", record.format)));
+            return Err(mismatch(PartMismatch::Format { found: record.format, wanted: PART_FORMAT }));
         }
         if (record.shard, record.shards) != (shard, shards) {
-            return Err(mismatch(format!("it records part {} of {}", record.shard, record.shards)));
+            return Err(mismatch(PartMismatch::OtherPart { shard: record.shard, shards: record.shards }));
         }
         if record.spec_sha256 != run.manifest().spec_sha256 {
-            return Err(mismatch("it is a part of another run (its spec hash differs)".into()));
+            return Err(mismatch(PartMismatch::OtherRun));
         }
-        let damaged = |path: &Path, problem: String| PartsError::Damaged {
+        let damaged = |path: &Path, problem| PartsError::Damaged {
             path: path.to_path_buf(),
             shard,
             shards,
@@ -285,13 +286,7 @@ fn read_parts(dir: &Path, run: &SweepRun) -> Result<(Vec<PathBuf>, Pass1), Parts
         };
         let content = record.content_sha256();
         if content != record.record_sha256 {
-            return Err(damaged(
-                &path,
-                format!(
-                    "its content hashes to {content}, not the recorded record_sha256 {}",
-                    record.record_sha256
-                ),
-            ));
+            return Err(damaged(&path, PartDamage::Record { content, recorded: record.record_sha256.clone() }));
         }
         let range = chunk_range(run.chunk_count(), shard, shards);
         let first_row: u64 = (0..range[0]).map(|i| run.chunk_rows(i)).sum();
@@ -301,7 +296,7 @@ fn read_parts(dir: &Path, run: &SweepRun) -> Result<(Vec<PathBuf>, Pass1), Parts
             || record.first_row != first_row
             || record.pass1.rows_read != rows
         {
-            return Err(mismatch("it covers other chunks or rows than the run has now".into()));
+            return Err(mismatch(PartMismatch::OtherCoverage));
         }
         let samples = dir.join(part_name(shard, shards, "samples"));
         let len = std::fs::metadata(&samples).map(|m| m.len()).map_err(|source| PartsError::Io {
@@ -311,7 +306,7 @@ fn read_parts(dir: &Path, run: &SweepRun) -> Result<(Vec<PathBuf>, Pass1), Parts
         if len != record.records * RECORD_BYTES as u64 {
             return Err(PartsError::Mismatch {
                 path: samples,
-                problem: format!("{len} bytes where the part's record says {} samples", record.records),
+                problem: PartMismatch::SamplesLength { bytes: len, samples: record.records },
             });
         }
         let actual = crate::io::sha256_file(&samples).map_err(|source| PartsError::Io {
@@ -319,13 +314,7 @@ fn read_parts(dir: &Path, run: &SweepRun) -> Result<(Vec<PathBuf>, Pass1), Parts
             source,
         })?;
         if actual != record.samples_sha256 {
-            return Err(damaged(
-                &samples,
-                format!(
-                    "its SHA-256 is {actual}, not the {} recorded when it was written",
-                    record.samples_sha256
-                ),
-            ));
+            return Err(damaged(&samples, PartDamage::Samples { actual, recorded: record.samples_sha256.clone() }));
         }
         files.push(samples);
         pass1.merge(&record.pass1);

@@ -186,10 +186,10 @@ pub enum SweepError {
     Routing(#[from] crate::model::RoutingError),
     /// Parquet encoding or decoding.
     #[error("{context}: {source}")]
-    Parquet { context: String, source: parquet::errors::ParquetError },
+    Parquet { context: FileOp, source: parquet::errors::ParquetError },
     /// Arrow decoding.
     #[error("{context}: {source}")]
-    Arrow { context: String, source: arrow::error::ArrowError },
+    Arrow { context: FileOp, source: arrow::error::ArrowError },
     /// Reading the run's state after its sweep.
     #[error("checking {} after the sweep: {source}", dir.display())]
     After {
@@ -211,4 +211,26 @@ pub enum SweepError {
     /// A file operation.
     #[error(transparent)]
     File(#[from] crate::io::FileError),
+}
+
+/// A file or directory being read or written, for an error's context.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{op} {}", path.display())]
+pub struct FileOp {
+    /// `reading` or `writing`.
+    pub op: &'static str,
+    /// The file or directory.
+    pub path: PathBuf,
+}
+
+impl FileOp {
+    /// Reading `path`.
+    pub fn reading(path: &std::path::Path) -> Self {
+        Self { op: "reading", path: path.to_path_buf() }
+    }
+
+    /// Writing `path`.
+    pub fn writing(path: &std::path::Path) -> Self {
+        Self { op: "writing", path: path.to_path_buf() }
+    }
 }

@@ -25,6 +25,7 @@
 use super::kind::RunSpec;
 use super::spec::SweepSpec;
 use super::store::{ChunkInfo, ChunkProblem, Manifest, RunDir};
+use super::error::FileOp;
 use super::SweepError;
 use arrow::datatypes::SchemaRef;
 use arrow::record_batch::RecordBatch;
@@ -162,7 +163,7 @@ impl<S: RunSpec> SweepRun<S> {
         let projection = columns.map(|c| self.projection(c)).transpose()?;
         let chunk = &self.chunks[index];
         let reader = open_chunk(&chunk.path, &self.schema(), projection.as_deref())?;
-        Ok(reader.map(move |b| b.map_err(|source| SweepError::Arrow { context: format!("reading {}", chunk.path.display()), source })))
+        Ok(reader.map(move |b| b.map_err(|source| SweepError::Arrow { context: FileOp::reading(&chunk.path), source })))
     }
 
     /// Root column indices of `columns`, sorted.
@@ -171,7 +172,7 @@ impl<S: RunSpec> SweepRun<S> {
         let mut indices = Vec::with_capacity(columns.len());
         for name in columns {
             let i = schema.index_of(name).map_err(|_| SweepError::Arrow {
-                context: format!("reading {}", self.dir.display()),
+                context: FileOp::reading(&self.dir),
                 source: arrow::error::ArrowError::SchemaError(format!(
                     "no column '{name}' (columns: {})",
                     schema.fields().iter().map(|f| f.name().as_str()).collect::<Vec<_>>().join(", ")
@@ -191,7 +192,7 @@ impl<S: RunSpec> SweepRun<S> {
                 Ok(reader) => {
                     let path = chunk.path.clone();
                     Box::new(reader.map(move |b| {
-                        b.map_err(|source| SweepError::Arrow { context: format!("reading {}", path.display()), source })
+                        b.map_err(|source| SweepError::Arrow { context: FileOp::reading(&path), source })
                     })) as Box<dyn Iterator<Item = _>>
                 }
                 Err(e) => Box::new(std::iter::once(Err(e))),

@@ -646,7 +646,7 @@ impl RunDir {
         })();
         let file = written.map_err(|e| {
             let _ = std::fs::remove_file(&tmp);
-            SweepError::Parquet { context: format!("writing {}", tmp.display()), source: e }
+            SweepError::Parquet { context: super::error::FileOp::writing(&tmp), source: e }
         })?;
         let committed = (|| {
             file.sync_all()?;
