@@ -183,9 +183,12 @@ mod tests {
 
     #[test]
     fn tension_and_effects_axes() {
+        let friction = crate::model::effects::FRICTION.key;
         let s = StudySpec::from_toml(
-            "[study]\n[[study.axis]]\nname = \"tension_n\"\nvalues = [[1.0, 2.0], [1, 3]]\n\
-             [[study.axis]]\nname = \"effects\"\nvalues = [{}, { friction_mu = 0.1 }]\n",
+            &format!(
+                "[study]\n[[study.axis]]\nname = \"tension_n\"\nvalues = [[1.0, 2.0], [1, 3]]\n\
+                 [[study.axis]]\nname = \"effects\"\nvalues = [{{}}, {{ {friction} = 0.1 }}]\n"
+            ),
             "t",
         )
         .unwrap();
@@ -193,7 +196,7 @@ mod tests {
         assert_eq!(s.variants[3].spec.tension.max_n, 3.0);
         assert_eq!(s.variants[3].spec.actuator.effects.friction_mu, 0.1);
         assert_eq!(s.variants[2].spec.actuator.effects.friction_mu, 0.0);
-        assert_eq!(s.variants[3].label(), "tension_n=1–3 N, effects={friction_mu:0.1}");
+        assert_eq!(s.variants[3].label(), format!("tension_n=1–3 N, effects={{{friction}:0.1}}"));
     }
 
     #[test]

@@ -652,6 +652,7 @@ impl RunSpec for CableSweepSpec {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::effects::FRICTION;
     use crate::sweep::solve::combination_index;
 
     const SPEC: &str = r#"
@@ -738,7 +739,10 @@ levels_mm = [0.0, 1.5, -1.5]
             (SPEC.replace("count = 3", "count = 0"), "count = 0"),
             (SPEC.replace("min = 0.5", "min = -0.5"), "0 ≤ min"),
             (SPEC.replace("levels_mm = [1.0, 3.0]", "levels_mm = []"), "levels_mm"),
-            (format!("{}\n[solver]\nmethod = \"rk4\"\n", SPEC.replace("[rod.gravity]", "[rod.effects]\nfriction_mu = 0.1\n[rod.gravity]")), "friction_mu"),
+            (
+                format!("{}\n[solver]\nmethod = \"rk4\"\n", SPEC.replace("[rod.gravity]", &format!("[rod.effects]\n{} = 0.1\n[rod.gravity]", FRICTION.key))),
+                FRICTION.key,
+            ),
             (format!("{SPEC}\n[output]\norder = 7\n[solver]\nmethod = \"rk4\"\n"), "steps_per_span"),
             (format!("{SPEC}\n[output]\norder = 9\n"), "highest order 8"),
             (SPEC.replace("axis = \"z\"", "axis = \"x\""), "unknown variant"),

@@ -777,7 +777,7 @@ mod tests {
         assert!(err("[tension]\ncount = 0\n").contains("count = 0"));
         assert!(err("[output]\nchunk_routings = 0\n").contains("chunk_routings"));
         assert!(err("[actuator]\nea_n = -3.0\n").contains("ea_n"));
-        assert!(err("[actuator.effects]\nchannel_offset_mm = 0.5\n").contains("mirror_dedup"));
+        assert!(err(&format!("[actuator.effects]\n{} = 0.5\n", crate::model::effects::CHANNEL_OFFSET.key)).contains("mirror_dedup"));
         assert!(err("[tension]\nmin_n = 2.0\nmax_n = 1.0\n").contains("max_n"));
     }
 
