@@ -5,7 +5,8 @@
 
 use cablemap::calibrate::captures::synth::{default_plan, load_unload_plan, one_cable_at_a_time, synth_captures, MarkerSpec};
 use cablemap::calibrate::captures::fit::Status;
-use cablemap::calibrate::captures::{diagnose_captures, fit_captures, Diagnose3Spec, Diagnosis3, Fit3Spec, Param};
+use cablemap::calibrate::captures::{diagnose_captures, fit_captures, Diagnose3Spec, Diagnosis3, Fit3Spec};
+use cablemap::calibrate::Parameter;
 use cablemap::calibrate::Effect;
 use cablemap::solver::spatial::SpatialOptions;
 use cablemap::model::Actuator;
@@ -187,14 +188,14 @@ fn the_3d_fit_recovers_the_rigidities_within_their_standard_errors() {
     let captures = one_cable_at_a_time(2, &[1.5, 3.0, 4.5, 6.0, 7.5], 5.0);
     let set = synth_captures(&truth, &options, captures, &markers, 1.0, 7, false).unwrap();
     let start = Actuator::read(std::path::Path::new(&soromox("actuator.toml"))).unwrap();
-    let spec = Fit3Spec { params: Param::BODY.to_vec(), noise_mm: 1.0, ..Fit3Spec::default() };
+    let spec = Fit3Spec { params: Parameter::BODY.to_vec(), noise_mm: 1.0, ..Fit3Spec::default() };
     let fit = fit_captures(&start, &set, &spec, &mut |_| {}).unwrap();
     assert!(fit.converged, "{}", fit.termination);
     for f in &fit.parameters {
         let want = f.param.get(&truth);
         println!("{}: {:?} {} ± {} (truth {want}, start {})", f.name, f.status, f.value, f.se, f.start);
     }
-    for p in Param::BODY {
+    for p in Parameter::BODY {
         let f = fit.parameter(p).unwrap();
         let want = p.get(&truth);
         match f.status {
@@ -203,7 +204,7 @@ fn the_3d_fit_recovers_the_rigidities_within_their_standard_errors() {
             Status::AtBound => panic!("{} is no effect", f.name),
         }
     }
-    for p in [Param::Ei, Param::Density] {
+    for p in [Parameter::Ei, Parameter::Density] {
         let f = fit.parameter(p).unwrap();
         assert!(f.status == Status::Fitted && f.se < 0.05 * p.get(&truth), "{f:?}");
     }

@@ -10,11 +10,9 @@
 //! library's messages.
 
 use super::{actuator_with, bad, Failure, Result, SolverRequest};
-use cablemap::calibrate::captures::{diagnose_request, Diagnose3Request};
-use cablemap::calibrate::captures::{self, Calibrate3Request, Param, PredictRequest};
+use cablemap::calibrate::captures::{self, PredictRequest};
 use cablemap::calibrate::diagnose::DiagnoseRequest;
-use cablemap::calibrate::fit::{parse_held, Held, Loss, Noise};
-use cablemap::calibrate::{CalibrateError, CalibrateRequest, Effect, FitSettings};
+use cablemap::calibrate::{CalibrateError, CalibrateRequest, Effect, FitSettings, LossKind, Parameter};
 use cablemap::design::actuator::DesignActuator;
 use cablemap::design::feasible_request::{FeasibleRequest, MapSource};
 use cablemap::design::targets::TargetSet;
@@ -345,74 +343,21 @@ struct FitPy {
 }
 
 impl FitPy {
-    /// The loss asked for, `default` when none.
-    fn loss(&self, default: &str) -> Result<Loss> {
-        match self.loss.as_deref().unwrap_or(default) {
-            "squares" => Ok(Loss::Squared),
-            "huber" if self.huber_k.is_finite() && self.huber_k > 0.0 => Ok(Loss::Huber { k: self.huber_k }),
-            "huber" => Err(bad(format!("huber_k {}: must be a number of σ > 0", self.huber_k))),
-            other => Err(bad(format!("loss {other:?}: use \"huber\" or \"squares\""))),
-        }
-    }
-
-    /// Each `fix` item as (name, value), the name parsed by `parse`.
-    fn held<P>(&self, parse: impl Fn(&str) -> Option<P>, names: &str) -> Result<Vec<(P, f64)>> {
-        self.fix
-            .iter()
-            .map(|item| {
-                let (name, value) = item.split_once('=').ok_or_else(|| bad(format!("fix {item}: expected NAME=VALUE, e.g. GA=1.70866")))?;
-                let p = parse(name).ok_or_else(|| {
-                    let effects: Vec<&str> = Effect::ALL.iter().map(|e| e.parameter_name()).collect();
-                    bad(format!("fix {item}: unknown parameter '{name}'; use {names} or one of {}", effects.join(", ")))
-                })?;
-                let v = value.trim().parse::<f64>().map_err(|_| bad(format!("fix {item}: '{value}' is not a number")))?;
-                Ok((p, v))
-            })
-            .collect()
-    }
-
-    /// The planar fit's settings (`calibrate`/`diagnose` without `--actuator`).
+    /// The fit settings asked for.
     fn settings(&self) -> Result<FitSettings> {
-        if self.holdout_cable.is_some() {
-            return Err(bad("holdout_cable holds out a cable's captures: give the actuator file by actuator=FILE.toml"));
-        }
-        if self.max_iterations == 0 {
-            return Err(bad("max_iterations must be at least 1"));
-        }
-        let held: Vec<(Held, f64)> = self.held(parse_held, "EA, GA, EI")?;
+        let held = self.fix.iter().map(|item| Parameter::parse_held(item)).collect::<std::result::Result<Vec<_>, _>>().map_err(|e| bad(e.to_string()))?;
+        let loss = self.loss.as_deref().map(LossKind::parse).transpose().map_err(|e| bad(e.to_string()))?;
         Ok(FitSettings {
-            noise: Noise { mm: self.noise_mm, deg: self.noise_deg },
+            noise_mm: self.noise_mm,
+            noise_deg: self.noise_deg,
             held,
-            loss: self.loss("huber")?,
+            loss,
+            huber_k: self.huber_k,
             max_iterations: self.max_iterations,
             centrelines: self.centrelines.clone(),
             markers: self.markers.clone(),
             angle_weight_mm_per_deg: self.angle_weight,
         })
-    }
-
-    /// The checks of the 3-D route (`--actuator FILE.toml`) every fit shares.
-    fn check_captures(&self) -> Result<()> {
-        if self.holdout.is_some() {
-            return Err(bad("holdout takes a routing of planar data; with actuator=FILE.toml, hold out a cable's captures by holdout_cable=K"));
-        }
-        if self.centrelines.is_some() {
-            return Err(bad("centrelines: planar centreline points; with actuator=FILE.toml, give 3-D markers by markers="));
-        }
-        if !self.rod_fields.is_empty() {
-            let names: Vec<&str> = self.rod_fields.keys().map(String::as_str).collect();
-            return Err(bad(format!(
-                "{}: with actuator=FILE.toml the rod and its effects come from FILE.toml's [rod] table; edit it instead",
-                names.join(", ")
-            )));
-        }
-        if !(self.noise_mm.is_finite() && self.noise_mm > 0.0) {
-            return Err(bad(format!("noise_mm {}: the markers' noise must be a standard deviation > 0 mm", self.noise_mm)));
-        }
-        if self.max_iterations == 0 {
-            return Err(bad("max_iterations must be at least 1"));
-        }
-        Ok(())
     }
 }
 
@@ -445,33 +390,19 @@ struct CalibratePy {
 
 fn calibrate_run(r: CalibratePy) -> Result<Finished> {
     let CalibratePy { fit, effects: names, out } = r;
-    let effects = effects(&names)?;
-    let Some(actuator) = &fit.actuator else {
-        if out.is_some() {
-            return Err(bad("out= writes a calibrated actuator file: calibrate captures against 3-D markers with actuator=FILE.toml"));
-        }
-        let request = CalibrateRequest {
-            data_path: fit.data.clone(),
-            actuator: rod_overrides(fit.rod_fields.clone())?,
-            options: fit.solver.options()?,
-            fit: fit.settings()?,
-            effects,
-            holdout: fit.holdout.clone(),
-        };
-        let report = cablemap::calibrate::run(&request).map_err(calibrate_failure)?;
-        return Ok((report.to_json_line(), report.to_string(), Vec::new()));
+    let request = CalibrateRequest {
+        data_path: fit.data.clone(),
+        actuator_file: fit.actuator.clone(),
+        rod: rod_overrides(fit.rod_fields.clone())?,
+        options: fit.solver.options()?,
+        spatial_options: spatial_options(&fit.solver)?,
+        fit: fit.settings()?,
+        effects: effects(&names)?,
+        holdout: fit.holdout.clone(),
+        holdout_cable: fit.holdout_cable,
+        out,
     };
-    fit.check_captures()?;
-    let mut request = Calibrate3Request::new(fit.data.clone(), fit.markers.clone(), actuator.clone());
-    request.held = fit.held(Param::parse, "EI, EA, GA, GJ, density")?;
-    request.effects = effects;
-    request.noise_mm = fit.noise_mm;
-    request.loss = fit.loss("squares")?;
-    request.max_iterations = fit.max_iterations;
-    request.holdout_cable = fit.holdout_cable;
-    request.out = out;
-    request.options = spatial_options(&fit.solver)?;
-    let report = captures::calibrate(&request, &mut |_| {}).map_err(calibrate_failure)?;
+    let report = cablemap::calibrate::run(&request).map_err(calibrate_failure)?;
     Ok((report.to_json_line(), report.to_string(), Vec::new()))
 }
 
@@ -498,52 +429,26 @@ struct DiagnosePy {
     report: bool,
 }
 
-/// The plots a planar diagnosis writes beside report.md.
-const DIAGNOSIS_PLOTS: [&str; 3] = ["residuals.png", "loops.png", "shapes.png"];
-
 fn diagnose_run(r: DiagnosePy) -> Result<Finished> {
     let DiagnosePy { fit, alpha, threshold, margin, max_effects, out, report } = r;
-    let Some(actuator) = &fit.actuator else {
-        let report_dir = report.then(|| out.clone().unwrap_or_else(|| DiagnoseRequest::default_report_dir(&fit.data)));
-        let request = DiagnoseRequest {
-            data_path: fit.data.clone(),
-            actuator: rod_overrides(fit.rod_fields.clone())?,
-            options: fit.solver.options()?,
-            fit: fit.settings()?,
-            holdout: fit.holdout.clone(),
-            alpha,
-            threshold,
-            margin,
-            max_effects,
-            report_dir,
-        };
-        let done = cablemap::calibrate::diagnose::run(&request).map_err(calibrate_failure)?;
-        let dir = done.report.as_deref().and_then(Path::parent);
-        let plots = pictures(dir, &DIAGNOSIS_PLOTS.map(String::from));
-        return Ok((done.to_json_line(), done.to_string(), plots));
-    };
-    fit.check_captures()?;
-    if !fit.fix.is_empty() {
-        return Err(bad("fix with actuator=FILE.toml: set the value in FILE.toml instead (a diagnosis fits the body the data determine)"));
-    }
-    let request = Diagnose3Request {
-        captures: fit.data.clone(),
-        markers: fit.markers.clone(),
-        actuator: actuator.clone(),
-        noise_mm: fit.noise_mm,
-        loss: fit.loss("squares")?,
-        max_iterations: fit.max_iterations,
+    let request = DiagnoseRequest {
+        data_path: fit.data.clone(),
+        actuator_file: fit.actuator.clone(),
+        rod: rod_overrides(fit.rod_fields.clone())?,
+        options: fit.solver.options()?,
+        spatial_options: spatial_options(&fit.solver)?,
+        fit: fit.settings()?,
+        holdout: fit.holdout.clone(),
         holdout_cable: fit.holdout_cable,
         alpha,
         threshold,
         margin,
         max_effects,
-        options: spatial_options(&fit.solver)?,
-        // The library's report directory is the command's; the binding returns the report object.
-        report_dir: None,
+        report_dir: report.then(|| out.clone().unwrap_or_else(|| DiagnoseRequest::default_report_dir(&fit.data))),
     };
-    let done = diagnose_request(&request).map_err(calibrate_failure)?;
-    Ok((done.to_json_line(), done.to_string(), Vec::new()))
+    let done = cablemap::calibrate::diagnose::run(&request).map_err(calibrate_failure)?;
+    let pictures = done.pictures().iter().map(|p| p.display().to_string()).collect();
+    Ok((done.to_json_line(), done.to_string(), pictures))
 }
 
 /// `cablemap diagnose`: finds, names and adds the effect the model misses.
@@ -569,7 +474,7 @@ struct PredictPy {
 pub(crate) fn predict(py: Python<'_>, request_json: &str) -> PyResult<Finished> {
     let r: PredictPy = super::from_json(request_json, "predict").map_err(|e| e.into_py(py))?;
     detached(py, move || {
-        let request = PredictRequest { captures: r.captures, markers: r.markers, actuator: r.actuator, options: spatial_options(&r.solver)? };
+        let request = PredictRequest { captures: r.captures, markers: r.markers, actuator: r.actuator, rod: RodOverrides::default(), options: spatial_options(&r.solver)? };
         let report = captures::predict(&request).map_err(calibrate_failure)?;
         Ok((report.to_json_line(), report.to_string(), Vec::new()))
     })

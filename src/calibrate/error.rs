@@ -42,6 +42,9 @@ pub enum CalibrateError {
     /// The solver refused the rod or its settings.
     #[error(transparent)]
     Simulate(#[from] crate::solver::SimulateError),
+    /// A setting the request's kind of data cannot use.
+    #[error(transparent)]
+    Refused(#[from] Refused),
     /// The request cannot be carried out on this data.
     #[error(transparent)]
     Invalid(#[from] InvalidRequest),
@@ -139,6 +142,12 @@ pub enum InvalidRequest {
     /// A cable driven both by its tension and by its displacement.
     #[error("{}: both '{tension}' and '{displacement}' are given; cable {cable} is driven either by its tension or by its displacement", .path.display())]
     BothDrives { path: std::path::PathBuf, tension: String, displacement: String, cable: usize },
+    /// A loss of no known name.
+    #[error("--loss {name}: use huber or squares")]
+    Loss { name: String },
+    /// Huber's k not a number of σ > 0.
+    #[error("--huber-k {k}: must be a number of σ > 0")]
+    HuberK { k: f64 },
     /// The fitted actuator cannot be written as TOML.
     #[error("writing the calibrated actuator: {0}")]
     CalibratedToml(#[source] toml::ser::Error),
@@ -184,7 +193,56 @@ pub enum HeldError {
     /// A rigidity or density that is not a finite number > 0.
     #[error("{name} = {value}: a held value must be a finite number (> 0 for a rigidity or the density)")]
     NotPositive { name: &'static str, value: f64 },
+    /// A `--fix` item that cannot be read.
+    #[error("--fix {item}: {reason}")]
+    Item { item: String, reason: HeldItem },
+    /// GJ or the density held on planar data.
+    #[error("{name}: GJ and the density are fitted or held only on captures with 3-D markers (--actuator FILE.toml); planar data fit EA, GA, EI and effects")]
+    NotPlanar { name: &'static str },
     /// The rod with the held values is not valid.
     #[error(transparent)]
     Rod(#[from] crate::model::ParameterError),
+}
+
+/// Why a `--fix NAME=VALUE` item cannot be read.
+#[derive(Debug, thiserror::Error)]
+pub enum HeldItem {
+    /// No `=`.
+    #[error("expected NAME=VALUE, e.g. GA=1.70866")]
+    NoValue,
+    /// No parameter of that name.
+    #[error("unknown parameter '{name}'; use EI, EA, GA, GJ, density or one of {}", Effect::ALL.iter().map(|e| e.parameter_name()).collect::<Vec<_>>().join(", "))]
+    Unknown { name: String },
+    /// The value is not a number.
+    #[error("'{value}' is not a number")]
+    NotANumber { value: String },
+}
+
+/// A setting the request's kind of data cannot use.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum Refused {
+    /// A routing to hold out, with captures.
+    #[error("--holdout takes a routing of planar data; with --actuator, hold out a cable's captures by --holdout-cable K")]
+    RoutingHoldoutOnCaptures,
+    /// Planar centreline points, with captures.
+    #[error("--centrelines: planar centreline points; with --actuator, give 3-D markers by --markers")]
+    CentrelinesOnCaptures,
+    /// Rod settings, with captures: the rod is the actuator file's.
+    #[error("with --actuator the rod and its effects come from FILE.toml's [rod] table; edit it instead of giving rod flags")]
+    RodOnCaptures,
+    /// Held values in a diagnosis of captures.
+    #[error("--fix with --actuator: set the value in FILE.toml instead (a diagnosis fits the body the data determine)")]
+    HeldInCapturesDiagnosis,
+    /// The captures' outputs and held-out cable, on planar data.
+    #[error("--out and --holdout-cable calibrate captures against 3-D markers: give the actuator with --actuator FILE.toml")]
+    CapturesSettingsOnMeasurements,
+    /// A cable to hold out, in a diagnosis of planar data.
+    #[error("--holdout-cable holds out a cable's captures: give the actuator with --actuator FILE.toml")]
+    CableHoldoutOnMeasurements,
+    /// Rod settings in a prediction: the rod is the actuator file's.
+    #[error("predict takes the rod from --actuator FILE.toml's [rod] table; edit it instead of giving rod flags")]
+    RodOnPredict,
+    /// No Levenberg–Marquardt iteration.
+    #[error("--max-iterations must be at least 1")]
+    NoIterations,
 }

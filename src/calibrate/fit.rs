@@ -33,7 +33,7 @@ use super::data::{CentrelinePoints, Dataset, Marker, MarkerPoints, Measurement, 
 use super::effect::Effect;
 use super::predict::{predict, Prediction};
 use super::stats;
-use super::{CalibrateError, HeldError, InvalidRequest, NoiseError};
+use super::{CalibrateError, HeldError, InvalidRequest, NoiseError, Parameter};
 use crate::model::Rod;
 use crate::solver::{CentrelinePoint, SolverOptions};
 use crate::numerics::lm;
@@ -815,32 +815,9 @@ pub fn fit_observed(
     })
 }
 
-/// Parameters held at a given value (`--fix NAME=VALUE`): a rigidity or an
-/// effect's parameter.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Held {
-    /// EA, GA or EI (index 0, 1, 2).
-    Rigidity(usize),
-    /// An effect, held at the value: part of every model, not fitted.
-    Effect(Effect),
-}
-
-/// Parses the NAME of `--fix NAME=VALUE`: EA, GA, EI (any case, or
-/// `ea_n`, `ga_n`, `ei_n_mm2`), an effect's name or its parameter's name.
-pub fn parse_held(name: &str) -> Option<Held> {
-    let lower = name.trim().to_ascii_lowercase();
-    match lower.as_str() {
-        "ea" | "ea_n" => return Some(Held::Rigidity(0)),
-        "ga" | "ga_n" => return Some(Held::Rigidity(1)),
-        "ei" | "ei_n_mm2" => return Some(Held::Rigidity(2)),
-        _ => {}
-    }
-    Effect::ALL.into_iter().find(|e| e.name() == lower || e.parameter_name() == lower).map(Held::Effect)
-}
-
 /// Applies `--fix` values to the starting actuator: returns it with the
 /// values set, which rigidities are held, and which effects are held.
-pub fn apply_held(base: &Rod, held: &[(Held, f64)]) -> Result<(Rod, [bool; 3], Vec<Effect>), CalibrateError> {
+pub fn apply_held(base: &Rod, held: &[(Parameter, f64)]) -> Result<(Rod, [bool; 3], Vec<Effect>), CalibrateError> {
     let mut a = base.clone();
     let mut fixed = [false; 3];
     let mut effects = Vec::new();
@@ -848,16 +825,19 @@ pub fn apply_held(base: &Rod, held: &[(Held, f64)]) -> Result<(Rod, [bool; 3], V
         if !v.is_finite() {
             return Err(CalibrateError::Held(HeldError::NotFinite { value: v }));
         }
-        match h {
-            Held::Rigidity(k) => {
-                *[&mut a.ea_n, &mut a.ga_n, &mut a.ei_n_mm2][k] = v;
-                fixed[k] = true;
-            }
-            Held::Effect(e) => {
+        let rigidity = match h {
+            Parameter::Ea => 0,
+            Parameter::Ga => 1,
+            Parameter::Ei => 2,
+            Parameter::Effect(e) => {
                 e.apply(&mut a, v);
                 effects.push(e);
+                continue;
             }
-        }
+            Parameter::Gj | Parameter::Density => return Err(CalibrateError::Held(HeldError::NotPlanar { name: h.name() })),
+        };
+        *[&mut a.ea_n, &mut a.ga_n, &mut a.ei_n_mm2][rigidity] = v;
+        fixed[rigidity] = true;
     }
     a.validate().map_err(|e| CalibrateError::Held(e.into()))?;
     Ok((a, fixed, effects))

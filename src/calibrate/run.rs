@@ -1,62 +1,32 @@
 //! The calibration workflow behind `cablemap calibrate`: fit EA, GA, EI
-//! (thesis eq. 2.14) and any chosen effects to measurements, and report them
-//! with standard errors, correlations and the RMS error per routing (and on
-//! a held-out routing).
+//! (thesis eq. 2.14) and any chosen effects to planar measurements, and
+//! report them with standard errors, correlations and the RMS error per
+//! routing (and on a held-out routing); or, on captures with 3-D markers,
+//! the actuator's rigidities, weight and effects
+//! ([`crate::calibrate::captures::run`]).
 //!
 //! [`run`] takes a [`CalibrateRequest`] and returns a [`CalibrateReport`],
 //! which serialises itself (the `--json` object) and displays itself (the
 //! text report).
 
 use super::data::{read_centrelines, read_markers, read_measurements, split_holdout, Dataset};
-use super::fit::{apply_held, fit_observed, rms_per_routing, FitProgress, FitResult, FitSpec, Held, Loss, Noise, RoutingRms, ShapeData};
+use super::captures::run::CapturesCalibration;
+use super::fit::{apply_held, fit_observed, rms_per_routing, FitProgress, FitResult, FitSpec, Loss, Noise, RoutingRms, ShapeData};
 use super::predict::predict;
-use super::{CalibrateError, Effect};
-use crate::model::{Rod, RodOverrides};
-use crate::solver::SolverOptions;
+use super::request::{DataKind, FitSettings, LossKind};
+use super::{CalibrateError, CalibrateRequest, Effect};
+use crate::model::Rod;
+use crate::numerics::lm;
 use serde::{Serialize, Serializer};
 use std::fmt;
-use std::path::PathBuf;
+use std::path::Path;
 use std::sync::Arc;
 
-/// Settings every fit shares (calibrate and diagnose).
-#[derive(Debug, Clone, PartialEq)]
-pub struct FitSettings {
-    /// Noise of rows that do not give their own.
-    pub noise: Noise,
-    /// Parameters held at a value instead of fitted (rigidities or effects).
-    pub held: Vec<(Held, f64)>,
-    /// Loss on the noise-whitened residuals.
-    pub loss: Loss,
-    /// Most Levenberg–Marquardt iterations per fit.
-    pub max_iterations: usize,
-    /// Measured centreline points (measurement, x_mm, y_mm), fitted as
-    /// distances to the simulated centreline.
-    pub centrelines: Option<PathBuf>,
-    /// Markers off the centreline (measurement, s_mm, offset_mm, x_mm, y_mm).
-    pub markers: Option<PathBuf>,
-    /// Weight of the tip angle in reported mm-equivalent RMS values, mm per degree.
-    pub angle_weight_mm_per_deg: f64,
-}
-
-impl Default for FitSettings {
-    fn default() -> Self {
-        let spec = FitSpec::default();
-        Self {
-            noise: spec.noise,
-            held: Vec::new(),
-            loss: spec.loss,
-            max_iterations: spec.max_iterations,
-            centrelines: None,
-            markers: None,
-            angle_weight_mm_per_deg: spec.angle_weight_mm_per_deg,
-        }
-    }
-}
-
 impl FitSettings {
-    /// The fit's settings (without effects) and the starting actuator with
+    /// A planar fit's settings (without effects) and the starting rod with
     /// the held values set; also the held effects. Reads the shape files.
     pub fn resolve(&self, base: &Rod, data: &Dataset) -> Result<(FitSpec, Rod, Vec<Effect>), CalibrateError> {
+        let loss = self.loss(LossKind::Huber)?;
         let (start, fixed_rigidities, held_effects) = apply_held(base, &self.held)?;
         let mut shapes = ShapeData::default();
         if let Some(p) = &self.centrelines {
@@ -65,36 +35,19 @@ impl FitSettings {
         if let Some(p) = &self.markers {
             shapes.markers = read_markers(p, data, start.length_mm)?;
         }
-        self.noise.validate()?;
+        let noise = self.noise();
+        noise.validate()?;
         let spec = FitSpec {
             effects: Vec::new(),
             angle_weight_mm_per_deg: self.angle_weight_mm_per_deg,
-            noise: self.noise,
-            loss: self.loss,
+            noise,
+            loss,
             fixed_rigidities,
             max_iterations: self.max_iterations,
             shapes: Arc::new(shapes),
         };
         Ok((spec, start, held_effects))
     }
-}
-
-/// Everything a calibration needs.
-#[derive(Debug, Clone)]
-pub struct CalibrateRequest {
-    /// The measurement file (CSV, or Parquet by its extension).
-    pub data_path: PathBuf,
-    /// Starting values and fixed parameters: overrides on the rod file's,
-    /// else the measurement file's, else the thesis's rod (validated here).
-    pub actuator: RodOverrides,
-    /// Solver settings.
-    pub options: SolverOptions,
-    /// Noise, held parameters, loss, shapes.
-    pub fit: FitSettings,
-    /// Effects whose parameters are fitted with the rigidities.
-    pub effects: Vec<Effect>,
-    /// A routing left out of the fit, whose error is reported.
-    pub holdout: Option<String>,
 }
 
 /// What a running calibration reports (only for large data files, from
@@ -113,6 +66,8 @@ pub enum CalibrateProgress {
     },
     /// After every accepted step.
     Iteration(FitProgress),
+    /// After every accepted step of a fit to 3-D markers.
+    MarkerStep(lm::Step),
 }
 
 impl fmt::Display for CalibrateProgress {
@@ -125,6 +80,7 @@ impl fmt::Display for CalibrateProgress {
                 pass_s * passes as f64
             ),
             CalibrateProgress::Iteration(p) => write!(f, "calibrate: iteration {} (of at most 200): RMS {:.4} mm", p.iteration, p.rms_mm),
+            CalibrateProgress::MarkerStep(s) => write!(f, "calibrate: iteration {}: marker RMS {:.3} σ", s.iteration, (s.cost / s.residuals as f64).sqrt()),
         }
     }
 }
@@ -132,10 +88,37 @@ impl fmt::Display for CalibrateProgress {
 /// Measurement files from this many rows on report their cost and progress.
 pub const LARGE_DATA_ROWS: usize = 2000;
 
-/// A finished calibration. Serialises to the `--json` object: the fit's
-/// fields, `holdout` and `held_effects`.
+/// A finished calibration, of either kind of data. Serialises to the
+/// `--json` object, displays as the text report.
 #[derive(Debug, Clone, Serialize)]
-pub struct CalibrateReport {
+#[serde(untagged)]
+pub enum CalibrateReport {
+    /// Planar measurements.
+    Measurements(MeasurementsCalibration),
+    /// Captures with 3-D markers.
+    Captures(CapturesCalibration),
+}
+
+impl CalibrateReport {
+    /// The `--json` object on one line (keys in alphabetical order).
+    pub fn to_json_line(&self) -> String {
+        serde_json::to_value(self).expect("a report serialises").to_string()
+    }
+}
+
+impl fmt::Display for CalibrateReport {
+    fn fmt(&self, out: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            CalibrateReport::Measurements(r) => r.fmt(out),
+            CalibrateReport::Captures(r) => r.fmt(out),
+        }
+    }
+}
+
+/// A finished calibration on planar measurements. Serialises to the
+/// `--json` object: the fit's fields, `holdout` and `held_effects`.
+#[derive(Debug, Clone, Serialize)]
+pub struct MeasurementsCalibration {
     /// The fit.
     #[serde(flatten)]
     pub fit: FitResult,
@@ -163,22 +146,27 @@ fn as_map<S: Serializer>(held: &[(Effect, f64)], serializer: S) -> Result<S::Ok,
     serializer.collect_map(held.iter().map(|(e, v)| (e.parameter_name(), v)))
 }
 
-impl CalibrateReport {
-    /// The `--json` object on one line (keys in alphabetical order).
-    pub fn to_json_line(&self) -> String {
-        serde_json::to_value(self).expect("a report serialises").to_string()
-    }
-}
-
 /// Runs a calibration.
 pub fn run(request: &CalibrateRequest) -> Result<CalibrateReport, CalibrateError> {
     run_observed(request, &mut |_| {})
 }
 
-/// [`run`], reporting the cost and progress of a fit on large data.
+/// [`run`], reporting the cost and progress of a fit on large data, and
+/// every step of a fit to 3-D markers.
 pub fn run_observed(request: &CalibrateRequest, observe: &mut dyn FnMut(CalibrateProgress)) -> Result<CalibrateReport, CalibrateError> {
+    match request.check()? {
+        DataKind::Measurements => calibrate_measurements(request, observe).map(CalibrateReport::Measurements),
+        DataKind::Captures { actuator_file } => calibrate_captures(request, actuator_file, observe).map(CalibrateReport::Captures),
+    }
+}
+
+fn calibrate_captures(request: &CalibrateRequest, actuator_file: &Path, observe: &mut dyn FnMut(CalibrateProgress)) -> Result<CapturesCalibration, CalibrateError> {
+    super::captures::run::calibrate(request, actuator_file, &mut |step| observe(CalibrateProgress::MarkerStep(step)))
+}
+
+fn calibrate_measurements(request: &CalibrateRequest, observe: &mut dyn FnMut(CalibrateProgress)) -> Result<MeasurementsCalibration, CalibrateError> {
     let data = &read_measurements(&request.data_path)?;
-    let actuator = request.actuator.resolve(data.actuator.as_ref())?;
+    let actuator = request.rod.resolve(data.actuator.as_ref())?;
     actuator.validate()?;
     let options = &request.options;
     let (train, held) = split_holdout(data, request.holdout.as_deref())?;
@@ -215,7 +203,7 @@ pub fn run_observed(request: &CalibrateRequest, observe: &mut dyn FnMut(Calibrat
         }
         None => None,
     };
-    Ok(CalibrateReport {
+    Ok(MeasurementsCalibration {
         holdout,
         held_effects: held_effects.iter().map(|e| (*e, e.current(&start).unwrap_or(0.0))).collect(),
         readings: train.iter().map(|g| g.rows.len()).sum(),
@@ -226,7 +214,7 @@ pub fn run_observed(request: &CalibrateRequest, observe: &mut dyn FnMut(Calibrat
     })
 }
 
-impl fmt::Display for CalibrateReport {
+impl fmt::Display for MeasurementsCalibration {
     fn fmt(&self, out: &mut fmt::Formatter<'_>) -> fmt::Result {
         let result = &self.fit;
         writeln!(

@@ -4,9 +4,7 @@
 
 use super::ActuatorArgs;
 use anyhow::bail;
-use cablemap::calibrate::fit::{parse_held, Held, Loss, Noise};
-use cablemap::calibrate::run::run_observed;
-use cablemap::calibrate::{CalibrateError, CalibrateRequest, Effect, FitSettings};
+use cablemap::calibrate::{run_observed, CalibrateError, CalibrateRequest, Effect, FitSettings, HoldoutError, LossKind, Parameter};
 use cablemap::solver::SolverOptions;
 use clap::Args;
 use std::io::Write;
@@ -47,44 +45,15 @@ pub struct FitArgs {
 }
 
 impl FitArgs {
-    /// The loss the flags describe, `default` when --loss is not given.
-    pub fn loss(&self, default: &str) -> anyhow::Result<Loss> {
-        match self.loss.as_deref().unwrap_or(default) {
-            "huber" => {
-                if !(self.huber_k.is_finite() && self.huber_k > 0.0) {
-                    bail!("--huber-k {}: must be a number of σ > 0", self.huber_k);
-                }
-                Ok(Loss::Huber { k: self.huber_k })
-            }
-            "squares" => Ok(Loss::Squared),
-            other => bail!("--loss {other}: use huber or squares"),
-        }
-    }
-
     /// The fit settings the flags describe.
     pub fn settings(&self) -> anyhow::Result<FitSettings> {
-        let mut held: Vec<(Held, f64)> = Vec::new();
-        for item in &self.fix {
-            let Some((name, value)) = item.split_once('=') else {
-                bail!("--fix {item}: expected NAME=VALUE, e.g. GA=1.70866");
-            };
-            let Some(h) = parse_held(name) else {
-                let effects: Vec<&str> = Effect::ALL.iter().map(|e| e.parameter_name()).collect();
-                bail!("--fix {item}: unknown parameter '{name}'; use EA, GA, EI or one of {}", effects.join(", "));
-            };
-            let Ok(v) = value.trim().parse::<f64>() else {
-                bail!("--fix {item}: '{value}' is not a number");
-            };
-            held.push((h, v));
-        }
-        let loss = self.loss("huber")?;
-        if self.max_iterations == 0 {
-            bail!("--max-iterations must be at least 1");
-        }
+        let held = self.fix.iter().map(|item| Parameter::parse_held(item)).collect::<Result<Vec<_>, _>>()?;
         Ok(FitSettings {
-            noise: Noise { mm: self.noise_mm, deg: self.noise_deg },
+            noise_mm: self.noise_mm,
+            noise_deg: self.noise_deg,
             held,
-            loss,
+            loss: self.loss.as_deref().map(LossKind::parse).transpose()?,
+            huber_k: self.huber_k,
             max_iterations: self.max_iterations,
             centrelines: self.centrelines.clone(),
             markers: self.markers.clone(),
@@ -99,7 +68,7 @@ pub fn with_flag(e: CalibrateError, holdout_flag: bool) -> anyhow::Error {
         CalibrateError::Held(inner) => anyhow::Error::new(inner).context("--fix"),
         CalibrateError::ActuatorFile(_) => anyhow::Error::new(e).context("--actuator-file"),
         CalibrateError::Noise(_) => anyhow::Error::new(e).context("--noise-mm / --noise-deg"),
-        CalibrateError::Holdout(_) if holdout_flag => anyhow::Error::new(e).context("--holdout"),
+        CalibrateError::Holdout(HoldoutError::UnknownRouting { .. } | HoldoutError::OnlyRouting { .. }) if holdout_flag => anyhow::Error::new(e).context("--holdout"),
         e => anyhow::Error::new(e),
     }
 }
@@ -154,19 +123,17 @@ pub fn parse_effects(names: &[String]) -> anyhow::Result<Vec<Effect>> {
 
 /// Runs `cablemap calibrate`.
 pub fn run(args: &CalibrateArgs) -> anyhow::Result<()> {
-    if let Some(actuator) = &args.spatial_actuator {
-        return run_captures(args, actuator);
-    }
-    if args.out.is_some() || args.holdout_cable.is_some() {
-        bail!("--out and --holdout-cable calibrate captures against 3-D markers: give the actuator with --actuator FILE.toml");
-    }
     let request = CalibrateRequest {
         data_path: args.data.clone(),
-        actuator: args.actuator.overrides(),
+        actuator_file: args.spatial_actuator.clone(),
+        rod: args.actuator.overrides(),
         options: args.actuator.solver_options(&SolverOptions::default()),
+        spatial_options: spatial_options(&args.actuator),
         fit: args.fit.settings()?,
         effects: parse_effects(&args.effects)?,
         holdout: args.holdout.clone(),
+        holdout_cable: args.holdout_cable,
+        out: args.out.clone(),
     };
     // Progress on stderr (stdout may be --json).
     let report = run_observed(&request, &mut |p| eprintln!("{p}")).map_err(|e| with_flag(e, true))?;
@@ -176,70 +143,6 @@ pub fn run(args: &CalibrateArgs) -> anyhow::Result<()> {
         writeln!(out, "{}", report.to_json_line())?;
     } else {
         write!(out, "{report}")?;
-    }
-    Ok(())
-}
-
-/// The 3-D route of `cablemap calibrate` (`--actuator FILE.toml`): captures
-/// and 3-D markers, the fit by the 3-D solver.
-fn run_captures(args: &CalibrateArgs, actuator: &std::path::Path) -> anyhow::Result<()> {
-    use cablemap::calibrate::captures::{self, Calibrate3Request, Param};
-    check_captures_flags(args.holdout.is_some(), &args.fit, &args.actuator)?;
-    let mut held = Vec::new();
-    for item in &args.fit.fix {
-        let Some((name, value)) = item.split_once('=') else {
-            bail!("--fix {item}: expected NAME=VALUE, e.g. GJ=9624");
-        };
-        let Some(p) = Param::parse(name) else {
-            let effects: Vec<&str> = Effect::ALL.iter().map(|e| e.parameter_name()).collect();
-            bail!("--fix {item}: unknown parameter '{name}'; use EI, EA, GA, GJ, density or one of {}", effects.join(", "));
-        };
-        let Ok(v) = value.trim().parse::<f64>() else {
-            bail!("--fix {item}: '{value}' is not a number");
-        };
-        held.push((p, v));
-    }
-    let mut request = Calibrate3Request::new(args.data.clone(), args.fit.markers.clone(), actuator.to_path_buf());
-    request.held = held;
-    request.effects = parse_effects(&args.effects)?;
-    request.noise_mm = args.fit.noise_mm;
-    request.loss = args.fit.loss("squares")?;
-    request.max_iterations = args.fit.max_iterations;
-    request.holdout_cable = args.holdout_cable;
-    request.out = args.out.clone();
-    request.options = spatial_options(&args.actuator);
-    let report = captures::calibrate(&request, &mut |step| {
-        eprintln!("calibrate: iteration {}: marker RMS {:.3} σ", step.iteration, (step.cost / step.residuals as f64).sqrt())
-    })
-    .map_err(|e| with_flag(e, false))?;
-    let stdout = std::io::stdout();
-    let mut out = stdout.lock();
-    if args.json {
-        writeln!(out, "{}", report.to_json_line())?;
-    } else {
-        write!(out, "{report}")?;
-    }
-    Ok(())
-}
-
-/// The flags of planar data that the captures route (`--actuator`) refuses,
-/// and the fit settings it checks, shared by `calibrate` and `diagnose`:
-/// `planar_holdout` is whether `--holdout ROUTING` was given.
-pub fn check_captures_flags(planar_holdout: bool, fit: &FitArgs, actuator: &ActuatorArgs) -> anyhow::Result<()> {
-    if planar_holdout {
-        bail!("--holdout takes a routing of planar data; with --actuator, hold out a cable's captures by --holdout-cable K");
-    }
-    if fit.centrelines.is_some() {
-        bail!("--centrelines: planar centreline points; with --actuator, give 3-D markers by --markers");
-    }
-    if actuator.sets_the_rod() {
-        bail!("with --actuator the rod and its effects come from FILE.toml's [rod] table; edit it instead of giving rod flags");
-    }
-    if !(fit.noise_mm.is_finite() && fit.noise_mm > 0.0) {
-        bail!("--noise-mm {}: the markers' noise must be a standard deviation > 0 mm", fit.noise_mm);
-    }
-    if fit.max_iterations == 0 {
-        bail!("--max-iterations must be at least 1");
     }
     Ok(())
 }

@@ -59,16 +59,15 @@ pub struct DiagnoseArgs {
 
 /// Runs `cablemap diagnose`.
 pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
-    if let Some(actuator) = &args.spatial_actuator {
-        return run_captures(args, actuator);
-    }
-    anyhow::ensure!(args.holdout_cable.is_none(), "--holdout-cable holds out a cable's captures: give the actuator with --actuator FILE.toml");
     let request = DiagnoseRequest {
         data_path: args.data.clone(),
-        actuator: args.actuator.overrides(),
+        actuator_file: args.spatial_actuator.clone(),
+        rod: args.actuator.overrides(),
         options: args.actuator.solver_options(&SolverOptions::default()),
+        spatial_options: super::calibrate::spatial_options(&args.actuator),
         fit: args.fit.settings()?,
         holdout: args.holdout.clone(),
+        holdout_cable: args.holdout_cable,
         alpha: args.alpha,
         threshold: args.threshold,
         margin: args.margin,
@@ -76,40 +75,6 @@ pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
         report_dir: (!args.no_report).then(|| args.out.clone().unwrap_or_else(|| DiagnoseRequest::default_report_dir(&args.data))),
     };
     let report = diagnose::run(&request).map_err(|e| match e {
-        CalibrateError::ReportDir(_) => anyhow::Error::new(e).context("--out"),
-        e => with_flag(e, false),
-    })?;
-    let stdout = std::io::stdout();
-    let mut out = stdout.lock();
-    if args.json {
-        writeln!(out, "{}", report.to_json_line())?;
-    } else {
-        write!(out, "{report}")?;
-    }
-    Ok(())
-}
-
-/// The 3-D route of `cablemap diagnose` (`--actuator FILE.toml`).
-fn run_captures(args: &DiagnoseArgs, actuator: &std::path::Path) -> anyhow::Result<()> {
-    use cablemap::calibrate::captures::{diagnose_request, Diagnose3Request};
-    super::calibrate::check_captures_flags(args.holdout.is_some(), &args.fit, &args.actuator)?;
-    anyhow::ensure!(args.fit.fix.is_empty(), "--fix with --actuator: set the value in FILE.toml instead (a diagnosis fits the body the data determine)");
-    let request = Diagnose3Request {
-        captures: args.data.clone(),
-        markers: args.fit.markers.clone(),
-        actuator: actuator.to_path_buf(),
-        noise_mm: args.fit.noise_mm,
-        loss: args.fit.loss("squares")?,
-        max_iterations: args.fit.max_iterations,
-        holdout_cable: args.holdout_cable,
-        alpha: args.alpha,
-        threshold: args.threshold,
-        margin: args.margin,
-        max_effects: args.max_effects,
-        options: super::calibrate::spatial_options(&args.actuator),
-        report_dir: (!args.no_report).then(|| args.out.clone().unwrap_or_else(|| DiagnoseRequest::default_report_dir(&args.data))),
-    };
-    let report = diagnose_request(&request).map_err(|e| match e {
         CalibrateError::ReportDir(_) => anyhow::Error::new(e).context("--out"),
         e => with_flag(e, false),
     })?;

@@ -32,11 +32,11 @@ pub struct PredictArgs {
 
 /// Runs `cablemap predict`.
 pub fn run(args: &PredictArgs) -> anyhow::Result<()> {
-    anyhow::ensure!(!args.solver.sets_the_rod(), "predict takes the rod from --actuator FILE.toml's [rod] table; edit it instead of giving rod flags");
     let request = PredictRequest {
         captures: args.captures.clone(),
         markers: args.markers.clone(),
         actuator: args.actuator.clone(),
+        rod: args.solver.overrides(),
         options: spatial_options(&args.solver),
     };
     let report = captures::predict(&request)?;

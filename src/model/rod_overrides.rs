@@ -37,6 +37,15 @@ pub struct RodOverrides {
 }
 
 impl RodOverrides {
+    /// Whether nothing is set: no file, no value, gravity on, no effect.
+    pub fn is_empty(&self) -> bool {
+        self.file.is_none()
+            && [self.length_mm, self.radius_mm, self.ea_n, self.ga_n, self.ei_n_mm2, self.density_g_cm3, self.cable_anchor_mm].iter().all(Option::is_none)
+            && !self.no_gravity
+            && self.effects.is_empty()
+            && self.radius_profile_mm.is_none()
+    }
+
     /// `base` with these values set (the file is not read: `base` is the base).
     pub fn apply(&self, base: &Rod) -> Rod {
         let mut rod = base.clone();

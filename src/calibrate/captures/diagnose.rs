@@ -23,7 +23,8 @@
 
 use super::errors::ErrorReport;
 use super::files::CaptureSet;
-use super::fit::{fit_captures, Fit3Result, Fit3Spec, Param, Status};
+use super::fit::{fit_captures, Fit3Result, Fit3Spec, Status};
+use crate::calibrate::Parameter;
 use super::simulate::solve_captures;
 use crate::calibrate::diagnose::criterion::{self, decide, rank, Candidate, Decision, NamedEffect};
 use crate::calibrate::diagnose::Verdict;
@@ -224,7 +225,7 @@ pub struct Diagnosis3 {
 fn candidate(effect: Effect, reference_bic: f64, result: &Result<Fit3Result, CalibrateError>) -> Candidate {
     match result {
         Ok(f) => {
-            let p = f.parameter(Param::Effect(effect)).expect("fitted effect");
+            let p = f.parameter(Parameter::Effect(effect)).expect("fitted effect");
             let mut flags = Vec::new();
             match p.status {
                 Status::Fitted => {}
@@ -263,7 +264,7 @@ fn candidate(effect: Effect, reference_bic: f64, result: &Result<Fit3Result, Cal
 struct Round<'a> {
     set: &'a CaptureSet,
     spec: &'a Diagnose3Spec,
-    body: Vec<Param>,
+    body: Vec<Parameter>,
     candidates: Vec<Effect>,
 }
 
@@ -275,11 +276,11 @@ impl Round<'_> {
             .par_iter()
             .map(|&e| {
                 let mut params = self.body.clone();
-                params.extend(effects.iter().map(|&x| Param::Effect(x)));
-                params.push(Param::Effect(e));
+                params.extend(effects.iter().map(|&x| Parameter::Effect(x)));
+                params.push(Parameter::Effect(e));
                 // From the reference's optimum, the new effect at its start.
                 let mut start = reference.actuator.clone();
-                Param::Effect(e).set(&mut start, e.start());
+                Parameter::Effect(e).set(&mut start, e.start());
                 let spec = Fit3Spec { params, ..self.spec.fit.clone() };
                 (e, fit_captures(&start, self.set, &spec, &mut |_| {}))
             })
@@ -325,21 +326,21 @@ pub fn diagnose_captures(base: &Actuator, set: &CaptureSet, spec: &Diagnose3Spec
             (train, Some(test))
         }
     };
-    let body: Vec<Param> = spec.fit.params.iter().copied().filter(|p| !matches!(p, Param::Effect(_))).collect();
+    let body: Vec<Parameter> = spec.fit.params.iter().copied().filter(|p| !matches!(p, Parameter::Effect(_))).collect();
     let baseline = fit_captures(base, &train, &Fit3Spec { params: body.clone(), ..spec.fit.clone() }, &mut |_| {})?;
     // The body parameters the baseline determined; undetermined ones stay held.
-    let body: Vec<Param> = baseline.parameters.iter().filter(|p| p.status == Status::Fitted).map(|p| p.param).collect();
+    let body: Vec<Parameter> = baseline.parameters.iter().filter(|p| p.status == Status::Fitted).map(|p| p.param).collect();
     let mut not_candidates = Vec::new();
     let candidates: Vec<Effect> = Effect::ALL
         .into_iter()
         .filter(|&e| {
-            let keep = !(e == Effect::Gravity && body.contains(&Param::Density));
+            let keep = !(e == Effect::Gravity && body.contains(&Parameter::Density));
             if !keep {
                 not_candidates.push(format!("{}: the density is fitted, and both scale the same weight", e.name()));
             }
             keep
         })
-        .filter(|e| spec.fit.params.iter().all(|p| *p != Param::Effect(*e)))
+        .filter(|e| spec.fit.params.iter().all(|p| *p != Parameter::Effect(*e)))
         .collect();
     let round = Round { set: &train, spec, body, candidates };
     let (first, fits) = round.run(&[], &baseline);
@@ -370,7 +371,7 @@ pub fn diagnose_captures(base: &Actuator, set: &CaptureSet, spec: &Diagnose3Spec
                 if let Decision::Named(e2) = decide(&cands2, spec.rule()) {
                     let f2 = fit_of(&fits2, e2);
                     let c2 = cands2.iter().find(|c| c.effect == e2).expect("candidate");
-                    if let Some(p1) = f2.parameter(Param::Effect(e)) {
+                    if let Some(p1) = f2.parameter(Parameter::Effect(e)) {
                         effects[0].parameter = p1.value;
                         effects[0].parameter_se = p1.se;
                     }

@@ -16,7 +16,7 @@ use super::errors::ErrorReport;
 use super::files::CaptureSet;
 use super::simulate::{solve_captures, CaptureSolution};
 use crate::calibrate::fit::Loss;
-use crate::calibrate::{stats, CalibrateError, Effect};
+use crate::calibrate::{stats, CalibrateError, Parameter};
 use crate::model::effects::Domain;
 use crate::solver::spatial::SpatialOptions;
 use crate::model::Actuator;
@@ -27,107 +27,11 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Mutex;
 use serde::Serialize;
 
-/// A parameter of the 3-D fit.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Param {
-    /// Bending rigidity EI (of the section of radius `radius_mm`), N·mm².
-    Ei,
-    /// Axial rigidity EA, N.
-    Ea,
-    /// Shear rigidity GA, N.
-    Ga,
-    /// Torsional rigidity GJ, N·mm² (set explicitly once fitted).
-    Gj,
-    /// Material density, g/cm³: the weight.
-    Density,
-    /// A registry effect's parameter.
-    Effect(Effect),
-}
-
-impl Param {
-    /// The rigidities and the weight, in report order.
-    pub const BODY: [Param; 5] = [Param::Ei, Param::Ea, Param::Ga, Param::Gj, Param::Density];
-
-    /// The name with its unit, as in the actuator file.
-    pub fn name(self) -> &'static str {
-        match self {
-            Param::Ei => "ei_n_mm2",
-            Param::Ea => "ea_n",
-            Param::Ga => "ga_n",
-            Param::Gj => "gj_n_mm2",
-            Param::Density => "density_g_cm3",
-            Param::Effect(e) => e.parameter_name(),
-        }
-    }
-
-    /// Parses `EI`, `ei_n_mm2`, `GJ`, `density`, an effect's name or its
-    /// parameter's name (any case).
-    pub fn parse(name: &str) -> Option<Param> {
-        let lower = name.trim().to_ascii_lowercase();
-        let body = match lower.as_str() {
-            "ei" | "ei_n_mm2" => Some(Param::Ei),
-            "ea" | "ea_n" => Some(Param::Ea),
-            "ga" | "ga_n" => Some(Param::Ga),
-            "gj" | "gj_n_mm2" => Some(Param::Gj),
-            "density" | "density_g_cm3" => Some(Param::Density),
-            _ => None,
-        };
-        body.or_else(|| Effect::ALL.into_iter().find(|e| e.name() == lower || e.parameter_name() == lower).map(Param::Effect))
-    }
-
-    /// The value on `a`.
-    pub fn get(self, a: &Actuator) -> f64 {
-        match self {
-            Param::Ei => a.rod.ei_n_mm2,
-            Param::Ea => a.rod.ea_n,
-            Param::Ga => a.rod.ga_n,
-            Param::Gj => a.torsional_rigidity_n_mm2(),
-            Param::Density => a.rod.density_g_cm3,
-            Param::Effect(e) => e.current(&a.rod).unwrap_or_else(|| e.start()),
-        }
-    }
-
-    /// Sets the value on `a` (an effect is switched on).
-    pub fn set(self, a: &mut Actuator, v: f64) {
-        match self {
-            Param::Ei => a.rod.ei_n_mm2 = v,
-            Param::Ea => a.rod.ea_n = v,
-            Param::Ga => a.rod.ga_n = v,
-            Param::Gj => a.gj_n_mm2 = Some(v),
-            Param::Density => a.rod.density_g_cm3 = v,
-            Param::Effect(e) => e.apply(&mut a.rod, v),
-        }
-    }
-
-    fn to_internal(self, v: f64) -> f64 {
-        match self {
-            Param::Effect(e) => e.to_internal(v),
-            _ => v.ln(),
-        }
-    }
-
-    fn from_internal(self, x: f64) -> f64 {
-        match self {
-            Param::Effect(e) => e.from_internal(x),
-            _ => x.exp(),
-        }
-    }
-
-    /// d value / d internal coordinate.
-    fn derivative(self, x: f64) -> f64 {
-        match self {
-            Param::Effect(e) => e.derivative(x),
-            _ => x.exp(),
-        }
-    }
-}
-
 /// What a 3-D fit fits and how.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Fit3Spec {
     /// Parameters to fit (those the data do not determine are held).
-    pub params: Vec<Param>,
+    pub params: Vec<Parameter>,
     /// The system's noise σ₀ per coordinate, mm, added in quadrature to a
     /// marker's own `sd_mm`.
     pub noise_mm: f64,
@@ -141,7 +45,7 @@ pub struct Fit3Spec {
 
 impl Default for Fit3Spec {
     fn default() -> Self {
-        Self { params: Param::BODY.to_vec(), noise_mm: 1.0, loss: Loss::Squared, max_iterations: 40, options: SpatialOptions::default() }
+        Self { params: Parameter::BODY.to_vec(), noise_mm: 1.0, loss: Loss::Squared, max_iterations: 40, options: SpatialOptions::default() }
     }
 }
 
@@ -165,7 +69,7 @@ pub struct Fitted3 {
     pub name: String,
     /// The parameter.
     #[serde(skip)]
-    pub param: Param,
+    pub param: Parameter,
     /// Value (fitted, or the start when undetermined).
     pub value: f64,
     /// The starting value.
@@ -218,7 +122,7 @@ pub struct Fit3Result {
 
 impl Fit3Result {
     /// A fitted (or held) parameter by kind.
-    pub fn parameter(&self, p: Param) -> Option<&Fitted3> {
+    pub fn parameter(&self, p: Parameter) -> Option<&Fitted3> {
         self.parameters.iter().find(|f| f.param == p)
     }
 }
@@ -228,7 +132,7 @@ struct Problem<'a> {
     base: &'a Actuator,
     set: &'a CaptureSet,
     spec: &'a Fit3Spec,
-    params: Vec<Param>,
+    params: Vec<Parameter>,
     sigma: Vec<f64>,
     /// The relative cost reduction of the last accepted step (f64 bits):
     /// below [`ENOUGH_REDUCTION`] the fit stops.
@@ -350,9 +254,9 @@ pub fn fit_captures(base: &Actuator, set: &CaptureSet, spec: &Fit3Spec, observe:
         return Err(crate::calibrate::NoiseError::Markers { value: spec.noise_mm }.into());
     }
     base.channels().map_err(|e| CalibrateError::Actuator(e.into()))?;
-    let mut params: Vec<Param> = Vec::new();
+    let mut params: Vec<Parameter> = Vec::new();
     for &p in &spec.params {
-        if p == Param::Density && !base.rod.gravity.enabled {
+        if p == Parameter::Density && !base.rod.gravity.enabled {
             return Err(crate::calibrate::InvalidRequest::DensityWithoutGravity.into());
         }
         if !params.contains(&p) {
@@ -374,7 +278,7 @@ pub fn fit_captures(base: &Actuator, set: &CaptureSet, spec: &Fit3Spec, observe:
             // An effect that the data do not call for runs toward its
             // thesis value (0, or an infinitely stiff clamp): bounded near
             // where it no longer matters, so the fit does not spend steps on the way.
-            Param::Effect(e) => match e.fit().domain {
+            Parameter::Effect(e) => match e.fit().domain {
                 Domain::Signed => (-EFFECT_SIGNED_BOUND, EFFECT_SIGNED_BOUND),
                 Domain::Fraction => (-EFFECT_LOGIT_BOUND, EFFECT_LOGIT_BOUND),
                 Domain::Positive => (x - EFFECT_RANGE.ln(), x + EFFECT_RANGE.ln()),
@@ -424,7 +328,7 @@ pub fn fit_captures(base: &Actuator, set: &CaptureSet, spec: &Fit3Spec, observe:
             .iter()
             .enumerate()
             .filter(|&(k, &idx)| {
-                if matches!(params[idx], Param::Effect(_)) {
+                if matches!(params[idx], Parameter::Effect(_)) {
                     // Reported at its bound, not held: see `Status::AtBound`.
                     return false;
                 }
@@ -468,7 +372,7 @@ pub fn fit_captures(base: &Actuator, set: &CaptureSet, spec: &Fit3Spec, observe:
                 se: if fitted { param.derivative(x[k]).abs() * v.max(0.0).sqrt() } else { f64::NAN },
                 status: match (fitted, param) {
                     (false, _) => Status::Undetermined,
-                    (true, Param::Effect(_)) if x[k] <= bounds[k].0 + 1e-9 || x[k] >= bounds[k].1 - 1e-9 => Status::AtBound,
+                    (true, Parameter::Effect(_)) if x[k] <= bounds[k].0 + 1e-9 || x[k] >= bounds[k].1 - 1e-9 => Status::AtBound,
                     _ => Status::Fitted,
                 },
             }

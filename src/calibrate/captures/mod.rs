@@ -24,6 +24,6 @@ pub mod synth;
 pub use diagnose::{diagnose_captures, Diagnose3Spec, Diagnosis3};
 pub use errors::ErrorReport;
 pub use files::{read_capture_set, Actuation, Capture, CaptureSet, MarkerReading};
-pub use fit::{fit_captures, Fit3Result, Fit3Spec, Param};
-pub use run::{calibrate, diagnose_request, predict, Calibrate3Report, Calibrate3Request, Diagnose3Request, PredictReport, PredictRequest};
+pub use fit::{fit_captures, Fit3Result, Fit3Spec};
+pub use run::{calibrate, calibrated_toml, diagnose_request, predict, CapturesCalibration, PredictReport, PredictRequest};
 pub use simulate::{solve_captures, CaptureSolution};

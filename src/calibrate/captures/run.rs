@@ -9,13 +9,15 @@
 
 use super::errors::ErrorReport;
 use super::files::{read_capture_set, CaptureSet};
-use super::fit::{fit_captures, Fit3Result, Fit3Spec, Param, Status};
+use super::fit::{fit_captures, Fit3Result, Fit3Spec, Status};
+use crate::calibrate::Parameter;
 use super::simulate::solve_captures;
 use super::diagnose::{diagnose_captures, Diagnose3Spec, Diagnosis3};
-use crate::calibrate::fit::Loss;
-use crate::calibrate::{CalibrateError, Effect};
+use crate::calibrate::request::{DiagnoseRequest, LossKind};
+use crate::calibrate::Refused;
+use crate::calibrate::{CalibrateError, CalibrateRequest};
 use crate::solver::spatial::SpatialOptions;
-use crate::model::Actuator;
+use crate::model::{Actuator, RodOverrides};
 use serde::Serialize;
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -29,6 +31,8 @@ pub struct PredictRequest {
     pub markers: Option<PathBuf>,
     /// The actuator file.
     pub actuator: PathBuf,
+    /// Rod settings: refused, the rod is the actuator file's.
+    pub rod: RodOverrides,
     /// The 3-D solver's settings.
     pub options: SpatialOptions,
 }
@@ -53,6 +57,9 @@ fn read_set(captures: &Path, markers: Option<&Path>, actuator: &Actuator) -> Res
 
 /// Simulates every capture with the request's actuator and reports the errors.
 pub fn predict(request: &PredictRequest) -> Result<PredictReport, CalibrateError> {
+    if !request.rod.is_empty() {
+        return Err(Refused::RodOnPredict.into());
+    }
     let actuator = read_actuator(&request.actuator)?;
     let set = read_set(&request.captures, request.markers.as_deref(), &actuator)?;
     let solutions = solve_captures(&actuator, &request.options, &set)?;
@@ -73,58 +80,9 @@ impl fmt::Display for PredictReport {
     }
 }
 
-/// What a 3-D calibration needs.
-#[derive(Debug, Clone)]
-pub struct Calibrate3Request {
-    /// The captures file.
-    pub captures: PathBuf,
-    /// The markers file.
-    pub markers: Option<PathBuf>,
-    /// The actuator file: the starting values and everything not fitted.
-    pub actuator: PathBuf,
-    /// Parameters held at a value (`--fix`), not fitted.
-    pub held: Vec<(Param, f64)>,
-    /// Effects fitted besides the rigidities and the weight.
-    pub effects: Vec<Effect>,
-    /// The system's noise per coordinate, mm (added to a marker's `sd_mm`).
-    pub noise_mm: f64,
-    /// Loss on the whitened residuals.
-    pub loss: Loss,
-    /// Most Levenberg–Marquardt iterations.
-    pub max_iterations: usize,
-    /// Fit on the captures where this cable (1-based) does not pull; the
-    /// others are predicted with the fitted actuator.
-    pub holdout_cable: Option<usize>,
-    /// Where to write `calibrated.toml` and `fit.json` (none: not written).
-    pub out: Option<PathBuf>,
-    /// The 3-D solver's settings.
-    pub options: SpatialOptions,
-}
-
-impl Calibrate3Request {
-    /// A request with the defaults: fit EI, EA, GA, GJ and (with gravity)
-    /// the density, noise 1 mm, least squares, at most 40 iterations.
-    pub fn new(captures: PathBuf, markers: Option<PathBuf>, actuator: PathBuf) -> Self {
-        let spec = Fit3Spec::default();
-        Self {
-            captures,
-            markers,
-            actuator,
-            held: Vec::new(),
-            effects: Vec::new(),
-            noise_mm: spec.noise_mm,
-            loss: spec.loss,
-            max_iterations: spec.max_iterations,
-            holdout_cable: None,
-            out: None,
-            options: SpatialOptions::default(),
-        }
-    }
-}
-
-/// A finished 3-D calibration; serialises to `fit.json`.
+/// A finished calibration on captures with 3-D markers; serialises to `fit.json`.
 #[derive(Debug, Clone, Serialize)]
-pub struct Calibrate3Report {
+pub struct CapturesCalibration {
     /// The fit on the fitted captures.
     #[serde(flatten)]
     pub fit: Fit3Result,
@@ -143,7 +101,7 @@ pub struct Calibrate3Report {
     pub written: Vec<PathBuf>,
 }
 
-impl Calibrate3Report {
+impl CapturesCalibration {
     /// `fit.json`'s text (pretty-printed).
     pub fn to_json_pretty(&self) -> String {
         serde_json::to_string_pretty(self).expect("a report serialises")
@@ -157,7 +115,7 @@ impl Calibrate3Report {
 
 /// The actuator file of a fit: the start with the fitted values, and a
 /// header saying where they came from.
-pub fn calibrated_toml(report: &Calibrate3Report, source: &Path) -> Result<String, CalibrateError> {
+pub fn calibrated_toml(report: &CapturesCalibration, source: &Path) -> Result<String, CalibrateError> {
     let body = toml::to_string(&report.fit.actuator).map_err(crate::calibrate::InvalidRequest::CalibratedToml)?;
     let mut head = format!("# cablemap calibrate: {} fitted to {} captures, starting from {}\n", fitted_names(&report.fit), report.captures_fitted, source.display());
     for p in &report.fit.parameters {
@@ -180,26 +138,28 @@ fn fitted_names(fit: &Fit3Result) -> String {
     }
 }
 
-/// Runs a 3-D calibration, reporting each accepted step to `observe`.
-pub fn calibrate(request: &Calibrate3Request, observe: &mut dyn FnMut(crate::numerics::lm::Step)) -> Result<Calibrate3Report, CalibrateError> {
+/// Runs a calibration of the actuator in `actuator_file` on the request's
+/// captures, reporting each accepted step to `observe`.
+pub fn calibrate(request: &CalibrateRequest, actuator_file: &Path, observe: &mut dyn FnMut(crate::numerics::lm::Step)) -> Result<CapturesCalibration, CalibrateError> {
     let started = std::time::Instant::now();
-    let mut base = read_actuator(&request.actuator)?;
-    let set = read_set(&request.captures, request.markers.as_deref(), &base)?;
-    for &(p, v) in &request.held {
-        if !(v.is_finite() && (matches!(p, Param::Effect(_)) || v > 0.0)) {
+    let loss = request.fit.loss(LossKind::Squares)?;
+    let mut base = read_actuator(actuator_file)?;
+    let set = read_set(&request.data_path, request.fit.markers.as_deref(), &base)?;
+    for &(p, v) in &request.fit.held {
+        if !(v.is_finite() && (matches!(p, Parameter::Effect(_)) || v > 0.0)) {
             return Err(CalibrateError::Held(crate::calibrate::HeldError::NotPositive { name: p.name(), value: v }));
         }
         p.set(&mut base, v);
     }
-    let is_held = |p: Param| request.held.iter().any(|(h, _)| *h == p);
-    if let Some(&e) = request.effects.iter().find(|&&e| is_held(Param::Effect(e))) {
+    let is_held = |p: Parameter| request.fit.held.iter().any(|(h, _)| *h == p);
+    if let Some(&e) = request.effects.iter().find(|&&e| is_held(Parameter::Effect(e))) {
         return Err(CalibrateError::FittedAndHeld { effect: e });
     }
-    let mut params: Vec<Param> = Param::BODY.iter().copied().filter(|&p| !is_held(p)).collect();
+    let mut params: Vec<Parameter> = Parameter::BODY.iter().copied().filter(|&p| !is_held(p)).collect();
     if !base.rod.gravity.enabled {
-        params.retain(|&p| p != Param::Density);
+        params.retain(|&p| p != Parameter::Density);
     }
-    params.extend(request.effects.iter().map(|&e| Param::Effect(e)));
+    params.extend(request.effects.iter().map(|&e| Parameter::Effect(e)));
     let (train, test) = match request.holdout_cable {
         None => (set, None),
         Some(k) => {
@@ -214,14 +174,14 @@ pub fn calibrate(request: &Calibrate3Request, observe: &mut dyn FnMut(crate::num
             (train, Some(test))
         }
     };
-    let spec = Fit3Spec { params, noise_mm: request.noise_mm, loss: request.loss, max_iterations: request.max_iterations, options: request.options.clone() };
+    let spec = Fit3Spec { params, noise_mm: request.fit.noise_mm, loss, max_iterations: request.fit.max_iterations, options: request.spatial_options.clone() };
     let fit = fit_captures(&base, &train, &spec, observe)?;
     let holdout = match &test {
-        Some(t) => Some(ErrorReport::of(t, &solve_captures(&fit.actuator, &request.options, t)?)),
+        Some(t) => Some(ErrorReport::of(t, &solve_captures(&fit.actuator, &request.spatial_options, t)?)),
         None => None,
     };
-    let mut report = Calibrate3Report {
-        held: request.held.iter().map(|(p, v)| (p.name().to_string(), *v)).collect(),
+    let mut report = CapturesCalibration {
+        held: request.fit.held.iter().map(|(p, v)| (p.name().to_string(), *v)).collect(),
         holdout_cable: request.holdout_cable,
         holdout,
         captures_fitted: train.captures.len(),
@@ -233,7 +193,7 @@ pub fn calibrate(request: &Calibrate3Request, observe: &mut dyn FnMut(crate::num
         let io = |context: String| move |source| CalibrateError::Io { context, source };
         std::fs::create_dir_all(dir).map_err(io(format!("creating {}", dir.display())))?;
         let toml_path = dir.join("calibrated.toml");
-        std::fs::write(&toml_path, calibrated_toml(&report, &request.actuator)?).map_err(io(format!("writing {}", toml_path.display())))?;
+        std::fs::write(&toml_path, calibrated_toml(&report, actuator_file)?).map_err(io(format!("writing {}", toml_path.display())))?;
         let json_path = dir.join("fit.json");
         std::fs::write(&json_path, report.to_json_pretty() + "\n").map_err(io(format!("writing {}", json_path.display())))?;
         report.written = vec![toml_path, json_path];
@@ -241,7 +201,7 @@ pub fn calibrate(request: &Calibrate3Request, observe: &mut dyn FnMut(crate::num
     Ok(report)
 }
 
-impl fmt::Display for Calibrate3Report {
+impl fmt::Display for CapturesCalibration {
     fn fmt(&self, out: &mut fmt::Formatter<'_>) -> fmt::Result {
         let fit = &self.fit;
         writeln!(
@@ -284,76 +244,25 @@ impl fmt::Display for Calibrate3Report {
     }
 }
 
-/// What `diagnose --actuator` needs.
-#[derive(Debug, Clone)]
-pub struct Diagnose3Request {
-    /// The captures file.
-    pub captures: std::path::PathBuf,
-    /// The markers file.
-    pub markers: Option<std::path::PathBuf>,
-    /// The actuator file: the start and everything not fitted.
-    pub actuator: std::path::PathBuf,
-    /// The system's noise per coordinate, mm.
-    pub noise_mm: f64,
-    /// Loss on the whitened residuals.
-    pub loss: crate::calibrate::fit::Loss,
-    /// Most Levenberg–Marquardt iterations per fit.
-    pub max_iterations: usize,
-    /// Captures in which this cable pulls are held out.
-    pub holdout_cable: Option<usize>,
-    /// The noise test's level.
-    pub alpha: f64,
-    /// BIC decrease an effect needs.
-    pub threshold: f64,
-    /// BIC lead over the runner-up.
-    pub margin: f64,
-    /// Most effects added.
-    pub max_effects: usize,
-    /// The 3-D solver's settings.
-    pub options: crate::solver::spatial::SpatialOptions,
-    /// Report directory (`report.md` and a picture per capture); none for no report.
-    pub report_dir: Option<std::path::PathBuf>,
-}
-
-impl Diagnose3Request {
-    /// A request with the defaults of `diagnose --actuator`: noise 0.4 mm,
-    /// least squares, at most 200 iterations per fit, α = 1e-3, BIC
-    /// threshold and margin 10, at most two effects, no held-out cable, no report.
-    pub fn new(captures: std::path::PathBuf, markers: Option<std::path::PathBuf>, actuator: std::path::PathBuf) -> Self {
-        let spec = Diagnose3Spec::default();
-        Self {
-            captures,
-            markers,
-            actuator,
-            noise_mm: 0.4,
-            loss: crate::calibrate::fit::Loss::Squared,
-            max_iterations: 200,
-            holdout_cable: None,
-            alpha: spec.alpha,
-            threshold: spec.threshold,
-            margin: spec.margin,
-            max_effects: spec.max_effects,
-            options: crate::solver::spatial::SpatialOptions::default(),
-            report_dir: None,
-        }
-    }
-}
-
 /// Reads the request's files, runs [`diagnose_captures`] and writes the
 /// report directory when asked for (refused first when inside a sweep run,
 /// before anything is read); the report's files are in `written`.
-pub fn diagnose_request(request: &Diagnose3Request) -> Result<Diagnosis3, CalibrateError> {
+pub fn diagnose_request(request: &DiagnoseRequest, actuator_file: &Path) -> Result<Diagnosis3, CalibrateError> {
+    if !request.fit.held.is_empty() {
+        return Err(Refused::HeldInCapturesDiagnosis.into());
+    }
+    let loss = request.fit.loss(LossKind::Squares)?;
     if let Some(dir) = &request.report_dir {
         crate::io::check_outside_run_dir(dir, "the report directory")?;
     }
-    let base = Actuator::read(&request.actuator).map_err(|e| CalibrateError::Actuator(e.into()))?;
-    let set = read_capture_set(&request.captures, request.markers.as_deref(), base.cables.len(), base.rod.length_mm)?;
-    let mut params: Vec<Param> = Param::BODY.to_vec();
+    let base = Actuator::read(actuator_file).map_err(|e| CalibrateError::Actuator(e.into()))?;
+    let set = read_capture_set(&request.data_path, request.fit.markers.as_deref(), base.cables.len(), base.rod.length_mm)?;
+    let mut params: Vec<Parameter> = Parameter::BODY.to_vec();
     if !base.rod.gravity.enabled {
-        params.retain(|&p| p != Param::Density);
+        params.retain(|&p| p != Parameter::Density);
     }
     let spec = Diagnose3Spec {
-        fit: Fit3Spec { params, noise_mm: request.noise_mm, loss: request.loss, max_iterations: request.max_iterations, options: request.options.clone() },
+        fit: Fit3Spec { params, noise_mm: request.fit.noise_mm, loss, max_iterations: request.fit.max_iterations, options: request.spatial_options.clone() },
         holdout_cable: request.holdout_cable,
         threshold: request.threshold,
         margin: request.margin,
@@ -362,8 +271,8 @@ pub fn diagnose_request(request: &Diagnose3Request) -> Result<Diagnosis3, Calibr
     };
     let mut d = diagnose_captures(&base, &set, &spec)?;
     if let Some(dir) = &request.report_dir {
-        let sources = super::report::ReportSources { captures: &request.captures, markers: request.markers.as_deref(), actuator: &request.actuator };
-        d.written = super::report::write_report(dir, sources, &set, &d, &request.options)?;
+        let sources = super::report::ReportSources { captures: &request.data_path, markers: request.fit.markers.as_deref(), actuator: actuator_file };
+        d.written = super::report::write_report(dir, sources, &set, &d, &request.spatial_options)?;
     }
     Ok(d)
 }

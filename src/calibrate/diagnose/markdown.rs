@@ -17,6 +17,9 @@ use std::path::{Path, PathBuf};
 /// Writes `report.md` and its plots into `dir` (created if needed);
 /// returns the report's path. [`crate::calibrate::diagnose::run()`] has refused a `dir` inside a
 /// sweep run before reading the measurements.
+/// The pictures beside `report.md`.
+pub const PICTURES: [&str; 3] = ["residuals.png", "loops.png", "shapes.png"];
+
 pub(super) fn write_report(
     dir: &Path,
     data_path: &Path,

@@ -18,6 +18,7 @@ pub mod verdict;
 
 pub use analysis::{diagnose, model_name, DiagnoseSpec, Diagnosis};
 pub use criterion::{Candidate, NamedEffect};
-pub use report::DiagnoseReport;
-pub use run::{run, DiagnoseRequest};
+pub use report::{DiagnoseReport, MeasurementsDiagnosis};
+pub use crate::calibrate::request::DiagnoseRequest;
+pub use run::run;
 pub use verdict::Verdict;

@@ -6,15 +6,51 @@
 use super::analysis::{model_name, Diagnosis, ResidualDiagnostics, Signature};
 use super::criterion::{Candidate, NamedEffect};
 use super::Verdict;
+use crate::calibrate::captures::Diagnosis3;
 use crate::calibrate::fit::FitResult;
 use crate::calibrate::Effect;
 use serde::Serialize;
 use std::fmt;
 use std::path::PathBuf;
 
-/// A finished diagnosis and the report written for it.
+/// A finished diagnosis of either kind of data: serialises to the
+/// `--json` object, displays as the summary.
+#[derive(Debug, Clone, Serialize)]
+#[serde(untagged)]
+pub enum DiagnoseReport {
+    /// Planar measurements.
+    Measurements(MeasurementsDiagnosis),
+    /// Captures with 3-D markers.
+    Captures(Diagnosis3),
+}
+
+impl DiagnoseReport {
+    /// The `--json` object on one line (keys in alphabetical order).
+    pub fn to_json_line(&self) -> String {
+        serde_json::to_value(self).expect("a report serialises").to_string()
+    }
+
+    /// The pictures written beside the report (none without one).
+    pub fn pictures(&self) -> Vec<PathBuf> {
+        match self {
+            DiagnoseReport::Measurements(m) => m.report.as_deref().and_then(std::path::Path::parent).map_or_else(Vec::new, |dir| super::markdown::PICTURES.iter().map(|p| dir.join(p)).collect()),
+            DiagnoseReport::Captures(d) => d.written.iter().skip(1).cloned().collect(),
+        }
+    }
+}
+
+impl fmt::Display for DiagnoseReport {
+    fn fmt(&self, out: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            DiagnoseReport::Measurements(m) => m.fmt(out),
+            DiagnoseReport::Captures(d) => d.fmt(out),
+        }
+    }
+}
+
+/// A finished diagnosis of planar measurements and the report written for it.
 #[derive(Debug, Clone)]
-pub struct DiagnoseReport {
+pub struct MeasurementsDiagnosis {
     /// The diagnosis.
     pub diagnosis: Diagnosis,
     /// The Markdown report's path, when one was written.
@@ -49,7 +85,7 @@ struct Json<'a> {
     report: Option<String>,
 }
 
-impl Serialize for DiagnoseReport {
+impl Serialize for MeasurementsDiagnosis {
     fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
         let d = &self.diagnosis;
         let first = d.named.first();
@@ -82,14 +118,7 @@ impl Serialize for DiagnoseReport {
     }
 }
 
-impl DiagnoseReport {
-    /// The `--json` object on one line (keys in alphabetical order).
-    pub fn to_json_line(&self) -> String {
-        serde_json::to_value(self).expect("a report serialises").to_string()
-    }
-}
-
-impl fmt::Display for DiagnoseReport {
+impl fmt::Display for MeasurementsDiagnosis {
     fn fmt(&self, out: &mut fmt::Formatter<'_>) -> fmt::Result {
         let d = &self.diagnosis;
         writeln!(out, "verdict: {}", d.verdict)?;
