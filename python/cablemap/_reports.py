@@ -465,10 +465,11 @@ def diagnose(
 ) -> DiagnoseReport:
     """Finds, names and adds the effect the model misses, as ``cablemap diagnose DATA --json``.
 
-    Planar data: the report (report.md and its plots, shown in notebooks) goes
-    to ``out``, by default beside the data (``m.csv`` → ``m-diagnosis/``);
+    The report (report.md and its pictures, shown in notebooks) goes to
+    ``out``, by default beside the data (``m.csv`` → ``m-diagnosis/``);
     ``report=False`` writes none (``--no-report``). With ``actuator`` (an
-    actuator file's path): captures and 3-D markers, by the 3-D solver.
+    actuator file's path): captures and 3-D markers, by the 3-D solver (a
+    picture per capture).
     ``alpha``, ``threshold``, ``margin``, ``max_effects`` and the fit's
     settings (see :func:`calibrate`) as the flags.
     """

@@ -5,6 +5,7 @@
 //! columns, malformed or impossible values, inconsistent routings) is the
 //! same and every error names the file, the row and the column.
 
+use super::error::{CsvLineError, GeometryProblem, RowConflict, TableProblem};
 use super::{CalibrateError, HoldoutError};
 use crate::model::routing::{ControlPoints, CONTROL_POINTS};
 use std::collections::{BTreeMap, HashMap};
@@ -167,11 +168,11 @@ pub fn read_measurements(path: &Path) -> Result<Dataset, CalibrateError> {
 /// top of it (or of the thesis's actuator). `None` without a header.
 fn actuator_of_front_matter(path: &Path, front: &str) -> Result<Option<crate::model::Rod>, CalibrateError> {
     use crate::model::Rod;
-    let bad = |message: String| CalibrateError::Geometry { path: path.display().to_string(), message };
+    let bad = |problem: GeometryProblem| CalibrateError::Geometry { path: path.display().to_string(), problem };
     if front.trim().is_empty() {
         return Ok(None);
     }
-    let mut table: toml::Table = toml::from_str(front).map_err(|e| bad(e.to_string().trim_end().to_string()))?;
+    let mut table: toml::Table = toml::from_str(front).map_err(|e| bad(GeometryProblem::Toml(e)))?;
     if table.is_empty() {
         return Ok(None);
     }
@@ -179,19 +180,19 @@ fn actuator_of_front_matter(path: &Path, front: &str) -> Result<Option<crate::mo
         None => Rod::default(),
         Some(toml::Value::String(name)) => {
             let file = path.parent().unwrap_or(Path::new(".")).join(&name);
-            Rod::from_toml_file(&file).map_err(|e| bad(e.to_string()))?
+            Rod::from_toml_file(&file).map_err(|e| bad(e.into()))?
         }
-        Some(other) => return Err(bad(format!("actuator_file = {other} must be a file name in quotes"))),
+        Some(other) => return Err(bad(GeometryProblem::ActuatorFileName { value: other.to_string() })),
     };
     if table.is_empty() {
         return Ok(Some(base));
     }
-    let mut merged = toml::Table::try_from(&base).map_err(|e| bad(e.to_string()))?;
+    let mut merged = toml::Table::try_from(&base).map_err(|e| bad(GeometryProblem::Merge(e)))?;
     for (k, v) in table {
         merged.insert(k, v);
     }
-    let text = toml::to_string(&merged).map_err(|e| bad(e.to_string()))?;
-    Rod::from_toml_str(&text).map(Some).map_err(|e| bad(e.to_string()))
+    let text = toml::to_string(&merged).map_err(|e| bad(GeometryProblem::Merge(e)))?;
+    Rod::from_toml_str(&text).map(Some).map_err(|e| bad(e.into()))
 }
 
 /// Reads a CSV or (by its `.parquet` extension) Parquet file as text cells.
@@ -233,7 +234,7 @@ fn parse_csv(path: &Path, text: &str) -> Result<Table, CalibrateError> {
         return Err(CalibrateError::Empty { path: path.display().to_string() });
     };
     let header: Vec<String> = split_csv_line(head.trim_start_matches('\u{feff}'))
-        .map_err(|e| CalibrateError::Malformed { path: path.display().to_string(), row: 0, message: e.to_string() })?
+        .map_err(|e| CalibrateError::Malformed { path: path.display().to_string(), row: 0, problem: e.into() })?
         .into_iter()
         .map(|h| h.trim().to_string())
         .collect();
@@ -242,14 +243,7 @@ fn parse_csv(path: &Path, text: &str) -> Result<Table, CalibrateError> {
         // semicolons, a tab export); say so instead of "missing column".
         for (sep, name) in [(';', "semicolon"), ('\t', "tab"), ('|', "pipe")] {
             if head.contains(sep) {
-                return Err(CalibrateError::Malformed {
-                    path: path.display().to_string(),
-                    row: 0,
-                    message: format!(
-                        "the header is one column with {name}s in it: the file looks {name}-separated, but measurement \
-                         CSV files are comma-separated (docs/measurements.md); save or export it with commas"
-                    ),
-                });
+                return Err(CalibrateError::Malformed { path: path.display().to_string(), row: 0, problem: TableProblem::OtherDelimiter { name } });
             }
         }
     }
@@ -257,28 +251,17 @@ fn parse_csv(path: &Path, text: &str) -> Result<Table, CalibrateError> {
     for (data_row, (_, line)) in lines.enumerate() {
         let row = data_row + 1;
         let cells = split_csv_line(line)
-            .map_err(|e| CalibrateError::Malformed { path: path.display().to_string(), row, message: e.to_string() })?;
+            .map_err(|e| CalibrateError::Malformed { path: path.display().to_string(), row, problem: e.into() })?;
         if cells.len() != header.len() {
             return Err(CalibrateError::Malformed {
                 path: path.display().to_string(),
                 row,
-                message: format!("{} fields, but the header has {}", cells.len(), header.len()),
+                problem: TableProblem::FieldCount { fields: cells.len(), header: header.len() },
             });
         }
         rows.push(cells);
     }
     Ok(Table { header, rows, front })
-}
-
-/// Why a CSV line cannot be split into fields.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
-enum CsvLineError {
-    /// `a"b`: a quote inside a field that did not start with one.
-    #[error("a quote in the middle of an unquoted field")]
-    StrayQuote,
-    /// `"a,b`: the line ends inside a quoted field.
-    #[error("a quoted field is not closed")]
-    Unclosed,
 }
 
 fn split_csv_line(line: &str) -> Result<Vec<String>, CsvLineError> {
@@ -318,18 +301,18 @@ fn split_csv_line(line: &str) -> Result<Vec<String>, CsvLineError> {
 fn read_parquet_table(path: &Path) -> Result<Table, CalibrateError> {
     use arrow::util::display::{ArrayFormatter, FormatOptions};
     use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
-    let err = |message: String| CalibrateError::Malformed { path: path.display().to_string(), row: 0, message };
+    let err = |problem: TableProblem| CalibrateError::Malformed { path: path.display().to_string(), row: 0, problem };
     let file = std::fs::File::open(path)
         .map_err(|source| CalibrateError::Io { context: format!("opening {}", path.display()), source })?;
     let reader = ParquetRecordBatchReaderBuilder::try_new(file)
-        .map_err(|e| err(format!("not a readable Parquet file: {e}")))?
+        .map_err(|e| err(TableProblem::NotParquet(e)))?
         .build()
-        .map_err(|e| err(format!("not a readable Parquet file: {e}")))?;
+        .map_err(|e| err(TableProblem::NotParquet(e)))?;
     let mut header: Option<Vec<String>> = None;
     let mut rows = Vec::new();
     let options = FormatOptions::default().with_null("");
     for batch in reader {
-        let batch = batch.map_err(|e| err(format!("reading Parquet data: {e}")))?;
+        let batch = batch.map_err(|e| err(TableProblem::ParquetData(e)))?;
         let names: Vec<String> = batch.schema().fields().iter().map(|f| f.name().clone()).collect();
         header.get_or_insert(names);
         let formatters = batch
@@ -337,7 +320,7 @@ fn read_parquet_table(path: &Path) -> Result<Table, CalibrateError> {
             .iter()
             .map(|c| ArrayFormatter::try_new(c.as_ref(), &options))
             .collect::<Result<Vec<_>, _>>()
-            .map_err(|e| err(format!("unsupported column type: {e}")))?;
+            .map_err(|e| err(TableProblem::ColumnType(e)))?;
         for i in 0..batch.num_rows() {
             rows.push(formatters.iter().map(|f| f.value(i).to_string()).collect());
         }
@@ -410,11 +393,7 @@ pub(crate) fn check_unique_columns(path: &Path, table: &Table) -> Result<(), Cal
             return Err(CalibrateError::Malformed {
                 path: path.display().to_string(),
                 row: 0,
-                message: format!(
-                    "the header names column '{name}' twice (columns {} and {}); give each column once, so it is clear which values are meant",
-                    first + 1,
-                    i + 1
-                ),
+                problem: TableProblem::DuplicateColumn { name: name.clone(), first: first + 1, second: i + 1 },
             });
         }
     }
@@ -498,14 +477,14 @@ fn parse_measurements(path: &Path, table: &Table) -> Result<Dataset, CalibrateEr
             return Err(CalibrateError::Inconsistent {
                 path: path.display().to_string(),
                 row: c.row,
-                message: format!("measurement id {measurement} already used on row {first}; ids must be unique"),
+                conflict: RowConflict::MeasurementId { measurement, first },
             });
         }
         if let Some(first) = steps.insert((routing.clone(), step), c.row) {
             return Err(CalibrateError::Inconsistent {
                 path: path.display().to_string(),
                 row: c.row,
-                message: format!("routing '{routing}' has step {step} twice (rows {first} and {}); steps order the protocol", c.row),
+                conflict: RowConflict::StepTwice { routing: routing.clone(), step, first, row: c.row },
             });
         }
         match routings.get(&routing) {
@@ -513,9 +492,14 @@ fn parse_measurements(path: &Path, table: &Table) -> Result<Dataset, CalibrateEr
                 return Err(CalibrateError::Inconsistent {
                     path: path.display().to_string(),
                     row: c.row,
-                    message: format!(
-                        "routing '{routing}' has control points {y_mm:?} mm and clamp tilt {clamp_tilt_rad} rad here but {y0:?} mm and {t0} rad on row {first}; give each routing its own id"
-                    ),
+                    conflict: RowConflict::RoutingChanged {
+                        routing: routing.clone(),
+                        y_mm,
+                        tilt_rad: clamp_tilt_rad,
+                        first_y_mm: *y0,
+                        first_tilt_rad: *t0,
+                        first: *first,
+                    },
                 });
             }
             Some(_) => {}
@@ -799,7 +783,7 @@ mod tests {
     fn the_geometry_header_gives_the_body_and_round_trips() {
         let mut a = crate::model::Rod { length_mm: 360.0, cable_anchor_mm: Some(305.0), ..Default::default() };
         a.radius_profile_mm = vec![(0.0, 15.4), (305.0, 6.4), (360.0, 4.8)];
-        a.effects.friction_mu = 0.3;
+        crate::calibrate::Effect::Friction.apply(&mut a, 0.3);
         let header = geometry_header(&a);
         assert!(header.lines().all(|l| l.starts_with("# ")) && !header.contains("friction"), "{header}");
         let text = format!("{header}measurement,routing,y0_mm,y1_mm,y2_mm,y3_mm,y4_mm,tension_n,direction,step,dwell_s,tip_x_mm,tip_y_mm,tip_angle_rad\n1,a,0,1,1,1,1,0,rest,0,0,360,0,0\n");
@@ -807,7 +791,7 @@ mod tests {
         let table = parse_csv(p, &text).unwrap();
         let body = actuator_of_front_matter(p, &table.front).unwrap().unwrap();
         assert_eq!((body.length_mm, body.cable_anchor_mm, &body.radius_profile_mm), (360.0, Some(305.0), &a.radius_profile_mm));
-        assert_eq!(body.effects.friction_mu, 0.0);
+        assert_eq!(crate::calibrate::Effect::Friction.current(&body), None);
         assert_eq!(parse_measurements(p, &table).unwrap().rows.len(), 1);
         // A bad body in the header is named.
         let bad = parse_csv(p, "# radius_profile_mm = [[0.0, 5.0], [30.0, -1.0], [65.0, 4.0]]\nmeasurement\n").unwrap();

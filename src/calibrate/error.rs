@@ -19,15 +19,15 @@ pub enum CalibrateError {
     #[error("{path}: row {row}, column '{column}': '{value}' is not valid, expected {expected}")]
     BadValue { path: String, row: usize, column: String, value: String, expected: String },
     /// A row cannot be split into fields (or the file cannot be decoded).
-    #[error("{path}: row {row}: {message}")]
-    Malformed { path: String, row: usize, message: String },
+    #[error("{path}: row {row}: {problem}")]
+    Malformed { path: String, row: usize, problem: TableProblem },
     /// The file's geometry header (`# key = value` lines before the CSV
     /// header) is invalid.
-    #[error("{path}: the geometry header (the '#' lines before the column names): {message}; see docs/measurements.md")]
-    Geometry { path: String, message: String },
+    #[error("{path}: the geometry header (the '#' lines before the column names): {problem}; see docs/measurements.md")]
+    Geometry { path: String, problem: GeometryProblem },
     /// Rows contradict each other.
-    #[error("{path}: row {row}: {message}")]
-    Inconsistent { path: String, row: usize, message: String },
+    #[error("{path}: row {row}: {conflict}")]
+    Inconsistent { path: String, row: usize, conflict: RowConflict },
     /// A routing in the data is not a valid routing for the actuator.
     #[error("routing '{routing}' (first on row {row}): {source}")]
     Routing { routing: String, row: usize, source: crate::model::RoutingError },
@@ -245,4 +245,97 @@ pub enum Refused {
     /// No Levenberg–Marquardt iteration.
     #[error("--max-iterations must be at least 1")]
     NoIterations,
+}
+
+/// Why a table cannot be split into rows and cells.
+#[derive(Debug, thiserror::Error)]
+pub enum TableProblem {
+    /// A CSV line that cannot be split into fields.
+    #[error(transparent)]
+    Line(#[from] CsvLineError),
+    /// A header of one column holding another delimiter.
+    #[error(
+        "the header is one column with {name}s in it: the file looks {name}-separated, but measurement \
+         CSV files are comma-separated (docs/measurements.md); save or export it with commas"
+    )]
+    OtherDelimiter { name: &'static str },
+    /// A row with another number of fields than the header.
+    #[error("{fields} fields, but the header has {header}")]
+    FieldCount { fields: usize, header: usize },
+    /// A column named twice (1-based positions).
+    #[error("the header names column '{name}' twice (columns {first} and {second}); give each column once, so it is clear which values are meant")]
+    DuplicateColumn { name: String, first: usize, second: usize },
+    /// Not a Parquet file.
+    #[error("not a readable Parquet file: {0}")]
+    NotParquet(#[source] parquet::errors::ParquetError),
+    /// Parquet data that cannot be decoded.
+    #[error("reading Parquet data: {0}")]
+    ParquetData(#[source] arrow::error::ArrowError),
+    /// A Parquet column of a type without a text form.
+    #[error("unsupported column type: {0}")]
+    ColumnType(#[source] arrow::error::ArrowError),
+}
+
+/// Why a CSV line cannot be split into fields.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+pub enum CsvLineError {
+    /// `a"b`: a quote inside a field that did not start with one.
+    #[error("a quote in the middle of an unquoted field")]
+    StrayQuote,
+    /// `"a,b`: the line ends inside a quoted field.
+    #[error("a quoted field is not closed")]
+    Unclosed,
+}
+
+/// Why a measurement file's geometry header cannot be used.
+#[derive(Debug, thiserror::Error)]
+pub enum GeometryProblem {
+    /// Not TOML.
+    #[error("{}", .0.to_string().trim_end())]
+    Toml(#[source] toml::de::Error),
+    /// `actuator_file` not a quoted file name.
+    #[error("actuator_file = {value} must be a file name in quotes")]
+    ActuatorFileName { value: String },
+    /// The rod file it names is not valid.
+    #[error(transparent)]
+    RodFile(#[from] crate::model::rod::ActuatorFileError),
+    /// The rod it describes is not valid.
+    #[error(transparent)]
+    Rod(#[from] crate::model::rod::RodTextError),
+    /// The merged rod cannot be written back as TOML.
+    #[error("{0}")]
+    Merge(#[source] toml::ser::Error),
+}
+
+/// How a row contradicts another.
+#[derive(Debug, thiserror::Error)]
+pub enum RowConflict {
+    /// A measurement id used twice in a measurement file.
+    #[error("measurement id {measurement} already used on row {first}; ids must be unique")]
+    MeasurementId { measurement: i64, first: usize },
+    /// A routing's step given twice.
+    #[error("routing '{routing}' has step {step} twice (rows {first} and {row}); steps order the protocol")]
+    StepTwice { routing: String, step: i64, first: usize, row: usize },
+    /// A routing id with other control points or tilt than before.
+    #[error("routing '{routing}' has control points {y_mm:?} mm and clamp tilt {tilt_rad} rad here but {first_y_mm:?} mm and {first_tilt_rad} rad on row {first}; give each routing its own id")]
+    RoutingChanged {
+        routing: String,
+        y_mm: [f64; crate::model::routing::CONTROL_POINTS],
+        tilt_rad: f64,
+        first_y_mm: [f64; crate::model::routing::CONTROL_POINTS],
+        first_tilt_rad: f64,
+        first: usize,
+    },
+    /// A capture id used twice.
+    #[error("measurement id {measurement} is used again (first on row {first}); give each capture its own id")]
+    CaptureId { measurement: i64, first: usize },
+    /// A marker given twice in one capture.
+    #[error("marker '{marker}' of measurement {measurement} is given twice (first on row {first}); name each marker once per capture")]
+    MarkerTwice { marker: String, measurement: i64, first: usize },
+    /// A marker named like the captures file's tip columns.
+    #[error("marker '{marker}' of measurement {measurement} is also the captures file's tip columns; rename it")]
+    MarkerIsTip { marker: String, measurement: i64 },
+    /// A capture without any measured point.
+    #[error("capture {measurement} has no measured point: give its markers in the markers file (--markers) or tip_x_mm, tip_y_mm, tip_z_mm columns")]
+    NoPoint { measurement: i64 },
 }

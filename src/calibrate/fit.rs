@@ -179,7 +179,7 @@ pub const RIGIDITY_NAMES: [&str; 3] = ["ea_n", "ga_n", "ei_n_mm2"];
 /// One fitted parameter.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct FittedParameter {
-    /// Name with unit (`ea_n`, `friction_mu`, …).
+    /// Name with unit (`ea_n`, an effect's parameter, …).
     pub name: String,
     /// Fitted value.
     pub value: f64,

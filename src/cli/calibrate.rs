@@ -19,7 +19,7 @@ pub struct FitArgs {
     /// Noise of the tip angle, degrees; a `noise_deg` column overrides it per row.
     #[arg(long, default_value_t = 1.0, value_name = "DEG")]
     pub noise_deg: f64,
-    /// Hold a parameter at a value instead of fitting it (repeatable): EA, GA, EI or an effect parameter, e.g. GA=1.70866 or friction_mu=0.05.
+    /// Hold a parameter at a value instead of fitting it (repeatable): EA, GA, EI or an effect parameter, e.g. GA=1.70866.
     #[arg(long = "fix", value_name = "NAME=VALUE")]
     pub fix: Vec<String>,
     /// Loss on the noise-whitened residuals: huber (robust to a few bad readings) or squares

@@ -5,6 +5,7 @@
 //! table of text cells, so every error names the file, the row and the
 //! column.
 
+use crate::calibrate::error::RowConflict;
 use crate::calibrate::data::{check_unique_columns, column_index, read_table, Cells, Direction, Table};
 use crate::calibrate::CalibrateError;
 use std::collections::BTreeMap;
@@ -182,7 +183,7 @@ pub fn read_captures(path: &Path, cables: usize, length_mm: f64) -> Result<(Vec<
             return Err(CalibrateError::Inconsistent {
                 path: path.display().to_string(),
                 row: i + 1,
-                message: format!("measurement id {measurement} is used again (first on row {first}); give each capture its own id"),
+                conflict: RowConflict::CaptureId { measurement, first },
             });
         }
         let mut actuation = Vec::with_capacity(cables);
@@ -285,7 +286,7 @@ pub fn read_markers_3d(path: &Path, captures: &[Capture], length_mm: f64) -> Res
             return Err(CalibrateError::Inconsistent {
                 path: path.display().to_string(),
                 row: i + 1,
-                message: format!("marker '{}' of measurement {id} is given twice (first on row {}); name each marker once per capture", reading.marker, first.row),
+                conflict: RowConflict::MarkerTwice { marker: reading.marker.clone(), measurement: id, first: first.row },
             });
         }
         list.push(reading);
@@ -305,7 +306,7 @@ pub fn read_capture_set(captures_path: &Path, markers_path: Option<&Path>, cable
                 return Err(CalibrateError::Inconsistent {
                     path: p.display().to_string(),
                     row: m.row,
-                    message: format!("marker '{}' of measurement {id} is also the captures file's tip columns; rename it", m.marker),
+                    conflict: RowConflict::MarkerIsTip { marker: m.marker.clone(), measurement: id },
                 });
             }
             entry.extend(list);
@@ -315,10 +316,7 @@ pub fn read_capture_set(captures_path: &Path, markers_path: Option<&Path>, cable
         return Err(CalibrateError::Inconsistent {
             path: captures_path.display().to_string(),
             row: c.row,
-            message: format!(
-                "capture {} has no measured point: give its markers in the markers file (--markers) or tip_x_mm, tip_y_mm, tip_z_mm columns",
-                c.measurement
-            ),
+            conflict: RowConflict::NoPoint { measurement: c.measurement },
         });
     }
     Ok(CaptureSet { captures, markers })
