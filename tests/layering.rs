@@ -16,26 +16,99 @@ fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
 }
 
 /// Every source file of `src/` (the binary's too), by its path below
-/// `src/`, with its text, test modules cut off (tests may use anything).
+/// `src/`, with its test code cut off (tests may use anything): items under
+/// `#[cfg(test)]` anywhere in a file, and whole files that are test modules.
 fn all_sources() -> Vec<(String, String)> {
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
     let mut files = Vec::new();
     rust_files(&src, &mut files);
-    files.into_iter().map(|p| (p.strip_prefix(&src).unwrap().display().to_string(), without_tests(&p))).collect()
+    let test_files: Vec<PathBuf> = files.iter().flat_map(|p| test_module_files(p)).collect();
+    files
+        .into_iter()
+        .filter(|p| !test_files.contains(p))
+        .map(|p| (p.strip_prefix(&src).unwrap().display().to_string(), without_tests(&std::fs::read_to_string(&p).unwrap())))
+        .collect()
 }
 
-/// Library source files with their text, test modules cut off.
+/// Library source files with their text, test code cut off.
 fn library_sources() -> Vec<(String, String)> {
     all_sources().into_iter().filter(|(file, _)| !file.starts_with("cli/") && file != "main.rs").collect()
 }
 
-/// A source file's text with its test module cut off.
-fn without_tests(path: &Path) -> String {
-    let text = std::fs::read_to_string(path).unwrap();
-    match text.find("#[cfg(test)]") {
-        Some(i) => text[..i].to_string(),
-        None => text,
+/// The end of the item that starts at `at` (after its attributes): past its
+/// `;`, or past the brace group that closes it.
+fn item_end(text: &str, at: usize) -> usize {
+    let mut i = at;
+    loop {
+        let rest = &text[i..];
+        i += rest.len() - rest.trim_start().len();
+        if text[i..].starts_with("#[") {
+            i = group_end(text, i + 1).unwrap_or(text.len());
+        } else {
+            break;
+        }
     }
+    // The first `;` or `{` outside the signature's brackets (`[f64; 3]`).
+    let mut depth = 0usize;
+    for (k, c) in text[i..].char_indices() {
+        match c {
+            '(' | '[' => depth += 1,
+            ')' | ']' => depth = depth.saturating_sub(1),
+            ';' if depth == 0 => return i + k + 1,
+            '{' if depth == 0 => return group_end(text, i + k).unwrap_or(text.len()),
+            _ => {}
+        }
+    }
+    text.len()
+}
+
+/// `text` with every item under `#[cfg(test)]` removed.
+fn without_tests(text: &str) -> String {
+    let mut kept = String::new();
+    let mut from = 0;
+    while let Some(k) = text[from..].find("#[cfg(test)]") {
+        let at = from + k;
+        kept.push_str(&text[from..at]);
+        from = item_end(text, at + "#[cfg(test)]".len());
+    }
+    kept.push_str(&text[from..]);
+    kept
+}
+
+/// The files that `path` declares as test modules (`#[cfg(test)] mod name;`,
+/// with or without `#[path = "…"]`).
+fn test_module_files(path: &Path) -> Vec<PathBuf> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let dir = path.parent().unwrap();
+    // A module's own folder: `a.rs` declares `a/b.rs`, `a/mod.rs` declares `a/b.rs`.
+    let stem = path.file_stem().unwrap().to_str().unwrap();
+    let child_dir = if stem == "mod" || stem == "lib" || stem == "main" { dir.to_path_buf() } else { dir.join(stem) };
+    let mut found = Vec::new();
+    for (at, _) in text.match_indices("#[cfg(test)]") {
+        let end = item_end(&text, at + "#[cfg(test)]".len());
+        let item = &text[at..end];
+        if !item.trim_end().ends_with(';') {
+            continue;
+        }
+        if let Some(p) = item.find("#[path = \"") {
+            let rest = &item[p + "#[path = \"".len()..];
+            if let Some(q) = rest.find('"') {
+                found.push(dir.join(&rest[..q]));
+            }
+        } else if let Some(name) = item.trim_end().trim_end_matches(';').split_whitespace().last() {
+            found.push(child_dir.join(format!("{name}.rs")));
+            found.push(child_dir.join(name).join("mod.rs"));
+        }
+    }
+    found
+}
+
+#[test]
+fn test_code_is_cut_wherever_it_sits() {
+    let code = "fn a() {}\n#[cfg(test)]\n#[path = \"t.rs\"]\nmod tests;\nfn b() {}\n#[cfg(test)]\nfn helper(v: [f64; 3]) { if x { y } }\nfn c() {}\n#[cfg(test)]\nmod tests { fn d() {} }\n";
+    let kept = without_tests(code);
+    assert!(kept.contains("fn a()") && kept.contains("fn b()") && kept.contains("fn c()"), "{kept}");
+    assert!(!kept.contains("helper") && !kept.contains("fn d()") && !kept.contains("t.rs"), "{kept}");
 }
 
 #[test]
@@ -652,14 +725,15 @@ fn the_detector_of_sentence_errors_sees_each_form() {
 }
 
 #[test]
-fn no_source_file_in_these_layers_is_over_1200_lines() {
+fn no_source_file_is_over_1200_lines() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut files = Vec::new();
+    rust_files(&src, &mut files);
     let mut long = Vec::new();
-    for (file, text) in all_sources() {
-        let _ = text;
-        let lines = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("src").join(&file)).unwrap().lines().count();
-        let owned = ["sweep/", "reduce/", "study/", "mould/", "io/", "plot/", "job.rs", "map.rs"];
-        if lines > 1200 && owned.iter().any(|d| file.starts_with(d)) {
-            long.push(format!("src/{file}: {lines} lines"));
+    for path in files {
+        let lines = std::fs::read_to_string(&path).unwrap().lines().count();
+        if lines > 1200 {
+            long.push(format!("{}: {lines} lines", path.strip_prefix(&src).unwrap().display()));
         }
     }
     assert!(long.is_empty(), "split these by job (at most 1,200 lines a file):\n{}", long.join("\n"));
