@@ -8,7 +8,7 @@
 use crate::io::FileError;
 use crate::study::{StudyError, StudySpec};
 use crate::sweep::report::SweepReport;
-use crate::sweep::{run_status_of, run_sweep_of, CableSweepSpec, RunSpec, SweepError, SweepOptions, SweepSpec};
+use crate::sweep::{run_status, run_sweep, SweepError, SweepOptions, SweepSpec};
 use std::path::{Path, PathBuf};
 
 /// Top-level tables of a planar sweep spec (docs/schema.md).
@@ -19,10 +19,9 @@ const CABLE_KEYS: [&str; 5] = ["rod", "gj_n_mm2", "gravity_direction", "solver",
 /// The spec a job file holds, by kind.
 #[derive(Debug, Clone)]
 pub enum JobSpec {
-    /// A planar single-cable sweep.
-    Planar(SweepSpec),
-    /// A sweep of several or spatial cables.
-    Cables(CableSweepSpec),
+    /// A sweep: a planar single-cable sweep or a sweep of several or
+    /// spatial cables ([`SweepSpec::kind`]).
+    Sweep(SweepSpec),
     /// A study: one planar sweep and map per actuator variant.
     Study(StudySpec),
 }
@@ -89,7 +88,7 @@ pub enum JobError {
 impl Job {
     /// The built-in thesis spec (jobs/thesis.toml).
     pub fn thesis() -> Self {
-        Self { path: None, spec: JobSpec::Planar(SweepSpec::thesis()), blank: false }
+        Self { path: None, spec: JobSpec::Sweep(SweepSpec::thesis()), blank: false }
     }
 
     /// The spec at `path`, or the built-in thesis spec when `None`.
@@ -115,12 +114,12 @@ impl Job {
             return Err(JobError::CableStudy { path: path.to_path_buf() });
         } else if has("study") {
             JobSpec::Study(StudySpec::from_table(table, &origin)?)
-        } else if has("cable") {
-            JobSpec::Cables(CableSweepSpec::from_toml(&text, &origin)?)
         } else if !table.is_empty() && !table.keys().any(known) {
             return Err(JobError::NotAJob { path: path.to_path_buf(), tables: table.keys().cloned().collect() });
         } else {
-            JobSpec::Planar(SweepSpec::from_toml(&text, &origin)?)
+            // `[[cable]]` tables make a cable sweep, else a planar one (whose
+            // parser names a misspelt table).
+            JobSpec::Sweep(SweepSpec::from_toml(&text, &origin)?)
         };
         Ok(Self { path: Some(path.to_path_buf()), spec, blank: SweepSpec::is_blank_toml(&text) })
     }
@@ -135,24 +134,19 @@ impl Job {
     /// Runs one shard of the job's sweep into `out` and reads the run's
     /// state after it. A study has no single sweep: [`JobError::StudyNotASweep`].
     pub fn sweep(&self, out: &Path, options: &SweepOptions) -> Result<SweepReport, JobError> {
-        match &self.spec {
-            JobSpec::Planar(spec) => Ok(sweep_of(spec, out, options)?),
-            JobSpec::Cables(spec) => Ok(sweep_of(spec, out, options)?),
-            JobSpec::Study(_) => Err(JobError::StudyNotASweep { path: self.path.clone().unwrap_or_default() }),
-        }
+        let JobSpec::Sweep(spec) = &self.spec else {
+            return Err(JobError::StudyNotASweep { path: self.path.clone().unwrap_or_default() });
+        };
+        let summary = run_sweep(spec, out, options)?;
+        let status = run_status(out).map_err(|e| SweepError::After { dir: out.to_path_buf(), source: Box::new(e) })?;
+        Ok(SweepReport::new(summary, &status))
     }
-}
-
-/// One shard of `spec`'s sweep into `out`, and the run's state after it.
-fn sweep_of<S: RunSpec>(spec: &S, out: &Path, options: &SweepOptions) -> Result<SweepReport, SweepError> {
-    let summary = run_sweep_of(spec, out, options)?;
-    let status = run_status_of::<S>(out).map_err(|e| SweepError::After { dir: out.to_path_buf(), source: Box::new(e) })?;
-    Ok(SweepReport::new(summary, &status))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sweep::RunKind;
 
     fn load(text: &str) -> Result<Job, JobError> {
         let dir = tempfile::tempdir().unwrap();
@@ -163,11 +157,15 @@ mod tests {
 
     #[test]
     fn a_spec_is_told_by_its_tables() {
-        assert!(matches!(load("[grid]\nlevels = 3\n").unwrap().spec, JobSpec::Planar(_)));
-        assert!(matches!(load("# nothing\n").unwrap().spec, JobSpec::Planar(_)));
+        let kind = |job: Job| match job.spec {
+            JobSpec::Sweep(s) => Some(s.kind()),
+            JobSpec::Study(_) => None,
+        };
+        assert_eq!(kind(load("[grid]\nlevels = 3\n").unwrap()), Some(RunKind::Planar));
+        assert_eq!(kind(load("# nothing\n").unwrap()), Some(RunKind::Planar));
         assert!(load("# nothing\n").unwrap().note().is_some_and(|n| n.contains("sets nothing")));
         let cable = "[[cable]]\ny_mm = [1, 1, 1, 1, 1]\ntension_n = { min = 0.0, max = 1.0, count = 2 }\n";
-        assert!(matches!(load(cable).unwrap().spec, JobSpec::Cables(_)));
+        assert_eq!(kind(load(cable).unwrap()), Some(RunKind::Cables));
         let study = "[grid]\nlevels = 3\n[study]\n[[study.axis]]\nname = \"length_mm\"\nvalues = [55.0, 65.0]\n";
         assert!(matches!(load(study).unwrap().spec, JobSpec::Study(_)));
     }
@@ -191,8 +189,8 @@ mod tests {
         for (name, kind) in [("thesis.toml", "planar"), ("quick.toml", "planar"), ("antagonistic-pair.toml", "cables"), ("spatial-pair.toml", "cables"), ("study.toml", "study")] {
             let job = Job::load(&jobs.join(name)).unwrap();
             let found = match job.spec {
-                JobSpec::Planar(_) => "planar",
-                JobSpec::Cables(_) => "cables",
+                JobSpec::Sweep(s) if s.planar().is_some() => "planar",
+                JobSpec::Sweep(_) => "cables",
                 JobSpec::Study(_) => "study",
             };
             assert_eq!(found, kind, "{name}");

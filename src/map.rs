@@ -6,7 +6,7 @@
 //! the command line prints).
 //!
 //! A run directory's kind ([`RunKind`]) picks its code in one place,
-//! [`on_kind`]; each kind says how it is reduced ([`MapKind`]).
+//! [`reduce`].
 
 use crate::job::{Job, JobError, JobSpec};
 use crate::reduce::parts::PartReport;
@@ -14,9 +14,7 @@ use crate::reduce::tables::PLANAR_MAP_DIR;
 use crate::reduce::{reduce_cable_run, reduce_run, write_map_replacing, CableMapSummary, MapSummary, ReduceError};
 use crate::study::{StudyError, StudyProgress, StudyReport, StudyRequest};
 use crate::sweep::progress::ProgressMode;
-use crate::sweep::{
-    run_kind, run_status_of, CableSweepSpec, RunKind, RunSpec, StatusReport, SweepError, SweepOptions, SweepReport, SweepSpec,
-};
+use crate::sweep::{run_kind, run_status, RunKind, StatusReport, SweepError, SweepOptions, SweepReport};
 use serde::Serialize;
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -220,117 +218,70 @@ impl fmt::Display for ReduceReport {
     }
 }
 
-/// A kind of sweep that can be mapped: how its run directory is reduced.
-pub trait MapKind: RunSpec {
-    /// Reduces `request.run` (a run of this kind) into `request.out`.
-    fn reduce(request: &ReduceRequest) -> Result<ReduceReport, MapError>;
-    /// Writes one part of the reduce of `part.run` (split for a cluster array).
-    fn reduce_part(part: &PartRequest) -> Result<PartWritten, MapError>;
+/// Reduces a planar run (or the parts of its reduce) into a map.
+fn reduce_planar(request: &ReduceRequest) -> Result<ReduceReport, MapError> {
+    let (run, out) = (&request.run, &request.out);
+    let options = request.settings.options(out);
+    crate::reduce::check_map_out(out).map_err(MapError::Write)?;
+    let start = Instant::now();
+    let reduced = match request.source {
+        Source::Run { partial } => reduce_run(run, partial, &options),
+        Source::Parts => crate::reduce::parts::merge_parts(run, out, &options),
+    };
+    let (map, grid) = reduced.map_err(|source| MapError::Reduce { run: run.clone(), source })?;
+    let reduce_s = start.elapsed().as_secs_f64();
+    let pictures = write_map_replacing(out, &map, &grid.actuator, &grid.solver).map_err(MapError::Write)?;
+    let total_s = start.elapsed().as_secs_f64();
+    let sparse_note = crate::reduce::Density::sparse_note(&map.summary, &map.cells);
+    Ok(ReduceReport::Planar(PlanarMapReport {
+        summary: map.summary,
+        map_dir: out.clone(),
+        pictures: pictures.into_iter().map(|p| p.file).collect(),
+        reduce_s,
+        total_s,
+        sparse_note,
+    }))
 }
 
-impl MapKind for SweepSpec {
-    fn reduce(request: &ReduceRequest) -> Result<ReduceReport, MapError> {
-        let (run, out) = (&request.run, &request.out);
-        let options = request.settings.options(out);
-        crate::reduce::check_map_out(out).map_err(MapError::Write)?;
-        let start = Instant::now();
-        let reduced = match request.source {
-            Source::Run { partial } => reduce_run(run, partial, &options),
-            Source::Parts => crate::reduce::parts::merge_parts(run, out, &options),
-        };
-        let (map, spec) = reduced.map_err(|source| MapError::Reduce { run: run.clone(), source })?;
-        let reduce_s = start.elapsed().as_secs_f64();
-        let pictures = write_map_replacing(out, &map, &spec.actuator, &spec.solver).map_err(MapError::Write)?;
-        let total_s = start.elapsed().as_secs_f64();
-        let sparse_note = crate::reduce::Density::sparse_note(&map.summary, &map.cells);
-        Ok(ReduceReport::Planar(PlanarMapReport {
-            summary: map.summary,
-            map_dir: out.clone(),
-            pictures: pictures.into_iter().map(|p| p.file).collect(),
-            reduce_s,
-            total_s,
-            sparse_note,
-        }))
-    }
-
-    fn reduce_part(request: &PartRequest) -> Result<PartWritten, MapError> {
-        let PartRequest { run, out, shard, shards, .. } = request;
-        let start = Instant::now();
-        let part = crate::reduce::parts::write_part(run, out, *shard, *shards).map_err(|source| MapError::Reduce { run: run.clone(), source })?;
-        Ok(PartWritten { request: request.clone(), part, reduce_s: start.elapsed().as_secs_f64() })
-    }
+/// Reduces a cable sweep into its reach map (and planar map).
+fn reduce_cables(request: &ReduceRequest) -> Result<ReduceReport, MapError> {
+    let (run, out) = (&request.run, &request.out);
+    let Source::Run { partial } = request.source else {
+        return Err(MapError::CablesHaveNoParts { run: run.clone() });
+    };
+    let start = Instant::now();
+    let options = request.settings.options(out);
+    let map = reduce_cable_run(run, partial, request.settings.cell_mm, &options, out)
+        .map_err(|source| MapError::Reduce { run: run.clone(), source })?;
+    Ok(ReduceReport::Cables(CableMapReport {
+        summary: map.summary,
+        map_dir: out.clone(),
+        planar: map.planar.map(|(m, p)| (m.summary, p.into_iter().map(|p| p.file).collect())),
+        total_s: start.elapsed().as_secs_f64(),
+    }))
 }
 
-impl MapKind for CableSweepSpec {
-    fn reduce(request: &ReduceRequest) -> Result<ReduceReport, MapError> {
-        let (run, out) = (&request.run, &request.out);
-        let Source::Run { partial } = request.source else {
-            return Err(MapError::CablesHaveNoParts { run: run.clone() });
-        };
-        let start = Instant::now();
-        let options = request.settings.options(out);
-        let map = reduce_cable_run(run, partial, request.settings.cell_mm, &options, out)
-            .map_err(|source| MapError::Reduce { run: run.clone(), source })?;
-        Ok(ReduceReport::Cables(CableMapReport {
-            summary: map.summary,
-            map_dir: out.clone(),
-            planar: map.planar.map(|(m, p)| (m.summary, p.into_iter().map(|p| p.file).collect())),
-            total_s: start.elapsed().as_secs_f64(),
-        }))
-    }
-
-    fn reduce_part(request: &PartRequest) -> Result<PartWritten, MapError> {
-        Err(MapError::CablesHaveNoParts { run: request.run.clone() })
-    }
-}
-
-/// Code for a run of any kind: [`on_kind`] calls [`KindVisitor::visit`]
-/// with the kind's spec type.
-pub trait KindVisitor {
-    /// What the visit returns.
-    type Output;
-    /// Does the work for runs of spec type `S`.
-    fn visit<S: MapKind>(self) -> Self::Output;
-}
-
-/// Calls `visitor` with the spec type of `kind`: the one place a run
-/// directory's kind picks code.
-pub fn on_kind<V: KindVisitor>(kind: RunKind, visitor: V) -> V::Output {
-    match kind {
-        RunKind::Planar => visitor.visit::<SweepSpec>(),
-        RunKind::Cables => visitor.visit::<CableSweepSpec>(),
-    }
-}
-
-/// The kind of the run directory `dir`, a map given in its place named as such.
-fn kind_of(dir: &Path) -> Result<RunKind, MapError> {
-    run_kind(dir).map_err(|e| crate::reduce::map_given_as_run(&e).map_or(MapError::Sweep(e), MapError::Write))
+/// The kind of the run directory `dir`, a map given in its place named as
+/// such; a directory without a manifest is read as planar, whose reader
+/// then says what the directory is instead (a map, missing, the parent of
+/// runs).
+fn kind_or_planar(dir: &Path) -> RunKind {
+    run_kind(dir).unwrap_or(RunKind::Planar)
 }
 
 /// The state of the run directory `dir`, of any kind (`cablemap status`).
 pub fn status(dir: &Path) -> Result<StatusReport, MapError> {
-    struct Status<'a>(&'a Path);
-    impl KindVisitor for Status<'_> {
-        type Output = Result<StatusReport, SweepError>;
-        fn visit<S: MapKind>(self) -> Self::Output {
-            Ok(StatusReport::new(&run_status_of::<S>(self.0)?))
-        }
-    }
-    Ok(on_kind(kind_of(dir)?, Status(dir))?)
+    run_kind(dir).map_err(|e| crate::reduce::map_given_as_run(&e).map_or(MapError::Sweep(e), MapError::Write))?;
+    Ok(StatusReport::new(&run_status(dir)?))
 }
 
-/// Reduces a run directory of any kind into a map (`cablemap reduce`).
+/// Reduces a run directory of any kind into a map (`cablemap reduce`): the
+/// one place a run directory's kind picks its code.
 pub fn reduce(request: &ReduceRequest) -> Result<ReduceReport, MapError> {
-    struct Reduce<'a>(&'a ReduceRequest);
-    impl KindVisitor for Reduce<'_> {
-        type Output = Result<ReduceReport, MapError>;
-        fn visit<S: MapKind>(self) -> Self::Output {
-            S::reduce(self.0)
-        }
+    match kind_or_planar(&request.run) {
+        RunKind::Planar => reduce_planar(request),
+        RunKind::Cables => reduce_cables(request),
     }
-    // A directory without a manifest is read as planar, whose reader then
-    // says what the directory is instead (a map, missing, the parent of runs).
-    on_kind(run_kind(&request.run).unwrap_or(RunKind::Planar), Reduce(request))
 }
 
 /// One part of a planar run's reduce (`reduce --shard I --shards N`).
@@ -359,16 +310,16 @@ pub struct PartWritten {
     pub reduce_s: f64,
 }
 
-/// Writes one part of the reduce of a run into its map's parts directory.
+/// Writes one part of the reduce of a planar run into its map's parts
+/// directory (a cable sweep's reduce has no parts).
 pub fn reduce_part(request: &PartRequest) -> Result<PartWritten, MapError> {
-    struct Part<'a>(&'a PartRequest);
-    impl KindVisitor for Part<'_> {
-        type Output = Result<PartWritten, MapError>;
-        fn visit<S: MapKind>(self) -> Self::Output {
-            S::reduce_part(self.0)
-        }
+    if kind_or_planar(&request.run) == RunKind::Cables {
+        return Err(MapError::CablesHaveNoParts { run: request.run.clone() });
     }
-    on_kind(run_kind(&request.run).unwrap_or(RunKind::Planar), Part(request))
+    let PartRequest { run, out, shard, shards, .. } = request;
+    let start = Instant::now();
+    let part = crate::reduce::parts::write_part(run, out, *shard, *shards).map_err(|source| MapError::Reduce { run: run.clone(), source })?;
+    Ok(PartWritten { request: request.clone(), part, reduce_s: start.elapsed().as_secs_f64() })
 }
 
 impl Serialize for PartWritten {

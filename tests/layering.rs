@@ -572,7 +572,7 @@ fn a_run_kind_picks_its_code_in_one_place() {
         .filter(|(f, code)| f != "sweep/kind.rs" && code.contains("RunKind::Planar =>"))
         .map(|(f, _)| f)
         .collect();
-    assert_eq!(matched, ["map.rs"], "a run directory's kind picks its code in map::on_kind only");
+    assert_eq!(matched, ["map.rs"], "a run directory's kind picks its code in map::reduce only");
 }
 
 #[test]

@@ -9,8 +9,8 @@ mod process;
 use arrow::array::{Array, Float64Array, Int64Array, StringArray};
 use arrow::record_batch::RecordBatch;
 use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
-use cablemap::sweep::CableSweepSpec;
-use cablemap::sweep::{open_run_of, Completeness};
+use cablemap::sweep::SweepSpec;
+use cablemap::sweep::{open_run, Completeness};
 use std::collections::BTreeMap;
 use std::path::Path;
 use std::process::Stdio;
@@ -60,7 +60,7 @@ fn f64s(batch: &RecordBatch, name: &str) -> Vec<Option<f64>> {
 
 /// Every row of a cable run (through the library's reader), in order.
 fn rows_of(run: &Path) -> RecordBatch {
-    let run = open_run_of::<CableSweepSpec>(run, Completeness::Complete).unwrap();
+    let run = open_run(run, Completeness::Complete).unwrap();
     let batches: Vec<RecordBatch> = run.batches().map(|b| b.unwrap()).collect();
     arrow::compute::concat_batches(&run.schema(), &batches).unwrap()
 }
@@ -541,8 +541,11 @@ fn runs_of_the_other_kind_and_bad_specs_are_refused() {
     assert!(run(&["sweep", s(&spec), "--out", s(&cables), "--quiet"]).0);
     let (ok, _, stderr) = run(&["sweep", s(&planar_spec), "--out", s(&cables)]);
     assert!(!ok && stderr.contains("cablemap-cables/1"), "{stderr}");
-    // The planar library reader names the kind of a cable run.
-    let e = cablemap::sweep::open_run(&cables, Completeness::Complete).unwrap_err().to_string();
+    // The library's reader opens a run of either kind; the planar map's
+    // reader names the kind of a cable run.
+    let run = cablemap::sweep::open_run(&cables, Completeness::Complete).unwrap();
+    assert_eq!(run.spec().kind(), cablemap::sweep::RunKind::Cables);
+    let e = cablemap::reduce::reduce_run(&cables, false, &Default::default()).unwrap_err().to_string();
     assert!(e.contains("cablemap-cables/1") && e.contains("another kind"), "{e}");
 }
 
@@ -552,9 +555,10 @@ fn the_shipped_job_specs_are_valid() {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("jobs").join(name);
         let text = std::fs::read_to_string(&path).unwrap();
         let job = cablemap::job::Job::load(&path).unwrap();
-        assert!(matches!(job.spec, cablemap::job::JobSpec::Cables(_)), "{name}");
-        let spec = CableSweepSpec::from_toml(&text, name).unwrap();
-        assert!(spec.routings() > 1 && spec.actuation_combinations() > 1);
+        assert!(matches!(&job.spec, cablemap::job::JobSpec::Sweep(s) if s.kind() == cablemap::sweep::RunKind::Cables), "{name}");
+        let spec = SweepSpec::from_toml(&text, name).unwrap();
+        let grid = spec.cables().unwrap();
+        assert!(grid.routings() > 1 && grid.actuation_combinations() > 1);
     }
 }
 

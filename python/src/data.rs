@@ -11,11 +11,11 @@
 
 use super::{bad, from_json, to_json, Failure, Result};
 use cablemap::job::{Job, JobError};
-use cablemap::map::{self, KindVisitor, MapError, MapKind, MapSettings, ReduceRequest, Source};
+use cablemap::map::{self, MapError, MapSettings, ReduceRequest, Source};
 use cablemap::reduce::tables::{map_tables as library_map_tables, ReadError};
 use cablemap::reduce::{ModeBoundaries, ReduceError, DEFAULT_MEMORY_SAMPLES};
 use cablemap::sweep::progress::ProgressMode;
-use cablemap::sweep::{open_run_of, run_kind, Completeness, RunKind, SweepError, SweepOptions};
+use cablemap::sweep::{open_run, Completeness, SweepError, SweepOptions};
 use parquet::arrow::ArrowWriter;
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
@@ -226,28 +226,21 @@ struct RunFiles {
     rows_total: u64,
 }
 
-/// Opens a run of the visited kind and lists its files.
-struct OpenRun<'a> {
-    dir: &'a Path,
-    completeness: Completeness,
-}
-
-impl KindVisitor for OpenRun<'_> {
-    type Output = Result<RunFiles>;
-    fn visit<S: MapKind>(self) -> Self::Output {
-        let run = open_run_of::<S>(self.dir, self.completeness).map_err(cablemap::reduce::run_open_error)?;
-        let mut empty = Vec::new();
-        let writer = ArrowWriter::try_new(&mut empty, run.schema(), None).map_err(|e| Failure::File(format!("the run's schema as Parquet: {e}")))?;
-        writer.close().map_err(|e| Failure::File(format!("the run's schema as Parquet: {e}")))?;
-        Ok(RunFiles {
-            kind: S::KIND,
-            format: S::FORMAT,
-            files: run.chunk_paths().into_iter().map(Path::to_path_buf).collect(),
-            empty,
-            rows_done: run.rows_done(),
-            rows_total: run.rows_total(),
-        })
-    }
+/// Opens a run of any kind and lists its files.
+fn open_run_files(dir: &Path, completeness: Completeness) -> Result<RunFiles> {
+    let run = open_run(dir, completeness).map_err(cablemap::reduce::run_open_error)?;
+    let mut empty = Vec::new();
+    let writer = ArrowWriter::try_new(&mut empty, run.schema(), None).map_err(|e| Failure::File(format!("the run's schema as Parquet: {e}")))?;
+    writer.close().map_err(|e| Failure::File(format!("the run's schema as Parquet: {e}")))?;
+    let kind = run.spec().kind();
+    Ok(RunFiles {
+        kind: kind.name(),
+        format: kind.format(),
+        files: run.chunk_paths().into_iter().map(Path::to_path_buf).collect(),
+        empty,
+        rows_done: run.rows_done(),
+        rows_total: run.rows_total(),
+    })
 }
 
 /// The checked chunk files of run directory `run` (a complete run unless
@@ -257,12 +250,7 @@ impl KindVisitor for OpenRun<'_> {
 #[pyfunction]
 fn run_files<'py>(py: Python<'py>, run: PathBuf, partial: bool) -> PyResult<Bound<'py, PyDict>> {
     let completeness = if partial { Completeness::AllowPartial } else { Completeness::Complete };
-    let open = || -> Result<RunFiles> {
-        // A directory without a manifest is opened as planar, whose reader
-        // says what it is instead (a map, missing, the parent of runs).
-        let kind = run_kind(&run).unwrap_or(RunKind::Planar);
-        map::on_kind(kind, OpenRun { dir: &run, completeness })
-    };
+    let open = || -> Result<RunFiles> { open_run_files(&run, completeness) };
     let files = py.detach(open).map_err(|e| e.into_py(py))?;
     let out = PyDict::new(py);
     out.set_item("kind", files.kind)?;

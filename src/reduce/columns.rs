@@ -11,7 +11,7 @@ use crate::sweep::schema::{
     coefficient_column, control_point_column, displacement_column, tension_column, Axis, LENGTH_MM, ROUTING_ID, STATUS, TENSION_N, TIP_ANGLE_RAD,
     TIP_TANGENT_X, TIP_TANGENT_Y, TIP_X_MM, TIP_Y_MM, Y_MM,
 };
-use crate::sweep::CableSweepSpec;
+use crate::sweep::spec::{CablesGrid, OutputSpec};
 use arrow::array::{Array, ArrayRef, AsArray, Float64Array, Int64Array, StringArray};
 use arrow::compute::cast;
 use arrow::datatypes::{DataType, Field, Float64Type, Int64Type, Schema};
@@ -122,14 +122,14 @@ impl RowColumns {
 
 /// The columns of a cable sweep's rows that [`cable_planar_batch`] reads:
 /// give them to the run's projected reader.
-pub(crate) fn cable_planar_columns(spec: &CableSweepSpec) -> Vec<String> {
+pub(crate) fn cable_planar_columns(spec: &CablesGrid, output: &OutputSpec) -> Vec<String> {
     let mut names: Vec<String> = vec![ROUTING_ID.into(), STATUS.into()];
     names.extend((0..CONTROL_POINTS).map(|p| control_point_column(1, Axis::Y, p)));
     names.extend((1..=spec.actuator.cables.len()).map(tension_column));
     // A displacement-driven cable's command (its row key) is its displacement.
     names.extend(spec.grids.iter().enumerate().filter(|(_, g)| g.by_displacement).map(|(c, _)| displacement_column(c + 1)));
     names.extend([TIP_X_MM, TIP_Y_MM, TIP_TANGENT_X, TIP_TANGENT_Y, LENGTH_MM].map(String::from));
-    names.extend((0..=spec.output.order).map(coefficient_column));
+    names.extend((0..=output.order).map(coefficient_column));
     names
 }
 
@@ -139,7 +139,7 @@ pub(crate) fn cable_planar_columns(spec: &CableSweepSpec) -> Vec<String> {
 /// = cable 1's, and `tip_angle_rad` = the signed in-plane tangent angle,
 /// continuous from the clamp. No mirror images are added (a pair's mirror
 /// is another routing of the spec, if swept).
-pub(crate) fn cable_planar_batch(spec: &CableSweepSpec, batch: &RecordBatch) -> Result<RecordBatch, ReduceError> {
+pub(crate) fn cable_planar_batch(spec: &CablesGrid, output: &OutputSpec, batch: &RecordBatch) -> Result<RecordBatch, ReduceError> {
     let grids = spec.actuation_grids();
     let f = |name: &str| batch.column_by_name(name).expect("projected").as_primitive::<Float64Type>().clone();
     let ids = batch.column_by_name(ROUTING_ID).expect("projected").as_primitive::<Int64Type>().clone();
@@ -176,7 +176,7 @@ pub(crate) fn cable_planar_batch(spec: &CableSweepSpec, batch: &RecordBatch) -> 
     // unwrap atan2 toward θ_e − θ_0 = a_0·L (rest basis; a_0·ℓ deformed),
     // the clamp's shear angle θ_0 being far below π.
     let (tx, ty, len, a0) = (f(TIP_TANGENT_X), f(TIP_TANGENT_Y), f(LENGTH_MM), f(&coefficient_column(0)));
-    let rest = spec.output.length_basis == LengthBasis::Rest;
+    let rest = output.length_basis == LengthBasis::Rest;
     let length_mm = spec.actuator.rod.length_mm;
     let angle: Float64Array = (0..n)
         .map(|i| {
@@ -190,7 +190,7 @@ pub(crate) fn cable_planar_batch(spec: &CableSweepSpec, batch: &RecordBatch) -> 
         })
         .collect();
     push(TIP_ANGLE_RAD, Arc::new(angle));
-    for i in 0..=spec.output.order {
+    for i in 0..=output.order {
         let name = coefficient_column(i);
         push(&name, batch.column_by_name(&name).expect("projected").clone());
     }

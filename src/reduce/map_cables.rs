@@ -13,7 +13,7 @@ use crate::model::routing::CONTROL_POINTS;
 use crate::solver::record::{simulate_command, SimulateCommand};
 use crate::model::Actuator;
 use crate::sweep::schema::Axis;
-use crate::sweep::CableSweepSpec;
+use crate::sweep::spec::{CablesGrid, OutputSpec, RoutingGrid, SweepSpec};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -38,20 +38,26 @@ struct CablesFile {
     /// Why the file is there, for a reader of the folder.
     about: String,
     /// The run's spec, every default filled in.
-    spec: CableSweepSpec,
+    spec: SweepSpec,
 }
 
 /// The cables of a several-cable map: the run's spec, and from it each
 /// design's actuator.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MapCables {
-    spec: CableSweepSpec,
+    spec: CablesGrid,
+    output: OutputSpec,
 }
+
+/// A [`CABLES_FILE`] holding a planar sweep's spec.
+#[derive(Debug, thiserror::Error)]
+#[error("it holds a planar sweep's spec, not a cable sweep's")]
+struct NotCables;
 
 impl MapCables {
     /// The cables of the map of a run of `spec`.
-    pub fn of_spec(spec: &CableSweepSpec) -> Self {
-        Self { spec: spec.clone() }
+    pub fn of_spec(spec: &CablesGrid, output: &OutputSpec) -> Self {
+        Self { spec: spec.clone(), output: output.clone() }
     }
 
     /// The cables of the map in `map_dir`: `None` for a map of one planar
@@ -63,8 +69,11 @@ impl MapCables {
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
             Err(e) => return Err(ReduceError::CablesFile { path, source: Box::new(e) }),
         };
-        let file: CablesFile = serde_json::from_str(&text).map_err(|e| ReduceError::CablesFile { path, source: Box::new(e) })?;
-        Ok(Some(Self { spec: file.spec }))
+        let file: CablesFile = serde_json::from_str(&text).map_err(|e| ReduceError::CablesFile { path: path.clone(), source: Box::new(e) })?;
+        match file.spec.routings {
+            RoutingGrid::Cables(spec) => Ok(Some(Self { spec, output: file.spec.output })),
+            RoutingGrid::Planar(_) => Err(ReduceError::CablesFile { path, source: Box::new(NotCables) }),
+        }
     }
 
     /// Writes [`CABLES_FILE`] into `dir`.
@@ -73,16 +82,21 @@ impl MapCables {
             about: "the cable sweep spec of this map: a design's routing_id (routing × tension combinations + combination) \
                     and this spec give every cable's routing and tension"
                 .into(),
-            spec: self.spec.clone(),
+            spec: SweepSpec { routings: RoutingGrid::Cables(self.spec.clone()), output: self.output.clone() },
         };
         let path = dir.join(CABLES_FILE);
         let json = serde_json::to_string_pretty(&file).map_err(|source| ReduceError::WriteJson { path: path.clone(), source })? + "\n";
         super::tables::write_file(&path, json.as_bytes())
     }
 
-    /// The run's spec.
-    pub fn spec(&self) -> &CableSweepSpec {
+    /// The run's cables and their grids.
+    pub fn spec(&self) -> &CablesGrid {
         &self.spec
+    }
+
+    /// What the run's rows store.
+    pub fn output(&self) -> &OutputSpec {
+        &self.output
     }
 
     /// Cables per actuator.
@@ -209,7 +223,8 @@ tension_n = { min = 0.0, max = 2.0, count = 11 }
 
     #[test]
     fn a_designs_row_key_gives_every_cable_and_the_file_reads_back() {
-        let cables = MapCables::of_spec(&CableSweepSpec::from_toml(SPEC, "test").unwrap());
+        let spec = SweepSpec::from_toml(SPEC, "test").unwrap();
+        let cables = MapCables::of_spec(spec.cables().unwrap(), &spec.output);
         // Routing 1 (y1 at its second level), combination 9·11 + 4: 1.8 N and 0.8 N.
         let key = row_key(1, 9 * 11 + 4, 121) as i64;
         let a = cables.actuator(key);

@@ -18,13 +18,14 @@
 //! mismatched or mixed-N parts; `MAP_DIR.parts/` may be removed once the
 //! map is merged.
 
-use super::pipeline::{check_options, reduce_spilled, run_open_error};
+use super::pipeline::{check_options, planar_grid, reduce_spilled, run_open_error};
 use super::samples::Pass1;
-use super::source::PlanarSource;
+use super::source::run_info;
 use super::spill::{self, SpillWriter, RECORD_BYTES};
 use super::error::{PartDamage, PartMismatch};
 use super::{columns, MapData, PartsError, ReduceError, ReduceOptions};
-use crate::sweep::{open_run, Completeness, SweepRun, SweepSpec};
+use crate::sweep::spec::PlanarGrid;
+use crate::sweep::{open_run, Completeness, SweepRun};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -109,7 +110,8 @@ pub fn write_part(run_dir: &Path, map_dir: &Path, shard: u64, shards: u64) -> Re
     }
     super::output::check_map_out(map_dir)?;
     let run = open_run(run_dir, Completeness::Complete).map_err(run_open_error)?;
-    let info = SweepSpec::run_info(&run);
+    planar_grid(&run)?;
+    let info = run_info(&run);
     let [first, end] = chunk_range(run.chunk_count(), shard, shards);
     let first_row: u64 = (0..first).map(|i| run.chunk_rows(i)).sum();
     let dir = parts_dir(map_dir);
@@ -324,9 +326,10 @@ fn read_parts(dir: &Path, run: &SweepRun) -> Result<(Vec<PathBuf>, Pass1), Parts
 
 /// Merges the parts in `map_dir`'s parts directory into the map of the
 /// run in `run_dir` (a complete run). Returns the map and the run's spec.
-pub fn merge_parts(run_dir: &Path, map_dir: &Path, options: &ReduceOptions) -> Result<(MapData, SweepSpec), ReduceError> {
+pub fn merge_parts(run_dir: &Path, map_dir: &Path, options: &ReduceOptions) -> Result<(MapData, PlanarGrid), ReduceError> {
     let run = open_run(run_dir, Completeness::Complete).map_err(run_open_error)?;
-    let info = SweepSpec::run_info(&run);
+    let grid = planar_grid(&run)?.clone();
+    let info = run_info(&run);
     check_options(&info, options)?;
     let (files, pass1) = read_parts(&parts_dir(map_dir), &run)?;
     let scratch = spill::ScratchDir::new(&options.scratch_parent())?;
@@ -335,7 +338,7 @@ pub fn merge_parts(run_dir: &Path, map_dir: &Path, options: &ReduceOptions) -> R
     let map = reduce_spilled(&info, options, spill::Samples::Files(files), &pass1, &scratch.path, || {
         Ok(run.batches_projected(&names)?.map(|b| b.map_err(ReduceError::from)))
     })?;
-    Ok((map, run.spec().clone()))
+    Ok((map, grid))
 }
 
 #[cfg(test)]

@@ -3,7 +3,7 @@
 //! scratch samples, modes, grid, partitioned cells, pass 2 for the kept
 //! designs); [`reduce_run`] maps a planar sweep, and [`reduce_cable_run`] a
 //! cable sweep: its reach and, for a planar run, its feasibility map by the
-//! same stages (`source::PlanarSource` lays its rows out as planar rows).
+//! same stages (`source::planar_batch` lays its rows out as planar rows).
 
 use super::drawings::ModeDrawings;
 use super::grid;
@@ -13,13 +13,14 @@ use super::partition;
 use crate::plot::Picture;
 use super::reach::Reach;
 use super::samples;
-use super::source::{PlanarSource, RunInfo};
+use super::source::{planar_batch, planar_columns, run_info, RunInfo};
 use super::spill;
 use super::tables::{self, PLANAR_MAP_DIR};
 use super::{fetch, CableMapSummary, Design, MapCables, MapData, MapSummary, ReduceError, ReduceOptions, CELL_STATS_ORDER, MODES};
 use crate::solver::STATUS_OK;
 use crate::sweep::schema::STATUS_INVALID_ROUTING;
-use crate::sweep::{open_run_of, CableSweepSpec, Completeness, RunSpec, SweepError, SweepRun, SweepSpec};
+use crate::sweep::spec::{CablesGrid, PlanarGrid};
+use crate::sweep::{open_run, Completeness, RunKind, SweepError, SweepRun};
 use arrow::record_batch::RecordBatch;
 use std::path::Path;
 
@@ -163,27 +164,44 @@ pub fn run_open_error(e: SweepError) -> ReduceError {
 
 /// Opens the run of kind `S` in `run_dir`, refusing an unfinished run
 /// unless `partial`.
-fn open<S: RunSpec>(run_dir: &Path, partial: bool) -> Result<SweepRun<S>, ReduceError> {
+fn open(run_dir: &Path, partial: bool) -> Result<SweepRun, ReduceError> {
     let completeness = if partial { Completeness::AllowPartial } else { Completeness::Complete };
-    open_run_of(run_dir, completeness).map_err(run_open_error)
+    open_run(run_dir, completeness).map_err(run_open_error)
+}
+
+/// The refusal of a run of another kind than `wanted`.
+fn other_kind(run: &SweepRun, wanted: RunKind) -> ReduceError {
+    let found = run.spec().kind().format().to_string();
+    ReduceError::Sweep(SweepError::OtherKind { dir: run.dir().to_path_buf(), found, wanted: wanted.format().to_string() })
+}
+
+/// The planar grid of a planar run, else [`SweepError::OtherKind`].
+pub(crate) fn planar_grid(run: &SweepRun) -> Result<&PlanarGrid, ReduceError> {
+    run.spec().planar().ok_or_else(|| other_kind(run, RunKind::Planar))
+}
+
+/// The cables' grid of a cable sweep, else [`SweepError::OtherKind`].
+fn cables_grid(run: &SweepRun) -> Result<&CablesGrid, ReduceError> {
+    run.spec().cables().ok_or_else(|| other_kind(run, RunKind::Cables))
 }
 
 /// Reduces the sweep run in `run_dir` (refusing an unfinished run unless
 /// `partial`). Returns the map and the run's spec (for drawing).
-pub fn reduce_run(run_dir: &Path, partial: bool, options: &ReduceOptions) -> Result<(MapData, SweepSpec), ReduceError> {
-    let run = open::<SweepSpec>(run_dir, partial)?;
+pub fn reduce_run(run_dir: &Path, partial: bool, options: &ReduceOptions) -> Result<(MapData, PlanarGrid), ReduceError> {
+    let run = open(run_dir, partial)?;
+    let grid = planar_grid(&run)?.clone();
     let map = planar_map(&run, options)?;
-    Ok((map, run.spec().clone()))
+    Ok((map, grid))
 }
 
 /// The feasibility map of an opened run of any kind whose rows read as
 /// planar rows, by [`reduce_batches`].
-fn planar_map<S: PlanarSource>(run: &SweepRun<S>, options: &ReduceOptions) -> Result<MapData, ReduceError> {
+fn planar_map(run: &SweepRun, options: &ReduceOptions) -> Result<MapData, ReduceError> {
     let spec = run.spec();
-    let info = S::run_info(run);
-    let names = spec.planar_columns();
+    let info = run_info(run);
+    let names = planar_columns(spec);
     let names: Vec<&str> = names.iter().map(String::as_str).collect();
-    reduce_batches(&info, options, || Ok(run.batches_projected(&names)?.map(|b| spec.planar_batch(b?))))
+    reduce_batches(&info, options, || Ok(run.batches_projected(&names)?.map(|b| planar_batch(spec, b?))))
 }
 
 /// A cable sweep's map as [`reduce_cable_run`] wrote it.
@@ -209,14 +227,15 @@ pub fn reduce_cable_run(
     out: &Path,
 ) -> Result<CableMap, ReduceError> {
     check_map_out(out)?;
-    let run: SweepRun<CableSweepSpec> = open(run_dir, partial)?;
-    let spec = run.spec();
-    let cell_mm = cell_mm.unwrap_or(spec.output.cell_mm);
+    let run = open(run_dir, partial)?;
+    let spec = cables_grid(&run)?;
+    let output = &run.spec().output;
+    let cell_mm = cell_mm.or(output.cell_mm).unwrap_or(super::DEFAULT_CELL_MM);
     check_cell_mm(cell_mm, spec.actuator.rod.length_mm)?;
     let reach = Reach::count(&run, cell_mm)?;
-    let planar = if spec.is_planar() && spec.output.order >= 1 {
+    let planar = if spec.is_planar() && output.order >= 1 {
         let map = planar_map(&run, &ReduceOptions { cell_mm, ..options.clone() })?;
-        let cables = MapCables::of_spec(spec);
+        let cables = MapCables::of_spec(spec, output);
         let drawings = ModeDrawings::of_cables(&map, &cables);
         Some((map, drawings, cables))
     } else {
@@ -225,7 +244,7 @@ pub fn reduce_cable_run(
     let counts = run.status_counts();
     let count = |s: &str| counts.get(s).copied().unwrap_or(0);
     let rows = run.rows_done();
-    let layout = spec.layout();
+    let layout = run.spec().layout();
     let summary = CableMapSummary {
         format: tables::MAP_FORMAT.into(),
         kind: "cables".into(),

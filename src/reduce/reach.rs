@@ -5,7 +5,7 @@
 
 use super::ReduceError;
 use crate::sweep::schema::{TIP_X_MM, TIP_Y_MM, TIP_Z_MM};
-use crate::sweep::{CableSweepSpec, SweepRun};
+use crate::sweep::SweepRun;
 use arrow::array::{Array, AsArray};
 use arrow::datatypes::Float64Type;
 use std::collections::BTreeMap;
@@ -31,7 +31,7 @@ pub(crate) struct Reach {
 
 impl Reach {
     /// Counts the solved tips of every written row, chunk by chunk.
-    pub fn count(run: &SweepRun<CableSweepSpec>, cell_mm: f64) -> Result<Self, ReduceError> {
+    pub fn count(run: &SweepRun, cell_mm: f64) -> Result<Self, ReduceError> {
         let mut reach = Reach { cell_mm, planes: Default::default(), voxels: BTreeMap::new(), tips: 0 };
         let index = |v: f64| (v / cell_mm).floor() as i32;
         for batch in run.batches_projected(&[TIP_X_MM, TIP_Y_MM, TIP_Z_MM])? {

@@ -1,12 +1,12 @@
 //! What the reducer reads of a run, for each kind of run: what it needs to
 //! know of the run ([`RunInfo`]) and the run's rows in the planar row layout
-//! ([`PlanarSource`]), so that one pipeline maps a planar sweep and a planar
+//! ([`planar_batch`]), so that one pipeline maps a planar sweep and a planar
 //! cable sweep alike.
 
 use super::columns::{cable_planar_batch, cable_planar_columns, RowColumns};
 use super::{MapBody, ReduceError};
 use crate::shape::LengthBasis;
-use crate::sweep::{CableSweepSpec, RunSpec, SweepRun, SweepSpec};
+use crate::sweep::{RoutingGrid, SweepRun, SweepSpec};
 use arrow::record_batch::RecordBatch;
 use serde::{Deserialize, Serialize};
 
@@ -37,70 +37,47 @@ pub struct RunInfo {
     pub body: MapBody,
 }
 
-/// A kind of run whose rows the planar reducer can map.
-pub(crate) trait PlanarSource: RunSpec {
-    /// What the reducer needs to know of an opened run of this kind.
-    fn run_info(run: &SweepRun<Self>) -> RunInfo;
-    /// The columns to read from the run.
-    fn planar_columns(&self) -> Vec<String>;
-    /// One batch of those columns in the planar row layout.
-    fn planar_batch(&self, batch: RecordBatch) -> Result<RecordBatch, ReduceError>;
-}
-
-/// A planar sweep's rows are in the planar layout already.
-impl PlanarSource for SweepSpec {
-    fn run_info(run: &SweepRun<Self>) -> RunInfo {
-        let spec = run.spec();
-        RunInfo {
-            mirrored: spec.grid.mirror_dedup,
-            order: spec.output.order,
-            tension_range_n: [spec.tension.min_n, spec.tension.max_n],
-            tensions_found: spec.displacement.is_some(),
-            radius_mm: spec.actuator.radius_mm,
-            length_mm: spec.actuator.length_mm,
-            run_dir: run.dir().display().to_string(),
-            spec_hash: run.manifest().spec_sha256.clone(),
-            length_basis: spec.output.length_basis,
-            body: MapBody::of(&spec.actuator),
+/// What the reducer needs to know of an opened run: a planar sweep's grid
+/// and ladder, or a planar cable sweep's grids (its tension range spans
+/// every cable's grid).
+pub(crate) fn run_info(run: &SweepRun) -> RunInfo {
+    let spec = run.spec();
+    let (mirrored, tension_range_n, tensions_found, rod) = match &spec.routings {
+        RoutingGrid::Planar(p) => (p.grid.mirror_dedup, [p.tension.min_n, p.tension.max_n], p.displacement.is_some(), &p.actuator),
+        RoutingGrid::Cables(c) => {
+            let tensions: Vec<f64> = c.grids.iter().filter(|g| !g.by_displacement).flat_map(|g| [g.actuation.min, g.actuation.max]).collect();
+            let range = [tensions.iter().copied().fold(f64::MAX, f64::min), tensions.iter().copied().fold(0.0, f64::max)];
+            (false, range, c.grids.iter().any(|g| g.by_displacement), &c.actuator.rod)
         }
-    }
-
-    fn planar_columns(&self) -> Vec<String> {
-        RowColumns::names(self.output.order)
-    }
-
-    fn planar_batch(&self, batch: RecordBatch) -> Result<RecordBatch, ReduceError> {
-        Ok(batch)
+    };
+    RunInfo {
+        mirrored,
+        order: spec.output.order,
+        tension_range_n,
+        tensions_found,
+        radius_mm: rod.radius_mm,
+        length_mm: rod.length_mm,
+        run_dir: run.dir().display().to_string(),
+        spec_hash: run.manifest().spec_sha256.clone(),
+        length_basis: spec.output.length_basis,
+        body: MapBody::of(rod),
     }
 }
 
-/// A planar cable sweep's rows, each with cable 1's routing and tension
-/// and its row key ([`cable_planar_batch`]); its tension range spans every
-/// cable's grid.
-impl PlanarSource for CableSweepSpec {
-    fn run_info(run: &SweepRun<Self>) -> RunInfo {
-        let spec = run.spec();
-        let tensions: Vec<f64> = spec.grids.iter().filter(|g| !g.by_displacement).flat_map(|g| [g.actuation.min, g.actuation.max]).collect();
-        let rod = &spec.actuator.rod;
-        RunInfo {
-            mirrored: false,
-            order: spec.output.order,
-            tension_range_n: [tensions.iter().copied().fold(f64::MAX, f64::min), tensions.iter().copied().fold(0.0, f64::max)],
-            tensions_found: spec.grids.iter().any(|g| g.by_displacement),
-            radius_mm: rod.radius_mm,
-            length_mm: rod.length_mm,
-            run_dir: run.dir().display().to_string(),
-            spec_hash: run.manifest().spec_sha256.clone(),
-            length_basis: spec.output.length_basis,
-            body: MapBody::of(rod),
-        }
+/// The columns to read from the run for its rows in the planar layout.
+pub(crate) fn planar_columns(spec: &SweepSpec) -> Vec<String> {
+    match &spec.routings {
+        RoutingGrid::Planar(_) => RowColumns::names(spec.output.order),
+        RoutingGrid::Cables(c) => cable_planar_columns(c, &spec.output),
     }
+}
 
-    fn planar_columns(&self) -> Vec<String> {
-        cable_planar_columns(self)
-    }
-
-    fn planar_batch(&self, batch: RecordBatch) -> Result<RecordBatch, ReduceError> {
-        cable_planar_batch(self, &batch)
+/// One batch of [`planar_columns`] in the planar row layout: a planar
+/// sweep's rows are in it already; a planar cable sweep's rows carry cable
+/// 1's routing and tension and their row key ([`cable_planar_batch`]).
+pub(crate) fn planar_batch(spec: &SweepSpec, batch: RecordBatch) -> Result<RecordBatch, ReduceError> {
+    match &spec.routings {
+        RoutingGrid::Planar(_) => Ok(batch),
+        RoutingGrid::Cables(c) => cable_planar_batch(c, &spec.output, &batch),
     }
 }

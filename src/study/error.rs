@@ -138,6 +138,9 @@ pub enum SpecProblem {
     /// The base sweep spec is refused.
     #[error("the base sweep spec: {0}")]
     Base(#[source] Box<crate::sweep::SweepError>),
+    /// A base spec of several or spatial cables.
+    #[error("the base sweep spec has [[cable]] tables: a study varies a planar sweep spec")]
+    CableBase,
     /// No axes.
     #[error("[study] has no [[study.axis]]: give at least one axis (name and values or scale)")]
     NoAxes,

@@ -100,6 +100,9 @@ impl StudySpec {
         let section: StudySection = section.try_into().map_err(|e| bad(SpecProblem::StudySection(e)))?;
         let base_text = toml::to_string(&table).map_err(|e| bad(SpecProblem::BaseText(e)))?;
         let base = SweepSpec::from_toml(&base_text, origin).map_err(|e| bad(SpecProblem::Base(Box::new(e))))?;
+        if base.planar().is_none() {
+            return Err(bad(SpecProblem::CableBase));
+        }
         if section.axis.is_empty() {
             return Err(bad(SpecProblem::NoAxes));
         }
@@ -111,7 +114,7 @@ impl StudySpec {
                 return Err(bad(SpecProblem::AxisTwice { axis: a.name.clone() }));
             }
             // The tension ladder of a cable driven by its displacement is unused.
-            if base.displacement.is_some() && changes.iter().any(|(_, c)| matches!(c, Change::Tension { .. })) {
+            if base.planar().is_some_and(|p| p.displacement.is_some()) && changes.iter().any(|(_, c)| matches!(c, Change::Tension { .. })) {
                 return Err(bad(SpecProblem::TensionOfDisplacement { axis: a.name.clone() }));
             }
             axes.push((a.name.clone(), changes));
@@ -172,10 +175,10 @@ mod tests {
         assert_eq!(s.variants.len(), 4);
         let v = &s.variants[1];
         assert_eq!(v.label(), "length_mm=55, ei_n_mm2=×1.25");
-        assert_eq!(v.spec.actuator.length_mm, 55.0);
-        assert_eq!(v.spec.actuator.ei_n_mm2, 115.117 * 1.25);
-        assert_eq!(v.spec.grid.levels, 3);
-        assert_eq!(s.variants[2].spec.actuator.length_mm, 65.0);
+        assert_eq!(v.spec.planar().unwrap().actuator.length_mm, 55.0);
+        assert_eq!(v.spec.planar().unwrap().actuator.ei_n_mm2, 115.117 * 1.25);
+        assert_eq!(v.spec.planar().unwrap().grid.levels, 3);
+        assert_eq!(s.variants[2].spec.planar().unwrap().actuator.length_mm, 65.0);
         // The variant's spec.toml reads back as the same spec (same hash: same run).
         let text = toml::to_string(&v.spec).unwrap();
         assert_eq!(SweepSpec::from_toml(&text, "v").unwrap().hash_hex(), v.spec.hash_hex());
@@ -193,9 +196,9 @@ mod tests {
         )
         .unwrap();
         assert_eq!(s.variants.len(), 4);
-        assert_eq!(s.variants[3].spec.tension.max_n, 3.0);
-        assert_eq!(s.variants[3].spec.actuator.effects.friction_mu, 0.1);
-        assert_eq!(s.variants[2].spec.actuator.effects.friction_mu, 0.0);
+        assert_eq!(s.variants[3].spec.planar().unwrap().tension.max_n, 3.0);
+        assert_eq!(s.variants[3].spec.planar().unwrap().actuator.effects.friction_mu, 0.1);
+        assert_eq!(s.variants[2].spec.planar().unwrap().actuator.effects.friction_mu, 0.0);
         assert_eq!(s.variants[3].label(), format!("tension_n=1–3 N, effects={{{friction}:0.1}}"));
     }
 
@@ -206,7 +209,7 @@ mod tests {
             // Without mirror_dedup: a tilt or an offset breaks the mirror symmetry.
             let text = format!("[grid]\nmirror_dedup = false\n[study]\n[[study.axis]]\nname = \"{}\"\nvalues = [{v}]\n", info.path);
             let s = StudySpec::from_toml(&text, "t").unwrap_or_else(|e| panic!("{}: {e}", info.path));
-            assert_eq!((info.get)(&s.variants[0].spec.actuator), v, "{}", info.path);
+            assert_eq!((info.get)(&s.variants[0].spec.planar().unwrap().actuator), v, "{}", info.path);
         }
     }
 
@@ -224,7 +227,7 @@ mod tests {
         assert!(err(&format!("{displaced}[study]\n[[study.axis]]\nname = \"tension_n\"\nvalues = [[1.0, 2.0]]\n")).contains("[displacement]"));
         // Other axes over a displacement-driven base keep its ladder.
         let s = StudySpec::from_toml(&format!("{displaced}[study]\n[[study.axis]]\nname = \"ei_n_mm2\"\nvalues = [100.0, 120.0]\n"), "t").unwrap();
-        assert!(s.variants.iter().all(|v| v.spec.displacement.as_ref().is_some_and(|d| d.count == 3)));
+        assert!(s.variants.iter().all(|v| v.spec.planar().unwrap().displacement.as_ref().is_some_and(|d| d.count == 3)));
         let e = err("[study]\n[[study.axis]]\nname = \"length_mm\"\nvalues = [65, -5]\n");
         assert!(e.contains("variant 1 (length_mm=-5)") && e.contains("length_mm"), "{e}");
         assert!(err("[grid]\nlevles = 3\n[study]\n[[study.axis]]\nname = \"length_mm\"\nvalues = [65]\n").contains("levles"));

@@ -26,7 +26,7 @@
 //! its neighbours and on the sharding).
 
 use super::kind::ChunkLayout;
-use super::spec::SweepSpec;
+use super::spec::{OutputSpec, PlanarGrid};
 use crate::model::routing::{ControlPoints, CONTROL_POINTS};
 use std::ops::Range;
 
@@ -45,12 +45,12 @@ pub struct SweepPlan {
 }
 
 impl SweepPlan {
-    /// The plan of a (validated) spec.
-    pub fn new(spec: &SweepSpec) -> Self {
+    /// The plan of a (validated) planar spec's grid and output.
+    pub fn new(spec: &PlanarGrid, output: &OutputSpec) -> Self {
         let levels = u64::from(spec.grid.levels);
         let grid = levels.pow(CONTROL_POINTS as u32);
         let routings = if spec.grid.mirror_dedup { grid.div_ceil(2) } else { grid };
-        let chunk_routings = u64::from(spec.output.chunk_routings);
+        let chunk_routings = u64::from(output.chunk_routings);
         Self {
             levels_mm: spec.levels_mm(),
             routings,
@@ -116,12 +116,14 @@ impl SweepPlan {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sweep::SweepSpec;
     use proptest::prelude::*;
     use std::collections::HashSet;
 
     #[test]
     fn thesis_grid_has_the_thesis_count() {
-        let plan = SweepPlan::new(&SweepSpec::thesis());
+        let thesis = SweepSpec::thesis();
+        let plan = SweepPlan::new(thesis.planar().unwrap(), &thesis.output);
         assert_eq!(plan.routings, 29_525);
         assert_eq!(plan.total_rows(), 620_025);
         // The last kept routing is the self-mirror straight one.
@@ -141,12 +143,12 @@ mod tests {
     #[test]
     fn mirror_dedup_keeps_exactly_one_of_each_pair() {
         for levels in 1..=6u32 {
-            let mut spec = SweepSpec::default();
+            let (mut spec, output) = (PlanarGrid::default(), SweepSpec::default().output);
             spec.grid.levels = levels;
             spec.grid.mirror_dedup = false;
-            let full = SweepPlan::new(&spec);
+            let full = SweepPlan::new(&spec, &output);
             spec.grid.mirror_dedup = true;
-            let kept = SweepPlan::new(&spec);
+            let kept = SweepPlan::new(&spec, &output);
             let pairs: HashSet<[u64; 5]> = (0..full.routings).map(|id| canonical(full.routing_mm(id).0)).collect();
             let ours: HashSet<[u64; 5]> = (0..kept.routings)
                 .map(|id| {
@@ -165,13 +167,13 @@ mod tests {
         /// shard, whatever the grid, chunk size and shard count.
         #[test]
         fn shards_partition_rows(levels in 1u32..6, dedup: bool, tensions in 1u32..4, chunk in 1u32..40, shards in 1u64..20) {
-            let mut spec = SweepSpec::default();
+            let (mut spec, mut output) = (PlanarGrid::default(), SweepSpec::default().output);
             spec.grid.levels = levels;
             spec.grid.mirror_dedup = dedup;
             spec.tension.count = tensions;
             spec.tension.max_n = if tensions == 1 { spec.tension.min_n } else { 2.0 };
-            spec.output.chunk_routings = chunk;
-            let plan = SweepPlan::new(&spec);
+            output.chunk_routings = chunk;
+            let plan = SweepPlan::new(&spec, &output);
             let mut seen = HashSet::new();
             let mut rows = 0u64;
             for s in 0..shards {

@@ -16,23 +16,6 @@ pub enum SweepError {
         /// What is wrong.
         source: spec::SpecError,
     },
-    /// A cable sweep spec is malformed or invalid.
-    #[error("bad cable sweep spec {origin}: {source}")]
-    BadCableSpec {
-        /// The spec file, or where an in-memory spec came from.
-        origin: String,
-        /// What is wrong.
-        source: spec::CableSpecError,
-    },
-    /// A spec the engine refuses ([`super::RunSpec::check`] of an in-memory
-    /// spec of any kind).
-    #[error("bad sweep spec {origin}: {source}")]
-    InvalidSpec {
-        /// The spec file, or where an in-memory spec came from.
-        origin: String,
-        /// What is wrong.
-        source: kind::InvalidSpec,
-    },
     /// The whole sweep is larger than a sweep may be without `--allow-large`.
     #[error(
         "bad sweep spec (size): the sweep has {rows} rows ({routings} routings × {per_routing} {}), more than {}: check {}, or pass \

@@ -1,16 +1,17 @@
 //! What a kind of sweep is to the engine: a spec that enumerates routings
 //! (ids 0..routings, each with the same number of rows) and solves one
-//! routing into rows of a fixed Arrow schema ([`RunSpec`]). The one engine
-//! ([`crate::sweep::run`]) and the one run directory ([`crate::sweep::store`])
-//! serve every kind; each spec declares its kind once, in its `impl RunSpec`
+//! routing into rows of a fixed Arrow schema ([`RunSpec`]). The one spec
+//! ([`crate::sweep::SweepSpec`]), the one engine ([`crate::sweep::run`]) and
+//! the one run directory ([`crate::sweep::store`]) serve every kind; each
+//! kind declares itself once, in its `impl RunSpec`
 //! ([`crate::sweep::spec::planar`], [`crate::sweep::spec::cables`]).
 //!
 //! Chunks, shards and row counts follow from [`ChunkLayout`] alone, so
 //! sharding, resume, checksums and status are the same code for every kind,
 //! within the same limits ([`MAX_CHUNK_ROWS`], [`MAX_ROWS`]).
 
+use super::spec::{OutputSpec, SpecError};
 use super::SweepError;
-use crate::shape::LengthBasis;
 use arrow::datatypes::SchemaRef;
 use arrow::record_batch::RecordBatch;
 use std::ops::Range;
@@ -79,56 +80,36 @@ impl ChunkLayout {
     }
 }
 
-/// A spec the sweep engine can run: it fixes the run's format tag, its
-/// chunk layout and row schema, and solves one routing at a time.
-pub trait RunSpec: Clone + PartialEq + std::fmt::Debug + serde::Serialize + serde::de::DeserializeOwned + Send + Sync {
-    /// Format tag of the run's manifest and chunk footers.
-    const FORMAT: &'static str;
-    /// What `cablemap status` calls this kind of run.
-    const KIND: &'static str;
+/// A kind of sweep ([`super::spec::RoutingGrid`]'s variants): what the
+/// engine needs of it besides the spec's [`OutputSpec`] (given to each
+/// method): its run kind, its chunk layout and row schema, and how one
+/// routing is solved.
+pub trait RunSpec {
+    /// The kind of run (its format tag and name).
+    const KIND: RunKind;
     /// Per-thread solver state, cloned from a prototype for each worker.
     type Worker: Clone + Send + Sync;
     /// One solved routing (all its rows), ready for [`Self::batch`].
     type Solved: Send;
 
-    /// Checks the spec; the message names the setting.
-    fn check(&self) -> Result<(), InvalidSpec>;
-    /// Checks the whole sweep's size (refused above a bound unless `allow_large`).
-    fn check_run_size(&self, allow_large: bool) -> Result<(), SweepError>;
-    /// The spec with every default filled in, as compact JSON.
-    fn canonical_json(&self) -> String;
-    /// SHA-256 of [`Self::canonical_json`], hex.
-    fn hash_hex(&self) -> String;
-    /// The length the rows' a_i are per unit of.
-    fn length_basis(&self) -> LengthBasis;
-    /// Highest Legendre order stored.
-    fn order(&self) -> usize;
+    /// Checks the settings; the error names the setting.
+    fn check(&self, output: &OutputSpec) -> Result<(), SpecError>;
+    /// What a row of a routing is, for [`SweepError::TooLarge`].
+    fn rows_counted(&self) -> RowsCounted;
     /// Routings, rows per routing, chunks.
-    fn layout(&self) -> ChunkLayout;
+    fn layout(&self, output: &OutputSpec) -> ChunkLayout;
     /// The Arrow schema of the rows (docs/schema.md).
-    fn schema(&self) -> SchemaRef;
+    fn schema(&self, output: &OutputSpec) -> SchemaRef;
     /// Estimated bytes one row takes in memory while its chunk is built
     /// (every copy: solved rows, Arrow batch, encoder buffer); sizes the
     /// engine's memory check.
-    fn row_bytes(&self) -> u64;
+    fn row_bytes(&self, output: &OutputSpec) -> u64;
     /// The prototype worker.
     fn worker(&self) -> Result<Self::Worker, SweepError>;
     /// Solves routing `id`: [`ChunkLayout::tensions`] rows.
-    fn solve(&self, worker: &mut Self::Worker, id: u64) -> Result<Self::Solved, SweepError>;
+    fn solve(&self, output: &OutputSpec, worker: &mut Self::Worker, id: u64) -> Result<Self::Solved, SweepError>;
     /// The rows of a chunk's solved routings (in id order) as one batch of [`Self::schema`].
-    fn batch(&self, schema: &SchemaRef, solved: &[Self::Solved]) -> RecordBatch;
-}
-
-/// Why [`RunSpec::check`] refuses a spec: the setting and what to do, in
-/// the kind's own words (without the spec's origin, which the caller knows).
-#[derive(Debug, thiserror::Error)]
-pub enum InvalidSpec {
-    /// A planar sweep spec's setting.
-    #[error("{0}")]
-    Planar(#[source] super::spec::SpecError),
-    /// A cable sweep spec's setting.
-    #[error("{0}")]
-    Cables(#[source] super::spec::CableSpecError),
+    fn batch(&self, output: &OutputSpec, schema: &SchemaRef, solved: &[Self::Solved]) -> RecordBatch;
 }
 
 /// What a kind of sweep counts per routing, and where the counts are set
@@ -162,14 +143,32 @@ impl RowsCounted {
     }
 }
 
-/// The kind of sweep a run directory holds, from its manifest's format tag
-/// ([`crate::sweep::store::run_kind`] reads it).
+/// The kind of sweep a spec makes and a run directory holds (from its
+/// manifest's format tag, [`crate::sweep::store::run_kind`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum RunKind {
-    /// A planar single-cable sweep ([`crate::sweep::SweepSpec`]).
+    /// A planar single-cable sweep ([`crate::sweep::spec::PlanarGrid`]).
     Planar,
-    /// A sweep of several or spatial cables ([`crate::sweep::CableSweepSpec`]).
+    /// A sweep of several or spatial cables ([`crate::sweep::spec::CablesGrid`]).
     Cables,
+}
+
+impl RunKind {
+    /// The format tag of the kind's manifest and chunk footers.
+    pub fn format(self) -> &'static str {
+        match self {
+            RunKind::Planar => crate::io::run_markers::PLANAR_FORMAT,
+            RunKind::Cables => crate::io::run_markers::CABLES_FORMAT,
+        }
+    }
+
+    /// What `cablemap status` calls the kind.
+    pub fn name(self) -> &'static str {
+        match self {
+            RunKind::Planar => "planar single-cable sweep",
+            RunKind::Cables => "cable sweep",
+        }
+    }
 }
 
 #[cfg(test)]

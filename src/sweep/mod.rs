@@ -2,9 +2,9 @@
 //! tensions, written as Parquet chunks (thesis Ch. 4, model-notes §5). One
 //! engine serves every kind of sweep; a spec declares its kind once.
 //!
-//! - [`spec`]: the TOML job specs and their hashes, each with its kind
-//!   ([`RunSpec`]): the planar [`SweepSpec`], the [`CableSweepSpec`] of
-//!   several or spatial cables.
+//! - [`spec`]: the TOML job spec and its hash: one [`SweepSpec`] whose
+//!   routing grid is of a kind ([`RunSpec`]): the thesis's planar grid, or a
+//!   grid of several or spatial cables.
 //! - [`kind`]: what a kind of sweep provides the engine, and the limits every
 //!   kind keeps.
 //! - [`enumerate`]: planar routing ids, mirror de-duplication, chunks and shards.
@@ -32,10 +32,10 @@ pub mod store;
 
 pub use enumerate::SweepPlan;
 pub use error::SweepError;
-pub use kind::{ChunkLayout, InvalidSpec, RunKind, RunSpec};
-pub use read::{open_run, open_run_of, Completeness, SweepRun};
+pub use kind::{ChunkLayout, RunKind, RunSpec};
+pub use read::{open_run, Completeness, SweepRun};
 pub use report::{StatusReport, SweepReport};
-pub use run::{run_sweep, run_sweep_of, SweepOptions, SweepSummary, MAX_SHARDS};
-pub use spec::{CableSweepSpec, SweepSpec};
-pub use status::{run_status, run_status_of, RunStatus};
+pub use run::{run_sweep, SweepOptions, SweepSummary, MAX_SHARDS};
+pub use spec::{OutputSpec, RoutingGrid, SweepSpec};
+pub use status::{run_status, RunStatus};
 pub use store::run_kind;

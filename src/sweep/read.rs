@@ -7,7 +7,7 @@
 //! use arrow::datatypes::Float64Type;
 //!
 //! let run = open_run("runs/thesis".as_ref(), Completeness::Complete)?;
-//! println!("{} rows, {} levels", run.rows_done(), run.spec().grid.levels);
+//! println!("{} rows of order {}", run.rows_done(), run.spec().output.order);
 //! for batch in run.batches_projected(&["tip_x_mm", "tip_y_mm", "a0", "status"])? {
 //!     let batch = batch?;
 //!     let x: &Float64Array = batch.column_by_name("tip_x_mm").unwrap().as_primitive::<Float64Type>();
@@ -22,7 +22,6 @@
 //! chunk file at a time, in chunk order (routing id, then tension, rising),
 //! so memory does not grow with the number of rows.
 
-use super::kind::RunSpec;
 use super::spec::SweepSpec;
 use super::store::{ChunkInfo, ChunkProblem, Manifest, RunDir};
 use super::error::FileOp;
@@ -47,12 +46,11 @@ pub enum Completeness {
     AllowPartial,
 }
 
-/// A checked run directory, ready to read: a planar sweep by default, or
-/// any kind of sweep `S` ([`open_run_of`]).
+/// A checked run directory of any kind, ready to read.
 #[derive(Debug, Clone)]
-pub struct SweepRun<S = SweepSpec> {
+pub struct SweepRun {
     dir: PathBuf,
-    manifest: Manifest<S>,
+    manifest: Manifest,
     chunks: Vec<ChunkInfo>,
 }
 
@@ -60,14 +58,8 @@ pub struct SweepRun<S = SweepSpec> {
 /// file in `DIR/shards` must be a chunk of this run with the right row
 /// count, and with [`Completeness::Complete`] every chunk must be present.
 pub fn open_run(dir: &Path, completeness: Completeness) -> Result<SweepRun, SweepError> {
-    open_run_of::<SweepSpec>(dir, completeness)
-}
-
-/// [`open_run`] for a sweep of kind `S` (e.g. `open_run_of::<CableSweepSpec>`
-/// for a cable sweep; [`super::run_kind`] tells which kind a directory holds).
-pub fn open_run_of<S: RunSpec>(dir: &Path, completeness: Completeness) -> Result<SweepRun<S>, SweepError> {
     let run = RunDir::new(dir);
-    let manifest: Manifest<S> = run.read_manifest()?.ok_or_else(|| SweepError::no_run(dir))?;
+    let manifest: Manifest = run.read_manifest()?.ok_or_else(|| SweepError::no_run(dir))?;
     let scan = run.scan(&manifest)?;
     if !scan.damaged.is_empty() {
         return Err(SweepError::DamagedChunks { dir: dir.to_path_buf(), damaged: scan.damaged, shards: manifest.shards });
@@ -80,19 +72,19 @@ pub fn open_run_of<S: RunSpec>(dir: &Path, completeness: Completeness) -> Result
     Ok(sweep)
 }
 
-impl<S: RunSpec> SweepRun<S> {
+impl SweepRun {
     /// The run directory.
     pub fn dir(&self) -> &Path {
         &self.dir
     }
 
     /// The spec the run was made with (all defaults filled in).
-    pub fn spec(&self) -> &S {
+    pub fn spec(&self) -> &SweepSpec {
         &self.manifest.spec
     }
 
     /// The manifest (spec hash, tool version, counts).
-    pub fn manifest(&self) -> &Manifest<S> {
+    pub fn manifest(&self) -> &Manifest {
         &self.manifest
     }
 

@@ -2,7 +2,6 @@
 //! JSON `--json` prints ([`serde::Serialize`]) and the text the command
 //! line prints ([`std::fmt::Display`]).
 
-use super::kind::RunSpec;
 use super::run::SweepSummary;
 use super::status::{RunStatus, ShardStatus};
 use super::store::{failures, DamagedChunk};
@@ -17,9 +16,9 @@ use std::path::PathBuf;
 pub struct StatusReport {
     /// The run directory.
     pub dir: PathBuf,
-    /// What status calls this kind of run ([`RunSpec::KIND`]).
+    /// What status calls this kind of run ([`super::RunKind::name`]).
     pub kind: &'static str,
-    /// The run's format tag ([`RunSpec::FORMAT`]).
+    /// The run's format tag ([`super::RunKind::format`]).
     pub format: &'static str,
     /// A planar single-cable run: its status names no kind (the thesis's runs) and counts tensions.
     pub planar: bool,
@@ -60,14 +59,15 @@ pub struct StatusReport {
 }
 
 impl StatusReport {
-    /// The report of a run of kind `S`.
-    pub fn new<S: RunSpec>(s: &RunStatus<S>) -> Self {
+    /// The report of a run's status.
+    pub fn new(s: &RunStatus) -> Self {
         let m = &s.manifest;
+        let kind = m.spec.kind();
         Self {
             dir: s.dir.clone(),
-            kind: S::KIND,
-            format: S::FORMAT,
-            planar: S::FORMAT == super::store::FORMAT,
+            kind: kind.name(),
+            format: kind.format(),
+            planar: kind == super::RunKind::Planar,
             spec_sha256: m.spec_sha256.clone(),
             tool_version: m.tool_version.clone(),
             routings: m.routings,
@@ -75,7 +75,7 @@ impl StatusReport {
             total_rows: m.total_rows,
             chunks: m.chunks,
             shard_count: m.shards,
-            order: m.spec.order(),
+            order: m.spec.output.order,
             length_basis: m.length_basis,
             shards: s.shards.clone(),
             status_counts: s.status_counts.clone(),
@@ -202,7 +202,7 @@ pub struct SweepReport {
 
 impl SweepReport {
     /// The report of `summary` with the run's `status` after it.
-    pub fn new<S: RunSpec>(summary: SweepSummary, status: &RunStatus<S>) -> Self {
+    pub fn new(summary: SweepSummary, status: &RunStatus) -> Self {
         Self { summary, status: StatusReport::new(status) }
     }
 }

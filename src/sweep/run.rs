@@ -17,8 +17,8 @@
 
 use super::kind::{ChunkLayout, RunSpec};
 use super::progress::{Progress, ProgressMode};
-use super::spec::SweepSpec;
-use super::store::{total_status_counts, ChunkInfo, RunDir};
+use super::spec::{OutputSpec, RoutingGrid, SweepSpec};
+use super::store::{total_status_counts, ChunkInfo, Manifest, RunDir};
 use super::SweepError;
 use rayon::prelude::*;
 use std::collections::BTreeMap;
@@ -67,7 +67,7 @@ const SHARD_STATUS_BYTES: u64 = 64;
 /// estimated memory (chunks being built, one per thread, and the tables of
 /// chunk files and shards) is more than the machine has available, unless
 /// `allow_large`. The message gives the figures and what to change.
-fn check_memory<S: RunSpec>(spec: &S, shards: u64, threads: usize, allow_large: bool) -> Result<(), SweepError> {
+fn check_memory(spec: &SweepSpec, shards: u64, threads: usize, allow_large: bool) -> Result<(), SweepError> {
     let layout = spec.layout();
     let chunk_rows = layout.chunk_routings.min(layout.routings).saturating_mul(layout.tensions);
     let chunk_bytes = chunk_rows.saturating_mul(spec.row_bytes());
@@ -157,17 +157,10 @@ impl SweepSummary {
     }
 }
 
-/// Runs (or resumes) shard `options.shard` of `spec` into `dir`.
+/// Runs (or resumes) shard `options.shard` of `spec` (of any kind) into `dir`.
 pub fn run_sweep(spec: &SweepSpec, dir: &Path, options: &SweepOptions) -> Result<SweepSummary, SweepError> {
-    spec.validate().map_err(|source| SweepError::BadSpec { origin: "(in memory)".into(), source })?;
-    run_sweep_of(spec, dir, options)
-}
-
-/// Runs (or resumes) shard `options.shard` of a sweep of any kind
-/// ([`RunSpec`]: planar, or several/spatial cables) into `dir`.
-pub fn run_sweep_of<S: RunSpec>(spec: &S, dir: &Path, options: &SweepOptions) -> Result<SweepSummary, SweepError> {
     let started = Instant::now();
-    spec.check().map_err(|source| SweepError::InvalidSpec { origin: "(in memory)".into(), source })?;
+    spec.validate().map_err(|source| SweepError::BadSpec { origin: "(in memory)".into(), source })?;
     let (shard, shards) = (options.shard, options.shards);
     if shards == 0 || shard >= shards {
         return Err(SweepError::BadShard { shard, shards });
@@ -178,7 +171,7 @@ pub fn run_sweep_of<S: RunSpec>(spec: &S, dir: &Path, options: &SweepOptions) ->
     if options.threads == Some(0) {
         return Err(SweepError::NoThreads);
     }
-    spec.check_run_size(options.allow_large)?;
+    spec.check_size(options.allow_large)?;
     let (threads_wanted, capped) = capped_threads(options.threads);
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     check_memory(spec, shards, threads_wanted.unwrap_or(cores), options.allow_large)?;
@@ -261,28 +254,10 @@ pub fn run_sweep_of<S: RunSpec>(spec: &S, dir: &Path, options: &SweepOptions) ->
     }
     let progress = Progress::new(options.progress, label, shard_rows, rows_skipped);
 
-    let prototype = spec.worker()?;
-    let schema = spec.schema();
-    let written: Vec<ChunkInfo> = pool.install(|| {
-        pending
-            .par_iter()
-            .map(|&chunk| {
-                let routings = plan
-                    .chunk_ids(chunk)
-                    .into_par_iter()
-                    .map_init(
-                        || prototype.clone(),
-                        |worker, id| {
-                            let solved = spec.solve(worker, id);
-                            progress.add(plan.tensions);
-                            solved
-                        },
-                    )
-                    .collect::<Result<Vec<_>, _>>()?;
-                let batch = spec.batch(&schema, &routings);
-                run.write_chunk(&manifest, chunk, &batch)
-            })
-            .collect::<Result<Vec<_>, _>>()
+    let chunks = Chunks { run: &run, manifest: &manifest, plan, pending: &pending, progress: &progress };
+    let written = pool.install(|| match &spec.routings {
+        RoutingGrid::Planar(grid) => chunks.solve(grid, &spec.output),
+        RoutingGrid::Cables(grid) => chunks.solve(grid, &spec.output),
     })?;
     progress.finish();
 
@@ -305,4 +280,42 @@ pub fn run_sweep_of<S: RunSpec>(spec: &S, dir: &Path, options: &SweepOptions) ->
         wall_s,
         solves_per_s: rows_written as f64 / wall_s.max(1e-9),
     })
+}
+
+/// The chunks a shard still has to solve and write.
+struct Chunks<'a> {
+    run: &'a RunDir,
+    manifest: &'a Manifest,
+    plan: ChunkLayout,
+    pending: &'a [u64],
+    progress: &'a Progress,
+}
+
+impl Chunks<'_> {
+    /// Solves and writes the pending chunks of a sweep of kind `K` (in
+    /// parallel: the chunks, and the routings of each chunk).
+    fn solve<K: RunSpec + Sync>(&self, kind: &K, output: &OutputSpec) -> Result<Vec<ChunkInfo>, SweepError> {
+        let prototype = kind.worker()?;
+        let schema = kind.schema(output);
+        let plan = self.plan;
+        self.pending
+            .par_iter()
+            .map(|&chunk| {
+                let routings = plan
+                    .chunk_ids(chunk)
+                    .into_par_iter()
+                    .map_init(
+                        || prototype.clone(),
+                        |worker, id| {
+                            let solved = kind.solve(output, worker, id);
+                            self.progress.add(plan.tensions);
+                            solved
+                        },
+                    )
+                    .collect::<Result<Vec<_>, _>>()?;
+                let batch = kind.batch(output, &schema, &routings);
+                self.run.write_chunk(self.manifest, chunk, &batch)
+            })
+            .collect()
+    }
 }

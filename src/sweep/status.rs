@@ -1,8 +1,6 @@
 //! `cablemap status DIR`: what a run directory holds: rows done per shard,
 //! failures by status, chunks in progress, and whether the run is complete.
 
-use super::kind::RunSpec;
-use super::spec::SweepSpec;
 use super::store::{failures, total_status_counts, DamagedChunk, Manifest, RunDir};
 use super::SweepError;
 use serde::Serialize;
@@ -28,11 +26,11 @@ pub struct ShardStatus {
 
 /// The state of a run directory.
 #[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct RunStatus<S = SweepSpec> {
+pub struct RunStatus {
     /// The run directory.
     pub dir: PathBuf,
     /// The manifest.
-    pub manifest: Manifest<S>,
+    pub manifest: Manifest,
     /// One entry per shard.
     pub shards: Vec<ShardStatus>,
     /// Rows written over all shards.
@@ -50,7 +48,7 @@ pub struct RunStatus<S = SweepSpec> {
     pub complete: bool,
 }
 
-impl<S: RunSpec> RunStatus<S> {
+impl RunStatus {
     /// Written rows whose solve failed.
     pub fn failures(&self) -> u64 {
         failures(&self.status_counts)
@@ -74,8 +72,9 @@ impl<S: RunSpec> RunStatus<S> {
             "shards": self.shards,
         });
         // Planar records stay as they were; other kinds say what they are.
-        if S::FORMAT != super::store::FORMAT {
-            value["format"] = S::FORMAT.into();
+        let format = self.manifest.spec.kind().format();
+        if format != super::store::FORMAT {
+            value["format"] = format.into();
         }
         value
     }
@@ -130,15 +129,10 @@ pub(super) fn runs_beside_text(runs_beside: &[PathBuf]) -> String {
     format!(" (the run directories beside it: {}; a typo?)", list.join(", "))
 }
 
-/// Reads and checks a run directory (manifest and every chunk footer).
+/// Reads and checks a run directory of any kind (manifest and every chunk footer).
 pub fn run_status(dir: &Path) -> Result<RunStatus, SweepError> {
-    run_status_of::<SweepSpec>(dir)
-}
-
-/// [`run_status`] for a sweep of kind `S`.
-pub fn run_status_of<S: RunSpec>(dir: &Path) -> Result<RunStatus<S>, SweepError> {
     let run = RunDir::new(dir);
-    let manifest: Manifest<S> = run.read_manifest()?.ok_or_else(|| SweepError::no_run(dir))?;
+    let manifest: Manifest = run.read_manifest()?.ok_or_else(|| SweepError::no_run(dir))?;
     let plan = manifest.spec.layout();
     let scan = run.scan(&manifest)?;
     let shards = manifest.shards.max(1);

@@ -23,7 +23,7 @@
 //! instead. Its spec hash and counts are recomputed on every read, so an
 //! edited manifest is refused.
 
-use super::kind::{RunKind, RunSpec};
+use super::kind::RunKind;
 use super::spec::SweepSpec;
 use super::SweepError;
 use crate::shape::LengthBasis;
@@ -74,19 +74,17 @@ pub mod keys {
 }
 
 /// The run's manifest (`DIR/manifest.json`). Written once, never changed.
-/// `S` is the kind of sweep ([`RunSpec`]): a planar [`SweepSpec`] by
-/// default, or a [`super::spec::CableSweepSpec`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct Manifest<S = SweepSpec> {
-    /// [`FORMAT`] for planar runs, [`RunSpec::FORMAT`] of the kind otherwise.
+pub struct Manifest {
+    /// The format tag of the spec's kind ([`RunKind::format`]).
     pub format: String,
     /// Version of the tool that created the run.
     pub tool_version: String,
     /// SHA-256 of the canonical spec JSON.
     pub spec_sha256: String,
     /// The spec with every default filled in.
-    pub spec: S,
+    pub spec: SweepSpec,
     /// The length the a_i columns are per unit of (the spec's
     /// `output.length_basis`, repeated here for readers of the manifest).
     pub length_basis: LengthBasis,
@@ -104,16 +102,16 @@ pub struct Manifest<S = SweepSpec> {
     pub total_rows: u64,
 }
 
-impl<S: RunSpec> Manifest<S> {
+impl Manifest {
     /// The manifest of a run of `spec` in `shards` shards.
-    pub fn new(spec: &S, shards: u64) -> Self {
+    pub fn new(spec: &SweepSpec, shards: u64) -> Self {
         let plan = spec.layout();
         Self {
-            format: S::FORMAT.into(),
+            format: spec.kind().format().into(),
             tool_version: TOOL_VERSION.into(),
             spec_sha256: spec.hash_hex(),
             spec: spec.clone(),
-            length_basis: spec.length_basis(),
+            length_basis: spec.output.length_basis,
             shards,
             routings: plan.routings,
             tensions: plan.tensions,
@@ -124,13 +122,13 @@ impl<S: RunSpec> Manifest<S> {
     }
 }
 
-impl<S: RunSpec> Manifest<S> {
+impl Manifest {
     /// Checks that the manifest is self-consistent: the spec hash is the
     /// hash of the spec it holds and the counts follow from that spec. A
     /// hand-edited field (a changed `tension.max_n`) fails here instead of
     /// silently changing what later stages report.
     pub fn verify(&self) -> Result<(), ManifestMismatch> {
-        self.spec.check().map_err(ManifestMismatch::InvalidSpec)?;
+        self.spec.validate().map_err(ManifestMismatch::InvalidSpec)?;
         let hash = self.spec.hash_hex();
         if hash != self.spec_sha256 {
             return Err(ManifestMismatch::Hash { hash, recorded: self.spec_sha256.clone() });
@@ -153,7 +151,7 @@ impl<S: RunSpec> Manifest<S> {
 pub enum ManifestMismatch {
     /// The spec it holds is refused.
     #[error("its spec is invalid ({0})")]
-    InvalidSpec(super::kind::InvalidSpec),
+    InvalidSpec(super::spec::SpecError),
     /// The spec does not hash to the recorded hash.
     #[error("its spec hashes to {hash}, not the recorded spec_sha256 {recorded} (the file was edited or damaged)")]
     Hash {
@@ -415,36 +413,23 @@ impl RunDir {
     }
 
     /// Reads and parses the manifest; `Ok(None)` when there is none.
-    pub fn read_manifest<S: RunSpec>(&self) -> Result<Option<Manifest<S>>, SweepError> {
+    pub fn read_manifest(&self) -> Result<Option<Manifest>, SweepError> {
         let path = self.manifest_path();
         let text = match crate::io::read_utf8(&path) {
             Ok(t) => t,
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
             Err(source) => return Err(FileError::new("reading", path, source).into()),
         };
-        let manifest: Manifest<S> = match serde_json::from_str(&text) {
-            Ok(m) => m,
-            Err(e) => {
-                // A run of the other kind (planar or cables) fails on its
-                // spec's fields: name its format instead.
-                let format = serde_json::from_str::<serde_json::Value>(&text)
-                    .ok()
-                    .and_then(|v| v.get("format").and_then(|f| f.as_str()).map(str::to_string));
-                return Err(match format {
-                    Some(f) if f != S::FORMAT && crate::io::run_markers::FORMATS.contains(&f.as_str()) => {
-                        SweepError::OtherKind { dir: self.root.clone(), found: f, wanted: S::FORMAT.into() }
-                    }
-                    _ => SweepError::CorruptManifest { path, problem: ManifestProblem::Json(e) },
-                });
-            }
-        };
-        if manifest.format != S::FORMAT {
-            return Err(SweepError::CorruptManifest { path, problem: ManifestProblem::Format { found: manifest.format, wanted: S::FORMAT } });
+        let manifest: Manifest =
+            serde_json::from_str(&text).map_err(|e| SweepError::CorruptManifest { path: path.clone(), problem: ManifestProblem::Json(e) })?;
+        let wanted = manifest.spec.kind().format();
+        if manifest.format != wanted {
+            return Err(SweepError::CorruptManifest { path, problem: ManifestProblem::Format { found: manifest.format, wanted } });
         }
-        if manifest.length_basis != manifest.spec.length_basis() {
+        if manifest.length_basis != manifest.spec.output.length_basis {
             return Err(SweepError::CorruptManifest {
                 path,
-                problem: ManifestProblem::LengthBasis { manifest: manifest.length_basis, spec: manifest.spec.length_basis() },
+                problem: ManifestProblem::LengthBasis { manifest: manifest.length_basis, spec: manifest.spec.output.length_basis },
             });
         }
         manifest.verify().map_err(|e| SweepError::CorruptManifest { path, problem: ManifestProblem::Mismatch(e) })?;
@@ -454,7 +439,7 @@ impl RunDir {
     /// Creates DIR and its manifest for a new run, or checks that an
     /// existing run is the same job (spec, tool version, shard count).
     /// Returns the manifest in force.
-    pub fn create_or_check<S: RunSpec>(&self, spec: &S, shards: u64) -> Result<Manifest<S>, SweepError> {
+    pub fn create_or_check(&self, spec: &SweepSpec, shards: u64) -> Result<Manifest, SweepError> {
         let io = |op: &'static str, source| SweepError::from(FileError::new(op, &self.root, source));
         std::fs::create_dir_all(&self.root).map_err(|e| io("creating output directory", e))?;
         let wanted = Manifest::new(spec, shards);
@@ -472,6 +457,10 @@ impl RunDir {
                 }
             }
         };
+        if existing.format != wanted.format {
+            // A run of the other kind (planar or cables): name its format.
+            return Err(SweepError::OtherKind { dir: self.root.clone(), found: existing.format, wanted: wanted.format });
+        }
         if existing.spec_sha256 != wanted.spec_sha256 {
             return Err(SweepError::SpecMismatch {
                 dir: self.root.clone(),
@@ -506,7 +495,7 @@ impl RunDir {
 
     /// Writes the manifest under a temporary name and links it into place
     /// unless one exists. Returns false when another process won.
-    fn publish_manifest<S: RunSpec>(&self, manifest: &Manifest<S>) -> Result<bool, SweepError> {
+    fn publish_manifest(&self, manifest: &Manifest) -> Result<bool, SweepError> {
         let path = self.manifest_path();
         let tmp = crate::io::temp_path(&path);
         let text = serde_json::to_string_pretty(manifest).expect("manifest serialises") + "\n";
@@ -535,7 +524,7 @@ impl RunDir {
     /// Lists DIR/shards: verified chunk files (footer checked against the
     /// manifest) and temporary files. Anything else is an error, as is a
     /// chunk file that is unreadable or belongs to another job.
-    pub fn scan<S: RunSpec>(&self, manifest: &Manifest<S>) -> Result<Scan, SweepError> {
+    pub fn scan(&self, manifest: &Manifest) -> Result<Scan, SweepError> {
         for entry in list_dir(&self.root)? {
             let name = entry.to_string_lossy();
             if !is_run_entry(&name) {
@@ -616,14 +605,14 @@ impl RunDir {
 
     /// Writes one chunk atomically: temporary file (unique to this writer),
     /// footer, fsync, checksum record, rename, directory fsync.
-    pub fn write_chunk<S: RunSpec>(&self, manifest: &Manifest<S>, chunk: u64, batch: &RecordBatch) -> Result<ChunkInfo, SweepError> {
+    pub fn write_chunk(&self, manifest: &Manifest, chunk: u64, batch: &RecordBatch) -> Result<ChunkInfo, SweepError> {
         let path = self.chunk_path(chunk);
         let tmp = crate::io::temp_path(&path);
         let io = |source| SweepError::from(FileError::new("writing", &tmp, source));
         let status_counts = count_statuses(batch);
         let kv = |k: &str, v: String| KeyValue::new(k.to_string(), v);
         let metadata = vec![
-            kv(keys::FORMAT, S::FORMAT.into()),
+            kv(keys::FORMAT, manifest.format.clone()),
             kv(keys::VERSION, TOOL_VERSION.into()),
             kv(keys::SPEC_SHA256, manifest.spec_sha256.clone()),
             kv(keys::SPEC, manifest.spec.canonical_json()),
@@ -739,7 +728,7 @@ fn list_dir(dir: &Path) -> Result<Vec<std::ffi::OsString>, SweepError> {
 
 /// Reads a chunk file's footer and checks it is chunk `chunk` of this run
 /// with `rows` rows.
-pub fn check_chunk<S: RunSpec>(path: &Path, chunk: u64, manifest: &Manifest<S>, rows: u64) -> Result<ChunkInfo, SweepError> {
+pub fn check_chunk(path: &Path, chunk: u64, manifest: &Manifest, rows: u64) -> Result<ChunkInfo, SweepError> {
     let file =
         File::open(path).map_err(FileError::on("opening", path))?;
     let meta = ParquetMetaDataReader::new()
@@ -751,8 +740,9 @@ pub fn check_chunk<S: RunSpec>(path: &Path, chunk: u64, manifest: &Manifest<S>, 
         .map(|v| v.iter().filter_map(|k| Some((k.key.as_str(), k.value.as_deref()?))).collect())
         .unwrap_or_default();
     let foreign = |reason| SweepError::ForeignChunk { path: path.to_path_buf(), reason };
-    if kv.get(keys::FORMAT) != Some(&S::FORMAT) {
-        return Err(foreign(ForeignReason::NoFormat { key: keys::FORMAT, format: S::FORMAT }));
+    let format = manifest.spec.kind().format();
+    if kv.get(keys::FORMAT) != Some(&format) {
+        return Err(foreign(ForeignReason::NoFormat { key: keys::FORMAT, format }));
     }
     if kv.get(keys::SPEC_SHA256) != Some(&manifest.spec_sha256.as_str()) {
         let found = kv.get(keys::SPEC_SHA256).unwrap_or(&"(none)").to_string();

@@ -43,24 +43,24 @@ use crate::model::routing::CONTROL_POINTS;
 use crate::solver::spatial::{SpatialError, SpatialOptions};
 use crate::model::{Actuator, Cable, Rod, MAX_CABLES};
 use crate::shape::LengthBasis;
-use crate::sweep::kind::{ChunkLayout, InvalidSpec, RowsCounted, RunSpec, MAX_CHUNK_ROWS, MAX_ROWS};
+use crate::sweep::kind::{ChunkLayout, RowsCounted, RunKind, RunSpec, MAX_CHUNK_ROWS};
 use crate::sweep::schema::{cable_batch, cable_schema, Axis, CableRow};
 use crate::sweep::solve::{self, Stored, TensionCombinations};
+use crate::sweep::spec::{OutputSpec, RoutingGrid, SpecError, SweepSpec};
 use crate::sweep::SweepError;
 use arrow::datatypes::SchemaRef;
 use arrow::record_batch::RecordBatch;
 use serde::{Deserialize, Serialize};
-use sha2::{Digest, Sha256};
 
 /// Most values in one tension grid.
 pub const MAX_TENSION_COUNT: u32 = 10_000;
 
-/// A cable sweep job: the actuator it varies, how each cable varies, the
-/// solver settings and what to store. Reads and writes the TOML above (and
-/// the same keys, in the same order, as the canonical JSON its hash covers).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(try_from = "SpecFile", into = "SpecFile")]
-pub struct CableSweepSpec {
+/// The kind of sweep of several or spatial cables: the actuator it varies,
+/// how each cable varies and the solver settings. Its spec file is the TOML
+/// above (and the same keys, in the same order, are the canonical JSON its
+/// hash covers).
+#[derive(Debug, Clone, PartialEq)]
+pub struct CablesGrid {
     /// The actuator every routing varies: rod, torsion, gravity direction and
     /// each cable's fixed control points and anchor (its swept points at
     /// these values until a routing sets them), every tension 0 (a row's
@@ -70,8 +70,6 @@ pub struct CableSweepSpec {
     pub grids: Vec<CableGrid>,
     /// Numerical settings of the 3-D solver.
     pub solver: SpatialOptions,
-    /// What each row stores; the map resolution.
-    pub output: CableOutputSpec,
 }
 
 /// What a sweep varies of one cable: its actuation (tension or
@@ -122,22 +120,18 @@ impl ValueGrid {
     }
 }
 
-/// Output settings.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+/// The `[output]` table of a cable sweep spec: no centreline; the reach
+/// maps' cell size.
+#[derive(Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
-pub struct CableOutputSpec {
-    /// Highest Legendre order stored (each of the three series).
-    pub order: usize,
-    /// Basis of the coefficients.
-    pub length_basis: LengthBasis,
-    /// Cell size of the reach maps, mm.
-    pub cell_mm: f64,
-    /// Routings per chunk file (each chunk is built in memory: at most
-    /// [`MAX_CHUNK_ROWS`] rows with the tension combinations).
-    pub chunk_routings: u32,
+struct Output {
+    order: usize,
+    length_basis: LengthBasis,
+    cell_mm: f64,
+    chunk_routings: u32,
 }
 
-impl Default for CableOutputSpec {
+impl Default for Output {
     fn default() -> Self {
         Self { order: 3, length_basis: LengthBasis::Rest, cell_mm: 1.0, chunk_routings: 64 }
     }
@@ -152,7 +146,7 @@ impl Default for CableOutputSpec {
 /// either does not compile until the format says where it goes.
 #[derive(Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-struct SpecFile {
+pub(super) struct SpecFile {
     #[serde(default)]
     rod: Rod,
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -162,7 +156,7 @@ struct SpecFile {
     #[serde(default)]
     solver: SpatialOptions,
     #[serde(default)]
-    output: CableOutputSpec,
+    output: Output,
     #[serde(rename = "cable")]
     cables: Vec<CableFile>,
 }
@@ -187,33 +181,10 @@ struct CableFile {
     sweeps: Vec<PointSweep>,
 }
 
-impl TryFrom<SpecFile> for CableSweepSpec {
-    type Error = CableSpecError;
-
-    fn try_from(file: SpecFile) -> Result<Self, CableSpecError> {
-        let SpecFile { rod, gj_n_mm2, gravity_direction, solver, output, cables } = file;
-        let (cables, grids) = cables
-            .into_iter()
-            .enumerate()
-            .map(|(i, c)| {
-                let CableFile { y_mm, z_mm, anchor_mm, tension_n, displacement_mm, cable_ea_n, sweeps } = c;
-                let (actuation, by_displacement) = match (tension_n, displacement_mm) {
-                    (Some(t), None) => (t, false),
-                    (None, Some(d)) => (d, true),
-                    (t, _) => return Err(CableSpecError::Actuation { cable: i + 1, both: t.is_some() }),
-                };
-                Ok((Cable { anchor_mm, cable_ea_n, ..Cable::spatial(y_mm, z_mm, 0.0) }, CableGrid { actuation, by_displacement, sweeps }))
-            })
-            .collect::<Result<Vec<_>, CableSpecError>>()?
-            .into_iter()
-            .unzip();
-        Ok(Self { actuator: Actuator { rod, gj_n_mm2, gravity_direction, cables }, grids, solver, output })
-    }
-}
-
-impl From<CableSweepSpec> for SpecFile {
-    fn from(spec: CableSweepSpec) -> Self {
-        let CableSweepSpec { actuator, grids, solver, output } = spec;
+impl SpecFile {
+    /// The layout of a cable spec.
+    pub(super) fn of(grid: &CablesGrid, output: &OutputSpec) -> Self {
+        let CablesGrid { actuator, grids, solver } = grid.clone();
         let Actuator { rod, gj_n_mm2, gravity_direction, cables } = actuator;
         let cables = cables
             .into_iter()
@@ -225,171 +196,39 @@ impl From<CableSweepSpec> for SpecFile {
                 CableFile { y_mm, z_mm, anchor_mm, tension_n, displacement_mm, cable_ea_n, sweeps: grid.sweeps }
             })
             .collect();
+        let OutputSpec { order, length_basis, cell_mm, chunk_routings, centreline: _ } = output.clone();
+        let output = Output { order, length_basis, cell_mm: cell_mm.unwrap_or(Output::default().cell_mm), chunk_routings };
         SpecFile { rod, gj_n_mm2, gravity_direction, solver, output, cables }
+    }
+
+    /// The spec it lays out.
+    pub(super) fn into_spec(self) -> Result<SweepSpec, SpecError> {
+        let SpecFile { rod, gj_n_mm2, gravity_direction, solver, output, cables } = self;
+        let (cables, grids) = cables
+            .into_iter()
+            .enumerate()
+            .map(|(i, c)| {
+                let CableFile { y_mm, z_mm, anchor_mm, tension_n, displacement_mm, cable_ea_n, sweeps } = c;
+                let (actuation, by_displacement) = match (tension_n, displacement_mm) {
+                    (Some(t), None) => (t, false),
+                    (None, Some(d)) => (d, true),
+                    (t, _) => return Err(SpecError::Actuation { cable: i + 1, both: t.is_some() }),
+                };
+                Ok((Cable { anchor_mm, cable_ea_n, ..Cable::spatial(y_mm, z_mm, 0.0) }, CableGrid { actuation, by_displacement, sweeps }))
+            })
+            .collect::<Result<Vec<_>, SpecError>>()?
+            .into_iter()
+            .unzip();
+        let Output { order, length_basis, cell_mm, chunk_routings } = output;
+        let grid = CablesGrid { actuator: Actuator { rod, gj_n_mm2, gravity_direction, cables }, grids, solver };
+        let output = OutputSpec { order, length_basis, centreline: false, cell_mm: Some(cell_mm), chunk_routings };
+        Ok(SweepSpec { routings: RoutingGrid::Cables(grid), output })
     }
 }
 
-/// What is wrong with a cable sweep spec: the cable and setting, and what
-/// to do.
-#[derive(Debug, thiserror::Error)]
-pub enum CableSpecError {
-    /// The TOML text does not parse, has unknown keys or a bad `[[cable]]`.
-    #[error("{0}")]
-    Toml(#[from] toml::de::Error),
-    /// A cable with neither or both of a tension grid and a displacement grid.
-    #[error(
-        "cable {cable}: give {} of tension_n = {{ min, max, count }} (N) and displacement_mm = {{ min, max, count }} (mm)",
-        if *both { "only one" } else { "one" }
-    )]
-    Actuation {
-        /// The cable, from 1.
-        cable: usize,
-        /// Whether both were given (else neither).
-        both: bool,
-    },
-    /// Too few or too many cables.
-    #[error("give 1 to {MAX_CABLES} [[cable]] tables, got {count}")]
-    CableCount {
-        /// The cables given.
-        count: usize,
-    },
-    /// A grid's range.
-    #[error("cable {cable}: {key} needs 0 ≤ min ≤ max (finite), got min = {min}, max = {max}")]
-    GridRange {
-        /// The cable, from 1.
-        cable: usize,
-        /// `tension_n` or `displacement_mm`.
-        key: &'static str,
-        /// Its first value.
-        min: f64,
-        /// Its last value.
-        max: f64,
-    },
-    /// A grid's count.
-    #[error("cable {cable}: {key}.count = {count} must be 1 … {MAX_TENSION_COUNT}")]
-    GridCount {
-        /// The cable, from 1.
-        cable: usize,
-        /// `tension_n` or `displacement_mm`.
-        key: &'static str,
-        /// The count given.
-        count: u32,
-    },
-    /// A displacement as long as the rod.
-    #[error("cable {cable}: displacement_mm.max = {max_mm} is not shorter than the rod ({length_mm} mm): a cable cannot be pulled in by its length")]
-    DisplacementBeyondRod {
-        /// The cable, from 1.
-        cable: usize,
-        /// The largest displacement, mm.
-        max_mm: f64,
-        /// The rod's length, mm.
-        length_mm: f64,
-    },
-    /// A cable stiffness that is not a stiffness.
-    #[error("cable {cable}: cable_ea_n = {ea_n} must be a finite stiffness > 0 N (leave it out for an inextensible cable)")]
-    CableStiffness {
-        /// The cable, from 1.
-        cable: usize,
-        /// The stiffness given, N.
-        ea_n: f64,
-    },
-    /// Displacement driving with the method that cannot meet it.
-    #[error(
-        "cable {cable} is driven by its displacement: [solver] method = \"rk4\" does not integrate the cables' paths; use the default \
-         collocation"
-    )]
-    DisplacementWithRk4 {
-        /// The cable, from 1.
-        cable: usize,
-    },
-    /// An anchor off the rod.
-    #[error(
-        "cable {cable}: anchor_mm = {} must lie on the rod, in (0, {length_mm}] mm (the rod's length_mm; leave anchor_mm out for the tip)",
-        crate::io::fmt_num(*anchor_mm)
-    )]
-    Anchor {
-        /// The cable, from 1.
-        cable: usize,
-        /// The anchor given, mm.
-        anchor_mm: f64,
-        /// The rod's length, mm.
-        length_mm: f64,
-    },
-    /// A sweep without finite levels.
-    #[error("cable {cable}: a sweep needs at least one finite level in levels_mm")]
-    NoLevels {
-        /// The cable, from 1.
-        cable: usize,
-    },
-    /// A sweep without control points.
-    #[error("cable {cable}: a sweep needs at least one control point in points (0 … 4)")]
-    NoPoints {
-        /// The cable, from 1.
-        cable: usize,
-    },
-    /// A control point that does not exist.
-    #[error("cable {cable}: control point {point} does not exist (points are 0 … 4)")]
-    NoSuchPoint {
-        /// The cable, from 1.
-        cable: usize,
-        /// The point given.
-        point: usize,
-    },
-    /// A control point swept twice.
-    #[error("cable {cable}: {} control point {point} is swept twice", axis.name())]
-    SweptTwice {
-        /// The cable, from 1.
-        cable: usize,
-        /// The axis.
-        axis: Axis,
-        /// The point.
-        point: usize,
-    },
-    /// An order the 3-D solver's settings do not resolve.
-    #[error("{0}")]
-    Order(#[source] SpatialError),
-    /// A cell size that is not a length.
-    #[error("output.cell_mm = {cell_mm} must be a positive length")]
-    CellSize {
-        /// The cell size given, mm.
-        cell_mm: f64,
-    },
-    /// `chunk_routings = 0`.
-    #[error("output.chunk_routings = 0: a chunk needs at least one routing")]
-    NoChunkRoutings,
-    /// More rows per routing than a chunk may hold.
-    #[error(
-        "{combinations} tension combinations per routing (the product of the cables' tension_n.count) is more than {MAX_CHUNK_ROWS} \
-         rows per chunk: use fewer tensions"
-    )]
-    TooManyCombinations {
-        /// Rows per routing.
-        combinations: u64,
-    },
-    /// More rows per chunk than a chunk may hold.
-    #[error(
-        "output.chunk_routings = {chunk_routings} × {combinations} tension combinations gives {chunk_rows} rows per chunk, more than \
-         {MAX_CHUNK_ROWS} (each chunk is built in memory): lower chunk_routings to ≤ {most}"
-    )]
-    ChunkRows {
-        /// Routings per chunk.
-        chunk_routings: u32,
-        /// Rows per routing.
-        combinations: u64,
-        /// Rows per chunk.
-        chunk_rows: u64,
-        /// The most routings per chunk.
-        most: u64,
-    },
-    /// The rod's parameters.
-    #[error("{0}")]
-    Rod(#[source] crate::model::ParameterError),
-    /// A rod the 3-D solver does not model.
-    #[error("[rod] {0}")]
-    RodUnsupported(#[source] SpatialError),
-    /// The gravity direction.
-    #[error("{0}")]
-    Gravity(#[source] SpatialError),
+/// Parses a cable spec's TOML (unchecked).
+pub(super) fn from_toml(text: &str) -> Result<SweepSpec, SpecError> {
+    toml::from_str::<SpecFile>(text)?.into_spec()
 }
 
 /// One swept dimension: cable, axis, control point, levels.
@@ -401,15 +240,7 @@ struct Dimension {
     levels: Vec<f64>,
 }
 
-impl CableSweepSpec {
-    /// Reads and checks a spec; `origin` names it in errors.
-    pub fn from_toml(text: &str, origin: &str) -> Result<Self, SweepError> {
-        let bad = |source| SweepError::BadCableSpec { origin: origin.into(), source };
-        let spec: Self = toml::from_str(text).map_err(|e| bad(CableSpecError::Toml(e)))?;
-        spec.validate().map_err(bad)?;
-        Ok(spec)
-    }
-
+impl CablesGrid {
     fn dimensions(&self) -> Vec<Dimension> {
         let mut dims = Vec::new();
         for (cable, g) in self.grids.iter().enumerate() {
@@ -432,11 +263,11 @@ impl CableSweepSpec {
         self.grids.iter().map(|g| u64::from(g.actuation.count.max(1))).product()
     }
 
-    /// Checks the spec; messages name the field.
-    pub fn validate(&self) -> Result<(), CableSpecError> {
+    /// Checks the spec with its `output`; messages name the field.
+    fn validate(&self, output: &OutputSpec) -> Result<(), SpecError> {
         let cables = &self.actuator.cables;
         if cables.is_empty() || cables.len() > MAX_CABLES {
-            return Err(CableSpecError::CableCount { count: cables.len() });
+            return Err(SpecError::CableCount { count: cables.len() });
         }
         let length_mm = self.actuator.rod.length_mm;
         for (i, (c, g)) in cables.iter().zip(&self.grids).enumerate() {
@@ -444,60 +275,60 @@ impl CableSweepSpec {
             let t = &g.actuation;
             let key = if g.by_displacement { "displacement_mm" } else { "tension_n" };
             if !(t.min.is_finite() && t.max.is_finite() && t.min >= 0.0 && t.max >= t.min) {
-                return Err(CableSpecError::GridRange { cable, key, min: t.min, max: t.max });
+                return Err(SpecError::GridRange { cable, key, min: t.min, max: t.max });
             }
             if t.count == 0 || t.count > MAX_TENSION_COUNT {
-                return Err(CableSpecError::GridCount { cable, key, count: t.count });
+                return Err(SpecError::GridCount { cable, key, count: t.count });
             }
             if g.by_displacement && t.max >= length_mm {
-                return Err(CableSpecError::DisplacementBeyondRod { cable, max_mm: t.max, length_mm });
+                return Err(SpecError::DisplacementBeyondRod { cable: Some(cable), max_mm: t.max, length_mm });
             }
             if let Some(ea_n) = c.cable_ea_n.filter(|ea| !(ea.is_finite() && *ea > 0.0)) {
-                return Err(CableSpecError::CableStiffness { cable, ea_n });
+                return Err(SpecError::CableStiffness { cable: Some(cable), ea_n });
             }
             if g.by_displacement && self.solver.method == crate::solver::SolverMethod::Rk4 {
-                return Err(CableSpecError::DisplacementWithRk4 { cable });
+                return Err(SpecError::DisplacementWithRk4 { cable: Some(cable) });
             }
             // The anchor is not swept: outside the rod, every routing's rows
             // would be invalid_routing.
             if let Some(anchor_mm) = c.anchor_mm {
                 if !(anchor_mm.is_finite() && anchor_mm > 0.0 && anchor_mm <= length_mm) {
-                    return Err(CableSpecError::Anchor { cable, anchor_mm, length_mm });
+                    return Err(SpecError::Anchor { cable, anchor_mm, length_mm });
                 }
             }
             let mut seen = std::collections::BTreeSet::new();
             for s in &g.sweeps {
                 if s.levels_mm.is_empty() || s.levels_mm.iter().any(|v| !v.is_finite()) {
-                    return Err(CableSpecError::NoLevels { cable });
+                    return Err(SpecError::NoLevels { cable });
                 }
                 if s.points.is_empty() {
-                    return Err(CableSpecError::NoPoints { cable });
+                    return Err(SpecError::NoPoints { cable });
                 }
                 for &point in &s.points {
                     if point >= CONTROL_POINTS {
-                        return Err(CableSpecError::NoSuchPoint { cable, point });
+                        return Err(SpecError::NoSuchPoint { cable, point });
                     }
                     if !seen.insert((s.axis, point)) {
-                        return Err(CableSpecError::SweptTwice { cable, axis: s.axis, point });
+                        return Err(SpecError::SweptTwice { cable, axis: s.axis, point });
                     }
                 }
             }
         }
-        crate::solver::spatial::check_order(self.output.order, &self.solver).map_err(CableSpecError::Order)?;
-        if !(self.output.cell_mm.is_finite() && self.output.cell_mm > 0.0) {
-            return Err(CableSpecError::CellSize { cell_mm: self.output.cell_mm });
+        crate::solver::spatial::check_order(output.order, &self.solver).map_err(SpecError::SpatialOrder)?;
+        if let Some(cell_mm) = output.cell_mm.filter(|c| !(c.is_finite() && *c > 0.0)) {
+            return Err(SpecError::CellSize { cell_mm });
         }
-        if self.output.chunk_routings == 0 {
-            return Err(CableSpecError::NoChunkRoutings);
+        if output.chunk_routings == 0 {
+            return Err(SpecError::NoChunkRoutings { cables: true });
         }
         let combinations = self.actuation_combinations();
-        let chunk_rows = u64::from(self.output.chunk_routings).saturating_mul(combinations);
+        let chunk_rows = u64::from(output.chunk_routings).saturating_mul(combinations);
         if chunk_rows > MAX_CHUNK_ROWS {
             return Err(if combinations > MAX_CHUNK_ROWS {
-                CableSpecError::TooManyCombinations { combinations }
+                SpecError::TooManyCombinations { combinations }
             } else {
-                CableSpecError::ChunkRows {
-                    chunk_routings: self.output.chunk_routings,
+                SpecError::CombinationChunkRows {
+                    chunk_routings: output.chunk_routings,
                     combinations,
                     chunk_rows,
                     most: MAX_CHUNK_ROWS / combinations,
@@ -508,9 +339,9 @@ impl CableSweepSpec {
         // rod the 3-D solver models; a routing's own faults are its rows' status.
         let base = self.actuator_for(0, &self.dimensions());
         match crate::solver::spatial::validated_channels(&base, crate::solver::Backend::spatial(self.solver.method)) {
-            Err(SpatialError::Actuator(crate::model::ActuatorError::Parameter(e))) => return Err(CableSpecError::Rod(e)),
-            Err(e @ SpatialError::Unsupported(_)) => return Err(CableSpecError::RodUnsupported(e)),
-            Err(e @ SpatialError::Actuator(crate::model::ActuatorError::GravityDirection(_))) => return Err(CableSpecError::Gravity(e)),
+            Err(SpatialError::Actuator(crate::model::ActuatorError::Parameter(e))) => return Err(SpecError::Rod(e)),
+            Err(e @ SpatialError::Unsupported(_)) => return Err(SpecError::RodUnsupported(e)),
+            Err(e @ SpatialError::Actuator(crate::model::ActuatorError::GravityDirection(_))) => return Err(SpecError::Gravity(e)),
             _ => {}
         }
         Ok(())
@@ -583,53 +414,31 @@ pub struct CableWorker {
 
 /// The sweep of several or spatial cables: each routing is solved by its
 /// own 3-D solver through its tension combinations ([`solve::cable_routing`]).
-impl RunSpec for CableSweepSpec {
-    const FORMAT: &'static str = crate::io::run_markers::CABLES_FORMAT;
-    const KIND: &'static str = "cable sweep";
+impl RunSpec for CablesGrid {
+    const KIND: RunKind = RunKind::Cables;
     type Worker = CableWorker;
     type Solved = Vec<CableRow>;
 
-    fn check(&self) -> Result<(), InvalidSpec> {
-        self.validate().map_err(InvalidSpec::Cables)
+    fn check(&self, output: &OutputSpec) -> Result<(), SpecError> {
+        self.validate(output)
     }
 
-    fn check_run_size(&self, allow_large: bool) -> Result<(), SweepError> {
-        let (routings, per_routing) = (self.routings(), self.actuation_combinations());
-        let rows = routings.saturating_mul(per_routing);
-        if rows > MAX_ROWS && !allow_large {
-            return Err(SweepError::TooLarge { rows, routings, per_routing, counted: RowsCounted::TensionCombinations });
-        }
-        Ok(())
+    fn rows_counted(&self) -> RowsCounted {
+        RowsCounted::TensionCombinations
     }
 
-    fn canonical_json(&self) -> String {
-        serde_json::to_string(self).expect("spec serialises")
+    fn layout(&self, output: &OutputSpec) -> ChunkLayout {
+        ChunkLayout::new(self.routings(), self.actuation_combinations(), u64::from(output.chunk_routings))
     }
 
-    fn hash_hex(&self) -> String {
-        Sha256::digest(self.canonical_json().as_bytes()).iter().map(|b| format!("{b:02x}")).collect()
+    fn schema(&self, output: &OutputSpec) -> SchemaRef {
+        cable_schema(self.actuator.cables.len(), output.order)
     }
 
-    fn length_basis(&self) -> LengthBasis {
-        self.output.length_basis
-    }
-
-    fn order(&self) -> usize {
-        self.output.order
-    }
-
-    fn layout(&self) -> ChunkLayout {
-        ChunkLayout::new(self.routings(), self.actuation_combinations(), u64::from(self.output.chunk_routings))
-    }
-
-    fn schema(&self) -> SchemaRef {
-        cable_schema(self.actuator.cables.len(), self.output.order)
-    }
-
-    fn row_bytes(&self) -> u64 {
+    fn row_bytes(&self, output: &OutputSpec) -> u64 {
         // Per copy: the row (its cables' control points, tensions, pose and
         // three series) or its columns; three copies as for planar rows.
-        let (cables, terms) = (self.actuator.cables.len() as u64, self.output.order as u64 + 1);
+        let (cables, terms) = (self.actuator.cables.len() as u64, output.order as u64 + 1);
         3 * (256 + 96 * cables + 24 * terms)
     }
 
@@ -637,15 +446,15 @@ impl RunSpec for CableSweepSpec {
         Ok(CableWorker { dims: self.dimensions(), combinations: self.combinations() })
     }
 
-    fn solve(&self, worker: &mut CableWorker, id: u64) -> Result<Vec<CableRow>, SweepError> {
+    fn solve(&self, output: &OutputSpec, worker: &mut CableWorker, id: u64) -> Result<Vec<CableRow>, SweepError> {
         let actuator = self.actuator_for(id, &worker.dims);
-        let stored = Stored { order: self.output.order, length_basis: self.output.length_basis, centreline: false };
+        let stored = Stored { order: output.order, length_basis: output.length_basis, centreline: false };
         Ok(solve::cable_routing(id, actuator, &self.solver, stored, &worker.combinations))
     }
 
-    fn batch(&self, schema: &SchemaRef, solved: &[Vec<CableRow>]) -> RecordBatch {
+    fn batch(&self, output: &OutputSpec, schema: &SchemaRef, solved: &[Vec<CableRow>]) -> RecordBatch {
         let rows: Vec<&CableRow> = solved.iter().flatten().collect();
-        cable_batch(schema, &rows, self.actuator.cables.len(), self.output.order)
+        cable_batch(schema, &rows, self.actuator.cables.len(), output.order)
     }
 }
 
@@ -654,6 +463,10 @@ mod tests {
     use super::*;
     use crate::model::effects::FRICTION;
     use crate::sweep::solve::combination_index;
+
+    fn grid(text: &str) -> CablesGrid {
+        SweepSpec::from_toml(text, "test").unwrap().cables().unwrap().clone()
+    }
 
     const SPEC: &str = r#"
 [rod.gravity]
@@ -676,7 +489,7 @@ levels_mm = [0.0, 1.5, -1.5]
 
     #[test]
     fn spec_counts_routings_and_tensions() {
-        let spec = CableSweepSpec::from_toml(SPEC, "test").unwrap();
+        let spec = grid(SPEC);
         assert_eq!(spec.routings(), 2 * 2 * 3);
         assert_eq!(spec.actuation_combinations(), 6);
         let dims = spec.dimensions();
@@ -693,7 +506,7 @@ levels_mm = [0.0, 1.5, -1.5]
 
     #[test]
     fn the_file_layout_round_trips_in_its_key_order() {
-        let spec = CableSweepSpec::from_toml(&format!("gj_n_mm2 = 4000\ngravity_direction = [1, 0, 0]\n{SPEC}"), "test").unwrap();
+        let spec = SweepSpec::from_toml(&format!("gj_n_mm2 = 4000\ngravity_direction = [1, 0, 0]\n{SPEC}"), "test").unwrap();
         let json = spec.canonical_json();
         // The canonical order (the spec hash covers it): the actuator's
         // settings, solver, output, then the cables with their grids.
@@ -701,19 +514,21 @@ levels_mm = [0.0, 1.5, -1.5]
         let keys = ["rod", "gj_n_mm2", "gravity_direction", "solver", "output", "cable", "y_mm", "z_mm", "tension_n", "sweep"];
         assert!(keys.windows(2).all(|w| at(w[0]) < at(w[1])), "{json}");
         assert!(!json.contains("anchor_mm"), "no anchor, no key: {json}");
-        let back: CableSweepSpec = serde_json::from_str(&json).unwrap();
+        let back: SweepSpec = serde_json::from_str(&json).unwrap();
         assert_eq!(back, spec);
+        let back = back.cables().unwrap();
         assert_eq!(back.actuator.gj_n_mm2, Some(4000.0));
         assert!(back.actuator.cables.iter().all(|c| c.tension_n == 0.0));
     }
 
     #[test]
     fn a_routings_rows_are_in_grid_order_and_actuator_at_rebuilds_each() {
-        let spec = CableSweepSpec::from_toml(SPEC, "test").unwrap();
-        let layout = spec.layout();
+        let whole = SweepSpec::from_toml(SPEC, "test").unwrap();
+        let (spec, output) = (whole.cables().unwrap(), &whole.output);
+        let layout = whole.layout();
         assert_eq!((layout.routings, layout.tensions), (12, 6));
         let mut worker = spec.worker().unwrap();
-        let rows = spec.solve(&mut worker, 7).unwrap();
+        let rows = spec.solve(output, &mut worker, 7).unwrap();
         assert_eq!(rows.len(), 6);
         let grids = spec.actuation_grids();
         for (k, row) in rows.iter().enumerate() {
@@ -725,8 +540,8 @@ levels_mm = [0.0, 1.5, -1.5]
             assert_eq!(actuator.cables.iter().map(|c| (c.y_mm, c.z_mm)).collect::<Vec<_>>(), row.cables);
         }
         // The batch has the fixed schema whatever the rows' nulls.
-        let schema = spec.schema();
-        let batch = spec.batch(&schema, &[rows]);
+        let schema = whole.schema();
+        let batch = spec.batch(output, &schema, &[rows]);
         assert_eq!(batch.schema(), schema);
         assert_eq!(batch.num_rows(), 6);
     }
@@ -751,10 +566,12 @@ levels_mm = [0.0, 1.5, -1.5]
                 "cable 1: anchor_mm = -1 must lie on the rod",
             ),
             (SPEC.replace("y_mm = [-2, -2, -2, -2, -2]", "y_mm = [-2, -2, -2, -2, -2]\nanchor_mm = 70"), "cable 2: anchor_mm = 70"),
-            ("[rod]\n".to_string(), "cable"),
         ] {
-            let e = CableSweepSpec::from_toml(&text, "spec.toml").unwrap_err().to_string();
+            let e = SweepSpec::from_toml(&text, "spec.toml").unwrap_err().to_string();
             assert!(e.contains(needle) && e.contains("spec.toml"), "{needle}: {e}");
         }
+        // Without a cable, the layout of a cable spec has nothing to sweep.
+        assert!(from_toml("cable = []\n[rod]\n").is_ok_and(|s| s.validate().unwrap_err().to_string().contains("[[cable]]")));
+        assert!(from_toml("[rod]\n").unwrap_err().to_string().contains("cable"));
     }
 }

@@ -1,9 +1,9 @@
 //! The planar single-cable sweep spec (`cablemap-sweep/2` runs): a TOML
 //! file naming the actuator, the solver settings, the routing grid, the
 //! tension ladder and what to store. Unknown fields are rejected so that a
-//! typo never silently falls back to a default. Its kind ([`RunSpec`]): one
-//! [`Simulator`] per worker, each routing solved through the rising tension
-//! ladder ([`solve::planar_routing`]).
+//! typo never silently falls back to a default. Its kind ([`RunSpec`] for
+//! [`PlanarGrid`]): one [`Simulator`] per worker, each routing solved
+//! through the rising tension ladder ([`solve::planar_routing`]).
 //!
 //! ```toml
 //! [actuator]            # model::Rod; omitted fields keep the thesis values
@@ -36,16 +36,14 @@ use crate::model::{Rod, Routing};
 use crate::solver::{Simulator, SolverOptions};
 use crate::shape::LengthBasis;
 use crate::sweep::enumerate::SweepPlan;
-use crate::sweep::kind::{ChunkLayout, InvalidSpec, RowsCounted, RunSpec, MAX_CHUNK_ROWS, MAX_ROWS};
+use crate::sweep::kind::{ChunkLayout, RowsCounted, RunKind, RunSpec, MAX_CHUNK_ROWS};
 use crate::sweep::schema::{arrow_schema, build_batch, SolvedRouting};
 use crate::sweep::solve::{self, Stored};
+use crate::sweep::spec::{OutputSpec, SpecError, SweepSpec, RoutingGrid, ValueGrid};
 use crate::sweep::SweepError;
-use crate::sweep::spec::ValueGrid;
 use arrow::datatypes::SchemaRef;
 use arrow::record_batch::RecordBatch;
 use serde::{Deserialize, Serialize};
-use sha2::{Digest, Sha256};
-use std::path::Path;
 
 /// The thesis sweep (thesis Ch. 4, model-notes §5): `jobs/thesis.toml`,
 /// built into the binary as the default spec.
@@ -60,7 +58,7 @@ pub const MAX_TENSIONS: u32 = 100_000;
 /// Most RK4 steps per span (memory grows with it; 24 is the default).
 pub const MAX_STEPS_PER_SPAN: usize = 100_000;
 /// Most memory one chunk may take while it is built (its solved rows, the
-/// Arrow batch and the Parquet encoder's buffers; [`SweepSpec::row_bytes`]).
+/// Arrow batch and the Parquet encoder's buffers; [`PlanarGrid::row_bytes`]).
 /// Chunks are built one per thread at once, so this bounds the sweep's
 /// memory per thread whatever the centreline's resolution. Rows without a
 /// centreline reach it near [`MAX_CHUNK_ROWS`].
@@ -73,10 +71,11 @@ const ROW_FIXED_BYTES: u64 = 256;
 /// rows, the Arrow batch, the encoded Parquet row group.
 const ROW_COPIES: u64 = 3;
 
-/// A complete sweep job. Every section may be omitted (thesis defaults).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
-#[serde(deny_unknown_fields, default)]
-pub struct SweepSpec {
+/// The thesis's kind of sweep: one planar cable in a rod, its routings a
+/// grid of control-point levels, each solved through an actuation ladder.
+/// Every table of its spec file may be omitted (thesis defaults).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct PlanarGrid {
     /// Rod parameters and effects.
     pub actuator: Rod,
     /// Numerical settings of the solver.
@@ -88,10 +87,69 @@ pub struct SweepSpec {
     pub tension: TensionSpec,
     /// The displacement ladder each routing is solved through instead of
     /// the tension ladder: the cable driven by its displacement.
-    #[serde(skip_serializing_if = "Option::is_none")]
     pub displacement: Option<DisplacementSpec>,
-    /// What each row stores and how rows are grouped into files.
-    pub output: OutputSpec,
+}
+
+/// The file layout of a planar sweep spec (its TOML tables, and the key
+/// order of the canonical JSON the spec hash covers).
+#[derive(Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields, default)]
+pub(super) struct SpecFile {
+    actuator: Rod,
+    solver: SolverOptions,
+    grid: GridSpec,
+    tension: TensionSpec,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    displacement: Option<DisplacementSpec>,
+    output: Output,
+}
+
+/// The `[output]` table of a planar sweep spec.
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub(super) struct Output {
+    order: usize,
+    length_basis: LengthBasis,
+    centreline: bool,
+    chunk_routings: u32,
+}
+
+impl Default for Output {
+    fn default() -> Self {
+        Self { order: 3, length_basis: LengthBasis::default(), centreline: false, chunk_routings: 256 }
+    }
+}
+
+impl From<Output> for OutputSpec {
+    fn from(o: Output) -> Self {
+        let Output { order, length_basis, centreline, chunk_routings } = o;
+        OutputSpec { order, length_basis, centreline, cell_mm: None, chunk_routings }
+    }
+}
+
+impl SpecFile {
+    /// The layout of a planar spec.
+    pub(super) fn of(grid: &PlanarGrid, output: &OutputSpec) -> Self {
+        let PlanarGrid { actuator, solver, grid, tension, displacement } = grid.clone();
+        let OutputSpec { order, length_basis, centreline, chunk_routings, cell_mm: _ } = output.clone();
+        Self { actuator, solver, grid, tension, displacement, output: Output { order, length_basis, centreline, chunk_routings } }
+    }
+
+    /// The spec it lays out.
+    pub(super) fn into_spec(self) -> SweepSpec {
+        let SpecFile { actuator, solver, grid, tension, displacement, output } = self;
+        SweepSpec { routings: RoutingGrid::Planar(PlanarGrid { actuator, solver, grid, tension, displacement }), output: output.into() }
+    }
+}
+
+/// Parses a planar spec's TOML (unchecked).
+pub(super) fn from_toml(text: &str) -> Result<SweepSpec, SpecError> {
+    let file: SpecFile = toml::from_str(text)?;
+    // A [tension] table beside [displacement] would be silently unused.
+    if file.displacement.is_some() && toml::from_str::<toml::Table>(text).is_ok_and(|t| t.contains_key("tension")) {
+        return Err(SpecError::TensionAndDisplacement);
+    }
+    Ok(file.into_spec())
 }
 
 /// The routing grid: every control point y0…y4 takes one of `levels`
@@ -163,204 +221,9 @@ pub enum Ladder {
     DisplacementMm(Vec<f64>),
 }
 
-/// What is stored.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct OutputSpec {
-    /// Highest Legendre order n: columns a0 … an.
-    pub order: usize,
-    /// The length the a_i columns are per unit of: `rest` (the thesis's
-    /// basis, the default) or `deformed`.
-    pub length_basis: LengthBasis,
-    /// Store the centreline of each solve as list columns.
-    pub centreline: bool,
-    /// Routings per chunk file (each chunk is written atomically; a resumed
-    /// run redoes at most the chunks that were in progress).
-    pub chunk_routings: u32,
-}
-
-impl Default for OutputSpec {
-    fn default() -> Self {
-        Self { order: 3, length_basis: LengthBasis::default(), centreline: false, chunk_routings: 256 }
-    }
-}
-
-/// What is wrong with a sweep spec: the section and setting, and what to do.
-#[derive(Debug, thiserror::Error)]
-pub enum SpecError {
-    /// The actuator's parameters.
-    #[error("[actuator] {0}")]
-    Rod(#[source] crate::model::ParameterError),
-    /// The TOML text does not parse or has unknown keys.
-    #[error("{0}")]
-    Toml(#[from] toml::de::Error),
-    /// Both ladders given.
-    #[error("[displacement] give either [tension] or [displacement], not both: the cable is driven by one of them")]
-    TensionAndDisplacement,
-    /// More steps per span than memory allows.
-    #[error(
-        "[solver] steps_per_span = {steps} is more than {MAX_STEPS_PER_SPAN}: the solver would need more memory than a machine has, \
-         and {resolving} steps already resolve every supported order"
-    )]
-    StepsPerSpan {
-        /// The steps asked for.
-        steps: usize,
-        /// Steps that resolve the highest supported order.
-        resolving: usize,
-    },
-    /// The solver refuses the settings for this actuator.
-    #[error("[solver] {0}")]
-    Solver(#[source] crate::solver::SimulateError),
-    /// More tensions than a routing may have.
-    #[error("[tension] count = {count} is more than {MAX_TENSIONS} tensions per routing")]
-    TooManyTensions {
-        /// The count asked for.
-        count: u32,
-    },
-    /// No tension, or a lowest tension below 0.
-    #[error("[tension] min_n = {min_n} must be a finite tension ≥ 0 N")]
-    TensionMin {
-        /// The lowest tension, N.
-        min_n: f64,
-    },
-    /// A highest tension below the lowest.
-    #[error("[tension] max_n = {max_n} must be finite and ≥ min_n = {min_n}")]
-    TensionMax {
-        /// The highest tension, N.
-        max_n: f64,
-        /// The lowest, N.
-        min_n: f64,
-    },
-    /// `count = 0`.
-    #[error("[tension] count = 0: at least one tension is needed")]
-    NoTensions,
-    /// One tension over a range.
-    #[error("[tension] count = 1 needs min_n = max_n (or give count ≥ 2)")]
-    OneTensionOverARange,
-    /// A displacement count out of range.
-    #[error("[displacement] count = {count} must be 1 … {MAX_TENSIONS} displacements per routing")]
-    DisplacementCount {
-        /// The count asked for.
-        count: u32,
-    },
-    /// A smallest displacement below 0.
-    #[error("[displacement] min_mm = {min_mm} must be a finite displacement ≥ 0 mm (the length pulled in at the base)")]
-    DisplacementMin {
-        /// The smallest displacement, mm.
-        min_mm: f64,
-    },
-    /// A largest displacement below the smallest.
-    #[error("[displacement] max_mm = {max_mm} must be finite and ≥ min_mm = {min_mm} (equal when count = 1)")]
-    DisplacementMax {
-        /// The largest displacement, mm.
-        max_mm: f64,
-        /// The smallest, mm.
-        min_mm: f64,
-    },
-    /// A displacement as long as the rod.
-    #[error("[displacement] max_mm = {max_mm} is not shorter than the rod ({length_mm} mm): a cable cannot be pulled in by its length")]
-    DisplacementBeyondRod {
-        /// The largest displacement, mm.
-        max_mm: f64,
-        /// The rod's length, mm.
-        length_mm: f64,
-    },
-    /// A cable stiffness that is not a stiffness.
-    #[error("[displacement] cable_ea_n = {ea_n} must be a finite stiffness > 0 N (leave it out for an inextensible cable)")]
-    CableStiffness {
-        /// The stiffness given, N.
-        ea_n: f64,
-    },
-    /// Displacement driving with the method that cannot meet it.
-    #[error(
-        "[displacement] [solver] method = \"rk4\" does not integrate the cable's path, so it cannot meet a displacement: use the default \
-         collocation"
-    )]
-    DisplacementWithRk4,
-    /// A level count out of range.
-    #[error("[grid] levels = {levels} must be between 1 and {MAX_LEVELS}")]
-    Levels {
-        /// The levels asked for.
-        levels: u32,
-    },
-    /// Levels beyond the body.
-    #[error("[grid] extent_r = {extent_r} puts levels beyond ±r (outside the body): use a fraction 0 ≤ extent_r < 1")]
-    ExtentR {
-        /// The half-width of the levels over r.
-        extent_r: f64,
-    },
-    /// Levels and channel offset together beyond the body.
-    #[error("[grid] extent_r = {extent_r} with {} = {offset_mm} puts the channel beyond ±r: reduce one of them", crate::model::effects::CHANNEL_OFFSET.key)]
-    ChannelBeyondBody {
-        /// The half-width of the levels over r.
-        extent_r: f64,
-        /// The channel offset, mm.
-        offset_mm: f64,
-    },
-    /// Mirror de-duplication of an actuator that is not mirror-symmetric.
-    #[error(
-        "[grid] mirror_dedup = true needs a mirror-symmetric actuator ({} = 0 and gravity along the clamp axis): set mirror_dedup = false",
-        crate::model::effects::CHANNEL_OFFSET.key
-    )]
-    MirrorAsymmetric,
-    /// An order above the highest stored.
-    #[error("[output] order = {order} is above the supported {MAX_ORDER}")]
-    Order {
-        /// The order asked for.
-        order: usize,
-    },
-    /// An order the solver settings do not resolve.
-    #[error("[output] {0}")]
-    Resolution(#[source] crate::solver::resolution::OrderError),
-    /// `chunk_routings = 0`.
-    #[error("[output] chunk_routings = 0: a chunk needs at least one routing")]
-    NoChunkRoutings,
-    /// More rows per chunk than a chunk may hold.
-    #[error(
-        "[output] chunk_routings = {chunk_routings} × {ladder_table} count = {count} gives {chunk_rows} rows per chunk, more than \
-         {MAX_CHUNK_ROWS} (each chunk is built in memory): lower chunk_routings to ≤ {most}"
-    )]
-    ChunkRows {
-        /// Routings per chunk.
-        chunk_routings: u32,
-        /// The ladder's table, `[tension]` or `[displacement]`.
-        ladder_table: &'static str,
-        /// Rows per routing.
-        count: u32,
-        /// Rows per chunk.
-        chunk_rows: u64,
-        /// The most routings per chunk.
-        most: u64,
-    },
-    /// A chunk would take more memory than a chunk may.
-    #[error(
-        "[output] chunk_routings = {chunk_routings} × {ladder_table} count = {count} gives {chunk_rows} rows per chunk taking about {} \
-         of memory while it is built, more than {} ({}): {fix}",
-        crate::io::fmt_bytes(*chunk_bytes),
-        crate::io::fmt_bytes(MAX_CHUNK_BYTES),
-        centreline_text(*centreline)
-    )]
-    ChunkBytes {
-        /// Routings per chunk.
-        chunk_routings: u32,
-        /// The ladder's table, `[tension]` or `[displacement]`.
-        ladder_table: &'static str,
-        /// Rows per routing.
-        count: u32,
-        /// Rows per chunk.
-        chunk_rows: u64,
-        /// Memory of a chunk while it is built, bytes.
-        chunk_bytes: u64,
-        /// With a stored centreline: its points per row and the solver's steps per span.
-        centreline: Option<(u64, usize)>,
-        /// What to change.
-        fix: ChunkBytesFix,
-    },
-}
-
 /// Why a chunk is built in memory as large as it is, for
 /// [`SpecError::ChunkBytes`].
-fn centreline_text(centreline: Option<(u64, usize)>) -> String {
+pub(super) fn centreline_text(centreline: Option<(u64, usize)>) -> String {
     match centreline {
         Some((points, steps)) => format!("with centreline = true each row holds {points} centreline points ([solver] steps_per_span = {steps})"),
         None => "each chunk is built in memory".to_string(),
@@ -397,37 +260,11 @@ pub enum ChunkBytesFix {
     },
 }
 
-impl SweepSpec {
-    /// The thesis sweep (the built-in default).
-    pub fn thesis() -> Self {
-        Self::from_toml(THESIS_SPEC_TOML, "built-in thesis spec").expect("jobs/thesis.toml is valid")
-    }
-
-    /// Parses and validates a spec; `origin` names it in errors.
-    pub fn from_toml(text: &str, origin: &str) -> Result<Self, SweepError> {
-        let spec: SweepSpec =
-            toml::from_str(text).map_err(|e| SweepError::BadSpec { origin: origin.to_string(), source: SpecError::Toml(e) })?;
-        // A [tension] table beside [displacement] would be silently unused.
-        if spec.displacement.is_some() && toml::from_str::<toml::Table>(text).is_ok_and(|t| t.contains_key("tension")) {
-            return Err(SweepError::BadSpec {
-                origin: origin.to_string(),
-                source: SpecError::TensionAndDisplacement,
-            });
-        }
-        spec.validate().map_err(|source| SweepError::BadSpec { origin: origin.to_string(), source })?;
-        Ok(spec)
-    }
-
-    /// Reads, parses and validates a spec file.
-    pub fn load(path: &Path) -> Result<Self, SweepError> {
-        let text = crate::io::read_utf8(path)
-            .map_err(crate::io::FileError::on("reading spec", path))?;
-        Self::from_toml(&text, &path.display().to_string())
-    }
-
-    /// Checks every setting; the message names the field and what to do.
-    pub fn validate(&self) -> Result<(), SpecError> {
-        self.actuator.validate().map_err(SpecError::Rod)?;
+impl PlanarGrid {
+    /// Checks every setting with the spec's `output`; the error names the
+    /// field and what to do.
+    fn validate(&self, output: &OutputSpec) -> Result<(), SpecError> {
+        self.actuator.validate().map_err(SpecError::Actuator)?;
         // Sizes before anything is allocated for them.
         if self.solver.steps_per_span > MAX_STEPS_PER_SPAN {
             let resolving = crate::solver::resolution::REQUIRED_STEPS_PER_SPAN[crate::solver::resolution::MAX_RESOLVED_ORDER];
@@ -447,13 +284,13 @@ impl SweepSpec {
                 return Err(SpecError::DisplacementMax { max_mm: d.max_mm, min_mm: d.min_mm });
             }
             if d.max_mm >= self.actuator.length_mm {
-                return Err(SpecError::DisplacementBeyondRod { max_mm: d.max_mm, length_mm: self.actuator.length_mm });
+                return Err(SpecError::DisplacementBeyondRod { cable: None, max_mm: d.max_mm, length_mm: self.actuator.length_mm });
             }
             if let Some(ea_n) = d.cable_ea_n.filter(|ea| !(ea.is_finite() && *ea > 0.0)) {
-                return Err(SpecError::CableStiffness { ea_n });
+                return Err(SpecError::CableStiffness { cable: None, ea_n });
             }
             if self.solver.method == crate::solver::SolverMethod::Rk4 {
-                return Err(SpecError::DisplacementWithRk4);
+                return Err(SpecError::DisplacementWithRk4 { cable: None });
             }
         }
         crate::solver::Simulator::new(&self.actuator, &self.solver).map_err(SpecError::Solver)?;
@@ -464,7 +301,7 @@ impl SweepSpec {
         if !(g.extent_r.is_finite() && g.extent_r >= 0.0 && g.extent_r < 1.0) {
             return Err(SpecError::ExtentR { extent_r: g.extent_r });
         }
-        let delta = self.actuator.effects.channel_offset_mm;
+        let delta = (crate::model::effects::CHANNEL_OFFSET.get)(&self.actuator);
         // A tapered body's levels are fractions of its narrowest radius along the cable.
         let r = self.actuator.channel_radius_mm();
         if (g.extent_r * r).abs() + delta.abs() >= r {
@@ -490,19 +327,19 @@ impl SweepSpec {
         if t.count == 1 && t.max_n != t.min_n {
             return Err(SpecError::OneTensionOverARange);
         }
-        let o = &self.output;
+        let o = output;
         if o.order > MAX_ORDER {
             return Err(SpecError::Order { order: o.order });
         }
         crate::solver::resolution::check_order(o.order, &self.solver).map_err(SpecError::Resolution)?;
         if o.chunk_routings == 0 {
-            return Err(SpecError::NoChunkRoutings);
+            return Err(SpecError::NoChunkRoutings { cables: false });
         }
         let count = self.ladder_count();
         let chunk_rows = u64::from(o.chunk_routings) * u64::from(count);
-        let chunk_bytes = chunk_rows.saturating_mul(self.row_bytes());
+        let chunk_bytes = chunk_rows.saturating_mul(self.row_bytes(o));
         if chunk_rows <= MAX_CHUNK_ROWS && chunk_bytes > MAX_CHUNK_BYTES {
-            return Err(self.chunk_bytes_error(chunk_rows, chunk_bytes));
+            return Err(self.chunk_bytes_error(o, chunk_rows, chunk_bytes));
         }
         if chunk_rows > MAX_CHUNK_ROWS {
             return Err(SpecError::ChunkRows {
@@ -519,62 +356,27 @@ impl SweepSpec {
     /// Points of each row's stored centreline: the solvers' nodes from
     /// clamp to tip, two knot spans of `steps_per_span` steps (both
     /// methods; docs/schema.md); 0 when no centreline is stored.
-    pub fn centreline_points(&self) -> u64 {
-        if self.output.centreline {
+    pub fn centreline_points(&self, output: &OutputSpec) -> u64 {
+        if output.centreline {
             2 * self.solver.steps_per_span as u64 + 1
         } else {
             0
         }
     }
 
-    /// Estimated bytes one row takes in memory while its chunk is built,
-    /// all copies together ([`ROW_COPIES`]): fixed columns and a_i, and the
-    /// centreline's x and y lists when stored.
-    pub fn row_bytes(&self) -> u64 {
-        let per_copy = ROW_FIXED_BYTES + 8 * (self.output.order as u64 + 1) + 16 * self.centreline_points();
-        ROW_COPIES * per_copy
-    }
-
     /// The refusal of a chunk of `chunk_rows` rows that would take
     /// `chunk_bytes` (more than [`MAX_CHUNK_BYTES`]), with what to change.
-    fn chunk_bytes_error(&self, chunk_rows: u64, chunk_bytes: u64) -> SpecError {
-        let o = &self.output;
+    fn chunk_bytes_error(&self, o: &OutputSpec, chunk_rows: u64, chunk_bytes: u64) -> SpecError {
         let count = self.ladder_count();
-        let routing_bytes = u64::from(count) * self.row_bytes();
+        let routing_bytes = u64::from(count) * self.row_bytes(o);
         let ladder_table = self.ladder_table();
         let fix = match MAX_CHUNK_BYTES / routing_bytes.max(1) {
             0 => ChunkBytesFix::OneRouting { count, routing_bytes, ladder_table },
             most if o.centreline => ChunkBytesFix::FewerRoutingsOrCentreline { most },
             most => ChunkBytesFix::FewerRoutings { most },
         };
-        let centreline = o.centreline.then(|| (self.centreline_points(), self.solver.steps_per_span));
+        let centreline = o.centreline.then(|| (self.centreline_points(o), self.solver.steps_per_span));
         SpecError::ChunkBytes { chunk_routings: o.chunk_routings, ladder_table, count, chunk_rows, chunk_bytes, centreline, fix }
-    }
-
-    /// Checks the size of the whole sweep: more than [`MAX_ROWS`] rows is
-    /// refused (a typo like `levels = 99` means 10¹¹ rows) unless
-    /// `allow_large`, for a deliberate huge job.
-    pub fn check_size(&self, allow_large: bool) -> Result<(), SweepError> {
-        let plan = SweepPlan::new(self);
-        let rows = plan.total_rows();
-        if rows > MAX_ROWS && !allow_large {
-            return Err(SweepError::TooLarge {
-                rows,
-                routings: plan.routings,
-                per_routing: plan.tensions,
-                counted: RowsCounted::Actuations { ladder_table: self.ladder_table() },
-            });
-        }
-        Ok(())
-    }
-
-    /// Whether a spec file's text sets nothing (empty, or comments only):
-    /// such a spec is the built-in thesis sweep, which the caller should say.
-    pub fn is_blank_toml(text: &str) -> bool {
-        text.lines().all(|l| {
-            let l = l.trim();
-            l.is_empty() || l.starts_with('#')
-        })
     }
 
     /// The actuation ladder: the displacements when given, else the tensions.
@@ -616,68 +418,36 @@ impl SweepSpec {
         let d = f64::from(n - 1);
         (0..n).map(|i| half * (2.0 * f64::from(i) - d) / d).collect()
     }
-
-    /// The spec with every default filled in, as compact JSON: what the
-    /// hash covers and what every output file records.
-    pub fn canonical_json(&self) -> String {
-        serde_json::to_string(self).expect("spec serialises")
-    }
-
-    /// SHA-256 of [`Self::canonical_json`], hex. Two specs with the same
-    /// meaning (whatever their formatting) have the same hash.
-    pub fn hash_hex(&self) -> String {
-        let digest = Sha256::digest(self.canonical_json().as_bytes());
-        digest.iter().map(|b| format!("{b:02x}")).collect()
-    }
-
-    /// Parses the canonical JSON written by [`Self::canonical_json`].
-    pub fn from_canonical_json(text: &str) -> Result<Self, serde_json::Error> {
-        serde_json::from_str(text)
-    }
 }
 
 /// The planar single-cable sweep: one [`Simulator`] per worker, each
-/// routing solved through the rising tension ladder.
-impl RunSpec for SweepSpec {
-    const FORMAT: &'static str = crate::io::run_markers::PLANAR_FORMAT;
-    const KIND: &'static str = "planar single-cable sweep";
+/// routing solved through the rising actuation ladder.
+impl RunSpec for PlanarGrid {
+    const KIND: RunKind = RunKind::Planar;
     type Worker = Simulator;
     type Solved = SolvedRouting;
 
-    fn check(&self) -> Result<(), InvalidSpec> {
-        self.validate().map_err(InvalidSpec::Planar)
+    fn check(&self, output: &OutputSpec) -> Result<(), SpecError> {
+        self.validate(output)
     }
 
-    fn check_run_size(&self, allow_large: bool) -> Result<(), SweepError> {
-        self.check_size(allow_large)
+    fn rows_counted(&self) -> RowsCounted {
+        RowsCounted::Actuations { ladder_table: self.ladder_table() }
     }
 
-    fn canonical_json(&self) -> String {
-        SweepSpec::canonical_json(self)
+    fn layout(&self, output: &OutputSpec) -> ChunkLayout {
+        SweepPlan::new(self, output).layout()
     }
 
-    fn hash_hex(&self) -> String {
-        SweepSpec::hash_hex(self)
+    fn schema(&self, output: &OutputSpec) -> SchemaRef {
+        arrow_schema(output.order, output.centreline)
     }
 
-    fn length_basis(&self) -> LengthBasis {
-        self.output.length_basis
-    }
-
-    fn order(&self) -> usize {
-        self.output.order
-    }
-
-    fn layout(&self) -> ChunkLayout {
-        SweepPlan::new(self).layout()
-    }
-
-    fn schema(&self) -> SchemaRef {
-        arrow_schema(self.output.order, self.output.centreline)
-    }
-
-    fn row_bytes(&self) -> u64 {
-        SweepSpec::row_bytes(self)
+    /// Fixed columns and a_i, and the centreline's x and y lists when
+    /// stored, in each of [`ROW_COPIES`] copies.
+    fn row_bytes(&self, output: &OutputSpec) -> u64 {
+        let per_copy = ROW_FIXED_BYTES + 8 * (output.order as u64 + 1) + 16 * self.centreline_points(output);
+        ROW_COPIES * per_copy
     }
 
     fn worker(&self) -> Result<Simulator, SweepError> {
@@ -686,17 +456,16 @@ impl RunSpec for SweepSpec {
         Ok(sim)
     }
 
-    fn solve(&self, worker: &mut Simulator, id: u64) -> Result<SolvedRouting, SweepError> {
+    fn solve(&self, output: &OutputSpec, worker: &mut Simulator, id: u64) -> Result<SolvedRouting, SweepError> {
         // The plan holds only the levels (a few numbers): cheap per routing.
-        let routing_mm = SweepPlan::new(self).routing_mm(id);
+        let routing_mm = SweepPlan::new(self, output).routing_mm(id);
         let routing = Routing::for_actuator(routing_mm, &self.actuator)?;
-        let o = &self.output;
-        let stored = Stored { order: o.order, length_basis: o.length_basis, centreline: o.centreline };
+        let stored = Stored { order: output.order, length_basis: output.length_basis, centreline: output.centreline };
         Ok(solve::planar_routing(worker, id, routing_mm, &routing, &self.ladder(), stored))
     }
 
-    fn batch(&self, schema: &SchemaRef, solved: &[SolvedRouting]) -> RecordBatch {
-        build_batch(schema, self.output.order, self.output.centreline, solved)
+    fn batch(&self, output: &OutputSpec, schema: &SchemaRef, solved: &[SolvedRouting]) -> RecordBatch {
+        build_batch(schema, output.order, output.centreline, solved)
     }
 }
 
@@ -708,10 +477,15 @@ mod tests {
         SweepSpec::from_toml(text, "test").unwrap_err().to_string()
     }
 
+    fn planar(spec: &SweepSpec) -> &PlanarGrid {
+        spec.planar().expect("a planar spec")
+    }
+
     #[test]
     fn thesis_spec_is_the_default() {
         let s = SweepSpec::thesis();
         assert_eq!(s, SweepSpec::default());
+        let s = planar(&s);
         assert_eq!(s.levels_mm(), vec![-4.0, -3.0, -2.0, -1.0, 0.0, 1.0, 2.0, 3.0, 4.0]);
         let t = s.tensions_n();
         assert_eq!(t.len(), 21);
@@ -721,7 +495,7 @@ mod tests {
 
     #[test]
     fn levels_are_exactly_symmetric() {
-        let mut s = SweepSpec::default();
+        let mut s = PlanarGrid::default();
         s.grid.levels = 7;
         s.grid.extent_r = 0.73;
         let l = s.levels_mm();
@@ -761,12 +535,14 @@ mod tests {
             let spec =
                 SweepSpec::from_toml(&format!("[solver]\nmethod = \"{method}\"\nsteps_per_span = 30\n[output]\ncentreline = true\n"), "t")
                     .unwrap();
-            let mut sim = crate::solver::Simulator::new(&spec.actuator, &spec.solver).unwrap();
+            let grid = planar(&spec);
+            let mut sim = crate::solver::Simulator::new(&grid.actuator, &grid.solver).unwrap();
             sim.set_routing_mm(&[1.0, 2.0, 0.0, -1.0, 1.0]).unwrap();
             sim.solve(1.5).unwrap();
-            assert_eq!(sim.centreline().len() as u64, spec.centreline_points(), "{method}");
+            assert_eq!(sim.centreline().len() as u64, grid.centreline_points(&spec.output), "{method}");
         }
-        assert_eq!(SweepSpec::thesis().centreline_points(), 0);
+        let thesis = SweepSpec::thesis();
+        assert_eq!(planar(&thesis).centreline_points(&thesis.output), 0);
     }
 
     #[test]
