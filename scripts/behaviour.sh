@@ -62,6 +62,22 @@ for f in none friction clamp; do
     run "calibrate-$f" calibrate "$work/$f.csv" --json
     run "diagnose-$f" diagnose "$work/$f.csv" --no-report --json
 done
+# a fit with an effect and a held-out routing, a diagnosis with a held-out routing and markers
+"$bin" synth --out "$work/shapes.csv" --effect friction --magnitude 0.08 --seed 7 --markers-out "$work/shapes-markers.csv" --centreline-out "$work/shapes-centrelines.csv" > /dev/null
+cp "$work/shapes.csv" "$out/synth-shapes.csv"
+cp "$work/shapes-markers.csv" "$out/synth-shapes-markers.csv"
+cp "$work/shapes-centrelines.csv" "$out/synth-shapes-centrelines.csv"
+run calibrate-effect-holdout calibrate "$work/friction.csv" --effect friction --holdout s_curve --json
+run calibrate-shapes calibrate "$work/shapes.csv" --markers "$work/shapes-markers.csv" --centrelines "$work/shapes-centrelines.csv" --fix GA=1.7 --json
+run diagnose-holdout diagnose "$work/clamp.csv" --holdout arc --out "$work/clamp-diagnosis" --json
+# several-cable captures made by synth --actuator, fitted and diagnosed back
+"$bin" synth --actuator tests/data/spatial/antagonistic.toml --out "$work/pair-captures.csv" --markers-out "$work/pair-markers.csv" --effect friction --magnitude 0.1 --seed 2 > /dev/null
+cp "$work/pair-captures.csv" "$out/synth-pair-captures.csv"
+cp "$work/pair-markers.csv" "$out/synth-pair-markers.csv"
+run calibrate-pair calibrate "$work/pair-captures.csv" --actuator tests/data/spatial/antagonistic.toml --markers "$work/pair-markers.csv" --effect friction --json
+run calibrate-pair-holdout calibrate "$work/pair-captures.csv" --actuator tests/data/spatial/antagonistic.toml --markers "$work/pair-markers.csv" --holdout-cable 2 --json
+run diagnose-pair diagnose "$work/pair-captures.csv" --actuator tests/data/spatial/antagonistic.toml --markers "$work/pair-markers.csv" --out "$work/pair-diagnosis" --json
+run predict-pair predict "$work/pair-captures.csv" --actuator tests/data/spatial/antagonistic.toml --markers "$work/pair-markers.csv" --json
 run predict-soromox predict "$work/captures.csv" --actuator "$work/actuator.toml" --markers "$work/markers.csv" --json
 run calibrate-soromox calibrate "$work/captures.csv" --actuator "$work/actuator.toml" --markers "$work/markers.csv" --out "$work/fit" --json
 run diagnose-soromox diagnose "$work/captures.csv" --actuator "$work/actuator.toml" --markers "$work/markers.csv" --json

@@ -4,6 +4,12 @@
 //! Both formats go through one table of text cells, so every check (missing
 //! columns, malformed or impossible values, inconsistent routings) is the
 //! same and every error names the file, the row and the column.
+//!
+//! CSV is split here, not by the `csv` crate: that crate reads a stray
+//! quote inside an unquoted field as text and an unclosed quote as a field
+//! running to the end of the file, where a measurement file must be refused
+//! with the row ([`CsvLineError`]); it also does not take lines ended by a
+//! lone CR or the `#` geometry header.
 
 use super::error::{CsvLineError, GeometryProblem, RowConflict, TableProblem};
 use super::{CalibrateError, HoldoutError};

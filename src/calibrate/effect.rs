@@ -5,7 +5,7 @@
 //! fraction by a logit) and what values are physically plausible; this
 //! module adds only what separates two candidates.
 
-use crate::model::effects::{Domain, EffectInfo, Fit, REGISTRY};
+use crate::model::effects::{self, Domain, EffectInfo, Fit};
 use crate::model::Rod;
 use serde::Serialize;
 
@@ -44,17 +44,15 @@ impl Effect {
 
     /// The candidate's registry entry.
     pub fn info(self) -> &'static EffectInfo {
-        // The one place a candidate meets its entry: by the fit's name.
-        let name = match self {
-            Effect::Friction => "friction",
-            Effect::Gravity => "gravity",
-            Effect::Stiffening => "stiffening",
-            Effect::ClampCompliance => "clamp_compliance",
-            Effect::ChannelOffset => "channel_offset",
-            Effect::Creep => "creep",
-            Effect::StiffnessGradient => "stiffness_gradient",
-        };
-        REGISTRY.iter().copied().find(|e| e.fit.is_some_and(|f| f.name == name)).expect("every candidate has a registry entry with a fit")
+        match self {
+            Effect::Friction => &effects::FRICTION,
+            Effect::Gravity => &effects::GRAVITY_SCALE,
+            Effect::Stiffening => &effects::STIFFENING,
+            Effect::ClampCompliance => &effects::CLAMP_COMPLIANCE,
+            Effect::ChannelOffset => &effects::CHANNEL_OFFSET,
+            Effect::Creep => &effects::CREEP_FRACTION,
+            Effect::StiffnessGradient => &effects::STIFFNESS_GRADIENT,
+        }
     }
 
     /// How the candidate is fitted.

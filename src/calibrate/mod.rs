@@ -1,4 +1,4 @@
-//! Calibration and the model-discrepancy workflow (issue 6): measurement
+//! Calibration and the model-discrepancy workflow: measurement
 //! files, synthetic data with a hidden effect, the fit of EA, GA, EI (thesis
 //! eq. 2.14) with or without extra effects, and the diagnosis that names the
 //! missing effect.

@@ -19,8 +19,8 @@ pub struct Prediction {
 
 /// The actuator of one routing group: the clamp tilt turns gravity the
 /// other way in the clamp's frame (gravity direction −tilt from the axis).
-pub fn group_actuator(actuator: &Rod, group: &RoutingGroup) -> Rod {
-    let mut a = actuator.clone();
+pub fn group_actuator(rod: &Rod, group: &RoutingGroup) -> Rod {
+    let mut a = rod.clone();
     a.gravity.direction_rad -= group.clamp_tilt_rad;
     a
 }
@@ -28,13 +28,13 @@ pub fn group_actuator(actuator: &Rod, group: &RoutingGroup) -> Rod {
 /// Solves the rows of one routing in protocol order, from an unloaded,
 /// virgin rod (no creep history) at the first row.
 pub fn predict_group(
-    actuator: &Rod,
+    rod: &Rod,
     options: &SolverOptions,
     data: &Dataset,
     group: &RoutingGroup,
     keep_centrelines: bool,
 ) -> Result<Vec<Prediction>, CalibrateError> {
-    let a = group_actuator(actuator, group);
+    let a = group_actuator(rod, group);
     let first_row = data.rows[group.rows[0]].row;
     let routing = Routing::for_actuator(group.routing_mm, &a)
         .map_err(|source| CalibrateError::Routing { routing: group.routing.clone(), row: first_row, source })?;
@@ -76,7 +76,7 @@ pub fn predict_group(
 /// Solves every row of `groups` (in parallel over routings); the result is
 /// indexed like `data.rows`, `None` for rows of routings not in `groups`.
 pub fn predict(
-    actuator: &Rod,
+    rod: &Rod,
     options: &SolverOptions,
     data: &Dataset,
     groups: &[RoutingGroup],
@@ -84,7 +84,7 @@ pub fn predict(
 ) -> Result<Vec<Option<Prediction>>, CalibrateError> {
     let per_group: Vec<Vec<Prediction>> = groups
         .par_iter()
-        .map(|g| predict_group(actuator, options, data, g, keep_centrelines))
+        .map(|g| predict_group(rod, options, data, g, keep_centrelines))
         .collect::<Result<_, _>>()?;
     let mut out = vec![None; data.rows.len()];
     for (g, preds) in groups.iter().zip(per_group) {

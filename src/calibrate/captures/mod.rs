@@ -1,5 +1,5 @@
 //! Calibration, prediction and diagnosis with several cables and 3-D
-//! markers (issue 26): captures with one actuation column per cable,
+//! markers: captures with one actuation column per cable,
 //! body-fixed markers measured in the clamp frame, an actuator file, and
 //! the 3-D solver ([`crate::solver::spatial::SpatialSolver`]).
 //!
