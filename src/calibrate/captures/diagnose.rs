@@ -26,11 +26,11 @@ use super::files::CaptureSet;
 use super::fit::{fit_captures, Fit3Result, Fit3Spec, Status};
 use crate::calibrate::Parameter;
 use super::simulate::solve_captures;
-use crate::calibrate::diagnose::criterion::{self, decide, rank, Candidate, Decision, NamedEffect};
+use crate::calibrate::diagnose::criterion::{self, Candidate, NamedEffect};
+use crate::calibrate::diagnose::rounds::{self, Evidence, Judged, Model, Rounds, Search, Thresholds};
 use crate::calibrate::diagnose::Verdict;
 use crate::calibrate::{CalibrateError, Effect};
 use crate::model::Actuator;
-use rayon::prelude::*;
 use serde::Serialize;
 use std::collections::BTreeMap;
 
@@ -259,51 +259,95 @@ fn candidate(effect: Effect, reference_bic: f64, result: &Result<Fit3Result, Cal
     }
 }
 
-/// What every round shares: the fitted captures, the settings, the body
-/// parameters the baseline determined and the candidate effects.
-struct Round<'a> {
+impl Judged for Fit3Result {
+    fn chi2(&self) -> f64 {
+        self.chi2
+    }
+
+    fn p_value(&self) -> f64 {
+        self.p_value
+    }
+
+    fn bic(&self) -> f64 {
+        self.bic
+    }
+
+    fn converged(&self) -> bool {
+        self.converged
+    }
+
+    fn effect_parameter(&self, effect: Effect) -> Option<(f64, f64)> {
+        self.parameter(Parameter::Effect(effect)).map(|p| (p.value, p.se))
+    }
+
+    fn chi2_text(&self) -> String {
+        criterion::chi2_text(self.chi2, self.dof, self.reduced_chi2, self.p_value)
+    }
+}
+
+/// Captures as the diagnosis's evidence: the fitted captures, the
+/// settings, the body parameters the baseline determined and the
+/// candidate effects.
+struct Captures<'a> {
     set: &'a CaptureSet,
     spec: &'a Diagnose3Spec,
     body: Vec<Parameter>,
     candidates: Vec<Effect>,
 }
 
-impl Round<'_> {
-    /// Every candidate not in `effects`, refitted with them from `reference`'s optimum.
-    fn run(&self, effects: &[Effect], reference: &Fit3Result) -> (Vec<Candidate>, Vec<(Effect, Fit3Result)>) {
-        let todo: Vec<Effect> = self.candidates.iter().copied().filter(|e| !effects.contains(e)).collect();
-        let results: Vec<(Effect, Result<Fit3Result, CalibrateError>)> = todo
-            .par_iter()
-            .map(|&e| {
-                let mut params = self.body.clone();
-                params.extend(effects.iter().map(|&x| Parameter::Effect(x)));
-                params.push(Parameter::Effect(e));
-                // From the reference's optimum, the new effect at its start.
-                let mut start = reference.actuator.clone();
-                Parameter::Effect(e).set(&mut start, e.start());
-                let spec = Fit3Spec { params, ..self.spec.fit.clone() };
-                (e, fit_captures(&start, self.set, &spec, &mut |_| {}))
-            })
-            .collect();
-        let mut cands = Vec::new();
-        let mut fits = Vec::new();
-        for (e, r) in results {
-            cands.push(candidate(e, reference.bic, &r));
-            if let Ok(f) = r {
-                fits.push((e, f));
-            }
-        }
-        rank(&mut cands);
-        (cands, fits)
+impl Evidence for Captures<'_> {
+    type Fit = Fit3Result;
+
+    fn search(&self) -> Search {
+        Search::Frugal
     }
-}
 
-fn fit_of(fits: &[(Effect, Fit3Result)], e: Effect) -> Fit3Result {
-    fits.iter().find(|(f, _)| *f == e).expect("a candidate that counts was fitted").1.clone()
-}
+    fn candidate_effects(&self) -> &[Effect] {
+        &self.candidates
+    }
 
-fn chi2_text(f: &Fit3Result) -> String {
-    criterion::chi2_text(f.chi2, f.dof, f.reduced_chi2, f.p_value)
+    fn refit(&self, effects: &[Effect], reference: &Fit3Result) -> Result<Fit3Result, CalibrateError> {
+        let mut params = self.body.clone();
+        params.extend(effects.iter().map(|&x| Parameter::Effect(x)));
+        // From the reference's optimum, the new effect at its start.
+        let mut start = reference.actuator.clone();
+        let new = *effects.last().expect("a round adds an effect");
+        Parameter::Effect(new).set(&mut start, new.start());
+        let spec = Fit3Spec { params, ..self.spec.fit.clone() };
+        fit_captures(&start, self.set, &spec, &mut |_| {})
+    }
+
+    fn candidate(&self, effect: Effect, reference_bic: f64, fit: &Result<Fit3Result, CalibrateError>) -> Candidate {
+        candidate(effect, reference_bic, fit)
+    }
+
+    fn not_converged(&self, baseline: &Fit3Result) -> String {
+        format!("the body fit did not converge ({}), so nothing can be concluded", baseline.termination)
+    }
+
+    fn nothing_counts(&self) -> String {
+        "the body fit is consistent with the noise, but no candidate fit converged to a plausible value, so no effect can be ruled out".to_string()
+    }
+
+    fn baseline_explains(&self, baseline: &Fit3Result) -> String {
+        format!(
+            "the body (rigidities and weight) explains the markers to within the stated noise ({}) and no candidate effect is warranted",
+            baseline.chi2_text()
+        )
+    }
+
+    fn model_explains(&self, model: &Model<Fit3Result>) -> String {
+        format!("{} explains the markers to within the stated noise ({})", model_name(&model.effects), model.fit.chi2_text())
+    }
+
+    fn unexplained(&self, best: &Model<Fit3Result>, alpha: f64) -> String {
+        format!(
+            "even the best model tried ({}) stays above the stated noise: {}, below {:.0e} (chi-square test of the noise-whitened marker coordinates); the markers show something no candidate effect describes, or the noise is larger than stated",
+            model_name(&best.effects),
+            best.fit.chi2_text(),
+            alpha
+        )
+    }
 }
 
 /// Runs the 3-D diagnosis of `set` from the actuator `base`.
@@ -342,106 +386,12 @@ pub fn diagnose_captures(base: &Actuator, set: &CaptureSet, spec: &Diagnose3Spec
         })
         .filter(|e| spec.fit.params.iter().all(|p| *p != Parameter::Effect(*e)))
         .collect();
-    let round = Round { set: &train, spec, body, candidates };
-    let (first, fits) = round.run(&[], &baseline);
-    let mut effects: Vec<NamedEffect> = Vec::new();
-    let mut partial_effects = Vec::new();
-    let mut ambiguous_between = Vec::new();
-    let mut separating_measurement = None;
-    let mut second_round = Vec::new();
-    let mut extended = baseline.clone();
-    let mut extended_effects: Vec<Effect> = Vec::new();
-    let mut verdict;
-    let decision = decide(&first, spec.rule());
-    match decision {
-        Decision::None => verdict = Verdict::Consistent,
-        Decision::Ambiguous(a, b) => {
-            ambiguous_between = vec![a, b];
-            separating_measurement = Some(a.separating_measurement(b).to_string());
-            verdict = Verdict::Ambiguous(a, b);
-        }
-        Decision::Named(e) => {
-            let c = first.iter().find(|c| c.effect == e).expect("candidate");
-            effects.push(NamedEffect::of(c));
-            extended = fit_of(&fits, e);
-            extended_effects = vec![e];
-            // A second effect only when the first leaves the fit above the noise.
-            if spec.max_effects > 1 && !extended.p_value.ge(&spec.alpha) {
-                let (cands2, fits2) = round.run(&[e], &extended);
-                if let Decision::Named(e2) = decide(&cands2, spec.rule()) {
-                    let f2 = fit_of(&fits2, e2);
-                    let c2 = cands2.iter().find(|c| c.effect == e2).expect("candidate");
-                    if let Some(p1) = f2.parameter(Parameter::Effect(e)) {
-                        effects[0].parameter = p1.value;
-                        effects[0].parameter_se = p1.se;
-                    }
-                    effects.push(NamedEffect::of(c2));
-                    extended = f2;
-                    extended_effects.push(e2);
-                }
-                second_round = cands2;
-            }
-            verdict = Verdict::Named(e);
-        }
-    }
-    let judged = match decision {
-        Decision::Ambiguous(a, _) => fit_of(&fits, a),
-        _ => extended.clone(),
-    };
-    let any_counts = first.iter().any(Candidate::counts);
-    let reason;
-    let mut signature_of = None;
-    if !baseline.converged {
-        verdict = Verdict::Inconclusive;
-        effects.clear();
-        extended = baseline.clone();
-        extended_effects.clear();
-        reason = format!("the body fit did not converge ({}), so nothing can be concluded", baseline.termination);
-    } else if judged.p_value >= spec.alpha {
-        reason = match verdict {
-            Verdict::Consistent if !any_counts => {
-                verdict = Verdict::Inconclusive;
-                "the body fit is consistent with the noise, but no candidate fit converged to a plausible value, so no effect can be ruled out".to_string()
-            }
-            Verdict::Consistent => format!("the body (rigidities and weight) explains the markers to within the stated noise ({}) and no candidate effect is warranted", chi2_text(&baseline)),
-            Verdict::Ambiguous(..) => format!("two effects fit equally well and the better one is consistent with the noise ({})", chi2_text(&judged)),
-            _ => format!("{} explains the markers to within the stated noise ({})", model_name(&extended_effects), chi2_text(&extended)),
-        };
-    } else {
-        // Not explained: the effects that help are reported, named nowhere.
-        let mut best = judged.clone();
-        let mut best_effects = match decision {
-            Decision::Ambiguous(a, _) => vec![a],
-            _ => extended_effects.clone(),
-        };
-        if best_effects.is_empty() {
-            if let Some(c) = first.iter().find(|c| c.counts()) {
-                let f = fit_of(&fits, c.effect);
-                if f.chi2 < best.chi2 {
-                    best = f;
-                    best_effects = vec![c.effect];
-                }
-            }
-        }
-        partial_effects = std::mem::take(&mut effects);
-        if partial_effects.is_empty() {
-            if let Some(c) = first.iter().find(|c| c.counts() && c.delta_bic <= -spec.threshold) {
-                partial_effects.push(NamedEffect::of(c));
-            }
-        }
-        ambiguous_between.clear();
-        separating_measurement = None;
-        extended = baseline.clone();
-        extended_effects.clear();
-        verdict = Verdict::Unexplained;
-        reason = format!(
-            "even the best model tried ({}) stays above the stated noise: {}, below {:.0e} (chi-square test of the noise-whitened marker coordinates); the markers show something no candidate effect describes, or the noise is larger than stated",
-            model_name(&best_effects),
-            chi2_text(&best),
-            spec.alpha
-        );
-        signature_of = Some(signature(&train, &best, &best_effects));
-    }
+    let evidence = Captures { set: &train, spec, body, candidates };
+    let thresholds = Thresholds { rule: spec.rule(), max_effects: spec.max_effects, alpha: spec.alpha };
+    let Rounds { verdict, reason, named: effects, partial_effects, ambiguous_between, separating_measurement, candidates: first, second_round, extended, best } =
+        rounds::run(&evidence, &baseline, thresholds);
+    let signature_of = (verdict == Verdict::Unexplained).then(|| signature(&train, &best.fit, &best.effects));
+    let (extended, extended_effects) = (extended.fit, extended.effects);
     let (holdout_rms_before, holdout_rms_after) = match &test {
         Some(t) => {
             let rms = |a: &Actuator| -> Result<f64, CalibrateError> { Ok(ErrorReport::of(t, &solve_captures(a, &spec.fit.options, t)?).rms_mm) };

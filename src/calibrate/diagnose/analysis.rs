@@ -20,7 +20,8 @@
 //! ([`Effect::plausible`]). Effects are added forward-stepwise by the same
 //! rule (at most `max_effects`).
 
-use super::criterion::{self, decide, rank, Candidate, Decision, NamedEffect};
+use super::criterion::{self, Candidate, NamedEffect};
+use super::rounds::{self, Evidence, Judged, Model, Rounds, Search, Thresholds};
 use super::Verdict;
 use crate::calibrate::data::{split_holdout, Dataset, Direction, RoutingGroup};
 use crate::calibrate::effect::Effect;
@@ -29,7 +30,6 @@ use crate::calibrate::predict::{predict, Prediction};
 use crate::calibrate::CalibrateError;
 use crate::model::Rod;
 use crate::solver::SolverOptions;
-use rayon::prelude::*;
 use serde::Serialize;
 
 /// Settings of a diagnosis.
@@ -188,52 +188,108 @@ fn candidate(effect: Effect, reference_bic: f64, result: &Result<FitResult, Cali
     }
 }
 
-/// One round: every effect not yet in `base_effects` (nor held) is refitted with them.
-fn round(
-    base: &Rod,
-    options: &SolverOptions,
-    data: &Dataset,
-    train: &[RoutingGroup],
-    spec: &DiagnoseSpec,
-    base_effects: &[Effect],
-    reference: &FitResult,
-) -> (Vec<Candidate>, Vec<(Effect, FitResult)>) {
-    let todo: Vec<Effect> =
-        Effect::ALL.into_iter().filter(|e| !base_effects.contains(e) && !spec.held_effects.contains(e)).collect();
-    let results: Vec<(Effect, Result<FitResult, CalibrateError>)> = todo
-        .par_iter()
-        .map(|&e| {
-            let mut effects = base_effects.to_vec();
-            effects.push(e);
-            // Start from the baseline's starting rigidities (a reference fit
-            // may have run a rigidity off to where it no longer matters) and
-            // the reference's effects.
-            let mut start = reference.actuator.clone();
-            start.ea_n = base.ea_n;
-            start.ga_n = base.ga_n;
-            start.ei_n_mm2 = base.ei_n_mm2;
-            let fs = FitSpec { effects, ..spec.fit.clone() };
-            (e, fit(&start, options, data, train, &fs))
-        })
-        .collect();
-    let mut cands = Vec::new();
-    let mut fits = Vec::new();
-    for (e, r) in results {
-        cands.push(candidate(e, reference.bic, &r));
-        if let Ok(f) = r {
-            fits.push((e, f));
-        }
+impl Judged for FitResult {
+    fn chi2(&self) -> f64 {
+        self.chi2
     }
-    rank(&mut cands);
-    (cands, fits)
+
+    fn p_value(&self) -> f64 {
+        self.p_value
+    }
+
+    fn bic(&self) -> f64 {
+        self.bic
+    }
+
+    fn converged(&self) -> bool {
+        self.converged
+    }
+
+    fn effect_parameter(&self, effect: Effect) -> Option<(f64, f64)> {
+        FitResult::effect_parameter(self, effect).map(|p| (p.value, p.se))
+    }
+
+    fn chi2_text(&self) -> String {
+        criterion::chi2_text(self.chi2, self.dof, self.reduced_chi2, self.p_value)
+    }
 }
 
-fn fit_of(fits: &[(Effect, FitResult)], e: Effect) -> FitResult {
-    fits.iter().find(|(fe, _)| *fe == e).expect("a candidate that counts was fitted").1.clone()
+/// Planar measurements as the diagnosis's evidence: the training routings,
+/// the starting rod and every candidate not held.
+struct Measurements<'a> {
+    base: &'a Rod,
+    options: &'a SolverOptions,
+    data: &'a Dataset,
+    train: &'a [RoutingGroup],
+    spec: &'a DiagnoseSpec,
+    candidates: Vec<Effect>,
 }
 
-fn chi2_text(f: &FitResult) -> String {
-    criterion::chi2_text(f.chi2, f.dof, f.reduced_chi2, f.p_value)
+impl Evidence for Measurements<'_> {
+    type Fit = FitResult;
+
+    fn search(&self) -> Search {
+        Search::Thorough
+    }
+
+    fn candidate_effects(&self) -> &[Effect] {
+        &self.candidates
+    }
+
+    fn refit(&self, effects: &[Effect], reference: &FitResult) -> Result<FitResult, CalibrateError> {
+        // Start from the baseline's starting rigidities (a reference fit
+        // may have run a rigidity off to where it no longer matters) and
+        // the reference's effects.
+        let mut start = reference.actuator.clone();
+        start.ea_n = self.base.ea_n;
+        start.ga_n = self.base.ga_n;
+        start.ei_n_mm2 = self.base.ei_n_mm2;
+        let fs = FitSpec { effects: effects.to_vec(), ..self.spec.fit.clone() };
+        fit(&start, self.options, self.data, self.train, &fs)
+    }
+
+    fn candidate(&self, effect: Effect, reference_bic: f64, fit: &Result<FitResult, CalibrateError>) -> Candidate {
+        candidate(effect, reference_bic, fit)
+    }
+
+    fn not_converged(&self, baseline: &FitResult) -> String {
+        format!(
+            "the thesis-model fit did not converge ({} iterations{}), so nothing can be concluded; no verdict is drawn from unconverged fits",
+            baseline.iterations,
+            if baseline.flags.is_empty() { String::new() } else { format!("; {}", baseline.flags.join("; ")) }
+        )
+    }
+
+    fn nothing_counts(&self) -> String {
+        "the thesis model is consistent with the noise, but no candidate fit converged to a plausible value, so no effect can be ruled out".to_string()
+    }
+
+    fn baseline_explains(&self, baseline: &FitResult) -> String {
+        format!(
+            "{} explains the data to within the stated noise ({}) and no candidate effect is warranted",
+            if self.spec.held_effects.is_empty() {
+                "the thesis model".to_string()
+            } else {
+                let held: Vec<String> =
+                    self.spec.held_effects.iter().map(|e| format!("{} = {}", e.parameter_name(), e.current(self.base).unwrap_or(0.0))).collect();
+                format!("the thesis model with {} held", held.join(", "))
+            },
+            baseline.chi2_text()
+        )
+    }
+
+    fn model_explains(&self, model: &Model<FitResult>) -> String {
+        format!("the model {} explains the data to within the stated noise ({})", model_name(&model.fit), model.fit.chi2_text())
+    }
+
+    fn unexplained(&self, best: &Model<FitResult>, alpha: f64) -> String {
+        format!(
+            "even the best model tried ({}) stays above the stated noise: {}, below {:.0e} (chi-square test of the noise-whitened residuals); the data show something no candidate effect describes, or the noise is larger than stated",
+            model_name(&best.fit),
+            best.fit.chi2_text(),
+            alpha
+        )
+    }
 }
 
 /// Runs the whole workflow on `data` with `base` as the starting actuator.
@@ -245,144 +301,12 @@ pub fn diagnose(base: &Rod, options: &SolverOptions, data: &Dataset, spec: &Diag
     let w = spec.fit.angle_weight_mm_per_deg;
     let baseline = fit(base, options, data, &train, &FitSpec { effects: Vec::new(), ..spec.fit.clone() })?;
     let diagnostics = residual_diagnostics(data, &train, &baseline.predictions, w);
-    let (candidates, fits) = round(base, options, data, &train, spec, &[], &baseline);
-    let mut named: Vec<NamedEffect> = Vec::new();
-    let mut ambiguous_between = Vec::new();
-    let mut separating_measurement = None;
-    let mut second_round = Vec::new();
-    let mut extended = baseline.clone();
-    let mut verdict;
-    // The naming rule on the first round (and a second effect on top).
-    let decision = decide(&candidates, spec.rule());
-    match decision {
-        Decision::None => verdict = Verdict::Consistent,
-        Decision::Ambiguous(a, b) => {
-            ambiguous_between = vec![a, b];
-            separating_measurement = Some(a.separating_measurement(b).to_string());
-            verdict = Verdict::Ambiguous(a, b);
-        }
-        Decision::Named(e) => {
-            let c = candidates.iter().find(|c| c.effect == e).expect("candidate");
-            named.push(NamedEffect::of(c));
-            extended = fit_of(&fits, e);
-            if spec.max_effects > 1 {
-                let (cands2, fits2) = round(base, options, data, &train, spec, &[e], &extended);
-                if let Decision::Named(e2) = decide(&cands2, spec.rule()) {
-                    let f2 = fit_of(&fits2, e2);
-                    let c2 = cands2.iter().find(|c| c.effect == e2).expect("candidate");
-                    // The first effect's value is re-estimated with the second.
-                    if let Some(p1) = f2.effect_parameter(e) {
-                        named[0].parameter = p1.value;
-                        named[0].parameter_se = p1.se;
-                    }
-                    named.push(NamedEffect::of(c2));
-                    extended = f2;
-                }
-                second_round = cands2;
-            }
-            verdict = Verdict::Named(e);
-        }
-    }
-    // The model judged against the noise: the named one, or for an
-    // ambiguous pair the better of the two.
-    let mut judged = match decision {
-        Decision::Ambiguous(a, _) => fit_of(&fits, a),
-        _ => extended.clone(),
-    };
-    let any_counts = candidates.iter().any(Candidate::counts);
-    let mut partial_effects = Vec::new();
-    let reason;
-    if !baseline.converged {
-        verdict = Verdict::Inconclusive;
-        named.clear();
-        extended = baseline.clone();
-        reason = format!(
-            "the thesis-model fit did not converge ({} iterations{}), so nothing can be concluded; no verdict is drawn from unconverged fits",
-            baseline.iterations,
-            if baseline.flags.is_empty() { String::new() } else { format!("; {}", baseline.flags.join("; ")) }
-        );
-    } else if judged.consistent_with_noise(spec.alpha) {
-        reason = match verdict {
-            Verdict::Consistent if !any_counts => {
-                verdict = Verdict::Inconclusive;
-                "the thesis model is consistent with the noise, but no candidate fit converged to a plausible value, so no effect can be ruled out".to_string()
-            }
-            Verdict::Consistent => format!(
-                "{} explains the data to within the stated noise ({}) and no candidate effect is warranted",
-                if spec.held_effects.is_empty() {
-                    "the thesis model".to_string()
-                } else {
-                    let held: Vec<String> = spec.held_effects.iter().map(|e| format!("{} = {}", e.parameter_name(), e.current(base).unwrap_or(0.0))).collect();
-                    format!("the thesis model with {} held", held.join(", "))
-                },
-                chi2_text(&baseline)
-            ),
-            Verdict::Ambiguous(..) => format!("two effects fit equally well and the better one is consistent with the noise ({})", chi2_text(&judged)),
-            _ => format!("the model {} explains the data to within the stated noise ({})", model_name(&extended), chi2_text(&extended)),
-        };
-    } else {
-        // Not explained yet: the best one or two library effects.
-        let mut best_pair: Option<(Effect, FitResult, Candidate, Candidate)> = None;
-        if !matches!(decision, Decision::Named(_)) && spec.max_effects > 1 {
-            if let Some(c1) = candidates.iter().find(|c| c.counts()) {
-                let e1 = c1.effect;
-                let f1 = fit_of(&fits, e1);
-                let (cands2, fits2) = round(base, options, data, &train, spec, &[e1], &f1);
-                if let Decision::Named(e2) = decide(&cands2, spec.rule()) {
-                    let f2 = fit_of(&fits2, e2);
-                    let c2 = cands2.iter().find(|c| c.effect == e2).expect("candidate").clone();
-                    best_pair = Some((e1, f2, c1.clone(), c2));
-                }
-                second_round = cands2;
-                if f1.chi2 < judged.chi2 {
-                    judged = f1;
-                }
-            }
-        }
-        match best_pair {
-            Some((e1, f2, c1, c2)) if f2.consistent_with_noise(spec.alpha) => {
-                let mut n1 = NamedEffect::of(&c1);
-                if let Some(p1) = f2.effect_parameter(e1) {
-                    n1.parameter = p1.value;
-                    n1.parameter_se = p1.se;
-                }
-                named = vec![n1, NamedEffect::of(&c2)];
-                ambiguous_between.clear();
-                separating_measurement = None;
-                extended = f2;
-                verdict = Verdict::Named(e1);
-                reason = format!("the model {} explains the data to within the stated noise ({})", model_name(&extended), chi2_text(&extended));
-            }
-            pair => {
-                if let Some((_, f2, _, _)) = pair {
-                    if f2.chi2 < judged.chi2 {
-                        judged = f2;
-                    }
-                }
-                if extended.chi2 < judged.chi2 {
-                    judged = extended.clone();
-                }
-                // The effects that help, kept for the report, named nowhere.
-                partial_effects = std::mem::take(&mut named);
-                if partial_effects.is_empty() {
-                    if let Some(c) = candidates.iter().find(|c| c.counts() && c.delta_bic <= -spec.threshold) {
-                        partial_effects.push(NamedEffect::of(c));
-                    }
-                }
-                ambiguous_between.clear();
-                separating_measurement = None;
-                extended = baseline.clone();
-                verdict = Verdict::Unexplained;
-                reason = format!(
-                    "even the best model tried ({}) stays above the stated noise: {}, below {:.0e} (chi-square test of the noise-whitened residuals); the data show something no candidate effect describes, or the noise is larger than stated",
-                    model_name(&judged),
-                    chi2_text(&judged),
-                    spec.alpha
-                );
-            }
-        }
-    }
-    let best = if judged.chi2 <= extended.chi2 { judged } else { extended.clone() };
+    let candidates: Vec<Effect> = Effect::ALL.into_iter().filter(|e| !spec.held_effects.contains(e)).collect();
+    let evidence = Measurements { base, options, data, train: &train, spec, candidates };
+    let thresholds = Thresholds { rule: spec.rule(), max_effects: spec.max_effects, alpha: spec.alpha };
+    let Rounds { verdict, reason, named, partial_effects, ambiguous_between, separating_measurement, candidates, second_round, extended, best } =
+        rounds::run(&evidence, &baseline, thresholds);
+    let (extended, best) = (extended.fit, best.fit);
     let signature = (verdict == Verdict::Unexplained).then(|| signature(data, &train, &best, &spec.fit));
     // Predict every row (the held-out routing too) with both models.
     let all = data.groups();

@@ -13,6 +13,7 @@ pub mod analysis;
 pub mod criterion;
 pub mod markdown;
 pub mod report;
+pub mod rounds;
 pub mod run;
 pub mod verdict;
 
