@@ -6,6 +6,9 @@
 mod body;
 mod canvas;
 mod design_shape;
+mod diagnosis_loops;
+mod diagnosis_residuals;
+mod diagnosis_shapes;
 pub mod heatmap;
 pub mod map_frame;
 pub mod modes;
@@ -16,9 +19,12 @@ pub mod spatial;
 
 pub use body::{body_series, draw_bodies, BodyDrawing};
 pub use design_shape::draw_design_shape;
+pub use diagnosis_loops::draw_diagnosis_loops;
+pub use diagnosis_residuals::draw_diagnosis_residuals;
+pub use diagnosis_shapes::draw_diagnosis_shapes;
 pub use canvas::{png_backend, register_fonts, PlotError, FONT};
 pub use series::{
-    clamp_half_width_mm, clamp_series, draw_legend, draw_series_on, hanging_chart, legend_size, series_points, Mark, PageChart, PictureSeries,
+    clamp_half_width_mm, clamp_series, draw_legend, draw_series_labels, draw_series_on, hanging_chart, legend_size, series_points, Mark, PageChart, PictureSeries,
     CLAMP_HALF_WIDTH_PER_RADIUS,
 };
 

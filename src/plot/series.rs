@@ -221,3 +221,15 @@ pub(super) fn page_chart<'a, 'b>(
         .map_err(|e| PlotError::new(path, e))?;
     Ok(chart)
 }
+
+/// Draws the series legend plotters keeps for `chart` at `position` in `font_size` points.
+pub fn draw_series_labels<'a, 'b: 'a>(chart: &mut PageChart<'a, 'b>, path: &Path, position: SeriesLabelPosition, font_size: u32) -> Result<(), PlotError> {
+    chart
+        .configure_series_labels()
+        .position(position)
+        .label_font((FONT, font_size))
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()
+        .map_err(|e| PlotError::new(path, e))
+}

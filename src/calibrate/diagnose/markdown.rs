@@ -5,12 +5,11 @@
 use super::analysis::{DiagnoseSpec, Diagnosis};
 use super::criterion::Candidate;
 use super::Verdict;
-use crate::calibrate::data::{CentrelinePoints, Dataset, Direction, MarkerPoints, RoutingGroup};
-use crate::calibrate::fit::{row_residual, FitResult};
+use crate::calibrate::data::{CentrelinePoints, Dataset};
+use crate::calibrate::fit::FitResult;
 use crate::calibrate::predict::Prediction;
 use crate::calibrate::CalibrateError;
-use crate::plot::{register_fonts, PlotError, FONT};
-use plotters::prelude::*;
+use crate::plot::PlotError;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -48,10 +47,10 @@ pub(super) fn write_report(
         std::fs::rename(&tmp, dir.join(name))
             .map_err(|source| CalibrateError::Io { context: format!("writing {}", dir.join(name).display()), source })
     };
-    atomic("residuals.png", &|p| residual_plot(p, data, &groups, d, after_label, angle_weight_mm_per_deg))?;
-    atomic("loops.png", &|p| loop_plot(p, data, &groups, d, after_label))?;
+    atomic("residuals.png", &|p| crate::plot::draw_diagnosis_residuals(p, data, &groups, d, after_label, angle_weight_mm_per_deg))?;
+    atomic("loops.png", &|p| crate::plot::draw_diagnosis_loops(p, data, &groups, d, after_label))?;
     let markers = (!spec.fit.shapes.markers.is_empty()).then_some(&spec.fit.shapes.markers);
-    atomic("shapes.png", &|p| shape_plot(p, data, &groups, d, centrelines, markers, after_label))?;
+    atomic("shapes.png", &|p| crate::plot::draw_diagnosis_shapes(p, data, &groups, d, centrelines, markers, after_label))?;
     crate::io::sync_dir(dir);
     let md = markdown(data_path, data, d, after_label, centrelines, spec.fit.noise.mm);
     let path = dir.join("report.md");
@@ -344,239 +343,6 @@ fn coefficient_section(out: &mut String, data: &Dataset, d: &Diagnosis, centreli
         }
     }
     out.push('\n');
-}
-
-type Chart<'a, 'b> = ChartContext<'a, BitMapBackend<'b>, Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>>;
-
-/// Draws the series legend of `chart` at `position` in `font_size` points.
-fn draw_legend<'a, 'b: 'a>(chart: &mut Chart<'a, 'b>, path: &Path, position: SeriesLabelPosition, font_size: u32) -> Result<(), PlotError> {
-    chart
-        .configure_series_labels()
-        .position(position)
-        .label_font((FONT, font_size))
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()
-        .map_err(|e| PlotError::new(path, e))
-}
-
-fn residual_plot(path: &Path, data: &Dataset, groups: &[RoutingGroup], d: &Diagnosis, after: Option<&str>, w: f64) -> Result<(), PlotError> {
-    register_fonts();
-    let height = if after.is_some() { 800 } else { 420 };
-    let root = crate::plot::png_backend(path, (1100, height))?.into_drawing_area();
-    root.fill(&WHITE).map_err(|e| PlotError::new(path, e))?;
-    let panels = root.split_evenly((if after.is_some() { 2 } else { 1 }, 1));
-    let order: Vec<usize> = groups.iter().flat_map(|g| g.rows.iter().copied()).collect();
-    let series = |preds: &[Option<Prediction>]| -> Vec<[f64; 3]> {
-        order.iter().map(|&i| row_residual(&data.rows[i], &preds[i].as_ref().expect("predicted").pose, w)).collect()
-    };
-    let before = series(&d.baseline_predictions);
-    let after_r = series(&d.extended_predictions);
-    let lim = before.iter().chain(&after_r).flat_map(|r| r.iter().map(|v| v.abs())).fold(1.0, f64::max) * 1.1;
-    let mut shown = vec![(&before, "thesis model".to_string())];
-    if let Some(label) = after {
-        shown.push((&after_r, label.to_string()));
-    }
-    for (panel, (res, title)) in panels.iter().zip(shown) {
-        let mut chart = ChartBuilder::on(panel)
-            .caption(format!("residuals (simulated − measured), {title}"), (FONT, 20))
-            .margin(10)
-            .x_label_area_size(35)
-            .y_label_area_size(60)
-            .build_cartesian_2d(-0.5..order.len() as f64 - 0.5, -lim..lim)
-            .map_err(|e| PlotError::new(path, e))?;
-        chart
-            .configure_mesh()
-            .x_desc("reading (routings in protocol order; loading ●, unloading ○, rest or static ×)")
-            .y_desc("mm  (θ: mm-equivalent)")
-            .label_style((FONT, 13))
-            .axis_desc_style((FONT, 14))
-            .draw()
-            .map_err(|e| PlotError::new(path, e))?;
-        // The held-out routing's readings on a grey band, so they stand apart.
-        let mut start = 0;
-        for g in groups {
-            let end = start + g.rows.len();
-            if d.holdout.as_deref() == Some(g.routing.as_str()) {
-                let band = Rectangle::new([(start as f64 - 0.5, -lim), (end as f64 - 0.5, lim)], BLACK.mix(0.07).filled());
-                chart.draw_series(std::iter::once(band)).map_err(|e| PlotError::new(path, e))?;
-            }
-            start = end;
-        }
-        // Loading filled, unloading open, rest and static captures as crosses:
-        // a friction or creep loop shows as two marker kinds apart.
-        let direction = |k: usize| data.rows[order[k]].direction;
-        let is_rest = |k: usize| matches!(direction(k), Direction::Rest | Direction::Static);
-        for (c, (name, colour)) in [("Δx", BLUE), ("Δy", GREEN), ("Δθ·w", RGBColor(230, 120, 0))].into_iter().enumerate() {
-            let at = |k: usize| (k as f64, res[k][c]);
-            chart
-                .draw_series((0..res.len()).filter(|&k| direction(k) == Direction::Load).map(|k| Circle::new(at(k), 3, colour.filled())))
-                .map_err(|e| PlotError::new(path, e))?
-                .label(name)
-                .legend(move |(x, y)| Circle::new((x + 8, y), 4, colour.filled()));
-            chart
-                .draw_series((0..res.len()).filter(|&k| direction(k) == Direction::Unload).map(|k| Circle::new(at(k), 3, colour.stroke_width(2))))
-                .map_err(|e| PlotError::new(path, e))?;
-            chart
-                .draw_series((0..res.len()).filter(|&k| is_rest(k)).map(|k| Cross::new(at(k), 3, colour.stroke_width(2))))
-                .map_err(|e| PlotError::new(path, e))?;
-        }
-        // Routing boundaries and names (the held-out one marked).
-        let mut k = 0;
-        for g in groups {
-            let first = k;
-            k += g.rows.len();
-            let x = k as f64 - 0.5;
-            chart.draw_series(LineSeries::new(vec![(x, -lim), (x, lim)], BLACK.mix(0.3))).map_err(|e| PlotError::new(path, e))?;
-            let held = d.holdout.as_deref() == Some(g.routing.as_str());
-            let name = format!("{}{}", g.routing, if held { " (held out)" } else { "" });
-            chart
-                .draw_series(std::iter::once(Text::new(name, (first as f64, lim * 0.97), (FONT, 12))))
-                .map_err(|e| PlotError::new(path, e))?;
-        }
-        draw_legend(&mut chart, path, SeriesLabelPosition::LowerRight, 13)?;
-    }
-    root.present().map_err(|e| PlotError::new(path, e))
-}
-
-fn loop_plot(path: &Path, data: &Dataset, groups: &[RoutingGroup], d: &Diagnosis, after: Option<&str>) -> Result<(), PlotError> {
-    register_fonts();
-    let cols = groups.len().clamp(1, 3);
-    let rows = groups.len().div_ceil(cols).max(1);
-    let root = crate::plot::png_backend(path, (420 * cols as u32, 360 * rows as u32))?.into_drawing_area();
-    root.fill(&WHITE).map_err(|e| PlotError::new(path, e))?;
-    let panels = root.split_evenly((rows, cols));
-    let orange = RGBColor(230, 120, 0);
-    for (panel, g) in panels.iter().zip(groups) {
-        let angle = |i: usize, preds: &[Option<Prediction>]| preds[i].as_ref().expect("predicted").pose.tip_angle_rad.to_degrees();
-        let measured: Vec<(f64, f64, Direction)> =
-            g.rows.iter().map(|&i| (data.rows[i].tension_n, data.rows[i].tip_angle_rad.to_degrees(), data.rows[i].direction)).collect();
-        let base: Vec<(f64, f64)> = g.rows.iter().map(|&i| (data.rows[i].tension_n, angle(i, &d.baseline_predictions))).collect();
-        let ext: Vec<(f64, f64)> = g.rows.iter().map(|&i| (data.rows[i].tension_n, angle(i, &d.extended_predictions))).collect();
-        let ys = measured.iter().map(|m| m.1).chain(base.iter().map(|b| b.1)).chain(ext.iter().map(|b| b.1));
-        let (lo, hi) = ys.fold((f64::MAX, f64::MIN), |(a, b), v| (a.min(v), b.max(v)));
-        let pad = 0.05 * (hi - lo).max(1.0);
-        let tmax = measured.iter().map(|m| m.0).fold(0.0, f64::max).max(1e-3) * 1.05;
-        let held = d.holdout.as_deref() == Some(g.routing.as_str());
-        let mut chart = ChartBuilder::on(panel)
-            .caption(format!("{}{}", g.routing, if held { " (held out)" } else { "" }), (FONT, 18))
-            .margin(8)
-            .x_label_area_size(35)
-            .y_label_area_size(50)
-            .build_cartesian_2d(-0.02 * tmax..tmax, (lo - pad)..(hi + pad))
-            .map_err(|e| PlotError::new(path, e))?;
-        chart
-            .configure_mesh()
-            .x_desc("tension (N)")
-            .y_desc("tip angle (°)")
-            .label_style((FONT, 12))
-            .axis_desc_style((FONT, 13))
-            .draw()
-            .map_err(|e| PlotError::new(path, e))?;
-        chart
-            .draw_series(LineSeries::new(base, BLUE.stroke_width(2)))
-            .map_err(|e| PlotError::new(path, e))?
-            .label("thesis model")
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], BLUE.stroke_width(2)));
-        if let Some(label) = after {
-            chart
-                .draw_series(LineSeries::new(ext, orange.stroke_width(2)))
-                .map_err(|e| PlotError::new(path, e))?
-                .label(label.to_string())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], orange.stroke_width(2)));
-        }
-        for (dir, colour, label) in [
-            (Direction::Load, BLACK, "measured, load"),
-            (Direction::Unload, RED, "measured, unload"),
-            (Direction::Rest, RGBColor(120, 120, 120), "measured, rest"),
-            (Direction::Static, RGBColor(60, 60, 200), "measured, static"),
-        ] {
-            // A legend entry only for kinds of reading this routing has.
-            if !measured.iter().any(|m| m.2 == dir) {
-                continue;
-            }
-            chart
-                .draw_series(measured.iter().filter(|m| m.2 == dir).map(|m| Circle::new((m.0, m.1), 4, colour.filled())))
-                .map_err(|e| PlotError::new(path, e))?
-                .label(label)
-                .legend(move |(x, y)| Circle::new((x + 8, y), 4, colour.filled()));
-        }
-        draw_legend(&mut chart, path, SeriesLabelPosition::UpperLeft, 11)?;
-    }
-    root.present().map_err(|e| PlotError::new(path, e))
-}
-
-fn shape_plot(
-    path: &Path,
-    data: &Dataset,
-    groups: &[RoutingGroup],
-    d: &Diagnosis,
-    centrelines: Option<&CentrelinePoints>,
-    markers: Option<&MarkerPoints>,
-    after: Option<&str>,
-) -> Result<(), PlotError> {
-    register_fonts();
-    // The reading at the top tension of each routing.
-    let picks: Vec<(&RoutingGroup, usize)> = groups
-        .iter()
-        .filter_map(|g| g.rows.iter().copied().max_by(|&a, &b| data.rows[a].tension_n.total_cmp(&data.rows[b].tension_n)).map(|i| (g, i)))
-        .collect();
-    let line = |preds: &[Option<Prediction>], i: usize| -> Vec<(f64, f64)> {
-        preds[i].as_ref().and_then(|p| p.centreline.as_ref()).map(|c| c.iter().map(|p| (p.y_mm, -p.x_mm)).collect()).unwrap_or_default()
-    };
-    let mut pts: Vec<(f64, f64)> = vec![(0.0, 0.0)];
-    for &(_, i) in &picks {
-        pts.extend(line(&d.baseline_predictions, i));
-        pts.extend(line(&d.extended_predictions, i));
-        pts.push((data.rows[i].tip_y_mm, -data.rows[i].tip_x_mm));
-    }
-    let (x0, x1) = pts.iter().fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.0), b.max(p.0)));
-    let (y0, y1) = pts.iter().fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.1), b.max(p.1)));
-    let span = (x1 - x0).max(y1 - y0) + 10.0;
-    let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
-    let root = crate::plot::png_backend(path, (850, 850))?.into_drawing_area();
-    root.fill(&WHITE).map_err(|e| PlotError::new(path, e))?;
-    let title = "shapes at the top tension: measured vs simulated";
-    let mut chart = crate::plot::hanging_chart(&root, path, title, (cx - span / 2.0, cx + span / 2.0), (cy - span / 2.0, cy + span / 2.0))?;
-    let orange = RGBColor(230, 120, 0);
-    for (k, &(g, i)) in picks.iter().enumerate() {
-        let first = k == 0;
-        let s = chart.draw_series(LineSeries::new(line(&d.baseline_predictions, i), BLUE.stroke_width(2))).map_err(|e| PlotError::new(path, e))?;
-        if first {
-            s.label("thesis model").legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], BLUE.stroke_width(2)));
-        }
-        if let Some(label) = after {
-            let s = chart.draw_series(LineSeries::new(line(&d.extended_predictions, i), orange.stroke_width(2))).map_err(|e| PlotError::new(path, e))?;
-            if first {
-                s.label(label.to_string()).legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], orange.stroke_width(2)));
-            }
-        }
-        let m = &data.rows[i];
-        let s = chart
-            .draw_series(std::iter::once(Cross::new((m.tip_y_mm, -m.tip_x_mm), 7, BLACK.stroke_width(2))))
-            .map_err(|e| PlotError::new(path, e))?;
-        if first {
-            s.label("measured tip").legend(|(x, y)| Cross::new((x + 8, y), 5, BLACK.stroke_width(2)));
-        }
-        if let Some(points) = centrelines.and_then(|c| c.get(&m.measurement)) {
-            chart
-                .draw_series(points.iter().map(|p| Circle::new((p[1], -p[0]), 2, BLACK.mix(0.6).filled())))
-                .map_err(|e| PlotError::new(path, e))?;
-        }
-        if let Some(ms) = markers.and_then(|c| c.get(&m.measurement)) {
-            let s = chart
-                .draw_series(ms.iter().map(|p| TriangleMarker::new((p.y_mm, -p.x_mm), 5, RED.filled())))
-                .map_err(|e| PlotError::new(path, e))?;
-            if first {
-                s.label("measured markers").legend(|(x, y)| TriangleMarker::new((x + 8, y), 4, RED.filled()));
-            }
-        }
-        chart
-            .draw_series(std::iter::once(Text::new(g.routing.clone(), (m.tip_y_mm + 2.0, -m.tip_x_mm + 2.0), (FONT, 13))))
-            .map_err(|e| PlotError::new(path, e))?;
-    }
-    draw_legend(&mut chart, path, SeriesLabelPosition::LowerLeft, 13)?;
-    root.present().map_err(|e| PlotError::new(path, e))
 }
 
 #[cfg(test)]
