@@ -4,10 +4,11 @@
 //! effect into the actuator, refuses to overwrite files, writes them and
 //! says whether the noise hides the effect). Request in, report out.
 //!
-//! With an actuator file ([`CaptureSynthRequest`], `synth --actuator`):
-//! several-cable captures and 3-D markers in the format `calibrate`,
-//! `diagnose` and `predict` read ([`crate::calibrate::captures::synth`]
-//! generates them).
+//! The input decides the kind: without an actuator file, planar readings
+//! of one in-plane cable; with one (`synth --actuator`), several-cable
+//! captures and 3-D markers in the format `calibrate`, `diagnose` and
+//! `predict` read ([`crate::calibrate::captures::synth`] generates them).
+//! [`SynthRequest::check`] refuses once what the kind does not take.
 
 use crate::calibrate::data::{centrelines_csv, markers_csv, measurements_csv};
 use crate::calibrate::synth::{default_routings, hidden_effect_size, synthesize_with_markers, SynthSpec, VISIBLE_NOISE_SDS};
@@ -15,63 +16,171 @@ pub use crate::calibrate::synth::{HiddenEffect, HiddenEffectError, OUT_OF_LIBRAR
 use crate::calibrate::CalibrateError;
 use crate::io::FileError;
 use crate::model::routing::CONTROL_POINTS;
-use crate::calibrate::captures::files::{captures_csv, markers_3d_csv, Capture};
+use crate::calibrate::captures::files::{captures_csv, markers_3d_csv, read_captures};
 use crate::calibrate::captures::solve_captures;
 use crate::calibrate::captures::synth::{default_markers, default_plan, synth_captures, MarkerSpec};
 use crate::solver::spatial::SpatialOptions;
-use crate::model::{Actuator, ParameterError, Rod};
+use crate::model::rod::ActuatorFileError;
+use crate::model::{Actuator, ActuatorError, ParameterError, RodOverrides};
 use crate::solver::SolverOptions;
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::fmt;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Where the markers sit.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Markers {
-    /// At L/4, L/2, 3L/4 and L on alternate sides at the surface (r(s) for a tapered body).
+    /// Planar: at L/4, L/2, 3L/4 and L on alternate sides at the surface
+    /// (r(s) for a tapered body); captures: [`default_markers`].
     Default,
-    /// These (rest arc length, lateral body-frame offset), mm.
+    /// Planar: these (rest arc length, lateral body-frame offset), mm.
     At(Vec<(f64, f64)>),
+    /// Captures: these named markers at a rest arc length and body-frame offsets.
+    Placed(Vec<MarkerSpec>),
 }
 
-/// Everything a synthetic data set needs.
+/// Everything a synthetic data set needs. Without `actuator_file` the data
+/// are planar readings of the rod `rod` describes; with it, several-cable
+/// captures with 3-D markers of that actuator.
 #[derive(Debug, Clone)]
 pub struct SynthRequest {
-    /// The actuator without the hidden effect (the model a fit starts from).
-    pub actuator: Rod,
-    /// Solver settings.
+    /// A whole actuator (rod, torsion, gravity, cables) as TOML: captures
+    /// with 3-D markers, solved by the 3-D solver.
+    pub actuator_file: Option<PathBuf>,
+    /// Planar: the rod without the hidden effect (the model a fit starts from).
+    pub rod: RodOverrides,
+    /// The planar solver's settings.
     pub options: SolverOptions,
+    /// The 3-D solver's settings (captures).
+    pub spatial_options: SpatialOptions,
     /// The hidden effect.
     pub effect: HiddenEffect,
-    /// Routings with their ids; `None`: [`default_routings`].
+    /// Planar: routings with their ids; `None`: [`default_routings`].
     pub routings: Option<Vec<(String, [f64; CONTROL_POINTS])>>,
-    /// Clamp tilts of single routings, rad, by id.
+    /// Planar: clamp tilts of single routings, rad, by id.
     pub routing_tilts_rad: BTreeMap<String, f64>,
-    /// Top tension τ_u, N.
+    /// Top tension τ_u, N (captures: the default plan's).
     pub max_tension_n: f64,
-    /// Loading steps from rest to τ_u.
+    /// Planar: loading steps from rest to τ_u.
     pub load_steps: usize,
-    /// Dwell before each loaded reading, s.
+    /// Dwell before each loaded reading, s (captures: before each capture of the default plan).
     pub step_dwell_s: f64,
-    /// Dwell before each rest reading, s.
+    /// Planar: dwell before each rest reading, s.
     pub rest_dwell_s: f64,
-    /// Clamp axis from the vertical, rad.
+    /// Planar: clamp axis from the vertical, rad.
     pub clamp_tilt_rad: f64,
-    /// Noise on tip x and y (standard deviation), mm.
+    /// Noise on tip x and y (captures: on every marker coordinate), standard deviation, mm.
     pub noise_mm: f64,
-    /// Noise on the tip angle (standard deviation), degrees.
+    /// Planar: noise on the tip angle (standard deviation), degrees.
     pub noise_deg: f64,
     /// Seed of the noise.
     pub seed: u64,
-    /// The measurement file (CSV).
+    /// The measurement file (captures: the captures file), CSV.
     pub out: PathBuf,
-    /// Also the measured centreline points, and how many per reading.
+    /// Planar: also the measured centreline points, and how many per reading.
     pub centreline_out: Option<(PathBuf, usize)>,
-    /// Also the markers, and where they sit.
-    pub markers_out: Option<(PathBuf, Markers)>,
+    /// The markers file (required with captures).
+    pub markers_out: Option<PathBuf>,
+    /// Where the markers sit.
+    pub markers: Markers,
+    /// Captures: the captures to make, as a captures file (its actuation,
+    /// direction, step and dwell columns); `None`: [`default_plan`].
+    pub plan: Option<PathBuf>,
     /// Overwrite existing files.
     pub force: bool,
+}
+
+/// A setting the kind of data does not take.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SynthRefused {
+    /// Rod settings with an actuator file.
+    #[error("with --actuator the rod comes from FILE.toml's [rod] table; edit it instead of giving rod flags")]
+    RodOnCaptures,
+    /// A planar setting with an actuator file.
+    #[error("{flag} is for planar data; with --actuator the captures come from --plan or the default plan")]
+    PlanarOnly {
+        /// The setting, as its flag.
+        flag: &'static str,
+    },
+    /// Captures without a markers file.
+    #[error("with --actuator give --markers-out FILE: the 3-D markers are written there")]
+    NoMarkersFile,
+    /// Planar markers without a markers file.
+    #[error("--markers needs --markers-out FILE")]
+    MarkersWithoutFile,
+    /// A captures setting without an actuator file.
+    #[error("--plan and --markers-at make several-cable captures: give the actuator with --actuator FILE.toml")]
+    CapturesOnly,
+    /// A negative or non-finite marker noise.
+    #[error("--noise-mm {value}: must be a standard deviation ≥ 0 mm")]
+    MarkerNoise {
+        /// The value given.
+        value: f64,
+    },
+    /// A top tension that is not positive.
+    #[error("--tension-max-n {value}: must be a tension > 0 N")]
+    MaxTension {
+        /// The value given.
+        value: f64,
+    },
+    /// A negative or non-finite dwell.
+    #[error("--step-dwell-s {value}: must be a time ≥ 0 s")]
+    Dwell {
+        /// The value given.
+        value: f64,
+    },
+}
+
+/// The kind of data a synth request makes, decided by its input.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SynthKind<'a> {
+    /// Planar readings of one in-plane cable.
+    Readings,
+    /// Captures with 3-D markers of the actuator in this file.
+    Captures {
+        /// The actuator file.
+        actuator_file: &'a Path,
+    },
+}
+
+impl SynthRequest {
+    /// The kind of data, with the settings it refuses checked.
+    pub fn check(&self) -> Result<SynthKind<'_>, SynthRefused> {
+        let Some(actuator_file) = self.actuator_file.as_deref() else {
+            return match self.markers {
+                Markers::Placed(_) => Err(SynthRefused::CapturesOnly),
+                _ if self.plan.is_some() => Err(SynthRefused::CapturesOnly),
+                Markers::At(_) if self.markers_out.is_none() => Err(SynthRefused::MarkersWithoutFile),
+                _ => Ok(SynthKind::Readings),
+            };
+        };
+        if !self.rod.is_empty() {
+            return Err(SynthRefused::RodOnCaptures);
+        }
+        let planar_only = [
+            (self.routings.is_some(), "--routings"),
+            (self.centreline_out.is_some(), "--centreline-out"),
+            (matches!(self.markers, Markers::At(_)), "--markers (give --markers-at NAME:S:Y:Z;…)"),
+            (self.clamp_tilt_rad != 0.0, "--clamp-tilt-rad (set gravity_direction in FILE.toml)"),
+        ];
+        if let Some((_, flag)) = planar_only.iter().find(|(given, _)| *given) {
+            return Err(SynthRefused::PlanarOnly { flag });
+        }
+        if self.markers_out.is_none() {
+            return Err(SynthRefused::NoMarkersFile);
+        }
+        if !(self.noise_mm.is_finite() && self.noise_mm >= 0.0) {
+            return Err(SynthRefused::MarkerNoise { value: self.noise_mm });
+        }
+        if !(self.max_tension_n.is_finite() && self.max_tension_n > 0.0) {
+            return Err(SynthRefused::MaxTension { value: self.max_tension_n });
+        }
+        if !(self.step_dwell_s.is_finite() && self.step_dwell_s >= 0.0) {
+            return Err(SynthRefused::Dwell { value: self.step_dwell_s });
+        }
+        Ok(SynthKind::Captures { actuator_file })
+    }
 }
 
 /// Why synthetic data could not be made.
@@ -92,6 +201,18 @@ pub enum SynthError {
     /// Writing a file.
     #[error(transparent)]
     File(#[from] FileError),
+    /// A setting the kind of data does not take.
+    #[error(transparent)]
+    Refused(#[from] SynthRefused),
+    /// The planar rod's file.
+    #[error("--actuator-file")]
+    RodFile(#[source] ActuatorFileError),
+    /// The actuator file of captures.
+    #[error("--actuator")]
+    ActuatorFile(#[source] ActuatorError),
+    /// The plan's captures file.
+    #[error("--plan")]
+    Plan(#[source] CalibrateError),
 }
 
 /// How far the hidden effect moves the simulated readings, against the noise.
@@ -105,9 +226,9 @@ pub struct EffectVisibility {
     pub hidden_by_noise: bool,
 }
 
-/// What `synth` wrote.
+/// What `synth` wrote of planar readings.
 #[derive(Debug, Clone, Serialize)]
-pub struct SynthReport {
+pub struct ReadingsWritten {
     /// Readings written.
     pub readings: usize,
     /// Routings measured.
@@ -126,7 +247,7 @@ pub struct SynthReport {
     pub visibility: Option<EffectVisibility>,
 }
 
-impl fmt::Display for SynthReport {
+impl fmt::Display for ReadingsWritten {
     /// What `synth` says on stderr: the files, and a warning when the noise hides the effect.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         writeln!(
@@ -154,17 +275,45 @@ impl fmt::Display for SynthReport {
     }
 }
 
-/// Generates and writes the data set: the actuator with the hidden effect
+/// What `synth` wrote, of either kind of data.
+#[derive(Debug, Clone, Serialize)]
+#[serde(untagged)]
+pub enum SynthReport {
+    /// Planar readings.
+    Readings(ReadingsWritten),
+    /// Captures with 3-D markers.
+    Captures(CapturesWritten),
+}
+
+impl fmt::Display for SynthReport {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            SynthReport::Readings(r) => r.fmt(f),
+            SynthReport::Captures(r) => r.fmt(f),
+        }
+    }
+}
+
+/// Generates and writes the data set the request's input asks for.
+pub fn run(request: &SynthRequest) -> Result<SynthReport, SynthError> {
+    match request.check()? {
+        SynthKind::Readings => write_readings(request).map(SynthReport::Readings),
+        SynthKind::Captures { actuator_file } => write_captures(request, actuator_file).map(SynthReport::Captures),
+    }
+}
+
+/// Generates and writes planar readings: the rod with the hidden effect
 /// is validated, existing files are refused unless `force`, the readings
 /// (and centrelines and markers when asked) are written, and the effect's
 /// size is compared with the noise.
-pub fn run(request: &SynthRequest) -> Result<SynthReport, SynthError> {
-    let actuator = request.effect.apply(&request.actuator);
+fn write_readings(request: &SynthRequest) -> Result<ReadingsWritten, SynthError> {
+    let rod = request.rod.resolve(None).map_err(SynthError::RodFile)?;
+    let actuator = request.effect.apply(&rod);
     actuator.validate().map_err(SynthError::TrueActuator)?;
-    let markers = match &request.markers_out {
-        None => Vec::new(),
-        Some((_, Markers::At(m))) => m.clone(),
-        Some((_, Markers::Default)) => {
+    let markers = match (&request.markers_out, &request.markers) {
+        (None, _) => Vec::new(),
+        (Some(_), Markers::At(m)) => m.clone(),
+        (Some(_), _) => {
             let l = actuator.length_mm;
             let r = |f: f64| actuator.radius_at(f * l);
             vec![(0.25 * l, r(0.25)), (0.5 * l, -r(0.5)), (0.75 * l, r(0.75)), (l, -r(1.0))]
@@ -186,7 +335,7 @@ pub fn run(request: &SynthRequest) -> Result<SynthReport, SynthError> {
         seed: request.seed,
     };
     let centreline = request.centreline_out.as_ref();
-    let marker_file = request.markers_out.as_ref().map(|(p, _)| p);
+    let marker_file = request.markers_out.as_ref();
     for path in std::iter::once(&request.out).chain(centreline.map(|(p, _)| p)).chain(marker_file) {
         if !request.force && path.exists() {
             return Err(SynthError::Exists { path: path.clone() });
@@ -194,10 +343,10 @@ pub fn run(request: &SynthRequest) -> Result<SynthReport, SynthError> {
     }
     let points = centreline.map_or(0, |(_, n)| (*n).max(2));
     let (mut data, centrelines, marker_points) = synthesize_with_markers(&spec, points)?;
-    if !request.actuator.is_uniform_body() {
+    if !rod.is_uniform_body() {
         // The body goes into the file, so diagnose needs no geometry flags:
         // the rod's without the hidden effect (a glue joint is a segment).
-        data.actuator = Some(request.actuator.clone());
+        data.actuator = Some(rod.clone());
     }
     let write = |path: &PathBuf, text: String| crate::io::write_atomic(path, text.as_bytes()).map_err(FileError::on("writing", path));
     write(&request.out, measurements_csv(&data))?;
@@ -210,7 +359,7 @@ pub fn run(request: &SynthRequest) -> Result<SynthReport, SynthError> {
     let visibility = match request.effect {
         HiddenEffect::None => None,
         _ => {
-            let size = hidden_effect_size(&spec, &request.actuator)?;
+            let size = hidden_effect_size(&spec, &rod)?;
             Some(EffectVisibility {
                 max_tip_shift_mm: size.max_tip_shift_mm,
                 max_angle_shift_deg: size.max_angle_shift_deg,
@@ -218,7 +367,7 @@ pub fn run(request: &SynthRequest) -> Result<SynthReport, SynthError> {
             })
         }
     };
-    Ok(SynthReport {
+    Ok(ReadingsWritten {
         readings: data.rows.len(),
         routings: spec.routings.len(),
         out: request.out.clone(),
@@ -230,39 +379,9 @@ pub fn run(request: &SynthRequest) -> Result<SynthReport, SynthError> {
     })
 }
 
-/// Everything a synthetic set of several-cable captures with 3-D markers
-/// needs (`synth --actuator`).
-#[derive(Debug, Clone)]
-pub struct CaptureSynthRequest {
-    /// The actuator without the hidden effect (the model a fit starts from).
-    pub actuator: Actuator,
-    /// The 3-D solver's settings.
-    pub options: SpatialOptions,
-    /// The hidden effect (put into the actuator's rod).
-    pub effect: HiddenEffect,
-    /// The captures; `None`: [`default_plan`] up to `max_tension_n`.
-    pub plan: Option<Vec<Capture>>,
-    /// The default plan's top tension, N.
-    pub max_tension_n: f64,
-    /// The default plan's dwell before each capture, s.
-    pub dwell_s: f64,
-    /// The markers; `None`: [`default_markers`].
-    pub markers: Option<Vec<MarkerSpec>>,
-    /// Noise on every marker coordinate (standard deviation), mm.
-    pub noise_mm: f64,
-    /// Seed of the noise.
-    pub seed: u64,
-    /// The captures file (CSV).
-    pub out: PathBuf,
-    /// The markers file (CSV).
-    pub markers_out: PathBuf,
-    /// Overwrite existing files.
-    pub force: bool,
-}
-
-/// What `synth --actuator` wrote.
+/// What `synth --actuator` wrote of captures.
 #[derive(Debug, Clone, Serialize)]
-pub struct CaptureSynthReport {
+pub struct CapturesWritten {
     /// Captures written.
     pub captures: usize,
     /// Markers per capture.
@@ -281,14 +400,14 @@ pub struct CaptureSynthReport {
     pub max_marker_shift_mm: Option<f64>,
 }
 
-impl CaptureSynthReport {
+impl CapturesWritten {
     /// Whether the effect moves no marker by [`VISIBLE_NOISE_SDS`] noise standard deviations.
     pub fn hidden_by_noise(&self) -> bool {
         self.max_marker_shift_mm.is_some_and(|m| m < VISIBLE_NOISE_SDS * self.noise_mm)
     }
 }
 
-impl fmt::Display for CaptureSynthReport {
+impl fmt::Display for CapturesWritten {
     /// What `synth --actuator` says on stderr: the files, and a warning when the noise hides the effect.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         writeln!(
@@ -319,26 +438,35 @@ impl fmt::Display for CaptureSynthReport {
 /// is validated, existing files are refused unless `force`, every capture
 /// of the plan is solved with it and its markers measured with noise, and
 /// the effect's size is compared with the noise.
-pub fn run_captures(request: &CaptureSynthRequest) -> Result<CaptureSynthReport, SynthError> {
-    let mut truth = request.actuator.clone();
-    truth.rod = request.effect.apply(&request.actuator.rod);
+fn write_captures(request: &SynthRequest, actuator_file: &Path) -> Result<CapturesWritten, SynthError> {
+    let start = Actuator::read(actuator_file).map_err(SynthError::ActuatorFile)?;
+    let plan = match &request.plan {
+        Some(path) => read_captures(path, start.cables.len(), start.rod.length_mm).map_err(SynthError::Plan)?.0,
+        None => default_plan(start.cables.len(), request.max_tension_n, request.step_dwell_s),
+    };
+    let markers_out = request.markers_out.as_ref().expect("checked: captures have a markers file");
+    let mut truth = start.clone();
+    truth.rod = request.effect.apply(&start.rod);
     truth.rod.validate().map_err(SynthError::TrueActuator)?;
-    for path in [&request.out, &request.markers_out] {
+    for path in [&request.out, markers_out] {
         if !request.force && path.exists() {
             return Err(SynthError::Exists { path: path.clone() });
         }
     }
-    let plan = request.plan.clone().unwrap_or_else(|| default_plan(request.actuator.cables.len(), request.max_tension_n, request.dwell_s));
-    let markers = request.markers.clone().unwrap_or_else(|| default_markers(&request.actuator));
-    let set = synth_captures(&truth, &request.options, plan, &markers, request.noise_mm, request.seed, false)?;
+    let markers = match &request.markers {
+        Markers::Placed(m) => m.clone(),
+        _ => default_markers(&start),
+    };
+    let options = &request.spatial_options;
+    let set = synth_captures(&truth, options, plan, &markers, request.noise_mm, request.seed, false)?;
     let write = |path: &PathBuf, text: String| crate::io::write_atomic(path, text.as_bytes()).map_err(FileError::on("writing", path));
     write(&request.out, captures_csv(&set.captures))?;
-    write(&request.markers_out, markers_3d_csv(&set))?;
+    write(markers_out, markers_3d_csv(&set))?;
     let max_marker_shift_mm = match request.effect {
         HiddenEffect::None => None,
         _ => {
-            let with = solve_captures(&truth, &request.options, &set)?;
-            let without = solve_captures(&request.actuator, &request.options, &set)?;
+            let with = solve_captures(&truth, options, &set)?;
+            let without = solve_captures(&start, options, &set)?;
             let shift = with
                 .iter()
                 .zip(&without)
@@ -347,11 +475,11 @@ pub fn run_captures(request: &CaptureSynthRequest) -> Result<CaptureSynthReport,
             Some(shift)
         }
     };
-    Ok(CaptureSynthReport {
+    Ok(CapturesWritten {
         captures: set.captures.len(),
         markers: markers.len(),
         out: request.out.clone(),
-        markers_out: request.markers_out.clone(),
+        markers_out: markers_out.clone(),
         effect: request.effect.name(),
         magnitude: request.effect.magnitude(),
         noise_mm: request.noise_mm,

@@ -141,17 +141,6 @@ impl ActuatorArgs {
         }
     }
 
-    /// Whether any flag that sets the rod or its effects is given (the
-    /// solver's flags aside).
-    pub fn sets_the_rod(&self) -> bool {
-        let o = self.overrides();
-        o.file.is_some()
-            || [o.length_mm, o.radius_mm, o.ea_n, o.ga_n, o.ei_n_mm2, o.density_g_cm3, o.cable_anchor_mm].iter().any(Option::is_some)
-            || o.no_gravity
-            || !o.effects.is_empty()
-            || o.radius_profile_mm.is_some()
-    }
-
     /// Applies the overrides on top of `base` (`--actuator-file` aside).
     pub fn apply(&self, base: &Rod) -> Rod {
         self.overrides().apply(base)

@@ -4,10 +4,8 @@
 use super::{parse_list, ActuatorArgs};
 use cablemap::model::routing::CONTROL_POINTS;
 use cablemap::solver::SolverOptions;
-use cablemap::calibrate::captures::files::read_captures;
 use cablemap::calibrate::captures::synth::MarkerSpec;
-use cablemap::model::Actuator;
-use cablemap::synth::{CaptureSynthRequest, HiddenEffect, Markers, SynthRequest};
+use cablemap::synth::{HiddenEffect, Markers, SynthRequest};
 use anyhow::bail;
 use clap::Args;
 use std::collections::BTreeMap;
@@ -158,9 +156,9 @@ fn hidden_effect(args: &SynthArgs) -> anyhow::Result<HiddenEffect> {
     Ok(HiddenEffect::parse(name, magnitude, args.glue_length_mm)?)
 }
 
-/// The synth request the arguments describe.
+/// The synth request the arguments describe; the request decides the kind
+/// of data from `--actuator` and refuses what that kind does not take.
 fn request(args: &SynthArgs) -> anyhow::Result<SynthRequest> {
-    let actuator = args.actuator.resolve()?;
     let effect = hidden_effect(args)?;
     let (routings, routing_tilts_rad) = match &args.routings {
         Some(t) => {
@@ -169,15 +167,16 @@ fn request(args: &SynthArgs) -> anyhow::Result<SynthRequest> {
         }
         None => (None, BTreeMap::new()),
     };
-    let markers_out = match (&args.markers_out, &args.markers) {
-        (None, Some(_)) => bail!("--markers needs --markers-out FILE"),
-        (None, None) => None,
-        (Some(path), Some(text)) => Some((path.clone(), Markers::At(parse_markers(text)?))),
-        (Some(path), None) => Some((path.clone(), Markers::Default)),
+    let markers = match (&args.markers, &args.markers_at) {
+        (Some(text), _) => Markers::At(parse_markers(text)?),
+        (None, Some(text)) => Markers::Placed(parse_markers_at(text)?),
+        (None, None) => Markers::Default,
     };
     Ok(SynthRequest {
-        actuator,
+        actuator_file: args.spatial_actuator.clone(),
+        rod: args.actuator.overrides(),
         options: args.actuator.solver_options(&SolverOptions::default()),
+        spatial_options: super::calibrate::spatial_options(&args.actuator),
         effect,
         routings,
         routing_tilts_rad,
@@ -191,7 +190,9 @@ fn request(args: &SynthArgs) -> anyhow::Result<SynthRequest> {
         seed: args.seed,
         out: args.out.clone(),
         centreline_out: args.centreline_out.clone().map(|p| (p, args.centreline_points)),
-        markers_out,
+        markers_out: args.markers_out.clone(),
+        markers,
+        plan: args.plan.clone(),
         force: args.force,
     })
 }
@@ -212,53 +213,8 @@ fn parse_markers_at(text: &str) -> anyhow::Result<Vec<MarkerSpec>> {
     Ok(out)
 }
 
-/// The capture synth request the arguments describe (`--actuator`).
-fn capture_request(args: &SynthArgs, actuator: &std::path::Path) -> anyhow::Result<CaptureSynthRequest> {
-    anyhow::ensure!(!args.actuator.sets_the_rod(), "with --actuator the rod comes from FILE.toml's [rod] table; edit it instead of giving rod flags");
-    let planar_only = [
-        (args.routings.is_some(), "--routings"),
-        (args.centreline_out.is_some(), "--centreline-out"),
-        (args.markers.is_some(), "--markers (give --markers-at NAME:S:Y:Z;…)"),
-        (args.clamp_tilt_rad != 0.0, "--clamp-tilt-rad (set gravity_direction in FILE.toml)"),
-    ];
-    if let Some((_, flag)) = planar_only.iter().find(|(given, _)| *given) {
-        bail!("{flag} is for planar data; with --actuator the captures come from --plan or the default plan");
-    }
-    let Some(markers_out) = args.markers_out.clone() else {
-        bail!("with --actuator give --markers-out FILE: the 3-D markers are written there");
-    };
-    anyhow::ensure!(args.noise_mm.is_finite() && args.noise_mm >= 0.0, "--noise-mm {}: must be a standard deviation ≥ 0 mm", args.noise_mm);
-    anyhow::ensure!(args.max_tension.is_finite() && args.max_tension > 0.0, "--tension-max-n {}: must be a tension > 0 N", args.max_tension);
-    anyhow::ensure!(args.step_dwell_s.is_finite() && args.step_dwell_s >= 0.0, "--step-dwell-s {}: must be a time ≥ 0 s", args.step_dwell_s);
-    let start = Actuator::read(actuator).map_err(|e| anyhow::Error::new(e).context("--actuator"))?;
-    let plan = match &args.plan {
-        Some(path) => Some(read_captures(path, start.cables.len(), start.rod.length_mm).map_err(|e| anyhow::Error::new(e).context("--plan"))?.0),
-        None => None,
-    };
-    Ok(CaptureSynthRequest {
-        options: super::calibrate::spatial_options(&args.actuator),
-        effect: hidden_effect(args)?,
-        plan,
-        max_tension_n: args.max_tension,
-        dwell_s: args.step_dwell_s,
-        markers: args.markers_at.as_deref().map(parse_markers_at).transpose()?,
-        noise_mm: args.noise_mm,
-        seed: args.seed,
-        out: args.out.clone(),
-        markers_out,
-        force: args.force,
-        actuator: start,
-    })
-}
-
 /// Runs `cablemap synth`: what it wrote goes to stderr.
 pub fn run(args: &SynthArgs) -> anyhow::Result<()> {
-    if let Some(actuator) = &args.spatial_actuator {
-        let report = cablemap::synth::run_captures(&capture_request(args, actuator)?)?;
-        eprint!("{report}");
-        return Ok(());
-    }
-    anyhow::ensure!(args.plan.is_none() && args.markers_at.is_none(), "--plan and --markers-at make several-cable captures: give the actuator with --actuator FILE.toml");
     let report = cablemap::synth::run(&request(args)?)?;
     eprint!("{report}");
     Ok(())
