@@ -11,7 +11,7 @@
 use crate::job::{Job, JobError, JobSpec};
 use crate::reduce::parts::PartReport;
 use crate::reduce::tables::PLANAR_MAP_DIR;
-use crate::reduce::{reduce_cable_run, reduce_run, write_map_replacing, CableMapSummary, MapSummary, ReduceError};
+use crate::reduce::{reduce_cable_run, reduce_run, write_map_replacing, ReachMapSummary, MapSummary, ReduceError};
 use crate::study::{StudyError, StudyProgress, StudyReport, StudyRequest};
 use crate::sweep::progress::ProgressMode;
 use crate::sweep::{run_kind, run_status, RunKind, StatusReport, SweepError, SweepOptions, SweepReport};
@@ -99,9 +99,9 @@ pub struct PlanarMapReport {
 
 /// A cable sweep's map written.
 #[derive(Debug, Clone)]
-pub struct CableMapReport {
+pub struct ReachMapReport {
     /// summary.json.
-    pub summary: CableMapSummary,
+    pub summary: ReachMapSummary,
     /// The map directory.
     pub map_dir: PathBuf,
     /// The planar map (planar runs of order ≥ 1) and its pictures' file names.
@@ -116,7 +116,7 @@ pub enum ReduceReport {
     /// A planar single-cable run's map.
     Planar(PlanarMapReport),
     /// A cable sweep's reach map (and planar map).
-    Cables(CableMapReport),
+    Cables(ReachMapReport),
 }
 
 impl ReduceReport {
@@ -253,7 +253,7 @@ fn reduce_cables(request: &ReduceRequest) -> Result<ReduceReport, MapError> {
     let options = request.settings.options(out);
     let map = reduce_cable_run(run, partial, request.settings.cell_mm, &options, out)
         .map_err(|source| MapError::Reduce { run: run.clone(), source })?;
-    Ok(ReduceReport::Cables(CableMapReport {
+    Ok(ReduceReport::Cables(ReachMapReport {
         summary: map.summary,
         map_dir: out.clone(),
         planar: map.planar.map(|(m, p)| (m.summary, p.into_iter().map(|p| p.file).collect())),

@@ -1,7 +1,8 @@
-//! What a map holds: the feasibility map ([`MapData`]: its summary, cells,
-//! modes and designs) and the summary of a cable sweep's map
-//! ([`CableMapSummary`]). The pipeline computes them; the map format
-//! (`tables`) writes and reads them.
+//! What a map holds: the feasibility map of planar rows ([`MapData`]: its
+//! summary, cells, modes and designs), which every planar run has, and the
+//! reach map of a cable sweep's tips ([`ReachMapSummary`]; its directory
+//! holds the feasibility map of a planar cable sweep beside it). The
+//! pipeline computes them; the map format (`tables`) writes and reads them.
 
 use super::ModeBoundaries;
 use crate::model::ControlPoints;
@@ -23,7 +24,8 @@ pub const MAX_CELLS_PER_AXIS: usize = 100_000;
 /// coefficient is a curvature.
 pub const COEFFICIENT_UNIT: &str = "mm⁻¹";
 
-/// The summary written as summary.json (docs/maps.md).
+/// The summary of a feasibility map, written as its summary.json
+/// (docs/maps.md).
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct MapSummary {
     /// [`MAP_FORMAT`](super::tables::MAP_FORMAT): marks the directory as a map written by
@@ -202,9 +204,11 @@ pub struct MapData {
     pub designs: Vec<Design>,
 }
 
-/// `summary.json` of a cable sweep's map directory.
+/// `summary.json` of a cable sweep's reach map: the cells its tips reach
+/// (the feasibility map of a planar cable sweep, in its folder
+/// `planar_map`, has its own [`MapSummary`]).
 #[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct CableMapSummary {
+pub struct ReachMapSummary {
     /// [`MAP_FORMAT`](super::tables::MAP_FORMAT): marks the directory as a
     /// map written by cablemap.
     #[serde(default)]

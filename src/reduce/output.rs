@@ -6,7 +6,7 @@ use super::drawings::ModeDrawings;
 use crate::plot::{draw_heatmap, draw_modes, Picture, Scale};
 use super::reach::{Reach, PLANES};
 use super::tables::PLANAR_MAP_DIR;
-use super::{explorer, tables, CableMapSummary, CoefficientStats, MapCables, MapData, ReduceError, COEFFICIENT_UNIT};
+use super::{explorer, tables, ReachMapSummary, CoefficientStats, MapCables, MapData, ReduceError, COEFFICIENT_UNIT};
 use crate::model::Rod;
 use crate::plot::{draw_reach_maps, ReachPlane};
 use std::path::Path;
@@ -81,7 +81,7 @@ fn is_map_dir(dir: &Path) -> bool {
     // file a map consists of, so a user's own files are never deleted.
     let legacy_summary = summary.get("format").is_none()
         && (serde_json::from_value::<super::MapSummary>(summary.clone()).is_ok()
-            || serde_json::from_value::<CableMapSummary>(summary).is_ok());
+            || serde_json::from_value::<ReachMapSummary>(summary).is_ok());
     legacy_summary && holds_only_map_files(dir, 0)
 }
 
@@ -154,7 +154,7 @@ pub fn write_map_drawn(
 /// [`PLANAR_MAP_DIR`]. Returns the planar map and its pictures.
 pub(crate) fn write_cable_map(
     dir: &Path,
-    summary: &CableMapSummary,
+    summary: &ReachMapSummary,
     reach: &Reach,
     planar: Option<(MapData, ModeDrawings, MapCables)>,
     rod: &Rod,

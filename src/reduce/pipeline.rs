@@ -16,7 +16,7 @@ use super::samples;
 use super::source::{planar_batch, planar_columns, run_info, RunInfo};
 use super::spill;
 use super::tables::{self, PLANAR_MAP_DIR};
-use super::{fetch, CableMapSummary, Design, MapCables, MapData, MapSummary, ReduceError, ReduceOptions, CELL_STATS_ORDER, MODES};
+use super::{fetch, ReachMapSummary, Design, MapCables, MapData, MapSummary, ReduceError, ReduceOptions, CELL_STATS_ORDER, MODES};
 use crate::solver::STATUS_OK;
 use crate::sweep::schema::STATUS_INVALID_ROUTING;
 use crate::sweep::spec::{CablesGrid, PlanarGrid};
@@ -206,9 +206,9 @@ fn planar_map(run: &SweepRun, options: &ReduceOptions) -> Result<MapData, Reduce
 
 /// A cable sweep's map as [`reduce_cable_run`] wrote it.
 #[derive(Debug, Clone)]
-pub struct CableMap {
+pub struct ReachMap {
     /// summary.json.
-    pub summary: CableMapSummary,
+    pub summary: ReachMapSummary,
     /// The planar map and its pictures (planar runs of order ≥ 1).
     pub planar: Option<(MapData, Vec<Picture>)>,
 }
@@ -225,7 +225,7 @@ pub fn reduce_cable_run(
     cell_mm: Option<f64>,
     options: &ReduceOptions,
     out: &Path,
-) -> Result<CableMap, ReduceError> {
+) -> Result<ReachMap, ReduceError> {
     check_map_out(out)?;
     let run = open(run_dir, partial)?;
     let spec = cables_grid(&run)?;
@@ -245,7 +245,7 @@ pub fn reduce_cable_run(
     let count = |s: &str| counts.get(s).copied().unwrap_or(0);
     let rows = run.rows_done();
     let layout = run.spec().layout();
-    let summary = CableMapSummary {
+    let summary = ReachMapSummary {
         format: tables::MAP_FORMAT.into(),
         kind: "cables".into(),
         run_dir: run_dir.display().to_string(),
@@ -264,7 +264,7 @@ pub fn reduce_cable_run(
         planar_map: planar.is_some().then(|| PLANAR_MAP_DIR.to_string()),
     };
     let planar = write_cable_map(out, &summary, &reach, planar, &spec.actuator.rod)?;
-    Ok(CableMap { summary, planar })
+    Ok(ReachMap { summary, planar })
 }
 
 #[cfg(test)]

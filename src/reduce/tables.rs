@@ -4,12 +4,12 @@
 //! `modes.parquet` and `designs.parquet` hold [`CellStats`],
 //! [`ModeStats`](super::ModeStats) and [`Design`] rows. The design columns
 //! are the sweep's own (`sweep::schema`). A cable sweep's map holds
-//! [`CableMapSummary`] as its `summary.json`, the reach tables
+//! [`ReachMapSummary`] as its `summary.json`, the reach tables
 //! ([`REACH_FILES`]) and, for a planar run, a feasibility map in
 //! [`PLANAR_MAP_DIR`].
 
 use super::reach::{Reach, PLANES, VOXEL_AXES};
-use super::{CableMapSummary, CellStats, CoefficientStats, Design, MapData, MapSummary, ReduceError, CELL_STATS_ORDER, MAX_CELLS_PER_AXIS, MODES};
+use super::{ReachMapSummary, CellStats, CoefficientStats, Design, MapData, MapSummary, ReduceError, CELL_STATS_ORDER, MAX_CELLS_PER_AXIS, MODES};
 use crate::model::ControlPoints;
 use crate::sweep::schema::{coefficient_column, ROUTING_ID, TENSION_N, TIP_ANGLE_RAD, TIP_X_MM, TIP_Y_MM, Y_MM};
 use arrow::array::{Array, ArrayRef, AsArray, BooleanArray, Float64Array, Int32Array, Int64Array};
@@ -271,7 +271,7 @@ fn counts_table<const N: usize>(counts: &BTreeMap<[i32; N], i64>, axes: &[&str; 
 }
 
 /// Writes a cable sweep map's `summary.json` into `dir`.
-pub(crate) fn write_cable_summary(dir: &Path, summary: &CableMapSummary) -> Result<(), ReduceError> {
+pub(crate) fn write_cable_summary(dir: &Path, summary: &ReachMapSummary) -> Result<(), ReduceError> {
     let path = dir.join(SUMMARY_FILE);
     let json = serde_json::to_string_pretty(summary).map_err(|source| ReduceError::WriteJson { path: path.clone(), source })? + "\n";
     write_file(&path, json.as_bytes())
@@ -612,7 +612,7 @@ pub fn read_designs(dir: &Path, order: usize) -> Result<Vec<Design>, ReadError> 
 #[derive(Debug, Clone)]
 pub struct ReachTables {
     /// `summary.json`.
-    pub summary: CableMapSummary,
+    pub summary: ReachMapSummary,
     /// Solved tips per cell of the x–y, x–z and y–z planes (cell indices along the plane's axes).
     pub planes: [std::collections::BTreeMap<[i32; 2], i64>; 3],
     /// Solved tips per voxel (indices along x, y, z).
@@ -623,9 +623,9 @@ pub struct ReachTables {
 pub fn read_reach(dir: &Path) -> Result<ReachTables, ReadError> {
     let path = dir.join(SUMMARY_FILE);
     let text = crate::io::read_utf8(&path).map_err(|e| read_error(&path, MapProblem::CableMapUnreadable(e)))?;
-    let summary: CableMapSummary = serde_json::from_str(&text)
+    let summary: ReachMapSummary = serde_json::from_str(&text)
         .ok()
-        .filter(|s: &CableMapSummary| s.kind == "cables")
+        .filter(|s: &ReachMapSummary| s.kind == "cables")
         .ok_or_else(|| read_error(&path, MapProblem::NotCableMap))?;
     if !(summary.cell_mm > 0.0 && summary.cell_mm.is_finite()) {
         return Err(read_error(&path, MapProblem::CellSize { cell_mm: summary.cell_mm }));
@@ -684,7 +684,7 @@ pub fn map_tables(dir: &Path) -> Result<Vec<MapTable>, ReadError> {
     }
     let path = dir.join(SUMMARY_FILE);
     let text = crate::io::read_utf8(&path).map_err(|e| read_error(&path, MapProblem::CannotRead(e)))?;
-    let summary: CableMapSummary = serde_json::from_str(&text).map_err(|e| read_error(&path, MapProblem::CableContract(e)))?;
+    let summary: ReachMapSummary = serde_json::from_str(&text).map_err(|e| read_error(&path, MapProblem::CableContract(e)))?;
     let mut tables: Vec<MapTable> = REACH_FILES.iter().map(|f| table(dir, f)).collect();
     if let Some(planar) = &summary.planar_map {
         tables.extend(feasibility(&dir.join(planar))?);
