@@ -11,15 +11,14 @@
 
 use super::{bad, from_json, to_json, Failure, Result};
 use cablemap::job::{Job, JobError};
-use cablemap::map::{self, MapError, MapSettings, ReduceRequest, Source};
+use cablemap::map::{self, MapError, ReduceRequest, Source};
 use cablemap::reduce::tables::{map_tables as library_map_tables, ReadError};
-use cablemap::reduce::{ModeBoundaries, ReduceError, DEFAULT_MEMORY_SAMPLES};
+use cablemap::reduce::{MapSettingsFields, ReduceError, SettingNames};
 use cablemap::sweep::progress::ProgressMode;
 use cablemap::sweep::{open_run, Completeness, SweepError, SweepOptions};
 use parquet::arrow::ArrowWriter;
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
-use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
 // ---------------------------------------------------------------- errors
@@ -158,50 +157,15 @@ fn sweep(
 
 // ---------------------------------------------------------------- reduce
 
-/// The map settings of `cablemap.reduce` (the flags of `cablemap reduce`).
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct SettingsRequest {
-    /// `--cell-mm`.
-    cell_mm: Option<f64>,
-    /// `--a0-bounds`: three ascending values.
-    a0_bounds: Option<Vec<f64>>,
-    /// `--a1-bounds`: two ascending values.
-    a1_bounds: Option<Vec<f64>>,
-    /// `--designs-per-cell`.
-    designs_per_cell: usize,
-    /// `--memory-samples`.
-    memory_samples: Option<usize>,
-}
-
-impl SettingsRequest {
-    /// The settings, as `MapOptionArgs::settings` makes them.
-    fn settings(self) -> Result<MapSettings> {
-        let mode_boundaries = match (self.a0_bounds, self.a1_bounds) {
-            (None, None) => None,
-            (Some(a0), Some(a1)) => {
-                let a0: [f64; 3] = a0.try_into().map_err(|a: Vec<f64>| bad(format!("a0_bounds needs three values (4 ranges of a_0), got {}", a.len())))?;
-                let a1: [f64; 2] = a1.try_into().map_err(|a: Vec<f64>| bad(format!("a1_bounds needs two values (3 ranges of a_1), got {}", a.len())))?;
-                Some(ModeBoundaries { a0, a1 })
-            }
-            _ => return Err(bad("give both a0_bounds and a1_bounds, or neither (quantiles of the data)")),
-        };
-        let memory_samples = self.memory_samples.unwrap_or(DEFAULT_MEMORY_SAMPLES);
-        if memory_samples == 0 {
-            return Err(bad("memory_samples must be at least 1"));
-        }
-        Ok(MapSettings { cell_mm: self.cell_mm, mode_boundaries, designs_per_cell: self.designs_per_cell, memory_samples })
-    }
-}
-
 /// A run directory of any kind reduced into the map directory `out`
 /// (`cablemap reduce RUN --out OUT`, `partial` as `--partial`):
 /// `(report JSON as reduce --json prints it, report text)`.
 #[pyfunction]
 fn reduce(py: Python<'_>, run: PathBuf, out: PathBuf, partial: bool, settings_json: &str) -> PyResult<(String, String)> {
     let go = || -> Result<(String, String)> {
-        let settings: SettingsRequest = from_json(settings_json, "reduce settings")?;
-        let request = ReduceRequest { run, out, source: Source::Run { partial }, settings: settings.settings()? };
+        let fields: MapSettingsFields = from_json(settings_json, "reduce settings")?;
+        let settings = fields.settings(SettingNames::Keys).map_err(|e| bad(e.to_string()))?;
+        let request = ReduceRequest { run, out, source: Source::Run { partial }, settings };
         let report = map::reduce(&request)?;
         Ok((to_json(&report), report.to_string()))
     };

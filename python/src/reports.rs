@@ -19,7 +19,7 @@ use cablemap::design::targets::TargetSet;
 use cablemap::design::{DesignError, DesignRequest, SearchOptions, Target, Weights};
 use cablemap::solver::spatial::SpatialOptions;
 use cablemap::model::{Actuator, Rod, RodOverrides, REGISTRY};
-use cablemap::mould::MouldParams;
+use cablemap::mould::MouldSettings;
 use cablemap::shape::LengthBasis;
 use pyo3::prelude::*;
 use serde::Deserialize;
@@ -147,32 +147,6 @@ fn rod_overrides(fields: Map<String, Value>) -> Result<RodOverrides> {
 
 // ---------------------------------------------------------------- design
 
-/// The moulds' parameters of `design --moulds` (`--wall-mm`, …), each
-/// the default when not given.
-#[derive(Debug, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct MouldRequest {
-    wall_mm: Option<f64>,
-    tube_diameter_mm: Option<f64>,
-    clearance_mm: Option<f64>,
-    clamp_mm: Option<f64>,
-    min_skin_mm: Option<f64>,
-}
-
-impl MouldRequest {
-    fn params(&self) -> MouldParams {
-        let d = MouldParams::default();
-        MouldParams {
-            wall_mm: self.wall_mm.unwrap_or(d.wall_mm),
-            tube_diameter_mm: self.tube_diameter_mm.unwrap_or(d.tube_diameter_mm),
-            clearance_mm: self.clearance_mm.unwrap_or(d.clearance_mm),
-            clamp_mm: self.clamp_mm.unwrap_or(d.clamp_mm),
-            min_skin_mm: self.min_skin_mm.unwrap_or(d.min_skin_mm),
-            ..d
-        }
-    }
-}
-
 /// What `cablemap.design` asks: the flags of `cablemap design`.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -201,7 +175,7 @@ struct DesignPy {
     #[serde(default)]
     moulds: bool,
     #[serde(default)]
-    mould: MouldRequest,
+    mould: MouldSettings,
     #[serde(default)]
     solver: SolverRequest,
 }

@@ -2,7 +2,7 @@
 
 use super::{parse_list, ActuatorArgs};
 use cablemap::model::{Rod, Routing};
-use cablemap::mould::{MouldError, MouldOptions, MouldParams, MouldSet, MouldStyle};
+use cablemap::mould::{MouldError, MouldOptions, MouldParams, MouldSet, MouldSettings, MouldStyle};
 use anyhow::Context;
 use clap::Args;
 use std::io::Write;
@@ -31,14 +31,14 @@ pub struct MouldParamArgs {
 impl MouldParamArgs {
     /// The parameters.
     pub fn params(&self) -> MouldParams {
-        MouldParams {
-            wall_mm: self.wall_mm,
-            tube_diameter_mm: self.tube_diameter_mm,
-            clearance_mm: self.clearance_mm,
-            clamp_mm: self.clamp_mm,
-            min_skin_mm: self.min_skin_mm,
-            ..MouldParams::default()
+        MouldSettings {
+            wall_mm: Some(self.wall_mm),
+            tube_diameter_mm: Some(self.tube_diameter_mm),
+            clearance_mm: Some(self.clearance_mm),
+            clamp_mm: Some(self.clamp_mm),
+            min_skin_mm: Some(self.min_skin_mm),
         }
+        .params()
     }
 }
 

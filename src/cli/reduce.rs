@@ -3,7 +3,7 @@
 use super::output::Output;
 use cablemap::job::{Job, JobSpec};
 use cablemap::map::{self, MapError, MapReport, MapRequest, MapSettings, PartRequest, ReduceRequest, Source};
-use cablemap::reduce::{ModeBoundaries, ReduceError};
+use cablemap::reduce::{MapSettingsFields, ReduceError, SettingNames};
 use clap::Args;
 use std::path::{Path, PathBuf};
 
@@ -36,19 +36,14 @@ pub struct MapOptionArgs {
 impl MapOptionArgs {
     /// The map settings these arguments give.
     pub fn settings(&self) -> anyhow::Result<MapSettings> {
-        let mode_boundaries = match (&self.a0_bounds, &self.a1_bounds) {
-            (None, None) => None,
-            (Some(a0), Some(a1)) => {
-                let a0 = super::parse_list(a0, "--a0-bounds")?;
-                let a1 = super::parse_list(a1, "--a1-bounds")?;
-                anyhow::ensure!(a0.len() == 3, "--a0-bounds needs three values (4 ranges of a_0), got {}", a0.len());
-                anyhow::ensure!(a1.len() == 2, "--a1-bounds needs two values (3 ranges of a_1), got {}", a1.len());
-                Some(ModeBoundaries { a0: [a0[0], a0[1], a0[2]], a1: [a1[0], a1[1]] })
-            }
-            _ => anyhow::bail!("give both --a0-bounds and --a1-bounds, or neither (quantiles of the data)"),
+        let fields = MapSettingsFields {
+            cell_mm: self.cell_mm,
+            a0_bounds: self.a0_bounds.as_deref().map(|a0| super::parse_list(a0, "--a0-bounds")).transpose()?,
+            a1_bounds: self.a1_bounds.as_deref().map(|a1| super::parse_list(a1, "--a1-bounds")).transpose()?,
+            designs_per_cell: self.designs_per_cell,
+            memory_samples: Some(self.memory_samples),
         };
-        anyhow::ensure!(self.memory_samples >= 1, "--memory-samples must be at least 1");
-        Ok(MapSettings { cell_mm: self.cell_mm, mode_boundaries, designs_per_cell: self.designs_per_cell, memory_samples: self.memory_samples })
+        Ok(fields.settings(SettingNames::Flags)?)
     }
 }
 

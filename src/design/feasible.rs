@@ -3,7 +3,7 @@
 //! the sweep saw there, which characteristic mode the target falls in, and
 //! which simulated designs are nearest.
 
-use super::map::{map_error, Cell, MapDesign, MapDir, CELL_STATS_ORDER, MODES};
+use super::map::{map_error, Cell, MapDesign, MapDir, MapMismatch, CELL_STATS_ORDER, MODES};
 use super::search::routing::Design;
 use super::search::SeedSource;
 use super::target::{Component, Target, Weights};
@@ -334,16 +334,7 @@ fn check_length_basis(map: &MapDir, basis: LengthBasis, target: &Target) -> Resu
     if map_basis == basis || target.highest_order().is_none() {
         return Ok(());
     }
-    Err(map_error(
-        &map.path,
-        format!(
-            "the map's coefficients are {} ({map_basis} basis) but the target's are {} ({basis} basis); they differ \
-             by ℓ/L, which varies from design to design, so they cannot be compared: give the target in the map's \
-             basis (length basis '{map_basis}'), or reduce a sweep made with [output] length_basis = \"{basis}\"",
-            map_basis.describe(),
-            basis.describe()
-        ),
-    ))
+    Err(map_error(&map.path, MapMismatch::LengthBasis { map: map_basis, target: basis }))
 }
 
 /// The index of the cell containing coordinate `v` along an axis whose

@@ -4,7 +4,7 @@
 
 use super::sequence::{Channel, Setup};
 use super::targets::Quantity;
-use super::map::{map_error, MapDir};
+use super::map::{map_error, MapDir, MapMismatch};
 use super::DesignError;
 use std::path::Path;
 
@@ -25,10 +25,10 @@ pub fn open(dir: &Path) -> Result<MapDir, DesignError> {
 pub fn channels(dir: &Path, setup: &Setup, count: usize) -> Result<Vec<Vec<Channel>>, DesignError> {
     let map = open(dir)?;
     let Some(cables) = &map.cables else {
-        return Err(map_error(dir, "a map of one planar cable: its designs are not designs of the several-cable actuator; give the map of a cable sweep (`cablemap map` of a spec with [[cable]] tables)"));
+        return Err(map_error(dir, MapMismatch::OnePlanarCable));
     };
     if cables.count() != setup.cables() {
-        return Err(map_error(dir, format!("the map was made for {} cables, the actuator has {}", cables.count(), setup.cables())));
+        return Err(map_error(dir, MapMismatch::CableCount { map: cables.count(), actuator: setup.cables() }));
     }
     let mut out: Vec<Vec<Channel>> = Vec::new();
     let per_target = count.div_ceil(setup.targets.len().max(1));

@@ -154,12 +154,12 @@ pub enum DesignError {
         source: crate::io::InsideRunDir,
     },
     /// A design.json that cannot be read back.
-    #[error("{} {message}; give a design.json written by `cablemap design --out`", path.display())]
+    #[error("{} {problem}; give a design.json written by `cablemap design --out`", path.display())]
     DesignFile {
         /// The file.
         path: std::path::PathBuf,
         /// What is wrong with it.
-        message: String,
+        problem: record::DesignFileProblem,
     },
     /// Re-simulating a design (for its drawing) failed.
     #[error("re-simulating the design: {0}")]
@@ -220,13 +220,14 @@ pub enum DesignError {
     /// No seed design could be simulated, so there is nothing to refine.
     #[error("no starting design could be simulated within the bounds; check the actuator parameters and tension bounds")]
     NoSeed,
-    /// A map directory is missing a file or breaks the map contract.
-    #[error("map {path}: {message}")]
+    /// A map directory breaks the map contract, or was made for another
+    /// actuator or basis than the design's.
+    #[error("map {}: {problem}", path.display())]
     Map {
-        /// The map directory or file.
-        path: String,
+        /// The map directory.
+        path: std::path::PathBuf,
         /// What is wrong, and what to do.
-        message: String,
+        problem: map::MapMismatch,
     },
     /// A map table cannot be read.
     #[error(transparent)]

@@ -154,18 +154,32 @@ pub struct DesignFile {
     pub actuator: Rod,
 }
 
+/// What is wrong with a design.json read back ([`read_design_file`]).
+#[derive(Debug, thiserror::Error)]
+pub enum DesignFileProblem {
+    /// Not JSON.
+    #[error("is not JSON ({0})")]
+    NotJson(#[source] serde_json::Error),
+    /// No routing.
+    #[error("has no numeric routing_mm list")]
+    NoRouting,
+    /// An actuator that is no rod.
+    #[error("bad actuator object: {0}")]
+    Actuator(#[source] serde_json::Error),
+}
+
 /// Reads the routing and actuator of a design.json written by `design --out`.
 pub fn read_design_file(path: &Path) -> Result<DesignFile, DesignError> {
-    let bad = |message: String| DesignError::DesignFile { path: path.to_path_buf(), message };
+    let bad = |problem| DesignError::DesignFile { path: path.to_path_buf(), problem };
     let text = std::fs::read_to_string(path)
         .map_err(crate::io::FileError::on("reading", path))?;
-    let v: serde_json::Value = serde_json::from_str(&text).map_err(|e| bad(format!("is not JSON ({e})")))?;
+    let v: serde_json::Value = serde_json::from_str(&text).map_err(|e| bad(DesignFileProblem::NotJson(e)))?;
     let routing_mm: Vec<f64> = v
         .get("routing_mm")
         .and_then(|r| serde_json::from_value(r.clone()).ok())
-        .ok_or_else(|| bad("has no numeric routing_mm list".into()))?;
+        .ok_or_else(|| bad(DesignFileProblem::NoRouting))?;
     let actuator = match v.get("actuator") {
-        Some(a) => serde_json::from_value(a.clone()).map_err(|e| bad(format!("bad actuator object: {e}")))?,
+        Some(a) => serde_json::from_value(a.clone()).map_err(|e| bad(DesignFileProblem::Actuator(e)))?,
         None => Rod::default(),
     };
     Ok(DesignFile { routing_mm, actuator })

@@ -50,7 +50,7 @@ mod write;
 
 pub use error::{BodyFeature, MouldError, ParameterProblem};
 pub use moulds::{volume_below_face_mm3, Moulds, Part, PartKind};
-pub use params::{check_uniform_body, MouldParams, MAX_SIZE_MM, MAX_TRIANGLES};
+pub use params::{check_uniform_body, MouldParams, MouldSettings, MAX_SIZE_MM, MAX_TRIANGLES};
 pub use lumens::{LumenSummary, Lumens};
 pub use request::{build, check, check_body, for_actuator, resolve_style, ActuatorMoulds, MouldOptions, MouldReport, MouldStyle};
 pub use set::{MouldFile, MouldSet, MouldSummary, PlacedPart};

@@ -1,7 +1,7 @@
 //! The moulds' parameters and the bodies they can cast.
 
 use super::{BodyFeature, MouldError};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// Parameters of the moulds, mm.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -23,6 +23,38 @@ pub struct MouldParams {
 impl Default for MouldParams {
     fn default() -> Self {
         Self { wall_mm: 3.0, tube_diameter_mm: 1.0, clearance_mm: 0.15, clamp_mm: 10.0, min_skin_mm: 0.3, station_step_mm: 0.5 }
+    }
+}
+
+/// The moulds' parameters a user sets (`--wall-mm`, …; `cablemap.design`'s
+/// keywords), each [`MouldParams::default`]'s when not given.
+#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MouldSettings {
+    /// [`MouldParams::wall_mm`].
+    pub wall_mm: Option<f64>,
+    /// [`MouldParams::tube_diameter_mm`].
+    pub tube_diameter_mm: Option<f64>,
+    /// [`MouldParams::clearance_mm`].
+    pub clearance_mm: Option<f64>,
+    /// [`MouldParams::clamp_mm`].
+    pub clamp_mm: Option<f64>,
+    /// [`MouldParams::min_skin_mm`].
+    pub min_skin_mm: Option<f64>,
+}
+
+impl MouldSettings {
+    /// The parameters: those given, the defaults elsewhere.
+    pub fn params(&self) -> MouldParams {
+        let d = MouldParams::default();
+        MouldParams {
+            wall_mm: self.wall_mm.unwrap_or(d.wall_mm),
+            tube_diameter_mm: self.tube_diameter_mm.unwrap_or(d.tube_diameter_mm),
+            clearance_mm: self.clearance_mm.unwrap_or(d.clearance_mm),
+            clamp_mm: self.clamp_mm.unwrap_or(d.clamp_mm),
+            min_skin_mm: self.min_skin_mm.unwrap_or(d.min_skin_mm),
+            ..d
+        }
     }
 }
 

@@ -95,6 +95,98 @@ pub struct MapSettings {
     pub memory_samples: usize,
 }
 
+/// The map settings as a user gives them (`cablemap reduce`'s flags,
+/// `cablemap.reduce`'s keywords), each optional one at its default when
+/// not given; [`Self::settings`] checks them once for both.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MapSettingsFields {
+    /// Cell size, mm; `None`: [`DEFAULT_CELL_MM`], a cable sweep its spec's `output.cell_mm`.
+    pub cell_mm: Option<f64>,
+    /// Explicit a_0 boundaries of the modes: three values.
+    pub a0_bounds: Option<Vec<f64>>,
+    /// Explicit a_1 boundaries of the modes: two values.
+    pub a1_bounds: Option<Vec<f64>>,
+    /// Designs kept per cell in designs.parquet.
+    pub designs_per_cell: usize,
+    /// Samples held in memory at once; `None`: [`DEFAULT_MEMORY_SAMPLES`].
+    pub memory_samples: Option<usize>,
+}
+
+/// How a message names a setting of [`MapSettingsFields`]: by its key
+/// (`a0_bounds`, Python's keywords) or by its flag (`--a0-bounds`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SettingNames {
+    /// Keys, as the fields and Python's keywords are named.
+    Keys,
+    /// The command line's flags.
+    Flags,
+}
+
+impl SettingNames {
+    /// The name of the setting with key `key`.
+    fn name(self, key: &'static str) -> String {
+        match self {
+            SettingNames::Keys => key.to_string(),
+            SettingNames::Flags => format!("--{}", key.replace('_', "-")),
+        }
+    }
+}
+
+/// Why [`MapSettingsFields`] make no map settings.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum MapSettingsError {
+    /// Not three a_0 boundaries.
+    #[error("{} needs three values (4 ranges of a_0), got {count}", names.name("a0_bounds"))]
+    A0Bounds {
+        /// The values given.
+        count: usize,
+        /// How the setting is named.
+        names: SettingNames,
+    },
+    /// Not two a_1 boundaries.
+    #[error("{} needs two values (3 ranges of a_1), got {count}", names.name("a1_bounds"))]
+    A1Bounds {
+        /// The values given.
+        count: usize,
+        /// How the setting is named.
+        names: SettingNames,
+    },
+    /// One list of boundaries without the other.
+    #[error("give both {} and {}, or neither (quantiles of the data)", names.name("a0_bounds"), names.name("a1_bounds"))]
+    OneOfTheBounds {
+        /// How the settings are named.
+        names: SettingNames,
+    },
+    /// No sample held in memory.
+    #[error("{} must be at least 1", names.name("memory_samples"))]
+    NoMemorySamples {
+        /// How the setting is named.
+        names: SettingNames,
+    },
+}
+
+impl MapSettingsFields {
+    /// The map settings these fields give; a refusal names each setting
+    /// as `names` says.
+    pub fn settings(self, names: SettingNames) -> Result<MapSettings, MapSettingsError> {
+        let mode_boundaries = match (self.a0_bounds, self.a1_bounds) {
+            (None, None) => None,
+            (Some(a0), Some(a1)) => {
+                let a0: [f64; 3] = a0.try_into().map_err(|a: Vec<f64>| MapSettingsError::A0Bounds { count: a.len(), names })?;
+                let a1: [f64; 2] = a1.try_into().map_err(|a: Vec<f64>| MapSettingsError::A1Bounds { count: a.len(), names })?;
+                Some(ModeBoundaries { a0, a1 })
+            }
+            _ => return Err(MapSettingsError::OneOfTheBounds { names }),
+        };
+        let memory_samples = self.memory_samples.unwrap_or(DEFAULT_MEMORY_SAMPLES);
+        if memory_samples == 0 {
+            return Err(MapSettingsError::NoMemorySamples { names });
+        }
+        Ok(MapSettings { cell_mm: self.cell_mm, mode_boundaries, designs_per_cell: self.designs_per_cell, memory_samples })
+    }
+}
+
 impl MapSettings {
     /// The reduce options of a planar map (scratch beside the map: on the
     /// same disk as the results, not a RAM-backed /tmp).
