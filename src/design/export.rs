@@ -18,6 +18,43 @@ pub fn check_export_dir(dir: &Path) -> Result<(), DesignError> {
     Ok(crate::io::check_outside_run_dir(dir, "the export directory")?)
 }
 
+/// A design's export directory being written: each file written
+/// atomically, the names kept in the order written, so that what is
+/// reported is what was written.
+pub(super) struct Export<'a> {
+    dir: &'a Path,
+    written: Vec<String>,
+}
+
+impl<'a> Export<'a> {
+    /// Checks `dir` (outside any run directory) and creates it if missing.
+    pub(super) fn create(dir: &'a Path) -> Result<Self, DesignError> {
+        check_export_dir(dir)?;
+        std::fs::create_dir_all(dir).map_err(FileError::on("creating", dir))?;
+        Ok(Self { dir, written: Vec::new() })
+    }
+
+    /// Writes the file `name`.
+    pub(super) fn write(&mut self, name: &str, bytes: &[u8]) -> Result<(), DesignError> {
+        let path = self.dir.join(name);
+        crate::io::write_atomic(&path, bytes).map_err(FileError::on("writing", &path))?;
+        self.written.push(name.to_string());
+        Ok(())
+    }
+
+    /// Draws the picture `name` by `draw` (given its path).
+    pub(super) fn draw(&mut self, name: &str, draw: impl FnOnce(&Path) -> Result<(), DesignError>) -> Result<(), DesignError> {
+        draw(&self.dir.join(name))?;
+        self.written.push(name.to_string());
+        Ok(())
+    }
+
+    /// The names of the files written, in order.
+    pub(super) fn written(self) -> Vec<String> {
+        self.written
+    }
+}
+
 /// A 1:1 drawing of the straight body (L × 2r) with its channel, in mm
 /// (`width="…mm"` with a viewBox in mm, so it prints at true size). The
 /// clamp end is on the left; y grows upward as in the model.
@@ -139,25 +176,16 @@ pub fn write_all(
     record: &DesignRecord,
     tube_diameter_mm: f64,
 ) -> Result<Vec<String>, DesignError> {
-    check_export_dir(dir)?;
-    std::fs::create_dir_all(dir).map_err(FileError::on("creating", dir))?;
-    let mut written = Vec::new();
-    let mut write = |name: &str, bytes: &[u8]| {
-        let p = dir.join(name);
-        crate::io::write_atomic(&p, bytes).map_err(FileError::on("writing", &p))?;
-        written.push(name.to_string());
-        Ok::<_, DesignError>(())
-    };
-    write("design.json", record.to_file_text().as_bytes())?;
+    let mut export = Export::create(dir)?;
+    export.write("design.json", record.to_file_text().as_bytes())?;
     let act = &objective.rod;
     let routing = Routing::for_actuator(&eval.routing_mm, act)?;
-    write("channel.csv", routing.channel_csv().as_bytes())?;
+    export.write("channel.csv", routing.channel_csv().as_bytes())?;
     if act.is_uniform_body() {
-        write("mould.svg", mould_svg(&routing, act.radius_mm, tube_diameter_mm, eval.tension_n).as_bytes())?;
+        export.write("mould.svg", mould_svg(&routing, act.radius_mm, tube_diameter_mm, eval.tension_n).as_bytes())?;
     }
-    shape_png(&dir.join("shape.png"), objective, eval)?;
-    written.push("shape.png".to_string());
-    Ok(written)
+    export.draw("shape.png", |path| shape_png(path, objective, eval))?;
+    Ok(export.written())
 }
 
 /// Draws the achieved body over the target: the target tip as a cross and,

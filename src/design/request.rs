@@ -40,7 +40,7 @@ pub struct DesignRequest {
     /// Upper tension bound, N; the map's, else [`DEFAULT_TENSION_RANGE_N`], when none.
     pub tension_max_n: Option<f64>,
     /// Largest |y_i|, mm; the thesis's 0.999 r when none. With `moulds`, no
-    /// more than the moulds can cast ([`MouldParams::max_channel_offset_mm`]).
+    /// more than the moulds can cast ([`MouldParams::max_castable_offset_mm`]).
     pub max_offset_mm: Option<f64>,
     /// The length the target's coefficients are per unit of.
     pub length_basis: LengthBasis,
@@ -118,7 +118,7 @@ impl TargetOnly {
 pub struct MouldBound {
     /// The search's largest |y_i|, mm.
     pub search_max_offset_mm: f64,
-    /// The largest |y_c| the moulds can cast, mm ([`MouldParams::max_channel_offset_mm`]).
+    /// The largest |y_c| the moulds can cast, mm ([`MouldParams::max_castable_offset_mm`]).
     pub mould_max_offset_mm: f64,
     /// The moulds' parameters that bound it.
     pub mould: MouldParams,
@@ -141,9 +141,9 @@ impl std::fmt::Display for MouldBound {
 const MOULD_ROUNDING_MM: f64 = 1e-9;
 
 /// The largest control-point offset a design for the moulds allows: what
-/// they cast ([`MouldParams::max_channel_offset_mm`]), a hair inside it.
+/// they cast ([`MouldParams::max_castable_offset_mm`]), a hair inside it.
 pub fn mould_offset_limit_mm(params: &MouldParams, radius_mm: f64) -> f64 {
-    params.max_channel_offset_mm(radius_mm) - MOULD_ROUNDING_MM
+    params.max_castable_offset_mm(radius_mm) - MOULD_ROUNDING_MM
 }
 
 impl DesignRequest {
@@ -221,7 +221,7 @@ impl DesignRequest {
         }
         let bound = MouldBound {
             search_max_offset_mm: self.requested_max_offset_mm(),
-            mould_max_offset_mm: self.mould.max_channel_offset_mm(self.rod.radius_mm),
+            mould_max_offset_mm: self.mould.max_castable_offset_mm(self.rod.radius_mm),
             mould: self.mould.clone(),
         };
         (bound.search_max_offset_mm > bound.mould_max_offset_mm).then_some(bound)
@@ -272,7 +272,7 @@ mod tests {
     #[test]
     fn moulds_bound_the_search_by_the_moulds_own_rule() {
         let params = MouldParams::default();
-        let limit_mm = params.max_channel_offset_mm(5.0);
+        let limit_mm = params.max_castable_offset_mm(5.0);
         assert!(limit_mm < Bounds::thesis_max_offset_mm(5.0), "the thesis's bound exceeds the moulds': the case this guards");
         let bound = |r: &DesignRequest| r.objective(r.target.as_ref().unwrap(), None).unwrap().bounds.max_offset_mm;
         let with = request(Some(params.clone()), None);

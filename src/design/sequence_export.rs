@@ -6,8 +6,8 @@
 
 use super::sequence::Setup;
 use super::sequence_report::SequenceRun;
+use super::export::Export;
 use super::DesignError;
-use crate::io::FileError;
 use crate::model::cable;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -19,28 +19,20 @@ pub fn actuator_file_name(index: usize) -> String {
 
 /// Writes the design's files into `dir` and returns their names, in order.
 pub fn write_all(dir: &Path, run: &SequenceRun, setup: &Setup) -> Result<Vec<String>, DesignError> {
-    super::export::check_export_dir(dir)?;
-    std::fs::create_dir_all(dir).map_err(FileError::on("creating", dir))?;
-    let mut written = Vec::new();
-    let mut write = |name: &str, bytes: &[u8]| {
-        let p = dir.join(name);
-        crate::io::write_atomic(&p, bytes).map_err(FileError::on("writing", &p))?;
-        written.push(name.to_string());
-        Ok::<_, DesignError>(())
-    };
+    let mut export = Export::create(dir)?;
     let mut text = serde_json::to_string_pretty(&run.to_json()).expect("JSON values serialise");
     text.push('\n');
-    write("design.json", text.as_bytes())?;
+    export.write("design.json", text.as_bytes())?;
     let first = &run.targets[0].actuator;
     let channels = first.channels().map_err(|source| DesignError::Channels { source })?;
     for (i, ch) in channels.iter().enumerate() {
         let end = first.cables[i].anchor_or_tip_mm(first.rod.length_mm);
-        write(&cable::channel_file_name(i), ch.csv(end).as_bytes())?;
+        export.write(&cable::channel_file_name(i), ch.csv(end).as_bytes())?;
     }
     for (i, t) in run.targets.iter().enumerate() {
         let toml = toml::to_string(&t.actuator).map_err(|source| DesignError::ActuatorToml { target: t.target.name.clone(), source })?;
         let head = format!("# {}: the actuator of this design at this target; cablemap simulate --actuator FILE solves it again\n", t.target.name);
-        write(&actuator_file_name(i), format!("{head}{toml}").as_bytes())?;
+        export.write(&actuator_file_name(i), format!("{head}{toml}").as_bytes())?;
     }
     if let Some(tr) = &run.trajectory {
         let mut csv = String::from("leg,step,cable,actuation,tension_n,tip_x_mm,tip_y_mm,tip_z_mm,deviation_mm\n");
@@ -53,7 +45,7 @@ pub fn write_all(dir: &Path, run: &SequenceRun, setup: &Setup) -> Result<Vec<Str
                 }
             }
         }
-        write("trajectory.csv", csv.as_bytes())?;
+        export.write("trajectory.csv", csv.as_bytes())?;
         let waypoint = |t: &super::sequence_report::TargetOutcome| t.target.tip_mm().map(|v| v.unwrap_or(f64::NAN));
         let drawing = crate::plot::spatial::TrajectoryDrawing {
             waypoints: run.targets.iter().map(waypoint).collect(),
@@ -61,15 +53,13 @@ pub fn write_all(dir: &Path, run: &SequenceRun, setup: &Setup) -> Result<Vec<Str
             base_radius_mm: run.design.actuator.rod.radius_at(0.0),
         };
         let title = format!("trajectory: {} waypoints, actuation linear in each leg, {} steps per leg; largest distance from the straight legs {:.3} mm", run.targets.len(), tr.steps_per_leg, tr.max_deviation_mm);
-        drawing.draw(&dir.join("trajectory.png"), &title)?;
-        written.push("trajectory.png".to_string());
+        export.draw("trajectory.png", |path| Ok(drawing.draw(path, &title)?))?;
     }
     for (i, t) in run.targets.iter().enumerate() {
         let sim = setup.simulate(&t.actuator).map_err(|source| DesignError::ResimulateTarget { target: t.target.name.clone(), source })?;
         let name = format!("target_{}.png", i + 1);
         let tensions: Vec<String> = sim.pose.tensions_n.iter().map(|v| format!("{v:.3}")).collect();
-        crate::plot::spatial::draw_spatial(&dir.join(&name), &format!("{}: tensions [{}] N", t.target.name, tensions.join(", ")), &sim)?;
-        written.push(name);
+        export.draw(&name, |path| Ok(crate::plot::spatial::draw_spatial(path, &format!("{}: tensions [{}] N", t.target.name, tensions.join(", ")), &sim)?))?;
     }
-    Ok(written)
+    Ok(export.written())
 }

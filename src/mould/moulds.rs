@@ -177,7 +177,7 @@ impl Moulds {
         }
         let rho = p.tube_diameter_mm / 2.0;
         // The channel must keep min_skin of silicone to the surface everywhere.
-        let limit = p.max_channel_offset_mm(radius_mm);
+        let limit = p.max_castable_offset_mm(radius_mm);
         let n = (length / 0.05).ceil() as usize;
         let mut widest = vec![1.0_f64; channels.len()];
         for (k, routing) in channels.iter().enumerate() {

@@ -64,7 +64,7 @@ impl MouldParams {
     /// silicone must fit between the channel's centreline and the surface, mm.
     /// [`Moulds::new`] refuses a channel beyond it; `design --moulds` bounds
     /// its search by it.
-    pub fn max_channel_offset_mm(&self, radius_mm: f64) -> f64 {
+    pub fn max_castable_offset_mm(&self, radius_mm: f64) -> f64 {
         radius_mm - self.tube_diameter_mm / 2.0 - self.min_skin_mm
     }
 }
