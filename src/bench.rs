@@ -46,13 +46,13 @@ pub struct BenchFigures {
 pub fn method_label(options: &SolverOptions) -> String {
     match options.method {
         SolverMethod::Collocation => format!("collocation-{}", options.nodes_per_span),
-        SolverMethod::Rk4 => format!("rk4-{}", options.steps_per_span),
+        SolverMethod::Rk4 => format!("rk4-{}", options.planar_steps_per_span),
     }
 }
 
 /// The reference method: RK4, 24 steps per span, secant shooting.
 pub fn reference_options() -> SolverOptions {
-    SolverOptions { method: SolverMethod::Rk4, steps_per_span: 24, ..SolverOptions::default() }
+    SolverOptions { method: SolverMethod::Rk4, planar_steps_per_span: 24, ..SolverOptions::default() }
 }
 
 /// The sweep's ladder (21 tensions 1.0 → 2.0 N) timed with gravity on and
@@ -220,7 +220,7 @@ pub fn sample_spatial_pairs(count: usize, radius_mm: f64) -> Vec<[crate::solver:
 /// three series included. `gravity` is the direction (None: off).
 pub fn bench_spatial(
     rod: &Rod,
-    options: &crate::solver::spatial::SpatialOptions,
+    options: &SolverOptions,
     pairs: &[[crate::solver::spatial::Cable; 2]],
     tensions: usize,
     gravity: Option<[f64; 3]>,
@@ -276,7 +276,7 @@ pub fn bench_spatial(
     std::hint::black_box(sink);
     let method = match options.method {
         crate::solver::SolverMethod::Collocation => format!("spatial-collocation-{}", options.nodes_per_span),
-        crate::solver::SolverMethod::Rk4 => format!("spatial-rk4-{}", options.steps_per_span),
+        crate::solver::SolverMethod::Rk4 => format!("spatial-rk4-{}", options.spatial_steps_per_span),
     };
     Ok(figures(label, per_solve, tensions, passes as f64 / solves.max(1) as f64, failures, method))
 }

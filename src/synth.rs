@@ -19,7 +19,6 @@ use crate::model::routing::CONTROL_POINTS;
 use crate::calibrate::captures::files::{captures_csv, markers_3d_csv, read_captures};
 use crate::calibrate::captures::solve_captures;
 use crate::calibrate::captures::synth::{default_markers, default_plan, synth_captures, MarkerSpec};
-use crate::solver::spatial::SpatialOptions;
 use crate::model::rod::ActuatorFileError;
 use crate::model::{Actuator, ActuatorError, ParameterError, RodOverrides};
 use crate::solver::SolverOptions;
@@ -50,10 +49,8 @@ pub struct SynthRequest {
     pub actuator_file: Option<PathBuf>,
     /// Planar: the rod without the hidden effect (the model a fit starts from).
     pub rod: RodOverrides,
-    /// The planar solver's settings.
+    /// The solver's settings.
     pub options: SolverOptions,
-    /// The 3-D solver's settings (captures).
-    pub spatial_options: SpatialOptions,
     /// The hidden effect.
     pub effect: HiddenEffect,
     /// Planar: routings with their ids; `None`: [`default_routings`].
@@ -457,7 +454,7 @@ fn write_captures(request: &SynthRequest, actuator_file: &Path) -> Result<Captur
         Markers::Placed(m) => m.clone(),
         _ => default_markers(&start),
     };
-    let options = &request.spatial_options;
+    let options = &request.options;
     let set = synth_captures(&truth, options, plan, &markers, request.noise_mm, request.seed, false)?;
     let write = |path: &PathBuf, text: String| crate::io::write_atomic(path, text.as_bytes()).map_err(FileError::on("writing", path));
     write(&request.out, captures_csv(&set.captures))?;

@@ -8,7 +8,7 @@ use cablemap::calibrate::captures::fit::Status;
 use cablemap::calibrate::captures::{diagnose_captures, fit_captures, Diagnose3Spec, Diagnosis3, Fit3Spec};
 use cablemap::calibrate::Parameter;
 use cablemap::calibrate::Effect;
-use cablemap::solver::spatial::SpatialOptions;
+use cablemap::solver::SolverOptions;
 use cablemap::model::Actuator;
 use std::path::PathBuf;
 use std::process::Command;
@@ -183,7 +183,7 @@ fn tentacle_truth() -> Actuator {
 #[test]
 fn the_3d_fit_recovers_the_rigidities_within_their_standard_errors() {
     let truth = tentacle_truth();
-    let options = SpatialOptions::default();
+    let options = SolverOptions::default();
     let markers = soromox_markers();
     let captures = one_cable_at_a_time(2, &[1.5, 3.0, 4.5, 6.0, 7.5], 5.0);
     let set = synth_captures(&truth, &options, captures, &markers, 1.0, 7, false).unwrap();
@@ -236,7 +236,7 @@ fn hidden_in(effect: impl Fn(&mut Actuator), captures: Vec<cablemap::calibrate::
     let start = Actuator::read(std::path::Path::new(&soromox("actuator.toml"))).unwrap();
     let mut truth = start.clone();
     effect(&mut truth);
-    let set = synth_captures(&truth, &SpatialOptions::default(), captures, markers, 1.0, 3, false).unwrap();
+    let set = synth_captures(&truth, &SolverOptions::default(), captures, markers, 1.0, 3, false).unwrap();
     (start, set)
 }
 

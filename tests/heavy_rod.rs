@@ -63,7 +63,7 @@ fn heavy_rods_converge_and_refinement_agrees() {
 /// about the cut, and axial force EA (v1 − 1) = −τ t_c1 + (Rᵀ W)_1.
 #[test]
 fn heavy_rod_shape_is_in_equilibrium() {
-    let options = SolverOptions { steps_per_span: 400, ..SolverOptions::default() };
+    let options = SolverOptions { planar_steps_per_span: 400, ..SolverOptions::default() };
     for (ei, ea) in [(6000.0, 20.0), (6000.0, 60.0), (10000.0, 40.0)] {
         let a = heavy(ei, ea);
         let w = a.weight_n_per_mm();
@@ -119,7 +119,7 @@ fn heavy_rod_shape_is_in_equilibrium() {
 
 #[test]
 fn heavy_rod_agrees_with_rk4_where_rk4_converges() {
-    let rk4 = SolverOptions { method: SolverMethod::Rk4, steps_per_span: 96, ..SolverOptions::default() };
+    let rk4 = SolverOptions { method: SolverMethod::Rk4, planar_steps_per_span: 96, ..SolverOptions::default() };
     let a = heavy(10000.0, 40.0);
     for t in TENSIONS_N {
         let (p, q) = (solve(&a, &SolverOptions::default(), t).pose, solve(&a, &rk4, t).pose);

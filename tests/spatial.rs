@@ -3,7 +3,7 @@
 //! shooting solver), analytic solutions, symmetries and agreement with the
 //! planar solver.
 
-use cablemap::solver::spatial::{simulate_spatial, Cable, Actuator, SpatialError, SpatialOptions};
+use cablemap::solver::spatial::{simulate_spatial, Cable, Actuator, SpatialError};
 use cablemap::solver::Simulation;
 use cablemap::model::{ActuatorError, Rod, Routing};
 use cablemap::solver::{simulate, SolverOptions};
@@ -51,7 +51,7 @@ fn actuator_for(case: &Value) -> Actuator {
 }
 
 fn run(a: &Actuator) -> Simulation {
-    simulate_spatial(a, &SpatialOptions::default(), 3, LengthBasis::Rest).unwrap()
+    simulate_spatial(a, &SolverOptions::default(), 3, LengthBasis::Rest).unwrap()
 }
 
 fn angle(a: [f64; 3], b: [f64; 3]) -> f64 {
@@ -70,13 +70,13 @@ fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
 /// 1e-3 mm and 1e-5 rad.
 #[test]
 fn every_reference_case_agrees() {
-    let rk4 = SpatialOptions { method: cablemap::solver::SolverMethod::Rk4, ..SpatialOptions::default() };
-    for (options, tip_mm, angle_rad) in [(SpatialOptions::default(), 1e-6, 1e-7), (rk4, 1e-3, 1e-5)] {
+    let rk4 = SolverOptions { method: cablemap::solver::SolverMethod::Rk4, ..SolverOptions::default() };
+    for (options, tip_mm, angle_rad) in [(SolverOptions::default(), 1e-6, 1e-7), (rk4, 1e-3, 1e-5)] {
         reference_cases_agree(&options, tip_mm, angle_rad);
     }
 }
 
-fn reference_cases_agree(options: &SpatialOptions, tip_mm: f64, angle_rad: f64) {
+fn reference_cases_agree(options: &SolverOptions, tip_mm: f64, angle_rad: f64) {
     let cases = cases();
     assert_eq!(cases.len(), 8);
     let mut worst = [0.0f64; 4];
@@ -120,7 +120,7 @@ fn constant_offset_bends_at_constant_curvature_about_the_perpendicular_axis() {
     let (dy, dz, tau) = (2.4, -3.2, 1.5);
     let a = Actuator::with_cables(no_gravity(), vec![Cable::spatial([dy; 5], [dz; 5], tau)]);
     // Fine steps: this checks the model, not RK4's error (≈ 6e-6 mm at the default).
-    let sim = simulate_spatial(&a, &SpatialOptions { steps_per_span: 128, ..SpatialOptions::default() }, 3, LengthBasis::Rest).unwrap();
+    let sim = simulate_spatial(&a, &SolverOptions { spatial_steps_per_span: 128, ..SolverOptions::default() }, 3, LengthBasis::Rest).unwrap();
     let rod = &a.rod;
     let d = dy.hypot(dz);
     let kappa = tau * d / rod.ei_n_mm2;
@@ -245,7 +245,7 @@ fn planar_cases_agree_with_the_planar_solver() {
             let fine = SolverOptions { nodes_per_span: 32, ..SolverOptions::default() };
             let planar = simulate(&rod, &fine, &routing, tension, 3, LengthBasis::Rest).unwrap();
             let a = Actuator::with_cables(rod.clone(), vec![Cable::planar(*y, tension)]);
-            let opts = SpatialOptions { steps_per_span: 256, ..SpatialOptions::default() };
+            let opts = SolverOptions { spatial_steps_per_span: 256, ..SolverOptions::default() };
             let s = simulate_spatial(&a, &opts, 3, LengthBasis::Rest).unwrap();
             let tip = [planar.pose.tip_x_mm, planar.pose.tip_y_mm, 0.0];
             let d = dist(s.pose.tip_mm(), tip);
@@ -284,7 +284,7 @@ fn default_resolution_is_close_to_a_fine_one_on_planar_cases() {
 #[test]
 fn bad_input_gets_clear_errors() {
     let rod = Rod::default();
-    let err = |cables: Vec<Cable>| simulate_spatial(&Actuator::with_cables(rod.clone(), cables), &SpatialOptions::default(), 3, LengthBasis::Rest).unwrap_err();
+    let err = |cables: Vec<Cable>| simulate_spatial(&Actuator::with_cables(rod.clone(), cables), &SolverOptions::default(), 3, LengthBasis::Rest).unwrap_err();
     // Each coordinate below r, the distance √2·3.6 = 5.09 mm above it.
     let e = err(vec![Cable::spatial([3.6; 5], [3.6; 5], 1.0)]);
     assert!(matches!(e, SpatialError::Actuator(ActuatorError::OutsideBody { cable: 1, .. })), "{e}");
@@ -294,14 +294,14 @@ fn bad_input_gets_clear_errors() {
     assert!(e.to_string().contains("cable 2") && e.to_string().contains("-0.5"), "{e}");
     let mut a = Actuator::with_cables(rod.clone(), vec![Cable::planar([1.0; 5], 1.0)]);
     a.gravity_direction = Some([0.0, 0.0, 0.0]);
-    assert!(matches!(simulate_spatial(&a, &SpatialOptions::default(), 3, LengthBasis::Rest), Err(SpatialError::Actuator(ActuatorError::GravityDirection(_)))));
+    assert!(matches!(simulate_spatial(&a, &SolverOptions::default(), 3, LengthBasis::Rest), Err(SpatialError::Actuator(ActuatorError::GravityDirection(_)))));
     a.gravity_direction = None;
     a.rod.effects.friction_mu = 0.1;
     // The RK4 reference models the thesis's rod without effects; the default collocation models friction.
-    let rk4 = SpatialOptions { method: cablemap::solver::SolverMethod::Rk4, ..SpatialOptions::default() };
+    let rk4 = SolverOptions { method: cablemap::solver::SolverMethod::Rk4, ..SolverOptions::default() };
     let e = simulate_spatial(&a, &rk4, 3, LengthBasis::Rest).unwrap_err();
     assert!(e.to_string().contains("friction_mu") && e.to_string().contains("spatial RK4"), "{e}");
-    assert!(simulate_spatial(&a, &SpatialOptions::default(), 3, LengthBasis::Rest).is_ok());
+    assert!(simulate_spatial(&a, &SolverOptions::default(), 3, LengthBasis::Rest).is_ok());
 }
 
 #[test]
@@ -339,7 +339,7 @@ fn assert_planar_agreement(rod: &Rod, cable: Cable, what: &str) {
     let fine = SolverOptions { nodes_per_span: 32, ..SolverOptions::default() };
     let planar = simulate(&planar_rod, &fine, &routing, cable.tension_n, 3, LengthBasis::Rest).unwrap();
     let a = Actuator::with_cables(rod.clone(), vec![cable]);
-    let s = simulate_spatial(&a, &SpatialOptions { steps_per_span: 128, ..SpatialOptions::default() }, 3, LengthBasis::Rest).unwrap();
+    let s = simulate_spatial(&a, &SolverOptions { spatial_steps_per_span: 128, ..SolverOptions::default() }, 3, LengthBasis::Rest).unwrap();
     let d = dist(s.pose.tip_mm(), [planar.pose.tip_x_mm, planar.pose.tip_y_mm, 0.0]);
     assert!(d < 1e-6, "{what}: tip off by {d:.2e} mm");
     for i in 0..4 {

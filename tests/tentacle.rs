@@ -5,7 +5,8 @@
 //! per tendon converge, and converged shapes are in equilibrium, checked
 //! from the output centreline alone.
 
-use cablemap::solver::spatial::{simulate_spatial, Actuator, SpatialOptions};
+use cablemap::solver::spatial::{simulate_spatial, Actuator};
+use cablemap::solver::SolverOptions;
 use cablemap::solver::Simulation;
 use cablemap::shape::LengthBasis;
 use std::path::PathBuf;
@@ -37,7 +38,7 @@ fn capture_tensions() -> Vec<(f64, f64)> {
         .collect()
 }
 
-fn solve(a: &Actuator, options: &SpatialOptions) -> Simulation {
+fn solve(a: &Actuator, options: &SolverOptions) -> Simulation {
     let t: Vec<f64> = a.cables.iter().map(|c| c.tension_n).collect();
     simulate_spatial(a, options, 3, LengthBasis::Rest).unwrap_or_else(|e| panic!("tensions {t:?} N: {e}"))
 }
@@ -53,7 +54,7 @@ fn every_capture_and_a_grid_to_8_n_converge_at_full_weight() {
         }
     }
     for (t1, t2) in pairs {
-        let sim = solve(&tentacle(t1, t2), &SpatialOptions::default());
+        let sim = solve(&tentacle(t1, t2), &SolverOptions::default());
         let [x, y, z] = sim.pose.tip_mm();
         assert!([x, y, z].iter().all(|v| v.is_finite()), "{t1} {t2}: {:?}", sim.pose.tip_mm());
         // Both tendons sit on the +z side: pulling bends the tip toward +z,
@@ -68,7 +69,7 @@ fn every_capture_and_a_grid_to_8_n_converge_at_full_weight() {
         }
     }
     // Mirror images: tendon 1 alone and tendon 2 alone at the same tension.
-    let (a, b) = (solve(&tentacle(7.692308, 0.0), &SpatialOptions::default()), solve(&tentacle(0.0, 7.692308), &SpatialOptions::default()));
+    let (a, b) = (solve(&tentacle(7.692308, 0.0), &SolverOptions::default()), solve(&tentacle(0.0, 7.692308), &SolverOptions::default()));
     let (p, q) = (a.pose.tip_mm(), b.pose.tip_mm());
     assert!((p[0] - q[0]).abs() < 1e-7 && (p[1] + q[1]).abs() < 1e-7 && (p[2] - q[2]).abs() < 1e-7, "{p:?} vs {q:?}");
 }
@@ -82,7 +83,7 @@ fn every_capture_and_a_grid_to_8_n_converge_at_full_weight() {
 /// force R K_se (v − e₁), v = Rᵀ p', equals −Σ τ_i t_i + W(s).
 #[test]
 fn the_tentacles_shape_is_in_equilibrium() {
-    let options = SpatialOptions { steps_per_span: 360, ..SpatialOptions::default() };
+    let options = SolverOptions { spatial_steps_per_span: 360, ..SolverOptions::default() };
     let base = tentacle(0.0, 0.0);
     let rod = &base.rod;
     let body = rod.body().unwrap().expect("a tapered body");

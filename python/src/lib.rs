@@ -10,7 +10,7 @@
 //! file that cannot be read.
 
 use cablemap::solver::record::{self, SimulationRecord};
-use cablemap::solver::spatial::{SpatialError, SpatialOptions};
+use cablemap::solver::spatial::SpatialError;
 use cablemap::model::{Actuator, ActuatorError, Cable, LoadDirection, Rod, Routing, REGISTRY};
 use cablemap::solver::{simulate_actuator, simulate_held, Backend, Given, Hold, SimulateError, Simulation, Simulator, SolverMethod, SolverOptions};
 use cablemap::shape::LengthBasis;
@@ -200,20 +200,13 @@ struct SolverRequest {
 impl SolverRequest {
     /// The options, as `ActuatorArgs::solver_options` builds them.
     fn options(&self) -> Result<SolverOptions> {
-        let mut o = SolverOptions::default();
-        if let Some(n) = self.steps_per_span {
-            o.steps_per_span = n;
-        }
-        if let Some(m) = self.nodes_per_span {
-            o.nodes_per_span = m;
-        }
-        match self.method.as_deref() {
-            None => {}
-            Some("collocation") => o.method = SolverMethod::Collocation,
-            Some("rk4") => o.method = SolverMethod::Rk4,
+        let method = match self.method.as_deref() {
+            None => None,
+            Some("collocation") => Some(SolverMethod::Collocation),
+            Some("rk4") => Some(SolverMethod::Rk4),
             Some(other) => return Err(bad(format!("method {other:?}: expected \"collocation\" or \"rk4\""))),
-        }
-        Ok(o)
+        };
+        Ok(SolverOptions::with_given(self.steps_per_span, self.nodes_per_span, method))
     }
 }
 
@@ -286,7 +279,7 @@ fn simulate_request(request: SimulateRequest) -> Result<(Simulation, String)> {
                     Err(d) => Cable { displacement_mm: Some(d), ..cable },
                 };
                 let one = Actuator::with_cables(rod, vec![cable]);
-                simulate_actuator(&one, &options, &SpatialOptions::default(), given, Some(hold), order, basis)?
+                simulate_actuator(&one, &options, given, Some(hold), order, basis)?
             }
         };
         let json = SimulationRecord::from(&sim).to_json_line();
@@ -308,8 +301,7 @@ fn simulate_request(request: SimulateRequest) -> Result<(Simulation, String)> {
     if actuator.cables.is_empty() {
         return Err(bad("no cables: give cables=[...], routing_mm with tension_n, or an actuator with cables"));
     }
-    let spatial_options = SpatialOptions::with_given(solver.steps_per_span, None, None);
-    let sim = simulate_actuator(&actuator, &options, &spatial_options, given, Some(hold), order, basis)?;
+    let sim = simulate_actuator(&actuator, &options, given, Some(hold), order, basis)?;
     let json = record::simulation_json(&sim).to_string();
     Ok((sim, json))
 }

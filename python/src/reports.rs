@@ -17,7 +17,6 @@ use cablemap::design::actuator::DesignActuator;
 use cablemap::design::feasible_request::{FeasibleRequest, MapSource};
 use cablemap::design::targets::TargetSet;
 use cablemap::design::{DesignError, DesignRequest, SearchOptions, Target, Weights};
-use cablemap::solver::spatial::SpatialOptions;
 use cablemap::model::{Actuator, Rod, RodOverrides, REGISTRY};
 use cablemap::mould::MouldSettings;
 use cablemap::shape::LengthBasis;
@@ -91,13 +90,6 @@ fn pictures(dir: Option<&Path>, names: &[String]) -> Vec<String> {
 /// The length basis by its name (`rest` or `deformed`).
 fn length_basis(name: &str) -> Result<LengthBasis> {
     super::from_json(&format!("\"{name}\""), "length_basis (\"rest\" or \"deformed\")")
-}
-
-/// The 3-D solver's settings from the solver's fields, as the commands'
-/// `spatial_options`: only those given change the defaults.
-fn spatial_options(solver: &SolverRequest) -> Result<SpatialOptions> {
-    let method = solver.method.as_ref().map(|_| solver.options().map(|o| o.method)).transpose()?;
-    Ok(SpatialOptions::with_given(solver.steps_per_span, solver.nodes_per_span, method))
 }
 
 /// The rod overrides of a planar fit (the rod flags of `calibrate` and
@@ -369,7 +361,6 @@ fn calibrate_run(r: CalibratePy) -> Result<Finished> {
         actuator_file: fit.actuator.clone(),
         rod: rod_overrides(fit.rod_fields.clone())?,
         options: fit.solver.options()?,
-        spatial_options: spatial_options(&fit.solver)?,
         fit: fit.settings()?,
         effects: effects(&names)?,
         holdout: fit.holdout.clone(),
@@ -410,7 +401,6 @@ fn diagnose_run(r: DiagnosePy) -> Result<Finished> {
         actuator_file: fit.actuator.clone(),
         rod: rod_overrides(fit.rod_fields.clone())?,
         options: fit.solver.options()?,
-        spatial_options: spatial_options(&fit.solver)?,
         fit: fit.settings()?,
         holdout: fit.holdout.clone(),
         holdout_cable: fit.holdout_cable,
@@ -448,7 +438,7 @@ struct PredictPy {
 pub(crate) fn predict(py: Python<'_>, request_json: &str) -> PyResult<Finished> {
     let r: PredictPy = super::from_json(request_json, "predict").map_err(|e| e.into_py(py))?;
     detached(py, move || {
-        let request = PredictRequest { captures: r.captures, markers: r.markers, actuator: r.actuator, rod: RodOverrides::default(), options: spatial_options(&r.solver)? };
+        let request = PredictRequest { captures: r.captures, markers: r.markers, actuator: r.actuator, rod: RodOverrides::default(), options: r.solver.options()? };
         let report = captures::predict(&request).map_err(calibrate_failure)?;
         Ok((report.to_json_line(), report.to_string(), Vec::new()))
     })

@@ -7,7 +7,6 @@
 
 use super::fit::{Loss, Noise};
 use super::{CalibrateError, Effect, HeldError, InvalidRequest, NoiseError, Parameter, Refused};
-use crate::solver::spatial::SpatialOptions;
 use crate::model::RodOverrides;
 use crate::solver::SolverOptions;
 use std::path::{Path, PathBuf};
@@ -116,10 +115,8 @@ pub struct CalibrateRequest {
     /// Planar data: starting values and fixed parameters, overrides on the
     /// rod file's, else the measurement file's, else the thesis's rod.
     pub rod: RodOverrides,
-    /// The planar solver's settings.
+    /// The solver's settings.
     pub options: SolverOptions,
-    /// The 3-D solver's settings (captures).
-    pub spatial_options: SpatialOptions,
     /// Noise, held parameters, loss, shapes.
     pub fit: FitSettings,
     /// Effects whose parameters are fitted with the rigidities.
@@ -142,7 +139,6 @@ impl CalibrateRequest {
             actuator_file: None,
             rod: RodOverrides::default(),
             options: SolverOptions::default(),
-            spatial_options: SpatialOptions::default(),
             fit: FitSettings::default(),
             effects: Vec::new(),
             holdout: None,
@@ -175,10 +171,8 @@ pub struct DiagnoseRequest {
     /// rod file's, else the measurement file's, else the thesis's rod
     /// (validated here).
     pub rod: RodOverrides,
-    /// The planar solver's settings.
+    /// The solver's settings.
     pub options: SolverOptions,
-    /// The 3-D solver's settings (captures).
-    pub spatial_options: SpatialOptions,
     /// Noise, held parameters, loss, shapes.
     pub fit: FitSettings,
     /// Planar data: routing left out of every fit; the gap on it is shown
@@ -207,7 +201,6 @@ impl DiagnoseRequest {
             actuator_file: None,
             rod: RodOverrides::default(),
             options: SolverOptions::default(),
-            spatial_options: SpatialOptions::default(),
             fit: FitSettings::default(),
             holdout: None,
             holdout_cable: None,

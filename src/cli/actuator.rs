@@ -156,18 +156,11 @@ impl ActuatorArgs {
     /// Solver options with the step override.
     pub fn solver_options(&self, base: &SolverOptions) -> SolverOptions {
         let mut o = base.clone();
-        if let Some(n) = self.steps_per_span {
-            o.steps_per_span = n;
-        }
-        if let Some(m) = self.nodes_per_span {
-            o.nodes_per_span = m;
-        }
-        if let Some(m) = self.method {
-            o.method = match m {
-                MethodArg::Collocation => SolverMethod::Collocation,
-                MethodArg::Rk4 => SolverMethod::Rk4,
-            };
-        }
+        let method = self.method.map(|m| match m {
+            MethodArg::Collocation => SolverMethod::Collocation,
+            MethodArg::Rk4 => SolverMethod::Rk4,
+        });
+        o.give(self.steps_per_span, self.nodes_per_span, method);
         o
     }
 }

@@ -74,8 +74,8 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     // The 3-D solver: two spatial cables, in the table only (the JSON
     // array keeps its two planar rows), with its RK4 reference unless
     // --no-reference, and its ratio to the planar single-cable solve of this run.
-    let spatial_options = cablemap::solver::spatial::SpatialOptions { nodes_per_span: options.nodes_per_span, ..Default::default() };
-    let rk4_options = cablemap::solver::spatial::SpatialOptions { method: cablemap::solver::SolverMethod::Rk4, ..Default::default() };
+    let spatial_options = cablemap::solver::SolverOptions { nodes_per_span: options.nodes_per_span, ..Default::default() };
+    let rk4_options = cablemap::solver::SolverOptions { method: cablemap::solver::SolverMethod::Rk4, ..Default::default() };
     let pairs = cablemap::bench::sample_spatial_pairs(args.routings.div_ceil(4), base.radius_mm);
     println!(
         "3-D solver, {} two-cable spatial actuators x 21 tensions (tau1 1.0..2.0 N, tau2 = tau1/2, continuation), twist and both bending series a_0..a_3 included",

@@ -128,7 +128,6 @@ pub fn run(args: &CalibrateArgs) -> anyhow::Result<()> {
         actuator_file: args.spatial_actuator.clone(),
         rod: args.actuator.overrides(),
         options: args.actuator.solver_options(&SolverOptions::default()),
-        spatial_options: spatial_options(&args.actuator),
         fit: args.fit.settings()?,
         effects: parse_effects(&args.effects)?,
         holdout: args.holdout.clone(),
@@ -145,11 +144,4 @@ pub fn run(args: &CalibrateArgs) -> anyhow::Result<()> {
         write!(out, "{report}")?;
     }
     Ok(())
-}
-
-/// The 3-D solver's settings from the solver flags (--nodes-per-span,
-/// --steps-per-span for the centreline's resolution, --method).
-pub fn spatial_options(args: &ActuatorArgs) -> cablemap::solver::spatial::SpatialOptions {
-    let method = args.method.map(|_| args.solver_options(&SolverOptions::default()).method);
-    cablemap::solver::spatial::SpatialOptions::with_given(args.steps_per_span, args.nodes_per_span, method)
 }

@@ -64,7 +64,6 @@ pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
         actuator_file: args.spatial_actuator.clone(),
         rod: args.actuator.overrides(),
         options: args.actuator.solver_options(&SolverOptions::default()),
-        spatial_options: super::calibrate::spatial_options(&args.actuator),
         fit: args.fit.settings()?,
         holdout: args.holdout.clone(),
         holdout_cable: args.holdout_cable,

@@ -2,7 +2,6 @@
 //! simulates every capture with the given actuator (no fitting) and reports
 //! the markers' 3-D errors per capture, per marker and overall.
 
-use super::calibrate::spatial_options;
 use super::ActuatorArgs;
 use cablemap::calibrate::captures::{self, PredictRequest};
 use clap::Args;
@@ -37,7 +36,7 @@ pub fn run(args: &PredictArgs) -> anyhow::Result<()> {
         markers: args.markers.clone(),
         actuator: args.actuator.clone(),
         rod: args.solver.overrides(),
-        options: spatial_options(&args.solver),
+        options: args.solver.solver_options(&cablemap::solver::SolverOptions::default()),
     };
     let report = captures::predict(&request)?;
     let stdout = std::io::stdout();

@@ -131,8 +131,7 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         // and solved as every actuator's (the same planar backend).
         _ => {
             let one = Actuator::with_cables(actuator.clone(), vec![routing_cable(actuation, routing.control_points_mm().0, args.cable_ea_n)]);
-            let spatial_options = cablemap::solver::spatial::SpatialOptions::default();
-            let solved = simulate_actuator(&one, &options, &spatial_options, given_settings(args), Some(hold), exact_order, basis);
+            let solved = simulate_actuator(&one, &options, given_settings(args), Some(hold), exact_order, basis);
             if let (Err(e), true) = (&solved, args.json) {
                 if let Some(status) = e.failure_status() {
                     print_failure_json(status, &e.to_string())?;
@@ -189,7 +188,6 @@ fn report_png(args: &SimulateArgs) {
 /// in-plane cable with gravity in the plane, else the 3-D solver) and
 /// reported in the actuator's terms (the spatial record).
 fn run_spatial(args: &SimulateArgs) -> anyhow::Result<()> {
-    use cablemap::solver::spatial::SpatialOptions;
     use cablemap::solver::Hold;
     // The rod: the spatial file's [rod], else an --actuator-file, else the
     // thesis's; rod flags override either.
@@ -228,7 +226,6 @@ fn run_spatial(args: &SimulateArgs) -> anyhow::Result<()> {
         args.n_d
     );
     let options = args.actuator.solver_options(&SolverOptions::default());
-    let spatial_options = SpatialOptions::with_given(args.actuator.steps_per_span, None, None);
     let thesis = args.coefficients == CoefficientRoute::Thesis;
     let given = given_settings(args);
     // As the planar `--routing` path holds it.
@@ -236,7 +233,7 @@ fn run_spatial(args: &SimulateArgs) -> anyhow::Result<()> {
     let hold = Hold { direction, dwell_s: args.dwell_s.unwrap_or(spatial.rod.effects.creep_hold_s) };
     let order = if thesis { args.order.min(cablemap::solver::resolution::max_order(&options)) } else { args.order };
     let basis = args.basis.length_basis;
-    let solved = simulate_actuator(&spatial, &options, &spatial_options, given, Some(hold), order, basis);
+    let solved = simulate_actuator(&spatial, &options, given, Some(hold), order, basis);
     if let (Err(e), true) = (&solved, args.json) {
         if let Some(status) = e.failure_status() {
             print_failure_json(status, &e.to_string())?;

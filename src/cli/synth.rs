@@ -176,7 +176,6 @@ fn request(args: &SynthArgs) -> anyhow::Result<SynthRequest> {
         actuator_file: args.spatial_actuator.clone(),
         rod: args.actuator.overrides(),
         options: args.actuator.solver_options(&SolverOptions::default()),
-        spatial_options: super::calibrate::spatial_options(&args.actuator),
         effect,
         routings,
         routing_tilts_rad,

@@ -21,7 +21,7 @@
 
 use super::actuator::{ActuationBounds, CableFreedom, DesignActuator};
 use super::targets::{Quantity, ShapeTarget};
-use crate::solver::spatial::{SpatialError, SpatialOptions, SpatialSolver};
+use crate::solver::spatial::{SpatialError, SpatialSolver};
 use crate::model::Actuator;
 use crate::solver::{simulate_actuator, Given, Simulation, SolverOptions, TipPose};
 use crate::numerics::lm;
@@ -268,7 +268,7 @@ impl Setup {
 
     /// Solves one actuator by the backend `simulate` would use.
     pub fn simulate(&self, actuator: &Actuator) -> Result<Simulation, SpatialError> {
-        simulate_actuator(actuator, &self.options, &SpatialOptions::default(), Given::default(), None, self.order(), self.basis)
+        simulate_actuator(actuator, &self.options, Given::default(), None, self.order(), self.basis)
     }
 
     /// Solves target `t` at `x` ([`Setup::quick`]).
@@ -286,7 +286,7 @@ impl Setup {
             && !actuator.cables.iter().any(|c| c.is_displacement_driven())
             && self.options.method == crate::solver::SolverMethod::Collocation;
         if spatial {
-            let options = SpatialOptions { nodes_per_span: self.options.nodes_per_span, ..SpatialOptions::default() };
+            let options = SolverOptions { nodes_per_span: self.options.nodes_per_span, ..SolverOptions::default() };
             if let Ok(mut solver) = SpatialSolver::new(actuator, &options) {
                 let tensions: Vec<f64> = actuator.cables.iter().map(|c| c.tension_n).collect();
                 if let Ok(pose) = solver.solve(&tensions) {

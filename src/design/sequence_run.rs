@@ -76,7 +76,7 @@ fn command_of(actuator: &Actuator, file: Option<&std::path::Path>) -> String {
     match file {
         Some(p) => format!("cablemap simulate --actuator {} --json", super::feasible::shell_word(&p.display().to_string())),
         None => {
-            let c = crate::solver::record::simulate_command(actuator, &crate::solver::spatial::SpatialOptions::default());
+            let c = crate::solver::record::simulate_command(actuator, &crate::solver::SolverOptions::default());
             if c.missing.is_empty() {
                 c.text
             } else {

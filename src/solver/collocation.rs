@@ -460,7 +460,7 @@ impl Simulator {
             // The moment's change in angle units: δM·L/EI turns the tip by about that.
             let change = dphi.max(dmom * self.actuator.length_mm / self.actuator.ei_n_mm2);
             // Settled, and still contracting (a stalled iteration goes to Newton).
-            let settled = dphi <= SWEEP_ANGLE_TOLERANCE_RAD && dmom <= self.options.moment_tolerance_n_mm && dratio < FRICTION_TOLERANCE;
+            let settled = dphi <= SWEEP_ANGLE_TOLERANCE_RAD && dmom <= self.options.planar_moment_tolerance_n_mm && dratio < FRICTION_TOLERANCE;
             if settled && (passes == 1 || change <= 0.5 * previous || !has_weight) {
                 break Ok(());
             }
@@ -606,7 +606,7 @@ impl Simulator {
         let dmom = self.colloc_moment(c);
         // A non-finite strain reaches every later φ and every earlier M.
         if !(c.phi[c.phi.len() - 1] + c.phi[c.np() - 1] + c.mom[0] + dphi + dmom).is_finite() {
-            return Err(SolveFailure::NonFinite { s_mm: self.actuator.length_mm });
+            return Err(SolveFailure::NonFinite { s_mm: Some(self.actuator.length_mm) });
         }
         Ok((dphi, dmom))
     }
@@ -1048,7 +1048,7 @@ impl Simulator {
         let c = self.col.as_ref().expect("collocation state");
         let routing = self.routing.as_ref().expect("routing");
         let np = c.np();
-        let count = 2 * self.options.steps_per_span + 1;
+        let count = 2 * self.options.planar_steps_per_span + 1;
         let tension = self.last_tension_n.unwrap_or(0.0);
         let length = self.actuator.length_mm;
         let v1: Vec<f64> = c.strain.iter().map(|e| e.v1).collect();

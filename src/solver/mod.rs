@@ -70,6 +70,7 @@ mod probe;
 pub mod result;
 mod rk4;
 pub mod simulate;
+pub mod options;
 
 pub use backend::{Backend, Given, Support, Unsupported};
 pub use error::SimulateError;
@@ -79,6 +80,7 @@ pub use simulate::{
     check_ladder_tension, planar_problem, simulate, simulate_actuator, simulate_held, simulate_spatial, MAX_AUTO_SPATIAL_STEPS_PER_SPAN,
     MAX_AUTO_STEPS_PER_SPAN, MAX_LADDER_TENSION_N,
 };
+pub use options::{SolverMethod, SolverOptions};
 use creep::Creep;
 use friction::Friction;
 
@@ -103,12 +105,19 @@ pub enum SolveFailure {
     /// The clamp-compliance fixed point did not converge.
     #[error("the clamp rotation did not converge; try a stiffer clamp (clamp stiffness) or smaller tension steps")]
     ClampNotConverged,
-    /// A non-finite number appeared in the state.
-    #[error("a non-finite value appeared at s = {s_mm:.3} mm; check the actuator parameters, or try smaller tension steps")]
-    NonFinite { s_mm: f64 },
-    /// The friction tension profile did not settle.
+    /// A non-finite number appeared in the state at `s_mm` (planar), or in
+    /// the tip or a coefficient (spatial: `None`).
+    #[error("{}", non_finite_sentence(*s_mm))]
+    NonFinite { s_mm: Option<f64> },
+    /// The cables' tension profiles with friction did not settle.
     #[error("the cable tension profile with friction did not converge; try smaller tension steps or a smaller friction coefficient")]
     FrictionNotConverged,
+    /// The spatial cut equations at a point did not converge.
+    #[error("the cut equations did not converge at s = {s_mm:.3} mm (tension too high for this routing, or a cable pulls straight through the axis); lower the tension or raise --steps-per-span")]
+    CutEquationsNotConverged { s_mm: f64 },
+    /// The spatial backends' iteration on gravity's moment did not converge.
+    #[error("gravity's moment did not converge in {passes} passes (residual {residual_n_mm:.3e} N·mm); the rod may be too heavy for its stiffness")]
+    GravityNotConverged { passes: u32, residual_n_mm: f64 },
     /// The equilibrium under the rod's own weight was not found, even by
     /// Newton's method with continuation in the weight.
     #[error("the equilibrium under the rod's weight did not converge (reached {reached_percent:.0} % of the weight); try smaller tension steps from a lower tension, more nodes per span, or a smaller gravity scale")]
@@ -123,9 +132,8 @@ pub enum SolveFailure {
     DisplacementNotMet(actuation::DisplacementNotMet),
 }
 
-/// What a solve does not resolve, by how much, and what to raise (the
-/// planar and the 3-D solvers' [`SolveFailure::Unresolved`] and
-/// [`super::spatial::SpatialFailure::Unresolved`]).
+/// What a solve does not resolve, by how much, and what to raise
+/// ([`SolveFailure::Unresolved`]).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error(
     "the solver's discretisation does not resolve this shape: {what} is off by about {} {unit} (tolerance {} {unit}); {advice}",
@@ -160,7 +168,17 @@ impl SolveFailure {
             SolveFailure::WeightNotConverged { .. } => "weight_not_converged",
             SolveFailure::Unresolved(_) => "unresolved",
             SolveFailure::DisplacementNotMet(_) => "displacement_not_met",
+            SolveFailure::CutEquationsNotConverged { .. } => "cut_equations_not_converged",
+            SolveFailure::GravityNotConverged { .. } => "gravity_not_converged",
         }
+    }
+}
+
+/// [`SolveFailure::NonFinite`]'s sentence: where the value appeared, if known.
+fn non_finite_sentence(s_mm: Option<f64>) -> String {
+    match s_mm {
+        Some(s) => format!("a non-finite value appeared at s = {s:.3} mm; check the actuator parameters, or try smaller tension steps"),
+        None => "the solve gave a non-finite tip or coefficient; check the rod's parameters (rigidities, length, density) for absurd values".into(),
     }
 }
 
@@ -201,63 +219,6 @@ const ESTIMATED_ORDERS: usize = 24;
 
 /// Status string of a successful solve.
 pub const STATUS_OK: &str = "ok";
-
-/// How the centreline is integrated along each knot span of the routing.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "lowercase")]
-pub enum SolverMethod {
-    /// Spectral collocation on Chebyshev–Lobatto nodes per span (the
-    /// default): strains at `nodes_per_span + 1` points per span, integrals
-    /// by the exact integral of the interpolating polynomial; gravity's
-    /// distal moment by fixed-point sweeps (no shooting), with Newton's
-    /// method and continuation in the weight as the fallback for heavy rods.
-    #[default]
-    Collocation,
-    /// The reference method, a plain scheme to check against: classical RK4 with
-    /// `steps_per_span` steps per span and secant shooting on gravity's
-    /// base moment.
-    Rk4,
-}
-
-/// Numerical settings of the solver.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct SolverOptions {
-    /// Integration method.
-    pub method: SolverMethod,
-    /// Collocation: Chebyshev–Lobatto intervals per knot span (4–64); the
-    /// span's integrands are smooth, so the error falls geometrically with it.
-    /// With material stiffening at least [`MIN_NODES_WITH_STIFFENING`] are used.
-    pub nodes_per_span: usize,
-    /// RK4 steps on each of the routing's two knot spans (even, ≥ 2). With
-    /// collocation it sets the centreline's resolution: 2·steps_per_span + 1
-    /// evenly spaced points.
-    pub steps_per_span: usize,
-    /// Last Newton step accepted for the cable angle α, rad (the error left
-    /// is of the order of its square).
-    pub angle_tolerance_rad: f64,
-    /// Convergence of gravity's moment, N·mm: RK4, the residual at the tip;
-    /// collocation, the largest change at a node between the last sweeps.
-    /// 1e-8 N·mm leaves a curvature error of about 1e-10 /mm (δm/EI): far
-    /// below the solver's discretisation error.
-    pub moment_tolerance_n_mm: f64,
-    /// RK4: most shooting passes before giving up. (Collocation has no
-    /// shooting: its sweeps hand over to Newton's method when they stall.)
-    pub max_shooting_passes: u32,
-}
-
-impl Default for SolverOptions {
-    fn default() -> Self {
-        Self {
-            method: SolverMethod::Collocation,
-            nodes_per_span: 10,
-            steps_per_span: 24,
-            angle_tolerance_rad: 1e-7,
-            moment_tolerance_n_mm: 1e-8,
-            max_shooting_passes: 30,
-        }
-    }
-}
 
 /// Strains at one point.
 #[derive(Debug, Clone, Copy, Default)]
@@ -374,10 +335,10 @@ impl Simulator {
     pub fn new(rod: &Rod, options: &SolverOptions) -> Result<Self, SimulateError> {
         rod.validate().map_err(ParameterError::from)?;
         // The upper bound keeps a typo (2e9 steps) from exhausting memory.
-        if options.steps_per_span < 2 || options.steps_per_span % 2 != 0 || options.steps_per_span > MAX_STEPS_PER_SPAN {
+        if options.planar_steps_per_span < 2 || options.planar_steps_per_span % 2 != 0 || options.planar_steps_per_span > MAX_STEPS_PER_SPAN {
             return Err(ParameterError::OutOfRange {
                 name: "steps_per_span",
-                value: options.steps_per_span as f64,
+                value: options.planar_steps_per_span as f64,
                 expected: "an even number from 2 to 100000",
             }.into());
         }
@@ -388,7 +349,7 @@ impl Simulator {
                 expected: "between 4 and 64",
             }.into());
         }
-        let n = options.steps_per_span;
+        let n = options.planar_steps_per_span;
         // Material stiffening's curvature law u(m) has complex branch points
         // near the real axis (1 + 3 α r² u² = 0), which slows the spectral
         // convergence: 10 intervals leave 2e-6 rad there, 16 leave 1e-8.
@@ -725,7 +686,7 @@ impl Simulator {
     fn check_resolved(&mut self, pose: &TipPose, theta_error_rad: f64, tip_error_mm: f64) -> Result<f64, SolveFailure> {
         let scalars = [pose.tip_x_mm, pose.tip_y_mm, pose.tip_angle_rad, pose.tip_frame_angle_rad, pose.base_angle_rad, pose.length_mm];
         if !scalars.iter().all(|v| v.is_finite()) {
-            return Err(SolveFailure::NonFinite { s_mm: self.actuator.length_mm });
+            return Err(SolveFailure::NonFinite { s_mm: Some(self.actuator.length_mm) });
         }
         if self.is_probe {
             return Ok(0.0);
@@ -768,7 +729,7 @@ impl Simulator {
     pub fn resolution(&self) -> usize {
         match &self.col {
             Some(c) => c.intervals(),
-            None => self.options.steps_per_span,
+            None => self.options.planar_steps_per_span,
         }
     }
 
@@ -806,7 +767,7 @@ impl Simulator {
     pub fn coefficients_checked(&mut self, basis: LengthBasis, out: &mut [f64]) -> Result<(), SolveFailure> {
         self.coefficients_into(basis, out);
         if !out.iter().all(|a| a.is_finite()) {
-            return Err(SolveFailure::NonFinite { s_mm: self.actuator.length_mm });
+            return Err(SolveFailure::NonFinite { s_mm: Some(self.actuator.length_mm) });
         }
         let (error, k) = self.coefficient_error;
         let tolerance = resolution::ORDER_TOLERANCE_PER_MM;

@@ -17,7 +17,7 @@
 //!   ([`simulate_command`]).
 
 use crate::model::routing::ControlPoints;
-use super::spatial::SpatialOptions;
+use super::SolverOptions;
 use crate::model::Actuator;
 use super::{CentrelinePoint, Simulation, STATUS_OK};
 use crate::solver::result::PlanarPoint;
@@ -258,7 +258,7 @@ pub struct SimulateCommand {
 /// `--cable` per cable. Only what the 3-D solver models is written: it
 /// refuses the planar solver's effects and bodies, so they are never set on
 /// an actuator it solved.
-pub fn simulate_command(actuator: &Actuator, options: &SpatialOptions) -> SimulateCommand {
+pub fn simulate_command(actuator: &Actuator, options: &SolverOptions) -> SimulateCommand {
     let rod = &actuator.rod;
     let thesis = crate::model::Rod::default();
     let mut flags: Vec<String> = Vec::new();
@@ -292,15 +292,15 @@ pub fn simulate_command(actuator: &Actuator, options: &SpatialOptions) -> Simula
     if let Some(g) = actuator.gravity_direction {
         flags.push(format!("--gravity-direction {},{},{}", g[0], g[1], g[2]));
     }
-    let solver = SpatialOptions::default();
-    if options.steps_per_span != solver.steps_per_span {
-        flags.push(format!("--steps-per-span {}", options.steps_per_span));
+    let solver = SolverOptions::default();
+    if options.spatial_steps_per_span != solver.spatial_steps_per_span {
+        flags.push(format!("--steps-per-span {}", options.spatial_steps_per_span));
     }
-    if options.moment_tolerance_n_mm != solver.moment_tolerance_n_mm {
-        missing.push(format!("solver.moment_tolerance_n_mm = {}", options.moment_tolerance_n_mm));
+    if options.spatial_moment_tolerance_n_mm != solver.spatial_moment_tolerance_n_mm {
+        missing.push(format!("solver.moment_tolerance_n_mm = {}", options.spatial_moment_tolerance_n_mm));
     }
-    if options.max_passes != solver.max_passes {
-        missing.push(format!("solver.max_passes = {}", options.max_passes));
+    if options.spatial_max_passes != solver.spatial_max_passes {
+        missing.push(format!("solver.max_passes = {}", options.spatial_max_passes));
     }
     // The cable text holds only digits, signs, '.', ',', '=', 'e' and spaces:
     // double quotes keep it one shell word.
@@ -533,13 +533,13 @@ mod tests {
     #[test]
     fn the_simulate_command_gives_what_differs_from_the_thesis_rod() {
         let mut a = Actuator::with_cables(crate::model::Rod::default(), vec![Cable::planar([3.0; 5], 1.0), Cable::planar([-3.0; 5], 0.5)]);
-        let plain = simulate_command(&a, &SpatialOptions::default());
+        let plain = simulate_command(&a, &SolverOptions::default());
         assert_eq!(plain.text, r#"cablemap simulate --cable "y=3,3,3,3,3 tension=1" --cable "y=-3,-3,-3,-3,-3 tension=0.5""#);
         assert!(plain.missing.is_empty());
         a.rod.ei_n_mm2 = 90.5;
         a.rod.gravity.enabled = false;
         a.gj_n_mm2 = Some(80.0);
-        let options = SpatialOptions { steps_per_span: 16, ..SpatialOptions::default() };
+        let options = SolverOptions { spatial_steps_per_span: 16, ..SolverOptions::default() };
         let c = simulate_command(&a, &options);
         assert!(c.text.starts_with("cablemap simulate --ei-n-mm2 90.5 --no-gravity --steps-per-span 16 --cable "), "{}", c.text);
         assert_eq!(c.missing, ["gj_n_mm2 = 80"]);
@@ -559,7 +559,6 @@ mod tests {
             let sim = crate::solver::simulate_actuator(
                 &actuator,
                 &SolverOptions::default(),
-                &SpatialOptions::default(),
                 crate::solver::Given::default(),
                 None,
                 3,

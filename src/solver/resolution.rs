@@ -38,7 +38,7 @@ pub const MAX_RESOLVED_ORDER: usize = REQUIRED_STEPS_PER_SPAN.len() - 1;
 /// The table, the setting's value, its spec name and its flag for a method.
 fn discretisation(options: &SolverOptions) -> (&'static [usize; 17], usize, &'static str, &'static str) {
     match options.method {
-        SolverMethod::Rk4 => (&REQUIRED_STEPS_PER_SPAN, options.steps_per_span, "steps_per_span", "--steps-per-span"),
+        SolverMethod::Rk4 => (&REQUIRED_STEPS_PER_SPAN, options.planar_steps_per_span, "steps_per_span", "--steps-per-span"),
         SolverMethod::Collocation => (&REQUIRED_NODES_PER_SPAN, options.nodes_per_span, "nodes_per_span", "--nodes-per-span"),
     }
 }
@@ -104,7 +104,7 @@ mod tests {
     use crate::solver::Simulator;
 
     fn rk4(steps: usize) -> SolverOptions {
-        SolverOptions { method: SolverMethod::Rk4, steps_per_span: steps, ..SolverOptions::default() }
+        SolverOptions { method: SolverMethod::Rk4, planar_steps_per_span: steps, ..SolverOptions::default() }
     }
 
     fn collocation(nodes: usize) -> SolverOptions {

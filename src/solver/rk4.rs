@@ -115,7 +115,7 @@ impl Simulator {
     /// Places the stage points on the knot spans of `built` and samples the
     /// channel there.
     pub(super) fn rk4_set_routing(&mut self, built: &Routing) {
-        let n = self.options.steps_per_span;
+        let n = self.options.planar_steps_per_span;
         let knot = built.knot_mm();
         let length = self.actuator.length_mm;
         self.rk4.span_start_mm = [0.0, knot];
@@ -207,7 +207,7 @@ impl Simulator {
     /// solution's pass, which records the nodes; 2: the error estimate's
     /// coarse pass, on every other stage point). Returns the tip state.
     fn integrate_strided(&mut self, tension: f64, moment0: f64, stride: usize) -> Result<State, SolveFailure> {
-        let n = self.options.steps_per_span;
+        let n = self.options.planar_steps_per_span;
         let record = stride == 1;
         let mut st = State { phi: self.clamp_angle(moment0, tension)?, moment: moment0, ..State::default() };
         let mut scratch = Rk4Scratch::default();
@@ -239,7 +239,7 @@ impl Simulator {
                 })?;
                 st = State::from_array(y);
                 if !st.is_finite() {
-                    return Err(SolveFailure::NonFinite { s_mm: s + h });
+                    return Err(SolveFailure::NonFinite { s_mm: Some(s + h) });
                 }
             }
         }
@@ -263,7 +263,7 @@ impl Simulator {
     /// random bodies that fell short of the error by up to 3.7 times, while
     /// the whole difference was at least 4 times it (and 15 at the median).
     pub(super) fn rk4_error_estimate(&mut self, tension: f64) -> Result<(f64, f64), SolveFailure> {
-        let n = self.options.steps_per_span;
+        let n = self.options.planar_steps_per_span;
         let fine = self.rk4.nodes_state[2 * n];
         let moment0 = self.rk4.nodes_state[0].moment;
         self.rk4.probe = true;
@@ -281,7 +281,7 @@ impl Simulator {
         let mut passes = 1u32;
         let mut f0 = self.integrate(tension, *m0)?;
         let mut prev: Option<(f64, f64)> = None;
-        while f0.abs() > self.options.moment_tolerance_n_mm {
+        while f0.abs() > self.options.planar_moment_tolerance_n_mm {
             if passes >= self.options.max_shooting_passes {
                 return Err(SolveFailure::ShootingNotConverged { iterations: passes, residual_n_mm: f0 });
             }
@@ -303,7 +303,7 @@ impl Simulator {
     pub(super) fn rk4_solve(&mut self, tension: f64) -> Result<u32, SolveFailure> {
         let has_moment = self.weight_n_per_mm != 0.0;
         let has_friction = self.friction.acts_at(tension);
-        let n = self.options.steps_per_span;
+        let n = self.options.planar_steps_per_span;
         let mut passes;
         if has_moment {
             let (mut m0, mut slope) = self.rk4.continuation.predict(tension);
@@ -381,7 +381,7 @@ impl Simulator {
 
     /// The centreline of the last solve at the nodes.
     pub(super) fn rk4_centreline(&self) -> Vec<CentrelinePoint> {
-        let n = self.options.steps_per_span;
+        let n = self.options.planar_steps_per_span;
         let tension = self.last_tension_n.unwrap_or(0.0);
         (0..self.rk4.nodes_state.len())
             .map(|i| {
@@ -428,7 +428,7 @@ mod tests {
             let fine = SolverOptions { nodes_per_span: 64, ..SolverOptions::default() };
             let Ok(reference) = simulate(&a, &fine, &Routing::for_actuator(&y, &a).unwrap(), tension, 5, LengthBasis::Rest) else { continue };
             for n in [8, 16, 24] {
-                let mut sim = Simulator::new(&a, &SolverOptions { method: SolverMethod::Rk4, steps_per_span: n, ..SolverOptions::default() }).unwrap();
+                let mut sim = Simulator::new(&a, &SolverOptions { method: SolverMethod::Rk4, planar_steps_per_span: n, ..SolverOptions::default() }).unwrap();
                 sim.set_routing_mm(&y).unwrap();
                 let rungs = crate::solver::ladder::tension_rungs(tension);
                 let mut solved = None;

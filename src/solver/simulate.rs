@@ -10,7 +10,7 @@ use super::result::Simulation;
 use super::{tip_tolerance_mm, until_resolved, Backend, Given, Hold, SolveFailure, Solver, SolverMethod, SolverOptions, Simulator, Unresolved, MAX_NODES_PER_SPAN};
 use crate::model::parameter::ParameterError;
 use crate::solver::spatial::collocation::check_dwell;
-use crate::solver::spatial::{check_order, SpatialError, SpatialFailure, SpatialOptions, SpatialRk4Solver, SpatialSolver};
+use crate::solver::spatial::{check_order, SpatialError, SpatialRk4Solver, SpatialSolver};
 use crate::model::{Actuator, Cable, Rod, Routing};
 use crate::shape::LengthBasis;
 
@@ -99,8 +99,8 @@ fn refined(options: &mut SolverOptions) -> bool {
             options.nodes_per_span = (options.nodes_per_span * 3 / 2).clamp(options.nodes_per_span + 2, MAX_NODES_PER_SPAN);
             true
         }
-        SolverMethod::Rk4 if options.steps_per_span < MAX_AUTO_STEPS_PER_SPAN => {
-            options.steps_per_span = (2 * options.steps_per_span).min(MAX_AUTO_STEPS_PER_SPAN);
+        SolverMethod::Rk4 if options.planar_steps_per_span < MAX_AUTO_STEPS_PER_SPAN => {
+            options.planar_steps_per_span = (2 * options.planar_steps_per_span).min(MAX_AUTO_STEPS_PER_SPAN);
             true
         }
         _ => false,
@@ -129,7 +129,7 @@ pub const MAX_AUTO_STEPS_PER_SPAN: usize = 6144;
 /// A tip farther from the clamp than the stretched rod is long is refused too.
 pub fn simulate_spatial(
     actuator: &Actuator,
-    options: &SpatialOptions,
+    options: &SolverOptions,
     order: usize,
     basis: LengthBasis,
 ) -> Result<Simulation, SpatialError> {
@@ -142,7 +142,7 @@ pub fn simulate_spatial(
 /// reference models no effect a hold acts on.)
 pub fn simulate_spatial_held(
     actuator: &Actuator,
-    options: &SpatialOptions,
+    options: &SolverOptions,
     order: usize,
     basis: LengthBasis,
     hold: Option<Hold>,
@@ -159,7 +159,7 @@ pub fn simulate_spatial_held(
     until_resolved(
         options,
         |options| SpatialSolver::new(actuator, options)?.simulate(actuator, hold, order, basis),
-        |e| matches!(e, SpatialError::Solve(SpatialFailure::Unresolved(_))),
+        |e| matches!(e, SpatialError::Solve(SolveFailure::Unresolved(_))),
         |options| {
             let finer = options.nodes_per_span < MAX_NODES_PER_SPAN;
             options.nodes_per_span = (2 * options.nodes_per_span).min(MAX_NODES_PER_SPAN);
@@ -169,9 +169,9 @@ pub fn simulate_spatial_held(
 }
 
 /// [`simulate_spatial`] by the RK4 reference, refining by comparison with half the steps.
-fn simulate_spatial_rk4(actuator: &Actuator, options: &SpatialOptions, order: usize, basis: LengthBasis) -> Result<Simulation, SpatialError> {
-    let ladder = |options: &SpatialOptions| SpatialRk4Solver::new(actuator, options)?.simulate(actuator, None, order, basis);
-    let half = SpatialOptions { steps_per_span: (options.steps_per_span / 2).max(2), ..options.clone() };
+fn simulate_spatial_rk4(actuator: &Actuator, options: &SolverOptions, order: usize, basis: LengthBasis) -> Result<Simulation, SpatialError> {
+    let ladder = |options: &SolverOptions| SpatialRk4Solver::new(actuator, options)?.simulate(actuator, None, order, basis);
+    let half = SolverOptions { spatial_steps_per_span: (options.spatial_steps_per_span / 2).max(2), ..options.clone() };
     // A coarse solve that fails says nothing about the fine one: the
     // comparison then moves one level up.
     let mut coarse = ladder(&half).ok();
@@ -179,7 +179,7 @@ fn simulate_spatial_rk4(actuator: &Actuator, options: &SpatialOptions, order: us
         options,
         |options| {
             let fine = ladder(options)?;
-            let steps = options.steps_per_span;
+            let steps = options.spatial_steps_per_span;
             let failure = match &coarse {
                 Some(c) => unresolved_part(&fine, c, steps),
                 None => Some(unresolved("the tip position".into(), f64::INFINITY, 0.0, "mm", steps)),
@@ -192,10 +192,10 @@ fn simulate_spatial_rk4(actuator: &Actuator, options: &SpatialOptions, order: us
                 }
             }
         },
-        |e| matches!(e, SpatialError::Solve(SpatialFailure::Unresolved(_))),
+        |e| matches!(e, SpatialError::Solve(SolveFailure::Unresolved(_))),
         |options| {
-            let finer = options.steps_per_span < MAX_AUTO_SPATIAL_STEPS_PER_SPAN;
-            options.steps_per_span = (2 * options.steps_per_span).min(MAX_AUTO_SPATIAL_STEPS_PER_SPAN);
+            let finer = options.spatial_steps_per_span < MAX_AUTO_SPATIAL_STEPS_PER_SPAN;
+            options.spatial_steps_per_span = (2 * options.spatial_steps_per_span).min(MAX_AUTO_SPATIAL_STEPS_PER_SPAN);
             finer
         },
     )
@@ -204,16 +204,16 @@ fn simulate_spatial_rk4(actuator: &Actuator, options: &SpatialOptions, order: us
 /// Most RK4 steps per span [`simulate_spatial`] refines to by itself.
 pub const MAX_AUTO_SPATIAL_STEPS_PER_SPAN: usize = 2560;
 
-/// [`SpatialFailure::Unresolved`] for `what` at `steps` per span.
-fn unresolved(what: String, estimate: f64, tolerance: f64, unit: &'static str, steps: usize) -> SpatialFailure {
+/// [`SolveFailure::Unresolved`] for `what` at `steps` per span.
+fn unresolved(what: String, estimate: f64, tolerance: f64, unit: &'static str, steps: usize) -> SolveFailure {
     let advice = format!("raise --steps-per-span above {steps} (sweep spec: [solver] steps_per_span), or lower the tensions");
-    SpatialFailure::Unresolved(Unresolved { what, estimate, tolerance, unit, advice })
+    SolveFailure::Unresolved(Unresolved { what, estimate, tolerance, unit, advice })
 }
 
 /// What of `fine` (at `steps` per span) is not resolved, judged against
 /// `coarse` (at fewer steps): the tip or a coefficient further off than
 /// its tolerance, or a tip beyond the stretched length. `None` if all is.
-fn unresolved_part(fine: &Simulation, coarse: &Simulation, steps: usize) -> Option<SpatialFailure> {
+fn unresolved_part(fine: &Simulation, coarse: &Simulation, steps: usize) -> Option<SolveFailure> {
     let unresolved = |what: String, estimate: f64, tolerance: f64, unit| Some(unresolved(what, estimate, tolerance, unit, steps));
     let tolerance = tip_tolerance_mm(fine.actuator.rod.length_mm);
     let [x, y, z] = fine.pose.tip_mm();
@@ -245,15 +245,13 @@ fn unresolved_part(fine: &Simulation, coarse: &Simulation, steps: usize) -> Opti
 
 /// Solves `actuator` with the backend that serves it ([`Backend::serving`]):
 /// one in-plane cable with gravity in the plane takes the planar fast path
-/// (`options`, and `hold` for the final tension), anything else the 3-D
-/// solver (`spatial_options`). `given` names the settings asked for
+/// (and `hold` for the final tension), anything else a 3-D backend, each
+/// reading its settings of `options`. `given` names the settings asked for
 /// explicitly; one a backend does not read is refused, not ignored. The
 /// result holds `actuator` as given.
-#[allow(clippy::too_many_arguments)]
 pub fn simulate_actuator(
     actuator: &Actuator,
     options: &SolverOptions,
-    spatial_options: &SpatialOptions,
     given: Given,
     hold: Option<Hold>,
     order: usize,
@@ -262,11 +260,9 @@ pub fn simulate_actuator(
     actuator.channels()?;
     let backend = Backend::serving(actuator, options, given)?;
     if matches!(backend, Backend::Spatial | Backend::SpatialRk4) {
-        // One set of settings: the method picked the backend, and the
-        // collocation's intervals are the planar solver's option.
+        // The backend picked is the method's.
         let method = if backend == Backend::Spatial { SolverMethod::Collocation } else { SolverMethod::Rk4 };
-        let spatial_options = SpatialOptions { method, nodes_per_span: options.nodes_per_span, ..spatial_options.clone() };
-        return simulate_spatial_held(actuator, &spatial_options, order, basis, hold);
+        return simulate_spatial_held(actuator, &SolverOptions { method, ..options.clone() }, order, basis, hold);
     }
     let (rod, routing) = planar_problem(actuator)?;
     let cable = &actuator.cables[0];

@@ -60,7 +60,7 @@ mod tests {
             }),
             ("no gravity", |a| a.gravity.enabled = false),
         ];
-        let rk4 = SolverOptions { method: SolverMethod::Rk4, steps_per_span: 192, ..SolverOptions::default() };
+        let rk4 = SolverOptions { method: SolverMethod::Rk4, planar_steps_per_span: 192, ..SolverOptions::default() };
         for (name, setup) in cases {
             let mut a = Rod::default();
             setup(&mut a);
@@ -394,7 +394,7 @@ mod body_tests {
                 Segment { end_mm: 40.0, ea_n: None, ga_n: None, ei_n_mm2: None, density_g_cm3: Some(1.5) },
                 Segment { end_mm: 65.0, ea_n: None, ga_n: None, ei_n_mm2: None, density_g_cm3: None },
             ];
-            let options = SolverOptions { steps_per_span: 2000, ..SolverOptions::default() };
+            let options = SolverOptions { planar_steps_per_span: 2000, ..SolverOptions::default() };
             let mut sim = Simulator::new(&a, &options).unwrap();
             sim.set_routing_mm(&[0.0; 5]).unwrap();
             let pose = sim.solve(0.0).unwrap();
@@ -447,7 +447,7 @@ mod body_tests {
         let mut a = Rod::default();
         a.radius_profile_mm = vec![(0.0, 6.5), (65.0, 4.0)];
         a.effects.stiffness_gradient_beta = -0.5;
-        let rk4 = SolverOptions { method: SolverMethod::Rk4, steps_per_span: 192, ..SolverOptions::default() };
+        let rk4 = SolverOptions { method: SolverMethod::Rk4, planar_steps_per_span: 192, ..SolverOptions::default() };
         let mut sims = [Simulator::new(&a, &SolverOptions::default()).unwrap(), Simulator::new(&a, &rk4).unwrap()];
         let mut poses = [Vec::new(), Vec::new()];
         for (sim, out) in sims.iter_mut().zip(&mut poses) {

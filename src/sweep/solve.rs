@@ -7,10 +7,10 @@
 
 use super::schema::{CableRow, SolvedRouting, SolvedRow, STATUS_FAILED, STATUS_INVALID_ROUTING};
 use crate::model::routing::ControlPoints;
-use crate::solver::spatial::{Actuator, SpatialError, SpatialOptions, SpatialSolver};
+use crate::solver::spatial::{Actuator, SpatialError, SpatialSolver};
 use crate::solver::{ladder, Solver};
 use crate::model::{Actuation, Routing};
-use crate::solver::{Simulator, SolveFailure, TipPose, STATUS_OK};
+use crate::solver::{Simulator, SolveFailure, SolverOptions, TipPose, STATUS_OK};
 use crate::sweep::spec::Ladder;
 use crate::shape::LengthBasis;
 
@@ -70,7 +70,7 @@ fn planar_row(sim: &mut Simulator, actuation: Actuation, tension: &mut [f64; 1],
             let scalars = [pose.tip_x_mm, pose.tip_y_mm, pose.tip_angle_rad, pose.base_angle_rad, pose.length_mm];
             if !scalars.iter().chain(&a).all(|v| v.is_finite()) {
                 // Stored as a failure so that outputs are never NaN.
-                return failed(SolveFailure::NonFinite { s_mm: f64::NAN }.status());
+                return failed(SolveFailure::NonFinite { s_mm: None }.status());
             }
             let centreline = stored.centreline.then(|| {
                 let points = sim.centreline();
@@ -161,7 +161,7 @@ pub fn combination_index(combo: &[usize], grids: &[Vec<f64>]) -> usize {
 /// [`SpatialSolver`]: from zero up to the first combination, then along the
 /// snake. Returns the rows in grid order (cable 1's tension slowest). An
 /// actuator the solver refuses gives rows of [`STATUS_INVALID_ROUTING`].
-pub fn cable_routing(id: u64, mut actuator: Actuator, options: &SpatialOptions, stored: Stored, combinations: &TensionCombinations) -> Vec<CableRow> {
+pub fn cable_routing(id: u64, mut actuator: Actuator, options: &SolverOptions, stored: Stored, combinations: &TensionCombinations) -> Vec<CableRow> {
     let combos = &combinations.snake;
     let geometry: Vec<_> = actuator.cables.iter().map(|c| (c.y_mm, c.z_mm)).collect();
     // A row's tension and displacement per cable: the command exactly, and

@@ -18,7 +18,7 @@ use super::simulate::{solve_captures, CaptureSolution};
 use crate::calibrate::fit::Loss;
 use crate::calibrate::{stats, CalibrateError, Parameter};
 use crate::model::effects::Domain;
-use crate::solver::spatial::SpatialOptions;
+use crate::solver::SolverOptions;
 use crate::model::Actuator;
 use crate::numerics::lm;
 use nalgebra::DMatrix;
@@ -40,12 +40,12 @@ pub struct Fit3Spec {
     /// Most Levenberg–Marquardt iterations.
     pub max_iterations: usize,
     /// The 3-D solver's settings.
-    pub options: SpatialOptions,
+    pub options: SolverOptions,
 }
 
 impl Default for Fit3Spec {
     fn default() -> Self {
-        Self { params: Parameter::BODY.to_vec(), noise_mm: 1.0, loss: Loss::Squared, max_iterations: 40, options: SpatialOptions::default() }
+        Self { params: Parameter::BODY.to_vec(), noise_mm: 1.0, loss: Loss::Squared, max_iterations: 40, options: SolverOptions::default() }
     }
 }
 

@@ -11,7 +11,7 @@ use super::simulate::solve_captures;
 use crate::calibrate::diagnose::markdown::candidate_table;
 use crate::calibrate::CalibrateError;
 use crate::solver::simulate::simulate_spatial_held;
-use crate::solver::spatial::SpatialOptions;
+use crate::solver::SolverOptions;
 use crate::model::{Actuator, LoadDirection};
 use crate::solver::{Hold, Simulation};
 use crate::plot::spatial::{draw_spatial_with_points, SpatialPoints};
@@ -40,7 +40,7 @@ pub fn capture_picture_name(measurement: i64) -> String {
 /// The capture's body simulated alone with `actuator` (its cables'
 /// actuation set, reached in the capture's direction and held its dwell
 /// from a virgin rod): the body a picture draws.
-fn capture_body(actuator: &Actuator, options: &SpatialOptions, c: &Capture) -> Result<Simulation, CalibrateError> {
+fn capture_body(actuator: &Actuator, options: &SolverOptions, c: &Capture) -> Result<Simulation, CalibrateError> {
     let mut a = actuator.clone();
     for (cable, act) in a.cables.iter_mut().zip(&c.actuation) {
         match *act {
@@ -59,7 +59,7 @@ fn capture_body(actuator: &Actuator, options: &SpatialOptions, c: &Capture) -> R
 /// Writes `report.md` and a picture per capture of `set` into `dir`
 /// (created if needed), the pictures with the diagnosis's final model;
 /// returns the files written (the report first).
-pub fn write_report(dir: &Path, sources: ReportSources<'_>, set: &CaptureSet, d: &Diagnosis3, options: &SpatialOptions) -> Result<Vec<PathBuf>, CalibrateError> {
+pub fn write_report(dir: &Path, sources: ReportSources<'_>, set: &CaptureSet, d: &Diagnosis3, options: &SolverOptions) -> Result<Vec<PathBuf>, CalibrateError> {
     let io = |context: String| move |source| CalibrateError::Io { context, source };
     std::fs::create_dir_all(dir).map_err(io(format!("creating report directory {}", dir.display())))?;
     let solutions = solve_captures(&d.actuator, options, set)?;

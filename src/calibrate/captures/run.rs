@@ -16,7 +16,7 @@ use super::diagnose::{diagnose_captures, Diagnose3Spec, Diagnosis3};
 use crate::calibrate::request::{DiagnoseRequest, LossKind};
 use crate::calibrate::Refused;
 use crate::calibrate::{CalibrateError, CalibrateRequest};
-use crate::solver::spatial::SpatialOptions;
+use crate::solver::SolverOptions;
 use crate::model::{Actuator, RodOverrides};
 use serde::Serialize;
 use std::fmt;
@@ -34,7 +34,7 @@ pub struct PredictRequest {
     /// Rod settings: refused, the rod is the actuator file's.
     pub rod: RodOverrides,
     /// The 3-D solver's settings.
-    pub options: SpatialOptions,
+    pub options: SolverOptions,
 }
 
 /// The markers' errors of a prediction; serialises to `predict --json`.
@@ -174,10 +174,10 @@ pub fn calibrate(request: &CalibrateRequest, actuator_file: &Path, observe: &mut
             (train, Some(test))
         }
     };
-    let spec = Fit3Spec { params, noise_mm: request.fit.noise_mm, loss, max_iterations: request.fit.max_iterations, options: request.spatial_options.clone() };
+    let spec = Fit3Spec { params, noise_mm: request.fit.noise_mm, loss, max_iterations: request.fit.max_iterations, options: request.options.clone() };
     let fit = fit_captures(&base, &train, &spec, observe)?;
     let holdout = match &test {
-        Some(t) => Some(ErrorReport::of(t, &solve_captures(&fit.actuator, &request.spatial_options, t)?)),
+        Some(t) => Some(ErrorReport::of(t, &solve_captures(&fit.actuator, &request.options, t)?)),
         None => None,
     };
     let mut report = CapturesCalibration {
@@ -262,7 +262,7 @@ pub fn diagnose_request(request: &DiagnoseRequest, actuator_file: &Path) -> Resu
         params.retain(|&p| p != Parameter::Density);
     }
     let spec = Diagnose3Spec {
-        fit: Fit3Spec { params, noise_mm: request.fit.noise_mm, loss, max_iterations: request.fit.max_iterations, options: request.spatial_options.clone() },
+        fit: Fit3Spec { params, noise_mm: request.fit.noise_mm, loss, max_iterations: request.fit.max_iterations, options: request.options.clone() },
         holdout_cable: request.holdout_cable,
         threshold: request.threshold,
         margin: request.margin,
@@ -272,7 +272,7 @@ pub fn diagnose_request(request: &DiagnoseRequest, actuator_file: &Path) -> Resu
     let mut d = diagnose_captures(&base, &set, &spec)?;
     if let Some(dir) = &request.report_dir {
         let sources = super::report::ReportSources { captures: &request.data_path, markers: request.fit.markers.as_deref(), actuator: actuator_file };
-        d.written = super::report::write_report(dir, sources, &set, &d, &request.spatial_options)?;
+        d.written = super::report::write_report(dir, sources, &set, &d, &request.options)?;
     }
     Ok(d)
 }

@@ -15,7 +15,8 @@ use super::files::{Actuation, Capture, CaptureSet, MarkerReading};
 use crate::calibrate::data::Direction;
 use crate::calibrate::CalibrateError;
 use crate::solver::Solver;
-use crate::solver::spatial::{SpatialError, SpatialFailure, SpatialOptions, SpatialSolver};
+use crate::solver::spatial::{SpatialError, SpatialSolver};
+use crate::solver::{SolveFailure, SolverOptions};
 use crate::model::{Actuator, LoadDirection};
 use crate::solver::{CentrelinePoint, Hold, TipPose};
 use rayon::prelude::*;
@@ -112,7 +113,7 @@ fn solve_at(solver: &mut SpatialSolver, c: &Capture, fraction: f64, tensions: &m
 
 
 /// Solves one chain with one solver at `options`.
-fn solve_chain(actuator: &Actuator, options: &SpatialOptions, set: &CaptureSet, chain: &[usize]) -> Result<Vec<(usize, CaptureSolution)>, CalibrateError> {
+fn solve_chain(actuator: &Actuator, options: &SolverOptions, set: &CaptureSet, chain: &[usize]) -> Result<Vec<(usize, CaptureSolution)>, CalibrateError> {
     let length = actuator.rod.length_mm;
     let mut solver = SpatialSolver::new(actuator, options).map_err(CalibrateError::Actuator)?;
     let protocol = chain.iter().any(|&i| set.captures[i].direction != Direction::Static);
@@ -172,7 +173,7 @@ fn solve_chain(actuator: &Actuator, options: &SpatialOptions, set: &CaptureSet, 
 /// set per capture), indexed like `set.captures`. A chain the
 /// discretisation does not resolve is solved again at twice the collocation
 /// intervals (up to the most there are), as single solves are.
-pub fn solve_captures(actuator: &Actuator, options: &SpatialOptions, set: &CaptureSet) -> Result<Vec<CaptureSolution>, CalibrateError> {
+pub fn solve_captures(actuator: &Actuator, options: &SolverOptions, set: &CaptureSet) -> Result<Vec<CaptureSolution>, CalibrateError> {
     let chains = chains(&set.captures);
     let solved: Vec<Vec<(usize, CaptureSolution)>> = chains
         .par_iter()
@@ -180,7 +181,7 @@ pub fn solve_captures(actuator: &Actuator, options: &SpatialOptions, set: &Captu
             let mut options = options.clone();
             loop {
                 match solve_chain(actuator, &options, set, chain) {
-                    Err(CalibrateError::Capture { failure: SpatialError::Solve(SpatialFailure::Unresolved(_)), .. })
+                    Err(CalibrateError::Capture { failure: SpatialError::Solve(SolveFailure::Unresolved(_)), .. })
                         if options.nodes_per_span < crate::solver::MAX_NODES_PER_SPAN =>
                     {
                         options.nodes_per_span = (2 * options.nodes_per_span).min(crate::solver::MAX_NODES_PER_SPAN);
@@ -209,7 +210,7 @@ mod tests {
         let mut rod = crate::model::Rod::default();
         rod.gravity.enabled = false;
         let a = Actuator::with_cables(rod, vec![Cable::spatial([2.0; 5], [1.0; 5], 0.0)]);
-        let mut solver = SpatialSolver::new(&a, &SpatialOptions::default()).unwrap();
+        let mut solver = SpatialSolver::new(&a, &SolverOptions::default()).unwrap();
         solver.solve(&[0.0]).unwrap();
         let m = |s: f64| MarkerReading { marker: "m".into(), s_mm: s, offset_y_mm: 3.0, offset_z_mm: -4.0, measured_mm: [0.0; 3], sd_mm: None, row: 1 };
         let p = markers_on(&solver, &[m(20.0), m(75.0)], 65.0);

@@ -7,7 +7,7 @@ use super::simulate::solve_captures;
 use crate::calibrate::data::Direction;
 use crate::calibrate::rng::Rng;
 use crate::calibrate::CalibrateError;
-use crate::solver::spatial::SpatialOptions;
+use crate::solver::SolverOptions;
 use crate::model::Actuator;
 
 /// A body-fixed marker to place on every capture.
@@ -104,7 +104,7 @@ pub fn default_markers(actuator: &Actuator) -> Vec<MarkerSpec> {
 /// readings carry `sd_mm` = `noise_mm` when `state_sd` is set).
 pub fn synth_captures(
     truth: &Actuator,
-    options: &SpatialOptions,
+    options: &SolverOptions,
     captures: Vec<Capture>,
     markers: &[MarkerSpec],
     noise_mm: f64,

@@ -1,5 +1,5 @@
-//! Why an actuator or a spatial solve was rejected ([`SpatialError`]), and
-//! why the spatial solver found no solution ([`SpatialFailure`]).
+//! Why an actuator or a spatial solve was rejected ([`SpatialError`]); why
+//! a solve found no solution is the one [`crate::solver::SolveFailure`].
 
 use crate::model::{ActuatorError, ParameterError};
 
@@ -55,7 +55,7 @@ pub enum SpatialError {
     AnchorTwice { cable_mm: f64, rod_mm: f64 },
     /// The solve failed.
     #[error(transparent)]
-    Solve(#[from] SpatialFailure),
+    Solve(#[from] crate::solver::SolveFailure),
 }
 
 impl SpatialError {
@@ -68,32 +68,6 @@ impl SpatialError {
             _ => None,
         }
     }
-}
-
-/// Why a spatial solve produced no result.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum SpatialFailure {
-    /// The local equations at a point did not converge.
-    #[error("the cut equations did not converge at s = {s_mm:.3} mm (tension too high for this routing, or a cable pulls straight through the axis); lower the tension or raise --steps-per-span")]
-    Local { s_mm: f64 },
-    /// Gravity's moment iteration did not converge.
-    #[error("gravity's moment did not converge in {passes} passes (residual {residual_n_mm:.3e} N·mm); the rod may be too heavy for its stiffness")]
-    Gravity { passes: u32, residual_n_mm: f64 },
-    /// A number of the result is not finite.
-    #[error("the solve gave a non-finite tip or coefficient; check the rod's parameters (rigidities, length, density) for absurd values")]
-    NonFinite,
-    /// A displacement-driven cable's displacement was not met.
-    #[error(transparent)]
-    DisplacementNotMet(crate::solver::actuation::DisplacementNotMet),
-    /// The cables' tension profiles with friction did not settle.
-    #[error("the cable tension profiles with friction did not converge; try smaller tension steps or a smaller friction coefficient")]
-    Friction,
-    /// The steps do not resolve the solution: its difference to the same
-    /// solve at half the steps is above the tolerance, up to the most steps
-    /// tried ([`crate::solver::simulate_spatial`]), or the tip lies farther from the
-    /// clamp than the stretched rod is long.
-    #[error(transparent)]
-    Unresolved(crate::solver::Unresolved),
 }
 
 impl SpatialError {
@@ -110,19 +84,3 @@ impl SpatialError {
         Ok(())
     }
 }
-
-impl SpatialFailure {
-    /// Short machine-readable status (as the planar solver's
-    /// [`crate::solver::SolveFailure::status`]).
-    pub fn status(&self) -> &'static str {
-        match self {
-            SpatialFailure::Local { .. } => "cut_equations_not_converged",
-            SpatialFailure::Gravity { .. } => "gravity_not_converged",
-            SpatialFailure::NonFinite => "non_finite",
-            SpatialFailure::Friction => "friction_not_converged",
-            SpatialFailure::DisplacementNotMet(_) => "displacement_not_met",
-            SpatialFailure::Unresolved(_) => "unresolved",
-        }
-    }
-}
-

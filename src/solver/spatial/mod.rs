@@ -15,6 +15,6 @@ pub mod solver;
 pub use crate::model::actuator::{Actuator, EI_OVER_GJ};
 pub use crate::model::cable::{self, Cable, MAX_CABLES};
 pub use crate::solver::simulate_spatial;
-pub use error::{SpatialError, SpatialFailure};
+pub use error::SpatialError;
 pub use collocation::SpatialSolver;
-pub use solver::{check_order, validated_channels, SpatialOptions, SpatialRk4Solver, MAX_SPATIAL_ORDER};
+pub use solver::{check_order, validated_channels, SpatialRk4Solver, MAX_SPATIAL_ORDER};

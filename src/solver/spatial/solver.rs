@@ -48,7 +48,8 @@
 //! (the planar a_i count the same jump of θ).
 
 use super::cable::{Channel, ChannelPoint3};
-use super::error::{SpatialError, SpatialFailure};
+use super::error::SpatialError;
+use crate::solver::{SolveFailure, SolverOptions};
 use super::Actuator;
 use crate::solver::Backend;
 use crate::solver::result::{CableAtNode, CentrelinePoint, PerCable, TipFrame, TipPose};
@@ -56,7 +57,6 @@ use crate::model::Rod;
 use crate::numerics::{rk4_step, Rk4Scratch};
 use crate::shape::{self, LengthBasis};
 use nalgebra::{Matrix3, Matrix6, Quaternion, UnitQuaternion, Vector3, Vector6, LU, U6};
-use serde::{Deserialize, Serialize};
 
 type V3 = Vector3<f64>;
 type M3 = Matrix3<f64>;
@@ -83,62 +83,6 @@ pub const MAX_SPATIAL_ORDER: usize = 8;
 /// within a factor 1.5 of the tolerance was moved to the next grid point,
 /// and the table made monotone. At the default 10 steps a_5 is resolved.
 pub const REQUIRED_SPATIAL_STEPS_PER_SPAN: [usize; MAX_SPATIAL_ORDER + 1] = [4, 4, 4, 4, 6, 6, 12, 12, 24];
-
-/// Numerical settings of the spatial solver.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct SpatialOptions {
-    /// RK4 steps per knot span of the routing (≥ 2); anchors split a span
-    /// and share its steps in proportion to length.
-    pub steps_per_span: usize,
-    /// Convergence of gravity's distal moment at the tip, N·mm. 1e-7 N·mm
-    /// moves the tip by about δm L²/(2 EI) ≈ 2e-6 mm and turns it by
-    /// δm L/EI ≈ 6e-8 rad: well below RK4's error at the default steps.
-    pub moment_tolerance_n_mm: f64,
-    /// Most integration passes per solve (gravity's Broyden iteration).
-    pub max_passes: u32,
-    /// Collocation intervals per span of the 3-D collocation (4 … 64).
-    pub nodes_per_span: usize,
-    /// The 3-D method: spectral collocation (the default,
-    /// [`crate::solver::spatial::collocation`]) or the RK4 reference (`rk4`).
-    pub method: crate::solver::SolverMethod,
-}
-
-impl SpatialOptions {
-    /// The 3-D defaults with the solver settings a user gave: a field left
-    /// `None` keeps the 3-D solver's own default (not the planar solver's).
-    pub fn with_given(steps_per_span: Option<usize>, nodes_per_span: Option<usize>, method: Option<crate::solver::SolverMethod>) -> Self {
-        let d = Self::default();
-        Self {
-            steps_per_span: steps_per_span.unwrap_or(d.steps_per_span),
-            nodes_per_span: nodes_per_span.unwrap_or(d.nodes_per_span),
-            method: method.unwrap_or(d.method),
-            ..d
-        }
-    }
-}
-
-impl Default for SpatialOptions {
-    fn default() -> Self {
-        Self { steps_per_span: 10, moment_tolerance_n_mm: 1e-7, max_passes: 40, nodes_per_span: 10, method: crate::solver::SolverMethod::Collocation }
-    }
-}
-
-impl SpatialOptions {
-    /// Checks the settings (the message names the setting and its range).
-    pub fn check(&self) -> Result<(), SpatialError> {
-        if self.steps_per_span < 2 {
-            return Err(SpatialError::StepsPerSpan(self.steps_per_span));
-        }
-        if !(4..=crate::solver::MAX_NODES_PER_SPAN).contains(&self.nodes_per_span) {
-            return Err(SpatialError::NodesPerSpan { nodes: self.nodes_per_span, max: crate::solver::MAX_NODES_PER_SPAN });
-        }
-        if !(self.moment_tolerance_n_mm.is_finite() && self.moment_tolerance_n_mm > 0.0) {
-            return Err(SpatialError::MomentTolerance);
-        }
-        Ok(())
-    }
-}
 
 /// What a pass records at one step point of the rod (the centreline's
 /// nodes are made from these when asked for, [`SpatialRk4Solver::centreline`]).
@@ -231,7 +175,7 @@ pub struct SpatialRk4Solver {
     stiff: [f64; 6],
     /// Weight per unit rest length along the gravity direction, N/mm (global vector).
     weight: V3,
-    options: SpatialOptions,
+    options: SolverOptions,
     cables: usize,
     base_tension_n: Vec<f64>,
     scale: f64,
@@ -269,12 +213,12 @@ pub struct SpatialRk4Solver {
 
 impl SpatialRk4Solver {
     /// A solver for `actuator` (its cables, rod, torsion and gravity).
-    pub fn new(actuator: &Actuator, options: &SpatialOptions) -> Result<Self, SpatialError> {
+    pub fn new(actuator: &Actuator, options: &SolverOptions) -> Result<Self, SpatialError> {
         let channels = validated_channels(actuator, Backend::SpatialRk4)?;
-        if options.steps_per_span < 2 {
-            return Err(SpatialError::StepsPerSpan(options.steps_per_span));
+        if options.spatial_steps_per_span < 2 {
+            return Err(SpatialError::StepsPerSpan(options.spatial_steps_per_span));
         }
-        if !(options.moment_tolerance_n_mm.is_finite() && options.moment_tolerance_n_mm > 0.0) {
+        if !(options.spatial_moment_tolerance_n_mm.is_finite() && options.spatial_moment_tolerance_n_mm > 0.0) {
             return Err(SpatialError::MomentTolerance);
         }
         let rod = actuator.rod.clone();
@@ -296,7 +240,7 @@ impl SpatialRk4Solver {
         let mut points_s = Vec::new();
         for w in cuts.windows(2) {
             let (a, b) = (w[0], w[1]);
-            let steps = ((options.steps_per_span as f64 * (b - a) / span).ceil() as usize).max(2);
+            let steps = ((options.spatial_steps_per_span as f64 * (b - a) / span).ceil() as usize).max(2);
             let h = (b - a) / steps as f64;
             let mid = 0.5 * (a + b);
             let active = actuator.cables.iter().map(|c| mid < c.anchor_or_tip_mm(length)).collect();
@@ -428,7 +372,7 @@ impl SpatialRk4Solver {
         }
     }
 
-    fn solve_inner(&mut self) -> Result<TipPose, SpatialFailure> {
+    fn solve_inner(&mut self) -> Result<TipPose, SolveFailure> {
         let gravity = self.weight.norm() > 0.0;
         let mut passes = 1;
         // The first pass of a solve refactors everything (the tensions
@@ -444,9 +388,9 @@ impl SpatialRk4Solver {
             let mut m = self.m0;
             let mut f = residual(&end);
             let mut b = self.binv;
-            while f.norm() > self.options.moment_tolerance_n_mm {
-                if passes >= self.options.max_passes {
-                    return Err(SpatialFailure::Gravity { passes, residual_n_mm: f.norm() });
+            while f.norm() > self.options.spatial_moment_tolerance_n_mm {
+                if passes >= self.options.spatial_max_passes {
+                    return Err(SolveFailure::GravityNotConverged { passes, residual_n_mm: f.norm() });
                 }
                 let dm = -(b * f);
                 let m_new = m + dm;
@@ -503,7 +447,7 @@ impl SpatialRk4Solver {
     /// ∫ (σ/L)^j κ_k ds (RK4 quadrature with the stage values: a few
     /// back-substitutions, much cheaper than another pass). Returns the tip
     /// state and the local solution there.
-    fn pass(&mut self, m0: V3) -> Result<(State, [f64; 6]), SpatialFailure> {
+    fn pass(&mut self, m0: V3) -> Result<(State, [f64; 6]), SolveFailure> {
         let mut y: State = [0.0; 11];
         y[3] = 1.0;
         y[7..10].copy_from_slice(m0.as_slice());
@@ -518,7 +462,7 @@ impl SpatialRk4Solver {
         // the tangent before to the one after. `ending` holds v just before
         // such a point until the next segment's first stage gives v after it.
         let mut ending: Option<V3> = None;
-        let result = (|| {
+        let result = (|| -> Result<(), SolveFailure> {
             for (si, seg) in segments.iter().enumerate() {
                 let h = seg.h_mm;
                 for j in 0..seg.steps {
@@ -554,7 +498,7 @@ impl SpatialRk4Solver {
                             }
                         }
                         *dy = f;
-                        Ok(())
+                        Ok::<(), SolveFailure>(())
                     })?;
                     let norm = (y[3] * y[3] + y[4] * y[4] + y[5] * y[5] + y[6] * y[6]).sqrt();
                     y[3..7].iter_mut().for_each(|c| *c /= norm);
@@ -600,7 +544,7 @@ impl SpatialRk4Solver {
     }
 
     /// Derivative of the state at point `k` (half-step index) and the local solution.
-    fn deriv(&mut self, seg: &Segment, k: usize, slot: usize, y: &State) -> Result<(State, Local), SpatialFailure> {
+    fn deriv(&mut self, seg: &Segment, k: usize, slot: usize, y: &State) -> Result<(State, Local), SolveFailure> {
         let q = quat(y);
         let r = q.to_rotation_matrix().into_inner();
         let s = self.points_s[k];
@@ -622,7 +566,7 @@ impl SpatialRk4Solver {
     /// Newton on the cut equations at point `k`, warm-started from `slot`,
     /// then the curvature vector κ_b from x' (with the last Newton
     /// Jacobian's factors: it is within one converged step of the solution's).
-    fn local_solve(&mut self, seg: &Segment, k: usize, slot: usize, nw: V3, mw: V3, r: M3) -> Result<Local, SpatialFailure> {
+    fn local_solve(&mut self, seg: &Segment, k: usize, slot: usize, nw: V3, mw: V3, r: M3) -> Result<Local, SolveFailure> {
         let chans = &self.chan[k * self.cables..(k + 1) * self.cables];
         let mut taus = [0.0; super::cable::MAX_CABLES];
         for (i, (&t, &on)) in self.base_tension_n.iter().zip(&seg.active).enumerate() {
@@ -696,7 +640,7 @@ impl SpatialRk4Solver {
             }
         }
         let Some(lu) = converged else {
-            return Err(SpatialFailure::Local { s_mm: self.points_s[k] });
+            return Err(SolveFailure::CutEquationsNotConverged { s_mm: self.points_s[k] });
         };
         self.warm[slot] = x;
         self.lus[slot] = Some(lu);
@@ -936,7 +880,7 @@ impl crate::solver::Solver for SpatialRk4Solver {
         let a = self.coefficients_unchecked(order, basis);
         let finite = pose.tip_mm().iter().chain(&[pose.length_mm, pose.angle_from_clamp_axis_rad()]).chain(a.iter().flatten()).all(|v| v.is_finite());
         if !finite {
-            return Err(SpatialFailure::NonFinite.into());
+            return Err(SolveFailure::NonFinite { s_mm: None }.into());
         }
         Ok(a)
     }
@@ -951,11 +895,26 @@ pub fn validated_channels(actuator: &Actuator, backend: Backend) -> Result<Vec<C
     Ok(channels)
 }
 
+/// Checks the spatial backends' settings of `options` (the message names
+/// the setting and its range).
+pub(crate) fn check_options(options: &SolverOptions) -> Result<(), SpatialError> {
+    if options.spatial_steps_per_span < 2 {
+        return Err(SpatialError::StepsPerSpan(options.spatial_steps_per_span));
+    }
+    if !(4..=crate::solver::MAX_NODES_PER_SPAN).contains(&options.nodes_per_span) {
+        return Err(SpatialError::NodesPerSpan { nodes: options.nodes_per_span, max: crate::solver::MAX_NODES_PER_SPAN });
+    }
+    if !(options.spatial_moment_tolerance_n_mm.is_finite() && options.spatial_moment_tolerance_n_mm > 0.0) {
+        return Err(SpatialError::MomentTolerance);
+    }
+    Ok(())
+}
+
 /// Checks that `order` is resolved with `options` (the message names the
 /// fix): the collocation estimates its coefficients' error at every solve
 /// (up to [`MAX_SPATIAL_ORDER`]); the RK4 reference needs the steps of
 /// [`REQUIRED_SPATIAL_STEPS_PER_SPAN`].
-pub fn check_order(order: usize, options: &SpatialOptions) -> Result<(), SpatialError> {
+pub fn check_order(order: usize, options: &SolverOptions) -> Result<(), SpatialError> {
     if order > MAX_SPATIAL_ORDER {
         return Err(SpatialError::OrderAbove { order, max: MAX_SPATIAL_ORDER });
     }
@@ -963,8 +922,8 @@ pub fn check_order(order: usize, options: &SpatialOptions) -> Result<(), Spatial
         return Ok(());
     }
     let need = REQUIRED_SPATIAL_STEPS_PER_SPAN[order];
-    if options.steps_per_span < need {
-        return Err(SpatialError::OrderSteps { order, need, have: options.steps_per_span });
+    if options.spatial_steps_per_span < need {
+        return Err(SpatialError::OrderSteps { order, need, have: options.spatial_steps_per_span });
     }
     Ok(())
 }

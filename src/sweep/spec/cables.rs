@@ -8,7 +8,7 @@
 //! ```toml
 //! gravity_direction = [1, 0, 0]   # optional, as in the actuator file
 //! [rod]                            # optional: model::Rod
-//! [solver]                         # optional: SpatialOptions
+//! [solver]                         # optional: SolverOptions (its spatial keys)
 //! [output]
 //! order = 3                        # a0…a3, a_bend_y0…, a_twist0…
 //! cell_mm = 1.0                    # reach-map cell / voxel size
@@ -40,7 +40,8 @@
 //! holds `output.chunk_routings` routings.
 
 use crate::model::routing::CONTROL_POINTS;
-use crate::solver::spatial::{SpatialError, SpatialOptions};
+use crate::solver::spatial::SpatialError;
+use crate::solver::SolverOptions;
 use crate::model::{Actuator, Cable, Rod, MAX_CABLES};
 use crate::shape::LengthBasis;
 use crate::sweep::kind::{ChunkLayout, RowsCounted, RunKind, RunSpec, MAX_CHUNK_ROWS};
@@ -68,8 +69,8 @@ pub struct CablesGrid {
     pub actuator: Actuator,
     /// What the sweep varies of each cable, in the actuator's cable order.
     pub grids: Vec<CableGrid>,
-    /// Numerical settings of the 3-D solver.
-    pub solver: SpatialOptions,
+    /// Numerical settings of the solver.
+    pub solver: SolverOptions,
 }
 
 /// What a sweep varies of one cable: its actuation (tension or
@@ -153,8 +154,8 @@ pub(super) struct SpecFile {
     gj_n_mm2: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     gravity_direction: Option<[f64; 3]>,
-    #[serde(default)]
-    solver: SpatialOptions,
+    #[serde(default, with = "crate::solver::options::spatial_table")]
+    solver: SolverOptions,
     #[serde(default)]
     output: Output,
     #[serde(rename = "cable")]

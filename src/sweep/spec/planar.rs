@@ -96,6 +96,7 @@ pub struct PlanarGrid {
 #[serde(deny_unknown_fields, default)]
 pub(super) struct SpecFile {
     actuator: Rod,
+    #[serde(with = "crate::solver::options::planar_table")]
     solver: SolverOptions,
     grid: GridSpec,
     tension: TensionSpec,
@@ -266,9 +267,9 @@ impl PlanarGrid {
     fn validate(&self, output: &OutputSpec) -> Result<(), SpecError> {
         self.actuator.validate().map_err(SpecError::Actuator)?;
         // Sizes before anything is allocated for them.
-        if self.solver.steps_per_span > MAX_STEPS_PER_SPAN {
+        if self.solver.planar_steps_per_span > MAX_STEPS_PER_SPAN {
             let resolving = crate::solver::resolution::REQUIRED_STEPS_PER_SPAN[crate::solver::resolution::MAX_RESOLVED_ORDER];
-            return Err(SpecError::StepsPerSpan { steps: self.solver.steps_per_span, resolving });
+            return Err(SpecError::StepsPerSpan { steps: self.solver.planar_steps_per_span, resolving });
         }
         if self.tension.count > MAX_TENSIONS {
             return Err(SpecError::TooManyTensions { count: self.tension.count });
@@ -358,7 +359,7 @@ impl PlanarGrid {
     /// methods; docs/schema.md); 0 when no centreline is stored.
     pub fn centreline_points(&self, output: &OutputSpec) -> u64 {
         if output.centreline {
-            2 * self.solver.steps_per_span as u64 + 1
+            2 * self.solver.planar_steps_per_span as u64 + 1
         } else {
             0
         }
@@ -375,7 +376,7 @@ impl PlanarGrid {
             most if o.centreline => ChunkBytesFix::FewerRoutingsOrCentreline { most },
             most => ChunkBytesFix::FewerRoutings { most },
         };
-        let centreline = o.centreline.then(|| (self.centreline_points(o), self.solver.steps_per_span));
+        let centreline = o.centreline.then(|| (self.centreline_points(o), self.solver.planar_steps_per_span));
         SpecError::ChunkBytes { chunk_routings: o.chunk_routings, ladder_table, count, chunk_rows, chunk_bytes, centreline, fix }
     }
 

@@ -56,7 +56,7 @@ impl SpatialSolver {
     /// spaced points (the option's centreline resolution) and at every
     /// span boundary (each anchor among them, where its cable ends).
     pub fn centreline(&self) -> Vec<CentrelinePoint> {
-        self.nodes(2 * self.options.steps_per_span + 1)
+        self.nodes(2 * self.options.spatial_steps_per_span + 1)
     }
 
     /// The pose of the last successful solve.
@@ -118,7 +118,7 @@ impl SpatialSolver {
         let (a, error) = self.coefficients_with_error(order, basis)?;
         let tolerance = crate::solver::resolution::ORDER_TOLERANCE_PER_MM;
         if !(error <= tolerance) {
-            return Err(SpatialFailure::Unresolved(self.unresolved(format!("a_0 … a_{order}"), error, tolerance, "mm⁻¹")).into());
+            return Err(SolveFailure::Unresolved(self.unresolved(format!("a_0 … a_{order}"), error, tolerance, "mm⁻¹")).into());
         }
         Ok(a)
     }

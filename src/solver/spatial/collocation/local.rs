@@ -9,7 +9,7 @@ impl SpatialSolver {
     /// solve (chord steps) while they contract fast, and a fresh one
     /// otherwise; a step below [`LOCAL_STEP_TOLERANCE`] ends it (what is
     /// left is about the contraction factor times that step).
-    pub(super) fn local_solve(&self, i: usize, tensions: &[f64], nw: V3, mw: V3, kept: &mut Option<Matrix6<f64>>, commit: bool) -> Result<[f64; 6], SpatialFailure> {
+    pub(super) fn local_solve(&self, i: usize, tensions: &[f64], nw: V3, mw: V3, kept: &mut Option<Matrix6<f64>>, commit: bool) -> Result<[f64; 6], SolveFailure> {
         let mut x = self.local[i];
         // The kept inverse is updated in place by a committed sweep, on a
         // copy by a finite-difference sweep.
@@ -84,7 +84,7 @@ impl SpatialSolver {
             previous = big;
         }
         *inverse = None;
-        Err(SpatialFailure::Local { s_mm: self.s[i] })
+        Err(SolveFailure::CutEquationsNotConverged { s_mm: self.s[i] })
     }
 
     /// The internal force and moment (body frame) at node `i` for the

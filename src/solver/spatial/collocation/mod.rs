@@ -54,8 +54,9 @@
 //! body y, and the torsion u_1 (twist).
 
 use super::cable::Channel;
-use super::solver::{SpatialOptions, MAX_SPATIAL_ORDER};
-use super::{Actuator, SpatialError, SpatialFailure};
+use super::solver::MAX_SPATIAL_ORDER;
+use crate::solver::{SolveFailure, SolverOptions};
+use super::{Actuator, SpatialError};
 use crate::solver::result::{CableAtNode, CentrelinePoint, PerCable, TipFrame, TipPose};
 use crate::solver::collocation::FRICTION_SUBSTEPS;
 use crate::solver::creep::Creep;
@@ -235,7 +236,7 @@ type Factors = nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>;
 #[derive(Debug, Clone)]
 pub struct SpatialSolver {
     rod: Rod,
-    options: SpatialOptions,
+    options: SolverOptions,
     cables: usize,
     /// Tensions of the actuator's cables (scaled by `scale` in a solve), N.
     base_tension_n: Vec<f64>,
@@ -323,9 +324,9 @@ pub struct SpatialSolver {
 
 impl SpatialSolver {
     /// A solver for `actuator` (its cables, rod, body, torsion and gravity).
-    pub fn new(actuator: &Actuator, options: &SpatialOptions) -> Result<Self, SpatialError> {
+    pub fn new(actuator: &Actuator, options: &SolverOptions) -> Result<Self, SpatialError> {
         let channels = super::solver::validated_channels(actuator, crate::solver::Backend::Spatial)?;
-        options.check()?;
+        super::solver::check_options(options)?;
         let rod = actuator.rod.clone();
         let body = rod.body().map_err(SpatialError::Body)?;
         let length = rod.length_mm;
@@ -562,11 +563,11 @@ impl SpatialSolver {
                 let pose = self.pose_of_state(passes, &tensions);
                 if !pose.tip_mm().iter().chain(&[pose.length_mm, pose.tip_angle_rad]).all(|v| v.is_finite()) {
                     self.forget();
-                    return Err(SpatialFailure::NonFinite.into());
+                    return Err(SolveFailure::NonFinite { s_mm: None }.into());
                 }
                 if let Err(e) = self.check_resolved(&pose) {
                     self.forget();
-                    return Err(SpatialFailure::Unresolved(e).into());
+                    return Err(SolveFailure::Unresolved(e).into());
                 }
                 self.remember(&tensions);
                 self.last = Some(pose);
@@ -732,7 +733,7 @@ impl crate::solver::Solver for SpatialSolver {
     fn coefficients(&mut self, order: usize, basis: LengthBasis) -> Result<[Vec<f64>; 3], SpatialError> {
         let a = SpatialSolver::coefficients(self, order, basis)?;
         if !a.iter().flatten().all(|v| v.is_finite()) {
-            return Err(SpatialFailure::NonFinite.into());
+            return Err(SolveFailure::NonFinite { s_mm: None }.into());
         }
         Ok(a)
     }
@@ -740,7 +741,7 @@ impl crate::solver::Solver for SpatialSolver {
 
 impl From<crate::solver::actuation::DisplacementNotMet> for SpatialError {
     fn from(e: crate::solver::actuation::DisplacementNotMet) -> Self {
-        SpatialFailure::DisplacementNotMet(e).into()
+        SolveFailure::DisplacementNotMet(e).into()
     }
 }
 

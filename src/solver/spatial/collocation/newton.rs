@@ -3,7 +3,7 @@
 use super::*;
 
 impl SpatialSolver {
-    pub(super) fn solve_inner(&mut self, tensions: &[f64]) -> Result<u32, SpatialFailure> {
+    pub(super) fn solve_inner(&mut self, tensions: &[f64]) -> Result<u32, SolveFailure> {
         let has_weight = self.has_weight && self.weight_fraction > 0.0;
         let has_friction = self.friction && tensions.iter().any(|&t| t > 0.0);
         if !has_weight && !has_friction {
@@ -26,7 +26,7 @@ impl SpatialSolver {
             };
             passes += 1;
             let k = self.tolerance_scale;
-            let settled = change.0 <= k * SWEEP_ANGLE_TOLERANCE_RAD && change.1 <= k * self.options.moment_tolerance_n_mm * self.m_scale && change.2 < k * FRICTION_TOLERANCE;
+            let settled = change.0 <= k * SWEEP_ANGLE_TOLERANCE_RAD && change.1 <= k * self.options.spatial_moment_tolerance_n_mm * self.m_scale && change.2 < k * FRICTION_TOLERANCE;
             let change = change.0.max(change.1).max(change.2);
             if settled && (passes == 1 || change <= 0.5 * previous[0] || !has_weight) {
                 std::mem::swap(&mut self.state, &mut self.next);
@@ -34,13 +34,13 @@ impl SpatialSolver {
             }
             let most = if has_weight { MAX_SWEEPS } else { FRICTION_MAX_PASSES as u32 };
             if !has_weight && passes >= most {
-                break Err(SpatialFailure::Friction);
+                break Err(SolveFailure::FrictionNotConverged);
             }
             // Stalled (a heavy rod, where the sweeps do not contract): less
             // than a third off over two sweeps (Anderson's changes are not
             // monotone from one sweep to the next).
             if passes >= most || (has_weight && passes >= 3 && change > 0.67 * previous[1]) {
-                break Err(SpatialFailure::Gravity { passes, residual_n_mm: change / self.m_scale });
+                break Err(SolveFailure::GravityNotConverged { passes, residual_n_mm: change / self.m_scale });
             }
             previous = [change, previous[0]];
             self.anderson.output_mut().copy_from_slice(&self.next);
@@ -52,7 +52,7 @@ impl SpatialSolver {
         };
         match outcome {
             Ok(()) => Ok(passes),
-            Err(SpatialFailure::Friction) => Err(SpatialFailure::Friction),
+            Err(SolveFailure::FrictionNotConverged) => Err(SolveFailure::FrictionNotConverged),
             Err(_) => {
                 self.anderson.clear();
                 self.state.copy_from_slice(&predicted.0);
@@ -64,7 +64,7 @@ impl SpatialSolver {
 
     /// Newton from the current state; if it fails, continuation in the
     /// weight from a weightless rod. Returns the Newton iterations.
-    pub(super) fn newton_continued(&mut self, tensions: &[f64]) -> Result<u32, SpatialFailure> {
+    pub(super) fn newton_continued(&mut self, tensions: &[f64]) -> Result<u32, SolveFailure> {
         let saved = self.state.clone();
         let saved_local = self.local.clone();
         if let Ok(n) = self.newton(tensions) {
@@ -75,7 +75,7 @@ impl SpatialSolver {
         let full = self.weight_fraction;
         self.weight_fraction = 0.0;
         let mut iterations = 0;
-        let result = (|| -> Result<(), SpatialFailure> {
+        let result = (|| -> Result<(), SolveFailure> {
             // Weightless: one sweep from any start.
             self.sweep(tensions, true)?;
             std::mem::swap(&mut self.state, &mut self.next);
@@ -95,7 +95,7 @@ impl SpatialSolver {
                         self.local.copy_from_slice(&local);
                         step /= 2.0;
                         if step < MIN_WEIGHT_STEP {
-                            return Err(SpatialFailure::Gravity { passes: iterations, residual_n_mm: f64::NAN });
+                            return Err(SolveFailure::GravityNotConverged { passes: iterations, residual_n_mm: f64::NAN });
                         }
                     }
                 }
@@ -122,9 +122,9 @@ impl SpatialSolver {
     /// factored; its factors are kept across iterations and solves for
     /// chord steps while those contract by half or better, and then serve
     /// as GMRES's right preconditioner.
-    pub(super) fn newton(&mut self, tensions: &[f64]) -> Result<u32, SpatialFailure> {
+    pub(super) fn newton(&mut self, tensions: &[f64]) -> Result<u32, SolveFailure> {
         let n = self.state.len();
-        let residual = |this: &mut Self| -> Result<DVector<f64>, SpatialFailure> {
+        let residual = |this: &mut Self| -> Result<DVector<f64>, SolveFailure> {
             this.sweep(tensions, true)?;
             Ok(DVector::from_iterator(n, this.state.iter().zip(&this.next).map(|(z, g)| z - g)))
         };
@@ -137,7 +137,7 @@ impl SpatialSolver {
                 self.newton_factors = factors;
                 return Ok(it);
             }
-            let failed = SpatialFailure::Gravity { passes: it, residual_n_mm: norm / self.m_scale };
+            let failed = SolveFailure::GravityNotConverged { passes: it, residual_n_mm: norm / self.m_scale };
             let mut delta = None;
             let mut step = Step::Chord;
             if krylov {
@@ -207,7 +207,7 @@ impl SpatialSolver {
             self.newton_factors = factors;
             return Ok(NEWTON_MAX_ITERATIONS);
         }
-        Err(SpatialFailure::Gravity { passes: NEWTON_MAX_ITERATIONS, residual_n_mm: norm / self.m_scale })
+        Err(SolveFailure::GravityNotConverged { passes: NEWTON_MAX_ITERATIONS, residual_n_mm: norm / self.m_scale })
     }
 
     /// A Newton–Krylov step at the current state (F(z) = `f`, G(z) in
@@ -215,7 +215,7 @@ impl SpatialSolver {
     /// [`KRYLOV_TOLERANCE`], J v = (F(z + εv) − F(z))/ε by one sweep,
     /// right-preconditioned by `factors` when given. `None` when GMRES
     /// does not reach its tolerance.
-    pub(super) fn krylov_step(&mut self, tensions: &[f64], f: &DVector<f64>, factors: Option<&Factors>) -> Result<Option<DVector<f64>>, SpatialFailure> {
+    pub(super) fn krylov_step(&mut self, tensions: &[f64], f: &DVector<f64>, factors: Option<&Factors>) -> Result<Option<DVector<f64>>, SolveFailure> {
         let n = self.state.len();
         let base = self.state.clone();
         let g0 = self.next.clone();
@@ -260,7 +260,7 @@ impl SpatialSolver {
 
     /// The Jacobian of F(z) = z − G(z) at the current state by forward
     /// differences of sweeps (each from the committed local solutions).
-    pub(super) fn jacobian(&mut self, tensions: &[f64]) -> Result<DMatrix<f64>, SpatialFailure> {
+    pub(super) fn jacobian(&mut self, tensions: &[f64]) -> Result<DMatrix<f64>, SolveFailure> {
         let n = self.state.len();
         let base = self.state.clone();
         let g0 = self.next.clone();

@@ -24,7 +24,7 @@ impl SpatialSolver {
     /// Jacobian leaves them). Returns the largest changes of the distal
     /// force and moment (in angle units: N_b·L²/EI, M_b·L/EI, at the weight
     /// on) and of the friction profiles.
-    pub(super) fn sweep(&mut self, tensions: &[f64], commit: bool) -> Result<(f64, f64, f64), SpatialFailure> {
+    pub(super) fn sweep(&mut self, tensions: &[f64], commit: bool) -> Result<(f64, f64, f64), SolveFailure> {
         let nn = self.nodes_count();
         let mut ubuf = std::mem::take(&mut self.ubuf);
         let w_scale = if self.has_weight { self.weight_fraction } else { 0.0 };
@@ -98,7 +98,7 @@ impl SpatialSolver {
         let change_ratio = if self.friction { self.friction_profiles(commit) } else { 0.0 };
         let (change_n, change_m) = (change_n * w_scale, change_m * w_scale);
         if !(change_n + change_m + change_ratio).is_finite() {
-            return Err(SpatialFailure::NonFinite);
+            return Err(SolveFailure::NonFinite { s_mm: None });
         }
         Ok((change_n, change_m, change_ratio))
     }

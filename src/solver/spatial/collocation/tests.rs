@@ -20,7 +20,7 @@ fn planar_against_spatial(rod: &Rod, y: [f64; 5], tau: f64, anchor: Option<f64>)
     let mut cable = Cable::planar(y, tau);
     cable.anchor_mm = anchor;
     let a = Actuator::with_cables(rod.clone(), vec![cable]);
-    let options = SpatialOptions { nodes_per_span: 24, ..Default::default() };
+    let options = SolverOptions { nodes_per_span: 24, ..Default::default() };
     let sp = crate::solver::spatial::simulate_spatial(&a, &options, 3, LengthBasis::Rest).unwrap();
     let tip = dist(sp.pose.tip_mm(), [p.pose.tip_x_mm, p.pose.tip_y_mm, 0.0]);
     let angle = (sp.pose.tip_angle_rad - p.pose.tip_angle_rad).abs();
@@ -80,7 +80,7 @@ fn in_plane_it_agrees_with_the_planar_solver_for_every_body_and_effect() {
 
 fn simulate(a: &Actuator) -> crate::solver::Simulation {
     let options = crate::solver::SolverOptions::default();
-    crate::solver::simulate_actuator(a, &options, &SpatialOptions::default(), Default::default(), None, 3, LengthBasis::Rest).unwrap()
+    crate::solver::simulate_actuator(a, &options, Default::default(), None, 3, LengthBasis::Rest).unwrap()
 }
 
 fn same_shape(p: &crate::solver::Simulation, q: &crate::solver::Simulation) -> f64 {
@@ -158,14 +158,14 @@ fn bad_displacements_and_stiffnesses_are_refused_by_name() {
     for (d, ea, needle) in [(-1.0, None, "negative"), (f64::NAN, None, "finite"), (80.0, None, "cannot be pulled in"), (1.0, Some(0.0), "cable_ea_n")] {
         let cable = Cable { displacement_mm: Some(d), cable_ea_n: ea, ..Cable::planar(y, 0.0) };
         let a = Actuator::with_cables(Rod::default(), vec![cable]);
-        let e = crate::solver::simulate_actuator(&a, &Default::default(), &SpatialOptions::default(), Default::default(), None, 3, LengthBasis::Rest).unwrap_err();
+        let e = crate::solver::simulate_actuator(&a, &Default::default(), Default::default(), None, 3, LengthBasis::Rest).unwrap_err();
         assert!(e.to_string().contains(needle) && e.to_string().contains("cable 1"), "{e}");
     }
     // The RK4 references do not integrate the cables' paths.
     let cable = Cable { displacement_mm: Some(1.0), ..Cable::planar(y, 0.0) };
     let a = Actuator::with_cables(Rod::default(), vec![cable]);
     let rk4 = crate::solver::SolverOptions { method: crate::solver::SolverMethod::Rk4, ..Default::default() };
-    let e = crate::solver::simulate_actuator(&a, &rk4, &SpatialOptions::default(), Default::default(), None, 3, LengthBasis::Rest).unwrap_err();
+    let e = crate::solver::simulate_actuator(&a, &rk4, Default::default(), None, 3, LengthBasis::Rest).unwrap_err();
     assert!(e.to_string().contains("displacement"), "{e}");
     // A file gives one actuation.
     let both = "[[cable]]\ny_mm = [1, 1, 1, 1, 1]\ntension_n = 1\ndisplacement_mm = 1\n";
