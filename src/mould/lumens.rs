@@ -21,7 +21,7 @@
 
 use super::mesh::{Mesh, MeshBuilder, Point};
 use super::polygon::{self, P2};
-use super::{MouldError, MouldParams, ParameterProblem, MAX_SIZE_MM, MAX_TRIANGLES};
+use super::{MouldError, MouldParams, ParameterProblem, MAX_TRIANGLES};
 use crate::model::cable::Channel;
 use crate::model::routing::CONTROL_POINTS;
 use crate::model::Actuator;
@@ -147,7 +147,7 @@ impl Lumens {
         actuator.rod.validate()?;
         let (length_mm, radius_mm) = (actuator.rod.length_mm, actuator.rod.radius_mm);
         let profile_mm = actuator.rod.radius_profile_mm.as_slice();
-        for (name, value) in [
+        super::params::check_sizes([
             ("wall_mm", p.wall_mm),
             ("tube_diameter_mm", p.tube_diameter_mm),
             ("clamp_mm", p.clamp_mm),
@@ -155,14 +155,7 @@ impl Lumens {
             ("station_step_mm", p.station_step_mm),
             ("radius_mm", radius_mm),
             ("length_mm", length_mm),
-        ] {
-            if !value.is_finite() {
-                return bad(name, ParameterProblem::NotFinite { value });
-            }
-            if value.abs() > MAX_SIZE_MM {
-                return bad(name, ParameterProblem::TooLarge { value });
-            }
-        }
+        ])?;
         if p.tube_diameter_mm <= 0.0 || p.tube_diameter_mm > radius_mm {
             return bad("tube_diameter_mm", ParameterProblem::Tube { tube_mm: p.tube_diameter_mm, radius_mm, pour: false });
         }

@@ -3,7 +3,7 @@
 
 use super::font::{text_pixels, text_width_mm};
 use super::mesh::{heightfield_solid, sided, Mesh, Sided};
-use super::{MouldError, MouldParams, ParameterProblem, MAX_SIZE_MM, MAX_TRIANGLES};
+use super::{MouldError, MouldParams, ParameterProblem, MAX_TRIANGLES};
 use crate::model::Routing;
 use serde::Serialize;
 
@@ -127,7 +127,7 @@ impl Moulds {
         if let Some(k) = channels.iter().position(|c| c.length_mm() != length) {
             return bad("channels", ParameterProblem::ChannelLengths { cable: k + 1, length_mm: channels[k].length_mm(), first_mm: length });
         }
-        let sizes = [
+        super::params::check_sizes([
             ("wall_mm", p.wall_mm),
             ("tube_diameter_mm", p.tube_diameter_mm),
             ("clearance_mm", p.clearance_mm),
@@ -136,16 +136,7 @@ impl Moulds {
             ("station_step_mm", p.station_step_mm),
             ("radius_mm", radius_mm),
             ("length_mm", length),
-        ];
-        for (name, value) in sizes {
-            if !value.is_finite() {
-                return bad(name, ParameterProblem::NotFinite { value });
-            }
-            // Beyond any printer's bed; the meshes of such moulds would not fit in memory.
-            if value.abs() > MAX_SIZE_MM {
-                return bad(name, ParameterProblem::TooLarge { value });
-            }
-        }
+        ])?;
         if p.tube_diameter_mm <= 0.0 || p.tube_diameter_mm > radius_mm {
             return bad("tube_diameter_mm", ParameterProblem::Tube { tube_mm: p.tube_diameter_mm, radius_mm, pour: true });
         }

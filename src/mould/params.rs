@@ -1,6 +1,6 @@
 //! The moulds' parameters and the bodies they can cast.
 
-use super::{BodyFeature, MouldError};
+use super::{BodyFeature, MouldError, ParameterProblem};
 use serde::{Deserialize, Serialize};
 
 /// Parameters of the moulds, mm.
@@ -56,6 +56,21 @@ impl MouldSettings {
             ..d
         }
     }
+}
+
+/// Refuses a size (a parameter or the body's) that is not finite or is
+/// beyond any printer's bed (the meshes of such moulds would not fit in
+/// memory), named by its key.
+pub(super) fn check_sizes(sizes: impl IntoIterator<Item = (&'static str, f64)>) -> Result<(), MouldError> {
+    for (name, value) in sizes {
+        if !value.is_finite() {
+            return Err(MouldError::BadParameter { name, problem: ParameterProblem::NotFinite { value } });
+        }
+        if value.abs() > MAX_SIZE_MM {
+            return Err(MouldError::BadParameter { name, problem: ParameterProblem::TooLarge { value } });
+        }
+    }
+    Ok(())
 }
 
 impl MouldParams {
