@@ -228,9 +228,9 @@ fn reduce_planar(request: &ReduceRequest) -> Result<ReduceReport, MapError> {
         Source::Run { partial } => reduce_run(run, partial, &options),
         Source::Parts => crate::reduce::parts::merge_parts(run, out, &options),
     };
-    let (map, grid) = reduced.map_err(|source| MapError::Reduce { run: run.clone(), source })?;
+    let (map, grid, solver) = reduced.map_err(|source| MapError::Reduce { run: run.clone(), source })?;
     let reduce_s = start.elapsed().as_secs_f64();
-    let pictures = write_map_replacing(out, &map, &grid.actuator, &grid.solver).map_err(MapError::Write)?;
+    let pictures = write_map_replacing(out, &map, &grid.actuator, &solver).map_err(MapError::Write)?;
     let total_s = start.elapsed().as_secs_f64();
     let sparse_note = crate::reduce::Density::sparse_note(&map.summary, &map.cells);
     Ok(ReduceReport::Planar(PlanarMapReport {

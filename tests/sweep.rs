@@ -587,8 +587,9 @@ fn the_reducer_reads_a_sweep_through_open_run() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path().join("run");
     assert!(sweep(Path::new(QUICK), &dir, &[]).0);
-    let (map, spec) = reduce_run(&dir, false, &ReduceOptions::default()).unwrap();
-    assert_eq!(Some(&spec), open_run(&dir, Completeness::Complete).unwrap().spec().planar());
+    let (map, grid, solver) = reduce_run(&dir, false, &ReduceOptions::default()).unwrap();
+    let run = open_run(&dir, Completeness::Complete).unwrap();
+    assert_eq!((Some(&grid), &solver), (run.spec().planar(), &run.spec().solver));
     assert_eq!(map.summary.rows_total, (2 * 122 - 1) * 5);
     assert_eq!(map.summary.rows_converged, map.summary.rows_total);
 }

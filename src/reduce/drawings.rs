@@ -71,7 +71,7 @@ impl ModeDrawings {
                 drawings.shapes.push(None);
                 continue;
             };
-            match simulate_spatial(&cables.actuator(d.routing_id), &spec.solver, 1, cables.output().length_basis) {
+            match simulate_spatial(&cables.actuator(d.routing_id), cables.solver(), 1, cables.output().length_basis) {
                 // The sweep reached the row along its tension path; a solve from
                 // zero could in principle land on another equilibrium: then the
                 // drawing would not be the row's, and is not made.

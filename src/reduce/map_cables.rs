@@ -13,6 +13,7 @@ use crate::model::routing::CONTROL_POINTS;
 use crate::solver::record::{simulate_command, SimulateCommand};
 use crate::model::Actuator;
 use crate::sweep::schema::Axis;
+use crate::solver::SolverOptions;
 use crate::sweep::spec::{CablesGrid, OutputSpec, RoutingGrid, SweepSpec};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -46,6 +47,7 @@ struct CablesFile {
 #[derive(Debug, Clone, PartialEq)]
 pub struct MapCables {
     spec: CablesGrid,
+    solver: SolverOptions,
     output: OutputSpec,
 }
 
@@ -56,8 +58,8 @@ struct NotCables;
 
 impl MapCables {
     /// The cables of the map of a run of `spec`.
-    pub fn of_spec(spec: &CablesGrid, output: &OutputSpec) -> Self {
-        Self { spec: spec.clone(), output: output.clone() }
+    pub fn of_spec(spec: &CablesGrid, solver: &SolverOptions, output: &OutputSpec) -> Self {
+        Self { spec: spec.clone(), solver: solver.clone(), output: output.clone() }
     }
 
     /// The cables of the map in `map_dir`: `None` for a map of one planar
@@ -71,7 +73,7 @@ impl MapCables {
         };
         let file: CablesFile = serde_json::from_str(&text).map_err(|e| ReduceError::CablesFile { path: path.clone(), source: Box::new(e) })?;
         match file.spec.routings {
-            RoutingGrid::Cables(spec) => Ok(Some(Self { spec, output: file.spec.output })),
+            RoutingGrid::Cables(spec) => Ok(Some(Self { spec, solver: file.spec.solver, output: file.spec.output })),
             RoutingGrid::Planar(_) => Err(ReduceError::CablesFile { path, source: Box::new(NotCables) }),
         }
     }
@@ -82,7 +84,7 @@ impl MapCables {
             about: "the cable sweep spec of this map: a design's routing_id (routing × tension combinations + combination) \
                     and this spec give every cable's routing and tension"
                 .into(),
-            spec: SweepSpec { routings: RoutingGrid::Cables(self.spec.clone()), output: self.output.clone() },
+            spec: SweepSpec { routings: RoutingGrid::Cables(self.spec.clone()), solver: self.solver.clone(), output: self.output.clone() },
         };
         let path = dir.join(CABLES_FILE);
         let json = serde_json::to_string_pretty(&file).map_err(|source| ReduceError::WriteJson { path: path.clone(), source })? + "\n";
@@ -92,6 +94,11 @@ impl MapCables {
     /// The run's cables and their grids.
     pub fn spec(&self) -> &CablesGrid {
         &self.spec
+    }
+
+    /// The run's solver settings.
+    pub fn solver(&self) -> &SolverOptions {
+        &self.solver
     }
 
     /// What the run's rows store.
@@ -113,7 +120,7 @@ impl MapCables {
     /// The `cablemap simulate` command that solves the design whose
     /// `routing_id` is `row_key` again, with the map's rod and solver.
     pub fn command(&self, row_key: i64) -> SimulateCommand {
-        simulate_command(&self.actuator(row_key), &self.spec.solver)
+        simulate_command(&self.actuator(row_key), &self.solver)
     }
 
     /// Every cable's actuation of a design, e.g. `1.80, 0.80 N` (a
@@ -224,7 +231,7 @@ tension_n = { min = 0.0, max = 2.0, count = 11 }
     #[test]
     fn a_designs_row_key_gives_every_cable_and_the_file_reads_back() {
         let spec = SweepSpec::from_toml(SPEC, "test").unwrap();
-        let cables = MapCables::of_spec(spec.cables().unwrap(), &spec.output);
+        let cables = MapCables::of_spec(spec.cables().unwrap(), &spec.solver, &spec.output);
         // Routing 1 (y1 at its second level), combination 9·11 + 4: 1.8 N and 0.8 N.
         let key = row_key(1, 9 * 11 + 4, 121) as i64;
         let a = cables.actuator(key);

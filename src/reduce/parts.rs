@@ -24,6 +24,7 @@ use super::source::run_info;
 use super::spill::{self, SpillWriter, RECORD_BYTES};
 use super::error::{PartDamage, PartMismatch};
 use super::{columns, MapData, PartsError, ReduceError, ReduceOptions};
+use crate::solver::SolverOptions;
 use crate::sweep::spec::PlanarGrid;
 use crate::sweep::{open_run, Completeness, SweepRun};
 use serde::{Deserialize, Serialize};
@@ -326,7 +327,7 @@ fn read_parts(dir: &Path, run: &SweepRun) -> Result<(Vec<PathBuf>, Pass1), Parts
 
 /// Merges the parts in `map_dir`'s parts directory into the map of the
 /// run in `run_dir` (a complete run). Returns the map and the run's spec.
-pub fn merge_parts(run_dir: &Path, map_dir: &Path, options: &ReduceOptions) -> Result<(MapData, PlanarGrid), ReduceError> {
+pub fn merge_parts(run_dir: &Path, map_dir: &Path, options: &ReduceOptions) -> Result<(MapData, PlanarGrid, SolverOptions), ReduceError> {
     let run = open_run(run_dir, Completeness::Complete).map_err(run_open_error)?;
     let grid = planar_grid(&run)?.clone();
     let info = run_info(&run);
@@ -338,7 +339,7 @@ pub fn merge_parts(run_dir: &Path, map_dir: &Path, options: &ReduceOptions) -> R
     let map = reduce_spilled(&info, options, spill::Samples::Files(files), &pass1, &scratch.path, || {
         Ok(run.batches_projected(&names)?.map(|b| b.map_err(ReduceError::from)))
     })?;
-    Ok((map, grid))
+    Ok((map, grid, run.spec().solver.clone()))
 }
 
 #[cfg(test)]

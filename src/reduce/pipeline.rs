@@ -19,6 +19,7 @@ use super::tables::{self, PLANAR_MAP_DIR};
 use super::{fetch, ReachMapSummary, Design, MapCables, MapData, MapSummary, ReduceError, ReduceOptions, CELL_STATS_ORDER, MODES};
 use crate::solver::STATUS_OK;
 use crate::sweep::schema::STATUS_INVALID_ROUTING;
+use crate::solver::SolverOptions;
 use crate::sweep::spec::{CablesGrid, PlanarGrid};
 use crate::sweep::{open_run, Completeness, RunKind, SweepError, SweepRun};
 use arrow::record_batch::RecordBatch;
@@ -187,11 +188,11 @@ fn cables_grid(run: &SweepRun) -> Result<&CablesGrid, ReduceError> {
 
 /// Reduces the sweep run in `run_dir` (refusing an unfinished run unless
 /// `partial`). Returns the map and the run's spec (for drawing).
-pub fn reduce_run(run_dir: &Path, partial: bool, options: &ReduceOptions) -> Result<(MapData, PlanarGrid), ReduceError> {
+pub fn reduce_run(run_dir: &Path, partial: bool, options: &ReduceOptions) -> Result<(MapData, PlanarGrid, SolverOptions), ReduceError> {
     let run = open(run_dir, partial)?;
     let grid = planar_grid(&run)?.clone();
     let map = planar_map(&run, options)?;
-    Ok((map, grid))
+    Ok((map, grid, run.spec().solver.clone()))
 }
 
 /// The feasibility map of an opened run of any kind whose rows read as
@@ -235,7 +236,7 @@ pub fn reduce_cable_run(
     let reach = Reach::count(&run, cell_mm)?;
     let planar = if spec.is_planar() && output.order >= 1 {
         let map = planar_map(&run, &ReduceOptions { cell_mm, ..options.clone() })?;
-        let cables = MapCables::of_spec(spec, output);
+        let cables = MapCables::of_spec(spec, &run.spec().solver, output);
         let drawings = ModeDrawings::of_cables(&map, &cables);
         Some((map, drawings, cables))
     } else {

@@ -259,8 +259,8 @@ pub fn run_variant(
     };
     let mut reduce = reduce.clone();
     reduce.scratch_dir.get_or_insert_with(|| v.dir(dir));
-    let (map, grid) = crate::reduce::reduce_run(&run, false, &reduce).map_err(reduce_err)?;
-    crate::reduce::write_map_replacing(&v.map_dir(dir), &map, &grid.actuator, &grid.solver).map_err(reduce_err)?;
+    let (map, grid, solver) = crate::reduce::reduce_run(&run, false, &reduce).map_err(reduce_err)?;
+    crate::reduce::write_map_replacing(&v.map_dir(dir), &map, &grid.actuator, &solver).map_err(reduce_err)?;
     Ok(VariantRun {
         sweep: summary,
         map: map.summary,

@@ -12,6 +12,7 @@
 
 use super::spec::{OutputSpec, SpecError};
 use super::SweepError;
+use crate::solver::SolverOptions;
 use arrow::datatypes::SchemaRef;
 use arrow::record_batch::RecordBatch;
 use std::ops::Range;
@@ -81,9 +82,9 @@ impl ChunkLayout {
 }
 
 /// A kind of sweep ([`super::spec::RoutingGrid`]'s variants): what the
-/// engine needs of it besides the spec's [`OutputSpec`] (given to each
-/// method): its run kind, its chunk layout and row schema, and how one
-/// routing is solved.
+/// engine needs of it besides the spec's solver settings and
+/// [`OutputSpec`] (given to the methods that read them): its run kind, its
+/// chunk layout and row schema, and how one routing is solved.
 pub trait RunSpec {
     /// The kind of run (its format tag and name).
     const KIND: RunKind;
@@ -93,7 +94,7 @@ pub trait RunSpec {
     type Solved: Send;
 
     /// Checks the settings; the error names the setting.
-    fn check(&self, output: &OutputSpec) -> Result<(), SpecError>;
+    fn check(&self, solver: &SolverOptions, output: &OutputSpec) -> Result<(), SpecError>;
     /// What a row of a routing is, for [`SweepError::TooLarge`].
     fn rows_counted(&self) -> RowsCounted;
     /// Routings, rows per routing, chunks.
@@ -103,11 +104,11 @@ pub trait RunSpec {
     /// Estimated bytes one row takes in memory while its chunk is built
     /// (every copy: solved rows, Arrow batch, encoder buffer); sizes the
     /// engine's memory check.
-    fn row_bytes(&self, output: &OutputSpec) -> u64;
+    fn row_bytes(&self, solver: &SolverOptions, output: &OutputSpec) -> u64;
     /// The prototype worker.
-    fn worker(&self) -> Result<Self::Worker, SweepError>;
+    fn worker(&self, solver: &SolverOptions) -> Result<Self::Worker, SweepError>;
     /// Solves routing `id`: [`ChunkLayout::tensions`] rows.
-    fn solve(&self, output: &OutputSpec, worker: &mut Self::Worker, id: u64) -> Result<Self::Solved, SweepError>;
+    fn solve(&self, solver: &SolverOptions, output: &OutputSpec, worker: &mut Self::Worker, id: u64) -> Result<Self::Solved, SweepError>;
     /// The rows of a chunk's solved routings (in id order) as one batch of [`Self::schema`].
     fn batch(&self, output: &OutputSpec, schema: &SchemaRef, solved: &[Self::Solved]) -> RecordBatch;
 }

@@ -17,7 +17,7 @@
 
 use super::kind::{ChunkLayout, RunSpec};
 use super::progress::{Progress, ProgressMode};
-use super::spec::{OutputSpec, RoutingGrid, SweepSpec};
+use super::spec::{RoutingGrid, SweepSpec};
 use super::store::{total_status_counts, ChunkInfo, Manifest, RunDir};
 use super::SweepError;
 use rayon::prelude::*;
@@ -256,8 +256,8 @@ pub fn run_sweep(spec: &SweepSpec, dir: &Path, options: &SweepOptions) -> Result
 
     let chunks = Chunks { run: &run, manifest: &manifest, plan, pending: &pending, progress: &progress };
     let written = pool.install(|| match &spec.routings {
-        RoutingGrid::Planar(grid) => chunks.solve(grid, &spec.output),
-        RoutingGrid::Cables(grid) => chunks.solve(grid, &spec.output),
+        RoutingGrid::Planar(grid) => chunks.solve(grid, spec),
+        RoutingGrid::Cables(grid) => chunks.solve(grid, spec),
     })?;
     progress.finish();
 
@@ -294,8 +294,9 @@ struct Chunks<'a> {
 impl Chunks<'_> {
     /// Solves and writes the pending chunks of a sweep of kind `K` (in
     /// parallel: the chunks, and the routings of each chunk).
-    fn solve<K: RunSpec + Sync>(&self, kind: &K, output: &OutputSpec) -> Result<Vec<ChunkInfo>, SweepError> {
-        let prototype = kind.worker()?;
+    fn solve<K: RunSpec + Sync>(&self, kind: &K, spec: &SweepSpec) -> Result<Vec<ChunkInfo>, SweepError> {
+        let (solver, output) = (&spec.solver, &spec.output);
+        let prototype = kind.worker(solver)?;
         let schema = kind.schema(output);
         let plan = self.plan;
         self.pending
@@ -307,7 +308,7 @@ impl Chunks<'_> {
                     .map_init(
                         || prototype.clone(),
                         |worker, id| {
-                            let solved = kind.solve(output, worker, id);
+                            let solved = kind.solve(solver, output, worker, id);
                             self.progress.add(plan.tensions);
                             solved
                         },

@@ -69,8 +69,6 @@ pub struct CablesGrid {
     pub actuator: Actuator,
     /// What the sweep varies of each cable, in the actuator's cable order.
     pub grids: Vec<CableGrid>,
-    /// Numerical settings of the solver.
-    pub solver: SolverOptions,
 }
 
 /// What a sweep varies of one cable: its actuation (tension or
@@ -184,8 +182,9 @@ struct CableFile {
 
 impl SpecFile {
     /// The layout of a cable spec.
-    pub(super) fn of(grid: &CablesGrid, output: &OutputSpec) -> Self {
-        let CablesGrid { actuator, grids, solver } = grid.clone();
+    pub(super) fn of(grid: &CablesGrid, solver: &SolverOptions, output: &OutputSpec) -> Self {
+        let CablesGrid { actuator, grids } = grid.clone();
+        let solver = solver.clone();
         let Actuator { rod, gj_n_mm2, gravity_direction, cables } = actuator;
         let cables = cables
             .into_iter()
@@ -221,9 +220,9 @@ impl SpecFile {
             .into_iter()
             .unzip();
         let Output { order, length_basis, cell_mm, chunk_routings } = output;
-        let grid = CablesGrid { actuator: Actuator { rod, gj_n_mm2, gravity_direction, cables }, grids, solver };
+        let grid = CablesGrid { actuator: Actuator { rod, gj_n_mm2, gravity_direction, cables }, grids };
         let output = OutputSpec { order, length_basis, centreline: false, cell_mm: Some(cell_mm), chunk_routings };
-        Ok(SweepSpec { routings: RoutingGrid::Cables(grid), output })
+        Ok(SweepSpec { routings: RoutingGrid::Cables(grid), solver, output })
     }
 }
 
@@ -265,7 +264,7 @@ impl CablesGrid {
     }
 
     /// Checks the spec with its `output`; messages name the field.
-    fn validate(&self, output: &OutputSpec) -> Result<(), SpecError> {
+    fn validate(&self, solver: &SolverOptions, output: &OutputSpec) -> Result<(), SpecError> {
         let cables = &self.actuator.cables;
         if cables.is_empty() || cables.len() > MAX_CABLES {
             return Err(SpecError::CableCount { count: cables.len() });
@@ -287,7 +286,7 @@ impl CablesGrid {
             if let Some(ea_n) = c.cable_ea_n.filter(|ea| !(ea.is_finite() && *ea > 0.0)) {
                 return Err(SpecError::CableStiffness { cable: Some(cable), ea_n });
             }
-            if g.by_displacement && self.solver.method == crate::solver::SolverMethod::Rk4 {
+            if g.by_displacement && solver.method == crate::solver::SolverMethod::Rk4 {
                 return Err(SpecError::DisplacementWithRk4 { cable: Some(cable) });
             }
             // The anchor is not swept: outside the rod, every routing's rows
@@ -315,7 +314,7 @@ impl CablesGrid {
                 }
             }
         }
-        crate::solver::spatial::check_order(output.order, &self.solver).map_err(SpecError::SpatialOrder)?;
+        crate::solver::spatial::check_order(output.order, &solver).map_err(SpecError::SpatialOrder)?;
         if let Some(cell_mm) = output.cell_mm.filter(|c| !(c.is_finite() && *c > 0.0)) {
             return Err(SpecError::CellSize { cell_mm });
         }
@@ -339,7 +338,7 @@ impl CablesGrid {
         // The base actuator (swept points at their first level) must be a
         // rod the 3-D solver models; a routing's own faults are its rows' status.
         let base = self.actuator_for(0, &self.dimensions());
-        match crate::solver::spatial::validated_channels(&base, crate::solver::Backend::spatial(self.solver.method)) {
+        match crate::solver::spatial::validated_channels(&base, crate::solver::Backend::spatial(solver.method)) {
             Err(SpatialError::Actuator(crate::model::ActuatorError::Parameter(e))) => return Err(SpecError::Rod(e)),
             Err(e @ SpatialError::Unsupported(_)) => return Err(SpecError::RodUnsupported(e)),
             Err(e @ SpatialError::Actuator(crate::model::ActuatorError::GravityDirection(_))) => return Err(SpecError::Gravity(e)),
@@ -420,8 +419,8 @@ impl RunSpec for CablesGrid {
     type Worker = CableWorker;
     type Solved = Vec<CableRow>;
 
-    fn check(&self, output: &OutputSpec) -> Result<(), SpecError> {
-        self.validate(output)
+    fn check(&self, solver: &SolverOptions, output: &OutputSpec) -> Result<(), SpecError> {
+        self.validate(solver, output)
     }
 
     fn rows_counted(&self) -> RowsCounted {
@@ -436,21 +435,21 @@ impl RunSpec for CablesGrid {
         cable_schema(self.actuator.cables.len(), output.order)
     }
 
-    fn row_bytes(&self, output: &OutputSpec) -> u64 {
+    fn row_bytes(&self, _solver: &SolverOptions, output: &OutputSpec) -> u64 {
         // Per copy: the row (its cables' control points, tensions, pose and
         // three series) or its columns; three copies as for planar rows.
         let (cables, terms) = (self.actuator.cables.len() as u64, output.order as u64 + 1);
         3 * (256 + 96 * cables + 24 * terms)
     }
 
-    fn worker(&self) -> Result<CableWorker, SweepError> {
+    fn worker(&self, _solver: &SolverOptions) -> Result<CableWorker, SweepError> {
         Ok(CableWorker { dims: self.dimensions(), combinations: self.combinations() })
     }
 
-    fn solve(&self, output: &OutputSpec, worker: &mut CableWorker, id: u64) -> Result<Vec<CableRow>, SweepError> {
+    fn solve(&self, solver: &SolverOptions, output: &OutputSpec, worker: &mut CableWorker, id: u64) -> Result<Vec<CableRow>, SweepError> {
         let actuator = self.actuator_for(id, &worker.dims);
         let stored = Stored { order: output.order, length_basis: output.length_basis, centreline: false };
-        Ok(solve::cable_routing(id, actuator, &self.solver, stored, &worker.combinations))
+        Ok(solve::cable_routing(id, actuator, solver, stored, &worker.combinations))
     }
 
     fn batch(&self, output: &OutputSpec, schema: &SchemaRef, solved: &[Vec<CableRow>]) -> RecordBatch {
@@ -528,8 +527,8 @@ levels_mm = [0.0, 1.5, -1.5]
         let (spec, output) = (whole.cables().unwrap(), &whole.output);
         let layout = whole.layout();
         assert_eq!((layout.routings, layout.tensions), (12, 6));
-        let mut worker = spec.worker().unwrap();
-        let rows = spec.solve(output, &mut worker, 7).unwrap();
+        let mut worker = spec.worker(&whole.solver).unwrap();
+        let rows = spec.solve(&whole.solver, output, &mut worker, 7).unwrap();
         assert_eq!(rows.len(), 6);
         let grids = spec.actuation_grids();
         for (k, row) in rows.iter().enumerate() {

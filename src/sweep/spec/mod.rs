@@ -27,6 +27,7 @@ use crate::model::routing::CONTROL_POINTS;
 use crate::model::MAX_CABLES;
 use crate::shape::LengthBasis;
 use crate::solver::spatial::SpatialError;
+use crate::solver::SolverOptions;
 use arrow::datatypes::SchemaRef;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
@@ -37,6 +38,8 @@ use std::path::Path;
 pub struct SweepSpec {
     /// What is swept, and so the kind of the run.
     pub routings: RoutingGrid,
+    /// Numerical settings of the solver (the kind's backend reads its own).
+    pub solver: SolverOptions,
     /// What each row stores and how rows are grouped into files.
     pub output: OutputSpec,
 }
@@ -74,7 +77,7 @@ pub struct OutputSpec {
 impl Default for SweepSpec {
     /// The thesis sweep's settings (`jobs/thesis.toml`).
     fn default() -> Self {
-        Self { routings: RoutingGrid::Planar(PlanarGrid::default()), output: planar::Output::default().into() }
+        Self { routings: RoutingGrid::Planar(PlanarGrid::default()), solver: SolverOptions::default(), output: planar::Output::default().into() }
     }
 }
 
@@ -483,8 +486,8 @@ impl SweepSpec {
     /// Checks every setting; the message names the setting and what to do.
     pub fn validate(&self) -> Result<(), SpecError> {
         match &self.routings {
-            RoutingGrid::Planar(p) => p.check(&self.output),
-            RoutingGrid::Cables(c) => c.check(&self.output),
+            RoutingGrid::Planar(p) => p.check(&self.solver, &self.output),
+            RoutingGrid::Cables(c) => c.check(&self.solver, &self.output),
         }
     }
 
@@ -524,8 +527,8 @@ impl SweepSpec {
     /// (every copy: solved rows, Arrow batch, encoder buffer).
     pub fn row_bytes(&self) -> u64 {
         match &self.routings {
-            RoutingGrid::Planar(p) => p.row_bytes(&self.output),
-            RoutingGrid::Cables(c) => c.row_bytes(&self.output),
+            RoutingGrid::Planar(p) => p.row_bytes(&self.solver, &self.output),
+            RoutingGrid::Cables(c) => c.row_bytes(&self.solver, &self.output),
         }
     }
 
@@ -552,8 +555,8 @@ impl SweepSpec {
 impl Serialize for SweepSpec {
     fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
         match &self.routings {
-            RoutingGrid::Planar(p) => planar::SpecFile::of(p, &self.output).serialize(serializer),
-            RoutingGrid::Cables(c) => cables::SpecFile::of(c, &self.output).serialize(serializer),
+            RoutingGrid::Planar(p) => planar::SpecFile::of(p, &self.solver, &self.output).serialize(serializer),
+            RoutingGrid::Cables(c) => cables::SpecFile::of(c, &self.solver, &self.output).serialize(serializer),
         }
     }
 }

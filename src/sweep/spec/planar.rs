@@ -78,8 +78,6 @@ const ROW_COPIES: u64 = 3;
 pub struct PlanarGrid {
     /// Rod parameters and effects.
     pub actuator: Rod,
-    /// Numerical settings of the solver.
-    pub solver: SolverOptions,
     /// The grid of routings.
     pub grid: GridSpec,
     /// The tension ladder each routing is solved through (unless
@@ -130,8 +128,9 @@ impl From<Output> for OutputSpec {
 
 impl SpecFile {
     /// The layout of a planar spec.
-    pub(super) fn of(grid: &PlanarGrid, output: &OutputSpec) -> Self {
-        let PlanarGrid { actuator, solver, grid, tension, displacement } = grid.clone();
+    pub(super) fn of(grid: &PlanarGrid, solver: &SolverOptions, output: &OutputSpec) -> Self {
+        let PlanarGrid { actuator, grid, tension, displacement } = grid.clone();
+        let solver = solver.clone();
         let OutputSpec { order, length_basis, centreline, chunk_routings, cell_mm: _ } = output.clone();
         Self { actuator, solver, grid, tension, displacement, output: Output { order, length_basis, centreline, chunk_routings } }
     }
@@ -139,7 +138,7 @@ impl SpecFile {
     /// The spec it lays out.
     pub(super) fn into_spec(self) -> SweepSpec {
         let SpecFile { actuator, solver, grid, tension, displacement, output } = self;
-        SweepSpec { routings: RoutingGrid::Planar(PlanarGrid { actuator, solver, grid, tension, displacement }), output: output.into() }
+        SweepSpec { routings: RoutingGrid::Planar(PlanarGrid { actuator, grid, tension, displacement }), solver, output: output.into() }
     }
 }
 
@@ -264,12 +263,12 @@ pub enum ChunkBytesFix {
 impl PlanarGrid {
     /// Checks every setting with the spec's `output`; the error names the
     /// field and what to do.
-    fn validate(&self, output: &OutputSpec) -> Result<(), SpecError> {
+    fn validate(&self, solver: &SolverOptions, output: &OutputSpec) -> Result<(), SpecError> {
         self.actuator.validate().map_err(SpecError::Actuator)?;
         // Sizes before anything is allocated for them.
-        if self.solver.planar_steps_per_span > MAX_STEPS_PER_SPAN {
+        if solver.planar_steps_per_span > MAX_STEPS_PER_SPAN {
             let resolving = crate::solver::resolution::REQUIRED_STEPS_PER_SPAN[crate::solver::resolution::MAX_RESOLVED_ORDER];
-            return Err(SpecError::StepsPerSpan { steps: self.solver.planar_steps_per_span, resolving });
+            return Err(SpecError::StepsPerSpan { steps: solver.planar_steps_per_span, resolving });
         }
         if self.tension.count > MAX_TENSIONS {
             return Err(SpecError::TooManyTensions { count: self.tension.count });
@@ -290,11 +289,11 @@ impl PlanarGrid {
             if let Some(ea_n) = d.cable_ea_n.filter(|ea| !(ea.is_finite() && *ea > 0.0)) {
                 return Err(SpecError::CableStiffness { cable: None, ea_n });
             }
-            if self.solver.method == crate::solver::SolverMethod::Rk4 {
+            if solver.method == crate::solver::SolverMethod::Rk4 {
                 return Err(SpecError::DisplacementWithRk4 { cable: None });
             }
         }
-        crate::solver::Simulator::new(&self.actuator, &self.solver).map_err(SpecError::Solver)?;
+        crate::solver::Simulator::new(&self.actuator, &solver).map_err(SpecError::Solver)?;
         let g = &self.grid;
         if g.levels == 0 || g.levels > MAX_LEVELS {
             return Err(SpecError::Levels { levels: g.levels });
@@ -332,15 +331,15 @@ impl PlanarGrid {
         if o.order > MAX_ORDER {
             return Err(SpecError::Order { order: o.order });
         }
-        crate::solver::resolution::check_order(o.order, &self.solver).map_err(SpecError::Resolution)?;
+        crate::solver::resolution::check_order(o.order, &solver).map_err(SpecError::Resolution)?;
         if o.chunk_routings == 0 {
             return Err(SpecError::NoChunkRoutings { cables: false });
         }
         let count = self.ladder_count();
         let chunk_rows = u64::from(o.chunk_routings) * u64::from(count);
-        let chunk_bytes = chunk_rows.saturating_mul(self.row_bytes(o));
+        let chunk_bytes = chunk_rows.saturating_mul(self.row_bytes(solver, o));
         if chunk_rows <= MAX_CHUNK_ROWS && chunk_bytes > MAX_CHUNK_BYTES {
-            return Err(self.chunk_bytes_error(o, chunk_rows, chunk_bytes));
+            return Err(self.chunk_bytes_error(solver, o, chunk_rows, chunk_bytes));
         }
         if chunk_rows > MAX_CHUNK_ROWS {
             return Err(SpecError::ChunkRows {
@@ -357,9 +356,9 @@ impl PlanarGrid {
     /// Points of each row's stored centreline: the solvers' nodes from
     /// clamp to tip, two knot spans of `steps_per_span` steps (both
     /// methods; docs/schema.md); 0 when no centreline is stored.
-    pub fn centreline_points(&self, output: &OutputSpec) -> u64 {
+    pub fn centreline_points(solver: &SolverOptions, output: &OutputSpec) -> u64 {
         if output.centreline {
-            2 * self.solver.planar_steps_per_span as u64 + 1
+            2 * solver.planar_steps_per_span as u64 + 1
         } else {
             0
         }
@@ -367,16 +366,16 @@ impl PlanarGrid {
 
     /// The refusal of a chunk of `chunk_rows` rows that would take
     /// `chunk_bytes` (more than [`MAX_CHUNK_BYTES`]), with what to change.
-    fn chunk_bytes_error(&self, o: &OutputSpec, chunk_rows: u64, chunk_bytes: u64) -> SpecError {
+    fn chunk_bytes_error(&self, solver: &SolverOptions, o: &OutputSpec, chunk_rows: u64, chunk_bytes: u64) -> SpecError {
         let count = self.ladder_count();
-        let routing_bytes = u64::from(count) * self.row_bytes(o);
+        let routing_bytes = u64::from(count) * self.row_bytes(solver, o);
         let ladder_table = self.ladder_table();
         let fix = match MAX_CHUNK_BYTES / routing_bytes.max(1) {
             0 => ChunkBytesFix::OneRouting { count, routing_bytes, ladder_table },
             most if o.centreline => ChunkBytesFix::FewerRoutingsOrCentreline { most },
             most => ChunkBytesFix::FewerRoutings { most },
         };
-        let centreline = o.centreline.then(|| (self.centreline_points(o), self.solver.planar_steps_per_span));
+        let centreline = o.centreline.then(|| (Self::centreline_points(solver, o), solver.planar_steps_per_span));
         SpecError::ChunkBytes { chunk_routings: o.chunk_routings, ladder_table, count, chunk_rows, chunk_bytes, centreline, fix }
     }
 
@@ -428,8 +427,8 @@ impl RunSpec for PlanarGrid {
     type Worker = Simulator;
     type Solved = SolvedRouting;
 
-    fn check(&self, output: &OutputSpec) -> Result<(), SpecError> {
-        self.validate(output)
+    fn check(&self, solver: &SolverOptions, output: &OutputSpec) -> Result<(), SpecError> {
+        self.validate(solver, output)
     }
 
     fn rows_counted(&self) -> RowsCounted {
@@ -446,18 +445,18 @@ impl RunSpec for PlanarGrid {
 
     /// Fixed columns and a_i, and the centreline's x and y lists when
     /// stored, in each of [`ROW_COPIES`] copies.
-    fn row_bytes(&self, output: &OutputSpec) -> u64 {
-        let per_copy = ROW_FIXED_BYTES + 8 * (output.order as u64 + 1) + 16 * self.centreline_points(output);
+    fn row_bytes(&self, solver: &SolverOptions, output: &OutputSpec) -> u64 {
+        let per_copy = ROW_FIXED_BYTES + 8 * (output.order as u64 + 1) + 16 * Self::centreline_points(solver, output);
         ROW_COPIES * per_copy
     }
 
-    fn worker(&self) -> Result<Simulator, SweepError> {
-        let mut sim = Simulator::new(&self.actuator, &self.solver)?;
+    fn worker(&self, solver: &SolverOptions) -> Result<Simulator, SweepError> {
+        let mut sim = Simulator::new(&self.actuator, solver)?;
         sim.set_cable_stiffness(self.displacement.as_ref().and_then(|d| d.cable_ea_n));
         Ok(sim)
     }
 
-    fn solve(&self, output: &OutputSpec, worker: &mut Simulator, id: u64) -> Result<SolvedRouting, SweepError> {
+    fn solve(&self, _solver: &SolverOptions, output: &OutputSpec, worker: &mut Simulator, id: u64) -> Result<SolvedRouting, SweepError> {
         // The plan holds only the levels (a few numbers): cheap per routing.
         let routing_mm = SweepPlan::new(self, output).routing_mm(id);
         let routing = Routing::for_actuator(routing_mm, &self.actuator)?;
@@ -537,13 +536,13 @@ mod tests {
                 SweepSpec::from_toml(&format!("[solver]\nmethod = \"{method}\"\nsteps_per_span = 30\n[output]\ncentreline = true\n"), "t")
                     .unwrap();
             let grid = planar(&spec);
-            let mut sim = crate::solver::Simulator::new(&grid.actuator, &grid.solver).unwrap();
+            let mut sim = crate::solver::Simulator::new(&grid.actuator, &spec.solver).unwrap();
             sim.set_routing_mm(&[1.0, 2.0, 0.0, -1.0, 1.0]).unwrap();
             sim.solve(1.5).unwrap();
-            assert_eq!(sim.centreline().len() as u64, grid.centreline_points(&spec.output), "{method}");
+            assert_eq!(sim.centreline().len() as u64, PlanarGrid::centreline_points(&spec.solver, &spec.output), "{method}");
         }
         let thesis = SweepSpec::thesis();
-        assert_eq!(planar(&thesis).centreline_points(&thesis.output), 0);
+        assert_eq!(PlanarGrid::centreline_points(&thesis.solver, &thesis.output), 0);
     }
 
     #[test]
