@@ -5,7 +5,8 @@
 //! Each request checks once what its kind refuses ([`Refused`]); the
 //! command line and Python only fill the fields.
 
-use super::fit::{Loss, Noise};
+use super::fit::Loss;
+use super::observations::measurements::Noise;
 use super::{CalibrateError, Effect, HeldError, InvalidRequest, NoiseError, Parameter, Refused};
 use crate::model::RodOverrides;
 use crate::solver::SolverOptions;

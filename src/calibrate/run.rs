@@ -11,7 +11,8 @@
 
 use super::data::{read_centrelines, read_markers, read_measurements, split_holdout, Dataset};
 use super::captures::run::CapturesCalibration;
-use super::fit::{apply_held, fit_observed, rms_per_routing, FitProgress, FitResult, FitSpec, Loss, Noise, RoutingRms, ShapeData};
+use super::fit::{FitResult, FitSpec, Loss};
+use super::observations::measurements::{apply_held, fit_measurements, planar_spec, rms_per_routing, FitProgress, MeasurementSettings, MeasurementsReport, Noise, RoutingRms, ShapeData};
 use super::predict::predict;
 use super::request::{DataKind, FitSettings, LossKind};
 use super::{CalibrateError, CalibrateRequest, Effect};
@@ -23,9 +24,10 @@ use std::path::Path;
 use std::sync::Arc;
 
 impl FitSettings {
-    /// A planar fit's settings (without effects) and the starting rod with
-    /// the held values set; also the held effects. Reads the shape files.
-    pub fn resolve(&self, base: &Rod, data: &Dataset) -> Result<(FitSpec, Rod, Vec<Effect>), CalibrateError> {
+    /// A planar fit's parameters (the rigidities, without effects) and
+    /// weighing, and the starting rod with the held values set; also the
+    /// held effects. Reads the shape files.
+    pub fn resolve(&self, base: &Rod, data: &Dataset) -> Result<(FitSpec, MeasurementSettings, Rod, Vec<Effect>), CalibrateError> {
         let loss = self.loss(LossKind::Huber)?;
         let (start, fixed_rigidities, held_effects) = apply_held(base, &self.held)?;
         let mut shapes = ShapeData::default();
@@ -37,16 +39,8 @@ impl FitSettings {
         }
         let noise = self.noise();
         noise.validate()?;
-        let spec = FitSpec {
-            effects: Vec::new(),
-            angle_weight_mm_per_deg: self.angle_weight_mm_per_deg,
-            noise,
-            loss,
-            fixed_rigidities,
-            max_iterations: self.max_iterations,
-            shapes: Arc::new(shapes),
-        };
-        Ok((spec, start, held_effects))
+        let settings = MeasurementSettings { angle_weight_mm_per_deg: self.angle_weight_mm_per_deg, noise, shapes: Arc::new(shapes) };
+        Ok((planar_spec(&[], fixed_rigidities, loss, self.max_iterations), settings, start, held_effects))
     }
 }
 
@@ -121,7 +115,7 @@ impl fmt::Display for CalibrateReport {
 pub struct MeasurementsCalibration {
     /// The fit.
     #[serde(flatten)]
-    pub fit: FitResult,
+    pub fit: FitResult<MeasurementsReport>,
     /// The error on the held-out routing.
     pub holdout: Option<RoutingRms>,
     /// Effects held at a value (`--fix`), with it.
@@ -170,15 +164,17 @@ fn calibrate_measurements(request: &CalibrateRequest, observe: &mut dyn FnMut(Ca
     actuator.validate()?;
     let options = &request.options;
     let (train, held) = split_holdout(data, request.holdout.as_deref())?;
-    let (mut spec, start, held_effects) = request.fit.resolve(&actuator, data)?;
+    let (spec, settings, start, held_effects) = request.fit.resolve(&actuator, data)?;
+    let mut effects = spec.effects();
     for &e in &request.effects {
-        if !spec.effects.contains(&e) {
-            spec.effects.push(e);
+        if !effects.contains(&e) {
+            effects.push(e);
         }
     }
-    if let Some(&effect) = spec.effects.iter().find(|e| held_effects.contains(e)) {
+    if let Some(&effect) = effects.iter().find(|e| held_effects.contains(e)) {
         return Err(CalibrateError::FittedAndHeld { effect });
     }
+    let spec = spec.with_effects(&effects);
     let large = data.rows.len() >= LARGE_DATA_ROWS;
     if large {
         // A fit re-simulates every reading (1 + parameters) times per
@@ -187,19 +183,19 @@ fn calibrate_measurements(request: &CalibrateRequest, observe: &mut dyn FnMut(Ca
         predict(&start, options, data, &train, false)?;
         // Central differences: two passes per parameter for the Jacobian,
         // plus the trial steps (at least two).
-        let passes = 2 * (3 + spec.effects.len()) + 2;
+        let passes = 2 * (3 + effects.len()) + 2;
         observe(CalibrateProgress::Cost { readings: data.rows.len(), pass_s: started.elapsed().as_secs_f64(), passes });
     }
-    let fit = fit_observed(&start, options, data, &train, &spec, &mut |p| {
+    let fit = fit_measurements(&start, options, data, &train, &settings, &spec, &mut |step| {
         if large {
-            observe(CalibrateProgress::Iteration(p));
+            observe(CalibrateProgress::Iteration(FitProgress::of(step)));
         }
     })?;
     let holdout = match &held {
         Some(g) => {
             let g = std::slice::from_ref(g);
-            let preds = predict(&fit.actuator, options, data, g, false)?;
-            Some(rms_per_routing(data, g, &preds, spec.angle_weight_mm_per_deg)[0].clone())
+            let preds = predict(fit.rod(), options, data, g, false)?;
+            Some(rms_per_routing(data, g, &preds, settings.angle_weight_mm_per_deg)[0].clone())
         }
         None => None,
     };
@@ -208,7 +204,7 @@ fn calibrate_measurements(request: &CalibrateRequest, observe: &mut dyn FnMut(Ca
         held_effects: held_effects.iter().map(|e| (*e, e.current(&start).unwrap_or(0.0))).collect(),
         readings: train.iter().map(|g| g.rows.len()).sum(),
         routings: train.len(),
-        noise: spec.noise,
+        noise: settings.noise,
         loss: spec.loss,
         fit,
     })
@@ -228,7 +224,7 @@ impl fmt::Display for MeasurementsCalibration {
             self.loss.describe()
         )?;
         for p in &result.parameters {
-            if p.fixed {
+            if p.status == super::fit::Status::Held {
                 writeln!(out, "  {:<30} {:>14.6}   (held)", p.name, p.value)?;
             } else {
                 writeln!(out, "  {:<30} {:>14.6} ± {}", p.name, p.value, crate::io::fmt_sig(p.se, 3))?;

@@ -316,7 +316,7 @@ pub fn synthesize_with_markers(spec: &SynthSpec, points: usize) -> Result<(Datas
                 }
                 if !spec.markers.is_empty() {
                     let on_body = spec.markers.iter().map(|&(s_mm, offset_mm)| {
-                        let exact = super::fit::simulated_marker(&Marker { s_mm, offset_mm, x_mm: 0.0, y_mm: 0.0 }, &line);
+                        let exact = super::observations::measurements::simulated_marker(&Marker { s_mm, offset_mm, x_mm: 0.0, y_mm: 0.0 }, &line);
                         Marker {
                             s_mm,
                             offset_mm,

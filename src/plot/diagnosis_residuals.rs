@@ -5,7 +5,7 @@
 use super::{draw_series_labels, register_fonts, PlotError, FONT};
 use crate::calibrate::data::{Dataset, Direction, RoutingGroup};
 use crate::calibrate::diagnose::Diagnosis;
-use crate::calibrate::fit::row_residual;
+use crate::calibrate::observations::measurements::row_residual;
 use crate::calibrate::predict::Prediction;
 use plotters::prelude::*;
 use std::path::Path;

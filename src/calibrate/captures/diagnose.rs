@@ -23,7 +23,9 @@
 
 use super::errors::ErrorReport;
 use super::files::CaptureSet;
-use super::fit::{fit_captures, Fit3Result, Fit3Spec, Status};
+use crate::calibrate::fit::{fit, FitResult, FitSpec, FittedParameter, FitReport, Loss, Status};
+use crate::calibrate::observations::captures::{Captures, CapturesReport};
+use crate::solver::SolverOptions;
 use crate::calibrate::Parameter;
 use super::simulate::solve_captures;
 use crate::calibrate::diagnose::criterion::{self, Candidate, NamedEffect};
@@ -39,7 +41,12 @@ use std::collections::BTreeMap;
 pub struct Diagnose3Spec {
     /// The body parameters to fit and the fit's settings (its `params` are
     /// the body's; the candidates are added to them).
-    pub fit: Fit3Spec,
+    pub fit: FitSpec,
+    /// The system's noise σ₀ per coordinate, mm, added in quadrature to a
+    /// marker's own `sd_mm`.
+    pub noise_mm: f64,
+    /// The 3-D solver's settings.
+    pub options: SolverOptions,
     /// Captures in which this cable (1-based) pulls are held out.
     pub holdout_cable: Option<usize>,
     /// Required BIC decrease against the model without the effect.
@@ -61,7 +68,11 @@ impl Diagnose3Spec {
 
 impl Default for Diagnose3Spec {
     fn default() -> Self {
-        Self { fit: Fit3Spec::default(), holdout_cable: None, threshold: 10.0, margin: 10.0, max_effects: 2, alpha: 1e-3 }
+        Self {
+            fit: FitSpec { params: Parameter::BODY.to_vec(), held: Vec::new(), loss: Loss::Squared, max_iterations: 40 },
+            noise_mm: 1.0,
+            options: SolverOptions::default(),
+            holdout_cable: None, threshold: 10.0, margin: 10.0, max_effects: 2, alpha: 1e-3 }
     }
 }
 
@@ -71,7 +82,8 @@ pub struct FitSummary {
     /// The model: the body and its effects.
     pub model: String,
     /// Parameters (name, value, SE, status).
-    pub parameters: Vec<super::fit::Fitted3>,
+    #[serde(serialize_with = "parameters_json")]
+    pub parameters: Vec<FittedParameter>,
     /// χ².
     pub chi2: f64,
     /// Degrees of freedom.
@@ -92,6 +104,11 @@ pub struct FitSummary {
     pub iterations: usize,
 }
 
+/// The parameters as a fit to 3-D markers writes them.
+fn parameters_json<S: serde::Serializer>(parameters: &[FittedParameter], serializer: S) -> Result<S::Ok, S::Error> {
+    CapturesReport::serialize_parameters(parameters, serializer)
+}
+
 fn model_name(effects: &[Effect]) -> String {
     if effects.is_empty() {
         "the body (rigidities and weight)".into()
@@ -100,7 +117,7 @@ fn model_name(effects: &[Effect]) -> String {
     }
 }
 
-fn summary(f: &Fit3Result, effects: &[Effect]) -> FitSummary {
+fn summary(f: &FitResult<CapturesReport>, effects: &[Effect]) -> FitSummary {
     FitSummary {
         model: model_name(effects),
         parameters: f.parameters.clone(),
@@ -131,7 +148,7 @@ pub struct Signature3 {
     pub summary: Vec<String>,
 }
 
-fn signature(set: &CaptureSet, f: &Fit3Result, effects: &[Effect]) -> Signature3 {
+fn signature(set: &CaptureSet, f: &FitResult<CapturesReport>, effects: &[Effect]) -> Signature3 {
     let mut by_cables: BTreeMap<String, Vec<f64>> = BTreeMap::new();
     let mut sums: BTreeMap<String, ([f64; 3], usize)> = BTreeMap::new();
     for (c, e) in set.captures.iter().zip(&f.errors.captures) {
@@ -222,13 +239,13 @@ pub struct Diagnosis3 {
     pub written: Vec<std::path::PathBuf>,
 }
 
-fn candidate(effect: Effect, reference_bic: f64, result: &Result<Fit3Result, CalibrateError>) -> Candidate {
+fn candidate(effect: Effect, reference_bic: f64, result: &Result<FitResult<CapturesReport>, CalibrateError>) -> Candidate {
     match result {
         Ok(f) => {
             let p = f.parameter(Parameter::Effect(effect)).expect("fitted effect");
             let mut flags = Vec::new();
             match p.status {
-                Status::Fitted => {}
+                Status::Fitted | Status::Held => {}
                 Status::Undetermined => flags.push(format!("{} is not determined by these data (held at its start)", p.name)),
                 Status::AtBound => flags.push(format!("{} is at the bound of its range", p.name)),
             }
@@ -259,7 +276,7 @@ fn candidate(effect: Effect, reference_bic: f64, result: &Result<Fit3Result, Cal
     }
 }
 
-impl Judged for Fit3Result {
+impl Judged for FitResult<CapturesReport> {
     fn chi2(&self) -> f64 {
         self.chi2
     }
@@ -288,15 +305,15 @@ impl Judged for Fit3Result {
 /// Captures as the diagnosis's evidence: the fitted captures, the
 /// settings, the body parameters the baseline determined and the
 /// candidate effects.
-struct Captures<'a> {
+struct CapturesEvidence<'a> {
     set: &'a CaptureSet,
     spec: &'a Diagnose3Spec,
     body: Vec<Parameter>,
     candidates: Vec<Effect>,
 }
 
-impl Evidence for Captures<'_> {
-    type Fit = Fit3Result;
+impl Evidence for CapturesEvidence<'_> {
+    type Fit = FitResult<CapturesReport>;
 
     fn search(&self) -> Search {
         Search::Frugal
@@ -306,41 +323,41 @@ impl Evidence for Captures<'_> {
         &self.candidates
     }
 
-    fn refit(&self, effects: &[Effect], reference: &Fit3Result) -> Result<Fit3Result, CalibrateError> {
+    fn refit(&self, effects: &[Effect], reference: &FitResult<CapturesReport>) -> Result<FitResult<CapturesReport>, CalibrateError> {
         let mut params = self.body.clone();
         params.extend(effects.iter().map(|&x| Parameter::Effect(x)));
         // From the reference's optimum, the new effect at its start.
         let mut start = reference.actuator.clone();
         let new = *effects.last().expect("a round adds an effect");
         Parameter::Effect(new).set(&mut start, new.start());
-        let spec = Fit3Spec { params, ..self.spec.fit.clone() };
-        fit_captures(&start, self.set, &spec, &mut |_| {})
+        let spec = FitSpec { params, ..self.spec.fit.clone() };
+        fit(&start, &Captures::new(self.set, self.spec.noise_mm, &self.spec.options), &spec, &mut |_| {})
     }
 
-    fn candidate(&self, effect: Effect, reference_bic: f64, fit: &Result<Fit3Result, CalibrateError>) -> Candidate {
+    fn candidate(&self, effect: Effect, reference_bic: f64, fit: &Result<FitResult<CapturesReport>, CalibrateError>) -> Candidate {
         candidate(effect, reference_bic, fit)
     }
 
-    fn not_converged(&self, baseline: &Fit3Result) -> String {
-        format!("the body fit did not converge ({}), so nothing can be concluded", baseline.termination)
+    fn not_converged(&self, baseline: &FitResult<CapturesReport>) -> String {
+        format!("the body fit did not converge ({}), so nothing can be concluded", baseline.report.termination)
     }
 
     fn nothing_counts(&self) -> String {
         "the body fit is consistent with the noise, but no candidate fit converged to a plausible value, so no effect can be ruled out".to_string()
     }
 
-    fn baseline_explains(&self, baseline: &Fit3Result) -> String {
+    fn baseline_explains(&self, baseline: &FitResult<CapturesReport>) -> String {
         format!(
             "the body (rigidities and weight) explains the markers to within the stated noise ({}) and no candidate effect is warranted",
             baseline.chi2_text()
         )
     }
 
-    fn model_explains(&self, model: &Model<Fit3Result>) -> String {
+    fn model_explains(&self, model: &Model<FitResult<CapturesReport>>) -> String {
         format!("{} explains the markers to within the stated noise ({})", model_name(&model.effects), model.fit.chi2_text())
     }
 
-    fn unexplained(&self, best: &Model<Fit3Result>, alpha: f64) -> String {
+    fn unexplained(&self, best: &Model<FitResult<CapturesReport>>, alpha: f64) -> String {
         format!(
             "even the best model tried ({}) stays above the stated noise: {}, below {:.0e} (chi-square test of the noise-whitened marker coordinates); the markers show something no candidate effect describes, or the noise is larger than stated",
             model_name(&best.effects),
@@ -371,7 +388,7 @@ pub fn diagnose_captures(base: &Actuator, set: &CaptureSet, spec: &Diagnose3Spec
         }
     };
     let body: Vec<Parameter> = spec.fit.params.iter().copied().filter(|p| !matches!(p, Parameter::Effect(_))).collect();
-    let baseline = fit_captures(base, &train, &Fit3Spec { params: body.clone(), ..spec.fit.clone() }, &mut |_| {})?;
+    let baseline = fit(base, &Captures::new(&train, spec.noise_mm, &spec.options), &FitSpec { params: body.clone(), ..spec.fit.clone() }, &mut |_| {})?;
     // The body parameters the baseline determined; undetermined ones stay held.
     let body: Vec<Parameter> = baseline.parameters.iter().filter(|p| p.status == Status::Fitted).map(|p| p.param).collect();
     let mut not_candidates = Vec::new();
@@ -386,7 +403,7 @@ pub fn diagnose_captures(base: &Actuator, set: &CaptureSet, spec: &Diagnose3Spec
         })
         .filter(|e| spec.fit.params.iter().all(|p| *p != Parameter::Effect(*e)))
         .collect();
-    let evidence = Captures { set: &train, spec, body, candidates };
+    let evidence = CapturesEvidence { set: &train, spec, body, candidates };
     let thresholds = Thresholds { rule: spec.rule(), max_effects: spec.max_effects, alpha: spec.alpha };
     let Rounds { verdict, reason, named: effects, partial_effects, ambiguous_between, separating_measurement, candidates: first, second_round, extended, best } =
         rounds::run(&evidence, &baseline, thresholds);
@@ -394,7 +411,7 @@ pub fn diagnose_captures(base: &Actuator, set: &CaptureSet, spec: &Diagnose3Spec
     let (extended, extended_effects) = (extended.fit, extended.effects);
     let (holdout_rms_before, holdout_rms_after) = match &test {
         Some(t) => {
-            let rms = |a: &Actuator| -> Result<f64, CalibrateError> { Ok(ErrorReport::of(t, &solve_captures(a, &spec.fit.options, t)?).rms_mm) };
+            let rms = |a: &Actuator| -> Result<f64, CalibrateError> { Ok(ErrorReport::of(t, &solve_captures(a, &spec.options, t)?).rms_mm) };
             (Some(rms(&baseline.actuator)?), Some(rms(&extended.actuator)?))
         }
         None => (None, None),
@@ -405,7 +422,7 @@ pub fn diagnose_captures(base: &Actuator, set: &CaptureSet, spec: &Diagnose3Spec
          `none` only when the body fit is consistent and a candidate fit converged, `unexplained` when the best model with one or two library effects has p < {:.0e}; \
          an effect is named when refitting it with the body lowers the BIC (n ln(Σρ/n) + p ln n) by at least {} against the model without it, leads the runner-up \
          by at least {} and has a plausible, determined value; effects are added forward-stepwise by the same rule (at most {}); only converged fits count",
-        spec.fit.noise_mm, spec.alpha, spec.alpha, spec.threshold, spec.margin, spec.max_effects
+        spec.noise_mm, spec.alpha, spec.alpha, spec.threshold, spec.margin, spec.max_effects
     );
     Ok(Diagnosis3 {
         verdict,

@@ -6,7 +6,6 @@
 //! - [`files`]: reading the captures and markers files (CSV, Parquet).
 //! - [`simulate`]: solving captures in warm-started chains; markers on the body.
 //! - [`errors`]: the markers' 3-D errors per capture, per marker and overall.
-//! - [`fit`]: the fit of rigidities, weight and effects.
 //! - [`synth`]: synthetic captures with a hidden effect and noise.
 //! - [`run`]: the `predict` and `calibrate` requests and their reports.
 //! - [`diagnose`]: the planar diagnosis's verdicts over the registry's effects in 3-D.
@@ -15,7 +14,6 @@
 pub mod diagnose;
 pub mod errors;
 pub mod files;
-pub mod fit;
 pub mod report;
 pub mod run;
 pub mod simulate;
@@ -24,6 +22,5 @@ pub mod synth;
 pub use diagnose::{diagnose_captures, Diagnose3Spec, Diagnosis3};
 pub use errors::ErrorReport;
 pub use files::{read_capture_set, Actuation, Capture, CaptureSet, MarkerReading};
-pub use fit::{fit_captures, Fit3Result, Fit3Spec};
 pub use run::{calibrate, calibrated_toml, diagnose_request, predict, CapturesCalibration, PredictReport, PredictRequest};
 pub use simulate::{solve_captures, CaptureSolution};

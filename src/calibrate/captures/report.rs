@@ -6,7 +6,7 @@
 
 use super::diagnose::{Diagnosis3, FitSummary};
 use super::files::{Actuation, Capture, CaptureSet};
-use super::fit::Status;
+use crate::calibrate::fit::Status;
 use super::simulate::solve_captures;
 use crate::calibrate::diagnose::markdown::candidate_table;
 use crate::calibrate::CalibrateError;
@@ -121,6 +121,7 @@ fn fit_section(out: &mut String, title: &str, f: &FitSummary) {
     for p in &f.parameters {
         let status = match p.status {
             Status::Fitted => "fitted",
+            Status::Held => "held",
             Status::Undetermined => "undetermined: held at its start",
             Status::AtBound => "at the bound of its range",
         };

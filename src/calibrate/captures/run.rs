@@ -9,7 +9,8 @@
 
 use super::errors::ErrorReport;
 use super::files::{read_capture_set, CaptureSet};
-use super::fit::{fit_captures, Fit3Result, Fit3Spec, Status};
+use crate::calibrate::fit::{fit, FitResult, FitSpec, Status};
+use crate::calibrate::observations::captures::{Captures, CapturesReport};
 use crate::calibrate::Parameter;
 use super::simulate::solve_captures;
 use super::diagnose::{diagnose_captures, Diagnose3Spec, Diagnosis3};
@@ -85,7 +86,7 @@ impl fmt::Display for PredictReport {
 pub struct CapturesCalibration {
     /// The fit on the fitted captures.
     #[serde(flatten)]
-    pub fit: Fit3Result,
+    pub fit: FitResult<CapturesReport>,
     /// Parameters held at a given value (`--fix`).
     pub held: Vec<(String, f64)>,
     /// The held-out cable (1-based), if any.
@@ -121,6 +122,7 @@ pub fn calibrated_toml(report: &CapturesCalibration, source: &Path) -> Result<St
     for p in &report.fit.parameters {
         match p.status {
             Status::Fitted => head.push_str(&format!("#   {} = {} ± {}\n", p.name, p.value, crate::io::fmt_sig(p.se, 3))),
+            Status::Held => head.push_str(&format!("#   {} = {} (held)\n", p.name, p.value)),
             Status::Undetermined => head.push_str(&format!("#   {} = {} (undetermined by the data: held at its start)\n", p.name, p.value)),
             Status::AtBound => head.push_str(&format!("#   {} = {} (run to the bound of its range: the data do not call for it)\n", p.name, p.value)),
         }
@@ -129,7 +131,7 @@ pub fn calibrated_toml(report: &CapturesCalibration, source: &Path) -> Result<St
     Ok(head + &body)
 }
 
-fn fitted_names(fit: &Fit3Result) -> String {
+fn fitted_names(fit: &FitResult<CapturesReport>) -> String {
     let names: Vec<&str> = fit.parameters.iter().filter(|p| p.status == Status::Fitted).map(|p| p.name.as_str()).collect();
     if names.is_empty() {
         "nothing".into()
@@ -174,8 +176,8 @@ pub fn calibrate(request: &CalibrateRequest, actuator_file: &Path, observe: &mut
             (train, Some(test))
         }
     };
-    let spec = Fit3Spec { params, noise_mm: request.fit.noise_mm, loss, max_iterations: request.fit.max_iterations, options: request.options.clone() };
-    let fit = fit_captures(&base, &train, &spec, observe)?;
+    let spec = FitSpec { params, held: Vec::new(), loss, max_iterations: request.fit.max_iterations };
+    let fit = fit(&base, &Captures::new(&train, request.fit.noise_mm, &request.options), &spec, observe)?;
     let holdout = match &test {
         Some(t) => Some(ErrorReport::of(t, &solve_captures(&fit.actuator, &request.options, t)?)),
         None => None,
@@ -215,6 +217,7 @@ impl fmt::Display for CapturesCalibration {
         for p in &fit.parameters {
             match p.status {
                 Status::Fitted => writeln!(out, "  {:<24} {:>14.6} ± {:<10}  (start {})", p.name, p.value, crate::io::fmt_sig(p.se, 3), crate::io::fmt_sig(p.start, 6))?,
+                Status::Held => writeln!(out, "  {:<24} {:>14.6}   (held)", p.name, p.value)?,
                 Status::Undetermined => writeln!(out, "  {:<24} {:>14.6}   undetermined by these data: held at its start", p.name, p.value)?,
                 Status::AtBound => writeln!(out, "  {:<24} {:>14.6}   at the bound of its range: the data do not call for it", p.name, p.value)?,
             }
@@ -232,7 +235,7 @@ impl fmt::Display for CapturesCalibration {
             crate::calibrate::stats::p_text(fit.p_value),
             if fit.p_value < 1e-3 { ": the model misses the markers by more than the stated noise" } else { ": consistent with the stated noise" }
         )?;
-        writeln!(out, "{} iterations: {}", fit.iterations, fit.termination)?;
+        writeln!(out, "{} iterations: {}", fit.iterations, fit.report.termination)?;
         if let (Some(k), Some(h)) = (self.holdout_cable, &self.holdout) {
             writeln!(out, "held out: the {} captures where cable {k} pulls, predicted with the fitted actuator:", h.captures.len())?;
             write!(out, "{h}")?;
@@ -262,7 +265,9 @@ pub fn diagnose_request(request: &DiagnoseRequest, actuator_file: &Path) -> Resu
         params.retain(|&p| p != Parameter::Density);
     }
     let spec = Diagnose3Spec {
-        fit: Fit3Spec { params, noise_mm: request.fit.noise_mm, loss, max_iterations: request.fit.max_iterations, options: request.options.clone() },
+        fit: FitSpec { params, held: Vec::new(), loss, max_iterations: request.fit.max_iterations },
+        noise_mm: request.fit.noise_mm,
+        options: request.options.clone(),
         holdout_cable: request.holdout_cable,
         threshold: request.threshold,
         margin: request.margin,

@@ -25,7 +25,10 @@ use super::rounds::{self, Evidence, Judged, Model, Rounds, Search, Thresholds};
 use super::Verdict;
 use crate::calibrate::data::{split_holdout, Dataset, Direction, RoutingGroup};
 use crate::calibrate::effect::Effect;
-use crate::calibrate::fit::{closest_on_centreline, fit, residuals, rms_per_routing, FitResult, FitSpec, RoutingRms};
+use crate::calibrate::fit::{FitResult, FitSpec, Loss};
+use crate::calibrate::observations::measurements::{
+    closest_on_centreline, fit_measurements, planar_spec, residuals, rms_per_routing, MeasurementSettings, MeasurementsReport, RoutingRms,
+};
 use crate::calibrate::predict::{predict, Prediction};
 use crate::calibrate::CalibrateError;
 use crate::model::Rod;
@@ -37,9 +40,11 @@ use serde::Serialize;
 pub struct DiagnoseSpec {
     /// Routing left out of every fit and used to measure the gap.
     pub holdout: Option<String>,
-    /// Noise, loss, held rigidities, iteration cap, shapes and the angle
-    /// weight of reported RMS values, for every fit (its `effects` are ignored).
+    /// The rigidities (some held), loss and iteration cap of every fit
+    /// (its effects are ignored).
     pub fit: FitSpec,
+    /// Noise, shapes and the angle weight of reported RMS values.
+    pub measurements: MeasurementSettings,
     /// Required BIC decrease against the model without the effect.
     pub threshold: f64,
     /// Required BIC lead over the runner-up.
@@ -62,7 +67,14 @@ impl DiagnoseSpec {
 
 impl Default for DiagnoseSpec {
     fn default() -> Self {
-        Self { holdout: None, fit: FitSpec::default(), threshold: 10.0, margin: 10.0, max_effects: 2, alpha: 1e-3, held_effects: Vec::new() }
+        Self {
+            holdout: None,
+            fit: planar_spec(&[], [false; 3], Loss::default(), 200),
+            measurements: MeasurementSettings::default(),
+            threshold: 10.0, margin: 10.0, max_effects: 2,
+            alpha: 1e-3,
+            held_effects: Vec::new(),
+        }
     }
 }
 
@@ -136,12 +148,12 @@ pub struct Diagnosis {
     /// Ranked candidates of the second round (given the first effect).
     pub second_round: Vec<Candidate>,
     /// The thesis-model fit.
-    pub baseline: FitResult,
+    pub baseline: FitResult<MeasurementsReport>,
     /// The final model's fit (the baseline if nothing was named).
-    pub extended: FitResult,
+    pub extended: FitResult<MeasurementsReport>,
     /// The best model tried (lowest χ² among the fits that count), whose
     /// residuals the signature describes.
-    pub best: FitResult,
+    pub best: FitResult<MeasurementsReport>,
     /// The residual's signature (with `unexplained`).
     pub signature: Option<Signature>,
     /// Residual diagnostics of the baseline.
@@ -162,7 +174,7 @@ pub struct Diagnosis {
     pub alpha: f64,
 }
 
-fn candidate(effect: Effect, reference_bic: f64, result: &Result<FitResult, CalibrateError>) -> Candidate {
+fn candidate(effect: Effect, reference_bic: f64, result: &Result<FitResult<MeasurementsReport>, CalibrateError>) -> Candidate {
     match result {
         Ok(f) => {
             let p = f.effect_parameter(effect).expect("fitted effect");
@@ -188,7 +200,7 @@ fn candidate(effect: Effect, reference_bic: f64, result: &Result<FitResult, Cali
     }
 }
 
-impl Judged for FitResult {
+impl Judged for FitResult<MeasurementsReport> {
     fn chi2(&self) -> f64 {
         self.chi2
     }
@@ -206,7 +218,7 @@ impl Judged for FitResult {
     }
 
     fn effect_parameter(&self, effect: Effect) -> Option<(f64, f64)> {
-        FitResult::effect_parameter(self, effect).map(|p| (p.value, p.se))
+        FitResult::<MeasurementsReport>::effect_parameter(self, effect).map(|p| (p.value, p.se))
     }
 
     fn chi2_text(&self) -> String {
@@ -216,7 +228,7 @@ impl Judged for FitResult {
 
 /// Planar measurements as the diagnosis's evidence: the training routings,
 /// the starting rod and every candidate not held.
-struct Measurements<'a> {
+struct MeasurementsEvidence<'a> {
     base: &'a Rod,
     options: &'a SolverOptions,
     data: &'a Dataset,
@@ -225,8 +237,8 @@ struct Measurements<'a> {
     candidates: Vec<Effect>,
 }
 
-impl Evidence for Measurements<'_> {
-    type Fit = FitResult;
+impl Evidence for MeasurementsEvidence<'_> {
+    type Fit = FitResult<MeasurementsReport>;
 
     fn search(&self) -> Search {
         Search::Thorough
@@ -236,23 +248,23 @@ impl Evidence for Measurements<'_> {
         &self.candidates
     }
 
-    fn refit(&self, effects: &[Effect], reference: &FitResult) -> Result<FitResult, CalibrateError> {
+    fn refit(&self, effects: &[Effect], reference: &FitResult<MeasurementsReport>) -> Result<FitResult<MeasurementsReport>, CalibrateError> {
         // Start from the baseline's starting rigidities (a reference fit
         // may have run a rigidity off to where it no longer matters) and
         // the reference's effects.
-        let mut start = reference.actuator.clone();
+        let mut start = reference.rod().clone();
         start.ea_n = self.base.ea_n;
         start.ga_n = self.base.ga_n;
         start.ei_n_mm2 = self.base.ei_n_mm2;
-        let fs = FitSpec { effects: effects.to_vec(), ..self.spec.fit.clone() };
-        fit(&start, self.options, self.data, self.train, &fs)
+        let fs = self.spec.fit.with_effects(effects);
+        fit_measurements(&start, self.options, self.data, self.train, &self.spec.measurements, &fs, &mut |_| {})
     }
 
-    fn candidate(&self, effect: Effect, reference_bic: f64, fit: &Result<FitResult, CalibrateError>) -> Candidate {
+    fn candidate(&self, effect: Effect, reference_bic: f64, fit: &Result<FitResult<MeasurementsReport>, CalibrateError>) -> Candidate {
         candidate(effect, reference_bic, fit)
     }
 
-    fn not_converged(&self, baseline: &FitResult) -> String {
+    fn not_converged(&self, baseline: &FitResult<MeasurementsReport>) -> String {
         format!(
             "the thesis-model fit did not converge ({} iterations{}), so nothing can be concluded; no verdict is drawn from unconverged fits",
             baseline.iterations,
@@ -264,7 +276,7 @@ impl Evidence for Measurements<'_> {
         "the thesis model is consistent with the noise, but no candidate fit converged to a plausible value, so no effect can be ruled out".to_string()
     }
 
-    fn baseline_explains(&self, baseline: &FitResult) -> String {
+    fn baseline_explains(&self, baseline: &FitResult<MeasurementsReport>) -> String {
         format!(
             "{} explains the data to within the stated noise ({}) and no candidate effect is warranted",
             if self.spec.held_effects.is_empty() {
@@ -278,11 +290,11 @@ impl Evidence for Measurements<'_> {
         )
     }
 
-    fn model_explains(&self, model: &Model<FitResult>) -> String {
+    fn model_explains(&self, model: &Model<FitResult<MeasurementsReport>>) -> String {
         format!("the model {} explains the data to within the stated noise ({})", model_name(&model.fit), model.fit.chi2_text())
     }
 
-    fn unexplained(&self, best: &Model<FitResult>, alpha: f64) -> String {
+    fn unexplained(&self, best: &Model<FitResult<MeasurementsReport>>, alpha: f64) -> String {
         format!(
             "even the best model tried ({}) stays above the stated noise: {}, below {:.0e} (chi-square test of the noise-whitened residuals); the data show something no candidate effect describes, or the noise is larger than stated",
             model_name(&best.fit),
@@ -298,21 +310,21 @@ pub fn diagnose(base: &Rod, options: &SolverOptions, data: &Dataset, spec: &Diag
         return Err(crate::calibrate::InvalidRequest::Alpha { alpha: spec.alpha }.into());
     }
     let (train, held) = split_holdout(data, spec.holdout.as_deref())?;
-    let w = spec.fit.angle_weight_mm_per_deg;
-    let baseline = fit(base, options, data, &train, &FitSpec { effects: Vec::new(), ..spec.fit.clone() })?;
+    let w = spec.measurements.angle_weight_mm_per_deg;
+    let baseline = fit_measurements(base, options, data, &train, &spec.measurements, &spec.fit.with_effects(&[]), &mut |_| {})?;
     let diagnostics = residual_diagnostics(data, &train, &baseline.predictions, w);
     let candidates: Vec<Effect> = Effect::ALL.into_iter().filter(|e| !spec.held_effects.contains(e)).collect();
-    let evidence = Measurements { base, options, data, train: &train, spec, candidates };
+    let evidence = MeasurementsEvidence { base, options, data, train: &train, spec, candidates };
     let thresholds = Thresholds { rule: spec.rule(), max_effects: spec.max_effects, alpha: spec.alpha };
     let Rounds { verdict, reason, named, partial_effects, ambiguous_between, separating_measurement, candidates, second_round, extended, best } =
         rounds::run(&evidence, &baseline, thresholds);
     let (extended, best) = (extended.fit, best.fit);
-    let signature = (verdict == Verdict::Unexplained).then(|| signature(data, &train, &best, &spec.fit));
+    let signature = (verdict == Verdict::Unexplained).then(|| signature(data, &train, &best, &spec.measurements));
     // Predict every row (the held-out routing too) with both models.
     let all = data.groups();
     let keep = true;
-    let baseline_predictions = predict(&baseline.actuator, options, data, &all, keep)?;
-    let extended_predictions = predict(&extended.actuator, options, data, &all, keep)?;
+    let baseline_predictions = predict(baseline.rod(), options, data, &all, keep)?;
+    let extended_predictions = predict(extended.rod(), options, data, &all, keep)?;
     let (holdout_rms_before, holdout_rms_after) = match &held {
         Some(g) => {
             let g = std::slice::from_ref(g);
@@ -328,7 +340,7 @@ pub fn diagnose(base: &Rod, options: &SolverOptions, data: &Dataset, spec: &Diag
          (n ln(Σρ/n) + p ln n) by at least {} against the model without it, leads the runner-up by at least {} and has physically plausible values; \
          effects are added forward-stepwise by the same rule (at most {}); only converged fits count",
         spec.fit.loss.describe(),
-        crate::calibrate::fit::OUTLIER_Z,
+        crate::calibrate::observations::measurements::OUTLIER_Z,
         spec.alpha,
         spec.alpha,
         spec.threshold,
@@ -360,7 +372,7 @@ pub fn diagnose(base: &Rod, options: &SolverOptions, data: &Dataset, spec: &Diag
 }
 
 /// "the thesis model" or "with friction + creep".
-pub fn model_name(f: &FitResult) -> String {
+pub fn model_name(f: &FitResult<MeasurementsReport>) -> String {
     if f.effects.is_empty() {
         "the thesis model".into()
     } else {
@@ -370,7 +382,7 @@ pub fn model_name(f: &FitResult) -> String {
 
 /// Where the residuals of `f` sit: by direction and tension, by routing,
 /// along the body (from shapes), with a few sentences.
-pub fn signature(data: &Dataset, groups: &[RoutingGroup], f: &FitResult, spec: &FitSpec) -> Signature {
+pub fn signature(data: &Dataset, groups: &[RoutingGroup], f: &FitResult<MeasurementsReport>, spec: &MeasurementSettings) -> Signature {
     let rows: Vec<usize> = groups.iter().flat_map(|g| g.rows.iter().copied()).collect();
     let max_t = rows.iter().map(|&i| data.rows[i].tension_n).fold(0.0, f64::max);
     let err = |i: usize| {
@@ -401,7 +413,7 @@ pub fn signature(data: &Dataset, groups: &[RoutingGroup], f: &FitResult, spec: &
     let mut by_routing: Vec<(String, f64, f64)> = f.per_routing.iter().map(|r| (r.routing.clone(), r.rms_position_mm, r.rms_angle_deg)).collect();
     by_routing.sort_by(|a, b| b.1.total_cmp(&a.1));
     // Along the body: shape residuals binned by quarter of the rest length.
-    let length = f.actuator.length_mm;
+    let length = f.rod().length_mm;
     let (mut ss, mut count) = ([0.0; 4], [0usize; 4]);
     let mut add = |s_mm: f64, d2: f64| {
         let q = ((s_mm / length * 4.0).floor().max(0.0) as usize).min(3);
@@ -416,7 +428,7 @@ pub fn signature(data: &Dataset, groups: &[RoutingGroup], f: &FitResult, spec: &
             add(s_mm, dist * dist);
         }
         for m in spec.shapes.markers.get(&id).into_iter().flatten() {
-            let q = crate::calibrate::fit::simulated_marker(m, line);
+            let q = crate::calibrate::observations::measurements::simulated_marker(m, line);
             add(m.s_mm, (q[0] - m.x_mm).powi(2) + (q[1] - m.y_mm).powi(2));
         }
     }

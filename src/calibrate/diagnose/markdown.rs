@@ -7,6 +7,7 @@ use super::criterion::Candidate;
 use super::Verdict;
 use crate::calibrate::data::{CentrelinePoints, Dataset};
 use crate::calibrate::fit::FitResult;
+use crate::calibrate::observations::measurements::MeasurementsReport;
 use crate::calibrate::predict::Prediction;
 use crate::calibrate::CalibrateError;
 use crate::plot::PlotError;
@@ -29,8 +30,8 @@ pub(super) fn write_report(
     std::fs::create_dir_all(dir)
         .map_err(|source| CalibrateError::Io { context: format!("creating report directory {}", dir.display()), source })?;
     let groups = data.groups();
-    let angle_weight_mm_per_deg = spec.fit.angle_weight_mm_per_deg;
-    let centrelines = (!spec.fit.shapes.centrelines.is_empty()).then_some(&spec.fit.shapes.centrelines);
+    let angle_weight_mm_per_deg = spec.measurements.angle_weight_mm_per_deg;
+    let centrelines = (!spec.measurements.shapes.centrelines.is_empty()).then_some(&spec.measurements.shapes.centrelines);
     // The second model in plots and tables, only when it differs from the thesis model.
     let after_label = (!d.extended.effects.is_empty()).then(|| model_label(&d.extended));
     let after_label = after_label.as_deref();
@@ -49,17 +50,17 @@ pub(super) fn write_report(
     };
     atomic("residuals.png", &|p| crate::plot::draw_diagnosis_residuals(p, data, &groups, d, after_label, angle_weight_mm_per_deg))?;
     atomic("loops.png", &|p| crate::plot::draw_diagnosis_loops(p, data, &groups, d, after_label))?;
-    let markers = (!spec.fit.shapes.markers.is_empty()).then_some(&spec.fit.shapes.markers);
+    let markers = (!spec.measurements.shapes.markers.is_empty()).then_some(&spec.measurements.shapes.markers);
     atomic("shapes.png", &|p| crate::plot::draw_diagnosis_shapes(p, data, &groups, d, centrelines, markers, after_label))?;
     crate::io::sync_dir(dir);
-    let md = markdown(data_path, data, d, after_label, centrelines, spec.fit.noise.mm);
+    let md = markdown(data_path, data, d, after_label, centrelines, spec.measurements.noise.mm);
     let path = dir.join("report.md");
     crate::io::write_atomic(&path, md.as_bytes())
         .map_err(|source| CalibrateError::Io { context: format!("writing {}", path.display()), source })?;
     Ok(path)
 }
 
-fn model_label(f: &FitResult) -> String {
+fn model_label(f: &FitResult<MeasurementsReport>) -> String {
     if f.effects.is_empty() {
         "thesis model".into()
     } else {
@@ -107,7 +108,7 @@ pub(crate) fn candidate_table(out: &mut String, cands: &[Candidate], rms: &str) 
 }
 
 /// One line on a fit's adequacy: χ², dof, χ²/dof, p, outliers, convergence.
-fn adequacy_line(f: &FitResult) -> String {
+fn adequacy_line(f: &FitResult<MeasurementsReport>) -> String {
     let mut line = format!(
         "χ² = {} on {} degrees of freedom, χ²/dof = {}, {}",
         num(f.chi2),
@@ -124,11 +125,11 @@ fn adequacy_line(f: &FitResult) -> String {
     line
 }
 
-fn fit_section(out: &mut String, title: &str, f: &FitResult) {
+fn fit_section(out: &mut String, title: &str, f: &FitResult<MeasurementsReport>) {
     let _ = writeln!(out, "### {title}\n");
     out.push_str("| parameter | value | SE |\n|---|---|---|\n");
     for p in &f.parameters {
-        let se = if p.fixed { "held".to_string() } else { num(p.se) };
+        let se = if p.status == crate::calibrate::fit::Status::Held { "held".to_string() } else { num(p.se) };
         let _ = writeln!(out, "| `{}` | {} | {} |", p.name, num(p.value), se);
     }
     let _ = writeln!(out, "\nAdequacy: {}.", adequacy_line(f));
@@ -304,7 +305,7 @@ fn coefficient_noise(prediction: &Option<Prediction>, count: usize, noise_mm: f6
 }
 
 fn coefficient_section(out: &mut String, data: &Dataset, d: &Diagnosis, centrelines: &CentrelinePoints, after_label: Option<&str>, noise_mm: f64) {
-    let length = d.baseline.actuator.length_mm;
+    let length = d.baseline.rod().length_mm;
     let mut rows = Vec::new();
     for g in data.groups() {
         let Some(i) = g.rows.iter().copied().filter(|i| centrelines.get(&data.rows[*i].measurement).is_some_and(|p| p.len() >= 5)).max_by(|&a, &b| data.rows[a].tension_n.total_cmp(&data.rows[b].tension_n)) else {
@@ -350,27 +351,30 @@ mod tests {
     use super::*;
     use crate::calibrate::stats::p_text;
 
-    fn fit_with_p(p_value: f64) -> FitResult {
+    fn fit_with_p(p_value: f64) -> FitResult<MeasurementsReport> {
         FitResult {
-            effects: Vec::new(),
-            actuator: crate::model::Rod::default(),
             parameters: Vec::new(),
             correlation: Vec::new(),
-            rss: 1.0,
+            loss: 1.0,
             n_residuals: 10,
             bic: 0.0,
             chi2: 5000.0,
             dof: 9,
             reduced_chi2: 555.6,
             p_value,
-            outliers: Vec::new(),
-            flags: Vec::new(),
-            implausible: false,
-            rms_mm: 1.0,
-            per_routing: Vec::new(),
             iterations: 3,
             converged: true,
-            predictions: Vec::new(),
+            termination: crate::numerics::lm::Termination::NoDescent,
+            actuator: crate::model::Actuator::with_cables(crate::model::Rod::default(), Vec::new()),
+            report: MeasurementsReport {
+                effects: Vec::new(),
+                outliers: Vec::new(),
+                flags: Vec::new(),
+                implausible: false,
+                rms_mm: 1.0,
+                per_routing: Vec::new(),
+                predictions: Vec::new(),
+            },
         }
     }
 

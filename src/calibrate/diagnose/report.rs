@@ -8,6 +8,7 @@ use super::criterion::{Candidate, NamedEffect};
 use super::Verdict;
 use crate::calibrate::captures::Diagnosis3;
 use crate::calibrate::fit::FitResult;
+use crate::calibrate::observations::measurements::MeasurementsReport;
 use crate::calibrate::Effect;
 use serde::Serialize;
 use std::fmt;
@@ -73,9 +74,9 @@ struct Json<'a> {
     second_round: &'a [Candidate],
     criterion: &'a str,
     alpha: f64,
-    baseline: &'a FitResult,
-    extended: &'a FitResult,
-    best: &'a FitResult,
+    baseline: &'a FitResult<MeasurementsReport>,
+    extended: &'a FitResult<MeasurementsReport>,
+    best: &'a FitResult<MeasurementsReport>,
     signature: &'a Option<Signature>,
     diagnostics: &'a ResidualDiagnostics,
     holdout: &'a Option<String>,
@@ -228,8 +229,8 @@ pub fn sig5(v: f64) -> String {
 
 /// The lines to paste to use the fitted model: flags for `simulate`,
 /// `design` and `sweep`-free commands, and the TOML block for a spec.
-pub fn next_step(fit: &FitResult) -> String {
-    let a = &fit.actuator;
+pub fn next_step(fit: &FitResult<MeasurementsReport>) -> String {
+    let a = fit.rod();
     let mut flags = vec![format!("--ea-n {}", sig5(a.ea_n)), format!("--ga-n {}", sig5(a.ga_n)), format!("--ei-n-mm2 {}", sig5(a.ei_n_mm2))];
     let mut toml = format!("[actuator]\nea_n = {}\nga_n = {}\nei_n_mm2 = {}\n", sig5(a.ea_n), sig5(a.ga_n), sig5(a.ei_n_mm2));
     // A non-uniform body stays as it was given (the fitted rigidities are

@@ -28,10 +28,11 @@ fn diagnose_measurements(request: &DiagnoseRequest) -> Result<MeasurementsDiagno
     let data = read_measurements(&request.data_path)?;
     let actuator = request.rod.resolve(data.actuator.as_ref())?;
     actuator.validate()?;
-    let (fit, start, held_effects) = request.fit.resolve(&actuator, &data)?;
+    let (fit, measurements, start, held_effects) = request.fit.resolve(&actuator, &data)?;
     let spec = DiagnoseSpec {
         holdout: request.holdout.clone(),
         fit,
+        measurements,
         threshold: request.threshold,
         margin: request.margin,
         max_effects: request.max_effects.max(1),
