@@ -7,7 +7,7 @@
 //! The input decides the kind: without an actuator file, planar readings
 //! of one in-plane cable; with one (`synth --actuator`), several-cable
 //! captures and 3-D markers in the format `calibrate`, `diagnose` and
-//! `predict` read ([`crate::calibrate::captures::synth`] generates them).
+//! `predict` read ([`crate::calibrate::synth::captures`] generates them).
 //! [`SynthRequest::check`] refuses once what the kind does not take.
 
 use crate::calibrate::data::{centrelines_csv, markers_csv, measurements_csv};
@@ -16,9 +16,9 @@ pub use crate::calibrate::synth::{HiddenEffect, HiddenEffectError, OUT_OF_LIBRAR
 use crate::calibrate::CalibrateError;
 use crate::io::FileError;
 use crate::model::routing::CONTROL_POINTS;
-use crate::calibrate::captures::files::{captures_csv, markers_3d_csv, read_captures};
-use crate::calibrate::captures::solve_captures;
-use crate::calibrate::captures::synth::{default_markers, default_plan, synth_captures, MarkerSpec};
+use crate::calibrate::observations::captures::files::{captures_csv, markers_3d_csv, read_captures};
+use crate::calibrate::observations::captures::simulate::solve_captures;
+use crate::calibrate::synth::captures::{default_markers, default_plan, synth_captures, MarkerSpec};
 use crate::model::rod::ActuatorFileError;
 use crate::model::{Actuator, ActuatorError, ParameterError, RodOverrides};
 use crate::solver::SolverOptions;

@@ -3,8 +3,9 @@
 //! (tests/data/soromox, MIT), and the 3-D fit's round trip on synthetic
 //! captures whose truth is known.
 
-use cablemap::calibrate::captures::synth::{default_plan, load_unload_plan, one_cable_at_a_time, synth_captures, MarkerSpec};
-use cablemap::calibrate::captures::{diagnose_captures, Diagnose3Spec, Diagnosis3};
+use cablemap::calibrate::synth::captures::{default_plan, load_unload_plan, one_cable_at_a_time, synth_captures, MarkerSpec};
+use cablemap::calibrate::diagnose::captures::{diagnose_captures, Diagnose3Spec, Diagnosis3};
+use cablemap::calibrate::observations::captures::files::{Capture, CaptureSet};
 use cablemap::calibrate::fit::{fit, FitSpec, Loss, Status};
 use cablemap::calibrate::observations::captures::Captures;
 use cablemap::calibrate::Parameter;
@@ -222,7 +223,7 @@ fn soromox_markers() -> Vec<MarkerSpec> {
 /// Synthetic captures of the tentacle (the file's materials) with `hidden`
 /// applied to the truth: each tendon alone at three levels, both at three
 /// pairs and one capture at rest, the four SoRoMoX markers, 1 mm noise.
-fn hidden(effect: impl Fn(&mut Actuator)) -> (Actuator, cablemap::calibrate::captures::CaptureSet) {
+fn hidden(effect: impl Fn(&mut Actuator)) -> (Actuator, CaptureSet) {
     // Each tendon alone at 2, 4.5, 7 N, at rest, and both at (4, 4), (7, 3),
     // (3, 7) N: the pairs bend the body out of either tendon's plane, which
     // separates effects on the cables' tension from effects on the body
@@ -233,7 +234,7 @@ fn hidden(effect: impl Fn(&mut Actuator)) -> (Actuator, cablemap::calibrate::cap
 }
 
 /// As [`hidden`], with the given captures and markers.
-fn hidden_in(effect: impl Fn(&mut Actuator), captures: Vec<cablemap::calibrate::captures::Capture>, markers: &[MarkerSpec]) -> (Actuator, cablemap::calibrate::captures::CaptureSet) {
+fn hidden_in(effect: impl Fn(&mut Actuator), captures: Vec<Capture>, markers: &[MarkerSpec]) -> (Actuator, CaptureSet) {
     let start = Actuator::read(std::path::Path::new(&soromox("actuator.toml"))).unwrap();
     let mut truth = start.clone();
     effect(&mut truth);
@@ -241,7 +242,7 @@ fn hidden_in(effect: impl Fn(&mut Actuator), captures: Vec<cablemap::calibrate::
     (start, set)
 }
 
-fn diagnosis(start: &Actuator, set: &cablemap::calibrate::captures::CaptureSet) -> Diagnosis3 {
+fn diagnosis(start: &Actuator, set: &CaptureSet) -> Diagnosis3 {
     let spec = Diagnose3Spec { noise_mm: 1.0, ..Diagnose3Spec::default() };
     let d = diagnose_captures(start, set, &spec).unwrap();
     println!("{d}");

@@ -10,7 +10,8 @@
 //! library's messages.
 
 use super::{actuator_with, bad, Failure, Result, SolverRequest};
-use cablemap::calibrate::captures::{self, PredictRequest};
+use cablemap::calibrate::predict::run as run_predict;
+use cablemap::calibrate::predict::PredictRequest;
 use cablemap::calibrate::diagnose::DiagnoseRequest;
 use cablemap::calibrate::{CalibrateError, CalibrateRequest, Effect, FitSettings, LossKind, Parameter};
 use cablemap::design::actuator::DesignActuator;
@@ -439,7 +440,7 @@ pub(crate) fn predict(py: Python<'_>, request_json: &str) -> PyResult<Finished> 
     let r: PredictPy = super::from_json(request_json, "predict").map_err(|e| e.into_py(py))?;
     detached(py, move || {
         let request = PredictRequest { captures: r.captures, markers: r.markers, actuator: r.actuator, rod: RodOverrides::default(), options: r.solver.options()? };
-        let report = captures::predict(&request).map_err(calibrate_failure)?;
+        let report = run_predict(&request).map_err(calibrate_failure)?;
         Ok((report.to_json_line(), report.to_string(), Vec::new()))
     })
 }

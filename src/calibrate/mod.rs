@@ -1,9 +1,9 @@
-//! Calibration and the model-discrepancy workflow: measurement
-//! files, synthetic data with a hidden effect, the fit of EA, GA, EI (thesis
-//! eq. 2.14) with or without extra effects, and the diagnosis that names the
-//! missing effect.
+//! Calibration and the model-discrepancy workflow: the observations a fit
+//! fits (planar measurement files, captures with 3-D markers:
+//! [`observations`]), synthetic data with a hidden effect, the one fit of
+//! the rigidities (thesis eq. 2.14), the weight and the effects ([`fit`]),
+//! and the one diagnosis that names the missing effect ([`diagnose`]).
 
-pub mod captures;
 pub mod data;
 pub mod diagnose;
 pub mod effect;
@@ -24,4 +24,4 @@ pub use error::{CalibrateError, HeldError, HeldItem, HoldoutError, InvalidReques
 pub use parameter::Parameter;
 pub use fit::{fit, FitResult, FitSpec, FittedParameter, Status};
 pub use request::{CalibrateRequest, DataKind, FitSettings, LossKind};
-pub use run::{run, run_observed, CalibrateProgress, CalibrateReport, MeasurementsCalibration};
+pub use run::{run, run_observed, CalibrateProgress, CalibrateReport, CapturesCalibration, MeasurementsCalibration};

@@ -1,9 +1,18 @@
 //! Simulating measurement rows: each routing's rows are solved in protocol
 //! order with one [`Simulator`], so tensions reuse warm starts and the load
-//! history (friction direction, creep) follows the experiment.
+//! history (friction direction, creep) follows the experiment. And the
+//! `predict` workflow: captures simulated with a given actuator, no fitting
+//! ([`run`]).
 
 use super::data::{Dataset, Direction, RoutingGroup};
-use super::CalibrateError;
+use super::observations::captures::errors::ErrorReport;
+use super::observations::captures::files::{read_actuator, read_actuator_set};
+use super::observations::captures::simulate::solve_captures;
+use super::{CalibrateError, Refused};
+use crate::model::RodOverrides;
+use serde::Serialize;
+use std::fmt;
+use std::path::PathBuf;
 use crate::model::{Rod, LoadDirection, Routing};
 use crate::solver::{CentrelinePoint, Hold, Simulator, SolverOptions, TipPose};
 use rayon::prelude::*;
@@ -93,6 +102,56 @@ pub fn predict(
         }
     }
     Ok(out)
+}
+
+/// What `predict` needs.
+#[derive(Debug, Clone)]
+pub struct PredictRequest {
+    /// The captures file.
+    pub captures: PathBuf,
+    /// The markers file (optional when the captures file has tip columns).
+    pub markers: Option<PathBuf>,
+    /// The actuator file.
+    pub actuator: PathBuf,
+    /// Rod settings: refused, the rod is the actuator file's.
+    pub rod: RodOverrides,
+    /// The 3-D solver's settings.
+    pub options: SolverOptions,
+}
+
+/// The markers' errors of a prediction; serialises to `predict --json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct PredictReport {
+    /// The actuator file used.
+    pub actuator: String,
+    /// The errors.
+    #[serde(flatten)]
+    pub errors: ErrorReport,
+}
+
+/// Simulates every capture with the request's actuator and reports the errors.
+pub fn run(request: &PredictRequest) -> Result<PredictReport, CalibrateError> {
+    if !request.rod.is_empty() {
+        return Err(Refused::RodOnPredict.into());
+    }
+    let actuator = read_actuator(&request.actuator)?;
+    let set = read_actuator_set(&request.captures, request.markers.as_deref(), &actuator)?;
+    let solutions = solve_captures(&actuator, &request.options, &set)?;
+    Ok(PredictReport { actuator: request.actuator.display().to_string(), errors: ErrorReport::of(&set, &solutions) })
+}
+
+impl PredictReport {
+    /// The `--json` object on one line.
+    pub fn to_json_line(&self) -> String {
+        serde_json::to_value(self).expect("a report serialises").to_string()
+    }
+}
+
+impl fmt::Display for PredictReport {
+    fn fmt(&self, out: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(out, "prediction with {} (no fitting)", self.actuator)?;
+        write!(out, "{}", self.errors)
+    }
 }
 
 #[cfg(test)]

@@ -3,14 +3,13 @@
 //! report them with standard errors, correlations and the RMS error per
 //! routing (and on a held-out routing); or, on captures with 3-D markers,
 //! the actuator's rigidities, weight and effects
-//! ([`crate::calibrate::captures::run`]).
+//! (`calibrate_captures`).
 //!
 //! [`run`] takes a [`CalibrateRequest`] and returns a [`CalibrateReport`],
 //! which serialises itself (the `--json` object) and displays itself (the
 //! text report).
 
 use super::data::{read_centrelines, read_markers, read_measurements, split_holdout, Dataset};
-use super::captures::run::CapturesCalibration;
 use super::fit::{FitResult, FitSpec, Loss};
 use super::observations::measurements::{apply_held, fit_measurements, planar_spec, rms_per_routing, FitProgress, MeasurementSettings, MeasurementsReport, Noise, RoutingRms, ShapeData};
 use super::predict::predict;
@@ -18,7 +17,14 @@ use super::request::{DataKind, FitSettings, LossKind};
 use super::{CalibrateError, CalibrateRequest, Effect};
 use crate::model::Rod;
 use crate::numerics::lm;
+use super::fit::{fit, Status};
+use super::observations::captures::errors::ErrorReport;
+use super::observations::captures::files::{read_actuator, read_actuator_set};
+use super::observations::captures::simulate::solve_captures;
+use super::observations::captures::{Captures, CapturesReport};
+use super::Parameter;
 use serde::{Serialize, Serializer};
+use std::path::PathBuf;
 use std::fmt;
 use std::path::Path;
 use std::sync::Arc;
@@ -154,10 +160,6 @@ pub fn run_observed(request: &CalibrateRequest, observe: &mut dyn FnMut(Calibrat
     }
 }
 
-fn calibrate_captures(request: &CalibrateRequest, actuator_file: &Path, observe: &mut dyn FnMut(CalibrateProgress)) -> Result<CapturesCalibration, CalibrateError> {
-    super::captures::run::calibrate(request, actuator_file, &mut |step| observe(CalibrateProgress::MarkerStep(step)))
-}
-
 fn calibrate_measurements(request: &CalibrateRequest, observe: &mut dyn FnMut(CalibrateProgress)) -> Result<MeasurementsCalibration, CalibrateError> {
     let data = &read_measurements(&request.data_path)?;
     let actuator = request.rod.resolve(data.actuator.as_ref())?;
@@ -280,5 +282,158 @@ impl fmt::Display for MeasurementsCalibration {
             writeln!(out, "warning: {f}")?;
         }
         writeln!(out, "cable stretch is not fitted: under tension control it is not identifiable")
+    }
+}
+
+/// A finished calibration on captures with 3-D markers; serialises to `fit.json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct CapturesCalibration {
+    /// The fit on the fitted captures.
+    #[serde(flatten)]
+    pub fit: FitResult<CapturesReport>,
+    /// Parameters held at a given value (`--fix`).
+    pub held: Vec<(String, f64)>,
+    /// The held-out cable (1-based), if any.
+    pub holdout_cable: Option<usize>,
+    /// The errors on the held-out captures, predicted with the fitted actuator.
+    pub holdout: Option<ErrorReport>,
+    /// Captures fitted.
+    pub captures_fitted: usize,
+    /// Wall time of the fit, s.
+    pub elapsed_s: f64,
+    /// The files written.
+    #[serde(skip)]
+    pub written: Vec<PathBuf>,
+}
+
+impl CapturesCalibration {
+    /// `fit.json`'s text (pretty-printed).
+    pub fn to_json_pretty(&self) -> String {
+        serde_json::to_string_pretty(self).expect("a report serialises")
+    }
+
+    /// One line of JSON.
+    pub fn to_json_line(&self) -> String {
+        serde_json::to_value(self).expect("a report serialises").to_string()
+    }
+}
+
+/// The actuator file of a fit: the start with the fitted values, and a
+/// header saying where they came from.
+pub fn calibrated_toml(report: &CapturesCalibration, source: &Path) -> Result<String, CalibrateError> {
+    let body = toml::to_string(&report.fit.actuator).map_err(crate::calibrate::InvalidRequest::CalibratedToml)?;
+    let mut head = format!("# cablemap calibrate: {} fitted to {} captures, starting from {}\n", fitted_names(&report.fit), report.captures_fitted, source.display());
+    for p in &report.fit.parameters {
+        match p.status {
+            Status::Fitted => head.push_str(&format!("#   {} = {} ± {}\n", p.name, p.value, crate::io::fmt_sig(p.se, 3))),
+            Status::Held => head.push_str(&format!("#   {} = {} (held)\n", p.name, p.value)),
+            Status::Undetermined => head.push_str(&format!("#   {} = {} (undetermined by the data: held at its start)\n", p.name, p.value)),
+            Status::AtBound => head.push_str(&format!("#   {} = {} (run to the bound of its range: the data do not call for it)\n", p.name, p.value)),
+        }
+    }
+    head.push_str(&format!("#   marker RMS {:.3} mm; χ²/dof {:.3}\n", report.fit.errors.rms_mm, report.fit.reduced_chi2));
+    Ok(head + &body)
+}
+
+fn fitted_names(fit: &FitResult<CapturesReport>) -> String {
+    let names: Vec<&str> = fit.parameters.iter().filter(|p| p.status == Status::Fitted).map(|p| p.name.as_str()).collect();
+    if names.is_empty() {
+        "nothing".into()
+    } else {
+        names.join(", ")
+    }
+}
+
+/// Runs a calibration of the actuator in `actuator_file` on the request's
+/// captures, reporting each accepted step to `observe`.
+fn calibrate_captures(request: &CalibrateRequest, actuator_file: &Path, observe: &mut dyn FnMut(CalibrateProgress)) -> Result<CapturesCalibration, CalibrateError> {
+    let started = std::time::Instant::now();
+    let loss = request.fit.loss(LossKind::Squares)?;
+    let mut base = read_actuator(actuator_file)?;
+    let set = read_actuator_set(&request.data_path, request.fit.markers.as_deref(), &base)?;
+    for &(p, v) in &request.fit.held {
+        if !(v.is_finite() && (matches!(p, Parameter::Effect(_)) || v > 0.0)) {
+            return Err(CalibrateError::Held(crate::calibrate::HeldError::NotPositive { name: p.name(), value: v }));
+        }
+        p.set(&mut base, v);
+    }
+    let is_held = |p: Parameter| request.fit.held.iter().any(|(h, _)| *h == p);
+    if let Some(&e) = request.effects.iter().find(|&&e| is_held(Parameter::Effect(e))) {
+        return Err(CalibrateError::FittedAndHeld { effect: e });
+    }
+    let mut params: Vec<Parameter> = Parameter::BODY.iter().copied().filter(|&p| !is_held(p)).collect();
+    if !base.rod.gravity.enabled {
+        params.retain(|&p| p != Parameter::Density);
+    }
+    params.extend(request.effects.iter().map(|&e| Parameter::Effect(e)));
+    let (train, test) = set.hold_out_cable(request.holdout_cable, base.cables.len())?;
+    let spec = FitSpec { params, held: Vec::new(), loss, max_iterations: request.fit.max_iterations };
+    let fit = fit(&base, &Captures::new(&train, request.fit.noise_mm, &request.options), &spec, &mut |step| observe(CalibrateProgress::MarkerStep(step)))?;
+    let holdout = match &test {
+        Some(t) => Some(ErrorReport::of(t, &solve_captures(&fit.actuator, &request.options, t)?)),
+        None => None,
+    };
+    let mut report = CapturesCalibration {
+        held: request.fit.held.iter().map(|(p, v)| (p.name().to_string(), *v)).collect(),
+        holdout_cable: request.holdout_cable,
+        holdout,
+        captures_fitted: train.captures.len(),
+        elapsed_s: started.elapsed().as_secs_f64(),
+        written: Vec::new(),
+        fit,
+    };
+    if let Some(dir) = &request.out {
+        let io = |context: String| move |source| CalibrateError::Io { context, source };
+        std::fs::create_dir_all(dir).map_err(io(format!("creating {}", dir.display())))?;
+        let toml_path = dir.join("calibrated.toml");
+        std::fs::write(&toml_path, calibrated_toml(&report, actuator_file)?).map_err(io(format!("writing {}", toml_path.display())))?;
+        let json_path = dir.join("fit.json");
+        std::fs::write(&json_path, report.to_json_pretty() + "\n").map_err(io(format!("writing {}", json_path.display())))?;
+        report.written = vec![toml_path, json_path];
+    }
+    Ok(report)
+}
+
+impl fmt::Display for CapturesCalibration {
+    fn fmt(&self, out: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let fit = &self.fit;
+        writeln!(
+            out,
+            "3-D fit of {} captures ({} marker coordinates, noise √(sd² + {} mm²) each); {:.1} s",
+            self.captures_fitted,
+            fit.n_residuals,
+            fit.noise_mm,
+            self.elapsed_s
+        )?;
+        for p in &fit.parameters {
+            match p.status {
+                Status::Fitted => writeln!(out, "  {:<24} {:>14.6} ± {:<10}  (start {})", p.name, p.value, crate::io::fmt_sig(p.se, 3), crate::io::fmt_sig(p.start, 6))?,
+                Status::Held => writeln!(out, "  {:<24} {:>14.6}   (held)", p.name, p.value)?,
+                Status::Undetermined => writeln!(out, "  {:<24} {:>14.6}   undetermined by these data: held at its start", p.name, p.value)?,
+                Status::AtBound => writeln!(out, "  {:<24} {:>14.6}   at the bound of its range: the data do not call for it", p.name, p.value)?,
+            }
+        }
+        for (name, v) in &self.held {
+            writeln!(out, "  {name:<24} {v:>14.6}   (held)")?;
+        }
+        write!(out, "{}", fit.errors)?;
+        writeln!(
+            out,
+            "χ² = {:.1} on {} dof (χ²/dof = {:.3}, {}){}",
+            fit.chi2,
+            fit.dof,
+            fit.reduced_chi2,
+            crate::calibrate::stats::p_text(fit.p_value),
+            if fit.p_value < 1e-3 { ": the model misses the markers by more than the stated noise" } else { ": consistent with the stated noise" }
+        )?;
+        writeln!(out, "{} iterations: {}", fit.iterations, fit.report.termination)?;
+        if let (Some(k), Some(h)) = (self.holdout_cable, &self.holdout) {
+            writeln!(out, "held out: the {} captures where cable {k} pulls, predicted with the fitted actuator:", h.captures.len())?;
+            write!(out, "{h}")?;
+        }
+        for p in &self.written {
+            writeln!(out, "wrote {}", p.display())?;
+        }
+        Ok(())
     }
 }

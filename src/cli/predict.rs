@@ -3,7 +3,8 @@
 //! the markers' 3-D errors per capture, per marker and overall.
 
 use super::ActuatorArgs;
-use cablemap::calibrate::captures::{self, PredictRequest};
+use cablemap::calibrate::predict;
+use cablemap::calibrate::predict::PredictRequest;
 use clap::Args;
 use std::io::Write;
 use std::path::PathBuf;
@@ -38,7 +39,7 @@ pub fn run(args: &PredictArgs) -> anyhow::Result<()> {
         rod: args.solver.overrides(),
         options: args.solver.solver_options(&cablemap::solver::SolverOptions::default()),
     };
-    let report = captures::predict(&request)?;
+    let report = predict::run(&request)?;
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
     if args.json {

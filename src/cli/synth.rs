@@ -4,7 +4,7 @@
 use super::{parse_list, ActuatorArgs};
 use cablemap::model::routing::CONTROL_POINTS;
 use cablemap::solver::SolverOptions;
-use cablemap::calibrate::captures::synth::MarkerSpec;
+use cablemap::calibrate::synth::captures::MarkerSpec;
 use cablemap::synth::{HiddenEffect, Markers, SynthRequest};
 use anyhow::bail;
 use clap::Args;

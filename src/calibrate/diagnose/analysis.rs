@@ -200,32 +200,6 @@ fn candidate(effect: Effect, reference_bic: f64, result: &Result<FitResult<Measu
     }
 }
 
-impl Judged for FitResult<MeasurementsReport> {
-    fn chi2(&self) -> f64 {
-        self.chi2
-    }
-
-    fn p_value(&self) -> f64 {
-        self.p_value
-    }
-
-    fn bic(&self) -> f64 {
-        self.bic
-    }
-
-    fn converged(&self) -> bool {
-        self.converged
-    }
-
-    fn effect_parameter(&self, effect: Effect) -> Option<(f64, f64)> {
-        FitResult::<MeasurementsReport>::effect_parameter(self, effect).map(|p| (p.value, p.se))
-    }
-
-    fn chi2_text(&self) -> String {
-        criterion::chi2_text(self.chi2, self.dof, self.reduced_chi2, self.p_value)
-    }
-}
-
 /// Planar measurements as the diagnosis's evidence: the training routings,
 /// the starting rod and every candidate not held.
 struct MeasurementsEvidence<'a> {

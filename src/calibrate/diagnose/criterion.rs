@@ -1,5 +1,5 @@
 //! The naming rule both diagnoses share (planar tip data in this folder's
-//! `analysis.rs`, 3-D markers in [`crate::calibrate::captures`]): a
+//! `analysis.rs`, 3-D markers in `captures.rs`): a
 //! candidate effect refitted with the body, the ranking of a round's
 //! candidates by BIC, and the decision of a round — an effect is named when
 //! its fit lowers the BIC by at least `threshold` against the model without

@@ -5,11 +5,15 @@
 //!
 //! [`run`] takes a [`DiagnoseRequest`] and returns a [`DiagnoseReport`],
 //! which serialises itself (the `--json` object) and displays itself (the
-//! summary). The naming rule (shared with the 3-D diagnosis of captures) is in
-//! [`criterion`], the planar workflow in [`analysis`], the Markdown report and its
-//! plots in [`markdown`].
+//! summary). The rounds and the verdict are one state machine for both
+//! kinds of data ([`rounds`]), the naming rule in [`criterion`]; each kind
+//! gives its refits and report: planar measurements in [`analysis`] (the
+//! Markdown report in [`markdown`]), captures with 3-D markers in
+//! [`captures`] (the report in [`captures_report`]).
 
 pub mod analysis;
+pub mod captures;
+pub mod captures_report;
 pub mod criterion;
 pub mod markdown;
 pub mod report;

@@ -6,7 +6,7 @@
 use super::analysis::{model_name, Diagnosis, ResidualDiagnostics, Signature};
 use super::criterion::{Candidate, NamedEffect};
 use super::Verdict;
-use crate::calibrate::captures::Diagnosis3;
+use super::captures::Diagnosis3;
 use crate::calibrate::fit::FitResult;
 use crate::calibrate::observations::measurements::MeasurementsReport;
 use crate::calibrate::Effect;

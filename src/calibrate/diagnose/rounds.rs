@@ -20,9 +20,10 @@
 //! The kind of data ([`Evidence`]) makes the fits and the sentences, and
 //! says how far to search ([`Search`]).
 
-use super::criterion::{decide, rank, Candidate, Decision, NamedEffect, Rule};
+use super::criterion::{self, decide, rank, Candidate, Decision, NamedEffect, Rule};
 use super::Verdict;
-use crate::calibrate::{CalibrateError, Effect};
+use crate::calibrate::fit::{FitReport, FitResult};
+use crate::calibrate::{CalibrateError, Effect, Parameter};
 use rayon::prelude::*;
 
 /// How far a diagnosis searches beyond the first round.
@@ -53,6 +54,32 @@ pub trait Judged {
     fn effect_parameter(&self, effect: Effect) -> Option<(f64, f64)>;
     /// "χ² = … on … dof, χ²/dof = …, p = …".
     fn chi2_text(&self) -> String;
+}
+
+impl<R: FitReport> Judged for FitResult<R> {
+    fn chi2(&self) -> f64 {
+        self.chi2
+    }
+
+    fn p_value(&self) -> f64 {
+        self.p_value
+    }
+
+    fn bic(&self) -> f64 {
+        self.bic
+    }
+
+    fn converged(&self) -> bool {
+        self.converged
+    }
+
+    fn effect_parameter(&self, effect: Effect) -> Option<(f64, f64)> {
+        self.parameter(Parameter::Effect(effect)).map(|p| (p.value, p.se))
+    }
+
+    fn chi2_text(&self) -> String {
+        criterion::chi2_text(self.chi2, self.dof, self.reduced_chi2, self.p_value)
+    }
 }
 
 /// A fit and the candidate effects fitted in it, in the order added.

@@ -9,7 +9,13 @@ use super::markdown::write_report;
 use super::report::{DiagnoseReport, MeasurementsDiagnosis};
 use crate::calibrate::data::read_measurements;
 use crate::calibrate::request::{DataKind, DiagnoseRequest};
-use crate::calibrate::CalibrateError;
+use super::captures::{diagnose_captures, Diagnose3Spec, Diagnosis3};
+use crate::calibrate::fit::FitSpec;
+use crate::calibrate::observations::captures::files::read_actuator_set;
+use crate::calibrate::observations::captures::files::read_actuator;
+use crate::calibrate::request::LossKind;
+use crate::calibrate::{CalibrateError, Parameter, Refused};
+use std::path::Path;
 
 /// Runs a diagnosis and writes its report (when asked for): a report
 /// directory inside a sweep run is refused first, before the measurements
@@ -17,7 +23,7 @@ use crate::calibrate::CalibrateError;
 pub fn run(request: &DiagnoseRequest) -> Result<DiagnoseReport, CalibrateError> {
     match request.check()? {
         DataKind::Measurements => diagnose_measurements(request).map(DiagnoseReport::Measurements),
-        DataKind::Captures { actuator_file } => crate::calibrate::captures::run::diagnose_request(request, actuator_file).map(DiagnoseReport::Captures),
+        DataKind::Captures { actuator_file } => diagnose_captures_request(request, actuator_file).map(DiagnoseReport::Captures),
     }
 }
 
@@ -45,4 +51,39 @@ fn diagnose_measurements(request: &DiagnoseRequest) -> Result<MeasurementsDiagno
         None => None,
     };
     Ok(MeasurementsDiagnosis { diagnosis, report })
+}
+
+/// Reads the request's files, runs [`diagnose_captures`] and writes the
+/// report directory when asked for (refused first when inside a sweep run,
+/// before anything is read); the report's files are in `written`.
+fn diagnose_captures_request(request: &DiagnoseRequest, actuator_file: &Path) -> Result<Diagnosis3, CalibrateError> {
+    if !request.fit.held.is_empty() {
+        return Err(Refused::HeldInCapturesDiagnosis.into());
+    }
+    let loss = request.fit.loss(LossKind::Squares)?;
+    if let Some(dir) = &request.report_dir {
+        crate::io::check_outside_run_dir(dir, "the report directory")?;
+    }
+    let base = read_actuator(actuator_file)?;
+    let set = read_actuator_set(&request.data_path, request.fit.markers.as_deref(), &base)?;
+    let mut params: Vec<Parameter> = Parameter::BODY.to_vec();
+    if !base.rod.gravity.enabled {
+        params.retain(|&p| p != Parameter::Density);
+    }
+    let spec = Diagnose3Spec {
+        fit: FitSpec { params, held: Vec::new(), loss, max_iterations: request.fit.max_iterations },
+        noise_mm: request.fit.noise_mm,
+        options: request.options.clone(),
+        holdout_cable: request.holdout_cable,
+        threshold: request.threshold,
+        margin: request.margin,
+        max_effects: request.max_effects,
+        alpha: request.alpha,
+    };
+    let mut d = diagnose_captures(&base, &set, &spec)?;
+    if let Some(dir) = &request.report_dir {
+        let sources = super::captures_report::ReportSources { captures: &request.data_path, markers: request.fit.markers.as_deref(), actuator: actuator_file };
+        d.written = super::captures_report::write_report(dir, sources, &set, &d, &request.options)?;
+    }
+    Ok(d)
 }

@@ -2,8 +2,8 @@
 //! (any hidden effect set on it) solved at every capture, its markers
 //! measured with Gaussian noise. How tests get 3-D data whose truth is known.
 
-use super::files::{Actuation, Capture, CaptureSet, MarkerReading};
-use super::simulate::solve_captures;
+use crate::calibrate::observations::captures::files::{Actuation, Capture, CaptureSet, MarkerReading};
+use crate::calibrate::observations::captures::simulate::solve_captures;
 use crate::calibrate::data::Direction;
 use crate::calibrate::rng::Rng;
 use crate::calibrate::CalibrateError;

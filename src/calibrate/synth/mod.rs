@@ -5,15 +5,18 @@
 //! top tension; unload in the same steps; rest again. Each step is held for
 //! the step dwell, the two rest states for the rest dwell.
 
+
+pub mod captures;
+
 use crate::model::ControlPoints;
-use super::data::{CentrelinePoints, Dataset, Direction, Marker, MarkerPoints, Measurement, RoutingGroup};
-use super::predict::predict_group;
-use super::rng::Rng;
-use super::{CalibrateError, InvalidRequest};
+use crate::calibrate::data::{CentrelinePoints, Dataset, Direction, Marker, MarkerPoints, Measurement, RoutingGroup};
+use crate::calibrate::predict::predict_group;
+use crate::calibrate::rng::Rng;
+use crate::calibrate::{CalibrateError, InvalidRequest};
 use crate::model::routing::CONTROL_POINTS;
 use crate::model::{Rod, Segment};
 use crate::solver::SolverOptions;
-use super::Effect;
+use crate::calibrate::Effect;
 
 /// Effects `synth` can hide that are deliberately not diagnosis candidates
 /// (nor registry entries), so that tests can check the diagnosis answers
@@ -316,7 +319,7 @@ pub fn synthesize_with_markers(spec: &SynthSpec, points: usize) -> Result<(Datas
                 }
                 if !spec.markers.is_empty() {
                     let on_body = spec.markers.iter().map(|&(s_mm, offset_mm)| {
-                        let exact = super::observations::measurements::simulated_marker(&Marker { s_mm, offset_mm, x_mm: 0.0, y_mm: 0.0 }, &line);
+                        let exact = crate::calibrate::observations::measurements::simulated_marker(&Marker { s_mm, offset_mm, x_mm: 0.0, y_mm: 0.0 }, &line);
                         Marker {
                             s_mm,
                             offset_mm,

@@ -5,9 +5,10 @@
 //! table of text cells, so every error names the file, the row and the
 //! column.
 
+use crate::model::Actuator;
 use crate::calibrate::error::RowConflict;
 use crate::calibrate::data::{check_unique_columns, column_index, read_table, Cells, Direction, Table};
-use crate::calibrate::CalibrateError;
+use crate::calibrate::{CalibrateError, HoldoutError};
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -118,6 +119,22 @@ impl CaptureSet {
         let captures: Vec<Capture> = self.captures.iter().filter(|c| keep(c)).cloned().collect();
         let markers = captures.iter().filter_map(|c| self.markers.get(&c.measurement).map(|m| (c.measurement, m.clone()))).collect();
         CaptureSet { captures, markers }
+    }
+
+    /// The captures fitted and those held out: with `cable` (1-based, of
+    /// `cables`), those where it does not pull and those where it does;
+    /// without, all and none.
+    pub fn hold_out_cable(&self, cable: Option<usize>, cables: usize) -> Result<(CaptureSet, Option<CaptureSet>), CalibrateError> {
+        let Some(k) = cable else { return Ok((self.clone(), None)) };
+        if k == 0 || k > cables {
+            return Err(HoldoutError::NoSuchCable { cable: k, cables }.into());
+        }
+        let train = self.subset(|c| !c.pulling_cables().contains(&k));
+        let test = self.subset(|c| c.pulling_cables().contains(&k));
+        if train.captures.is_empty() || test.captures.is_empty() {
+            return Err(HoldoutError::NotSeparable { cable: k, pulling: test.captures.len(), others: train.captures.len() }.into());
+        }
+        Ok((train, Some(test)))
     }
 }
 
@@ -355,6 +372,16 @@ pub fn markers_3d_csv(set: &CaptureSet) -> String {
         out.push_str(&format!("{id},{},{},{},{},{x},{y},{z},{sd}\n", m.marker, m.s_mm, m.offset_y_mm, m.offset_z_mm));
     }
     out
+}
+
+/// Reads an actuator file.
+pub(crate) fn read_actuator(path: &Path) -> Result<Actuator, CalibrateError> {
+    Actuator::read(path).map_err(|e| CalibrateError::Actuator(e.into()))
+}
+
+/// Reads captures and markers files for `actuator`'s cables and length.
+pub(crate) fn read_actuator_set(captures: &Path, markers: Option<&Path>, actuator: &Actuator) -> Result<CaptureSet, CalibrateError> {
+    read_capture_set(captures, markers, actuator.cables.len(), actuator.rod.length_mm)
 }
 
 #[cfg(test)]

@@ -4,10 +4,10 @@
 //! measured and simulated markers with the final model's body in two views
 //! (x–y and x–z, [`crate::plot::spatial`]).
 
-use super::diagnose::{Diagnosis3, FitSummary};
-use super::files::{Actuation, Capture, CaptureSet};
+use super::captures::{Diagnosis3, FitSummary};
+use crate::calibrate::observations::captures::files::{Actuation, Capture, CaptureSet};
 use crate::calibrate::fit::Status;
-use super::simulate::solve_captures;
+use crate::calibrate::observations::captures::simulate::solve_captures;
 use crate::calibrate::diagnose::markdown::candidate_table;
 use crate::calibrate::CalibrateError;
 use crate::solver::simulate::simulate_spatial_held;

@@ -21,13 +21,13 @@
 //! Gravity's scale is no candidate when the density is fitted: the two
 //! scale the same weight.
 
-use super::errors::ErrorReport;
-use super::files::CaptureSet;
+use crate::calibrate::observations::captures::errors::ErrorReport;
+use crate::calibrate::observations::captures::files::CaptureSet;
 use crate::calibrate::fit::{fit, FitResult, FitSpec, FittedParameter, FitReport, Loss, Status};
 use crate::calibrate::observations::captures::{Captures, CapturesReport};
 use crate::solver::SolverOptions;
 use crate::calibrate::Parameter;
-use super::simulate::solve_captures;
+use crate::calibrate::observations::captures::simulate::solve_captures;
 use crate::calibrate::diagnose::criterion::{self, Candidate, NamedEffect};
 use crate::calibrate::diagnose::rounds::{self, Evidence, Judged, Model, Rounds, Search, Thresholds};
 use crate::calibrate::diagnose::Verdict;
@@ -276,32 +276,6 @@ fn candidate(effect: Effect, reference_bic: f64, result: &Result<FitResult<Captu
     }
 }
 
-impl Judged for FitResult<CapturesReport> {
-    fn chi2(&self) -> f64 {
-        self.chi2
-    }
-
-    fn p_value(&self) -> f64 {
-        self.p_value
-    }
-
-    fn bic(&self) -> f64 {
-        self.bic
-    }
-
-    fn converged(&self) -> bool {
-        self.converged
-    }
-
-    fn effect_parameter(&self, effect: Effect) -> Option<(f64, f64)> {
-        self.parameter(Parameter::Effect(effect)).map(|p| (p.value, p.se))
-    }
-
-    fn chi2_text(&self) -> String {
-        criterion::chi2_text(self.chi2, self.dof, self.reduced_chi2, self.p_value)
-    }
-}
-
 /// Captures as the diagnosis's evidence: the fitted captures, the
 /// settings, the body parameters the baseline determined and the
 /// candidate effects.
@@ -373,20 +347,7 @@ pub fn diagnose_captures(base: &Actuator, set: &CaptureSet, spec: &Diagnose3Spec
     if !(spec.alpha > 0.0 && spec.alpha < 1.0) {
         return Err(crate::calibrate::InvalidRequest::Alpha { alpha: spec.alpha }.into());
     }
-    let (train, test) = match spec.holdout_cable {
-        None => (set.clone(), None),
-        Some(k) => {
-            if k == 0 || k > base.cables.len() {
-                return Err(crate::calibrate::HoldoutError::NoSuchCable { cable: k, cables: base.cables.len() }.into());
-            }
-            let train = set.subset(|c| !c.pulling_cables().contains(&k));
-            let test = set.subset(|c| c.pulling_cables().contains(&k));
-            if train.captures.is_empty() || test.captures.is_empty() {
-                return Err(crate::calibrate::HoldoutError::NotSeparable { cable: k, pulling: test.captures.len(), others: train.captures.len() }.into());
-            }
-            (train, Some(test))
-        }
-    };
+    let (train, test) = set.hold_out_cable(spec.holdout_cable, base.cables.len())?;
     let body: Vec<Parameter> = spec.fit.params.iter().copied().filter(|p| !matches!(p, Parameter::Effect(_))).collect();
     let baseline = fit(base, &Captures::new(&train, spec.noise_mm, &spec.options), &FitSpec { params: body.clone(), ..spec.fit.clone() }, &mut |_| {})?;
     // The body parameters the baseline determined; undetermined ones stay held.

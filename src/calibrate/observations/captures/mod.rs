@@ -12,9 +12,13 @@
 //! change far below the standard errors).
 
 use super::Observations;
-use crate::calibrate::captures::errors::ErrorReport;
-use crate::calibrate::captures::files::CaptureSet;
-use crate::calibrate::captures::simulate::{solve_captures, CaptureSolution};
+pub mod errors;
+pub mod files;
+pub mod simulate;
+
+use errors::ErrorReport;
+use files::CaptureSet;
+use simulate::{solve_captures, CaptureSolution};
 use crate::calibrate::fit::{Adequacy, Covariance, EffectBounds, FailedColumn, FitReport, FitRules, FitSpec, Fitted, FittedParameter, Status};
 use crate::calibrate::{stats, CalibrateError, InvalidRequest, NoiseError, Parameter};
 use crate::model::Actuator;
