@@ -22,7 +22,8 @@
 
 use super::friction::{MAX_PASSES as FRICTION_MAX_PASSES, TOLERANCE as FRICTION_TOLERANCE};
 use super::result::{PerCable, PlanarPoint};
-use super::{bending_moment, CentrelinePoint, ChannelSample, Simulator, SolveFailure, Strains, TipPose};
+use super::{bending_moment, CentrelinePoint, ChannelSample, PlanarState, SolveFailure, Strains, TipPose};
+use crate::model::Routing;
 use crate::shape::LengthBasis;
 use crate::numerics::anderson::Anderson;
 use crate::numerics::chebyshev::{self, next_coefficient, ESTIMATE_SAFETY, TAIL_COEFFICIENTS};
@@ -52,7 +53,7 @@ const MIN_WEIGHT_STEP: f64 = 1.0 / 1024.0;
 
 /// Nodes, integration matrix and state of the collocation.
 #[derive(Debug, Clone)]
-pub(super) struct Colloc {
+pub struct Colloc {
     /// Intervals per span (m); m + 1 nodes per span.
     m: usize,
     /// Integration matrix on [−1, 1], row-major: q[j][k] = ∫_{−1}^{x_j} ℓ_k(x) dx.
@@ -98,7 +99,7 @@ pub(super) struct Colloc {
     /// Rows of the discrete Chebyshev transform of a span's node values
     /// for its [`TAIL_COEFFICIENTS`] highest coefficients c_{m−2}, c_{m−1},
     /// c_m, row-major: their size is about the interpolant's error, the
-    /// a posteriori estimate of [`Simulator::colloc_error_estimate`].
+    /// a posteriori estimate of [`PlanarState::colloc_error_estimate`].
     tail: Vec<f64>,
     /// Anderson acceleration memory.
     anderson: Anderson,
@@ -367,10 +368,9 @@ fn turn((sn, cs): (f64, f64), delta: f64, phi: f64) -> (f64, f64) {
     }
 }
 
-impl Simulator {
+impl PlanarState {
     /// Places the nodes on the knot spans of `built` and samples the channel there.
-    pub(super) fn colloc_set_routing(&mut self, built: &super::Routing) {
-        let mut c = self.col.take().expect("collocation state");
+    pub(super) fn colloc_set_routing(&mut self, c: &mut Colloc, built: &Routing) {
         let knot = built.knot_mm();
         let bounds = super::span_boundaries(&self.actuator, self.body.as_ref(), knot);
         assert_eq!(bounds.len() - 1, c.spans(), "span count fixed by the actuator");
@@ -420,19 +420,11 @@ impl Simulator {
             }
         }
         self.cable_rest_length_mm = rest;
-        self.col = Some(c);
     }
 
     /// Solves for `tension` from the warm start; returns the passes used
     /// (sweeps, plus Newton iterations if the fallback ran).
-    pub(super) fn colloc_solve(&mut self, tension: f64) -> Result<u32, SolveFailure> {
-        let mut c = self.col.take().expect("collocation state");
-        let result = self.colloc_solve_with(&mut c, tension);
-        self.col = Some(c);
-        result
-    }
-
-    fn colloc_solve_with(&mut self, c: &mut Colloc, tension: f64) -> Result<u32, SolveFailure> {
+    pub(super) fn colloc_solve(&mut self, c: &mut Colloc, tension: f64) -> Result<u32, SolveFailure> {
         c.predict(tension);
         let has_weight = self.weight_n_per_mm != 0.0;
         let has_friction = self.friction.acts_at(tension);
@@ -892,8 +884,7 @@ impl Simulator {
     /// its highest Chebyshev coefficients, is what the integral misses. An
     /// error of M turns the rod by about δM·L/EI, and an error of the angle
     /// moves the tip by up to ℓ times it.
-    pub(super) fn colloc_error_estimate(&self) -> (f64, f64) {
-        let c = self.col.as_ref().expect("collocation state");
+    pub(super) fn colloc_error_estimate(&self, c: &Colloc) -> (f64, f64) {
         let np = c.np();
         let gravity = self.weight_n_per_mm != 0.0;
         let (mut phi_error, mut moment_error, mut position_error) = (0.0, 0.0, 0.0);
@@ -928,7 +919,7 @@ impl Simulator {
     }
 
     /// The cable's displacement at the base, mm: the rest path length
-    /// (kept at [`Simulator::colloc_set_routing`]) less the deformed one,
+    /// (kept at [`PlanarState::colloc_set_routing`]) less the deformed one,
     /// ∫ |(v1 − u y_c, v2 + y_c')| ds over the spans the cable runs in (the
     /// same span quadrature), plus its stretch ∫ τ(s)/EA dℓ.
     fn colloc_displacement_mm(&self, c: &Colloc, tension: f64) -> f64 {
@@ -953,8 +944,7 @@ impl Simulator {
     }
 
     /// The pose of the converged state.
-    pub(super) fn colloc_pose(&self, tension: f64, passes: u32) -> TipPose {
-        let c = self.col.as_ref().expect("collocation state");
+    pub(super) fn colloc_pose(&self, c: &Colloc, tension: f64, passes: u32) -> TipPose {
         let tip = c.s.len() - 1;
         let (et, e0) = (c.strain[tip], c.strain[0]);
         TipPose {
@@ -981,8 +971,7 @@ impl Simulator {
     /// its node values, so it misses about the size of their highest
     /// Chebyshev coefficients times the span's length; an error δθ of the
     /// angles adds (2n+1)/ℓ·δθ·(2 + ∫|P_n′| dt), with ∫|P_n′| dt ≤ √(2n(n+1)).
-    pub(super) fn colloc_coefficients(&self, basis: LengthBasis, out: &mut [f64]) -> (f64, usize) {
-        let c = self.col.as_ref().expect("collocation state");
+    pub(super) fn colloc_coefficients(&self, c: &Colloc, basis: LengthBasis, out: &mut [f64]) -> (f64, usize) {
         out.iter_mut().for_each(|a| *a = 0.0);
         if out.is_empty() {
             return (0.0, 0);
@@ -1044,8 +1033,7 @@ impl Simulator {
     /// points, interpolated from the nodes (spectrally accurate on each span),
     /// plus one exactly at the anchor of a cable knotted before the tip, where
     /// its path ends: beyond it the channel and cable fields are NaN.
-    pub(super) fn colloc_centreline(&self) -> Vec<CentrelinePoint> {
-        let c = self.col.as_ref().expect("collocation state");
+    pub(super) fn colloc_centreline(&self, c: &Colloc) -> Vec<CentrelinePoint> {
         let routing = self.routing.as_ref().expect("routing");
         let np = c.np();
         let count = 2 * self.options.planar_steps_per_span + 1;
@@ -1095,25 +1083,25 @@ impl Simulator {
 mod tests {
     use super::*;
     use crate::model::Rod;
-    use crate::solver::SolverOptions;
+    use crate::solver::{PlanarSolver, SolverOptions};
 
     /// The tip, tip angle and a_0 … a_order of a ladder up to `tension` at
     /// `m` intervals, with the tip's and the coefficients' error estimates.
     fn estimated(a: &Rod, m: usize, y: &[f64], tension: f64, order: usize) -> Option<([f64; 3], Vec<f64>, f64, f64)> {
-        let mut sim = Simulator::new(a, &SolverOptions { nodes_per_span: m, ..SolverOptions::default() }).ok()?;
+        let mut sim = PlanarSolver::<Colloc>::new(a, &SolverOptions { nodes_per_span: m, ..SolverOptions::default() }).ok()?;
         sim.set_routing_mm(y).ok()?;
         let rungs = crate::solver::ladder::tension_rungs(tension);
         let mut pose = None;
         for k in 1..=rungs {
             let t = tension * k as f64 / rungs as f64;
-            let passes = sim.colloc_solve(t).ok()?;
-            pose = Some(sim.colloc_pose(t, passes));
+            let passes = sim.state.colloc_solve(&mut sim.integrator, t).ok()?;
+            pose = Some(sim.state.colloc_pose(&sim.integrator, t, passes));
         }
         let pose = pose?;
-        let (theta_error, tip_error) = sim.colloc_error_estimate();
-        sim.theta_error_rad = theta_error;
+        let (theta_error, tip_error) = sim.state.colloc_error_estimate(&sim.integrator);
+        sim.state.theta_error_rad = theta_error;
         let mut c = vec![0.0; order + 1];
-        let (a_error, _) = sim.colloc_coefficients(crate::shape::LengthBasis::Rest, &mut c);
+        let (a_error, _) = sim.state.colloc_coefficients(&sim.integrator, crate::shape::LengthBasis::Rest, &mut c);
         Some(([pose.tip_x_mm, pose.tip_y_mm, pose.tip_angle_rad], c, tip_error, a_error))
     }
 

@@ -36,7 +36,7 @@ pub(crate) struct Creep {
     gain_times_ei: f64,
     /// Whether every solve starts from a rod with no load history (the
     /// default, held `effects.creep_hold_s`), or follows a protocol set by
-    /// `Simulator::set_hold`.
+    /// `PlanarSolver::set_hold`.
     virgin_holds: bool,
 }
 

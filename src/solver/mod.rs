@@ -13,10 +13,12 @@
 //! fixed-point sweeps and Newton's method), or with classical RK4
 //! ([`SolverMethod::Rk4`], the reference the collocation is checked against, in `rk4`).
 //!
-//! One file per piece: this file holds the cut equations shared by both
-//! integrators ([`Simulator::strains_at`]) and the public API; `collocation`
-//! and `rk4` are the two integrators; `continuation` is RK4's warm-start
-//! predictor; `friction` and `creep` are the two effects with state.
+//! One file per piece: this file holds the state both planar backends
+//! share and the cut equations ([`PlanarState::strains_at`]); `planar` the
+//! planar backends ([`PlanarSolver`] over one [`Integrator`], written once
+//! around the integration); `collocation` and `rk4` are the two
+//! integrators; `continuation` is RK4's warm-start predictor; `friction` and
+//! `creep` are the two effects with state.
 //!
 //! Gravity's moment beyond the cut, M_W(s), depends on the distal shape; it
 //! obeys M_W' = w (L − s)(y' cos β − x' sin β) with M_W(L) = 0, so its value at
@@ -25,10 +27,10 @@
 //! shooting at all.
 //!
 //! Effects (model-notes §6) enter as local terms: the bending law
-//! ([`Simulator::bending_curvature`]), the clamp boundary (`clamp_angle` in
+//! ([`PlanarState::bending_curvature`]), the clamp boundary (`clamp_angle` in
 //! each integrator), the routing (channel offset) and the weight.
 //! The section's rigidities and the weight beyond a cut are looked up in one
-//! place each ([`Simulator::section_at`], [`Simulator::distal_weight_n`]),
+//! place each ([`PlanarState::section_at`], [`PlanarState::distal_weight_n`]),
 //! and the bending moment at a cut is one function ([`bending_moment`]).
 //!
 //! Two effects carry state beyond one point, each a small state type with
@@ -44,7 +46,7 @@
 //! (σ is the deformed arc length throughout.)
 //!
 //! The hot paths (RK4's `integrate`, collocation's sweeps) work in buffers
-//! allocated once per [`Simulator`]; solving allocates nothing, except in
+//! allocated once per [`PlanarSolver`]; solving allocates nothing, except in
 //! collocation's Newton fallback for heavy rods (a dense Jacobian).
 
 use crate::model::parameter::ParameterError;
@@ -71,6 +73,8 @@ pub mod result;
 mod rk4;
 pub mod simulate;
 pub mod options;
+pub mod planar;
+mod simulator;
 
 pub use backend::{Backend, Given, Support, Unsupported};
 pub use error::SimulateError;
@@ -81,6 +85,8 @@ pub use simulate::{
     MAX_AUTO_STEPS_PER_SPAN, MAX_LADDER_TENSION_N,
 };
 pub use options::{SolverMethod, SolverOptions};
+pub use planar::{Integrator, PlanarSolver};
+pub use simulator::{PlanarCollocation, PlanarRk4, Simulator};
 use creep::Creep;
 use friction::Friction;
 
@@ -256,10 +262,12 @@ fn bending_moment(tension: f64, channel_y_mm: f64, cos_alpha: f64, distal_moment
     tension * channel_y_mm * cos_alpha + distal_moment
 }
 
-/// A reusable solver for one actuator: set a routing, then solve tensions
-/// (in rising order for the best warm starts). Holds all buffers it needs.
+/// The state both planar backends share ([`PlanarSolver`]): the rod, the
+/// routing's channel at the integrator's points, the hold, the effects
+/// with state (friction, creep's load history) and the warm starts of the
+/// cut equations; the cut equations themselves ([`PlanarState::strains_at`]).
 #[derive(Debug, Clone)]
-pub struct Simulator {
+pub struct PlanarState {
     actuator: Rod,
     options: SolverOptions,
     weight_n_per_mm: f64,
@@ -276,10 +284,6 @@ pub struct Simulator {
     friction: Friction,
     /// Creep: the hold and the load history per point.
     creep: Creep,
-    /// Collocation state (`None` with the RK4 method).
-    col: Option<Box<collocation::Colloc>>,
-    /// RK4 state (also sized with collocation: it is small).
-    rk4: rk4::Rk4,
     /// The non-uniform body (radius profile, segments); `None` for the
     /// uniform cylinder, solved on the fast path.
     body: Option<Body>,
@@ -296,7 +300,7 @@ pub struct Simulator {
     /// (the coefficients' error estimate starts from it).
     theta_error_rad: f64,
     /// The estimated error of the largest coefficient asked for in the
-    /// last [`Simulator::coefficients_into`], mm⁻¹, and its index.
+    /// last [`PlanarSolver::coefficients_into`], mm⁻¹, and its index.
     coefficient_error: (f64, usize),
     /// The routing as given (before the channel offset), for the probe.
     given_routing: Option<Routing>,
@@ -330,165 +334,7 @@ impl Hold {
     }
 }
 
-impl Simulator {
-    /// Creates a solver for `actuator`; fails on invalid parameters.
-    pub fn new(rod: &Rod, options: &SolverOptions) -> Result<Self, SimulateError> {
-        rod.validate().map_err(ParameterError::from)?;
-        // The upper bound keeps a typo (2e9 steps) from exhausting memory.
-        if options.planar_steps_per_span < 2 || options.planar_steps_per_span % 2 != 0 || options.planar_steps_per_span > MAX_STEPS_PER_SPAN {
-            return Err(ParameterError::OutOfRange {
-                name: "steps_per_span",
-                value: options.planar_steps_per_span as f64,
-                expected: "an even number from 2 to 100000",
-            }.into());
-        }
-        if options.method == SolverMethod::Collocation && !(4..=MAX_NODES_PER_SPAN).contains(&options.nodes_per_span) {
-            return Err(ParameterError::OutOfRange {
-                name: "nodes_per_span",
-                value: options.nodes_per_span as f64,
-                expected: "between 4 and 64",
-            }.into());
-        }
-        let n = options.planar_steps_per_span;
-        // Material stiffening's curvature law u(m) has complex branch points
-        // near the real axis (1 + 3 α r² u² = 0), which slows the spectral
-        // convergence: 10 intervals leave 2e-6 rad there, 16 leave 1e-8.
-        let m = if rod.effects.stiffening_alpha > 0.0 {
-            options.nodes_per_span.max(MIN_NODES_WITH_STIFFENING)
-        } else {
-            options.nodes_per_span
-        };
-        let body = rod.body().map_err(ParameterError::from)?;
-        Backend::check_planar(rod, options, Given::default())?;
-        let spans = span_boundaries(rod, body.as_ref(), 0.5 * rod.cable_length_mm()).len() - 1;
-        // Per-point buffers: RK4 stage points, or collocation nodes.
-        let points = match options.method {
-            SolverMethod::Rk4 => 2 * (2 * n + 1),
-            SolverMethod::Collocation => spans * (m + 1),
-        };
-        let col = (options.method == SolverMethod::Collocation).then(|| Box::new(collocation::Colloc::new(m, spans)));
-        let beta = rod.gravity.direction_rad;
-        // A non-uniform body's weight is this factor times ∫ ρ r² (Body).
-        let weight_n_per_mm = match &body {
-            None => rod.weight_n_per_mm(),
-            Some(_) if !rod.gravity.enabled => 0.0,
-            Some(_) => rod.gravity.scale * 1e-6 * std::f64::consts::PI * rod.gravity.g_m_s2,
-        };
-        Ok(Self {
-            actuator: rod.clone(),
-            options: options.clone(),
-            weight_n_per_mm,
-            gravity_cos: beta.cos(),
-            gravity_sin: beta.sin(),
-            routing: None,
-            channel: vec![ChannelSample::default(); points],
-            cable_dir: vec![(1.0, 0.0); points],
-            last_tension_n: None,
-            friction: Friction::new(rod.effects.friction_mu, rod.effects.load_direction.slip_sign(), points),
-            creep: Creep::new(&rod.effects, rod.ei_n_mm2, points),
-            col,
-            rk4: rk4::Rk4::new(n),
-            body,
-            cable_end: points,
-            cable_rest_length_mm: 0.0,
-            cable_ea_n: None,
-            theta_error_rad: 0.0,
-            coefficient_error: (0.0, 0),
-            given_routing: None,
-            hold: Hold::default(),
-            probe: None,
-            is_probe: false,
-        })
-        .and_then(|mut sim: Simulator| {
-            // Outside a protocol every solve is held like this from a virgin rod.
-            let hold = Hold { direction: rod.effects.load_direction, dwell_s: rod.effects.creep_hold_s };
-            hold.check()?;
-            sim.apply_hold(hold);
-            Ok(sim)
-        })
-    }
-
-    /// The actuator this solver was built for.
-    pub fn actuator(&self) -> &Rod {
-        &self.actuator
-    }
-
-    /// Validates `y_mm` against the actuator and sets it as the routing.
-    pub fn set_routing_mm(&mut self, y_mm: &[f64]) -> Result<(), crate::model::routing::RoutingError> {
-        let routing = Routing::for_actuator(y_mm, &self.actuator)?;
-        self.set_routing(&routing);
-        Ok(())
-    }
-
-    /// Sets the routing (precomputing the channel at every stage point) and
-    /// forgets the warm start. The routing must span the cable's length
-    /// (build it with [`Routing::for_actuator`]).
-    pub fn set_routing(&mut self, routing: &Routing) {
-        debug_assert!((routing.length_mm() - self.actuator.cable_length_mm()).abs() <= 1e-9 * self.actuator.length_mm);
-        let delta = self.actuator.effects.channel_offset_mm;
-        let built = if delta != 0.0 { routing.shifted(delta) } else { routing.clone() };
-        if self.col.is_some() {
-            self.colloc_set_routing(&built);
-        } else {
-            self.rk4_set_routing(&built);
-        }
-        self.routing = Some(built);
-        self.given_routing = Some(routing.clone());
-        if let Some(p) = self.probe.as_mut() {
-            p.stale();
-        }
-        self.reset_warm_start();
-        self.reset_history();
-        self.last_tension_n = None;
-    }
-
-    /// Sets the cable's axial stiffness EA, N (`None`: inextensible), which
-    /// the pose's displacement adds the cable's stretch with (collocation;
-    /// RK4 reports no displacement).
-    pub fn set_cable_stiffness(&mut self, cable_ea_n: Option<f64>) {
-        self.cable_ea_n = cable_ea_n;
-    }
-
-    /// Forgets the warm start (the next solve starts cold). The creep
-    /// history is physical state and is kept.
-    pub fn reset_warm_start(&mut self) {
-        self.rk4.forget();
-        if let Some(col) = self.col.as_mut() {
-            col.forget();
-        }
-        self.cable_dir.iter_mut().for_each(|d| *d = (1.0, 0.0));
-        self.friction.forget();
-    }
-
-    /// Forgets the load history (creep): the material is as new, unloaded.
-    pub fn reset_history(&mut self) {
-        self.creep.forget();
-    }
-
-    /// Sets how the next solves are held: the load direction (sign of
-    /// friction) and the dwell time before the reading (creep). From then
-    /// on solves follow a protocol: the creep history carries over from
-    /// solve to solve (a dwell of 0 s leaves it unchanged).
-    ///
-    /// Without this call every solve is held `effects.creep_hold_s` on a
-    /// rod with no load history, in `effects.load_direction`.
-    pub fn set_hold(&mut self, hold: Hold) -> Result<(), ParameterError> {
-        hold.check()?;
-        self.creep.follow_protocol();
-        self.apply_hold(hold);
-        Ok(())
-    }
-
-    /// Hands a checked `hold` to friction (slip sign) and creep (dwell).
-    fn apply_hold(&mut self, hold: Hold) {
-        self.friction.set_slip_sign(hold.direction.slip_sign());
-        self.creep.set_dwell(hold.dwell_s);
-        self.hold = hold;
-        if let Some(p) = self.probe.as_mut() {
-            p.stale();
-        }
-    }
-
+impl PlanarState {
     /// The section's rigidities at reference arc length `s` (mm): the
     /// actuator's, or the non-uniform body's ([`Body::section_at`]), with
     /// the stiffness gradient.
@@ -497,7 +343,7 @@ impl Simulator {
         self.section_at_side(s, false)
     }
 
-    /// [`Simulator::section_at`], where a section that jumps at `s` (a
+    /// [`PlanarState::section_at`], where a section that jumps at `s` (a
     /// segment's end) is taken from the left with `left` (the last node of
     /// a span), from the right otherwise.
     #[inline]
@@ -547,7 +393,7 @@ impl Simulator {
         (u + self.actuator.rest_curvature_per_mm, du_dm)
     }
 
-    /// The elastic part of [`Simulator::bending_curvature`] with rigidity
+    /// The elastic part of [`PlanarState::bending_curvature`] with rigidity
     /// `ei` and radius `radius_mm`.
     #[inline]
     fn elastic_curvature(&self, m: f64, ei: f64, radius_mm: f64) -> (f64, f64) {
@@ -637,154 +483,6 @@ impl Simulator {
         }
         Err(SolveFailure::CableDirectionNotConverged { s_mm: s })
     }
-
-    /// Solves the statics for `tension_n` (N) on the current routing,
-    /// warm-started from the previous solves of this routing.
-    ///
-    /// # Panics
-    /// If no routing was set.
-    pub fn solve(&mut self, tension_n: f64) -> Result<TipPose, SolveFailure> {
-        assert!(self.routing.is_some(), "Simulator::solve called before set_routing");
-        if !(tension_n.is_finite() && tension_n >= 0.0) {
-            return Err(SolveFailure::InvalidTension(tension_n));
-        }
-        self.creep.begin_solve();
-        if let Some(p) = self.probe.as_mut() {
-            p.forget_solve();
-        }
-        let result = self.solve_inner(tension_n);
-        match &result {
-            Ok(pose) => self.last_tension_n = Some(pose.tension_n()),
-            Err(_) => {
-                self.last_tension_n = None;
-                self.reset_warm_start();
-            }
-        }
-        result
-    }
-
-    fn solve_inner(&mut self, tension: f64) -> Result<TipPose, SolveFailure> {
-        // The error estimate comes before the creep history moves on, so
-        // that a refused solve leaves the history as it was.
-        let (pose, (theta_error, tip_error)) = if self.col.is_some() {
-            let passes = self.colloc_solve(tension)?;
-            (self.colloc_pose(tension, passes), self.colloc_error_estimate())
-        } else {
-            let passes = self.rk4_solve(tension)?;
-            (self.rk4_pose(tension, passes), self.rk4_error_estimate(tension)?)
-        };
-        self.theta_error_rad = self.check_resolved(&pose, theta_error, tip_error)?;
-        self.creep.end_solve();
-        Ok(pose)
-    }
-
-    /// Refuses a pose with a non-finite number, an estimated tip error
-    /// `tip_error_mm` above [`tip_tolerance_mm`] (unless a probe at twice
-    /// the intervals agrees to within it), or a tip farther from the
-    /// clamp than the stretched rod is long (which no curve can do).
-    /// Returns the estimated error of the tangent angle, rad.
-    fn check_resolved(&mut self, pose: &TipPose, theta_error_rad: f64, tip_error_mm: f64) -> Result<f64, SolveFailure> {
-        let scalars = [pose.tip_x_mm, pose.tip_y_mm, pose.tip_angle_rad, pose.tip_frame_angle_rad, pose.base_angle_rad, pose.length_mm];
-        if !scalars.iter().all(|v| v.is_finite()) {
-            return Err(SolveFailure::NonFinite { s_mm: Some(self.actuator.length_mm) });
-        }
-        if self.is_probe {
-            return Ok(0.0);
-        }
-        let tolerance = tip_tolerance_mm(self.actuator.length_mm);
-        let reach = pose.tip_x_mm.hypot(pose.tip_y_mm);
-        if reach > pose.length_mm + tolerance {
-            return Err(self.unresolved(
-                format!("the tip (|tip| = {} mm is more than the stretched length ℓ = {} mm)", crate::io::fmt_num(reach), crate::io::fmt_num(pose.length_mm)),
-                reach - pose.length_mm,
-                tolerance,
-                "mm",
-            ));
-        }
-        if tip_error_mm <= tolerance {
-            return Ok(theta_error_rad);
-        }
-        // The estimate is an upper bound, often far above the error: a
-        // solve at twice the intervals tells.
-        match self.probe_pose(pose.tension_n()) {
-            Some(Ok(fine)) => {
-                let difference = (pose.tip_x_mm - fine.tip_x_mm).hypot(pose.tip_y_mm - fine.tip_y_mm);
-                if difference <= tolerance {
-                    return Ok((pose.tip_angle_rad - fine.tip_angle_rad).abs());
-                }
-                Err(self.unresolved("the tip position".into(), difference, tolerance, "mm"))
-            }
-            _ => Err(self.unresolved("the tip position".into(), tip_error_mm, tolerance, "mm")),
-        }
-    }
-
-    /// [`SolveFailure::Unresolved`] with the setting to raise for this
-    /// solver's method.
-    fn unresolved(&self, what: String, estimate: f64, tolerance: f64, unit: &'static str) -> SolveFailure {
-        SolveFailure::Unresolved(Unresolved { what, estimate, tolerance, unit, advice: resolution_advice(&self.options, self.resolution()) })
-    }
-
-    /// The resolution in use: collocation intervals per span (at least
-    /// [`MIN_NODES_WITH_STIFFENING`] with stiffening), or RK4 steps per span.
-    pub fn resolution(&self) -> usize {
-        match &self.col {
-            Some(c) => c.intervals(),
-            None => self.options.planar_steps_per_span,
-        }
-    }
-
-    /// Legendre curvature coefficients a_0 … a_{n−1} (n = `out.len()`) of the
-    /// last successful solve in `basis`, by the exact definition
-    /// (model-notes §4), computed from the solver's nodes without allocating.
-    ///
-    /// # Panics
-    /// If the last solve failed or none was made.
-    ///
-    /// Also estimates their error ([`Simulator::coefficient_error_per_mm`]);
-    /// [`Simulator::coefficients_checked`] refuses coefficients the
-    /// discretisation does not resolve.
-    pub fn coefficients_into(&mut self, basis: LengthBasis, out: &mut [f64]) {
-        assert!(self.last_tension_n.is_some(), "coefficients_into needs a successful solve");
-        let estimate = if self.col.is_some() { self.colloc_coefficients(basis, out) } else { self.rk4_coefficients(basis, out) };
-        self.coefficient_error = if estimate.0 <= resolution::ORDER_TOLERANCE_PER_MM || self.is_probe {
-            estimate
-        } else {
-            // As for the tip: a solve at twice the intervals tells.
-            self.probe_coefficient_difference(basis, out).unwrap_or(estimate)
-        };
-    }
-
-    /// The estimated error of the coefficients of the last
-    /// [`Simulator::coefficients_into`]: the largest over a_0 … a_n, mm⁻¹,
-    /// and the index k of the a_k it belongs to.
-    pub fn coefficient_error_per_mm(&self) -> (f64, usize) {
-        self.coefficient_error
-    }
-
-    /// [`Simulator::coefficients_into`], refusing coefficients whose
-    /// estimated error is above [`resolution::ORDER_TOLERANCE_PER_MM`]
-    /// or that are not finite.
-    pub fn coefficients_checked(&mut self, basis: LengthBasis, out: &mut [f64]) -> Result<(), SolveFailure> {
-        self.coefficients_into(basis, out);
-        if !out.iter().all(|a| a.is_finite()) {
-            return Err(SolveFailure::NonFinite { s_mm: Some(self.actuator.length_mm) });
-        }
-        let (error, k) = self.coefficient_error;
-        let tolerance = resolution::ORDER_TOLERANCE_PER_MM;
-        if !(error <= tolerance) {
-            return Err(self.unresolved(format!("a_{k}"), error, tolerance, "mm⁻¹"));
-        }
-        Ok(())
-    }
-
-    /// The centreline of the last successful solve, clamp to tip.
-    pub fn centreline(&self) -> Vec<CentrelinePoint> {
-        assert!(self.last_tension_n.is_some(), "centreline needs a successful solve");
-        if self.col.is_some() {
-            return self.colloc_centreline();
-        }
-        self.rk4_centreline()
-    }
 }
 
 /// The largest of the per-order coefficient `errors` (one that is not a
@@ -851,30 +549,6 @@ fn rotate((c, s): (f64, f64), delta: f64) -> (f64, f64) {
     (c * cd - s * sd, s * cd + c * sd)
 }
 
-/// The planar backends (collocation, or the RK4 reference by
-/// `options.method`) of one cable in the plane.
-impl Solver for Simulator {
-    type Error = SolveFailure;
-    fn backend(&self) -> Backend {
-        Backend::planar(self.options.method)
-    }
-    fn solve_tensions(&mut self, tensions_n: &[f64]) -> Result<TipPose, SolveFailure> {
-        self.solve(tensions_n[0])
-    }
-    fn hold_next(&mut self, hold: Hold) {
-        self.creep.follow_protocol();
-        self.apply_hold(hold);
-    }
-    fn centreline(&self) -> Vec<CentrelinePoint> {
-        Simulator::centreline(self)
-    }
-    /// Bending about body z only: twist and bending about y are zero in the plane.
-    fn coefficients(&mut self, order: usize, basis: LengthBasis) -> Result<[Vec<f64>; 3], SolveFailure> {
-        let mut a = vec![0.0; order + 1];
-        self.coefficients_checked(basis, &mut a)?;
-        Ok([vec![0.0; order + 1], vec![0.0; order + 1], a])
-    }
-}
 
 impl From<actuation::DisplacementNotMet> for SolveFailure {
     fn from(e: actuation::DisplacementNotMet) -> Self {

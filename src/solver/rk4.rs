@@ -7,10 +7,12 @@
 
 use super::continuation::Continuation;
 use super::result::{PerCable, PlanarPoint};
+use super::planar::{Integrator, PlanarSolver};
 use super::{
-    bending_moment, friction, rotate, CentrelinePoint, ChannelSample, Routing, Simulator, SolveFailure, Strains, TipPose,
+    bending_moment, friction, rotate, CentrelinePoint, ChannelSample, Routing, SolveFailure, SolverOptions, Strains, TipPose,
     CLAMP_MAX_ITERATIONS, CLAMP_TOLERANCE_RAD,
 };
+use crate::model::Rod;
 use crate::numerics::{rk4_step, Rk4Scratch};
 use crate::shape::{self, LengthBasis};
 
@@ -53,7 +55,7 @@ fn rotate_sin_cos((s, c): (f64, f64), delta: f64) -> (f64, f64) {
 /// RK4's state: the step grid, the nodes of the last pass and the warm
 /// start of the shooting.
 #[derive(Debug, Clone)]
-pub(super) struct Rk4 {
+pub struct Rk4 {
     /// Step length on each span, mm.
     step_mm: [f64; 2],
     /// Span starts, mm.
@@ -111,20 +113,20 @@ impl Rk4 {
     }
 }
 
-impl Simulator {
+impl PlanarSolver<Rk4> {
     /// Places the stage points on the knot spans of `built` and samples the
     /// channel there.
-    pub(super) fn rk4_set_routing(&mut self, built: &Routing) {
-        let n = self.options.planar_steps_per_span;
+    fn rk4_set_routing(&mut self, built: &Routing) {
+        let n = self.state.options.planar_steps_per_span;
         let knot = built.knot_mm();
-        let length = self.actuator.length_mm;
-        self.rk4.span_start_mm = [0.0, knot];
-        self.rk4.step_mm = [knot / n as f64, (length - knot) / n as f64];
+        let length = self.state.actuator.length_mm;
+        self.integrator.span_start_mm = [0.0, knot];
+        self.integrator.step_mm = [knot / n as f64, (length - knot) / n as f64];
         for span in 0..2 {
             for j in 0..=2 * n {
-                let s = self.rk4.span_start_mm[span] + 0.5 * j as f64 * self.rk4.step_mm[span];
+                let s = self.integrator.span_start_mm[span] + 0.5 * j as f64 * self.integrator.step_mm[span];
                 let c = built.channel_at(s);
-                self.channel[span * (2 * n + 1) + j] = ChannelSample { y: c.y_mm, dy: c.dy_ds };
+                self.state.channel[span * (2 * n + 1) + j] = ChannelSample { y: c.y_mm, dy: c.dy_ds };
             }
         }
     }
@@ -140,22 +142,22 @@ impl Simulator {
         (sp, cp): (f64, f64),
         tension: f64,
     ) -> Result<(State, Strains), SolveFailure> {
-        let ch = self.channel[k];
-        let local_tension = tension * self.friction.ratio(k);
-        let creep_offset = self.creep.offset(k);
-        let section = self.section_at(s);
-        let (e, dir) = self.strains_at(s, &section, ch, (sp, cp), st.moment, local_tension, self.cable_dir[k], creep_offset)?;
-        if self.rk4.probe {
+        let ch = self.state.channel[k];
+        let local_tension = tension * self.state.friction.ratio(k);
+        let creep_offset = self.state.creep.offset(k);
+        let section = self.state.section_at(s);
+        let (e, dir) = self.state.strains_at(s, &section, ch, (sp, cp), st.moment, local_tension, self.state.cable_dir[k], creep_offset)?;
+        if self.integrator.probe {
             return Ok((self.rates(s, &e, (sp, cp)), e));
         }
-        self.cable_dir[k] = dir;
+        self.state.cable_dir[k] = dir;
         // Only friction (cable angles) and creep (moments) need these.
-        if self.friction.is_on() {
-            self.friction.record_cable_direction(k, (sp, cp), dir);
+        if self.state.friction.is_on() {
+            self.state.friction.record_cable_direction(k, (sp, cp), dir);
         }
-        if self.creep.is_on() {
+        if self.state.creep.is_on() {
             let ei = section.ei_n_mm2;
-            self.creep.record_moment(k, bending_moment(local_tension, ch.y, dir.0, st.moment), ei);
+            self.state.creep.record_moment(k, bending_moment(local_tension, ch.y, dir.0, st.moment), ei);
         }
         Ok((self.rates(s, &e, (sp, cp)), e))
     }
@@ -165,12 +167,12 @@ impl Simulator {
     fn rates(&self, s: f64, e: &Strains, (sp, cp): (f64, f64)) -> State {
         let dx = e.v1 * cp - e.v2 * sp;
         let dy = e.v1 * sp + e.v2 * cp;
-        let wl = self.distal_weight_n(s);
+        let wl = self.state.distal_weight_n(s);
         State {
             x: dx,
             y: dy,
             phi: e.u,
-            moment: wl * (dy * self.gravity_cos - dx * self.gravity_sin),
+            moment: wl * (dy * self.state.gravity_cos - dx * self.state.gravity_sin),
             sigma: (e.v1 * e.v1 + e.v2 * e.v2).sqrt(),
         }
     }
@@ -179,14 +181,14 @@ impl Simulator {
     /// φ(0) = m(0)/k_θ with m(0) the bending moment there (fixed point, as
     /// m(0) depends on φ(0) only through the weight's direction).
     fn clamp_angle(&mut self, moment0: f64, tension: f64) -> Result<f64, SolveFailure> {
-        let Some(k_theta) = self.actuator.effects.clamp_stiffness_n_mm_per_rad else {
+        let Some(k_theta) = self.state.actuator.effects.clamp_stiffness_n_mm_per_rad else {
             return Ok(0.0);
         };
-        let ch = self.channel[0];
+        let ch = self.state.channel[0];
         let mut phi: f64 = 0.0;
         for _ in 0..CLAMP_MAX_ITERATIONS {
             let (_, (ca, _)) =
-                self.strains_at(0.0, &self.section_at(0.0), ch, phi.sin_cos(), moment0, tension, self.cable_dir[0], self.creep.offset(0))?;
+                self.state.strains_at(0.0, &self.state.section_at(0.0), ch, phi.sin_cos(), moment0, tension, self.state.cable_dir[0], self.state.creep.offset(0))?;
             let m = bending_moment(tension, ch.y, ca, moment0);
             let next = m / k_theta;
             if (next - phi).abs() < CLAMP_TOLERANCE_RAD {
@@ -207,15 +209,15 @@ impl Simulator {
     /// solution's pass, which records the nodes; 2: the error estimate's
     /// coarse pass, on every other stage point). Returns the tip state.
     fn integrate_strided(&mut self, tension: f64, moment0: f64, stride: usize) -> Result<State, SolveFailure> {
-        let n = self.options.planar_steps_per_span;
+        let n = self.state.options.planar_steps_per_span;
         let record = stride == 1;
         let mut st = State { phi: self.clamp_angle(moment0, tension)?, moment: moment0, ..State::default() };
         let mut scratch = Rk4Scratch::default();
         for span in 0..2 {
-            let h = self.rk4.step_mm[span] * stride as f64;
+            let h = self.integrator.step_mm[span] * stride as f64;
             let base = span * (2 * n + 1);
             for step in 0..n / stride {
-                let s = self.rk4.span_start_mm[span] + step as f64 * h;
+                let s = self.integrator.span_start_mm[span] + step as f64 * h;
                 let k = base + 2 * stride * step;
                 // One sin/cos per step; the stages rotate it by small angles.
                 let trig = st.phi.sin_cos();
@@ -228,10 +230,10 @@ impl Simulator {
                     if stage.index == 0 {
                         if record {
                             let node = span * n + step;
-                            self.rk4.nodes_state[node] = stage_state;
-                            self.rk4.nodes_strain[node] = e;
+                            self.integrator.nodes_state[node] = stage_state;
+                            self.integrator.nodes_strain[node] = e;
                         } else {
-                            self.rk4.record_coarse(span * (n / stride) + step, &stage_state, &e);
+                            self.integrator.record_coarse(span * (n / stride) + step, &stage_state, &e);
                         }
                     }
                     *dy = d.to_array();
@@ -245,13 +247,13 @@ impl Simulator {
         }
         // Tip node.
         let k_tip = 2 * (2 * n + 1) - 1;
-        let (_, e) = self.derivative(self.actuator.length_mm, k_tip, &st, st.phi.sin_cos(), tension)?;
+        let (_, e) = self.derivative(self.state.actuator.length_mm, k_tip, &st, st.phi.sin_cos(), tension)?;
         if record {
             let tip = 2 * n;
-            self.rk4.nodes_state[tip] = st;
-            self.rk4.nodes_strain[tip] = e;
+            self.integrator.nodes_state[tip] = st;
+            self.integrator.nodes_strain[tip] = e;
         } else {
-            self.rk4.record_coarse(2 * (n / stride), &st, &e);
+            self.integrator.record_coarse(2 * (n / stride), &st, &e);
         }
         Ok(st)
     }
@@ -262,13 +264,13 @@ impl Simulator {
     /// as h⁴, so Richardson's rule would take 1/15 of the difference; on
     /// random bodies that fell short of the error by up to 3.7 times, while
     /// the whole difference was at least 4 times it (and 15 at the median).
-    pub(super) fn rk4_error_estimate(&mut self, tension: f64) -> Result<(f64, f64), SolveFailure> {
-        let n = self.options.planar_steps_per_span;
-        let fine = self.rk4.nodes_state[2 * n];
-        let moment0 = self.rk4.nodes_state[0].moment;
-        self.rk4.probe = true;
+    fn rk4_error_estimate(&mut self, tension: f64) -> Result<(f64, f64), SolveFailure> {
+        let n = self.state.options.planar_steps_per_span;
+        let fine = self.integrator.nodes_state[2 * n];
+        let moment0 = self.integrator.nodes_state[0].moment;
+        self.integrator.probe = true;
         let coarse = self.integrate_strided(tension, moment0, 2);
-        self.rk4.probe = false;
+        self.integrator.probe = false;
         let coarse = coarse?;
         let theta_error = (fine.phi - coarse.phi).abs();
         let tip_error = (fine.x - coarse.x).hypot(fine.y - coarse.y);
@@ -281,8 +283,8 @@ impl Simulator {
         let mut passes = 1u32;
         let mut f0 = self.integrate(tension, *m0)?;
         let mut prev: Option<(f64, f64)> = None;
-        while f0.abs() > self.options.planar_moment_tolerance_n_mm {
-            if passes >= self.options.max_shooting_passes {
+        while f0.abs() > self.state.options.planar_moment_tolerance_n_mm {
+            if passes >= self.state.options.max_shooting_passes {
                 return Err(SolveFailure::ShootingNotConverged { iterations: passes, residual_n_mm: f0 });
             }
             if let Some((mp, fp)) = prev {
@@ -300,29 +302,29 @@ impl Simulator {
     }
 
     /// Solves for `tension` from the warm start; returns the passes used.
-    pub(super) fn rk4_solve(&mut self, tension: f64) -> Result<u32, SolveFailure> {
-        let has_moment = self.weight_n_per_mm != 0.0;
-        let has_friction = self.friction.acts_at(tension);
-        let n = self.options.planar_steps_per_span;
+    fn rk4_solve(&mut self, tension: f64) -> Result<u32, SolveFailure> {
+        let has_moment = self.state.weight_n_per_mm != 0.0;
+        let has_friction = self.state.friction.acts_at(tension);
+        let n = self.state.options.planar_steps_per_span;
         let mut passes;
         if has_moment {
-            let (mut m0, mut slope) = self.rk4.continuation.predict(tension);
+            let (mut m0, mut slope) = self.integrator.continuation.predict(tension);
             passes = self.shoot(tension, &mut m0, &mut slope)?;
             if has_friction {
                 passes += friction::settle(
                     self,
-                    |sim| sim.friction.update_from_rk4_nodes(n),
+                    |sim| sim.state.friction.update_from_rk4_nodes(n),
                     |sim| sim.shoot(tension, &mut m0, &mut slope),
                 )?;
             }
-            self.rk4.continuation.record(tension, m0, slope);
+            self.integrator.continuation.record(tension, m0, slope);
         } else {
             self.integrate(tension, 0.0)?;
             passes = 1;
             if has_friction {
                 passes += friction::settle(
                     self,
-                    |sim| sim.friction.update_from_rk4_nodes(n),
+                    |sim| sim.state.friction.update_from_rk4_nodes(n),
                     |sim| sim.integrate(tension, 0.0).map(|_| 1),
                 )?;
             }
@@ -331,11 +333,11 @@ impl Simulator {
     }
 
     /// The pose of the last pass.
-    pub(super) fn rk4_pose(&self, tension: f64, passes: u32) -> TipPose {
-        let n_nodes = self.rk4.nodes_state.len();
-        let base = self.rk4.nodes_state[0];
-        let tip = self.rk4.nodes_state[n_nodes - 1];
-        let (e0, et) = (self.rk4.nodes_strain[0], self.rk4.nodes_strain[n_nodes - 1]);
+    fn rk4_pose(&self, tension: f64, passes: u32) -> TipPose {
+        let n_nodes = self.integrator.nodes_state.len();
+        let base = self.integrator.nodes_state[0];
+        let tip = self.integrator.nodes_state[n_nodes - 1];
+        let (e0, et) = (self.integrator.nodes_strain[0], self.integrator.nodes_strain[n_nodes - 1]);
         TipPose {
             tensions_n: PerCable::one(tension),
             displacements_mm: PerCable::one(f64::NAN),
@@ -355,10 +357,10 @@ impl Simulator {
     ///
     /// Returns the estimated error of the largest a_n, mm⁻¹, and n: its
     /// difference to the coefficients of the error estimate's coarse pass
-    /// (see [`Simulator::rk4_error_estimate`]), which differ in both the
+    /// (see [`PlanarSolver::rk4_error_estimate`]), which differ in both the
     /// angles and the quadrature.
-    pub(super) fn rk4_coefficients(&mut self, basis: LengthBasis, out: &mut [f64]) -> (f64, usize) {
-        let r = &mut self.rk4;
+    fn rk4_coefficients(&mut self, basis: LengthBasis, out: &mut [f64]) -> (f64, usize) {
+        let r = &mut self.integrator;
         for (i, (st, e)) in r.nodes_state.iter().zip(&r.nodes_strain).enumerate() {
             r.theta[i] = st.phi + e.v2.atan2(e.v1);
             r.speed[i] = e.v1.hypot(e.v2);
@@ -374,23 +376,23 @@ impl Simulator {
         shape::legendre_from_tangent(&r.coarse_theta, &r.coarse_sigma, &r.coarse_speed, 2.0 * h, &mut coarse[..estimated]);
         let ell = r.sigma[r.sigma.len() - 1] - r.sigma[0];
         let errors = out.iter().enumerate().map(|(n, a)| coarse.get(n).map_or(f64::INFINITY, |c| (a - c).abs()));
-        let worst = super::largest_error(errors, basis, ell, self.actuator.length_mm);
-        basis.convert_from_deformed(out, ell, self.actuator.length_mm);
+        let worst = super::largest_error(errors, basis, ell, self.state.actuator.length_mm);
+        basis.convert_from_deformed(out, ell, self.state.actuator.length_mm);
         worst
     }
 
     /// The centreline of the last solve at the nodes.
-    pub(super) fn rk4_centreline(&self) -> Vec<CentrelinePoint> {
-        let n = self.options.planar_steps_per_span;
-        let tension = self.last_tension_n.unwrap_or(0.0);
-        (0..self.rk4.nodes_state.len())
+    fn rk4_centreline(&self) -> Vec<CentrelinePoint> {
+        let n = self.state.options.planar_steps_per_span;
+        let tension = self.state.last_tension_n.unwrap_or(0.0);
+        (0..self.integrator.nodes_state.len())
             .map(|i| {
                 let (span, j) = if i < n { (0, i) } else { (1, i - n) };
-                let s = self.rk4.span_start_mm[span] + j as f64 * self.rk4.step_mm[span];
+                let s = self.integrator.span_start_mm[span] + j as f64 * self.integrator.step_mm[span];
                 let k = span * (2 * n + 1) + 2 * j;
-                let st = self.rk4.nodes_state[i];
-                let e = self.rk4.nodes_strain[i];
-                let yc = self.channel[k].y;
+                let st = self.integrator.nodes_state[i];
+                let e = self.integrator.nodes_strain[i];
+                let yc = self.state.channel[k].y;
                 CentrelinePoint::from(PlanarPoint {
                     s_mm: s,
                     x_mm: st.x,
@@ -403,17 +405,53 @@ impl Simulator {
                     v2: e.v2,
                     u_per_mm: e.u,
                     channel_y_mm: yc,
-                    cable_tension_n: tension * self.friction.ratio(k),
+                    cable_tension_n: tension * self.state.friction.ratio(k),
                 })
             })
             .collect()
     }
 }
 
+
+/// The planar RK4 reference.
+impl Integrator for Rk4 {
+    const METHOD: super::SolverMethod = super::SolverMethod::Rk4;
+
+    fn build(_rod: &Rod, options: &SolverOptions, _spans: usize) -> (Self, usize) {
+        let n = options.planar_steps_per_span;
+        (Rk4::new(n), 2 * (2 * n + 1))
+    }
+
+    fn set_routing(p: &mut PlanarSolver<Self>, built: &Routing) {
+        p.rk4_set_routing(built);
+    }
+
+    fn forget(&mut self) {
+        Rk4::forget(self);
+    }
+
+    fn solve(p: &mut PlanarSolver<Self>, tension: f64) -> Result<(TipPose, (f64, f64)), SolveFailure> {
+        let passes = p.rk4_solve(tension)?;
+        Ok((p.rk4_pose(tension, passes), p.rk4_error_estimate(tension)?))
+    }
+
+    fn resolution(p: &PlanarSolver<Self>) -> usize {
+        p.state.options.planar_steps_per_span
+    }
+
+    fn coefficients(p: &mut PlanarSolver<Self>, basis: LengthBasis, out: &mut [f64]) -> (f64, usize) {
+        p.rk4_coefficients(basis, out)
+    }
+
+    fn centreline(p: &PlanarSolver<Self>) -> Vec<CentrelinePoint> {
+        p.rk4_centreline()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use crate::model::Routing;
-    use crate::solver::{simulate, Simulator, SolverMethod, SolverOptions};
+    use crate::solver::{simulate, SolverOptions};
     use crate::shape::LengthBasis;
 
     /// RK4's estimates (the differences to a pass at twice the step) bound
@@ -428,7 +466,7 @@ mod tests {
             let fine = SolverOptions { nodes_per_span: 64, ..SolverOptions::default() };
             let Ok(reference) = simulate(&a, &fine, &Routing::for_actuator(&y, &a).unwrap(), tension, 5, LengthBasis::Rest) else { continue };
             for n in [8, 16, 24] {
-                let mut sim = Simulator::new(&a, &SolverOptions { method: SolverMethod::Rk4, planar_steps_per_span: n, ..SolverOptions::default() }).unwrap();
+                let mut sim = crate::solver::PlanarRk4::new(&a, &SolverOptions { planar_steps_per_span: n, ..SolverOptions::default() }).unwrap();
                 sim.set_routing_mm(&y).unwrap();
                 let rungs = crate::solver::ladder::tension_rungs(tension);
                 let mut solved = None;
@@ -436,7 +474,7 @@ mod tests {
                     let t = tension * k as f64 / rungs as f64;
                     let Ok(passes) = sim.rk4_solve(t) else { break };
                     solved = (k == rungs).then(|| sim.rk4_pose(t, passes));
-                    sim.last_tension_n = Some(t);
+                    sim.state.last_tension_n = Some(t);
                 }
                 let Some(pose) = solved else { continue };
                 let (_, tip_error) = sim.rk4_error_estimate(tension).unwrap();
