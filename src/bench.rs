@@ -226,7 +226,7 @@ pub fn bench_spatial(
     gravity: Option<[f64; 3]>,
     label: &str,
 ) -> Result<BenchFigures, crate::Error> {
-    use crate::solver::spatial::{Actuator, SpatialRk4Solver, SpatialSolver};
+    use crate::solver::spatial::{Actuator, SpatialRk4, SpatialCollocation};
     use crate::solver::SolverMethod;
     let mut rod = rod.clone();
     rod.gravity.enabled = gravity.is_some();
@@ -244,7 +244,7 @@ pub fn bench_spatial(
         };
         match options.method {
             SolverMethod::Collocation => {
-                let mut solver = SpatialSolver::new(&actuator, options)?;
+                let mut solver = SpatialCollocation::new(&actuator, options)?;
                 for k in 0..tensions {
                     match solver.solve(&ladder(k)).and_then(|pose| Ok((pose, solver.coefficients(3, basis)?))) {
                         Ok((pose, a)) => {
@@ -257,7 +257,7 @@ pub fn bench_spatial(
                 }
             }
             SolverMethod::Rk4 => {
-                let mut solver = SpatialRk4Solver::new(&actuator, options)?;
+                let mut solver = SpatialRk4::new(&actuator, options)?;
                 for k in 0..tensions {
                     match solver.solve(&ladder(k)) {
                         Ok(pose) => {

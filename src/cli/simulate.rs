@@ -241,7 +241,7 @@ fn run_spatial(args: &SimulateArgs) -> anyhow::Result<()> {
     }
     let mut sim = solved?;
     // The thesis route needs a planar centreline: the one check refused it otherwise.
-    if thesis && sim.backend != Backend::Spatial {
+    if thesis && sim.backend != Backend::SpatialCollocation {
         let points: Vec<[f64; 2]> = sim.centreline.iter().map(|c| [c.x_mm, c.y_mm]).collect();
         sim.a_bend_z = cablemap::shape::thesis_coefficients(&points, args.order, args.n_d)
             .context("thesis coefficient route")?

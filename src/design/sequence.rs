@@ -21,7 +21,7 @@
 
 use super::actuator::{ActuationBounds, CableFreedom, DesignActuator};
 use super::targets::{Quantity, ShapeTarget};
-use crate::solver::spatial::{SpatialError, SpatialSolver};
+use crate::solver::spatial::{SpatialError, SpatialCollocation};
 use crate::model::Actuator;
 use crate::solver::{simulate_actuator, Given, Simulation, SolverOptions, TipPose};
 use crate::numerics::lm;
@@ -287,7 +287,7 @@ impl Setup {
             && self.options.method == crate::solver::SolverMethod::Collocation;
         if spatial {
             let options = SolverOptions { nodes_per_span: self.options.nodes_per_span, ..SolverOptions::default() };
-            if let Ok(mut solver) = SpatialSolver::new(actuator, &options) {
+            if let Ok(mut solver) = SpatialCollocation::new(actuator, &options) {
                 let tensions: Vec<f64> = actuator.cables.iter().map(|c| c.tension_n).collect();
                 if let Ok(pose) = solver.solve(&tensions) {
                     if let Ok([a_twist, a_bend_y, a_bend_z]) = solver.coefficients(self.order(), self.basis) {

@@ -133,7 +133,7 @@ mod tests {
     impl Solver for Toy {
         type Error = ToyError;
         fn backend(&self) -> crate::solver::Backend {
-            crate::solver::Backend::Spatial
+            crate::solver::Backend::SpatialCollocation
         }
         fn hold_next(&mut self, _: crate::solver::Hold) {}
         fn centreline(&self) -> Vec<crate::solver::CentrelinePoint> {

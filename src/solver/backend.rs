@@ -9,7 +9,7 @@
 //!   with z ≡ 0 — with every effect, tapered and segmented bodies and anchors;
 //! - [`Backend::PlanarRk4`], the planar reference: classical RK4 with
 //!   shooting (`rk4`), the same model with the cable knotted at the tip;
-//! - [`Backend::Spatial`], the 3-D solver (`crate::solver::spatial::collocation`):
+//! - [`Backend::SpatialCollocation`], the 3-D solver (`crate::solver::spatial::collocation`):
 //!   several cables, out-of-plane channels and gravity, spectral collocation
 //!   with every effect, tapered and segmented bodies and anchors;
 //! - [`Backend::SpatialRk4`], the 3-D reference: RK4 along s with Broyden on
@@ -34,7 +34,7 @@ pub enum Backend {
     PlanarRk4,
     /// The 3-D solver: several and out-of-plane cables, gravity in any
     /// direction, by spectral collocation (the default for such actuators).
-    Spatial,
+    SpatialCollocation,
     /// The 3-D reference: RK4 along s (`--method rk4`), uniform rods without effects.
     SpatialRk4,
 }
@@ -45,7 +45,7 @@ impl Backend {
         match self {
             Backend::PlanarCollocation => "planar collocation",
             Backend::PlanarRk4 => "planar RK4",
-            Backend::Spatial => "spatial",
+            Backend::SpatialCollocation => "spatial",
             Backend::SpatialRk4 => "spatial RK4",
         }
     }
@@ -152,7 +152,7 @@ const THESIS_EFFECTS: &[&EffectInfo] = &[&GRAVITY_DIRECTION, &GRAVITY_SCALE];
 
 impl Backend {
     /// Every backend, in the order a request is offered to them.
-    pub const ALL: [Backend; 4] = [Backend::PlanarCollocation, Backend::PlanarRk4, Backend::Spatial, Backend::SpatialRk4];
+    pub const ALL: [Backend; 4] = [Backend::PlanarCollocation, Backend::PlanarRk4, Backend::SpatialCollocation, Backend::SpatialRk4];
 
     /// The planar backend of `method`.
     pub fn planar(method: SolverMethod) -> Backend {
@@ -165,7 +165,7 @@ impl Backend {
     /// The spatial backend of `method`.
     pub fn spatial(method: SolverMethod) -> Backend {
         match method {
-            SolverMethod::Collocation => Backend::Spatial,
+            SolverMethod::Collocation => Backend::SpatialCollocation,
             SolverMethod::Rk4 => Backend::SpatialRk4,
         }
     }
@@ -191,7 +191,7 @@ impl Backend {
             Backend::PlanarCollocation => planar,
             // RK4 integrates each knot span in equal steps from clamp to tip.
             Backend::PlanarRk4 => Support { anchors: false, displacement: false, method: SolverMethod::Rk4, nodes_per_span: false, ..planar },
-            Backend::Spatial => Support {
+            Backend::SpatialCollocation => Support {
                 several_cables: true,
                 out_of_plane_channels: true,
                 gravity_out_of_plane: true,
@@ -397,7 +397,7 @@ fn advice(served_by: Option<Backend>, but_not: Option<&str>) -> String {
     let how = |b: Backend| match b {
         Backend::PlanarCollocation => "the planar collocation solver (the default --method collocation)",
         Backend::PlanarRk4 => "the planar rk4 solver (--method rk4)",
-        Backend::Spatial => "the spatial (3-D) solver",
+        Backend::SpatialCollocation => "the spatial (3-D) solver",
         Backend::SpatialRk4 => "the spatial rk4 solver (--method rk4 with several or spatial cables)",
     };
     match (served_by, but_not) {
@@ -445,11 +445,11 @@ mod tests {
         a.effects.creep_fraction = 0.2;
         assert_eq!(Backend::SpatialRk4.unmodelled_effect(&a).map(|e| e.key), Some("creep_fraction"));
         assert!(Backend::PlanarRk4.unmodelled_effect(&a).is_none());
-        assert!(Backend::Spatial.unmodelled_effect(&a).is_none());
+        assert!(Backend::SpatialCollocation.unmodelled_effect(&a).is_none());
         let mut b = Rod::default();
         b.effects.clamp_stiffness_n_mm_per_rad = Some(40.0);
         assert_eq!(Backend::SpatialRk4.unmodelled_effect(&b).map(|e| e.key), Some("clamp_stiffness_n_mm_per_rad"));
-        assert!(Backend::Spatial.unmodelled_effect(&b).is_none());
+        assert!(Backend::SpatialCollocation.unmodelled_effect(&b).is_none());
         b = Rod::default();
         b.gravity.scale = 2.0;
         assert!(Backend::SpatialRk4.unmodelled_effect(&b).is_none());

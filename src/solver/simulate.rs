@@ -10,7 +10,7 @@ use super::result::Simulation;
 use super::{tip_tolerance_mm, until_resolved, Backend, Given, Hold, SolveFailure, Solver, SolverMethod, SolverOptions, Simulator, Unresolved, MAX_NODES_PER_SPAN};
 use crate::model::parameter::ParameterError;
 use crate::solver::spatial::collocation::check_dwell;
-use crate::solver::spatial::{check_order, SpatialError, SpatialRk4Solver, SpatialSolver};
+use crate::solver::spatial::{check_order, SpatialError, SpatialRk4, SpatialCollocation};
 use crate::model::{Actuator, Cable, Rod, Routing};
 use crate::shape::LengthBasis;
 
@@ -116,12 +116,12 @@ pub const MAX_AUTO_STEPS_PER_SPAN: usize = 6144;
 /// deformations start from a nearby solution, and computes the coefficients
 /// a_0 … a_order in `basis`, by `options.method`:
 ///
-/// - collocation (the default, [`SpatialSolver`]): every solve estimates its
+/// - collocation (the default, [`SpatialCollocation`]): every solve estimates its
 ///   own error (the tip within [`tip_tolerance_mm`], every coefficient within
 ///   [`crate::solver::resolution::ORDER_TOLERANCE_PER_MM`]); where it is above,
 ///   the ladder is solved again at twice the intervals, up to
 ///   [`MAX_NODES_PER_SPAN`], beyond which the solve is refused as unresolved;
-/// - RK4 (the reference, [`SpatialRk4Solver`]): the result is checked against
+/// - RK4 (the reference, [`SpatialRk4`]): the result is checked against
 ///   the same solve at half the steps (RK4's error falls as h⁴, so their
 ///   difference is well above the finer one's error), doubling the steps up
 ///   to [`MAX_AUTO_SPATIAL_STEPS_PER_SPAN`].
@@ -158,7 +158,7 @@ pub fn simulate_spatial_held(
     }
     until_resolved(
         options,
-        |options| SpatialSolver::new(actuator, options)?.simulate(actuator, hold, order, basis),
+        |options| SpatialCollocation::new(actuator, options)?.simulate(actuator, hold, order, basis),
         |e| matches!(e, SpatialError::Solve(SolveFailure::Unresolved(_))),
         |options| {
             let finer = options.nodes_per_span < MAX_NODES_PER_SPAN;
@@ -170,7 +170,7 @@ pub fn simulate_spatial_held(
 
 /// [`simulate_spatial`] by the RK4 reference, refining by comparison with half the steps.
 fn simulate_spatial_rk4(actuator: &Actuator, options: &SolverOptions, order: usize, basis: LengthBasis) -> Result<Simulation, SpatialError> {
-    let ladder = |options: &SolverOptions| SpatialRk4Solver::new(actuator, options)?.simulate(actuator, None, order, basis);
+    let ladder = |options: &SolverOptions| SpatialRk4::new(actuator, options)?.simulate(actuator, None, order, basis);
     let half = SolverOptions { spatial_steps_per_span: (options.spatial_steps_per_span / 2).max(2), ..options.clone() };
     // A coarse solve that fails says nothing about the fine one: the
     // comparison then moves one level up.
@@ -259,9 +259,9 @@ pub fn simulate_actuator(
 ) -> Result<Simulation, SpatialError> {
     actuator.channels()?;
     let backend = Backend::serving(actuator, options, given)?;
-    if matches!(backend, Backend::Spatial | Backend::SpatialRk4) {
+    if matches!(backend, Backend::SpatialCollocation | Backend::SpatialRk4) {
         // The backend picked is the method's.
-        let method = if backend == Backend::Spatial { SolverMethod::Collocation } else { SolverMethod::Rk4 };
+        let method = if backend == Backend::SpatialCollocation { SolverMethod::Collocation } else { SolverMethod::Rk4 };
         return simulate_spatial_held(actuator, &SolverOptions { method, ..options.clone() }, order, basis, hold);
     }
     let (rod, routing) = planar_problem(actuator)?;

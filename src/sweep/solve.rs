@@ -7,7 +7,7 @@
 
 use super::schema::{CableRow, SolvedRouting, SolvedRow, STATUS_FAILED, STATUS_INVALID_ROUTING};
 use crate::model::routing::ControlPoints;
-use crate::solver::spatial::{Actuator, SpatialError, SpatialSolver};
+use crate::solver::spatial::{Actuator, SpatialError, SpatialCollocation};
 use crate::solver::{ladder, Solver};
 use crate::model::{Actuation, Routing};
 use crate::solver::{Simulator, SolveFailure, SolverOptions, TipPose, STATUS_OK};
@@ -117,7 +117,7 @@ impl TensionCombinations {
     /// Solves at `values` (each cable's command, scaled by `scale`): the
     /// tension-driven cables at theirs, the others' tensions found from
     /// `tensions_n` (which receives them).
-    fn solve(&self, solver: &mut SpatialSolver, values: &[f64], scale: f64, tensions_n: &mut [f64]) -> Result<TipPose, SpatialError> {
+    fn solve(&self, solver: &mut SpatialCollocation, values: &[f64], scale: f64, tensions_n: &mut [f64]) -> Result<TipPose, SpatialError> {
         if !self.any_displacement() {
             let t: Vec<f64> = values.iter().map(|v| v * scale).collect();
             return solver.solve(&t);
@@ -158,7 +158,7 @@ pub fn combination_index(combo: &[usize], grids: &[Vec<f64>]) -> usize {
 
 /// Solves routing `id` of a cable sweep, `actuator` (its cables' tensions
 /// are set per combination), through every tension combination by one
-/// [`SpatialSolver`]: from zero up to the first combination, then along the
+/// [`SpatialCollocation`]: from zero up to the first combination, then along the
 /// snake. Returns the rows in grid order (cable 1's tension slowest). An
 /// actuator the solver refuses gives rows of [`STATUS_INVALID_ROUTING`].
 pub fn cable_routing(id: u64, mut actuator: Actuator, options: &SolverOptions, stored: Stored, combinations: &TensionCombinations) -> Vec<CableRow> {
@@ -185,7 +185,7 @@ pub fn cable_routing(id: u64, mut actuator: Actuator, options: &SolverOptions, s
             c.tension_n = v;
         }
     }
-    let mut solver = match SpatialSolver::new(&actuator, options) {
+    let mut solver = match SpatialCollocation::new(&actuator, options) {
         Ok(s) => s,
         Err(_) => return combos.iter().map(|c| row(c, STATUS_INVALID_ROUTING, 0, None, None)).collect(),
     };

@@ -16,5 +16,5 @@ pub use crate::model::actuator::{Actuator, EI_OVER_GJ};
 pub use crate::model::cable::{self, Cable, MAX_CABLES};
 pub use crate::solver::simulate_spatial;
 pub use error::SpatialError;
-pub use collocation::SpatialSolver;
-pub use solver::{check_order, validated_channels, SpatialRk4Solver, MAX_SPATIAL_ORDER};
+pub use collocation::SpatialCollocation;
+pub use solver::{check_order, validated_channels, SpatialRk4, MAX_SPATIAL_ORDER};

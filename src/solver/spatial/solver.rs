@@ -66,7 +66,7 @@ type Factors = LU<f64, U6, U6>;
 /// A gravity pass started from a moment residual below this (N·mm) is
 /// expected to be the last (Broyden cuts the residual by 100× or more per
 /// pass), so it also computes the coefficients; if it is not the last,
-/// [`SpatialRk4Solver::coefficients`] runs one more pass.
+/// [`SpatialRk4::coefficients`] runs one more pass.
 const LAST_PASS_RESIDUAL_N_MM: f64 = 1e-5;
 
 /// Breakpoints closer than this are one (mm): an anchor this close to a
@@ -85,7 +85,7 @@ pub const MAX_SPATIAL_ORDER: usize = 8;
 pub const REQUIRED_SPATIAL_STEPS_PER_SPAN: [usize; MAX_SPATIAL_ORDER + 1] = [4, 4, 4, 4, 6, 6, 12, 12, 24];
 
 /// What a pass records at one step point of the rod (the centreline's
-/// nodes are made from these when asked for, [`SpatialRk4Solver::centreline`]).
+/// nodes are made from these when asked for, [`SpatialRk4::centreline`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct NodeRecord {
     /// Index of the half-step point (its channels in `chan`).
@@ -170,7 +170,7 @@ struct Local {
 
 /// Reusable spatial solver for one actuator: set the cables, then solve.
 #[derive(Debug, Clone)]
-pub struct SpatialRk4Solver {
+pub struct SpatialRk4 {
     rod: Rod,
     stiff: [f64; 6],
     /// Weight per unit rest length along the gravity direction, N/mm (global vector).
@@ -211,7 +211,7 @@ pub struct SpatialRk4Solver {
     last: Option<TipPose>,
 }
 
-impl SpatialRk4Solver {
+impl SpatialRk4 {
     /// A solver for `actuator` (its cables, rod, torsion and gravity).
     pub fn new(actuator: &Actuator, options: &SolverOptions) -> Result<Self, SpatialError> {
         let channels = validated_channels(actuator, Backend::SpatialRk4)?;
@@ -826,7 +826,7 @@ impl SpatialRk4Solver {
         Ok(())
     }
 
-    /// [`SpatialRk4Solver::coefficients`] of the last solve without the
+    /// [`SpatialRk4::coefficients`] of the last solve without the
     /// order check (the error estimate's coarse solve computes the same
     /// orders at half the steps); needs valid moments.
     pub(crate) fn coefficients_unchecked(&self, order: usize, basis: LengthBasis) -> [Vec<f64>; 3] {
@@ -858,7 +858,7 @@ impl SpatialRk4Solver {
 }
 
 /// The spatial RK4 reference: the thesis's uniform rod without effects.
-impl crate::solver::Solver for SpatialRk4Solver {
+impl crate::solver::Solver for SpatialRk4 {
     type Error = SpatialError;
     fn backend(&self) -> Backend {
         Backend::SpatialRk4
@@ -869,7 +869,7 @@ impl crate::solver::Solver for SpatialRk4Solver {
     /// It models no effect a hold acts on (friction, creep).
     fn hold_next(&mut self, _hold: crate::solver::Hold) {}
     fn centreline(&self) -> Vec<CentrelinePoint> {
-        SpatialRk4Solver::centreline(self)
+        SpatialRk4::centreline(self)
     }
     /// Without the order check (a refinement's coarse solve computes the
     /// same orders at half the steps); refuses a pose or coefficients that

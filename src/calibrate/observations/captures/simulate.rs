@@ -3,7 +3,7 @@
 //!
 //! Captures that are independent (`static`) and pull the same cables are
 //! solved as one chain, in order of their actuation, by one
-//! [`SpatialSolver`]: each solve is warm-started by the solver's
+//! [`SpatialCollocation`]: each solve is warm-started by the solver's
 //! extrapolation from the chain's previous ones (a few Newton steps instead
 //! of a ladder from the straight rod). A protocol (load, unload, rest rows)
 //! is one chain in step order, its hold (friction's direction, creep's
@@ -15,7 +15,7 @@ use super::files::{Actuation, Capture, CaptureSet, MarkerReading};
 use crate::calibrate::data::Direction;
 use crate::calibrate::CalibrateError;
 use crate::solver::Solver;
-use crate::solver::spatial::{SpatialError, SpatialSolver};
+use crate::solver::spatial::{SpatialError, SpatialCollocation};
 use crate::solver::{SolveFailure, SolverOptions};
 use crate::model::{Actuator, LoadDirection};
 use crate::solver::{CentrelinePoint, Hold, TipPose};
@@ -41,7 +41,7 @@ pub fn body_point_mm(node: &CentrelinePoint, marker: &MarkerReading, length_mm: 
 }
 
 /// The markers of `markers` on the last solve of `solver`.
-fn markers_on(solver: &SpatialSolver, markers: &[MarkerReading], length_mm: f64) -> Vec<[f64; 3]> {
+fn markers_on(solver: &SpatialCollocation, markers: &[MarkerReading], length_mm: f64) -> Vec<[f64; 3]> {
     let s: Vec<f64> = markers.iter().map(|m| m.s_mm).collect();
     solver.points_at(&s).iter().zip(markers).map(|(node, m)| body_point_mm(node, m, length_mm)).collect()
 }
@@ -102,7 +102,7 @@ fn hold_of(c: &Capture) -> Hold {
 
 /// One solve at `fraction` of the capture's actuation (displacement-driven
 /// cables by Newton on their tensions).
-fn solve_at(solver: &mut SpatialSolver, c: &Capture, fraction: f64, tensions: &mut [f64]) -> Result<TipPose, SpatialError> {
+fn solve_at(solver: &mut SpatialCollocation, c: &Capture, fraction: f64, tensions: &mut [f64]) -> Result<TipPose, SpatialError> {
     if c.actuation.iter().all(|a| matches!(a, Actuation::Tension(_))) {
         let t: Vec<f64> = c.tensions_n().iter().map(|t| t * fraction).collect();
         return solver.solve(&t);
@@ -115,7 +115,7 @@ fn solve_at(solver: &mut SpatialSolver, c: &Capture, fraction: f64, tensions: &m
 /// Solves one chain with one solver at `options`.
 fn solve_chain(actuator: &Actuator, options: &SolverOptions, set: &CaptureSet, chain: &[usize]) -> Result<Vec<(usize, CaptureSolution)>, CalibrateError> {
     let length = actuator.rod.length_mm;
-    let mut solver = SpatialSolver::new(actuator, options).map_err(CalibrateError::Actuator)?;
+    let mut solver = SpatialCollocation::new(actuator, options).map_err(CalibrateError::Actuator)?;
     let protocol = chain.iter().any(|&i| set.captures[i].direction != Direction::Static);
     let mut tensions = vec![0.0; actuator.cables.len()];
     let mut out = Vec::with_capacity(chain.len());
@@ -126,7 +126,7 @@ fn solve_chain(actuator: &Actuator, options: &SolverOptions, set: &CaptureSet, c
         let fail = |failure: SpatialError| CalibrateError::Capture { measurement: c.measurement, row: c.row, failure };
         // Friction's direction and creep's dwell matter only with those effects on.
         let hold = hold_of(c);
-        let set_hold = |solver: &mut SpatialSolver, hold: Hold| if protocol { solver.set_hold(hold) } else { solver.set_independent_hold(hold) };
+        let set_hold = |solver: &mut SpatialCollocation, hold: Hold| if protocol { solver.set_hold(hold) } else { solver.set_independent_hold(hold) };
         set_hold(&mut solver, hold).map_err(fail)?;
         // A long jump from the previous capture's tensions leaves the warm
         // start's basin: cross it in rungs of at most MAX_JUMP_N (static
@@ -210,7 +210,7 @@ mod tests {
         let mut rod = crate::model::Rod::default();
         rod.gravity.enabled = false;
         let a = Actuator::with_cables(rod, vec![Cable::spatial([2.0; 5], [1.0; 5], 0.0)]);
-        let mut solver = SpatialSolver::new(&a, &SolverOptions::default()).unwrap();
+        let mut solver = SpatialCollocation::new(&a, &SolverOptions::default()).unwrap();
         solver.solve(&[0.0]).unwrap();
         let m = |s: f64| MarkerReading { marker: "m".into(), s_mm: s, offset_y_mm: 3.0, offset_z_mm: -4.0, measured_mm: [0.0; 3], sd_mm: None, row: 1 };
         let p = markers_on(&solver, &[m(20.0), m(75.0)], 65.0);

@@ -2,7 +2,7 @@
 
 use super::*;
 
-impl SpatialSolver {
+impl SpatialCollocation {
     /// The curvature u from the internal moment `m` (body frame) and, when
     /// asked, du/dm: torsion u₁ = m₁/GJ; bending linear, m_b = EI u_b, or
     /// with material stiffening m_b = EI u_b (1 + α r² |u_b|²) (isotropic:
@@ -30,7 +30,7 @@ impl SpatialSolver {
         self.stiffened_curvature_law(m, sec, (gain, off), derivative)
     }
 
-    /// [`SpatialSolver::curvature_law`] with material stiffening, given
+    /// [`SpatialCollocation::curvature_law`] with material stiffening, given
     /// creep's terms at the node.
     #[inline(never)]
     pub(super) fn stiffened_curvature_law(&self, m: &V3, sec: &Section, (gain, off): (f64, V3), derivative: bool) -> (V3, M3) {
@@ -72,7 +72,7 @@ impl SpatialSolver {
     }
 
     /// The internal moment (body frame, N·mm) whose curvature by the law
-    /// of [`SpatialSolver::curvature_law`] at node `i` is `u`: the
+    /// of [`SpatialCollocation::curvature_law`] at node `i` is `u`: the
     /// law's inverse (bending: m_b ∥ u_b − offset, its size from a scalar
     /// cubic with stiffening and creep).
     pub(super) fn moment_of_curvature(&self, u: &V3, i: usize) -> V3 {

@@ -2,7 +2,7 @@
 
 use super::*;
 
-impl SpatialSolver {
+impl SpatialCollocation {
     /// The pose of the converged state.
     pub(super) fn pose_of_state(&self, passes: u32, tensions: &[f64]) -> TipPose {
         let tip = self.nodes_count() - 1;
@@ -72,7 +72,7 @@ impl SpatialSolver {
         self.estimate
     }
 
-    /// [`SpatialSolver::error_estimate`] of the state just solved.
+    /// [`SpatialCollocation::error_estimate`] of the state just solved.
     pub(super) fn estimate_errors(&self) -> (f64, f64) {
         let np = self.np;
         let (mut angle, mut moment, mut position) = (0.0, 0.0, 0.0);
@@ -123,7 +123,7 @@ impl SpatialSolver {
         Ok(a)
     }
 
-    /// [`SpatialSolver::unresolved`]'s failure at this solver's resolution.
+    /// [`SpatialCollocation::unresolved`]'s failure at this solver's resolution.
     pub(super) fn unresolved(&self, what: String, estimate: f64, tolerance: f64, unit: &'static str) -> crate::solver::Unresolved {
         let advice = format!(
             "raise --nodes-per-span above {} (spec: [solver] nodes_per_span; at most {}), or lower the tensions",
@@ -133,7 +133,7 @@ impl SpatialSolver {
         crate::solver::Unresolved { what, estimate, tolerance, unit, advice }
     }
 
-    /// [`SpatialSolver::coefficients`] without the check, with the estimated
+    /// [`SpatialCollocation::coefficients`] without the check, with the estimated
     /// error of the largest coefficient, 1/mm.
     pub fn coefficients_with_error(&self, order: usize, basis: LengthBasis) -> Result<([Vec<f64>; 3], f64), SpatialError> {
         if order > MAX_SPATIAL_ORDER {

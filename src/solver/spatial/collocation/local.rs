@@ -2,7 +2,7 @@
 
 use super::*;
 
-impl SpatialSolver {
+impl SpatialCollocation {
     /// Newton on the cut equations at node `i` (body-frame distal loads
     /// `nw`, `mw`), warm-started from the last (or predicted) local
     /// solution there. Steps use the inverse Jacobian kept from an earlier
@@ -127,7 +127,7 @@ impl SpatialSolver {
         [x[0] - 1.0 - n[0] * sec.inv_ea, x[1] - n[1] * sec.inv_ga, x[2] - n[2] * sec.inv_ga, x[3] - u[0], x[4] - u[1], x[5] - u[2]]
     }
 
-    /// [`SpatialSolver::residual`] and its Jacobian, I + C S with C =
+    /// [`SpatialCollocation::residual`] and its Jacobian, I + C S with C =
     /// blockdiag(K_se⁻¹, du/dm) and S the cables' stiffness (only a fresh
     /// local step needs it).
     pub(super) fn residual_and_jacobian(&self, i: usize, tensions: &[f64], x: &[f64; 6], nw: V3, mw: V3) -> ([f64; 6], Matrix6<f64>) {

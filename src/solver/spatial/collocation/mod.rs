@@ -234,7 +234,7 @@ type Factors = nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>;
 /// The 3-D collocation solver for one actuator: set tensions, then solve
 /// (in a ladder, for the best warm starts).
 #[derive(Debug, Clone)]
-pub struct SpatialSolver {
+pub struct SpatialCollocation {
     rod: Rod,
     options: SolverOptions,
     cables: usize,
@@ -316,16 +316,16 @@ pub struct SpatialSolver {
     solved: usize,
     passes: u32,
     last: Option<TipPose>,
-    /// The last solve's estimated errors ([`SpatialSolver::error_estimate`]).
+    /// The last solve's estimated errors ([`SpatialCollocation::error_estimate`]).
     estimate: (f64, f64),
     n_scale: f64,
     m_scale: f64,
 }
 
-impl SpatialSolver {
+impl SpatialCollocation {
     /// A solver for `actuator` (its cables, rod, body, torsion and gravity).
     pub fn new(actuator: &Actuator, options: &SolverOptions) -> Result<Self, SpatialError> {
-        let channels = super::solver::validated_channels(actuator, crate::solver::Backend::Spatial)?;
+        let channels = super::solver::validated_channels(actuator, crate::solver::Backend::SpatialCollocation)?;
         super::solver::check_options(options)?;
         let rod = actuator.rod.clone();
         let body = rod.body().map_err(SpatialError::Body)?;
@@ -591,7 +591,7 @@ impl SpatialSolver {
         Ok(())
     }
 
-    /// [`SpatialSolver::set_hold`] of a checked `hold`.
+    /// [`SpatialCollocation::set_hold`] of a checked `hold`.
     fn follow_hold(&mut self, hold: Hold) {
         self.creep.follow_protocol();
         self.creep.set_dwell(hold.dwell_s);
@@ -599,7 +599,7 @@ impl SpatialSolver {
         self.hold = hold;
     }
 
-    /// Like [`SpatialSolver::set_hold`] for independent captures: each of
+    /// Like [`SpatialCollocation::set_hold`] for independent captures: each of
     /// the next solves is reached in `hold.direction` and held `hold.dwell_s`
     /// from a rod with no load history (creep's history does not carry
     /// over from solve to solve; the warm start does).
@@ -715,10 +715,10 @@ impl SpatialSolver {
 }
 
 /// The spatial backend: several and out-of-plane cables by collocation.
-impl crate::solver::Solver for SpatialSolver {
+impl crate::solver::Solver for SpatialCollocation {
     type Error = SpatialError;
     fn backend(&self) -> crate::solver::Backend {
-        crate::solver::Backend::Spatial
+        crate::solver::Backend::SpatialCollocation
     }
     fn solve_tensions(&mut self, tensions_n: &[f64]) -> Result<TipPose, SpatialError> {
         self.solve(tensions_n)
@@ -727,11 +727,11 @@ impl crate::solver::Solver for SpatialSolver {
         self.follow_hold(hold);
     }
     fn centreline(&self) -> Vec<CentrelinePoint> {
-        SpatialSolver::centreline(self)
+        SpatialCollocation::centreline(self)
     }
     /// Refuses coefficients that are not finite.
     fn coefficients(&mut self, order: usize, basis: LengthBasis) -> Result<[Vec<f64>; 3], SpatialError> {
-        let a = SpatialSolver::coefficients(self, order, basis)?;
+        let a = SpatialCollocation::coefficients(self, order, basis)?;
         if !a.iter().flatten().all(|v| v.is_finite()) {
             return Err(SolveFailure::NonFinite { s_mm: None }.into());
         }

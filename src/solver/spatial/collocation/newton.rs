@@ -2,7 +2,7 @@
 
 use super::*;
 
-impl SpatialSolver {
+impl SpatialCollocation {
     pub(super) fn solve_inner(&mut self, tensions: &[f64]) -> Result<u32, SolveFailure> {
         let has_weight = self.has_weight && self.weight_fraction > 0.0;
         let has_friction = self.friction && tensions.iter().any(|&t| t > 0.0);

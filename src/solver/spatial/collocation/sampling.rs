@@ -2,7 +2,7 @@
 
 use super::*;
 
-impl SpatialSolver {
+impl SpatialCollocation {
     /// The centreline of the last solve at `count` evenly spaced points
     /// and at each span boundary, interpolated from the nodes (spectrally
     /// accurate on each span); a boundary's point is taken from the span

@@ -2,7 +2,7 @@
 
 use super::*;
 
-impl SpatialSolver {
+impl SpatialCollocation {
     /// The tension of cable `c` at node `i`, N.
     #[inline]
     pub(super) fn tension_at(&self, tensions: &[f64], i: usize, c: usize) -> f64 {
