@@ -738,3 +738,38 @@ fn no_source_file_is_over_1200_lines() {
     }
     assert!(long.is_empty(), "split these by job (at most 1,200 lines a file):\n{}", long.join("\n"));
 }
+
+/// The types of the library (structs, enums, traits, aliases) by name.
+fn type_names() -> Vec<String> {
+    let mut names = Vec::new();
+    for (_, code) in library_sources() {
+        for line in code.lines() {
+            let words: Vec<&str> = line.split_whitespace().collect();
+            let Some(k) = words.iter().position(|w| ["struct", "enum", "trait", "type"].contains(w)) else { continue };
+            if !words[..k].iter().all(|w| w.starts_with("pub")) {
+                continue;
+            }
+            if let Some(name) = words.get(k + 1) {
+                let name: String = name.chars().take_while(|c| c.is_alphanumeric() || *c == '_').collect();
+                if name.starts_with(|c: char| c.is_ascii_uppercase()) {
+                    names.push(name);
+                }
+            }
+        }
+    }
+    names
+}
+
+/// Types still twinned with a `3` beside their planar name; this list only
+/// shrinks (one concept, one type).
+const TWINNED_BY_A_3: [&str; 4] = ["ChannelPoint3", "Diagnose3Spec", "Diagnosis3", "Signature3"];
+
+#[test]
+fn no_type_is_a_twin_named_with_a_3() {
+    let names = type_names();
+    let twins: Vec<&String> = names.iter().filter(|n| n.contains('3') && names.contains(&n.replacen('3', "", 1))).collect();
+    let new: Vec<&&String> = twins.iter().filter(|n| !TWINNED_BY_A_3.contains(&n.as_str())).collect();
+    assert!(new.is_empty(), "one type per concept: {new:?} beside the same name without the 3 (generalise the one type)");
+    let gone: Vec<&&str> = TWINNED_BY_A_3.iter().filter(|t| !twins.iter().any(|n| n == *t)).collect();
+    assert!(gone.is_empty(), "{gone:?} no longer twinned: remove them from TWINNED_BY_A_3");
+}
