@@ -23,6 +23,7 @@
 use super::friction::{MAX_PASSES as FRICTION_MAX_PASSES, TOLERANCE as FRICTION_TOLERANCE};
 use super::result::{PerCable, PlanarPoint};
 use super::{bending_moment, CentrelinePoint, ChannelSample, PlanarState, SolveFailure, Strains, TipPose};
+use crate::model::body::BodySection;
 use crate::model::Routing;
 use crate::shape::LengthBasis;
 use crate::numerics::anderson::Anderson;
@@ -70,7 +71,7 @@ pub struct Colloc {
     start: Vec<f64>,
     /// The cross-section at each node (a span's last node takes a jump
     /// at its end from the left).
-    section: Vec<super::Section>,
+    section: Vec<BodySection>,
     /// Frame angle φ and gravity's distal moment M at the nodes.
     phi: Vec<f64>,
     mom: Vec<f64>,
@@ -372,17 +373,17 @@ impl PlanarState {
     /// Places the nodes on the knot spans of `built` and samples the channel there.
     pub(super) fn colloc_set_routing(&mut self, c: &mut Colloc, built: &Routing) {
         let knot = built.knot_mm();
-        let bounds = super::span_boundaries(&self.actuator, self.body.as_ref(), knot);
+        let bounds = super::span_boundaries(&self.rod, self.body.as_ref(), knot);
         assert_eq!(bounds.len() - 1, c.spans(), "span count fixed by the actuator");
         for span in 0..c.spans() {
             c.start[span] = bounds[span];
             c.half[span] = (bounds[span + 1] - bounds[span]) / 2.0;
         }
         let np = c.np();
-        let anchor = self.actuator.cable_length_mm();
+        let anchor = self.rod.cable_length_mm();
         // Boundaries closer than this were merged (the anchor may have been
         // merged into a breakpoint just below it).
-        let merged = crate::model::body::MERGE_TOLERANCE * self.actuator.length_mm;
+        let merged = crate::model::body::MERGE_TOLERANCE * self.rod.length_mm;
         self.cable_end = c.s.len();
         c.section.clear();
         for span in 0..c.spans() {
@@ -439,7 +440,7 @@ impl PlanarState {
         let mut passes = 0u32;
         let mut previous = f64::INFINITY;
         // Anderson acceleration of the sweeps, a fixed map of (φ, M, τ(s)/τ(0)).
-        let scale = self.actuator.length_mm / self.actuator.ei_n_mm2;
+        let scale = self.rod.length_mm / self.rod.ei_n_mm2;
         c.anderson.restart();
         let outcome = loop {
             c.begin_sweep(self.friction.ratios(), scale);
@@ -450,7 +451,7 @@ impl PlanarState {
             passes += 1;
             let dratio = if has_friction { self.colloc_update_tension_ratio(c) } else { 0.0 };
             // The moment's change in angle units: δM·L/EI turns the tip by about that.
-            let change = dphi.max(dmom * self.actuator.length_mm / self.actuator.ei_n_mm2);
+            let change = dphi.max(dmom * self.rod.length_mm / self.rod.ei_n_mm2);
             // Settled, and still contracting (a stalled iteration goes to Newton).
             let settled = dphi <= SWEEP_ANGLE_TOLERANCE_RAD && dmom <= self.options.planar_moment_tolerance_n_mm && dratio < FRICTION_TOLERANCE;
             if settled && (passes == 1 || change <= 0.5 * previous || !has_weight) {
@@ -505,7 +506,7 @@ impl PlanarState {
 
     /// Frame angle at the clamp from node 0's bending moment.
     fn colloc_clamp_angle(&self, c: &Colloc, tension: f64) -> f64 {
-        match self.actuator.effects.clamp_stiffness_n_mm_per_rad {
+        match self.rod.effects.clamp_stiffness_n_mm_per_rad {
             Some(k) => bending_moment(self.tension_at(0, tension), self.channel[0].y, self.cable_dir[0].0, c.mom[0]) / k,
             None => 0.0,
         }
@@ -598,7 +599,7 @@ impl PlanarState {
         let dmom = self.colloc_moment(c);
         // A non-finite strain reaches every later φ and every earlier M.
         if !(c.phi[c.phi.len() - 1] + c.phi[c.np() - 1] + c.mom[0] + dphi + dmom).is_finite() {
-            return Err(SolveFailure::NonFinite { s_mm: Some(self.actuator.length_mm) });
+            return Err(SolveFailure::NonFinite { s_mm: Some(self.rod.length_mm) });
         }
         Ok((dphi, dmom))
     }
@@ -759,7 +760,7 @@ impl PlanarState {
     /// Strains at a node with their derivatives with respect to φ and M
     /// (implicit function theorem on the cable-direction equation).
     #[allow(clippy::too_many_arguments)]
-    fn colloc_node_partials(&self, s: f64, section: &super::Section, ch: ChannelSample, (sp, cp): (f64, f64), moment: f64, t: f64, dir: (f64, f64), e: Strains) -> Partials {
+    fn colloc_node_partials(&self, s: f64, section: &BodySection, ch: ChannelSample, (sp, cp): (f64, f64), moment: f64, t: f64, dir: (f64, f64), e: Strains) -> Partials {
         let (ea, ga) = (section.ea_n, section.ga_n);
         let wl = self.distal_weight_n(s);
         let (gc, gs) = (self.gravity_cos, self.gravity_sin);
@@ -801,7 +802,7 @@ impl PlanarState {
         self.colloc_strains(c, tension)?;
         let nn = c.s.len();
         let np = c.np();
-        let scale = self.actuator.length_mm / self.actuator.ei_n_mm2;
+        let scale = self.rod.length_mm / self.rod.ei_n_mm2;
         let (gc, gs) = (self.gravity_cos, self.gravity_sin);
         let mut parts = vec![Partials::default(); nn];
         for i in 0..nn {
@@ -813,7 +814,7 @@ impl PlanarState {
             let dy = e.v1 * sp + e.v2 * cp;
             c.dmom[i] = self.distal_weight_n(c.s[i]) * (dy * gc - dx * gs);
         }
-        let k_theta = self.actuator.effects.clamp_stiffness_n_mm_per_rad;
+        let k_theta = self.rod.effects.clamp_stiffness_n_mm_per_rad;
         let mut jac = jac;
         if let Some(j) = jac.as_deref_mut() {
             j.fill(0.0);
@@ -909,7 +910,7 @@ impl PlanarState {
         }
         let ei_min = c.section.iter().map(|s| s.ei_n_mm2).fold(f64::INFINITY, f64::min);
         let scale = ESTIMATE_SAFETY / (c.m * c.m) as f64;
-        let theta_error = scale * (phi_error + moment_error * self.actuator.length_mm / ei_min);
+        let theta_error = scale * (phi_error + moment_error * self.rod.length_mm / ei_min);
         let ell = c.sigma[c.s.len() - 1];
         let mut tip_error = scale * position_error + ell * theta_error;
         if aliased {
@@ -1024,8 +1025,8 @@ impl PlanarState {
             let angles = self.theta_error_rad * (2.0 + (2.0 * nf * (nf + 1.0)).sqrt());
             quadrature_error.get(n).map_or(f64::INFINITY, |q| (2.0 * nf + 1.0) / ell * (ESTIMATE_SAFETY * q / (c.m * c.m) as f64 + angles))
         });
-        let worst = super::largest_error(errors, basis, ell, self.actuator.length_mm);
-        basis.convert_from_deformed(out, ell, self.actuator.length_mm);
+        let worst = super::largest_error(errors, basis, ell, self.rod.length_mm);
+        basis.convert_from_deformed(out, ell, self.rod.length_mm);
         worst
     }
 
@@ -1038,11 +1039,11 @@ impl PlanarState {
         let np = c.np();
         let count = 2 * self.options.planar_steps_per_span + 1;
         let tension = self.last_tension_n.unwrap_or(0.0);
-        let length = self.actuator.length_mm;
+        let length = self.rod.length_mm;
         let v1: Vec<f64> = c.strain.iter().map(|e| e.v1).collect();
         let v2: Vec<f64> = c.strain.iter().map(|e| e.v2).collect();
         let u: Vec<f64> = c.strain.iter().map(|e| e.u).collect();
-        let anchor = self.actuator.cable_length_mm();
+        let anchor = self.rod.cable_length_mm();
         let mut samples: Vec<f64> = (0..count).map(|k| length * k as f64 / (count - 1) as f64).collect();
         if anchor < length && !samples.contains(&anchor) {
             samples.insert(samples.partition_point(|&s| s < anchor), anchor);

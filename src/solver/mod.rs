@@ -51,7 +51,7 @@
 
 use crate::model::parameter::ParameterError;
 use crate::model::rod::{LoadDirection, Rod};
-use crate::model::body::{merge_sorted, Body};
+use crate::model::body::{merge_sorted, Body, BodySection};
 use crate::model::routing::Routing;
 use crate::shape::LengthBasis;
 use serde::{Deserialize, Serialize};
@@ -241,18 +241,6 @@ struct ChannelSample {
     dy: f64,
 }
 
-/// Rigidities of the cross-section at one point.
-#[derive(Debug, Clone, Copy)]
-struct Section {
-    /// Axial rigidity EA, N.
-    ea_n: f64,
-    /// Shear rigidity GA, N.
-    ga_n: f64,
-    /// Bending rigidity EI, N·mm².
-    ei_n_mm2: f64,
-    /// Radius r, mm (material stiffening's α r²).
-    radius_mm: f64,
-}
 
 /// Bending moment at a cut, N·mm: the cable's moment τ y_c cos α about the
 /// centreline (`tension` at the cut, channel offset `channel_y_mm`, cable
@@ -268,7 +256,7 @@ fn bending_moment(tension: f64, channel_y_mm: f64, cos_alpha: f64, distal_moment
 /// cut equations; the cut equations themselves ([`PlanarState::strains_at`]).
 #[derive(Debug, Clone)]
 pub struct PlanarState {
-    actuator: Rod,
+    rod: Rod,
     options: SolverOptions,
     weight_n_per_mm: f64,
     gravity_cos: f64,
@@ -339,7 +327,7 @@ impl PlanarState {
     /// actuator's, or the non-uniform body's ([`Body::section_at`]), with
     /// the stiffness gradient.
     #[inline]
-    fn section_at(&self, s: f64) -> Section {
+    fn section_at(&self, s: f64) -> BodySection {
         self.section_at_side(s, false)
     }
 
@@ -347,14 +335,11 @@ impl PlanarState {
     /// segment's end) is taken from the left with `left` (the last node of
     /// a span), from the right otherwise.
     #[inline]
-    fn section_at_side(&self, s: f64, left: bool) -> Section {
-        let a = &self.actuator;
+    fn section_at_side(&self, s: f64, left: bool) -> BodySection {
+        let a = &self.rod;
         let mut section = match &self.body {
-            None => Section { ea_n: a.ea_n, ga_n: a.ga_n, ei_n_mm2: a.ei_n_mm2, radius_mm: a.radius_mm },
-            Some(b) => {
-                let x = b.section_at_side(s, left);
-                Section { ea_n: x.ea_n, ga_n: x.ga_n, ei_n_mm2: x.ei_n_mm2, radius_mm: x.radius_mm }
-            }
+            None => BodySection { ea_n: a.ea_n, ga_n: a.ga_n, ei_n_mm2: a.ei_n_mm2, radius_mm: a.radius_mm },
+            Some(b) => b.section_at_side(s, left),
         };
         let beta = a.effects.stiffness_gradient_beta;
         if beta != 0.0 {
@@ -368,7 +353,7 @@ impl PlanarState {
     #[inline]
     fn distal_weight_n(&self, s: f64) -> f64 {
         match &self.body {
-            None => self.weight_n_per_mm * (self.actuator.length_mm - s),
+            None => self.weight_n_per_mm * (self.rod.length_mm - s),
             Some(b) => self.weight_n_per_mm * b.distal_density_area(s),
         }
     }
@@ -388,16 +373,16 @@ impl PlanarState {
     /// m = EI u (1 + α (r u)²); a rod cured bent adds its rest curvature u*
     /// (m = EI (u − u*), [`Rod::rest_curvature_per_mm`]).
     #[inline]
-    fn bending_curvature(&self, m: f64, section: &Section) -> (f64, f64) {
+    fn bending_curvature(&self, m: f64, section: &BodySection) -> (f64, f64) {
         let (u, du_dm) = self.elastic_curvature(m, section.ei_n_mm2, section.radius_mm);
-        (u + self.actuator.rest_curvature_per_mm, du_dm)
+        (u + self.rod.rest_curvature_per_mm, du_dm)
     }
 
     /// The elastic part of [`PlanarState::bending_curvature`] with rigidity
     /// `ei` and radius `radius_mm`.
     #[inline]
     fn elastic_curvature(&self, m: f64, ei: f64, radius_mm: f64) -> (f64, f64) {
-        let alpha = self.actuator.effects.stiffening_alpha;
+        let alpha = self.rod.effects.stiffening_alpha;
         if alpha == 0.0 {
             return (m / ei, 1.0 / ei);
         }
@@ -432,7 +417,7 @@ impl PlanarState {
     fn strains_at(
         &self,
         s: f64,
-        section: &Section,
+        section: &BodySection,
         ch: ChannelSample,
         (sp, cp): (f64, f64),
         moment: f64,

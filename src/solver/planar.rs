@@ -99,7 +99,7 @@ impl<I: Integrator> PlanarSolver<I> {
             Some(_) => rod.gravity.scale * 1e-6 * std::f64::consts::PI * rod.gravity.g_m_s2,
         };
         let state = PlanarState {
-            actuator: rod.clone(),
+            rod: rod.clone(),
             options,
             weight_n_per_mm,
             gravity_cos: beta.cos(),
@@ -131,12 +131,12 @@ impl<I: Integrator> PlanarSolver<I> {
 
     /// The rod this solver was built for.
     pub fn rod(&self) -> &Rod {
-        &self.state.actuator
+        &self.state.rod
     }
 
     /// Validates `y_mm` against the rod and sets it as the routing.
     pub fn set_routing_mm(&mut self, y_mm: &[f64]) -> Result<(), crate::model::routing::RoutingError> {
-        let routing = Routing::for_actuator(y_mm, &self.state.actuator)?;
+        let routing = Routing::for_actuator(y_mm, &self.state.rod)?;
         self.set_routing(&routing);
         Ok(())
     }
@@ -145,7 +145,7 @@ impl<I: Integrator> PlanarSolver<I> {
     /// forgets the warm start. The routing must span the cable's length
     /// (build it with [`Routing::for_actuator`]).
     pub fn set_routing(&mut self, routing: &Routing) {
-        let rod = &self.state.actuator;
+        let rod = &self.state.rod;
         debug_assert!((routing.length_mm() - rod.cable_length_mm()).abs() <= 1e-9 * rod.length_mm);
         let delta = rod.effects.channel_offset_mm;
         let built = if delta != 0.0 { routing.shifted(delta) } else { routing.clone() };
@@ -247,7 +247,7 @@ impl<I: Integrator> PlanarSolver<I> {
     /// Returns the estimated error of the tangent angle, rad.
     fn check_resolved(&mut self, pose: &TipPose, theta_error_rad: f64, tip_error_mm: f64) -> Result<f64, SolveFailure> {
         let scalars = [pose.tip_x_mm, pose.tip_y_mm, pose.tip_angle_rad, pose.tip_frame_angle_rad, pose.base_angle_rad, pose.length_mm];
-        let length_mm = self.state.actuator.length_mm;
+        let length_mm = self.state.rod.length_mm;
         if !scalars.iter().all(|v| v.is_finite()) {
             return Err(SolveFailure::NonFinite { s_mm: Some(length_mm) });
         }
@@ -327,7 +327,7 @@ impl<I: Integrator> PlanarSolver<I> {
     pub fn coefficients_checked(&mut self, basis: LengthBasis, out: &mut [f64]) -> Result<(), SolveFailure> {
         self.coefficients_into(basis, out);
         if !out.iter().all(|a| a.is_finite()) {
-            return Err(SolveFailure::NonFinite { s_mm: Some(self.state.actuator.length_mm) });
+            return Err(SolveFailure::NonFinite { s_mm: Some(self.state.rod.length_mm) });
         }
         let (error, k) = self.state.coefficient_error;
         let tolerance = resolution::ORDER_TOLERANCE_PER_MM;

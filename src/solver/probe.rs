@@ -53,7 +53,7 @@ impl PlanarSolver<Colloc> {
             Some(p) => p,
             None => {
                 let options = SolverOptions { nodes_per_span: (2 * self.resolution()).min(MAX_NODES_PER_SPAN), ..self.state.options.clone() };
-                let mut sim = PlanarSolver::new(&self.state.actuator, &options).ok()?;
+                let mut sim = PlanarSolver::new(&self.state.rod, &options).ok()?;
                 sim.state.is_probe = true;
                 Box::new(Probe { sim, current: false, solved_at: None })
             }

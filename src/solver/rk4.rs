@@ -119,7 +119,7 @@ impl PlanarSolver<Rk4> {
     fn rk4_set_routing(&mut self, built: &Routing) {
         let n = self.state.options.planar_steps_per_span;
         let knot = built.knot_mm();
-        let length = self.state.actuator.length_mm;
+        let length = self.state.rod.length_mm;
         self.integrator.span_start_mm = [0.0, knot];
         self.integrator.step_mm = [knot / n as f64, (length - knot) / n as f64];
         for span in 0..2 {
@@ -181,7 +181,7 @@ impl PlanarSolver<Rk4> {
     /// φ(0) = m(0)/k_θ with m(0) the bending moment there (fixed point, as
     /// m(0) depends on φ(0) only through the weight's direction).
     fn clamp_angle(&mut self, moment0: f64, tension: f64) -> Result<f64, SolveFailure> {
-        let Some(k_theta) = self.state.actuator.effects.clamp_stiffness_n_mm_per_rad else {
+        let Some(k_theta) = self.state.rod.effects.clamp_stiffness_n_mm_per_rad else {
             return Ok(0.0);
         };
         let ch = self.state.channel[0];
@@ -247,7 +247,7 @@ impl PlanarSolver<Rk4> {
         }
         // Tip node.
         let k_tip = 2 * (2 * n + 1) - 1;
-        let (_, e) = self.derivative(self.state.actuator.length_mm, k_tip, &st, st.phi.sin_cos(), tension)?;
+        let (_, e) = self.derivative(self.state.rod.length_mm, k_tip, &st, st.phi.sin_cos(), tension)?;
         if record {
             let tip = 2 * n;
             self.integrator.nodes_state[tip] = st;
@@ -376,8 +376,8 @@ impl PlanarSolver<Rk4> {
         shape::legendre_from_tangent(&r.coarse_theta, &r.coarse_sigma, &r.coarse_speed, 2.0 * h, &mut coarse[..estimated]);
         let ell = r.sigma[r.sigma.len() - 1] - r.sigma[0];
         let errors = out.iter().enumerate().map(|(n, a)| coarse.get(n).map_or(f64::INFINITY, |c| (a - c).abs()));
-        let worst = super::largest_error(errors, basis, ell, self.state.actuator.length_mm);
-        basis.convert_from_deformed(out, ell, self.state.actuator.length_mm);
+        let worst = super::largest_error(errors, basis, ell, self.state.rod.length_mm);
+        basis.convert_from_deformed(out, ell, self.state.rod.length_mm);
         worst
     }
 

@@ -11,7 +11,7 @@ impl SpatialCollocation {
     /// The linear law is inlined into the local residual (its hot loop);
     /// stiffening's Newton is not.
     #[inline(always)]
-    pub(super) fn curvature_law(&self, i: usize, m: &V3, sec: &Section, derivative: bool) -> (V3, M3) {
+    pub(super) fn curvature_law(&self, i: usize, m: &V3, sec: &NodeCompliance, derivative: bool) -> (V3, M3) {
         let rest = self.rod.rest_curvature_per_mm;
         if self.stiffening == 0.0 && !self.creep.is_on() {
             // The elastic linear law (most solves) without adding creep's
@@ -33,7 +33,7 @@ impl SpatialCollocation {
     /// [`SpatialCollocation::curvature_law`] with material stiffening, given
     /// creep's terms at the node.
     #[inline(never)]
-    pub(super) fn stiffened_curvature_law(&self, m: &V3, sec: &Section, (gain, off): (f64, V3), derivative: bool) -> (V3, M3) {
+    pub(super) fn stiffened_curvature_law(&self, m: &V3, sec: &NodeCompliance, (gain, off): (f64, V3), derivative: bool) -> (V3, M3) {
         let alpha = self.stiffening;
         let rest = self.rod.rest_curvature_per_mm;
         let mb = (m[1] * m[1] + m[2] * m[2]).sqrt();
@@ -104,7 +104,7 @@ impl SpatialCollocation {
     /// Creep's extra compliance over the hold and its held curvature at
     /// node `i` (components about body y and z in 1 and 2).
     #[inline]
-    pub(super) fn creep_terms(&self, i: usize, sec: &Section) -> (f64, V3) {
+    pub(super) fn creep_terms(&self, i: usize, sec: &NodeCompliance) -> (f64, V3) {
         if !self.creep.is_on() {
             return (0.0, V3::zeros());
         }

@@ -200,9 +200,9 @@ impl Grid {
     }
 }
 
-/// The cross-section at a node.
+/// The cross-section at a node as the residual uses it: GJ, EI, r and the four compliances.
 #[derive(Debug, Clone, Copy)]
-struct Section {
+struct NodeCompliance {
     gj: f64,
     ei: f64,
     radius: f64,
@@ -268,7 +268,7 @@ pub struct SpatialCollocation {
     half: Vec<f64>,
     // Per node.
     s: Vec<f64>,
-    section: Vec<Section>,
+    section: Vec<NodeCompliance>,
     /// The weight beyond the cut (all of it), N.
     distal_weight: Vec<f64>,
     /// Channels, node-major (nn × cables).
@@ -390,7 +390,7 @@ impl SpatialCollocation {
                     ei *= f;
                     gj *= f;
                 }
-                section.push(Section { gj, ei, radius, inv_ea: 1.0 / ea, inv_ga: 1.0 / ga, inv_gj: 1.0 / gj, inv_ei: 1.0 / ei });
+                section.push(NodeCompliance { gj, ei, radius, inv_ea: 1.0 / ea, inv_ga: 1.0 / ga, inv_gj: 1.0 / gj, inv_ei: 1.0 / ei });
                 distal_weight.push(match &body {
                     None => weight_factor * (length - sj),
                     Some(b) => weight_factor * b.distal_density_area(sj),
