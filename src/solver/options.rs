@@ -120,9 +120,8 @@ pub mod planar_table {
         max_shooting_passes: u32,
     }
 
-    impl Default for Table {
-        fn default() -> Self {
-            let o = SolverOptions::default();
+    impl From<&SolverOptions> for Table {
+        fn from(o: &SolverOptions) -> Self {
             Self {
                 method: o.method,
                 nodes_per_span: o.nodes_per_span,
@@ -134,17 +133,15 @@ pub mod planar_table {
         }
     }
 
+    impl Default for Table {
+        fn default() -> Self {
+            Self::from(&SolverOptions::default())
+        }
+    }
+
     /// Writes the planar table of `o`.
     pub fn serialize<S: Serializer>(o: &SolverOptions, serializer: S) -> Result<S::Ok, S::Error> {
-        Table {
-            method: o.method,
-            nodes_per_span: o.nodes_per_span,
-            steps_per_span: o.planar_steps_per_span,
-            angle_tolerance_rad: o.angle_tolerance_rad,
-            moment_tolerance_n_mm: o.planar_moment_tolerance_n_mm,
-            max_shooting_passes: o.max_shooting_passes,
-        }
-        .serialize(serializer)
+        Table::from(o).serialize(serializer)
     }
 
     /// Reads a planar table; the spatial settings keep their defaults.
@@ -178,9 +175,8 @@ pub mod spatial_table {
         method: SolverMethod,
     }
 
-    impl Default for Table {
-        fn default() -> Self {
-            let o = SolverOptions::default();
+    impl From<&SolverOptions> for Table {
+        fn from(o: &SolverOptions) -> Self {
             Self {
                 steps_per_span: o.spatial_steps_per_span,
                 moment_tolerance_n_mm: o.spatial_moment_tolerance_n_mm,
@@ -191,16 +187,15 @@ pub mod spatial_table {
         }
     }
 
+    impl Default for Table {
+        fn default() -> Self {
+            Self::from(&SolverOptions::default())
+        }
+    }
+
     /// Writes the spatial table of `o`.
     pub fn serialize<S: Serializer>(o: &SolverOptions, serializer: S) -> Result<S::Ok, S::Error> {
-        Table {
-            steps_per_span: o.spatial_steps_per_span,
-            moment_tolerance_n_mm: o.spatial_moment_tolerance_n_mm,
-            max_passes: o.spatial_max_passes,
-            nodes_per_span: o.nodes_per_span,
-            method: o.method,
-        }
-        .serialize(serializer)
+        Table::from(o).serialize(serializer)
     }
 
     /// Reads a spatial table; the planar settings keep their defaults.

@@ -52,10 +52,10 @@ fn rotate_sin_cos((s, c): (f64, f64), delta: f64) -> (f64, f64) {
     (s, c)
 }
 
-/// RK4's state: the step grid, the nodes of the last pass and the warm
-/// start of the shooting.
+/// The planar RK4 integrator, shooting on the tip conditions: the step
+/// grid, the nodes of the last pass and the warm start of the shooting.
 #[derive(Debug, Clone)]
-pub struct Rk4 {
+pub struct ShootingRk4 {
     /// Step length on each span, mm.
     step_mm: [f64; 2],
     /// Span starts, mm.
@@ -80,7 +80,7 @@ pub struct Rk4 {
     continuation: Continuation,
 }
 
-impl Rk4 {
+impl ShootingRk4 {
     /// Buffers for `n` steps per span.
     pub(super) fn new(n: usize) -> Self {
         let nodes = 2 * n + 1;
@@ -113,7 +113,7 @@ impl Rk4 {
     }
 }
 
-impl PlanarSolver<Rk4> {
+impl PlanarSolver<ShootingRk4> {
     /// Places the stage points on the knot spans of `built` and samples the
     /// channel there.
     fn rk4_set_routing(&mut self, built: &Routing) {
@@ -414,12 +414,12 @@ impl PlanarSolver<Rk4> {
 
 
 /// The planar RK4 reference.
-impl Integrator for Rk4 {
+impl Integrator for ShootingRk4 {
     const METHOD: super::SolverMethod = super::SolverMethod::Rk4;
 
     fn build(_rod: &Rod, options: &SolverOptions, _spans: usize) -> (Self, usize) {
         let n = options.planar_steps_per_span;
-        (Rk4::new(n), 2 * (2 * n + 1))
+        (ShootingRk4::new(n), 2 * (2 * n + 1))
     }
 
     fn set_routing(p: &mut PlanarSolver<Self>, built: &Routing) {
@@ -427,7 +427,7 @@ impl Integrator for Rk4 {
     }
 
     fn forget(&mut self) {
-        Rk4::forget(self);
+        ShootingRk4::forget(self);
     }
 
     fn solve(p: &mut PlanarSolver<Self>, tension: f64) -> Result<(TipPose, (f64, f64)), SolveFailure> {

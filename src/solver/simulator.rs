@@ -5,7 +5,7 @@
 use super::collocation::Colloc;
 use super::error::SimulateError;
 use super::planar::{Integrator, PlanarSolver};
-use super::rk4::Rk4;
+use super::rk4::ShootingRk4;
 use super::{Backend, CentrelinePoint, Hold, SolveFailure, Solver, SolverMethod, SolverOptions, TipPose};
 use crate::model::parameter::ParameterError;
 use crate::model::{Rod, Routing};
@@ -15,7 +15,7 @@ use crate::shape::LengthBasis;
 pub type PlanarCollocation = PlanarSolver<Colloc>;
 /// The planar RK4 reference: classical RK4 with secant shooting, the
 /// plain scheme the collocation is checked against.
-pub type PlanarRk4 = PlanarSolver<Rk4>;
+pub type PlanarRk4 = PlanarSolver<ShootingRk4>;
 
 /// The planar backend `options.method` asks for, for callers that pick
 /// it at run time: each call goes to that backend's own (statically
