@@ -86,8 +86,11 @@ impl std::fmt::Display for LengthBasis {
 
 /// A basis name that is neither `rest` (alias `thesis`) nor `deformed`.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("unknown length basis '{0}': use 'rest' (the thesis's basis, per unit rest length; alias 'thesis') or 'deformed' (per unit deformed length)")]
-pub struct UnknownLengthBasis(pub String);
+#[error("unknown length basis '{given}': use 'rest' (the thesis's basis, per unit rest length; alias 'thesis') or 'deformed' (per unit deformed length)")]
+pub struct UnknownLengthBasis {
+    /// The name given.
+    pub given: String,
+}
 
 impl std::str::FromStr for LengthBasis {
     type Err = UnknownLengthBasis;
@@ -96,7 +99,7 @@ impl std::str::FromStr for LengthBasis {
         match text.trim().to_ascii_lowercase().as_str() {
             "rest" | "thesis" => Ok(LengthBasis::Rest),
             "deformed" => Ok(LengthBasis::Deformed),
-            _ => Err(UnknownLengthBasis(text.to_string())),
+            _ => Err(UnknownLengthBasis { given: text.to_string() }),
         }
     }
 }

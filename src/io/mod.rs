@@ -22,7 +22,7 @@ pub use atomic::{
 };
 pub use format::{fmt_bytes, fmt_num, fmt_sig};
 pub use memory::available_memory_bytes;
-pub use read::{read_text, read_utf8, subdirs_holding, FileError};
+pub use read::{read_text, read_utf8, subdirs_holding, FileError, SharedIoError};
 pub use run_dir::{check_outside_run_dir, enclosing_run_dir, is_run_dir, run_markers, InsideRunDir};
 pub use sha256::{hex, sha256_file};
 

@@ -35,6 +35,25 @@ impl FileError {
     }
 }
 
+/// An I/O error that can be cloned and compared, for the errors that are
+/// (the model's): the cause is shared, and two are equal when they say the
+/// same thing of the same kind.
+#[derive(Debug, Clone, thiserror::Error)]
+#[error(transparent)]
+pub struct SharedIoError(pub std::sync::Arc<std::io::Error>);
+
+impl PartialEq for SharedIoError {
+    fn eq(&self, other: &Self) -> bool {
+        self.0.kind() == other.0.kind() && self.0.to_string() == other.0.to_string()
+    }
+}
+
+impl From<std::io::Error> for SharedIoError {
+    fn from(e: std::io::Error) -> Self {
+        SharedIoError(std::sync::Arc::new(e))
+    }
+}
+
 /// [`read_utf8`] with the path in the error.
 pub fn read_text(path: &Path, op: &'static str) -> Result<String, FileError> {
     read_utf8(path).map_err(FileError::on(op, path))

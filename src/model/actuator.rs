@@ -77,14 +77,14 @@ impl Actuator {
 
     /// Reads the TOML format (docs/schema.md); `source` names the file in errors.
     pub fn from_toml(text: &str, source: &str) -> Result<Self, ActuatorError> {
-        toml::from_str(text).map_err(|e| ActuatorError::Toml { source_name: source.to_string(), message: e.to_string() })
+        toml::from_str(text).map_err(|e| ActuatorError::Toml { source_name: source.to_string(), source: e })
     }
 
     /// Reads and checks an actuator file ([`Actuator::channels`]; which
     /// backend serves it is decided when it is solved).
     pub fn read(path: &std::path::Path) -> Result<Self, ActuatorError> {
         let text = std::fs::read_to_string(path)
-            .map_err(|e| ActuatorError::Read { path: path.display().to_string(), message: e.to_string() })?;
+            .map_err(|e| ActuatorError::Read { path: path.to_path_buf(), source: e.into() })?;
         let a = Self::from_toml(&text, &path.display().to_string())?;
         a.channels()?;
         Ok(a)

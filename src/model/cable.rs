@@ -6,7 +6,7 @@
 //! is one parametric space curve r_c(s) = (0, y_c(s), z_c(s)) in the body
 //! frame. z ≡ 0 is today's planar routing.
 
-use crate::model::ActuatorError;
+use crate::model::{ActuatorError, CableSpecProblem, DisplacementProblem};
 use crate::model::routing::{ChannelPoint, Routing, CHANNEL_STEP_MM, CONTROL_POINTS};
 use crate::model::Rod;
 use serde::{Deserialize, Serialize};
@@ -304,19 +304,16 @@ pub fn validate(actuator: &Rod, cables: &[Cable]) -> Result<Vec<Channel>, Actuat
             }
         }
         if let Some(d) = cable.displacement_mm {
-            let bad = |why: String| Err(ActuatorError::Displacement { cable: cable_no, displacement_mm: d, why });
+            let bad = |problem| Err(ActuatorError::Displacement { cable: cable_no, displacement_mm: d, problem });
             if !d.is_finite() {
-                return bad("give a finite pulled-in length, mm".into());
+                return bad(DisplacementProblem::NotFinite);
             }
             if d < 0.0 {
-                return bad("a cable pulls: a negative displacement would push it; give the pulled-in length ≥ 0 mm".into());
+                return bad(DisplacementProblem::Negative);
             }
             let rest = channel.rest_length_mm(span);
             if d >= rest {
-                return bad(format!(
-                    "the cable is only {} mm long in the unloaded rod; it cannot be pulled in by that much",
-                    crate::io::fmt_num((rest * 1e3).round() / 1e3)
-                ));
+                return bad(DisplacementProblem::LongerThanCable { rest_length_mm: rest });
             }
         }
         for (other, earlier) in cables[..index].iter().enumerate() {
@@ -336,21 +333,21 @@ impl std::str::FromStr for Cable {
     type Err = ActuatorError;
 
     fn from_str(text: &str) -> Result<Self, Self::Err> {
-        let bad = |why: String| ActuatorError::CableSpec { text: text.to_string(), why };
+        let bad = |problem| ActuatorError::CableSpec { given: text.to_string(), problem };
         let points = |key: &str, value: &str| -> Result<[f64; CONTROL_POINTS], ActuatorError> {
             let v: Vec<f64> = value
                 .split(',')
-                .map(|x| x.trim().parse::<f64>().map_err(|_| bad(format!("{key}: '{}' is not a number", x.trim()))))
+                .map(|x| x.trim().parse::<f64>().map_err(|_| bad(CableSpecProblem::NotANumber { key: key.into(), value: x.trim().into() })))
                 .collect::<Result<_, _>>()?;
-            v.try_into().map_err(|v: Vec<f64>| bad(format!("{key} needs {CONTROL_POINTS} control points, got {}", v.len())))
+            v.try_into().map_err(|v: Vec<f64>| bad(CableSpecProblem::ControlPointCount { key: key.into(), expected: CONTROL_POINTS, got: v.len() }))
         };
         let number = |key: &str, value: &str| -> Result<f64, ActuatorError> {
-            value.trim().parse::<f64>().map_err(|_| bad(format!("{key}: '{value}' is not a number")))
+            value.trim().parse::<f64>().map_err(|_| bad(CableSpecProblem::NotANumber { key: key.into(), value: value.into() }))
         };
         let (mut y, mut z, mut tension, mut anchor, mut displacement, mut ea) = (None, None, None, None, None, None);
         for field in text.split_whitespace() {
-            let (key, value) = field.split_once('=').ok_or_else(|| bad(format!("'{field}' is not key=value")))?;
-            let slot_taken = |taken: bool| if taken { Err(bad(format!("{key}= is given twice"))) } else { Ok(()) };
+            let (key, value) = field.split_once('=').ok_or_else(|| bad(CableSpecProblem::NotKeyValue { field: field.into() }))?;
+            let slot_taken = |taken: bool| if taken { Err(bad(CableSpecProblem::GivenTwice { key: key.into() })) } else { Ok(()) };
             match key {
                 "y" => {
                     slot_taken(y.is_some())?;
@@ -376,13 +373,13 @@ impl std::str::FromStr for Cable {
                     slot_taken(ea.is_some())?;
                     ea = Some(number(key, value)?);
                 }
-                other => return Err(bad(format!("unknown field '{other}' (fields: y, z, tension, displacement, ea, anchor)"))),
+                other => return Err(bad(CableSpecProblem::UnknownField { key: other.into() })),
             }
         }
-        let y_mm = y.ok_or_else(|| bad("y= is missing".into()))?;
+        let y_mm = y.ok_or_else(|| bad(CableSpecProblem::MissingY))?;
         let tension_n = match (tension, displacement) {
-            (Some(_), Some(_)) => return Err(bad("give tension= or displacement=, not both".into())),
-            (None, None) => return Err(bad("tension= (N) or displacement= (mm) is missing".into())),
+            (Some(_), Some(_)) => return Err(bad(CableSpecProblem::TensionAndDisplacement)),
+            (None, None) => return Err(bad(CableSpecProblem::NoActuation)),
             (t, _) => t.unwrap_or(0.0),
         };
         Ok(Cable { y_mm, z_mm: z.unwrap_or([0.0; CONTROL_POINTS]), tension_n, displacement_mm: displacement, cable_ea_n: ea, anchor_mm: anchor })

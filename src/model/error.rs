@@ -14,8 +14,8 @@ pub enum ActuatorError {
     #[error("cable {cable}: tension {} N is invalid: a cable pulls with a finite tension ≥ 0 N", crate::io::fmt_num(*tension_n))]
     Tension { cable: usize, tension_n: f64 },
     /// A displacement is negative, not finite, or longer than the cable.
-    #[error("cable {cable}: displacement_mm = {} mm is invalid: {why}", crate::io::fmt_num(*displacement_mm))]
-    Displacement { cable: usize, displacement_mm: f64, why: String },
+    #[error("cable {cable}: displacement_mm = {} mm is invalid: {problem}", crate::io::fmt_num(*displacement_mm))]
+    Displacement { cable: usize, displacement_mm: f64, problem: DisplacementProblem },
     /// A cable stiffness is not a positive number.
     #[error("cable {cable}: cable_ea_n = {} N must be a finite stiffness > 0 N (leave it out for an inextensible cable)", crate::io::fmt_num(*cable_ea_n))]
     CableStiffness { cable: usize, cable_ea_n: f64 },
@@ -38,17 +38,55 @@ pub enum ActuatorError {
     #[error(transparent)]
     Parameter(#[from] ParameterError),
     /// The `--cable` text could not be read.
-    #[error("cable \"{text}\": {why} (expected \"y=Y0,Y1,Y2,Y3,Y4 z=Z0,Z1,Z2,Z3,Z4 tension=T\" or displacement=D in place of tension=T; z=, ea=EA (the cable's stiffness, N) and anchor=S optional)")]
-    CableSpec { text: String, why: String },
+    #[error("cable \"{given}\": {problem} (expected \"y=Y0,Y1,Y2,Y3,Y4 z=Z0,Z1,Z2,Z3,Z4 tension=T\" or displacement=D in place of tension=T; z=, ea=EA (the cable's stiffness, N) and anchor=S optional)")]
+    CableSpec { given: String, problem: CableSpecProblem },
     /// An actuator file is not valid TOML or has unknown fields.
-    #[error("actuator file {source_name}: {message}(see docs/schema.md, \"Spatial actuator file\")")]
-    Toml { source_name: String, message: String },
+    #[error("actuator file {source_name}: {source}(see docs/schema.md, \"Spatial actuator file\")")]
+    Toml { source_name: String, source: toml::de::Error },
     /// An actuator file cannot be read.
-    #[error("reading actuator file {path}: {message}")]
-    Read {
-        /// The file.
-        path: String,
-        /// The cause (as text: this error is cloned and compared).
-        message: String,
-    },
+    #[error("reading actuator file {}: {source}", path.display())]
+    Read { path: std::path::PathBuf, source: crate::io::SharedIoError },
+}
+
+/// Why a cable's displacement is refused ([`ActuatorError::Displacement`]).
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+pub enum DisplacementProblem {
+    /// Not a finite number.
+    #[error("give a finite pulled-in length, mm")]
+    NotFinite,
+    /// Below zero: it would push the cable.
+    #[error("a cable pulls: a negative displacement would push it; give the pulled-in length ≥ 0 mm")]
+    Negative,
+    /// At least the cable's length in the unloaded rod.
+    #[error("the cable is only {} mm long in the unloaded rod; it cannot be pulled in by that much", crate::io::fmt_num((rest_length_mm * 1e3).round() / 1e3))]
+    LongerThanCable { rest_length_mm: f64 },
+}
+
+/// What is wrong with a `--cable` text ([`ActuatorError::CableSpec`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum CableSpecProblem {
+    /// A field's value is not a number.
+    #[error("{key}: '{value}' is not a number")]
+    NotANumber { key: String, value: String },
+    /// A list of control points of the wrong length.
+    #[error("{key} needs {expected} control points, got {got}")]
+    ControlPointCount { key: String, expected: usize, got: usize },
+    /// A field without `=`.
+    #[error("'{field}' is not key=value")]
+    NotKeyValue { field: String },
+    /// A field given twice.
+    #[error("{key}= is given twice")]
+    GivenTwice { key: String },
+    /// A field the form does not have.
+    #[error("unknown field '{key}' (fields: y, z, tension, displacement, ea, anchor)")]
+    UnknownField { key: String },
+    /// No `y=`.
+    #[error("y= is missing")]
+    MissingY,
+    /// Both `tension=` and `displacement=`.
+    #[error("give tension= or displacement=, not both")]
+    TensionAndDisplacement,
+    /// Neither `tension=` nor `displacement=`.
+    #[error("tension= (N) or displacement= (mm) is missing")]
+    NoActuation,
 }

@@ -22,5 +22,5 @@ pub use parameter::{ParameterError, PlausibleRange};
 pub use rod::{Gravity, Rod};
 pub use rod_overrides::RodOverrides;
 pub use effects::{EffectInfo, REGISTRY};
-pub use error::ActuatorError;
+pub use error::{ActuatorError, CableSpecProblem, DisplacementProblem};
 pub use routing::{ControlPoints, Routing, RoutingError};

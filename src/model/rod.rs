@@ -34,12 +34,12 @@ pub const PLAUSIBLE_G_M_S2: PlausibleRange =
 /// What is wrong with an actuator's TOML text.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum RodTextError {
-    /// The file could not be read (the cause as text: this error is cloned and compared).
-    #[error("{0}")]
-    Read(String),
-    /// Not TOML, or a field unknown or of the wrong type (the parser's message).
-    #[error("{0}")]
-    Toml(String),
+    /// The file could not be read.
+    #[error(transparent)]
+    Read(crate::io::SharedIoError),
+    /// Not TOML, or a field unknown or of the wrong type.
+    #[error("{}", .0.to_string().trim_end())]
+    Toml(toml::de::Error),
     /// A parameter is invalid.
     #[error(transparent)]
     Parameter(#[from] ParameterError),
@@ -209,13 +209,13 @@ impl Rod {
     /// with [`Rod::validate`]. This module owns the actuator file format.
     pub fn from_toml_file(path: &std::path::Path) -> Result<Rod, ActuatorFileError> {
         let text = std::fs::read_to_string(path)
-            .map_err(|e| ActuatorFileError { path: path.display().to_string(), problem: RodTextError::Read(e.to_string()) })?;
+            .map_err(|e| ActuatorFileError { path: path.display().to_string(), problem: RodTextError::Read(e.into()) })?;
         Rod::from_toml_str(&text).map_err(|problem| ActuatorFileError { path: path.display().to_string(), problem })
     }
 
     /// Parses actuator TOML text (see [`Rod::from_toml_file`]).
     pub fn from_toml_str(text: &str) -> Result<Rod, RodTextError> {
-        let a: Rod = toml::from_str(text).map_err(|e| RodTextError::Toml(e.to_string().trim_end().to_string()))?;
+        let a: Rod = toml::from_str(text).map_err(RodTextError::Toml)?;
         a.validate()?;
         Ok(a)
     }
