@@ -28,9 +28,6 @@ pub enum SpatialError {
     /// A moment tolerance that is not a positive number.
     #[error("spatial solver: moment_tolerance_n_mm must be a positive number")]
     MomentTolerance,
-    /// A tension scale that is negative or not finite.
-    #[error("spatial solver: tension scale {0} must be finite and ≥ 0")]
-    TensionScale(f64),
     /// Not one tension per cable.
     #[error("spatial solver: {given} tensions given for {cables} cables")]
     TensionCount { given: usize, cables: usize },

@@ -177,8 +177,7 @@ pub struct SpatialRk4 {
     weight: V3,
     options: SolverOptions,
     cables: usize,
-    base_tension_n: Vec<f64>,
-    scale: f64,
+    tensions_n: Vec<f64>,
     segments: Vec<Segment>,
     points_s: Vec<f64>,
     chan: Vec<Chan>,
@@ -263,8 +262,7 @@ impl SpatialRk4 {
             weight,
             options: options.clone(),
             cables: n,
-            base_tension_n: actuator.cables.iter().map(|c| c.tension_n).collect(),
-            scale: 1.0,
+            tensions_n: actuator.cables.iter().map(|c| c.tension_n).collect(),
             segments,
             points_s,
             chan,
@@ -298,17 +296,14 @@ impl SpatialRk4 {
 
     /// Tension of every cable in the last solve, N.
     pub fn tensions_n(&self) -> Vec<f64> {
-        self.base_tension_n.iter().map(|t| t * self.scale).collect()
+        self.tensions_n.clone()
     }
 
-    /// Solves with every cable's tension scaled by `scale` (1 = the
-    /// actuator's tensions; continuation ladders step it from 0 to 1),
+    /// Sets every cable's tension (N, one per cable, each ≥ 0) and solves,
     /// warm-started from the previous solve.
-    pub fn solve_scaled(&mut self, scale: f64) -> Result<TipPose, SpatialError> {
-        if !(scale.is_finite() && scale >= 0.0) {
-            return Err(SpatialError::TensionScale(scale));
-        }
-        self.scale = scale;
+    pub fn solve(&mut self, tensions_n: &[f64]) -> Result<TipPose, SpatialError> {
+        SpatialError::check_tensions(tensions_n, self.cables)?;
+        self.tensions_n.copy_from_slice(tensions_n);
         self.last = None;
         let tensions = self.tensions_n();
         self.predict(&tensions);
@@ -327,13 +322,6 @@ impl SpatialRk4 {
             self.binv = M3::identity();
         }
         result.map_err(SpatialError::from)
-    }
-
-    /// Sets every cable's tension (N, one per cable, each ≥ 0) and solves.
-    pub fn solve(&mut self, tensions_n: &[f64]) -> Result<TipPose, SpatialError> {
-        SpatialError::check_tensions(tensions_n, self.cables)?;
-        self.base_tension_n.copy_from_slice(tensions_n);
-        self.solve_scaled(1.0)
     }
 
     /// Warm start for the next solve. When the tension step continues the
@@ -422,8 +410,8 @@ impl SpatialRk4 {
         // At the clamp R = I: the base tangent is v(0)'s direction.
         let base_v = self.nodes.first().map_or([1.0, 0.0, 0.0], |n| n.v);
         let mut tensions_n = PerCable::filled(self.cables, 0.0);
-        for (out, t) in tensions_n.iter_mut().zip(&self.base_tension_n) {
-            *out = t * self.scale;
+        for (out, t) in tensions_n.iter_mut().zip(&self.tensions_n) {
+            *out = *t;
         }
         let pose = TipPose {
             tensions_n,
@@ -569,8 +557,8 @@ impl SpatialRk4 {
     fn local_solve(&mut self, seg: &Segment, k: usize, slot: usize, nw: V3, mw: V3, r: M3) -> Result<Local, SolveFailure> {
         let chans = &self.chan[k * self.cables..(k + 1) * self.cables];
         let mut taus = [0.0; super::cable::MAX_CABLES];
-        for (i, (&t, &on)) in self.base_tension_n.iter().zip(&seg.active).enumerate() {
-            taus[i] = if on { t * self.scale } else { 0.0 };
+        for (i, (&t, &on)) in self.tensions_n.iter().zip(&seg.active).enumerate() {
+            taus[i] = if on { t } else { 0.0 };
         }
         let tensions = &taus[..self.cables];
         let mut x = self.warm[slot];
@@ -793,7 +781,7 @@ impl SpatialRk4 {
                         node.cables[i] = CableAtNode {
                             channel_mm: [c.r[1], c.r[2]],
                             position_mm: node.body_point_mm(c.r[1], c.r[2]),
-                            tension_n: self.base_tension_n[i] * self.scale,
+                            tension_n: self.tensions_n[i],
                         };
                     }
                 }

@@ -238,9 +238,8 @@ pub struct SpatialCollocation {
     rod: Rod,
     options: SolverOptions,
     cables: usize,
-    /// Tensions of the actuator's cables (scaled by `scale` in a solve), N.
-    base_tension_n: Vec<f64>,
-    scale: f64,
+    /// Each cable's tension in the last solve, N.
+    tensions_n: Vec<f64>,
     /// Unit gravity direction (global) and the fraction of the weight on
     /// (1, or less during the weight continuation).
     gravity_unit: V3,
@@ -440,8 +439,7 @@ impl SpatialCollocation {
         let mut solver = Self {
             options: options.clone(),
             cables: nc,
-            base_tension_n: actuator.cables.iter().map(|c| c.tension_n).collect(),
-            scale: 1.0,
+            tensions_n: actuator.cables.iter().map(|c| c.tension_n).collect(),
             gravity_unit,
             weight_fraction: 1.0,
             has_weight,
@@ -532,24 +530,14 @@ impl SpatialCollocation {
 
     /// Tension of every cable in the last solve, N.
     pub fn tensions_n(&self) -> Vec<f64> {
-        self.base_tension_n.iter().map(|t| t * self.scale).collect()
+        self.tensions_n.clone()
     }
 
-    /// Sets every cable's tension (N, one per cable, each ≥ 0) and solves.
+    /// Sets every cable's tension (N, one per cable, each ≥ 0) and solves,
+    /// warm-started from the previous solves.
     pub fn solve(&mut self, tensions_n: &[f64]) -> Result<TipPose, SpatialError> {
         SpatialError::check_tensions(tensions_n, self.cables)?;
-        self.base_tension_n.copy_from_slice(tensions_n);
-        self.solve_scaled(1.0)
-    }
-
-    /// Solves with every cable's tension scaled by `scale` (1 = the
-    /// actuator's tensions; continuation ladders step it from 0 to 1),
-    /// warm-started from the previous solves.
-    pub fn solve_scaled(&mut self, scale: f64) -> Result<TipPose, SpatialError> {
-        if !(scale.is_finite() && scale >= 0.0) {
-            return Err(SpatialError::TensionScale(scale));
-        }
-        self.scale = scale;
+        self.tensions_n.copy_from_slice(tensions_n);
         self.last = None;
         let tensions = self.tensions_n();
         self.predict(&tensions);
