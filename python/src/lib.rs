@@ -12,7 +12,7 @@
 use cablemap::solver::record::{self, SimulationRecord};
 use cablemap::solver::spatial::SpatialError;
 use cablemap::model::{Actuator, ActuatorError, Cable, LoadDirection, Rod, Routing, REGISTRY};
-use cablemap::solver::{simulate_actuator, simulate_held, Backend, Given, Hold, SimulateError, Simulation, Simulator, SolverMethod, SolverOptions};
+use cablemap::solver::{simulate_actuator, simulate_held, Backend, Given, Hold, SimulateError, Simulation, Simulator, SolverOptions, SolverSettings};
 use cablemap::shape::LengthBasis;
 use cablemap::sweep::solve::{planar_routing, Stored};
 use cablemap::sweep::spec::Ladder;
@@ -188,28 +188,6 @@ fn actuator_to_toml(py: Python<'_>, actuator_json: &str) -> PyResult<String> {
 
 // ---------------------------------------------------------------- simulate
 
-/// Solver settings (`--method`, `--nodes-per-span`, `--steps-per-span`).
-#[derive(Debug, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct SolverRequest {
-    method: Option<String>,
-    nodes_per_span: Option<usize>,
-    steps_per_span: Option<usize>,
-}
-
-impl SolverRequest {
-    /// The options, as `ActuatorArgs::solver_options` builds them.
-    fn options(&self) -> Result<SolverOptions> {
-        let method = match self.method.as_deref() {
-            None => None,
-            Some("collocation") => Some(SolverMethod::Collocation),
-            Some("rk4") => Some(SolverMethod::Rk4),
-            Some(other) => return Err(bad(format!("method {other:?}: expected \"collocation\" or \"rk4\""))),
-        };
-        Ok(SolverOptions::with_given(self.steps_per_span, self.nodes_per_span, method))
-    }
-}
-
 /// What `cablemap.simulate` asks: the fields of `cablemap simulate`.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -233,7 +211,7 @@ struct SimulateRequest {
     /// `--dwell-s`.
     dwell_s: Option<f64>,
     #[serde(default)]
-    solver: SolverRequest,
+    solver: SolverSettings,
 }
 
 /// Runs a simulate request as `src/cli/simulate.rs` does: `routing_mm`
@@ -241,7 +219,7 @@ struct SimulateRequest {
 /// the planar record's path; anything else the actuator's.
 fn simulate_request(request: SimulateRequest) -> Result<(Simulation, String)> {
     let SimulateRequest { mut actuator, routing_mm, tension_n, displacement_mm, cable_ea_n, order, length_basis: basis, direction, dwell_s, solver } = request;
-    let options = solver.options()?;
+    let options = solver.options();
     let load = match direction.as_deref() {
         None | Some("load") => LoadDirection::Load,
         Some("unload") => LoadDirection::Unload,
@@ -353,8 +331,8 @@ fn solve_batch<'py>(
         if !actuator.cables.is_empty() || actuator.gj_n_mm2.is_some() || actuator.gravity_direction.is_some() {
             return Err(bad("solve_batch solves one planar cable per routing: give the rod alone (no cables, gj_n_mm2 or gravity_direction)"));
         }
-        let solver: SolverRequest = from_json(solver_json, "solver")?;
-        let options = solver.options()?;
+        let solver: SolverSettings = from_json(solver_json, "solver")?;
+        let options = solver.options();
         let basis: LengthBasis = from_json(&format!("\"{length_basis}\""), "length_basis (\"rest\" or \"deformed\")")?;
         if routings_mm.len() % 5 != 0 {
             return Err(bad(format!("routings_mm: expected an (n, 5) array of control points, got {} numbers", routings_mm.len())));

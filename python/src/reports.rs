@@ -9,7 +9,7 @@
 //! the request wrote)`. Errors become the package's exceptions with the
 //! library's messages.
 
-use super::{actuator_with, bad, Failure, Result, SolverRequest};
+use super::{actuator_with, bad, Failure, Result};
 use cablemap::calibrate::predict::run as run_predict;
 use cablemap::calibrate::predict::PredictRequest;
 use cablemap::calibrate::diagnose::DiagnoseRequest;
@@ -21,6 +21,7 @@ use cablemap::design::{DesignError, DesignRequest, SearchOptions, Target, Weight
 use cablemap::model::{Actuator, Rod, RodOverrides, REGISTRY};
 use cablemap::mould::MouldSettings;
 use cablemap::shape::LengthBasis;
+use cablemap::solver::SolverSettings;
 use pyo3::prelude::*;
 use serde::Deserialize;
 use serde_json::{Map, Value};
@@ -170,7 +171,7 @@ struct DesignPy {
     #[serde(default)]
     mould: MouldSettings,
     #[serde(default)]
-    solver: SolverRequest,
+    solver: SolverSettings,
 }
 
 /// The design request of `cablemap.design`'s keywords (the flags of `cablemap design`).
@@ -207,7 +208,7 @@ fn design_request(r: DesignPy) -> Result<DesignRequest> {
     Ok(DesignRequest {
         rod: r.actuator.rod,
         actuator,
-        options: r.solver.options()?,
+        options: r.solver.options(),
         target: r.target.as_deref().map(Target::parse).transpose().map_err(|e| bad(format!("target: {e}")))?,
         targets,
         weights: r.weights.as_deref().map(Weights::parse).transpose().map_err(|e| bad(format!("weights: {e}")))?,
@@ -306,7 +307,7 @@ struct FitPy {
     max_iterations: usize,
     angle_weight: f64,
     #[serde(default)]
-    solver: SolverRequest,
+    solver: SolverSettings,
 }
 
 impl FitPy {
@@ -361,7 +362,7 @@ fn calibrate_run(r: CalibratePy) -> Result<Finished> {
         data_path: fit.data.clone(),
         actuator_file: fit.actuator.clone(),
         rod: rod_overrides(fit.rod_fields.clone())?,
-        options: fit.solver.options()?,
+        options: fit.solver.options(),
         fit: fit.settings()?,
         effects: effects(&names)?,
         holdout: fit.holdout.clone(),
@@ -401,7 +402,7 @@ fn diagnose_run(r: DiagnosePy) -> Result<Finished> {
         data_path: fit.data.clone(),
         actuator_file: fit.actuator.clone(),
         rod: rod_overrides(fit.rod_fields.clone())?,
-        options: fit.solver.options()?,
+        options: fit.solver.options(),
         fit: fit.settings()?,
         holdout: fit.holdout.clone(),
         holdout_cable: fit.holdout_cable,
@@ -431,7 +432,7 @@ struct PredictPy {
     actuator: PathBuf,
     markers: Option<PathBuf>,
     #[serde(default)]
-    solver: SolverRequest,
+    solver: SolverSettings,
 }
 
 /// `cablemap predict`: the markers' errors of an actuator on captures, no fitting.
@@ -439,7 +440,7 @@ struct PredictPy {
 pub(crate) fn predict(py: Python<'_>, request_json: &str) -> PyResult<Finished> {
     let r: PredictPy = super::from_json(request_json, "predict").map_err(|e| e.into_py(py))?;
     detached(py, move || {
-        let request = PredictRequest { captures: r.captures, markers: r.markers, actuator: r.actuator, rod: RodOverrides::default(), options: r.solver.options()? };
+        let request = PredictRequest { captures: r.captures, markers: r.markers, actuator: r.actuator, rod: RodOverrides::default(), options: r.solver.options() };
         let report = run_predict(&request).map_err(calibrate_failure)?;
         Ok((report.to_json_line(), report.to_string(), Vec::new()))
     })

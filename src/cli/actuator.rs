@@ -3,7 +3,7 @@
 //! [`RodOverrides`]) and the solver options.
 
 use cablemap::model::{EffectInfo, Rod, RodOverrides, REGISTRY};
-use cablemap::solver::{SolverMethod, SolverOptions};
+use cablemap::solver::{SolverMethod, SolverOptions, SolverSettings};
 use clap::Args;
 use std::path::PathBuf;
 
@@ -153,14 +153,17 @@ impl ActuatorArgs {
         self.overrides().resolve(None).map_err(|e| anyhow::Error::new(e).context("--actuator-file"))
     }
 
-    /// Solver options with the step override.
-    pub fn solver_options(&self, base: &SolverOptions) -> SolverOptions {
-        let mut o = base.clone();
+    /// The solver settings given by flags.
+    pub fn solver_settings(&self) -> SolverSettings {
         let method = self.method.map(|m| match m {
             MethodArg::Collocation => SolverMethod::Collocation,
             MethodArg::Rk4 => SolverMethod::Rk4,
         });
-        o.give(self.steps_per_span, self.nodes_per_span, method);
-        o
+        SolverSettings { method, nodes_per_span: self.nodes_per_span, steps_per_span: self.steps_per_span }
+    }
+
+    /// `base` with the solver settings given by flags.
+    pub fn solver_options(&self, base: &SolverOptions) -> SolverOptions {
+        self.solver_settings().applied_to(base)
     }
 }

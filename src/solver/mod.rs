@@ -84,7 +84,7 @@ pub use simulate::{
     check_ladder_tension, planar_problem, simulate, simulate_actuator, simulate_held, simulate_spatial, MAX_AUTO_SPATIAL_STEPS_PER_SPAN,
     MAX_AUTO_STEPS_PER_SPAN, MAX_LADDER_TENSION_N,
 };
-pub use options::{SolverMethod, SolverOptions};
+pub use options::{SolverMethod, SolverOptions, SolverSettings};
 pub use planar::{Integrator, PlanarSolver};
 pub use simulator::{PlanarCollocation, PlanarRk4, Simulator};
 use creep::Creep;

@@ -4,6 +4,7 @@
 //! keys and defaults of the backends it runs, so that the specs' files and
 //! the hashes over them read as they always have.
 
+use super::Given;
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 /// How the centreline is integrated along each knot span of the routing.
@@ -26,7 +27,7 @@ pub enum SolverMethod {
 /// Numerical settings of the solver, one set for every backend. A setting
 /// whose default differs between the planar and the spatial backends is
 /// two fields, named by the backends they tune; a setting given by the
-/// user (`--steps-per-span`) sets both ([`SolverOptions::with_given`]).
+/// user (`--steps-per-span`) sets both ([`SolverSettings::applied_to`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct SolverOptions {
     /// Collocation or the RK4 reference, for the planar and the spatial backends.
@@ -78,27 +79,51 @@ impl Default for SolverOptions {
     }
 }
 
-impl SolverOptions {
-    /// The defaults with the settings a user gave: a field left `None`
-    /// keeps each backend's own default; steps per span set both backends'.
-    pub fn with_given(steps_per_span: Option<usize>, nodes_per_span: Option<usize>, method: Option<SolverMethod>) -> Self {
-        let mut options = Self::default();
-        options.give(steps_per_span, nodes_per_span, method);
+/// The solver settings as a user gives them (`--method`,
+/// `--nodes-per-span`, `--steps-per-span`; the `solver` keys of Python's
+/// requests), each `None` when left at its default: they make the
+/// [`SolverOptions`] and say which settings were given ([`Given`]), so a
+/// backend that does not read one can refuse it.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SolverSettings {
+    /// Collocation or the RK4 reference.
+    pub method: Option<SolverMethod>,
+    /// Collocation intervals per knot span.
+    pub nodes_per_span: Option<usize>,
+    /// RK4 steps per knot span (both backends'); collocation's centreline resolution.
+    pub steps_per_span: Option<usize>,
+}
+
+impl SolverSettings {
+    /// The default options with these settings.
+    pub fn options(&self) -> SolverOptions {
+        self.applied_to(&SolverOptions::default())
+    }
+
+    /// `base` with these settings.
+    pub fn applied_to(&self, base: &SolverOptions) -> SolverOptions {
+        let mut options = base.clone();
+        if let Some(n) = self.steps_per_span {
+            options.planar_steps_per_span = n;
+            options.spatial_steps_per_span = n;
+        }
+        if let Some(m) = self.nodes_per_span {
+            options.nodes_per_span = m;
+        }
+        if let Some(m) = self.method {
+            options.method = m;
+        }
         options
     }
 
-    /// Sets the settings a user gave (`None` leaves a setting as it is);
-    /// steps per span set both backends'.
-    pub fn give(&mut self, steps_per_span: Option<usize>, nodes_per_span: Option<usize>, method: Option<SolverMethod>) {
-        if let Some(n) = steps_per_span {
-            self.planar_steps_per_span = n;
-            self.spatial_steps_per_span = n;
-        }
-        if let Some(m) = nodes_per_span {
-            self.nodes_per_span = m;
-        }
-        if let Some(m) = method {
-            self.method = m;
+    /// Which settings were given (the request's hold and coefficient route aside).
+    pub fn given(&self) -> Given {
+        Given {
+            method: self.method.is_some(),
+            nodes_per_span: self.nodes_per_span.is_some(),
+            steps_per_span: self.steps_per_span.is_some(),
+            ..Given::default()
         }
     }
 }
