@@ -7,7 +7,7 @@
 //! frame. z ≡ 0 is today's planar routing.
 
 use crate::model::{ActuatorError, CableSpecProblem, DisplacementProblem};
-use crate::model::routing::{ChannelPoint, Routing, CHANNEL_STEP_MM, CONTROL_POINTS};
+use crate::model::routing::{RoutingPoint, Routing, CHANNEL_STEP_MM, CONTROL_POINTS};
 use crate::model::Rod;
 use serde::{Deserialize, Serialize};
 
@@ -183,7 +183,7 @@ pub struct Channel {
 
 /// The channel's body-frame offset and its first two arc-length derivatives at one s.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ChannelPoint3 {
+pub struct ChannelPoint {
     /// (y_c, z_c), mm.
     pub r_mm: [f64; 2],
     /// (dy_c/ds, dz_c/ds).
@@ -194,9 +194,9 @@ pub struct ChannelPoint3 {
 
 impl Channel {
     /// Channel offset and derivatives at `s_mm`.
-    pub fn at(&self, s_mm: f64) -> ChannelPoint3 {
-        let (a, b): (ChannelPoint, ChannelPoint) = (self.y.channel_at(s_mm), self.z.channel_at(s_mm));
-        ChannelPoint3 { r_mm: [a.y_mm, b.y_mm], dr_ds: [a.dy_ds, b.dy_ds], d2r_ds2: [a.d2y_ds2, b.d2y_ds2] }
+    pub fn at(&self, s_mm: f64) -> ChannelPoint {
+        let (a, b): (RoutingPoint, RoutingPoint) = (self.y.channel_at(s_mm), self.z.channel_at(s_mm));
+        ChannelPoint { r_mm: [a.y_mm, b.y_mm], dr_ds: [a.dy_ds, b.dy_ds], d2r_ds2: [a.d2y_ds2, b.d2y_ds2] }
     }
 
     /// Arc length of the routing's interior knot, mm.

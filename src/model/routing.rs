@@ -147,9 +147,10 @@ pub struct Routing {
     s_knot_mm: f64,
 }
 
-/// The channel's lateral offset and its arc-length derivatives at one s.
+/// One routing spline's offset and its arc-length derivatives at one s
+/// (a planar channel's y_c, or one coordinate of a 3-D channel).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ChannelPoint {
+pub struct RoutingPoint {
     /// y_c(s), mm.
     pub y_mm: f64,
     /// dy_c/ds.
@@ -334,7 +335,7 @@ impl Routing {
     }
 
     /// y_c and its first two arc-length derivatives at `s_mm` (eq. 2.13).
-    pub fn channel_at(&self, s_mm: f64) -> ChannelPoint {
+    pub fn channel_at(&self, s_mm: f64) -> RoutingPoint {
         let z = self.parameter_at(s_mm);
         let span = usize::from(z >= 0.5);
         let (sp, yp) = (&self.s_poly[span], &self.y_poly[span]);
@@ -342,7 +343,7 @@ impl Routing {
         let s2 = horner_d2(sp, z);
         let y1 = horner_d1(yp, z);
         let y2 = horner_d2(yp, z);
-        ChannelPoint {
+        RoutingPoint {
             y_mm: horner(yp, z),
             dy_ds: y1 / s1,
             d2y_ds2: y2 / (s1 * s1) - y1 * s2 / (s1 * s1 * s1),

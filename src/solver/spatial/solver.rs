@@ -47,7 +47,7 @@
 //! the anchor to v̂ just after it, which the bending series add at that σ
 //! (the planar a_i count the same jump of θ).
 
-use super::cable::{Channel, ChannelPoint3};
+use super::cable::{Channel, ChannelPoint};
 use super::error::SpatialError;
 use crate::solver::{SolveFailure, SolverOptions};
 use super::Actuator;
@@ -112,8 +112,8 @@ struct Chan {
     d2r: V3,
 }
 
-impl From<ChannelPoint3> for Chan {
-    fn from(c: ChannelPoint3) -> Self {
+impl From<ChannelPoint> for Chan {
+    fn from(c: ChannelPoint) -> Self {
         Self {
             r: V3::new(0.0, c.r_mm[0], c.r_mm[1]),
             dr: V3::new(0.0, c.dr_ds[0], c.dr_ds[1]),
