@@ -4,7 +4,9 @@
 //! captures whose truth is known.
 
 use cablemap::calibrate::synth::captures::{default_plan, load_unload_plan, one_cable_at_a_time, synth_captures, MarkerSpec};
-use cablemap::calibrate::diagnose::captures::{diagnose_captures, Diagnose3Spec, Diagnosis3};
+use cablemap::calibrate::diagnose::captures::diagnose_captures;
+use cablemap::calibrate::diagnose::{DiagnoseSpec, Diagnosis};
+use cablemap::calibrate::observations::captures::CapturesReport;
 use cablemap::calibrate::observations::captures::files::{Capture, CaptureSet};
 use cablemap::calibrate::fit::{fit, FitSpec, Loss, Status};
 use cablemap::calibrate::observations::captures::Captures;
@@ -242,8 +244,8 @@ fn hidden_in(effect: impl Fn(&mut Actuator), captures: Vec<Capture>, markers: &[
     (start, set)
 }
 
-fn diagnosis(start: &Actuator, set: &CaptureSet) -> Diagnosis3 {
-    let spec = Diagnose3Spec { noise_mm: 1.0, ..Diagnose3Spec::default() };
+fn diagnosis(start: &Actuator, set: &CaptureSet) -> Diagnosis<CapturesReport> {
+    let spec = DiagnoseSpec { settings: 1.0, ..DiagnoseSpec::default() };
     let d = diagnose_captures(start, set, &spec).unwrap();
     println!("{d}");
     d
@@ -263,7 +265,7 @@ fn diagnose_names_a_hidden_clamp_compliance_in_3d() {
     let (start, set) = hidden(|a| Effect::ClampCompliance.apply(&mut a.rod, k));
     let d = diagnosis(&start, &set);
     assert_eq!(d.verdict.label(), "clamp_compliance", "{}", d.reason);
-    let (got, se) = (d.parameter.unwrap(), d.parameter_se.unwrap());
+    let (got, se) = (d.named[0].parameter, d.named[0].parameter_se);
     println!("hidden clamp stiffness {k} N·mm/rad: named at {got:.1} ± {se:.1}");
     assert!((got - k).abs() <= 0.25 * k, "{got} ± {se} vs {k}: not within ±25 %");
     assert!((got - k).abs() <= 2.0 * se, "{got} ± {se} vs {k}: not within 2 SE");
@@ -279,7 +281,7 @@ fn diagnose_names_a_hidden_friction_in_3d() {
     let (start, set) = hidden_in(|a| Effect::Friction.apply(&mut a.rod, mu), load_unload_plan(2, 7.0, 5.0), &soromox_markers());
     let d = diagnosis(&start, &set);
     assert_eq!(d.verdict.label(), "friction", "{}", d.reason);
-    let (got, se) = (d.parameter.unwrap(), d.parameter_se.unwrap());
+    let (got, se) = (d.named[0].parameter, d.named[0].parameter_se);
     println!("hidden friction μ {mu}: named at {got:.4} ± {se:.4}");
     assert!((got - mu).abs() <= 0.25 * mu, "{got} ± {se} vs {mu}: not within ±25 %");
 }

@@ -4,13 +4,14 @@
 use super::{draw_series_labels, register_fonts, PlotError, FONT};
 use crate::calibrate::data::{Dataset, Direction, RoutingGroup};
 use crate::calibrate::diagnose::Diagnosis;
+use crate::calibrate::observations::measurements::MeasurementsReport;
 use crate::calibrate::predict::Prediction;
 use plotters::prelude::*;
 use std::path::Path;
 
 /// Draws the tip angle against the tension of each routing of `groups`,
 /// measured and by `d`'s models, into `path`.
-pub fn draw_diagnosis_loops(path: &Path, data: &Dataset, groups: &[RoutingGroup], d: &Diagnosis, after: Option<&str>) -> Result<(), PlotError> {
+pub fn draw_diagnosis_loops(path: &Path, data: &Dataset, groups: &[RoutingGroup], d: &Diagnosis<MeasurementsReport>, after: Option<&str>) -> Result<(), PlotError> {
     register_fonts();
     let cols = groups.len().clamp(1, 3);
     let rows = groups.len().div_ceil(cols).max(1);
@@ -22,8 +23,8 @@ pub fn draw_diagnosis_loops(path: &Path, data: &Dataset, groups: &[RoutingGroup]
         let angle = |i: usize, preds: &[Option<Prediction>]| preds[i].as_ref().expect("predicted").pose.tip_angle_rad.to_degrees();
         let measured: Vec<(f64, f64, Direction)> =
             g.rows.iter().map(|&i| (data.rows[i].tension_n, data.rows[i].tip_angle_rad.to_degrees(), data.rows[i].direction)).collect();
-        let base: Vec<(f64, f64)> = g.rows.iter().map(|&i| (data.rows[i].tension_n, angle(i, &d.baseline_predictions))).collect();
-        let ext: Vec<(f64, f64)> = g.rows.iter().map(|&i| (data.rows[i].tension_n, angle(i, &d.extended_predictions))).collect();
+        let base: Vec<(f64, f64)> = g.rows.iter().map(|&i| (data.rows[i].tension_n, angle(i, &d.details.baseline_predictions))).collect();
+        let ext: Vec<(f64, f64)> = g.rows.iter().map(|&i| (data.rows[i].tension_n, angle(i, &d.details.extended_predictions))).collect();
         let ys = measured.iter().map(|m| m.1).chain(base.iter().map(|b| b.1)).chain(ext.iter().map(|b| b.1));
         let (lo, hi) = ys.fold((f64::MAX, f64::MIN), |(a, b), v| (a.min(v), b.max(v)));
         let pad = 0.05 * (hi - lo).max(1.0);

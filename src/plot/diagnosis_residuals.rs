@@ -5,6 +5,7 @@
 use super::{draw_series_labels, register_fonts, PlotError, FONT};
 use crate::calibrate::data::{Dataset, Direction, RoutingGroup};
 use crate::calibrate::diagnose::Diagnosis;
+use crate::calibrate::observations::measurements::MeasurementsReport;
 use crate::calibrate::observations::measurements::row_residual;
 use crate::calibrate::predict::Prediction;
 use plotters::prelude::*;
@@ -13,7 +14,7 @@ use std::path::Path;
 /// Draws the residuals of `d`'s models over `groups`' readings into `path`
 /// (`after`: the final model's label, when it differs from the thesis
 /// model; `w`: mm per degree of the angle).
-pub fn draw_diagnosis_residuals(path: &Path, data: &Dataset, groups: &[RoutingGroup], d: &Diagnosis, after: Option<&str>, w: f64) -> Result<(), PlotError> {
+pub fn draw_diagnosis_residuals(path: &Path, data: &Dataset, groups: &[RoutingGroup], d: &Diagnosis<MeasurementsReport>, after: Option<&str>, w: f64) -> Result<(), PlotError> {
     register_fonts();
     let height = if after.is_some() { 800 } else { 420 };
     let root = super::png_backend(path, (1100, height))?.into_drawing_area();
@@ -23,8 +24,8 @@ pub fn draw_diagnosis_residuals(path: &Path, data: &Dataset, groups: &[RoutingGr
     let series = |preds: &[Option<Prediction>]| -> Vec<[f64; 3]> {
         order.iter().map(|&i| row_residual(&data.rows[i], &preds[i].as_ref().expect("predicted").pose, w)).collect()
     };
-    let before = series(&d.baseline_predictions);
-    let after_r = series(&d.extended_predictions);
+    let before = series(&d.details.baseline_predictions);
+    let after_r = series(&d.details.extended_predictions);
     let lim = before.iter().chain(&after_r).flat_map(|r| r.iter().map(|v| v.abs())).fold(1.0, f64::max) * 1.1;
     let mut shown = vec![(&before, "thesis model".to_string())];
     if let Some(label) = after {

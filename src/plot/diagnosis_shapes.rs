@@ -4,6 +4,7 @@
 use super::{draw_series_labels, register_fonts, PlotError, FONT};
 use crate::calibrate::data::{CentrelinePoints, Dataset, MarkerPoints, RoutingGroup};
 use crate::calibrate::diagnose::Diagnosis;
+use crate::calibrate::observations::measurements::MeasurementsReport;
 use crate::calibrate::predict::Prediction;
 use plotters::prelude::*;
 use std::path::Path;
@@ -14,7 +15,7 @@ pub fn draw_diagnosis_shapes(
     path: &Path,
     data: &Dataset,
     groups: &[RoutingGroup],
-    d: &Diagnosis,
+    d: &Diagnosis<MeasurementsReport>,
     centrelines: Option<&CentrelinePoints>,
     markers: Option<&MarkerPoints>,
     after: Option<&str>,
@@ -30,8 +31,8 @@ pub fn draw_diagnosis_shapes(
     };
     let mut pts: Vec<(f64, f64)> = vec![(0.0, 0.0)];
     for &(_, i) in &picks {
-        pts.extend(line(&d.baseline_predictions, i));
-        pts.extend(line(&d.extended_predictions, i));
+        pts.extend(line(&d.details.baseline_predictions, i));
+        pts.extend(line(&d.details.extended_predictions, i));
         pts.push((data.rows[i].tip_y_mm, -data.rows[i].tip_x_mm));
     }
     let (x0, x1) = pts.iter().fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.0), b.max(p.0)));
@@ -45,12 +46,12 @@ pub fn draw_diagnosis_shapes(
     let orange = RGBColor(230, 120, 0);
     for (k, &(g, i)) in picks.iter().enumerate() {
         let first = k == 0;
-        let s = chart.draw_series(LineSeries::new(line(&d.baseline_predictions, i), BLUE.stroke_width(2))).map_err(|e| PlotError::new(path, e))?;
+        let s = chart.draw_series(LineSeries::new(line(&d.details.baseline_predictions, i), BLUE.stroke_width(2))).map_err(|e| PlotError::new(path, e))?;
         if first {
             s.label("thesis model").legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], BLUE.stroke_width(2)));
         }
         if let Some(label) = after {
-            let s = chart.draw_series(LineSeries::new(line(&d.extended_predictions, i), orange.stroke_width(2))).map_err(|e| PlotError::new(path, e))?;
+            let s = chart.draw_series(LineSeries::new(line(&d.details.extended_predictions, i), orange.stroke_width(2))).map_err(|e| PlotError::new(path, e))?;
             if first {
                 s.label(label.to_string()).legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], orange.stroke_width(2)));
             }

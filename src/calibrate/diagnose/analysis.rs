@@ -20,12 +20,13 @@
 //! ([`Effect::plausible`]). Effects are added forward-stepwise by the same
 //! rule (at most `max_effects`).
 
-use super::criterion::{self, Candidate, NamedEffect};
-use super::rounds::{self, Evidence, Judged, Model, Rounds, Search, Thresholds};
+use super::criterion::Candidate;
+use super::diagnosis::{DiagnoseSpec, Diagnosis, DiagnosisKind, Signature};
+use super::rounds::{self, Evidence, Judged, Model, Rounds, Search};
 use super::Verdict;
 use crate::calibrate::data::{split_holdout, Dataset, Direction, RoutingGroup};
 use crate::calibrate::effect::Effect;
-use crate::calibrate::fit::{FitResult, FitSpec, Loss};
+use crate::calibrate::fit::{FitResult, Loss};
 use crate::calibrate::observations::measurements::{
     closest_on_centreline, fit_measurements, planar_spec, residuals, rms_per_routing, MeasurementSettings, MeasurementsReport, RoutingRms,
 };
@@ -35,47 +36,37 @@ use crate::model::Rod;
 use crate::solver::SolverOptions;
 use serde::Serialize;
 
-/// Settings of a diagnosis.
-#[derive(Debug, Clone, PartialEq)]
-pub struct DiagnoseSpec {
-    /// Routing left out of every fit and used to measure the gap.
-    pub holdout: Option<String>,
-    /// The rigidities (some held), loss and iteration cap of every fit
-    /// (its effects are ignored).
-    pub fit: FitSpec,
-    /// Noise, shapes and the angle weight of reported RMS values.
-    pub measurements: MeasurementSettings,
-    /// Required BIC decrease against the model without the effect.
-    pub threshold: f64,
-    /// Required BIC lead over the runner-up.
-    pub margin: f64,
-    /// Most effects added.
-    pub max_effects: usize,
-    /// A model is consistent with the noise when P(χ²_dof ≥ χ²) ≥ alpha.
-    pub alpha: f64,
-    /// Effects held at given values on the starting actuator (`--fix`):
-    /// part of every model, not candidates.
-    pub held_effects: Vec<Effect>,
+impl DiagnosisKind for MeasurementsReport {
+    type Settings = MeasurementSettings;
+    type Holdout = String;
+    type Sites = ReadingSites;
+    type Details = MeasurementsDetails;
 }
 
-impl DiagnoseSpec {
-    /// The naming rule's thresholds.
-    pub fn rule(&self) -> criterion::Rule {
-        criterion::Rule { threshold: self.threshold, margin: self.margin }
-    }
-}
-
-impl Default for DiagnoseSpec {
+impl Default for DiagnoseSpec<MeasurementsReport> {
     fn default() -> Self {
         Self {
-            holdout: None,
             fit: planar_spec(&[], [false; 3], Loss::default(), 200),
-            measurements: MeasurementSettings::default(),
+            settings: MeasurementSettings::default(),
+            options: SolverOptions::default(),
+            holdout: None,
+            held_effects: Vec::new(),
             threshold: 10.0, margin: 10.0, max_effects: 2,
             alpha: 1e-3,
-            held_effects: Vec::new(),
         }
     }
+}
+
+/// What the planar report reads beyond the rounds: where the baseline's
+/// residuals sit and every row's predictions by both models.
+#[derive(Debug, Clone)]
+pub struct MeasurementsDetails {
+    /// Residual diagnostics of the baseline.
+    pub diagnostics: ResidualDiagnostics,
+    /// Predictions of every row (held-out included) by the baseline.
+    pub baseline_predictions: Vec<Option<Prediction>>,
+    /// Predictions of every row by the final model.
+    pub extended_predictions: Vec<Option<Prediction>>,
 }
 
 /// Residual statistics of one class of rows.
@@ -110,11 +101,9 @@ pub struct ResidualDiagnostics {
     pub per_routing: Vec<RoutingRms>,
 }
 
-/// The residual's signature when no library effect explains the data.
+/// Where planar residuals sit: by reading class and by routing, and along the body.
 #[derive(Debug, Clone, Serialize)]
-pub struct Signature {
-    /// The model whose residuals are described.
-    pub model: String,
+pub struct ReadingSites {
     /// By direction and tension band: rows, tip position RMS (mm), tip angle RMS (°).
     pub by_tension: Vec<(String, usize, f64, f64)>,
     /// Per routing, worst first: routing, tip position RMS (mm), tip angle RMS (°).
@@ -123,55 +112,6 @@ pub struct Signature {
     /// clamp (centreline points by their closest point, markers by s);
     /// empty without shape data.
     pub along_body_mm: Vec<f64>,
-    /// The same in words.
-    pub summary: Vec<String>,
-}
-
-/// The outcome of a diagnosis.
-#[derive(Debug, Clone)]
-pub struct Diagnosis {
-    /// The verdict.
-    pub verdict: Verdict,
-    /// Why, in one sentence (states the test).
-    pub reason: String,
-    /// Effects of the final model, in the order they were added.
-    pub named: Vec<NamedEffect>,
-    /// With `unexplained`: library effects that lower the BIC but leave the
-    /// fit above the noise.
-    pub partial_effects: Vec<NamedEffect>,
-    /// The two effects the data cannot tell apart, if ambiguous.
-    pub ambiguous_between: Vec<Effect>,
-    /// The measurement that would separate them.
-    pub separating_measurement: Option<String>,
-    /// Ranked candidates of the first round.
-    pub candidates: Vec<Candidate>,
-    /// Ranked candidates of the second round (given the first effect).
-    pub second_round: Vec<Candidate>,
-    /// The thesis-model fit.
-    pub baseline: FitResult<MeasurementsReport>,
-    /// The final model's fit (the baseline if nothing was named).
-    pub extended: FitResult<MeasurementsReport>,
-    /// The best model tried (lowest χ² among the fits that count), whose
-    /// residuals the signature describes.
-    pub best: FitResult<MeasurementsReport>,
-    /// The residual's signature (with `unexplained`).
-    pub signature: Option<Signature>,
-    /// Residual diagnostics of the baseline.
-    pub diagnostics: ResidualDiagnostics,
-    /// Held-out routing.
-    pub holdout: Option<String>,
-    /// Held-out RMS with the baseline, mm.
-    pub holdout_rms_before: Option<f64>,
-    /// Held-out RMS with the final model, mm.
-    pub holdout_rms_after: Option<f64>,
-    /// Predictions of every row (held-out included) by the baseline.
-    pub baseline_predictions: Vec<Option<Prediction>>,
-    /// Predictions of every row by the final model.
-    pub extended_predictions: Vec<Option<Prediction>>,
-    /// The decision rule in words.
-    pub criterion: String,
-    /// The noise test's level.
-    pub alpha: f64,
 }
 
 fn candidate(effect: Effect, reference_bic: f64, result: &Result<FitResult<MeasurementsReport>, CalibrateError>) -> Candidate {
@@ -204,10 +144,9 @@ fn candidate(effect: Effect, reference_bic: f64, result: &Result<FitResult<Measu
 /// the starting rod and every candidate not held.
 struct MeasurementsEvidence<'a> {
     base: &'a Rod,
-    options: &'a SolverOptions,
     data: &'a Dataset,
     train: &'a [RoutingGroup],
-    spec: &'a DiagnoseSpec,
+    spec: &'a DiagnoseSpec<MeasurementsReport>,
     candidates: Vec<Effect>,
 }
 
@@ -231,7 +170,7 @@ impl Evidence for MeasurementsEvidence<'_> {
         start.ga_n = self.base.ga_n;
         start.ei_n_mm2 = self.base.ei_n_mm2;
         let fs = self.spec.fit.with_effects(effects);
-        fit_measurements(&start, self.options, self.data, self.train, &self.spec.measurements, &fs, &mut |_| {})
+        fit_measurements(&start, &self.spec.options, self.data, self.train, &self.spec.settings, &fs, &mut |_| {})
     }
 
     fn candidate(&self, effect: Effect, reference_bic: f64, fit: &Result<FitResult<MeasurementsReport>, CalibrateError>) -> Candidate {
@@ -279,21 +218,20 @@ impl Evidence for MeasurementsEvidence<'_> {
 }
 
 /// Runs the whole workflow on `data` with `base` as the starting actuator.
-pub fn diagnose(base: &Rod, options: &SolverOptions, data: &Dataset, spec: &DiagnoseSpec) -> Result<Diagnosis, CalibrateError> {
-    if !(spec.alpha > 0.0 && spec.alpha < 1.0) {
-        return Err(crate::calibrate::InvalidRequest::Alpha { alpha: spec.alpha }.into());
-    }
+pub fn diagnose(base: &Rod, data: &Dataset, spec: &DiagnoseSpec<MeasurementsReport>) -> Result<Diagnosis<MeasurementsReport>, CalibrateError> {
+    let started = std::time::Instant::now();
+    spec.check()?;
+    let options = &spec.options;
     let (train, held) = split_holdout(data, spec.holdout.as_deref())?;
-    let w = spec.measurements.angle_weight_mm_per_deg;
-    let baseline = fit_measurements(base, options, data, &train, &spec.measurements, &spec.fit.with_effects(&[]), &mut |_| {})?;
+    let w = spec.settings.angle_weight_mm_per_deg;
+    let baseline = fit_measurements(base, options, data, &train, &spec.settings, &spec.fit.with_effects(&[]), &mut |_| {})?;
     let diagnostics = residual_diagnostics(data, &train, &baseline.predictions, w);
     let candidates: Vec<Effect> = Effect::ALL.into_iter().filter(|e| !spec.held_effects.contains(e)).collect();
-    let evidence = MeasurementsEvidence { base, options, data, train: &train, spec, candidates };
-    let thresholds = Thresholds { rule: spec.rule(), max_effects: spec.max_effects, alpha: spec.alpha };
+    let evidence = MeasurementsEvidence { base, data, train: &train, spec, candidates };
     let Rounds { verdict, reason, named, partial_effects, ambiguous_between, separating_measurement, candidates, second_round, extended, best } =
-        rounds::run(&evidence, &baseline, thresholds);
+        rounds::run(&evidence, &baseline, spec.thresholds());
     let (extended, best) = (extended.fit, best.fit);
-    let signature = (verdict == Verdict::Unexplained).then(|| signature(data, &train, &best, &spec.measurements));
+    let signature = (verdict == Verdict::Unexplained).then(|| signature(data, &train, &best, &spec.settings));
     // Predict every row (the held-out routing too) with both models.
     let all = data.groups();
     let keep = true;
@@ -330,18 +268,20 @@ pub fn diagnose(base: &Rod, options: &SolverOptions, data: &Dataset, spec: &Diag
         separating_measurement,
         candidates,
         second_round,
+        not_candidates: Vec::new(),
         baseline,
         extended,
         best,
         signature,
-        diagnostics,
         holdout: held.map(|g| g.routing),
         holdout_rms_before,
         holdout_rms_after,
-        baseline_predictions,
-        extended_predictions,
         criterion,
         alpha: spec.alpha,
+        fitted: train.iter().map(|g| g.rows.len()).sum(),
+        elapsed_s: started.elapsed().as_secs_f64(),
+        details: MeasurementsDetails { diagnostics, baseline_predictions, extended_predictions },
+        written: Vec::new(),
     })
 }
 
@@ -356,7 +296,7 @@ pub fn model_name(f: &FitResult<MeasurementsReport>) -> String {
 
 /// Where the residuals of `f` sit: by direction and tension, by routing,
 /// along the body (from shapes), with a few sentences.
-pub fn signature(data: &Dataset, groups: &[RoutingGroup], f: &FitResult<MeasurementsReport>, spec: &MeasurementSettings) -> Signature {
+pub fn signature(data: &Dataset, groups: &[RoutingGroup], f: &FitResult<MeasurementsReport>, spec: &MeasurementSettings) -> Signature<MeasurementsReport> {
     let rows: Vec<usize> = groups.iter().flat_map(|g| g.rows.iter().copied()).collect();
     let max_t = rows.iter().map(|&i| data.rows[i].tension_n).fold(0.0, f64::max);
     let err = |i: usize| {
@@ -439,7 +379,7 @@ pub fn signature(data: &Dataset, groups: &[RoutingGroup], f: &FitResult<Measurem
         let cells: Vec<String> = along_body_mm.iter().map(|v| if v.is_finite() { format!("{v:.2}") } else { "—".into() }).collect();
         summary.push(format!("Along the body (quarters from the clamp to the tip), shape error RMS {} mm.", cells.join(" / ")));
     }
-    Signature { model: model_name(f), by_tension, by_routing, along_body_mm, summary }
+    Signature { model: model_name(f), sites: ReadingSites { by_tension, by_routing, along_body_mm }, summary }
 }
 
 /// Residual statistics of the baseline over the fitted rows.

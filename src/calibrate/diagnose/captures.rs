@@ -28,51 +28,33 @@ use crate::calibrate::observations::captures::{Captures, CapturesReport};
 use crate::solver::SolverOptions;
 use crate::calibrate::Parameter;
 use crate::calibrate::observations::captures::simulate::solve_captures;
-use crate::calibrate::diagnose::criterion::{self, Candidate, NamedEffect};
-use crate::calibrate::diagnose::rounds::{self, Evidence, Judged, Model, Rounds, Search, Thresholds};
+use crate::calibrate::diagnose::criterion::{Candidate, NamedEffect};
+use crate::calibrate::diagnose::diagnosis::{fitted_effects, DiagnoseSpec, Diagnosis, DiagnosisKind, Signature};
+use crate::calibrate::diagnose::rounds::{self, Evidence, Judged, Model, Rounds, Search};
 use crate::calibrate::diagnose::Verdict;
 use crate::calibrate::{CalibrateError, Effect};
 use crate::model::Actuator;
 use serde::Serialize;
 use std::collections::BTreeMap;
 
-/// Settings of a 3-D diagnosis.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Diagnose3Spec {
-    /// The body parameters to fit and the fit's settings (its `params` are
-    /// the body's; the candidates are added to them).
-    pub fit: FitSpec,
+impl DiagnosisKind for CapturesReport {
     /// The system's noise σ₀ per coordinate, mm, added in quadrature to a
     /// marker's own `sd_mm`.
-    pub noise_mm: f64,
-    /// The 3-D solver's settings.
-    pub options: SolverOptions,
-    /// Captures in which this cable (1-based) pulls are held out.
-    pub holdout_cable: Option<usize>,
-    /// Required BIC decrease against the model without the effect.
-    pub threshold: f64,
-    /// Required BIC lead over the runner-up.
-    pub margin: f64,
-    /// Most effects added.
-    pub max_effects: usize,
-    /// Consistent with the noise when P(χ²_dof ≥ χ²) ≥ alpha.
-    pub alpha: f64,
+    type Settings = f64;
+    type Holdout = usize;
+    type Sites = MarkerSites;
+    type Details = ();
 }
 
-impl Diagnose3Spec {
-    /// The naming rule's thresholds.
-    pub fn rule(&self) -> criterion::Rule {
-        criterion::Rule { threshold: self.threshold, margin: self.margin }
-    }
-}
-
-impl Default for Diagnose3Spec {
+impl Default for DiagnoseSpec<CapturesReport> {
     fn default() -> Self {
         Self {
             fit: FitSpec { params: Parameter::BODY.to_vec(), held: Vec::new(), loss: Loss::Squared, max_iterations: 40 },
-            noise_mm: 1.0,
+            settings: 1.0,
             options: SolverOptions::default(),
-            holdout_cable: None, threshold: 10.0, margin: 10.0, max_effects: 2, alpha: 1e-3 }
+            holdout: None,
+            held_effects: Vec::new(),
+            threshold: 10.0, margin: 10.0, max_effects: 2, alpha: 1e-3 }
     }
 }
 
@@ -117,9 +99,10 @@ fn model_name(effects: &[Effect]) -> String {
     }
 }
 
-fn summary(f: &FitResult<CapturesReport>, effects: &[Effect]) -> FitSummary {
+/// The fit `f` in brief.
+pub(super) fn summary(f: &FitResult<CapturesReport>) -> FitSummary {
     FitSummary {
-        model: model_name(effects),
+        model: model_name(&fitted_effects(f)),
         parameters: f.parameters.clone(),
         chi2: f.chi2,
         dof: f.dof,
@@ -133,22 +116,18 @@ fn summary(f: &FitResult<CapturesReport>, effects: &[Effect]) -> FitSummary {
     }
 }
 
-/// Where the best model's residuals sit, when no library effect explains them.
+/// Where 3-D marker residuals sit: by marker and by the cables that pull.
 #[derive(Debug, Clone, Serialize)]
-pub struct Signature3 {
-    /// The model described.
-    pub model: String,
+pub struct MarkerSites {
     /// RMS per marker, mm.
     pub rms_by_marker_mm: BTreeMap<String, f64>,
     /// RMS of the captures grouped by the cables that pull (`1`, `2`, `1+2`, `none`), mm.
     pub rms_by_cables_mm: BTreeMap<String, f64>,
     /// Mean residual (simulated − measured) per marker, x y z, mm: a systematic offset.
     pub mean_residual_by_marker_mm: BTreeMap<String, [f64; 3]>,
-    /// The same in words.
-    pub summary: Vec<String>,
 }
 
-fn signature(set: &CaptureSet, f: &FitResult<CapturesReport>, effects: &[Effect]) -> Signature3 {
+fn signature(set: &CaptureSet, f: &FitResult<CapturesReport>) -> Signature<CapturesReport> {
     let mut by_cables: BTreeMap<String, Vec<f64>> = BTreeMap::new();
     let mut sums: BTreeMap<String, ([f64; 3], usize)> = BTreeMap::new();
     for (c, e) in set.captures.iter().zip(&f.errors.captures) {
@@ -181,62 +160,11 @@ fn signature(set: &CaptureSet, f: &FitResult<CapturesReport>, effects: &[Effect]
         let parts: Vec<String> = rms_by_cables_mm.iter().map(|(k, v)| format!("cable(s) {k}: {v:.2} mm")).collect();
         summary.push(format!("by the cables that pull: {}", parts.join(", ")));
     }
-    Signature3 { model: model_name(effects), rms_by_marker_mm: f.errors.rms_by_marker_mm.clone(), rms_by_cables_mm, mean_residual_by_marker_mm, summary }
-}
-
-/// The outcome of a 3-D diagnosis; serialises to `diagnose --json`.
-#[derive(Debug, Clone, Serialize)]
-pub struct Diagnosis3 {
-    /// The verdict's word.
-    pub verdict: Verdict,
-    /// Why, in one sentence.
-    pub reason: String,
-    /// The first named effect's parameter name, value and SE.
-    pub parameter_name: Option<&'static str>,
-    /// Its value.
-    pub parameter: Option<f64>,
-    /// Its SE.
-    pub parameter_se: Option<f64>,
-    /// The final model's effects in the order added.
-    pub effects: Vec<NamedEffect>,
-    /// With `unexplained`: effects that lower the BIC but leave the fit above the noise.
-    pub partial_effects: Vec<NamedEffect>,
-    /// The two effects the data cannot tell apart, if ambiguous.
-    pub ambiguous_between: Vec<Effect>,
-    /// The measurement that would separate them.
-    pub separating_measurement: Option<String>,
-    /// Ranked candidates of the first round.
-    pub candidates: Vec<Candidate>,
-    /// Of the second round.
-    pub second_round: Vec<Candidate>,
-    /// Candidates left out, and why.
-    pub not_candidates: Vec<String>,
-    /// The body fit.
-    pub baseline: FitSummary,
-    /// The final model's fit.
-    pub extended: FitSummary,
-    /// The residual's signature (with `unexplained`).
-    pub signature: Option<Signature3>,
-    /// The held-out cable.
-    pub holdout_cable: Option<usize>,
-    /// RMS of the held-out captures with the baseline and the final model, mm.
-    pub holdout_rms_before: Option<f64>,
-    /// After.
-    pub holdout_rms_after: Option<f64>,
-    /// The decision rule in words.
-    pub criterion: String,
-    /// The noise test's level.
-    pub alpha: f64,
-    /// Captures fitted.
-    pub captures_fitted: usize,
-    /// Wall time, s.
-    pub elapsed_s: f64,
-    /// The final model's actuator.
-    #[serde(skip)]
-    pub actuator: Actuator,
-    /// The report's files, when written (`report.md` first).
-    #[serde(skip)]
-    pub written: Vec<std::path::PathBuf>,
+    Signature {
+        model: model_name(&fitted_effects(f)),
+        sites: MarkerSites { rms_by_marker_mm: f.errors.rms_by_marker_mm.clone(), rms_by_cables_mm, mean_residual_by_marker_mm },
+        summary,
+    }
 }
 
 fn candidate(effect: Effect, reference_bic: f64, result: &Result<FitResult<CapturesReport>, CalibrateError>) -> Candidate {
@@ -281,7 +209,7 @@ fn candidate(effect: Effect, reference_bic: f64, result: &Result<FitResult<Captu
 /// candidate effects.
 struct CapturesEvidence<'a> {
     set: &'a CaptureSet,
-    spec: &'a Diagnose3Spec,
+    spec: &'a DiagnoseSpec<CapturesReport>,
     body: Vec<Parameter>,
     candidates: Vec<Effect>,
 }
@@ -305,7 +233,7 @@ impl Evidence for CapturesEvidence<'_> {
         let new = *effects.last().expect("a round adds an effect");
         Parameter::Effect(new).set(&mut start, new.start());
         let spec = FitSpec { params, ..self.spec.fit.clone() };
-        fit(&start, &Captures::new(self.set, self.spec.noise_mm, &self.spec.options), &spec, &mut |_| {})
+        fit(&start, &Captures::new(self.set, self.spec.settings, &self.spec.options), &spec, &mut |_| {})
     }
 
     fn candidate(&self, effect: Effect, reference_bic: f64, fit: &Result<FitResult<CapturesReport>, CalibrateError>) -> Candidate {
@@ -342,14 +270,12 @@ impl Evidence for CapturesEvidence<'_> {
 }
 
 /// Runs the 3-D diagnosis of `set` from the actuator `base`.
-pub fn diagnose_captures(base: &Actuator, set: &CaptureSet, spec: &Diagnose3Spec) -> Result<Diagnosis3, CalibrateError> {
+pub fn diagnose_captures(base: &Actuator, set: &CaptureSet, spec: &DiagnoseSpec<CapturesReport>) -> Result<Diagnosis<CapturesReport>, CalibrateError> {
     let started = std::time::Instant::now();
-    if !(spec.alpha > 0.0 && spec.alpha < 1.0) {
-        return Err(crate::calibrate::InvalidRequest::Alpha { alpha: spec.alpha }.into());
-    }
-    let (train, test) = set.hold_out_cable(spec.holdout_cable, base.cables.len())?;
+    spec.check()?;
+    let (train, test) = set.hold_out_cable(spec.holdout, base.cables.len())?;
     let body: Vec<Parameter> = spec.fit.params.iter().copied().filter(|p| !matches!(p, Parameter::Effect(_))).collect();
-    let baseline = fit(base, &Captures::new(&train, spec.noise_mm, &spec.options), &FitSpec { params: body.clone(), ..spec.fit.clone() }, &mut |_| {})?;
+    let baseline = fit(base, &Captures::new(&train, spec.settings, &spec.options), &FitSpec { params: body.clone(), ..spec.fit.clone() }, &mut |_| {})?;
     // The body parameters the baseline determined; undetermined ones stay held.
     let body: Vec<Parameter> = baseline.parameters.iter().filter(|p| p.status == Status::Fitted).map(|p| p.param).collect();
     let mut not_candidates = Vec::new();
@@ -362,14 +288,13 @@ pub fn diagnose_captures(base: &Actuator, set: &CaptureSet, spec: &Diagnose3Spec
             }
             keep
         })
-        .filter(|e| spec.fit.params.iter().all(|p| *p != Parameter::Effect(*e)))
+        .filter(|e| spec.fit.params.iter().all(|p| *p != Parameter::Effect(*e)) && !spec.held_effects.contains(e))
         .collect();
     let evidence = CapturesEvidence { set: &train, spec, body, candidates };
-    let thresholds = Thresholds { rule: spec.rule(), max_effects: spec.max_effects, alpha: spec.alpha };
-    let Rounds { verdict, reason, named: effects, partial_effects, ambiguous_between, separating_measurement, candidates: first, second_round, extended, best } =
-        rounds::run(&evidence, &baseline, thresholds);
-    let signature_of = (verdict == Verdict::Unexplained).then(|| signature(&train, &best.fit, &best.effects));
-    let (extended, extended_effects) = (extended.fit, extended.effects);
+    let Rounds { verdict, reason, named, partial_effects, ambiguous_between, separating_measurement, candidates, second_round, extended, best } =
+        rounds::run(&evidence, &baseline, spec.thresholds());
+    let signature = (verdict == Verdict::Unexplained).then(|| signature(&train, &best.fit));
+    let (extended, best) = (extended.fit, best.fit);
     let (holdout_rms_before, holdout_rms_after) = match &test {
         Some(t) => {
             let rms = |a: &Actuator| -> Result<f64, CalibrateError> { Ok(ErrorReport::of(t, &solve_captures(a, &spec.options, t)?).rms_mm) };
@@ -377,60 +302,108 @@ pub fn diagnose_captures(base: &Actuator, set: &CaptureSet, spec: &Diagnose3Spec
         }
         None => (None, None),
     };
-    let first_named = effects.first();
     let criterion = format!(
         "residuals are the markers' 3-D errors over σ = √(sd² + {} mm²) per coordinate; adequacy: χ² of these against χ²_dof, consistent when p ≥ {:.0e}; \
          `none` only when the body fit is consistent and a candidate fit converged, `unexplained` when the best model with one or two library effects has p < {:.0e}; \
          an effect is named when refitting it with the body lowers the BIC (n ln(Σρ/n) + p ln n) by at least {} against the model without it, leads the runner-up \
          by at least {} and has a plausible, determined value; effects are added forward-stepwise by the same rule (at most {}); only converged fits count",
-        spec.noise_mm, spec.alpha, spec.alpha, spec.threshold, spec.margin, spec.max_effects
+        spec.settings, spec.alpha, spec.alpha, spec.threshold, spec.margin, spec.max_effects
     );
-    Ok(Diagnosis3 {
+    Ok(Diagnosis {
         verdict,
         reason,
-        parameter_name: first_named.map(|n| n.parameter_name),
-        parameter: first_named.map(|n| n.parameter),
-        parameter_se: first_named.map(|n| n.parameter_se),
-        effects,
+        named,
         partial_effects,
         ambiguous_between,
         separating_measurement,
-        candidates: first,
+        candidates,
         second_round,
         not_candidates,
-        baseline: summary(&baseline, &[]),
-        extended: summary(&extended, &extended_effects),
-        signature: signature_of,
-        holdout_cable: spec.holdout_cable,
+        baseline,
+        extended,
+        best,
+        signature,
+        holdout: spec.holdout,
         holdout_rms_before,
         holdout_rms_after,
         criterion,
         alpha: spec.alpha,
-        captures_fitted: train.captures.len(),
+        fitted: train.captures.len(),
         elapsed_s: started.elapsed().as_secs_f64(),
-        actuator: extended.actuator.clone(),
+        details: (),
         written: Vec::new(),
     })
 }
 
-impl Diagnosis3 {
-    /// The `--json` object on one line.
-    pub fn to_json_line(&self) -> String {
-        serde_json::to_value(self).expect("a diagnosis serialises").to_string()
+/// The `--json` object's fields.
+#[derive(Serialize)]
+struct Json<'a> {
+    verdict: Verdict,
+    reason: &'a str,
+    parameter_name: Option<&'static str>,
+    parameter: Option<f64>,
+    parameter_se: Option<f64>,
+    effects: &'a [NamedEffect],
+    partial_effects: &'a [NamedEffect],
+    ambiguous_between: &'a [Effect],
+    separating_measurement: &'a Option<String>,
+    candidates: &'a [Candidate],
+    second_round: &'a [Candidate],
+    not_candidates: &'a [String],
+    baseline: FitSummary,
+    extended: FitSummary,
+    signature: &'a Option<Signature<CapturesReport>>,
+    holdout_cable: Option<usize>,
+    holdout_rms_before: Option<f64>,
+    holdout_rms_after: Option<f64>,
+    criterion: &'a str,
+    alpha: f64,
+    captures_fitted: usize,
+    elapsed_s: f64,
+}
+
+impl Serialize for Diagnosis<CapturesReport> {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        let first = self.first_named();
+        Json {
+            verdict: self.verdict,
+            reason: &self.reason,
+            parameter_name: first.map(|n| n.parameter_name),
+            parameter: first.map(|n| n.parameter),
+            parameter_se: first.map(|n| n.parameter_se),
+            effects: &self.named,
+            partial_effects: &self.partial_effects,
+            ambiguous_between: &self.ambiguous_between,
+            separating_measurement: &self.separating_measurement,
+            candidates: &self.candidates,
+            second_round: &self.second_round,
+            not_candidates: &self.not_candidates,
+            baseline: summary(&self.baseline),
+            extended: summary(&self.extended),
+            signature: &self.signature,
+            holdout_cable: self.holdout,
+            holdout_rms_before: self.holdout_rms_before,
+            holdout_rms_after: self.holdout_rms_after,
+            criterion: &self.criterion,
+            alpha: self.alpha,
+            captures_fitted: self.fitted,
+            elapsed_s: self.elapsed_s,
+        }
+        .serialize(serializer)
     }
 }
 
-impl std::fmt::Display for Diagnosis3 {
+impl std::fmt::Display for Diagnosis<CapturesReport> {
     fn fmt(&self, out: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         writeln!(out, "verdict: {}", self.verdict)?;
         writeln!(out, "  {}", self.reason)?;
-        for n in &self.effects {
+        for n in &self.named {
             writeln!(out, "  {} = {} ± {} (ΔBIC {:.1})", n.parameter_name, crate::io::fmt_sig(n.parameter, 4), crate::io::fmt_sig(n.parameter_se, 2), n.delta_bic)?;
         }
         for n in &self.partial_effects {
             writeln!(out, "  helps but does not explain: {} = {} (ΔBIC {:.1})", n.parameter_name, crate::io::fmt_sig(n.parameter, 4), n.delta_bic)?;
         }
-        writeln!(out, "body fit on {} captures: marker RMS {:.3} mm, χ²/dof {:.3}", self.captures_fitted, self.baseline.rms_mm, self.baseline.reduced_chi2)?;
+        writeln!(out, "body fit on {} captures: marker RMS {:.3} mm, χ²/dof {:.3}", self.fitted, self.baseline.errors.rms_mm, self.baseline.reduced_chi2)?;
         writeln!(out, "candidates (ΔBIC against the body fit):")?;
         for c in &self.candidates {
             let status = if c.counts() { String::new() } else { format!("  (does not count: {})", c.error.clone().unwrap_or_else(|| if c.converged { "implausible or undetermined value".into() } else { "did not converge".into() })) };
@@ -445,7 +418,7 @@ impl std::fmt::Display for Diagnosis3 {
                 writeln!(out, "  {line}")?;
             }
         }
-        if let (Some(k), Some(b), Some(a)) = (self.holdout_cable, self.holdout_rms_before, self.holdout_rms_after) {
+        if let (Some(k), Some(b), Some(a)) = (self.holdout, self.holdout_rms_before, self.holdout_rms_after) {
             writeln!(out, "held out (captures where cable {k} pulls): marker RMS {b:.3} mm with the body fit, {a:.3} mm with the final model")?;
         }
         writeln!(out, "{:.1} s", self.elapsed_s)?;

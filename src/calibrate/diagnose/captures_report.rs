@@ -4,7 +4,9 @@
 //! measured and simulated markers with the final model's body in two views
 //! (x–y and x–z, [`crate::plot::spatial`]).
 
-use super::captures::{Diagnosis3, FitSummary};
+use super::captures::{summary, FitSummary};
+use super::diagnosis::Diagnosis;
+use crate::calibrate::observations::captures::CapturesReport;
 use crate::calibrate::observations::captures::files::{Actuation, Capture, CaptureSet};
 use crate::calibrate::fit::Status;
 use crate::calibrate::observations::captures::simulate::solve_captures;
@@ -59,12 +61,13 @@ fn capture_body(actuator: &Actuator, options: &SolverOptions, c: &Capture) -> Re
 /// Writes `report.md` and a picture per capture of `set` into `dir`
 /// (created if needed), the pictures with the diagnosis's final model;
 /// returns the files written (the report first).
-pub fn write_report(dir: &Path, sources: ReportSources<'_>, set: &CaptureSet, d: &Diagnosis3, options: &SolverOptions) -> Result<Vec<PathBuf>, CalibrateError> {
+pub fn write_report(dir: &Path, sources: ReportSources<'_>, set: &CaptureSet, d: &Diagnosis<CapturesReport>, options: &SolverOptions) -> Result<Vec<PathBuf>, CalibrateError> {
     let io = |context: String| move |source| CalibrateError::Io { context, source };
     std::fs::create_dir_all(dir).map_err(io(format!("creating report directory {}", dir.display())))?;
-    let solutions = solve_captures(&d.actuator, options, set)?;
+    let solutions = solve_captures(&d.extended.actuator, options, set)?;
+    let model = summary(&d.extended).model;
     let names: Vec<String> = set.captures.iter().map(|c| capture_picture_name(c.measurement)).collect();
-    let fitted = |c: &Capture| match d.holdout_cable {
+    let fitted = |c: &Capture| match d.holdout {
         Some(k) => !c.pulling_cables().contains(&k),
         None => true,
     };
@@ -74,7 +77,7 @@ pub fn write_report(dir: &Path, sources: ReportSources<'_>, set: &CaptureSet, d:
         .zip(&solutions)
         .zip(&names)
         .map(|((c, sol), name)| {
-            let body = capture_body(&d.actuator, options, c)?;
+            let body = capture_body(&d.extended.actuator, options, c)?;
             let markers = set.markers.get(&c.measurement).map(Vec::as_slice).unwrap_or(&[]);
             let points = [
                 SpatialPoints { legend: "markers measured".into(), colour: BLACK.to_rgba(), points_mm: markers.iter().map(|m| m.measured_mm).collect(), crosses: true },
@@ -86,7 +89,7 @@ pub fn write_report(dir: &Path, sources: ReportSources<'_>, set: &CaptureSet, d:
                 c.measurement,
                 tensions.join(", "),
                 if fitted(c) { "" } else { "; held out" },
-                d.extended.model
+                model
             );
             let path = dir.join(name);
             // Drawn to a temporary file and renamed into place: a failure
@@ -141,19 +144,20 @@ fn fit_section(out: &mut String, title: &str, f: &FitSummary) {
     );
 }
 
-fn markdown(sources: ReportSources<'_>, set: &CaptureSet, d: &Diagnosis3, names: &[String]) -> String {
+fn markdown(sources: ReportSources<'_>, set: &CaptureSet, d: &Diagnosis<CapturesReport>, names: &[String]) -> String {
+    let (baseline, extended) = (summary(&d.baseline), summary(&d.extended));
     let mut out = String::new();
     let _ = writeln!(out, "# Diagnosis of {}\n", sources.captures.display());
     let _ = writeln!(
         out,
         "{} captures ({} fitted), markers {}, actuator {}.\n",
         set.captures.len(),
-        d.captures_fitted,
+        d.fitted,
         sources.markers.map_or_else(|| "from the captures file".to_string(), |m| m.display().to_string()),
         sources.actuator.display()
     );
     let _ = writeln!(out, "## Verdict: {}\n\n{}\n", d.verdict, d.reason);
-    for n in &d.effects {
+    for n in &d.named {
         let _ = writeln!(out, "- `{}` = {} ± {} (ΔBIC {:.1})", n.parameter_name, num(n.parameter), num(n.parameter_se), n.delta_bic);
     }
     for n in &d.partial_effects {
@@ -173,16 +177,16 @@ fn markdown(sources: ReportSources<'_>, set: &CaptureSet, d: &Diagnosis3, names:
         candidate_table(&mut out, &d.second_round, "marker RMS (mm)");
     }
     out.push_str("\n## Fits\n\n");
-    fit_section(&mut out, "Body fit", &d.baseline);
-    if d.extended.model != d.baseline.model {
-        fit_section(&mut out, "Final model", &d.extended);
+    fit_section(&mut out, "Body fit", &baseline);
+    if extended.model != baseline.model {
+        fit_section(&mut out, "Final model", &extended);
     }
     out.push_str("## Per-marker RMS of the 3-D errors (mm)\n\n| marker | body fit | final model |\n|---|---|---|\n");
-    for (marker, before) in &d.baseline.rms_by_marker_mm {
-        let after = d.extended.rms_by_marker_mm.get(marker).copied().unwrap_or(f64::NAN);
+    for (marker, before) in &baseline.rms_by_marker_mm {
+        let after = extended.rms_by_marker_mm.get(marker).copied().unwrap_or(f64::NAN);
         let _ = writeln!(out, "| {marker} | {before:.3} | {after:.3} |");
     }
-    let _ = writeln!(out, "| all | {:.3} | {:.3} |\n", d.baseline.rms_mm, d.extended.rms_mm);
+    let _ = writeln!(out, "| all | {:.3} | {:.3} |\n", baseline.rms_mm, extended.rms_mm);
     if let Some(s) = &d.signature {
         let _ = writeln!(out, "## Residual signature ({})\n", s.model);
         for line in &s.summary {
@@ -190,7 +194,7 @@ fn markdown(sources: ReportSources<'_>, set: &CaptureSet, d: &Diagnosis3, names:
         }
         out.push('\n');
     }
-    if let (Some(k), Some(b), Some(a)) = (d.holdout_cable, d.holdout_rms_before, d.holdout_rms_after) {
+    if let (Some(k), Some(b), Some(a)) = (d.holdout, d.holdout_rms_before, d.holdout_rms_after) {
         let _ = writeln!(out, "## Held out\n\nThe captures where cable {k} pulls: marker RMS {b:.3} mm with the body fit, {a:.3} mm with the final model.\n");
     }
     out.push_str("## Captures\n\nEach picture: the final model's body (silhouette, centreline, cables) in the x–y and x–z views, the measured markers (crosses) and the simulated ones (dots). The body is the capture solved from a virgin rod.\n\n");

@@ -2,7 +2,7 @@
 //! residual diagnostics, the fitted parameters and three PNG plots
 //! (residuals before/after, load/unload loops, measured vs simulated shapes).
 
-use super::analysis::{DiagnoseSpec, Diagnosis};
+use super::diagnosis::{DiagnoseSpec, Diagnosis};
 use super::criterion::Candidate;
 use super::Verdict;
 use crate::calibrate::data::{CentrelinePoints, Dataset};
@@ -14,24 +14,25 @@ use crate::plot::PlotError;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-/// Writes `report.md` and its plots into `dir` (created if needed);
-/// returns the report's path. [`crate::calibrate::diagnose::run()`] has refused a `dir` inside a
-/// sweep run before reading the measurements.
 /// The pictures beside `report.md`.
 pub const PICTURES: [&str; 3] = ["residuals.png", "loops.png", "shapes.png"];
 
+/// Writes `report.md` and its plots into `dir` (created if needed);
+/// returns the files written, the report first, then [`PICTURES`].
+/// [`crate::calibrate::diagnose::run()`] has refused a `dir` inside a
+/// sweep run before reading the measurements.
 pub(super) fn write_report(
     dir: &Path,
     data_path: &Path,
     data: &Dataset,
-    d: &Diagnosis,
-    spec: &DiagnoseSpec,
-) -> Result<PathBuf, CalibrateError> {
+    d: &Diagnosis<MeasurementsReport>,
+    spec: &DiagnoseSpec<MeasurementsReport>,
+) -> Result<Vec<PathBuf>, CalibrateError> {
     std::fs::create_dir_all(dir)
         .map_err(|source| CalibrateError::Io { context: format!("creating report directory {}", dir.display()), source })?;
     let groups = data.groups();
-    let angle_weight_mm_per_deg = spec.measurements.angle_weight_mm_per_deg;
-    let centrelines = (!spec.measurements.shapes.centrelines.is_empty()).then_some(&spec.measurements.shapes.centrelines);
+    let angle_weight_mm_per_deg = spec.settings.angle_weight_mm_per_deg;
+    let centrelines = (!spec.settings.shapes.centrelines.is_empty()).then_some(&spec.settings.shapes.centrelines);
     // The second model in plots and tables, only when it differs from the thesis model.
     let after_label = (!d.extended.effects.is_empty()).then(|| model_label(&d.extended));
     let after_label = after_label.as_deref();
@@ -50,14 +51,14 @@ pub(super) fn write_report(
     };
     atomic("residuals.png", &|p| crate::plot::draw_diagnosis_residuals(p, data, &groups, d, after_label, angle_weight_mm_per_deg))?;
     atomic("loops.png", &|p| crate::plot::draw_diagnosis_loops(p, data, &groups, d, after_label))?;
-    let markers = (!spec.measurements.shapes.markers.is_empty()).then_some(&spec.measurements.shapes.markers);
+    let markers = (!spec.settings.shapes.markers.is_empty()).then_some(&spec.settings.shapes.markers);
     atomic("shapes.png", &|p| crate::plot::draw_diagnosis_shapes(p, data, &groups, d, centrelines, markers, after_label))?;
     crate::io::sync_dir(dir);
-    let md = markdown(data_path, data, d, after_label, centrelines, spec.measurements.noise.mm);
+    let md = markdown(data_path, data, d, after_label, centrelines, spec.settings.noise.mm);
     let path = dir.join("report.md");
     crate::io::write_atomic(&path, md.as_bytes())
         .map_err(|source| CalibrateError::Io { context: format!("writing {}", path.display()), source })?;
-    Ok(path)
+    Ok(std::iter::once(path).chain(PICTURES.iter().map(|p| dir.join(p))).collect())
 }
 
 fn model_label(f: &FitResult<MeasurementsReport>) -> String {
@@ -165,7 +166,7 @@ fn fit_section(out: &mut String, title: &str, f: &FitResult<MeasurementsReport>)
     out.push('\n');
 }
 
-fn markdown(data_path: &Path, data: &Dataset, d: &Diagnosis, after_label: Option<&str>, centrelines: Option<&CentrelinePoints>, noise_mm: f64) -> String {
+fn markdown(data_path: &Path, data: &Dataset, d: &Diagnosis<MeasurementsReport>, after_label: Option<&str>, centrelines: Option<&CentrelinePoints>, noise_mm: f64) -> String {
     let mut out = String::new();
     let _ = writeln!(out, "# Model-discrepancy diagnosis\n\nData: `{}` ({} rows, {} routings).\n", data_path.display(), data.rows.len(), data.groups().len());
     out.push_str("## Verdict\n\n");
@@ -195,11 +196,11 @@ fn markdown(data_path: &Path, data: &Dataset, d: &Diagnosis, after_label: Option
                     let _ = writeln!(out, "- {line}");
                 }
                 out.push_str("\n| rows | n | tip position RMS (mm) | tip angle RMS (°) |\n|---|---|---|---|\n");
-                for (name, n, pos, ang) in &sig.by_tension {
+                for (name, n, pos, ang) in &sig.sites.by_tension {
                     let _ = writeln!(out, "| {name} | {n} | {} | {} |", num(*pos), num(*ang));
                 }
                 out.push_str("\n| routing | tip position RMS (mm) | tip angle RMS (°) |\n|---|---|---|\n");
-                for (r, pos, ang) in &sig.by_routing {
+                for (r, pos, ang) in &sig.sites.by_routing {
                     let _ = writeln!(out, "| {r} | {} | {} |", num(*pos), num(*ang));
                 }
             }
@@ -244,14 +245,14 @@ fn markdown(data_path: &Path, data: &Dataset, d: &Diagnosis, after_label: Option
         candidate_table(&mut out, &d.second_round, "tip RMS (mm)");
     }
     out.push_str("\n## Residual diagnostics of the thesis model\n\nResiduals are simulated − measured; θ is weighted so that the angle weight (mm per degree) converts it to mm.\n\n| rows | n | RMS (mm) | mean Δx (mm) | mean Δy (mm) | mean Δθ (°) |\n|---|---|---|---|---|---|\n");
-    for c in &d.diagnostics.classes {
+    for c in &d.details.diagnostics.classes {
         let _ = writeln!(out, "| {} | {} | {} | {} | {} | {} |", c.class, c.rows, num(c.rms_mm), num(c.mean_dx_mm), num(c.mean_dy_mm), num(c.mean_dtheta_deg));
     }
     let _ = writeln!(
         out,
         "\n- Load/unload gap the model misses (mean |Δθ_unload − Δθ_load| at equal tension): {}°  (friction or creep open a loop)\n- Rest-state shift the model misses (last rest − first rest): {}°  (creep leaves a residual bend)\n",
-        num(d.diagnostics.loop_gap_deg),
-        num(d.diagnostics.rest_shift_deg)
+        num(d.details.diagnostics.loop_gap_deg),
+        num(d.details.diagnostics.rest_shift_deg)
     );
     if let Some(c) = centrelines {
         coefficient_section(&mut out, data, d, c, after_label, noise_mm);
@@ -304,7 +305,7 @@ fn coefficient_noise(prediction: &Option<Prediction>, count: usize, noise_mm: f6
     Some(sum.iter().zip(&sum2).map(|(s, s2)| ((s2 - s * s / n) / (n - 1.0)).max(0.0).sqrt()).collect())
 }
 
-fn coefficient_section(out: &mut String, data: &Dataset, d: &Diagnosis, centrelines: &CentrelinePoints, after_label: Option<&str>, noise_mm: f64) {
+fn coefficient_section(out: &mut String, data: &Dataset, d: &Diagnosis<MeasurementsReport>, centrelines: &CentrelinePoints, after_label: Option<&str>, noise_mm: f64) {
     let length = d.baseline.rod().length_mm;
     let mut rows = Vec::new();
     for g in data.groups() {
@@ -318,8 +319,8 @@ fn coefficient_section(out: &mut String, data: &Dataset, d: &Diagnosis, centreli
         };
         let points = &centrelines[&m.measurement];
         let measured = shape_coefficients_rest_basis(points, length, SHAPE_ORDER).ok();
-        let spread = coefficient_noise(&d.baseline_predictions[i], points.len(), m.noise_mm.unwrap_or(noise_mm), length);
-        rows.push((g.routing.clone(), m.measurement, m.tension_n, measured, spread, simulated(&d.baseline_predictions), simulated(&d.extended_predictions)));
+        let spread = coefficient_noise(&d.details.baseline_predictions[i], points.len(), m.noise_mm.unwrap_or(noise_mm), length);
+        rows.push((g.routing.clone(), m.measurement, m.tension_n, measured, spread, simulated(&d.details.baseline_predictions), simulated(&d.details.extended_predictions)));
     }
     if rows.is_empty() {
         return;

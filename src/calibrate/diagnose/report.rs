@@ -3,10 +3,11 @@
 //!
 //! [`Display`]: std::fmt::Display
 
-use super::analysis::{model_name, Diagnosis, ResidualDiagnostics, Signature};
+use super::analysis::{model_name, ResidualDiagnostics};
 use super::criterion::{Candidate, NamedEffect};
+use super::diagnosis::{Diagnosis, Signature};
 use super::Verdict;
-use super::captures::Diagnosis3;
+use crate::calibrate::observations::captures::CapturesReport;
 use crate::calibrate::fit::FitResult;
 use crate::calibrate::observations::measurements::MeasurementsReport;
 use crate::calibrate::Effect;
@@ -20,9 +21,9 @@ use std::path::PathBuf;
 #[serde(untagged)]
 pub enum DiagnoseReport {
     /// Planar measurements.
-    Measurements(MeasurementsDiagnosis),
+    Measurements(Diagnosis<MeasurementsReport>),
     /// Captures with 3-D markers.
-    Captures(Diagnosis3),
+    Captures(Diagnosis<CapturesReport>),
 }
 
 impl DiagnoseReport {
@@ -34,8 +35,8 @@ impl DiagnoseReport {
     /// The pictures written beside the report (none without one).
     pub fn pictures(&self) -> Vec<PathBuf> {
         match self {
-            DiagnoseReport::Measurements(m) => m.report.as_deref().and_then(std::path::Path::parent).map_or_else(Vec::new, |dir| super::markdown::PICTURES.iter().map(|p| dir.join(p)).collect()),
-            DiagnoseReport::Captures(d) => d.written.iter().skip(1).cloned().collect(),
+            DiagnoseReport::Measurements(d) => d.pictures(),
+            DiagnoseReport::Captures(d) => d.pictures(),
         }
     }
 }
@@ -47,15 +48,6 @@ impl fmt::Display for DiagnoseReport {
             DiagnoseReport::Captures(d) => d.fmt(out),
         }
     }
-}
-
-/// A finished diagnosis of planar measurements and the report written for it.
-#[derive(Debug, Clone)]
-pub struct MeasurementsDiagnosis {
-    /// The diagnosis.
-    pub diagnosis: Diagnosis,
-    /// The Markdown report's path, when one was written.
-    pub report: Option<PathBuf>,
 }
 
 /// The `--json` object's fields.
@@ -77,7 +69,7 @@ struct Json<'a> {
     baseline: &'a FitResult<MeasurementsReport>,
     extended: &'a FitResult<MeasurementsReport>,
     best: &'a FitResult<MeasurementsReport>,
-    signature: &'a Option<Signature>,
+    signature: &'a Option<Signature<MeasurementsReport>>,
     diagnostics: &'a ResidualDiagnostics,
     holdout: &'a Option<String>,
     holdout_rms_before: Option<f64>,
@@ -86,10 +78,10 @@ struct Json<'a> {
     report: Option<String>,
 }
 
-impl Serialize for MeasurementsDiagnosis {
+impl Serialize for Diagnosis<MeasurementsReport> {
     fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        let d = &self.diagnosis;
-        let first = d.named.first();
+        let d = self;
+        let first = d.first_named();
         Json {
             verdict: d.verdict,
             reason: &d.reason,
@@ -108,20 +100,20 @@ impl Serialize for MeasurementsDiagnosis {
             extended: &d.extended,
             best: &d.best,
             signature: &d.signature,
-            diagnostics: &d.diagnostics,
+            diagnostics: &d.details.diagnostics,
             holdout: &d.holdout,
             holdout_rms_before: d.holdout_rms_before,
             holdout_rms_after: d.holdout_rms_after,
             not_identifiable: ["cable_stretch: under tension control the cable's stretch does not change the forces on the rod, so no tip reading can show it"],
-            report: self.report.as_ref().map(|p| p.display().to_string()),
+            report: self.written.first().map(|p| p.display().to_string()),
         }
         .serialize(serializer)
     }
 }
 
-impl fmt::Display for MeasurementsDiagnosis {
+impl fmt::Display for Diagnosis<MeasurementsReport> {
     fn fmt(&self, out: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let d = &self.diagnosis;
+        let d = self;
         writeln!(out, "verdict: {}", d.verdict)?;
         writeln!(out, "  {}", d.reason)?;
         for n in &d.partial_effects {
@@ -171,7 +163,7 @@ impl fmt::Display for MeasurementsDiagnosis {
         if d.verdict == Verdict::Consistent || !d.named.is_empty() && !matches!(d.verdict, Verdict::Unexplained | Verdict::Inconclusive) {
             write!(out, "{}", next_step(&d.extended))?;
         }
-        if let Some(p) = &self.report {
+        if let Some(p) = self.written.first() {
             writeln!(out, "report: {}", p.display())?;
         }
         Ok(())

@@ -4,12 +4,15 @@
 //! diagnosis and the report's files out. The report directory is refused
 //! before anything is read.
 
-use super::analysis::{diagnose, DiagnoseSpec};
+use super::analysis::diagnose;
+use super::captures::diagnose_captures;
+use super::diagnosis::{DiagnoseSpec, Diagnosis};
 use super::markdown::write_report;
-use super::report::{DiagnoseReport, MeasurementsDiagnosis};
+use super::report::DiagnoseReport;
 use crate::calibrate::data::read_measurements;
+use crate::calibrate::observations::captures::CapturesReport;
+use crate::calibrate::observations::measurements::MeasurementsReport;
 use crate::calibrate::request::{DataKind, DiagnoseRequest};
-use super::captures::{diagnose_captures, Diagnose3Spec, Diagnosis3};
 use crate::calibrate::fit::FitSpec;
 use crate::calibrate::observations::captures::files::read_actuator_set;
 use crate::calibrate::observations::captures::files::read_actuator;
@@ -27,7 +30,7 @@ pub fn run(request: &DiagnoseRequest) -> Result<DiagnoseReport, CalibrateError> 
     }
 }
 
-fn diagnose_measurements(request: &DiagnoseRequest) -> Result<MeasurementsDiagnosis, CalibrateError> {
+fn diagnose_measurements(request: &DiagnoseRequest) -> Result<Diagnosis<MeasurementsReport>, CalibrateError> {
     if let Some(dir) = &request.report_dir {
         crate::io::check_outside_run_dir(dir, "the report directory")?;
     }
@@ -36,27 +39,27 @@ fn diagnose_measurements(request: &DiagnoseRequest) -> Result<MeasurementsDiagno
     actuator.validate()?;
     let (fit, measurements, start, held_effects) = request.fit.resolve(&actuator, &data)?;
     let spec = DiagnoseSpec {
-        holdout: request.holdout.clone(),
         fit,
-        measurements,
+        settings: measurements,
+        options: request.options.clone(),
+        holdout: request.holdout.clone(),
+        held_effects,
         threshold: request.threshold,
         margin: request.margin,
         max_effects: request.max_effects.max(1),
         alpha: request.alpha,
-        held_effects,
     };
-    let diagnosis = diagnose(&start, &request.options, &data, &spec)?;
-    let report = match &request.report_dir {
-        Some(dir) => Some(write_report(dir, &request.data_path, &data, &diagnosis, &spec)?),
-        None => None,
-    };
-    Ok(MeasurementsDiagnosis { diagnosis, report })
+    let mut diagnosis = diagnose(&start, &data, &spec)?;
+    if let Some(dir) = &request.report_dir {
+        diagnosis.written = write_report(dir, &request.data_path, &data, &diagnosis, &spec)?;
+    }
+    Ok(diagnosis)
 }
 
 /// Reads the request's files, runs [`diagnose_captures`] and writes the
 /// report directory when asked for (refused first when inside a sweep run,
 /// before anything is read); the report's files are in `written`.
-fn diagnose_captures_request(request: &DiagnoseRequest, actuator_file: &Path) -> Result<Diagnosis3, CalibrateError> {
+fn diagnose_captures_request(request: &DiagnoseRequest, actuator_file: &Path) -> Result<Diagnosis<CapturesReport>, CalibrateError> {
     if !request.fit.held.is_empty() {
         return Err(Refused::HeldInCapturesDiagnosis.into());
     }
@@ -70,11 +73,12 @@ fn diagnose_captures_request(request: &DiagnoseRequest, actuator_file: &Path) ->
     if !base.rod.gravity.enabled {
         params.retain(|&p| p != Parameter::Density);
     }
-    let spec = Diagnose3Spec {
+    let spec = DiagnoseSpec {
         fit: FitSpec { params, held: Vec::new(), loss, max_iterations: request.fit.max_iterations },
-        noise_mm: request.fit.noise_mm,
+        settings: request.fit.noise_mm,
         options: request.options.clone(),
-        holdout_cable: request.holdout_cable,
+        holdout: request.holdout_cable,
+        held_effects: Vec::new(),
         threshold: request.threshold,
         margin: request.margin,
         max_effects: request.max_effects,
