@@ -773,3 +773,21 @@ fn no_type_is_a_twin_named_with_a_3() {
     let gone: Vec<&&str> = TWINNED_BY_A_3.iter().filter(|t| !twins.iter().any(|n| n == *t)).collect();
     assert!(gone.is_empty(), "{gone:?} no longer twinned: remove them from TWINNED_BY_A_3");
 }
+
+/// `python/src` converts Python's arguments and wraps the library's
+/// reports: every request it runs is the library's, deserialised, so the
+/// checks and defaults are written once.
+#[test]
+fn python_declares_no_request_of_its_own() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("python/src");
+    let mut files = Vec::new();
+    rust_files(&dir, &mut files);
+    assert!(!files.is_empty(), "no sources in {}", dir.display());
+    for path in files {
+        let text = std::fs::read_to_string(&path).unwrap();
+        let words: Vec<&str> = text.split(|c: char| !(c.is_alphanumeric() || c == '_')).filter(|w| !w.is_empty()).collect();
+        for w in words.windows(2).filter(|w| w[0] == "struct") {
+            assert!(!w[1].ends_with("Request"), "{} declares struct {}: fill the library's request instead", path.display(), w[1]);
+        }
+    }
+}

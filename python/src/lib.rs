@@ -2,17 +2,19 @@
 //!
 //! A thin layer: each function takes a request as JSON (built by the
 //! Python functions in `python/cablemap/__init__.py` from keyword
-//! arguments), builds the library's request the way the matching command
-//! in `src/cli/` does, runs it, and hands back the library's record as JSON
+//! arguments), deserialises it into the library's request (the one the
+//! matching command in `src/cli/` fills), runs it, and hands back the
+//! library's record as JSON
 //! and numeric series as little-endian `f64` bytes (numpy reads them without
 //! a copy per element). Errors are raised as the package's exceptions
 //! (`cablemap.errors`): bad input, a failed solve (with its status), or a
 //! file that cannot be read.
 
-use cablemap::solver::record::{self, SimulationRecord};
+use cablemap::io::SettingNames;
+use cablemap::model::{Actuator, ActuatorError, Rod, Routing, REGISTRY};
+use cablemap::solver::request::{SimulateRequest, SimulateRequestError};
 use cablemap::solver::spatial::SpatialError;
-use cablemap::model::{Actuator, ActuatorError, Cable, LoadDirection, Rod, Routing, REGISTRY};
-use cablemap::solver::{simulate_actuator, simulate_held, Backend, Given, Hold, SimulateError, Simulation, Simulator, SolverOptions, SolverSettings};
+use cablemap::solver::{Backend, Given, SimulateError, Simulator, SolverOptions, SolverSettings};
 use cablemap::shape::LengthBasis;
 use cablemap::sweep::solve::{planar_routing, Stored};
 use cablemap::sweep::spec::Ladder;
@@ -188,100 +190,13 @@ fn actuator_to_toml(py: Python<'_>, actuator_json: &str) -> PyResult<String> {
 
 // ---------------------------------------------------------------- simulate
 
-/// What `cablemap.simulate` asks: the fields of `cablemap simulate`.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct SimulateRequest {
-    /// The actuator (rod, and cables when given by them).
-    actuator: Actuator,
-    /// `--routing`: one planar cable's control points, mm.
-    routing_mm: Option<Vec<f64>>,
-    /// `--tension-n`.
-    tension_n: Option<f64>,
-    /// `--displacement-mm`.
-    displacement_mm: Option<f64>,
-    /// `--cable-ea-n`.
-    cable_ea_n: Option<f64>,
-    /// `--order`.
-    order: usize,
-    /// `--length-basis`.
-    length_basis: LengthBasis,
-    /// `--direction`: "load" or "unload".
-    direction: Option<String>,
-    /// `--dwell-s`.
-    dwell_s: Option<f64>,
-    #[serde(default)]
-    solver: SolverSettings,
-}
-
-/// Runs a simulate request as `src/cli/simulate.rs` does: `routing_mm`
-/// alone on an actuator without cables, torsion or gravity direction is
-/// the planar record's path; anything else the actuator's.
-fn simulate_request(request: SimulateRequest) -> Result<(Simulation, String)> {
-    let SimulateRequest { mut actuator, routing_mm, tension_n, displacement_mm, cable_ea_n, order, length_basis: basis, direction, dwell_s, solver } = request;
-    let options = solver.options();
-    let load = match direction.as_deref() {
-        None | Some("load") => LoadDirection::Load,
-        Some("unload") => LoadDirection::Unload,
-        Some(other) => return Err(bad(format!("direction {other:?}: expected \"load\" or \"unload\""))),
-    };
-    let given = Given {
-        method: solver.method.is_some(),
-        nodes_per_span: solver.nodes_per_span.is_some(),
-        steps_per_span: solver.steps_per_span.is_some(),
-        hold: load != LoadDirection::Load || dwell_s.is_some(),
-        thesis_coefficients: false,
-    };
-    let hold = Hold { direction: load, dwell_s: dwell_s.unwrap_or(actuator.rod.effects.creep_hold_s) };
-    let actuation = match (tension_n, displacement_mm) {
-        (Some(_), Some(_)) => return Err(bad("give tension_n or displacement_mm, not both")),
-        (t, d) => t.map(Ok).or(d.map(Err)),
-    };
-    let spatial = !actuator.cables.is_empty() || actuator.gj_n_mm2.is_some() || actuator.gravity_direction.is_some();
-    if !spatial {
-        let (Some(y), Some(actuation)) = (&routing_mm, actuation) else {
-            return Err(bad(
-                "say what to simulate: routing_mm=[y0, .., y4] with tension_n=T or displacement_mm=D (one planar cable), or cables=[{y_mm: [..], z_mm: [..], tension_n: T}, ..], or an actuator with cables",
-            ));
-        };
-        let rod = actuator.rod.clone();
-        rod.validate().map_err(|e| bad(e.to_string()))?;
-        let routing = Routing::for_actuator(y, &rod).map_err(|e| bad(format!("routing_mm: {e}")))?;
-        Backend::check_planar(&rod, &options, given).map_err(|e| bad(e.to_string()))?;
-        let sim = match actuation {
-            Ok(t) if cable_ea_n.is_none() => simulate_held(&rod, &options, &routing, t, order, basis, hold)?,
-            _ => {
-                let cable = Cable { cable_ea_n, ..Cable::planar(routing.control_points_mm().0, 0.0) };
-                let cable = match actuation {
-                    Ok(t) => Cable { tension_n: t, ..cable },
-                    Err(d) => Cable { displacement_mm: Some(d), ..cable },
-                };
-                let one = Actuator::with_cables(rod, vec![cable]);
-                simulate_actuator(&one, &options, given, Some(hold), order, basis)?
-            }
-        };
-        let json = SimulationRecord::from(&sim).to_json_line();
-        return Ok((sim, json));
+/// The library's simulate errors as the package's exceptions: a failed
+/// solve keeps its own message and status (without the routing it solved).
+fn simulate_failure(e: SimulateRequestError) -> Failure {
+    match e.solve_error() {
+        Some(solve) => solve.clone().into(),
+        None => bad(e.to_string()),
     }
-    if let (Some(y), Some(actuation)) = (&routing_mm, actuation) {
-        let y: [f64; 5] = y
-            .clone()
-            .try_into()
-            .map_err(|y: Vec<f64>| bad(format!("routing_mm: a routing needs exactly 5 control points y0..y4 (mm), got {}", y.len())))?;
-        let cable = Cable::planar(y, 0.0);
-        actuator.cables = vec![match actuation {
-            Ok(t) => Cable { tension_n: t, cable_ea_n, ..cable },
-            Err(d) => Cable { displacement_mm: Some(d), cable_ea_n, ..cable },
-        }];
-    } else if routing_mm.is_some() || actuation.is_some() {
-        return Err(bad("routing_mm needs its actuation (tension_n or displacement_mm) and the other way round"));
-    }
-    if actuator.cables.is_empty() {
-        return Err(bad("no cables: give cables=[...], routing_mm with tension_n, or an actuator with cables"));
-    }
-    let sim = simulate_actuator(&actuator, &options, given, Some(hold), order, basis)?;
-    let json = record::simulation_json(&sim).to_string();
-    Ok((sim, json))
 }
 
 /// Columns of the centreline array `simulate` returns.
@@ -292,13 +207,14 @@ const CENTRELINE: [&str; 9] = ["s_mm", "x_mm", "y_mm", "z_mm", "frame_angle_rad"
 #[pyfunction]
 fn simulate<'py>(py: Python<'py>, request_json: &str) -> PyResult<(String, Bound<'py, PyBytes>, Vec<&'static str>)> {
     let request: SimulateRequest = from_json(request_json, "simulate").map_err(|e| e.into_py(py))?;
-    let (sim, json) = py.detach(|| simulate_request(request)).map_err(|e| e.into_py(py))?;
-    let values: Vec<f64> = sim
+    let report = py.detach(|| request.run(SettingNames::Keys)).map_err(|e| simulate_failure(e).into_py(py))?;
+    let values: Vec<f64> = report
+        .simulation
         .centreline
         .iter()
         .flat_map(|c| [c.s_mm, c.x_mm, c.y_mm, c.z_mm, c.frame_angle_rad, c.tangent_angle_rad, c.arc_length_mm, c.u_per_mm[1], c.u_per_mm[2]])
         .collect();
-    Ok((json, f64_bytes(py, &values), CENTRELINE.to_vec()))
+    Ok((report.to_json(), f64_bytes(py, &values), CENTRELINE.to_vec()))
 }
 
 // ---------------------------------------------------------------- batches
@@ -328,7 +244,7 @@ fn solve_batch<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let prepare = || -> Result<(Rod, SolverOptions, LengthBasis)> {
         let actuator: Actuator = from_json(actuator_json, "actuator")?;
-        if !actuator.cables.is_empty() || actuator.gj_n_mm2.is_some() || actuator.gravity_direction.is_some() {
+        if !actuator.is_rod_alone() {
             return Err(bad("solve_batch solves one planar cable per routing: give the rod alone (no cables, gj_n_mm2 or gravity_direction)"));
         }
         let solver: SolverSettings = from_json(solver_json, "solver")?;

@@ -2,10 +2,11 @@
 //! decisions they make: the rod's overrides (a library
 //! [`RodOverrides`]) and the solver options.
 
-use cablemap::model::{EffectInfo, Rod, RodOverrides, REGISTRY};
+use anyhow::Context;
+use cablemap::model::{Actuator, EffectInfo, Rod, RodOverrides, REGISTRY};
 use cablemap::solver::{SolverMethod, SolverOptions, SolverSettings};
 use clap::Args;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Rod parameter overrides shared by every command that simulates.
 /// Defaults are the thesis's (model-notes §1).
@@ -151,6 +152,19 @@ impl ActuatorArgs {
     /// [`ActuatorArgs::overrides`] and resolves them on the data's rod.)
     pub fn resolve(&self) -> anyhow::Result<Rod> {
         self.overrides().resolve(None).map_err(|e| anyhow::Error::new(e).context("--actuator-file"))
+    }
+
+    /// The actuator of `--actuator FILE.toml` (`actuator_file`) with the
+    /// rod flags applied to its rod, else [`ActuatorArgs::resolve`]'s rod
+    /// without cables: the rod is given once, by one file or the other.
+    pub fn actuator(&self, actuator_file: Option<&Path>) -> anyhow::Result<Actuator> {
+        let Some(path) = actuator_file else {
+            return Ok(Actuator::with_cables(self.resolve()?, Vec::new()));
+        };
+        anyhow::ensure!(self.actuator_file.is_none(), "give the rod either in --actuator FILE's [rod] table or by --actuator-file, not both");
+        let mut actuator = Actuator::read(path).with_context(|| format!("--actuator {}", path.display()))?;
+        actuator.rod = self.apply(&actuator.rod);
+        Ok(actuator)
     }
 
     /// The solver settings given by flags.

@@ -144,19 +144,8 @@ pub fn run(args: &MouldArgs) -> anyhow::Result<()> {
 /// `cablemap mould --actuator FILE` / `--cable …`: one library request
 /// ([`cablemap::mould::build`]) for every cable's channel.
 fn run_actuator(args: &MouldArgs) -> anyhow::Result<()> {
-    use cablemap::model::{Actuator, Cable};
-    let mut actuator = match &args.spatial_actuator {
-        Some(path) => {
-            anyhow::ensure!(
-                args.actuator.actuator_file.is_none(),
-                "give the rod either in --actuator FILE's [rod] table or by --actuator-file, not both"
-            );
-            let mut a = Actuator::read(path).with_context(|| format!("--actuator {}", path.display()))?;
-            a.rod = args.actuator.apply(&a.rod);
-            a
-        }
-        None => Actuator::with_cables(args.actuator.resolve()?, Vec::new()),
-    };
+    use cablemap::model::Cable;
+    let mut actuator = args.actuator.actuator(args.spatial_actuator.as_deref())?;
     if !args.cable.is_empty() {
         actuator.cables = args.cable.iter().map(|c| c.parse::<Cable>()).collect::<Result<_, _>>().context("--cable")?;
     }

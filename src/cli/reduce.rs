@@ -3,7 +3,8 @@
 use super::output::Output;
 use cablemap::job::{Job, JobSpec};
 use cablemap::map::{self, MapError, MapReport, MapRequest, MapSettings, PartRequest, ReduceRequest, Source};
-use cablemap::reduce::{MapSettingsFields, ReduceError, SettingNames};
+use cablemap::io::SettingNames;
+use cablemap::reduce::{MapSettingsFields, ReduceError};
 use clap::Args;
 use std::path::{Path, PathBuf};
 

@@ -1,13 +1,12 @@
 //! `cablemap simulate`: one actuator, one tension.
 
 use super::{parse_list, ActuatorArgs, LengthBasisArgs};
-use cablemap::solver::record::{self, SimulationRecord};
-use cablemap::model::{Actuation, Actuator, Cable, LoadDirection, Routing};
-use cablemap::solver::{simulate_actuator, simulate_held, Backend, Given, Hold, SimulateError, SolverOptions};
-use cablemap::plot::{draw_bodies, BodyDrawing};
+use cablemap::io::SettingNames;
+use cablemap::model::{Cable, LoadDirection};
+use cablemap::plot::draw_simulation;
+use cablemap::solver::request::{CoefficientRoute, SimulateRequest};
 use anyhow::Context;
 use clap::Args;
-use plotters::style::full_palette::BLUE_800;
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -48,10 +47,10 @@ pub struct SimulateArgs {
     /// How a_i are computed: `exact` (the definition, from the solver's
     /// tangent angles) or `thesis` (thesis §3.3: tangent angles resampled at
     /// --n-d equal arc-length intervals, discrete Legendre vectors, eq. 3.12).
-    #[arg(long, value_enum, default_value_t = CoefficientRoute::Exact)]
-    pub coefficients: CoefficientRoute,
+    #[arg(long, value_enum, default_value_t = CoefficientsArg::Exact)]
+    pub coefficients: CoefficientsArg,
     /// Intervals n_d of the thesis route.
-    #[arg(long, default_value_t = 40)]
+    #[arg(long, default_value_t = cablemap::solver::request::DEFAULT_N_D)]
     pub n_d: usize,
     /// Print one JSON object instead of a report.
     #[arg(long)]
@@ -75,94 +74,72 @@ pub struct SimulateArgs {
     pub actuator: ActuatorArgs,
 }
 
-/// Most resampling intervals of the thesis route.
-pub const MAX_N_D: usize = 100_000;
-
 /// Which definition of the curvature coefficients to report.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum CoefficientRoute {
+pub enum CoefficientsArg {
     /// a_i = (2i+1)/ℓ ∫ P_i dθ, exactly (model-notes §4).
     Exact,
     /// The thesis's discrete route (§3.3, eq. 3.12), from the centreline points.
     Thesis,
 }
 
-/// Runs `cablemap simulate`.
+/// Runs `cablemap simulate`: fills the library's request and prints its report.
 pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
-    if !args.cable.is_empty() || args.spatial_actuator.is_some() || args.gravity_direction.is_some() {
-        return run_spatial(args);
+    let mut actuator = args.actuator.actuator(args.spatial_actuator.as_deref())?;
+    if !args.cable.is_empty() {
+        actuator.cables = args.cable.iter().map(|c| c.parse::<Cable>()).collect::<Result<_, _>>().context("--cable")?;
     }
-    let (Some(routing_text), Some(actuation)) = (&args.routing, planar_actuation(args)?) else {
-        anyhow::bail!(
-            "say what to simulate: --routing Y0,..,Y4 with --tension-n T or --displacement-mm D (one planar cable), --cable \"y=.. z=.. tension=T\" (repeatable), or --actuator FILE.toml"
-        );
+    if let Some(text) = &args.gravity_direction {
+        let g = parse_list(text, "--gravity-direction")?;
+        let g: [f64; 3] = g.try_into().map_err(|g: Vec<f64>| anyhow::anyhow!("--gravity-direction needs 3 numbers X,Y,Z, got {}", g.len()))?;
+        actuator.gravity_direction = Some(g);
+    }
+    let request = SimulateRequest {
+        actuator,
+        routing_mm: args.routing.as_deref().map(|r| parse_list(r, "--routing")).transpose()?,
+        tension_n: args.tension_n,
+        displacement_mm: args.displacement_mm,
+        cable_ea_n: args.cable_ea_n,
+        order: args.order,
+        length_basis: args.basis.length_basis,
+        direction: Some(if args.direction == "unload" { LoadDirection::Unload } else { LoadDirection::Load }),
+        dwell_s: args.dwell_s,
+        solver: args.actuator.solver_settings(),
+        coefficients: match args.coefficients {
+            CoefficientsArg::Exact => CoefficientRoute::Exact,
+            CoefficientsArg::Thesis => CoefficientRoute::Thesis,
+        },
+        n_d: args.n_d,
     };
-    let actuator = args.actuator.resolve()?;
-    actuator.validate()?;
-    let options = args.actuator.solver_options(&SolverOptions::default());
-    anyhow::ensure!(
-        args.n_d <= MAX_N_D,
-        "--n-d {} is more than {MAX_N_D} intervals (the thesis uses 40; the solver has only 2 × steps-per-span nodes to resample)",
-        args.n_d
-    );
-    let y = parse_list(routing_text, "--routing")?;
-    let routing = Routing::for_actuator(&y, &actuator).context("--routing")?;
-    // The one check: a setting the planar backend of --method does not read is refused.
-    Backend::check_planar(&actuator, &options, given_settings(args))?;
-    let direction = if args.direction == "unload" { LoadDirection::Unload } else { LoadDirection::Load };
-    let hold = Hold { direction, dwell_s: args.dwell_s.unwrap_or(actuator.effects.creep_hold_s) };
-    // The thesis route computes its own coefficients from the centreline
-    // (its order is limited by n_d, checked there), so the solver's exact
-    // ones are only needed up to what the steps resolve.
-    let exact_order = match args.coefficients {
-        CoefficientRoute::Exact => args.order,
-        CoefficientRoute::Thesis => args.order.min(cablemap::solver::resolution::max_order(&options)),
-    };
-    let basis = args.basis.length_basis;
-    let mut sim = match actuation {
-        Actuation::Tension(t) if args.cable_ea_n.is_none() => {
-            let solved = simulate_held(&actuator, &options, &routing, t, exact_order, basis, hold);
-            if let (Err(SimulateError::Solve(failure)), true) = (&solved, args.json) {
-                print_failure_json(failure.status(), &failure.to_string())?;
-            }
-            solved.with_context(|| format!("simulating routing {y:?} at {}", describe(actuation)))?
-        }
-        // A displacement, or a stiffness: the actuator's one cable, checked
-        // and solved as every actuator's (the same planar backend).
-        _ => {
-            let one = Actuator::with_cables(actuator.clone(), vec![routing_cable(actuation, routing.control_points_mm().0, args.cable_ea_n)]);
-            let solved = simulate_actuator(&one, &options, given_settings(args), Some(hold), exact_order, basis);
-            if let (Err(e), true) = (&solved, args.json) {
-                if let Some(status) = e.failure_status() {
-                    print_failure_json(status, &e.to_string())?;
+    let report = match request.run(SettingNames::Flags) {
+        Ok(report) => report,
+        Err(e) => {
+            // With --json, a failed solve is a record too: its status (the
+            // one a sweep stores for it, e.g. `non_finite`, `unresolved`)
+            // and the message, on stdout; the error still goes to stderr
+            // with a non-zero exit.
+            if let (Some(failure), true) = (e.solve_error(), args.json) {
+                if let Some(status) = failure.failure_status() {
+                    let record = serde_json::json!({ "status": status, "error": failure.to_string() });
+                    writeln!(std::io::stdout().lock(), "{record}")?;
                 }
             }
-            solved.with_context(|| format!("simulating routing {y:?} at {}", describe(actuation)))?
+            return Err(e.into());
         }
     };
-    if args.coefficients == CoefficientRoute::Thesis {
-        let points: Vec<[f64; 2]> = sim.centreline.iter().map(|c| [c.x_mm, c.y_mm]).collect();
-        sim.a_bend_z = cablemap::shape::thesis_coefficients(&points, args.order, args.n_d)
-            .context("thesis coefficient route")?
-            .in_basis(basis, actuator.length_mm)
-            .a;
-    }
     if let Some(path) = &args.csv {
-        record::write_planar_centreline_csv(path, &sim).with_context(|| format!("writing centreline CSV {}", path.display()))?;
+        report.write_centreline_csv(path).with_context(|| format!("writing centreline CSV {}", path.display()))?;
     }
     if let Some(path) = &args.png {
-        let title = format!("routing [{}] mm, tension {:.3} N", fmt_list(&y), sim.pose.tension_n());
-        let drawing = BodyDrawing::of_body(&sim, &actuator, "body (outline at ±r)".into(), BLUE_800);
-        draw_bodies(path, &title, &[drawing], &[])?;
+        draw_simulation(path, &report)?;
     }
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
     if args.json {
-        writeln!(out, "{}", SimulationRecord::from(&sim).to_json_line())?;
-        report_png(args);
-        return Ok(());
+        writeln!(out, "{}", report.to_json())?;
+    } else {
+        write!(out, "{report}")?;
     }
-    write!(out, "{}", record::planar_report(&sim))?;
     drop(out);
     report_png(args);
     Ok(())
@@ -180,143 +157,4 @@ fn report_png(args: &SimulateArgs) {
             println!("{line}");
         }
     }
-}
-
-/// An actuator given by its cables (`--cable`, `--actuator`, or a routing
-/// with spatial flags): solved by the backend that serves it
-/// ([`cablemap::solver::Backend::serving`]: the planar fast path for one
-/// in-plane cable with gravity in the plane, else the 3-D solver) and
-/// reported in the actuator's terms (the spatial record).
-fn run_spatial(args: &SimulateArgs) -> anyhow::Result<()> {
-    use cablemap::solver::Hold;
-    // The rod: the spatial file's [rod], else an --actuator-file, else the
-    // thesis's; rod flags override either.
-    let mut spatial = match &args.spatial_actuator {
-        Some(path) => {
-            anyhow::ensure!(
-                args.actuator.actuator_file.is_none(),
-                "give the rod either in --actuator FILE's [rod] table or by --actuator-file, not both"
-            );
-            let mut spatial = Actuator::read(path)?;
-            spatial.rod = args.actuator.apply(&spatial.rod);
-            spatial
-        }
-        None => Actuator::with_cables(args.actuator.resolve()?, Vec::new()),
-    };
-    if !args.cable.is_empty() {
-        spatial.cables = args.cable.iter().map(|c| c.parse::<Cable>()).collect::<Result<_, _>>().context("--cable")?;
-    }
-    if let (Some(routing), Some(actuation)) = (&args.routing, planar_actuation(args)?) {
-        let y = parse_list(routing, "--routing")?;
-        let y: [f64; 5] = y.try_into().map_err(|y: Vec<f64>| anyhow::anyhow!("--routing: a routing needs exactly 5 control points y0..y4 (mm), got {}", y.len()))?;
-        spatial.cables = vec![routing_cable(actuation, y, args.cable_ea_n)];
-    }
-    anyhow::ensure!(
-        !spatial.cables.is_empty(),
-        "no cables: give --cable \"y=.. z=.. tension=T\" (repeatable), --routing/--tension, or [[cable]] tables in --actuator"
-    );
-    if let Some(text) = &args.gravity_direction {
-        let g = parse_list(text, "--gravity-direction")?;
-        let g: [f64; 3] = g.try_into().map_err(|g: Vec<f64>| anyhow::anyhow!("--gravity-direction needs 3 numbers X,Y,Z, got {}", g.len()))?;
-        spatial.gravity_direction = Some(g);
-    }
-    anyhow::ensure!(
-        args.n_d <= MAX_N_D,
-        "--n-d {} is more than {MAX_N_D} intervals (the thesis uses 40; the solver has only 2 × steps-per-span nodes to resample)",
-        args.n_d
-    );
-    let options = args.actuator.solver_options(&SolverOptions::default());
-    let thesis = args.coefficients == CoefficientRoute::Thesis;
-    let given = given_settings(args);
-    // As the planar `--routing` path holds it.
-    let direction = if args.direction == "unload" { LoadDirection::Unload } else { LoadDirection::Load };
-    let hold = Hold { direction, dwell_s: args.dwell_s.unwrap_or(spatial.rod.effects.creep_hold_s) };
-    let order = if thesis { args.order.min(cablemap::solver::resolution::max_order(&options)) } else { args.order };
-    let basis = args.basis.length_basis;
-    let solved = simulate_actuator(&spatial, &options, given, Some(hold), order, basis);
-    if let (Err(e), true) = (&solved, args.json) {
-        if let Some(status) = e.failure_status() {
-            print_failure_json(status, &e.to_string())?;
-        }
-    }
-    let mut sim = solved?;
-    // The thesis route needs a planar centreline: the one check refused it otherwise.
-    if thesis && sim.backend != Backend::SpatialCollocation {
-        let points: Vec<[f64; 2]> = sim.centreline.iter().map(|c| [c.x_mm, c.y_mm]).collect();
-        sim.a_bend_z = cablemap::shape::thesis_coefficients(&points, args.order, args.n_d)
-            .context("thesis coefficient route")?
-            .in_basis(basis, spatial.rod.length_mm)
-            .a;
-        sim.a_bend_y = vec![0.0; sim.a_bend_z.len()];
-        sim.a_twist = vec![0.0; sim.a_bend_z.len()];
-    }
-    if let Some(path) = &args.csv {
-        record::write_actuator_centreline_csv(path, &sim).with_context(|| format!("writing centreline CSV {}", path.display()))?;
-    }
-    if let Some(path) = &args.png {
-        let tensions: Vec<String> = spatial.cables.iter().map(|c| format!("{:.3}", c.tension_n)).collect();
-        let title = format!("{} cable(s), tensions [{}] N", spatial.cables.len(), tensions.join(", "));
-        cablemap::plot::spatial::draw_spatial(path, &title, &sim)?;
-    }
-    let stdout = std::io::stdout();
-    let mut out = stdout.lock();
-    if args.json {
-        writeln!(out, "{}", record::simulation_json(&sim))?;
-    } else {
-        write!(out, "{}", record::report(&sim))?;
-    }
-    drop(out);
-    report_png(args);
-    Ok(())
-}
-
-/// `--routing`'s one cable on routing `y_mm`, driven by `actuation`, with stiffness `cable_ea_n`.
-fn routing_cable(actuation: Actuation, y_mm: [f64; 5], cable_ea_n: Option<f64>) -> Cable {
-    Cable { cable_ea_n, ..Cable::planar(y_mm, 0.0) }.actuated(actuation)
-}
-
-/// An actuation in words, for messages.
-fn describe(actuation: Actuation) -> String {
-    match actuation {
-        Actuation::Tension(t) => format!("{} N", cablemap::io::fmt_num(t)),
-        Actuation::Displacement(d) => format!("a displacement of {} mm", cablemap::io::fmt_num(d)),
-    }
-}
-
-/// `--routing`'s actuation: --tension-n or --displacement-mm (clap refuses
-/// both); `None` when neither is given.
-fn planar_actuation(args: &SimulateArgs) -> anyhow::Result<Option<Actuation>> {
-    match (args.tension_n, args.displacement_mm) {
-        (Some(t), None) => Ok(Some(Actuation::Tension(t))),
-        (None, Some(d)) => Ok(Some(Actuation::Displacement(d))),
-        (None, None) if args.routing.is_some() => {
-            anyhow::bail!("--routing needs its actuation: --tension-n T (N) or --displacement-mm D (mm, the length pulled in at the base)")
-        }
-        _ => Ok(None),
-    }
-}
-
-/// The settings given by flags rather than left at their defaults: the
-/// backend serving the request must read each ([`Backend::check`]).
-fn given_settings(args: &SimulateArgs) -> Given {
-    Given {
-        method: args.actuator.method.is_some(),
-        nodes_per_span: args.actuator.nodes_per_span.is_some(),
-        steps_per_span: args.actuator.steps_per_span.is_some(),
-        hold: args.direction != "load" || args.dwell_s.is_some(),
-        thesis_coefficients: args.coefficients == CoefficientRoute::Thesis,
-    }
-}
-
-/// With `--json`, a failed solve is a record too: its status (the one a
-/// sweep stores for it, e.g. `non_finite`, `unresolved`) and the message,
-/// on stdout; the error itself still goes to stderr with a non-zero exit.
-fn print_failure_json(status: &str, message: &str) -> anyhow::Result<()> {
-    let record = serde_json::json!({ "status": status, "error": message });
-    writeln!(std::io::stdout().lock(), "{record}")?;
-    Ok(())
-}
-
-fn fmt_list(v: &[f64]) -> String {
-    v.iter().map(|x| format!("{x}")).collect::<Vec<_>>().join(", ")
 }

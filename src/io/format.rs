@@ -1,5 +1,6 @@
-//! Numbers and sizes written for people: shortest round-trip numbers,
-//! significant digits, byte counts in binary units.
+//! Numbers, sizes and settings' names written for people: shortest
+//! round-trip numbers, significant digits, byte counts in binary units,
+//! a setting by its key or its flag ([`SettingNames`]).
 
 /// A number for a message: plain for ordinary magnitudes, scientific for
 /// extreme ones (1e308 is not printed as 309 digits).
@@ -70,5 +71,34 @@ mod tests {
         assert_eq!(fmt_bytes(512), "512 B");
         assert_eq!(fmt_bytes(512 << 20), "512.0 MiB");
         assert_eq!(fmt_bytes(u64::MAX), "16384.0 PiB");
+    }
+}
+
+/// How a message names a setting a user gave: by its key (`a0_bounds`,
+/// the fields of a request and Python's keywords) or by its flag
+/// (`--a0-bounds`, the command line's).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SettingNames {
+    /// Keys, as the fields and Python's keywords are named.
+    Keys,
+    /// The command line's flags.
+    Flags,
+}
+
+impl SettingNames {
+    /// The name of the setting with key `key`, whose flag is the key's words joined by `-`.
+    pub fn name(self, key: &'static str) -> String {
+        match self {
+            SettingNames::Keys => key.to_string(),
+            SettingNames::Flags => format!("--{}", key.replace('_', "-")),
+        }
+    }
+
+    /// `key` or `flag`: the name of a setting whose flag is not its key's words.
+    pub fn either(self, key: &'static str, flag: &'static str) -> &'static str {
+        match self {
+            SettingNames::Keys => key,
+            SettingNames::Flags => flag,
+        }
     }
 }

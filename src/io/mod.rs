@@ -5,7 +5,7 @@
 //! - [`run_dir`]: what marks a sweep run directory, and the refusal to
 //!   write inside one;
 //! - [`read`]: reading UTF-8 text with a typed error naming the path;
-//! - [`format`]: numbers and byte counts for people;
+//! - [`format`]: numbers, byte counts and settings' names for people;
 //! - [`memory`]: the memory still available;
 //! - [`sha256`]: file digests.
 
@@ -20,7 +20,7 @@ pub use atomic::{
     check_regular_or_new, create_locked, exchange, is_abandoned, is_stale, is_temp_of, sync_dir, temp_path, unique_token, write_atomic,
     write_atomic_in_run, write_dir_replacing, DirStep, STALE_TEMP_S,
 };
-pub use format::{fmt_bytes, fmt_num, fmt_sig};
+pub use format::{fmt_bytes, fmt_num, fmt_sig, SettingNames};
 pub use memory::available_memory_bytes;
 pub use read::{read_text, read_utf8, subdirs_holding, FileError, SharedIoError};
 pub use run_dir::{check_outside_run_dir, enclosing_run_dir, is_run_dir, run_markers, InsideRunDir};

@@ -40,6 +40,12 @@ impl Actuator {
         Self { rod, gj_n_mm2: None, gravity_direction: None, cables }
     }
 
+    /// Whether this is a rod alone: no cables, torsion or gravity
+    /// direction, so a routing on it is one planar cable.
+    pub fn is_rod_alone(&self) -> bool {
+        self.cables.is_empty() && self.gj_n_mm2.is_none() && self.gravity_direction.is_none()
+    }
+
     /// GJ in use, N·mm².
     pub fn torsional_rigidity_n_mm2(&self) -> f64 {
         self.gj_n_mm2.unwrap_or(self.rod.ei_n_mm2 / EI_OVER_GJ)

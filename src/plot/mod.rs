@@ -15,6 +15,7 @@ pub mod modes;
 pub mod mould;
 mod reach;
 mod series;
+mod simulation;
 pub mod spatial;
 
 pub use body::{body_series, draw_bodies, BodyDrawing};
@@ -35,6 +36,7 @@ pub use mould::draw_mould;
 
 /// Reach maps, as the cable map draws them.
 pub use reach::{draw_reach_maps, ReachPlane};
+pub use simulation::draw_simulation;
 
 /// One picture with the explanation the index page shows.
 #[derive(Debug, Clone)]

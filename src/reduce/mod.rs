@@ -60,7 +60,7 @@ pub use map_data::{
     ReachMapSummary, CellStats, CoefficientStats, Design, MapBody, MapData, MapSummary, ModeStats, CELL_STATS_ORDER, COEFFICIENT_UNIT,
     MAX_CELLS_PER_AXIS, MODES,
 };
-pub use options::{MapSettings, MapSettingsError, MapSettingsFields, ModeBoundaries, ReduceOptions, SettingNames, DEFAULT_CELL_MM, DEFAULT_MEMORY_SAMPLES};
+pub use options::{MapSettings, MapSettingsError, MapSettingsFields, ModeBoundaries, ReduceOptions, DEFAULT_CELL_MM, DEFAULT_MEMORY_SAMPLES};
 pub use output::{check_map_out, write_map, write_map_replacing};
 pub use pipeline::{map_given_as_run, reduce_batches, reduce_cable_run, reduce_run, run_open_error, ReachMap};
 pub use source::RunInfo;

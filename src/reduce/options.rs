@@ -2,6 +2,7 @@
 //! and the memory bound.
 
 use super::ReduceError;
+use crate::io::SettingNames;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -111,26 +112,6 @@ pub struct MapSettingsFields {
     pub designs_per_cell: usize,
     /// Samples held in memory at once; `None`: [`DEFAULT_MEMORY_SAMPLES`].
     pub memory_samples: Option<usize>,
-}
-
-/// How a message names a setting of [`MapSettingsFields`]: by its key
-/// (`a0_bounds`, Python's keywords) or by its flag (`--a0-bounds`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum SettingNames {
-    /// Keys, as the fields and Python's keywords are named.
-    Keys,
-    /// The command line's flags.
-    Flags,
-}
-
-impl SettingNames {
-    /// The name of the setting with key `key`.
-    fn name(self, key: &'static str) -> String {
-        match self {
-            SettingNames::Keys => key.to_string(),
-            SettingNames::Flags => format!("--{}", key.replace('_', "-")),
-        }
-    }
 }
 
 /// Why [`MapSettingsFields`] make no map settings.

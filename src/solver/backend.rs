@@ -22,7 +22,7 @@
 
 use crate::model::effects::{EffectInfo, GRAVITY_DIRECTION, GRAVITY_SCALE, REGISTRY};
 use crate::model::{Actuator, Cable, Rod};
-use crate::solver::{SolverMethod, SolverOptions};
+use crate::solver::{Given, SolverMethod, SolverOptions};
 
 /// A way to solve an actuator's statics.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize)]
@@ -55,23 +55,6 @@ impl std::fmt::Display for Backend {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(self.name())
     }
-}
-
-/// Settings of a request given explicitly (by a flag or a spec key) rather
-/// than left at their defaults: a backend that does not read one refuses
-/// it instead of ignoring it silently. Defaults every backend may ignore.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct Given {
-    /// The method (`--method`).
-    pub method: bool,
-    /// Collocation intervals per span (`--nodes-per-span`).
-    pub nodes_per_span: bool,
-    /// RK4 steps per span (`--steps-per-span`).
-    pub steps_per_span: bool,
-    /// A load direction or dwell of the final tension (`--direction`, `--dwell-s`).
-    pub hold: bool,
-    /// The thesis's coefficient route from a planar centreline (`--coefficients thesis`).
-    pub thesis_coefficients: bool,
 }
 
 /// One thing a request needs of its backend.

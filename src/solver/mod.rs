@@ -62,6 +62,7 @@ mod error;
 pub mod interface;
 pub mod ladder;
 pub mod record;
+pub mod request;
 pub mod resolution;
 pub mod spatial;
 pub(crate) mod collocation;
@@ -76,7 +77,7 @@ pub mod options;
 pub mod planar;
 mod simulator;
 
-pub use backend::{Backend, Given, Support, Unsupported};
+pub use backend::{Backend, Support, Unsupported};
 pub use error::SimulateError;
 pub use interface::{until_resolved, Solver};
 pub use result::{CableAtNode, CentrelinePoint, PerCable, Simulation, TipFrame, TipPose};
@@ -84,7 +85,7 @@ pub use simulate::{
     check_ladder_tension, planar_problem, simulate, simulate_actuator, simulate_held, simulate_spatial, MAX_AUTO_SPATIAL_STEPS_PER_SPAN,
     MAX_AUTO_STEPS_PER_SPAN, MAX_LADDER_TENSION_N,
 };
-pub use options::{SolverMethod, SolverOptions, SolverSettings};
+pub use options::{Given, SolverMethod, SolverOptions, SolverSettings};
 pub use planar::{Integrator, PlanarSolver};
 pub use simulator::{PlanarCollocation, PlanarRk4, Simulator};
 use creep::Creep;

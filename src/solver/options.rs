@@ -1,10 +1,10 @@
-//! The numerical settings of every backend ([`SolverOptions`]), and the
-//! two `[solver]` tables a sweep spec writes them as: a planar sweep's
+//! The numerical settings of every backend ([`SolverOptions`]), the
+//! settings a user gives ([`SolverSettings`]) and which a request gave
+//! ([`Given`]), and the two `[solver]` tables a sweep spec writes them as: a planar sweep's
 //! ([`planar_table`]) and a cable sweep's ([`spatial_table`]), each with the
 //! keys and defaults of the backends it runs, so that the specs' files and
 //! the hashes over them read as they always have.
 
-use super::Given;
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 /// How the centreline is integrated along each knot span of the routing.
@@ -77,6 +77,23 @@ impl Default for SolverOptions {
             spatial_max_passes: 40,
         }
     }
+}
+
+/// Settings of a request given explicitly (by a flag or a spec key) rather
+/// than left at their defaults: a backend that does not read one refuses
+/// it instead of ignoring it silently. Defaults every backend may ignore.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Given {
+    /// The method (`--method`).
+    pub method: bool,
+    /// Collocation intervals per span (`--nodes-per-span`).
+    pub nodes_per_span: bool,
+    /// RK4 steps per span (`--steps-per-span`).
+    pub steps_per_span: bool,
+    /// A load direction or dwell of the final tension (`--direction`, `--dwell-s`).
+    pub hold: bool,
+    /// The thesis's coefficient route from a planar centreline (`--coefficients thesis`).
+    pub thesis_coefficients: bool,
 }
 
 /// The solver settings as a user gives them (`--method`,
