@@ -145,8 +145,7 @@ fn bench_ladder(
     by_displacement: bool,
     label: &str,
 ) -> Result<BenchFigures, crate::Error> {
-    use crate::solver::Solver;
-    let mut sim = Simulator::new(actuator, options)?;
+    let mut sim = Simulator::for_rod(actuator, options)?;
     let mut per_solve = Vec::with_capacity(routings.len());
     let mut a = [0.0; 4];
     let (mut passes, mut solves, mut failures) = (0u64, 0u64, 0usize);
@@ -156,7 +155,7 @@ fn bench_ladder(
         sim.set_routing(&routing);
         let mut tension = [0.0];
         for &v in ladder {
-            let solved = if by_displacement { Solver::solve(&mut sim, &[crate::model::Actuation::Displacement(v)], &mut tension) } else { sim.solve(v) };
+            let solved = if by_displacement { sim.solve_actuation(crate::model::Actuation::Displacement(v), &mut tension) } else { sim.solve(v) };
             match solved {
                 Ok(pose) => {
                     sim.coefficients_into(crate::shape::LengthBasis::default(), &mut a);
@@ -213,8 +212,8 @@ pub fn sample_spatial_pairs(count: usize, radius_mm: f64) -> Vec<[crate::solver:
         .collect()
 }
 
-/// Times a 3-D solver (`options.method`: the collocation, or the RK4
-/// reference) on two-cable spatial actuators: per actuator, a ladder of
+/// Times the 3-D backend serving two cables (`options.method`: the
+/// collocation, or the RK4 reference) on two-cable spatial actuators: per actuator, a ladder of
 /// `tensions` steps with τ_1 = t and τ_2 = t/2, t from 1.0 to 2.0 N
 /// (continuation, as a sweep would step it), coefficients a_0 … a_3 of all
 /// three series included. `gravity` is the direction (None: off).
@@ -226,8 +225,8 @@ pub fn bench_spatial(
     gravity: Option<[f64; 3]>,
     label: &str,
 ) -> Result<BenchFigures, crate::Error> {
-    use crate::solver::spatial::{Actuator, SpatialRk4, SpatialCollocation};
-    use crate::solver::SolverMethod;
+    use crate::solver::spatial::Actuator;
+    use crate::solver::Solver;
     let mut rod = rod.clone();
     rod.gravity.enabled = gravity.is_some();
     let mut per_solve = Vec::with_capacity(pairs.len());
@@ -242,33 +241,15 @@ pub fn bench_spatial(
             let t = 1.0 + k as f64 / (tensions.max(2) - 1) as f64;
             [t, 0.5 * t]
         };
-        match options.method {
-            SolverMethod::Collocation => {
-                let mut solver = SpatialCollocation::new(&actuator, options)?;
-                for k in 0..tensions {
-                    match solver.solve(&ladder(k)).and_then(|pose| Ok((pose, solver.coefficients(3, basis)?))) {
-                        Ok((pose, a)) => {
-                            sink += a[2][0];
-                            passes += u64::from(pose.iterations);
-                            solves += 1;
-                        }
-                        Err(_) => failures += 1,
-                    }
+        let mut solver = Simulator::serving(&actuator, options, crate::solver::Given::default())?;
+        for k in 0..tensions {
+            match solver.solve_tensions(&ladder(k)).and_then(|pose| Ok((pose, solver.coefficients(3, basis)?))) {
+                Ok((pose, a)) => {
+                    sink += a[2][0];
+                    passes += u64::from(pose.iterations);
+                    solves += 1;
                 }
-            }
-            SolverMethod::Rk4 => {
-                let mut solver = SpatialRk4::new(&actuator, options)?;
-                for k in 0..tensions {
-                    match solver.solve(&ladder(k)) {
-                        Ok(pose) => {
-                            let a = solver.coefficients(3, basis)?;
-                            sink += a[2][0];
-                            passes += u64::from(pose.iterations);
-                            solves += 1;
-                        }
-                        Err(_) => failures += 1,
-                    }
-                }
+                Err(_) => failures += 1,
             }
         }
         per_solve.push(start.elapsed().as_secs_f64() * 1e6 / tensions as f64);

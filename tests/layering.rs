@@ -575,6 +575,34 @@ fn a_run_kind_picks_its_code_in_one_place() {
     assert_eq!(matched, ["map.rs"], "a run directory's kind picks its code in map::reduce only");
 }
 
+/// Files outside `src/solver/` that still build a backend by name, each
+/// with the reason; shrink only. The captures' chains read body points at
+/// the markers' s and hold each static capture from a virgin rod, which only
+/// the spatial collocation offers.
+const NAMING_A_BACKEND: &[&str] = &["calibrate/observations/captures/simulate.rs"];
+
+#[test]
+fn one_place_picks_the_backend() {
+    // Owner: src/solver/simulator.rs (Simulator::serving, Simulator::for_rod
+    // over Backend::serving's capability table). A workflow that builds a
+    // backend by name decides what the picker decides, and the two drift apart.
+    let named = ["SpatialCollocation::new", "SpatialRk4::new", "PlanarSolver::new", "PlanarCollocation::new", "PlanarRk4::new", "Backend::planar(", "Backend::spatial("];
+    let mut problems = Vec::new();
+    for (file, code) in all_sources() {
+        if file.starts_with("solver/") {
+            continue;
+        }
+        let code = squeezed(&code);
+        let names = named.iter().any(|n| code.contains(&squeezed(n)));
+        match (names, NAMING_A_BACKEND.contains(&file.as_str())) {
+            (true, false) => problems.push(format!("src/{file} builds a backend by name: ask crate::solver::Simulator (serving, for_rod) or Backend::serving")),
+            (false, true) => problems.push(format!("src/{file} no longer names a backend: remove it from NAMING_A_BACKEND")),
+            _ => {}
+        }
+    }
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+}
+
 #[test]
 fn every_backend_returns_the_one_result_type() {
     // Owner: src/solver/result.rs (TipPose, CentrelinePoint,

@@ -264,7 +264,7 @@ fn solve_batch<'py>(
         let rod = actuator.rod;
         Backend::check_planar(&rod, &options, Given::default()).map_err(|e| bad(e.to_string()))?;
         // Checks the rod once, before the threads start.
-        Simulator::new(&rod, &options).map_err(|e| bad(e.to_string()))?;
+        Simulator::for_rod(&rod, &options).map_err(|e| bad(e.to_string()))?;
         Ok((rod, options, basis))
     };
     let (rod, options, basis) = prepare().map_err(|e| e.into_py(py))?;
@@ -278,7 +278,7 @@ fn solve_batch<'py>(
             .par_chunks(5)
             .enumerate()
             .map_init(
-                || Simulator::new(&rod, &options).expect("checked before the threads"),
+                || Simulator::for_rod(&rod, &options).expect("checked before the threads"),
                 |sim, (i, y)| {
                     let mut fields = vec![[f64::NAN; BATCH_FIELDS.len()]; m];
                     let mut a = vec![f64::NAN; m * k];

@@ -47,7 +47,7 @@ pub fn predict_group(
     let first_row = data.rows[group.rows[0]].row;
     let routing = Routing::for_actuator(group.routing_mm, &a)
         .map_err(|source| CalibrateError::Routing { routing: group.routing.clone(), row: first_row, source })?;
-    let mut sim = Simulator::new(&a, options)?;
+    let mut sim = Simulator::for_rod(&a, options)?;
     sim.set_routing(&routing);
     let mut out = Vec::with_capacity(group.rows.len());
     for &i in &group.rows {

@@ -104,7 +104,7 @@ impl Objective {
         rod.validate()?;
         // The solver settings and the target's coefficient order, before any
         // search: every a_k compared must be resolved by the steps.
-        Simulator::new(&rod, &options)?;
+        Simulator::for_rod(&rod, &options)?;
         crate::solver::resolution::check_order(target.order(), &options).map_err(|source| DesignError::Resolution { source })?;
         weights.check_against(&target)?;
         bounds.validate(rod.channel_radius_mm())?;
@@ -119,7 +119,7 @@ impl Objective {
 
     /// A fresh simulator for this objective's actuator (one per thread).
     pub fn simulator(&self) -> Simulator {
-        Simulator::new(&self.rod, &self.options).expect("actuator validated in Objective::new")
+        Simulator::for_rod(&self.rod, &self.options).expect("actuator validated in Objective::new")
     }
 
     /// Number of residuals (one per target component).

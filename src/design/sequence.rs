@@ -21,9 +21,9 @@
 
 use super::actuator::{ActuationBounds, CableFreedom, DesignActuator};
 use super::targets::{Quantity, ShapeTarget};
-use crate::solver::spatial::{SpatialError, SpatialCollocation};
+use crate::solver::spatial::SpatialError;
 use crate::model::Actuator;
-use crate::solver::{simulate_actuator, Given, Simulation, SolverOptions, TipPose};
+use crate::solver::{simulate_actuator, Backend, Given, Simulation, Simulator, Solver, SolverOptions, TipPose};
 use crate::numerics::lm;
 use crate::shape::LengthBasis;
 use rayon::prelude::*;
@@ -278,18 +278,18 @@ impl Setup {
 
     /// What the search solves: for a tension-driven actuator the 3-D
     /// collocation serves, one cold solve at the full tensions (about 4×
-    /// cheaper than the ladder, the same pose to the solver's tolerance);
-    /// where that fails, and for every other actuator, [`Setup::simulate`].
-    /// The design's reported values are [`Setup::simulate`]'s.
+    /// cheaper than the ladder, the same pose to the solver's tolerance; the
+    /// planar backends' ladders are cheap already); where that fails, and
+    /// for every other actuator, [`Setup::simulate`]. The design's reported
+    /// values are [`Setup::simulate`]'s.
     pub fn quick(&self, actuator: &Actuator) -> Result<Achieved, SpatialError> {
-        let spatial = !crate::solver::backend::is_planar(actuator)
-            && !actuator.cables.iter().any(|c| c.is_displacement_driven())
-            && self.options.method == crate::solver::SolverMethod::Collocation;
-        if spatial {
+        let tension_driven = !actuator.cables.iter().any(|c| c.is_displacement_driven());
+        let cold = tension_driven.then(|| Backend::serving(actuator, &self.options, Given::default()));
+        if let Some(Ok(backend @ Backend::SpatialCollocation)) = cold {
             let options = SolverOptions { nodes_per_span: self.options.nodes_per_span, ..SolverOptions::default() };
-            if let Ok(mut solver) = SpatialCollocation::new(actuator, &options) {
+            if let Ok(mut solver) = Simulator::build(backend, actuator, &options) {
                 let tensions: Vec<f64> = actuator.cables.iter().map(|c| c.tension_n).collect();
-                if let Ok(pose) = solver.solve(&tensions) {
+                if let Ok(pose) = solver.solve_tensions(&tensions) {
                     if let Ok([a_twist, a_bend_y, a_bend_z]) = solver.coefficients(self.order(), self.basis) {
                         if a_twist.iter().chain(&a_bend_y).chain(&a_bend_z).all(|v| v.is_finite()) {
                             return Ok(Achieved { pose, a_bend_z, a_bend_y, a_twist });

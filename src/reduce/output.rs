@@ -250,7 +250,7 @@ mod tests {
     /// A small real run: 3 levels per control point, 4 tensions, as one batch.
     fn small_run() -> RecordBatch {
         let actuator = Rod::default();
-        let mut sim = Simulator::new(&actuator, &SolverOptions::default()).unwrap();
+        let mut sim = Simulator::for_rod(&actuator, &SolverOptions::default()).unwrap();
         let (mut ids, mut status, mut ys, mut t, mut out) = (vec![], vec![], vec![[0.0; 5]; 0], vec![], vec![]);
         for id in 0..243i64 {
             let mut k = id;

@@ -134,7 +134,7 @@ mod tests {
     fn coefficients(options: &SolverOptions, order: usize) -> Option<Vec<f64>> {
         let actuator = Rod::default();
         let routing = Routing::new(&[-4.0, 4.0, -4.0, 4.0, -4.0], actuator.length_mm, actuator.radius_mm).unwrap();
-        let mut sim = Simulator::new(&actuator, options).unwrap();
+        let mut sim = Simulator::for_rod(&actuator, options).unwrap();
         sim.set_routing(&routing);
         for t in [0.5, 1.0, 1.5, 2.0] {
             match sim.solve(t) {

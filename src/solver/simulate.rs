@@ -63,10 +63,10 @@ fn simulate_planar_cable(
     until_resolved(
         options,
         |options| {
-            let mut sim = Simulator::new(rod, options)?;
+            let mut sim = Simulator::for_rod(rod, options)?;
             sim.set_routing(routing);
             sim.set_cable_stiffness(cable.cable_ea_n);
-            Ok(sim.simulate(&actuator, Some(hold), order, basis)?)
+            Ok(sim.simulate_in_plane(&actuator, hold, order, basis)?)
         },
         |e| matches!(e, SimulateError::Solve(SolveFailure::Unresolved(_))),
         refined,

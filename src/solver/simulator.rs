@@ -1,14 +1,20 @@
-//! The planar backends by name — [`PlanarCollocation`] (the default) and
-//! [`PlanarRk4`] (the reference) — and [`Simulator`], the one of them
-//! `options.method` asks for, for callers that pick it at run time.
+//! The backends by name — [`PlanarCollocation`] (the default planar one)
+//! and [`PlanarRk4`] (its reference), the spatial ones in `spatial` — and
+//! [`Simulator`], the one place a backend is picked and built: the backend
+//! serving an actuator ([`Simulator::serving`], by [`Backend::serving`]'s
+//! capability table), or, for callers that set a rod's one in-plane cable's
+//! routing solve by solve, the backend serving that rod
+//! ([`Simulator::for_rod`]). Each call goes to the backend held, by a
+//! `match` (static dispatch, no trait object).
 
 use super::collocation::Colloc;
 use super::error::SimulateError;
 use super::planar::{Integrator, PlanarSolver};
 use super::rk4::ShootingRk4;
-use super::{Backend, CentrelinePoint, Hold, SolveFailure, Solver, SolverMethod, SolverOptions, TipPose};
+use super::spatial::{SpatialCollocation, SpatialError, SpatialRk4};
+use super::{planar_problem, Backend, CentrelinePoint, Given, Hold, SolveFailure, Solver, SolverMethod, SolverOptions, TipPose};
 use crate::model::parameter::ParameterError;
-use crate::model::{Rod, Routing};
+use crate::model::{Actuation, Actuator, Rod, Routing};
 use crate::shape::LengthBasis;
 
 /// The planar spectral collocation (the default planar backend).
@@ -17,33 +23,83 @@ pub type PlanarCollocation = PlanarSolver<Colloc>;
 /// plain scheme the collocation is checked against.
 pub type PlanarRk4 = PlanarSolver<ShootingRk4>;
 
-/// The planar backend `options.method` asks for, for callers that pick
-/// it at run time: each call goes to that backend's own (statically
-/// dispatched) solver.
+/// The backend picked for an actuator, ready to solve it repeatedly.
 #[derive(Debug, Clone)]
 pub enum Simulator {
     /// [`PlanarCollocation`].
-    Collocation(PlanarCollocation),
+    PlanarCollocation(PlanarCollocation),
     /// [`PlanarRk4`].
-    Rk4(PlanarRk4),
+    PlanarRk4(PlanarRk4),
+    /// [`SpatialCollocation`].
+    SpatialCollocation(SpatialCollocation),
+    /// [`SpatialRk4`].
+    SpatialRk4(SpatialRk4),
 }
 
 /// `$body` with `$s` bound to the backend a [`Simulator`] holds.
 macro_rules! each {
     ($sim:expr, $s:ident => $body:expr) => {
         match $sim {
-            Simulator::Collocation($s) => $body,
-            Simulator::Rk4($s) => $body,
+            Simulator::PlanarCollocation($s) => $body,
+            Simulator::PlanarRk4($s) => $body,
+            Simulator::SpatialCollocation($s) => $body,
+            Simulator::SpatialRk4($s) => $body,
+        }
+    };
+}
+
+/// `$body` with `$s` bound to the planar backend a [`Simulator`] holds: the
+/// operations on a rod's one in-plane cable (its routing, its tension).
+/// Only [`Simulator::for_rod`] is asked for them; a spatial backend there is
+/// a caller's mistake.
+macro_rules! planar {
+    ($sim:expr, $s:ident => $body:expr) => {
+        match $sim {
+            Simulator::PlanarCollocation($s) => $body,
+            Simulator::PlanarRk4($s) => $body,
+            Simulator::SpatialCollocation(_) | Simulator::SpatialRk4(_) => {
+                panic!("a rod's one in-plane cable is solved by the backend Simulator::for_rod picks, not a spatial one")
+            }
         }
     };
 }
 
 impl Simulator {
-    /// The planar backend of `options.method` for `rod`; fails on invalid parameters.
-    pub fn new(rod: &Rod, options: &SolverOptions) -> Result<Self, SimulateError> {
+    /// The backend serving `actuator` ([`Backend::serving`]: the planar one
+    /// of `options.method` for one in-plane cable with gravity in its plane,
+    /// else the spatial one), built for it; refused if that backend does not
+    /// model the actuator or a setting `given` explicitly.
+    pub fn serving(actuator: &Actuator, options: &SolverOptions, given: Given) -> Result<Self, SpatialError> {
+        actuator.channels()?;
+        let backend = Backend::serving(actuator, options, given)?;
+        Self::build(backend, actuator, options)
+    }
+
+    /// `backend` (the one [`Backend::serving`] picked) built for `actuator`.
+    pub fn build(backend: Backend, actuator: &Actuator, options: &SolverOptions) -> Result<Self, SpatialError> {
+        let options = SolverOptions { method: backend.support().method, ..options.clone() };
+        Ok(match backend {
+            Backend::PlanarCollocation | Backend::PlanarRk4 => {
+                let (rod, routing) = planar_problem(actuator)?;
+                let mut sim = Self::for_rod(&rod, &options)?;
+                sim.set_routing(&routing);
+                sim.set_cable_stiffness(actuator.cables[0].cable_ea_n);
+                sim
+            }
+            Backend::SpatialCollocation => Simulator::SpatialCollocation(SpatialCollocation::new(actuator, &options)?),
+            Backend::SpatialRk4 => Simulator::SpatialRk4(SpatialRk4::new(actuator, &options)?),
+        })
+    }
+
+    /// The backend serving `rod` with its one in-plane cable (the planar one
+    /// of `options.method`), for callers that hold the rod and set the
+    /// cable's routing solve by solve ([`Simulator::set_routing`]): the
+    /// planar routing sweep, the routing design, the planar measurements'
+    /// predictions. Fails on invalid parameters or a rod it does not model.
+    pub fn for_rod(rod: &Rod, options: &SolverOptions) -> Result<Self, SimulateError> {
         Ok(match options.method {
-            SolverMethod::Collocation => Simulator::Collocation(PlanarSolver::new(rod, options)?),
-            SolverMethod::Rk4 => Simulator::Rk4(PlanarSolver::new(rod, options)?),
+            SolverMethod::Collocation => Simulator::PlanarCollocation(PlanarSolver::new(rod, options)?),
+            SolverMethod::Rk4 => Simulator::PlanarRk4(PlanarSolver::new(rod, options)?),
         })
     }
 
@@ -52,74 +108,93 @@ impl Simulator {
         each!(self, s => s.rod())
     }
 
-    /// [`PlanarSolver::set_routing_mm`].
-    pub fn set_routing_mm(&mut self, y_mm: &[f64]) -> Result<(), crate::model::routing::RoutingError> {
-        each!(self, s => s.set_routing_mm(y_mm))
-    }
-
-    /// [`PlanarSolver::set_routing`].
-    pub fn set_routing(&mut self, routing: &Routing) {
-        each!(self, s => s.set_routing(routing))
-    }
-
-    /// [`PlanarSolver::set_cable_stiffness`].
-    pub fn set_cable_stiffness(&mut self, cable_ea_n: Option<f64>) {
-        each!(self, s => s.set_cable_stiffness(cable_ea_n))
-    }
-
-    /// [`PlanarSolver::reset_warm_start`].
-    pub fn reset_warm_start(&mut self) {
-        each!(self, s => s.reset_warm_start())
-    }
-
-    /// [`PlanarSolver::reset_history`].
-    pub fn reset_history(&mut self) {
-        each!(self, s => s.reset_history())
-    }
-
-    /// [`PlanarSolver::set_hold`].
-    pub fn set_hold(&mut self, hold: Hold) -> Result<(), ParameterError> {
-        each!(self, s => s.set_hold(hold))
-    }
-
-    /// [`PlanarSolver::solve`].
-    pub fn solve(&mut self, tension_n: f64) -> Result<TipPose, SolveFailure> {
-        each!(self, s => s.solve(tension_n))
-    }
-
-    /// [`PlanarSolver::resolution`].
-    pub fn resolution(&self) -> usize {
-        each!(self, s => s.resolution())
-    }
-
-    /// [`PlanarSolver::coefficients_into`].
-    pub fn coefficients_into(&mut self, basis: LengthBasis, out: &mut [f64]) {
-        each!(self, s => s.coefficients_into(basis, out))
-    }
-
-    /// [`PlanarSolver::coefficient_error_per_mm`].
-    pub fn coefficient_error_per_mm(&self) -> (f64, usize) {
-        each!(self, s => s.coefficient_error_per_mm())
-    }
-
-    /// [`PlanarSolver::coefficients_checked`].
-    pub fn coefficients_checked(&mut self, basis: LengthBasis, out: &mut [f64]) -> Result<(), SolveFailure> {
-        each!(self, s => s.coefficients_checked(basis, out))
-    }
-
-    /// [`PlanarSolver::centreline`].
+    /// The centreline of the last successful solve, clamp to tip.
     pub fn centreline(&self) -> Vec<CentrelinePoint> {
-        each!(self, s => s.centreline())
+        each!(self, s => Solver::centreline(s))
+    }
+
+    /// [`PlanarSolver::set_routing_mm`] (a rod's one in-plane cable).
+    pub fn set_routing_mm(&mut self, y_mm: &[f64]) -> Result<(), crate::model::routing::RoutingError> {
+        planar!(self, s => s.set_routing_mm(y_mm))
+    }
+
+    /// [`PlanarSolver::set_routing`] (a rod's one in-plane cable).
+    pub fn set_routing(&mut self, routing: &Routing) {
+        planar!(self, s => s.set_routing(routing))
+    }
+
+    /// [`PlanarSolver::set_cable_stiffness`] (a rod's one in-plane cable).
+    pub fn set_cable_stiffness(&mut self, cable_ea_n: Option<f64>) {
+        planar!(self, s => s.set_cable_stiffness(cable_ea_n))
+    }
+
+    /// [`PlanarSolver::reset_warm_start`] (a rod's one in-plane cable).
+    pub fn reset_warm_start(&mut self) {
+        planar!(self, s => s.reset_warm_start())
+    }
+
+    /// [`PlanarSolver::reset_history`] (a rod's one in-plane cable).
+    pub fn reset_history(&mut self) {
+        planar!(self, s => s.reset_history())
+    }
+
+    /// [`PlanarSolver::set_hold`] (a rod's one in-plane cable).
+    pub fn set_hold(&mut self, hold: Hold) -> Result<(), ParameterError> {
+        planar!(self, s => s.set_hold(hold))
+    }
+
+    /// [`PlanarSolver::solve`]: the one in-plane cable at `tension_n`.
+    pub fn solve(&mut self, tension_n: f64) -> Result<TipPose, SolveFailure> {
+        planar!(self, s => s.solve(tension_n))
+    }
+
+    /// [`Solver::solve`] of the one in-plane cable's `actuation`, its
+    /// tension found from (and left in) `tension_n`.
+    pub fn solve_actuation(&mut self, actuation: Actuation, tension_n: &mut [f64; 1]) -> Result<TipPose, SolveFailure> {
+        planar!(self, s => Solver::solve(s, &[actuation], &mut tension_n[..]))
+    }
+
+    /// [`Solver::simulate`] of the one in-plane cable of `actuator` (its
+    /// routing set), the final tension held by `hold`.
+    pub fn simulate_in_plane(&mut self, actuator: &Actuator, hold: Hold, order: usize, basis: LengthBasis) -> Result<super::Simulation, SolveFailure> {
+        planar!(self, s => s.simulate(actuator, Some(hold), order, basis))
+    }
+
+    /// [`PlanarSolver::resolution`] (a rod's one in-plane cable).
+    pub fn resolution(&self) -> usize {
+        planar!(self, s => s.resolution())
+    }
+
+    /// [`PlanarSolver::coefficients_into`] (a rod's one in-plane cable).
+    pub fn coefficients_into(&mut self, basis: LengthBasis, out: &mut [f64]) {
+        planar!(self, s => s.coefficients_into(basis, out))
+    }
+
+    /// [`PlanarSolver::coefficient_error_per_mm`] (a rod's one in-plane cable).
+    pub fn coefficient_error_per_mm(&self) -> (f64, usize) {
+        planar!(self, s => s.coefficient_error_per_mm())
+    }
+
+    /// [`PlanarSolver::coefficients_checked`] (a rod's one in-plane cable).
+    pub fn coefficients_checked(&mut self, basis: LengthBasis, out: &mut [f64]) -> Result<(), SolveFailure> {
+        planar!(self, s => s.coefficients_checked(basis, out))
     }
 }
 
+/// Every backend's solves, each call statically dispatched to the one held;
+/// a planar backend's failure is the one [`SolveFailure`], as a spatial one's.
 impl Solver for Simulator {
-    type Error = SolveFailure;
+    type Error = SpatialError;
     fn backend(&self) -> Backend {
         each!(self, s => s.backend())
     }
-    fn solve_tensions(&mut self, tensions_n: &[f64]) -> Result<TipPose, SolveFailure> {
-        each!(self, s => s.solve_tensions(tensions_n))
+    fn solve_tensions(&mut self, tensions_n: &[f64]) -> Result<TipPose, SpatialError> {
+        match self {
+            Simulator::PlanarCollocation(s) => Ok(s.solve_tensions(tensions_n)?),
+            Simulator::PlanarRk4(s) => Ok(s.solve_tensions(tensions_n)?),
+            Simulator::SpatialCollocation(s) => s.solve_tensions(tensions_n),
+            Simulator::SpatialRk4(s) => s.solve_tensions(tensions_n),
+        }
     }
     fn hold_next(&mut self, hold: Hold) {
         each!(self, s => s.hold_next(hold))
@@ -127,8 +202,13 @@ impl Solver for Simulator {
     fn centreline(&self) -> Vec<CentrelinePoint> {
         each!(self, s => Solver::centreline(s))
     }
-    fn coefficients(&mut self, order: usize, basis: LengthBasis) -> Result<[Vec<f64>; 3], SolveFailure> {
-        each!(self, s => Solver::coefficients(s, order, basis))
+    fn coefficients(&mut self, order: usize, basis: LengthBasis) -> Result<[Vec<f64>; 3], SpatialError> {
+        match self {
+            Simulator::PlanarCollocation(s) => Ok(Solver::coefficients(s, order, basis)?),
+            Simulator::PlanarRk4(s) => Ok(Solver::coefficients(s, order, basis)?),
+            Simulator::SpatialCollocation(s) => Solver::coefficients(s, order, basis),
+            Simulator::SpatialRk4(s) => Solver::coefficients(s, order, basis),
+        }
     }
 }
 

@@ -27,7 +27,7 @@ mod tests {
         let mut a = Rod::default();
         a.gravity.enabled = false;
         effects(&mut a);
-        let mut sim = Simulator::new(&a, &SolverOptions::default()).unwrap();
+        let mut sim = Simulator::for_rod(&a, &SolverOptions::default()).unwrap();
         sim.set_routing_mm(&[d_mm; 5]).unwrap();
         sim
     }
@@ -64,7 +64,7 @@ mod tests {
         for (name, setup) in cases {
             let mut a = Rod::default();
             setup(&mut a);
-            let mut sims = [Simulator::new(&a, &SolverOptions::default()).unwrap(), Simulator::new(&a, &rk4).unwrap()];
+            let mut sims = [Simulator::for_rod(&a, &SolverOptions::default()).unwrap(), Simulator::for_rod(&a, &rk4).unwrap()];
             for route in [[1.0, -2.0, 4.0, 4.0, -4.0], [-3.0, 1.0, -1.0, 0.0, -2.0]] {
                 let mut poses = [Vec::new(), Vec::new()];
                 for (sim, out) in sims.iter_mut().zip(&mut poses) {
@@ -138,7 +138,7 @@ mod tests {
     fn friction_makes_a_hysteresis_loop_on_a_curved_routing_with_gravity() {
         let mut a = Rod::default();
         a.effects.friction_mu = 0.2;
-        let mut sim = Simulator::new(&a, &SolverOptions::default()).unwrap();
+        let mut sim = Simulator::for_rod(&a, &SolverOptions::default()).unwrap();
         sim.set_routing_mm(&[1.0, -2.0, 4.0, 4.0, -4.0]).unwrap();
         let load = ladder(&mut sim, 1.5);
         sim.set_hold(Hold { direction: LoadDirection::Unload, dwell_s: 0.0 }).unwrap();
@@ -214,10 +214,10 @@ mod tests {
         let mut a = Rod::default();
         a.gravity.enabled = false;
         let route = [0.0, 2.0, 3.0, 1.0, 2.0];
-        let mut rigid = Simulator::new(&a, &SolverOptions::default()).unwrap();
+        let mut rigid = Simulator::for_rod(&a, &SolverOptions::default()).unwrap();
         rigid.set_routing_mm(&route).unwrap();
         a.effects.clamp_stiffness_n_mm_per_rad = Some(k_theta);
-        let mut compliant = Simulator::new(&a, &SolverOptions::default()).unwrap();
+        let mut compliant = Simulator::for_rod(&a, &SolverOptions::default()).unwrap();
         compliant.set_routing_mm(&route).unwrap();
         assert!((ladder(&mut rigid, tau).tip_y_mm - ladder(&mut compliant, tau).tip_y_mm).abs() < 1e-12);
     }
@@ -341,7 +341,7 @@ mod body_tests {
             let v1 = |s: f64| 1.0 - tau / body.section_at(s).ea_n;
             let (x, y, phi) = tip_by_quadrature(&kappa, &v1, &[0.0, 20.0, 30.0, 65.0]);
             let options = SolverOptions { nodes_per_span: 24, ..SolverOptions::default() };
-            let mut sim = Simulator::new(&a, &options).unwrap();
+            let mut sim = Simulator::for_rod(&a, &options).unwrap();
             sim.set_routing_mm(&[d; 5]).unwrap();
             let pose = sim.solve(tau).unwrap();
             let err = (pose.tip_x_mm - x).hypot(pose.tip_y_mm - y);
@@ -362,7 +362,7 @@ mod body_tests {
         let mut a = tapered_thesis_rod();
         a.gravity.enabled = false;
         a.cable_anchor_mm = Some(anchor);
-        let mut sim = Simulator::new(&a, &SolverOptions::default()).unwrap();
+        let mut sim = Simulator::for_rod(&a, &SolverOptions::default()).unwrap();
         sim.set_routing_mm(&[d; 5]).unwrap();
         let pose = sim.solve(tau).unwrap();
         let line = sim.centreline();
@@ -380,7 +380,7 @@ mod body_tests {
         // A routing spans the cable only: its control points sit on [0, s_k].
         let r = Routing::for_actuator([d; 5], &a).unwrap();
         assert_eq!(r.length_mm(), anchor);
-        assert!(Simulator::new(&a, &SolverOptions { method: SolverMethod::Rk4, ..SolverOptions::default() }).is_err());
+        assert!(Simulator::for_rod(&a, &SolverOptions { method: SolverMethod::Rk4, ..SolverOptions::default() }).is_err());
     }
 
     #[test]
@@ -395,7 +395,7 @@ mod body_tests {
                 Segment { end_mm: 65.0, ea_n: None, ga_n: None, ei_n_mm2: None, density_g_cm3: None },
             ];
             let options = SolverOptions { planar_steps_per_span: 2000, ..SolverOptions::default() };
-            let mut sim = Simulator::new(&a, &options).unwrap();
+            let mut sim = Simulator::for_rod(&a, &options).unwrap();
             sim.set_routing_mm(&[0.0; 5]).unwrap();
             let pose = sim.solve(0.0).unwrap();
             let line = sim.centreline();
@@ -431,7 +431,7 @@ mod body_tests {
         let route = [1.0, -2.0, 4.0, 4.0, -4.0];
         let mut poses = Vec::new();
         for a in [Rod::default(), flat, split] {
-            let mut sim = Simulator::new(&a, &SolverOptions::default()).unwrap();
+            let mut sim = Simulator::for_rod(&a, &SolverOptions::default()).unwrap();
             sim.set_routing_mm(&route).unwrap();
             poses.push((1..=8).map(|k| sim.solve(0.25 * k as f64).unwrap()).collect::<Vec<_>>());
         }
@@ -448,7 +448,7 @@ mod body_tests {
         a.radius_profile_mm = vec![(0.0, 6.5), (65.0, 4.0)];
         a.effects.stiffness_gradient_beta = -0.5;
         let rk4 = SolverOptions { method: SolverMethod::Rk4, planar_steps_per_span: 192, ..SolverOptions::default() };
-        let mut sims = [Simulator::new(&a, &SolverOptions::default()).unwrap(), Simulator::new(&a, &rk4).unwrap()];
+        let mut sims = [Simulator::for_rod(&a, &SolverOptions::default()).unwrap(), Simulator::for_rod(&a, &rk4).unwrap()];
         let mut poses = [Vec::new(), Vec::new()];
         for (sim, out) in sims.iter_mut().zip(&mut poses) {
             sim.set_routing_mm(&[1.0, -2.0, 3.5, 3.5, -3.5]).unwrap();
@@ -467,7 +467,7 @@ mod body_tests {
         // 360 mm, r 15.4 → 6.4 → 4.8 mm, tendon knotted at 305 mm, full gravity.
         let mut a = Rod { length_mm: 360.0, cable_anchor_mm: Some(305.0), ..Rod::default() };
         a.radius_profile_mm = vec![(0.0, 15.4), (305.0, 6.4), (360.0, 4.8)];
-        let mut sim = Simulator::new(&a, &SolverOptions::default()).unwrap();
+        let mut sim = Simulator::for_rod(&a, &SolverOptions::default()).unwrap();
         sim.set_routing_mm(&[4.0; 5]).unwrap();
         let mut last = None;
         for k in 1..=31 {
@@ -493,7 +493,7 @@ mod anchor_edge_tests {
             a.gravity.enabled = false;
             a.radius_profile_mm = vec![(0.0, 6.0), (50.0, 5.0), (65.0, 4.0)];
             a.cable_anchor_mm = Some(anchor);
-            let mut sim = Simulator::new(&a, &SolverOptions::default()).unwrap();
+            let mut sim = Simulator::for_rod(&a, &SolverOptions::default()).unwrap();
             sim.set_routing_mm(&[2.0; 5]).unwrap();
             let pose = sim.solve(1.0).unwrap();
             assert!(sim.centreline().iter().filter(|p| p.s_mm > 50.5).all(|p| p.u_per_mm[2] == 0.0));

@@ -7,8 +7,8 @@
 
 use super::schema::{CableRow, SolvedRouting, SolvedRow, STATUS_FAILED, STATUS_INVALID_ROUTING};
 use crate::model::routing::ControlPoints;
-use crate::solver::spatial::{Actuator, SpatialError, SpatialCollocation};
-use crate::solver::{ladder, Solver};
+use crate::solver::spatial::{Actuator, SpatialError};
+use crate::solver::{ladder, Given, Solver};
 use crate::model::{Actuation, Routing};
 use crate::solver::{Simulator, SolveFailure, SolverOptions, TipPose, STATUS_OK};
 use crate::sweep::spec::Ladder;
@@ -51,7 +51,7 @@ fn planar_row(sim: &mut Simulator, actuation: Actuation, tension: &mut [f64; 1],
     let (solved, command) = match actuation {
         Actuation::Tension(t) => (sim.solve(t), (t, f64::NAN)),
         Actuation::Displacement(d) => {
-            let solved = Solver::solve(sim, &[Actuation::Displacement(d)], &mut tension[..]);
+            let solved = sim.solve_actuation(Actuation::Displacement(d), tension);
             if solved.is_err() {
                 // A failed rung leaves no tension to start from: the next starts from zero.
                 tension[0] = 0.0;
@@ -117,10 +117,10 @@ impl TensionCombinations {
     /// Solves at `values` (each cable's command, scaled by `scale`): the
     /// tension-driven cables at theirs, the others' tensions found from
     /// `tensions_n` (which receives them).
-    fn solve(&self, solver: &mut SpatialCollocation, values: &[f64], scale: f64, tensions_n: &mut [f64]) -> Result<TipPose, SpatialError> {
+    fn solve(&self, solver: &mut Simulator, values: &[f64], scale: f64, tensions_n: &mut [f64]) -> Result<TipPose, SpatialError> {
         if !self.any_displacement() {
             let t: Vec<f64> = values.iter().map(|v| v * scale).collect();
-            return solver.solve(&t);
+            return solver.solve_tensions(&t);
         }
         let mut rung = [Actuation::Tension(0.0); crate::model::MAX_CABLES];
         for (i, (&v, &d)) in values.iter().zip(&self.by_displacement).enumerate() {
@@ -158,9 +158,11 @@ pub fn combination_index(combo: &[usize], grids: &[Vec<f64>]) -> usize {
 
 /// Solves routing `id` of a cable sweep, `actuator` (its cables' tensions
 /// are set per combination), through every tension combination by one
-/// [`SpatialCollocation`]: from zero up to the first combination, then along the
-/// snake. Returns the rows in grid order (cable 1's tension slowest). An
-/// actuator the solver refuses gives rows of [`STATUS_INVALID_ROUTING`].
+/// solver, the backend serving the actuator ([`Simulator::serving`]: the
+/// planar one for one in-plane cable, as for a single simulation): from
+/// zero up to the first combination, then along the snake. Returns the rows
+/// in grid order (cable 1's tension slowest). An actuator the solver
+/// refuses gives rows of [`STATUS_INVALID_ROUTING`].
 pub fn cable_routing(id: u64, mut actuator: Actuator, options: &SolverOptions, stored: Stored, combinations: &TensionCombinations) -> Vec<CableRow> {
     let combos = &combinations.snake;
     let geometry: Vec<_> = actuator.cables.iter().map(|c| (c.y_mm, c.z_mm)).collect();
@@ -185,7 +187,7 @@ pub fn cable_routing(id: u64, mut actuator: Actuator, options: &SolverOptions, s
             c.tension_n = v;
         }
     }
-    let mut solver = match SpatialCollocation::new(&actuator, options) {
+    let mut solver = match Simulator::serving(&actuator, options, Given::default()) {
         Ok(s) => s,
         Err(_) => return combos.iter().map(|c| row(c, STATUS_INVALID_ROUTING, 0, None, None)).collect(),
     };

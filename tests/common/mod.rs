@@ -30,7 +30,7 @@ pub struct Row {
 /// Simulates the sweep: one routing of each mirror pair.
 pub fn simulate_rows() -> Vec<Row> {
     let actuator = Rod::default();
-    let mut sim = Simulator::new(&actuator, &SolverOptions::default()).unwrap();
+    let mut sim = Simulator::for_rod(&actuator, &SolverOptions::default()).unwrap();
     let mut rows = Vec::new();
     for id in 0..LEVELS_MM.len().pow(5) {
         let mut k = id;

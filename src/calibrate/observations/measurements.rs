@@ -741,7 +741,7 @@ mod tests {
         // A straight centreline along +x from the clamp to 65 mm, frame angle 0.
         let mut a = Rod::default();
         a.gravity.enabled = false;
-        let mut sim = crate::solver::Simulator::new(&a, &SolverOptions::default()).unwrap();
+        let mut sim = crate::solver::Simulator::for_rod(&a, &SolverOptions::default()).unwrap();
         sim.set_routing_mm(&[0.0; 5]).unwrap();
         sim.solve(0.0).unwrap();
         let template = sim.centreline()[0];

@@ -336,9 +336,11 @@ impl CablesGrid {
             });
         }
         // The base actuator (swept points at their first level) must be a
-        // rod the 3-D solver models; a routing's own faults are its rows' status.
+        // rod the backend serving it models; a routing's own faults are its
+        // rows' status.
         let base = self.actuator_for(0, &self.dimensions());
-        match crate::solver::spatial::validated_channels(&base, crate::solver::Backend::spatial(solver.method)) {
+        let served = base.channels().map_err(SpatialError::from).and_then(|_| Ok(crate::solver::Backend::serving(&base, solver, crate::solver::Given::default())?));
+        match served {
             Err(SpatialError::Actuator(crate::model::ActuatorError::Parameter(e))) => return Err(SpecError::Rod(e)),
             Err(e @ SpatialError::Unsupported(_)) => return Err(SpecError::RodUnsupported(e)),
             Err(e @ SpatialError::Actuator(crate::model::ActuatorError::GravityDirection(_))) => return Err(SpecError::Gravity(e)),

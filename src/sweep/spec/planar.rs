@@ -293,7 +293,7 @@ impl PlanarGrid {
                 return Err(SpecError::DisplacementWithRk4 { cable: None });
             }
         }
-        crate::solver::Simulator::new(&self.actuator, &solver).map_err(SpecError::Solver)?;
+        crate::solver::Simulator::for_rod(&self.actuator, &solver).map_err(SpecError::Solver)?;
         let g = &self.grid;
         if g.levels == 0 || g.levels > MAX_LEVELS {
             return Err(SpecError::Levels { levels: g.levels });
@@ -451,7 +451,7 @@ impl RunSpec for PlanarGrid {
     }
 
     fn worker(&self, solver: &SolverOptions) -> Result<Simulator, SweepError> {
-        let mut sim = Simulator::new(&self.actuator, solver)?;
+        let mut sim = Simulator::for_rod(&self.actuator, solver)?;
         sim.set_cable_stiffness(self.displacement.as_ref().and_then(|d| d.cable_ea_n));
         Ok(sim)
     }
@@ -536,7 +536,7 @@ mod tests {
                 SweepSpec::from_toml(&format!("[solver]\nmethod = \"{method}\"\nsteps_per_span = 30\n[output]\ncentreline = true\n"), "t")
                     .unwrap();
             let grid = planar(&spec);
-            let mut sim = crate::solver::Simulator::new(&grid.actuator, &spec.solver).unwrap();
+            let mut sim = crate::solver::Simulator::for_rod(&grid.actuator, &spec.solver).unwrap();
             sim.set_routing_mm(&[1.0, 2.0, 0.0, -1.0, 1.0]).unwrap();
             sim.solve(1.5).unwrap();
             assert_eq!(sim.centreline().len() as u64, PlanarGrid::centreline_points(&spec.solver, &spec.output), "{method}");
