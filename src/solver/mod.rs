@@ -82,12 +82,12 @@ pub use error::SimulateError;
 pub use interface::{until_resolved, Solver};
 pub use result::{CableAtNode, CentrelinePoint, PerCable, Simulation, TipFrame, TipPose};
 pub use simulate::{
-    check_ladder_tension, planar_problem, simulate, simulate_actuator, simulate_held, simulate_spatial, MAX_AUTO_SPATIAL_STEPS_PER_SPAN,
+    check_ladder_tension, simulate, simulate_actuator, simulate_held, simulate_spatial, MAX_AUTO_SPATIAL_STEPS_PER_SPAN,
     MAX_AUTO_STEPS_PER_SPAN, MAX_LADDER_TENSION_N,
 };
 pub use options::{Given, SolverMethod, SolverOptions, SolverSettings};
 pub use planar::{Integrator, PlanarSolver};
-pub use simulator::{PlanarCollocation, PlanarRk4, Simulator};
+pub use simulator::{planar_problem, PlanarCollocation, PlanarRk4, Simulator};
 use creep::Creep;
 use friction::Friction;
 

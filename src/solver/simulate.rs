@@ -7,7 +7,7 @@
 
 use super::error::SimulateError;
 use super::result::Simulation;
-use super::{tip_tolerance_mm, until_resolved, Backend, Given, Hold, SolveFailure, Solver, SolverMethod, SolverOptions, Simulator, Unresolved, MAX_NODES_PER_SPAN};
+use super::{tip_tolerance_mm, until_resolved, planar_problem, Backend, Given, Hold, SolveFailure, Solver, SolverMethod, SolverOptions, Simulator, Unresolved, MAX_NODES_PER_SPAN};
 use crate::model::parameter::ParameterError;
 use crate::solver::spatial::collocation::check_dwell;
 use crate::solver::spatial::{check_order, SpatialError, SpatialRk4, SpatialCollocation};
@@ -275,24 +275,4 @@ pub fn simulate_actuator(
     sim.actuator = actuator.clone();
     sim.actuator.cables[0].tension_n = tension;
     Ok(sim)
-}
-
-/// The planar solver's input for a planar `actuator` (one cable, z ≡ 0,
-/// gravity in the x–y plane): the rod with the cable's anchor and gravity's
-/// in-plane direction, and the cable's routing over [0, anchor].
-pub fn planar_problem(actuator: &Actuator) -> Result<(Rod, Routing), SpatialError> {
-    let cable = &actuator.cables[0];
-    let mut rod = actuator.rod.clone();
-    if let Some(anchor) = cable.anchor_mm {
-        if rod.cable_anchor_mm.is_some_and(|k| k != anchor) {
-            return Err(SpatialError::AnchorTwice { cable_mm: anchor, rod_mm: rod.cable_anchor_mm.unwrap_or(anchor) });
-        }
-        rod.cable_anchor_mm = Some(anchor);
-    }
-    if let (Some(g), true) = (actuator.gravity_direction, rod.gravity.enabled) {
-        rod.gravity.direction_rad = g[1].atan2(g[0]);
-    }
-    let routing = Routing::for_actuator(cable.y_mm, &rod)
-        .map_err(|source| crate::model::ActuatorError::Routing { cable: 1, axis: 'y', source })?;
-    Ok((rod, routing))
 }

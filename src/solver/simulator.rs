@@ -12,7 +12,7 @@ use super::error::SimulateError;
 use super::planar::{Integrator, PlanarSolver};
 use super::rk4::ShootingRk4;
 use super::spatial::{SpatialCollocation, SpatialError, SpatialRk4};
-use super::{planar_problem, Backend, CentrelinePoint, Given, Hold, SolveFailure, Solver, SolverMethod, SolverOptions, TipPose};
+use super::{Backend, CentrelinePoint, Given, Hold, SolveFailure, Solver, SolverMethod, SolverOptions, TipPose};
 use crate::model::parameter::ParameterError;
 use crate::model::{Actuation, Actuator, Rod, Routing};
 use crate::shape::LengthBasis;
@@ -210,6 +210,26 @@ impl Solver for Simulator {
             Simulator::SpatialRk4(s) => Solver::coefficients(s, order, basis),
         }
     }
+}
+
+/// The planar solver's input for a planar `actuator` (one cable, z ≡ 0,
+/// gravity in the x–y plane): the rod with the cable's anchor and gravity's
+/// in-plane direction, and the cable's routing over [0, anchor].
+pub fn planar_problem(actuator: &Actuator) -> Result<(Rod, Routing), SpatialError> {
+    let cable = &actuator.cables[0];
+    let mut rod = actuator.rod.clone();
+    if let Some(anchor) = cable.anchor_mm {
+        if rod.cable_anchor_mm.is_some_and(|k| k != anchor) {
+            return Err(SpatialError::AnchorTwice { cable_mm: anchor, rod_mm: rod.cable_anchor_mm.unwrap_or(anchor) });
+        }
+        rod.cable_anchor_mm = Some(anchor);
+    }
+    if let (Some(g), true) = (actuator.gravity_direction, rod.gravity.enabled) {
+        rod.gravity.direction_rad = g[1].atan2(g[0]);
+    }
+    let routing = Routing::for_actuator(cable.y_mm, &rod)
+        .map_err(|source| crate::model::ActuatorError::Routing { cable: 1, axis: 'y', source })?;
+    Ok((rod, routing))
 }
 
 /// The planar spectral collocation.

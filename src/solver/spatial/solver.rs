@@ -289,11 +289,6 @@ impl SpatialRk4 {
         &self.rod
     }
 
-    /// Number of cables.
-    pub fn cable_count(&self) -> usize {
-        self.cables
-    }
-
     /// Tension of every cable in the last solve, N.
     pub fn tensions_n(&self) -> Vec<f64> {
         self.tensions_n.clone()

@@ -518,16 +518,6 @@ impl SpatialCollocation {
         &self.rod
     }
 
-    /// Number of cables.
-    pub fn cable_count(&self) -> usize {
-        self.cables
-    }
-
-    /// Collocation intervals per span in use.
-    pub fn intervals(&self) -> usize {
-        self.m
-    }
-
     /// Tension of every cable in the last solve, N.
     pub fn tensions_n(&self) -> Vec<f64> {
         self.tensions_n.clone()
