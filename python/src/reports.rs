@@ -10,18 +10,18 @@
 //! library's messages.
 
 use super::{actuator_with, bad, Failure, Result};
+use cablemap::solver::SolverSettings;
 use cablemap::calibrate::predict::run as run_predict;
 use cablemap::calibrate::predict::PredictRequest;
 use cablemap::calibrate::diagnose::DiagnoseRequest;
-use cablemap::calibrate::{CalibrateError, CalibrateRequest, Effect, FitSettings, LossKind, Parameter};
+use cablemap::calibrate::{CalibrateError, CalibrateRequest};
 use cablemap::design::actuator::DesignActuator;
 use cablemap::design::feasible_request::{FeasibleRequest, MapSource};
 use cablemap::design::targets::TargetSet;
 use cablemap::design::{DesignError, DesignRequest, SearchOptions, Target, Weights};
-use cablemap::model::{Actuator, Rod, RodOverrides, REGISTRY};
+use cablemap::model::{Actuator, Rod};
 use cablemap::mould::MouldSettings;
 use cablemap::shape::LengthBasis;
-use cablemap::solver::SolverSettings;
 use pyo3::prelude::*;
 use serde::Deserialize;
 use serde_json::{Map, Value};
@@ -92,51 +92,6 @@ fn pictures(dir: Option<&Path>, names: &[String]) -> Vec<String> {
 /// The length basis by its name (`rest` or `deformed`).
 fn length_basis(name: &str) -> Result<LengthBasis> {
     super::from_json(&format!("\"{name}\""), "length_basis (\"rest\" or \"deformed\")")
-}
-
-/// The rod overrides of a planar fit (the rod flags of `calibrate` and
-/// `diagnose`): `actuator_file`, the rod's fields by their flags' names,
-/// `gravity=False` for `--no-gravity`, and effects by their registry names.
-fn rod_overrides(fields: Map<String, Value>) -> Result<RodOverrides> {
-    let mut o = RodOverrides::default();
-    let number = |key: &str, v: &Value| v.as_f64().ok_or_else(|| bad(format!("{key}: expected a number, got {v}")));
-    for (key, value) in fields {
-        let slot = match key.as_str() {
-            "length_mm" => &mut o.length_mm,
-            "radius_mm" => &mut o.radius_mm,
-            "ea_n" => &mut o.ea_n,
-            "ga_n" => &mut o.ga_n,
-            "ei_n_mm2" => &mut o.ei_n_mm2,
-            "density_g_cm3" => &mut o.density_g_cm3,
-            "cable_anchor_mm" => &mut o.cable_anchor_mm,
-            "actuator_file" => {
-                let path = value.as_str().ok_or_else(|| bad(format!("actuator_file: expected a rod file's path, got {value}")))?;
-                o.file = Some(PathBuf::from(path));
-                continue;
-            }
-            "gravity" => {
-                o.no_gravity = !value.as_bool().ok_or_else(|| bad(format!("gravity: expected True or False, got {value}")))?;
-                continue;
-            }
-            "radius_profile_mm" => {
-                o.radius_profile_mm = Some(super::from_json(&value.to_string(), "radius_profile_mm (a list of [s_mm, r_mm] points)")?);
-                continue;
-            }
-            _ => {
-                if let Some(info) = REGISTRY.iter().find(|i| i.name == key) {
-                    o.effects.push((*info, number(&key, &value)?));
-                    continue;
-                }
-                let mut known = ["actuator_file", "length_mm", "radius_mm", "ea_n", "ga_n", "ei_n_mm2", "density_g_cm3", "gravity", "radius_profile_mm", "cable_anchor_mm"]
-                    .map(String::from)
-                    .to_vec();
-                known.extend(REGISTRY.iter().map(|i| i.name.to_string()));
-                return Err(bad(format!("unknown rod field {key:?}: the fields are {}", known.join(", "))));
-            }
-        };
-        *slot = Some(number(&key, &value)?);
-    }
-    Ok(o)
 }
 
 // ---------------------------------------------------------------- design
@@ -281,166 +236,33 @@ pub(crate) fn feasible(py: Python<'_>, request_json: &str) -> PyResult<Finished>
 
 // ---------------------------------------------------------------- fits
 
-/// The settings every fit shares (`calibrate` and `diagnose`'s flags).
-/// Flattened into each fit's request, so unknown fields are not denied
-/// (serde cannot beside `flatten`): the Python functions name every field.
-#[derive(Debug, Deserialize)]
-struct FitPy {
-    /// The measurements (planar) or the captures (with `actuator`).
-    data: PathBuf,
-    /// `--actuator FILE.toml`: the 3-D route (captures and 3-D markers).
-    actuator: Option<PathBuf>,
-    /// The planar route's rod: `actuator_file` and rod fields.
-    #[serde(default)]
-    rod_fields: Map<String, Value>,
-    markers: Option<PathBuf>,
-    centrelines: Option<PathBuf>,
-    holdout: Option<String>,
-    holdout_cable: Option<usize>,
-    noise_mm: f64,
-    noise_deg: f64,
-    /// `--fix NAME=VALUE`, each.
-    #[serde(default)]
-    fix: Vec<String>,
-    loss: Option<String>,
-    huber_k: f64,
-    max_iterations: usize,
-    angle_weight: f64,
-    #[serde(default)]
-    solver: SolverSettings,
-}
-
-impl FitPy {
-    /// The fit settings asked for.
-    fn settings(&self) -> Result<FitSettings> {
-        let held = self.fix.iter().map(|item| Parameter::parse_held(item)).collect::<std::result::Result<Vec<_>, _>>().map_err(|e| bad(e.to_string()))?;
-        let loss = self.loss.as_deref().map(LossKind::parse).transpose().map_err(|e| bad(e.to_string()))?;
-        Ok(FitSettings {
-            noise_mm: self.noise_mm,
-            noise_deg: self.noise_deg,
-            held,
-            loss,
-            huber_k: self.huber_k,
-            max_iterations: self.max_iterations,
-            centrelines: self.centrelines.clone(),
-            markers: self.markers.clone(),
-            angle_weight_mm_per_deg: self.angle_weight,
-        })
-    }
-}
-
-/// Effects by name, each once, the unknown one named.
-fn effects(names: &[String]) -> Result<Vec<Effect>> {
-    let mut out = Vec::new();
-    for n in names {
-        let e = Effect::parse(n).ok_or_else(|| {
-            let all: Vec<&str> = Effect::ALL.iter().map(|e| e.name()).collect();
-            bad(format!("effect {n:?}: unknown effect; use one of {}", all.join(", ")))
-        })?;
-        if !out.contains(&e) {
-            out.push(e);
-        }
-    }
-    Ok(out)
-}
-
-/// What `cablemap.calibrate` asks: the flags of `cablemap calibrate`.
-#[derive(Debug, Deserialize)]
-struct CalibratePy {
-    #[serde(flatten)]
-    fit: FitPy,
-    /// `--effect`, each.
-    #[serde(default)]
-    effects: Vec<String>,
-    /// With `actuator`: where to write calibrated.toml and fit.json.
-    out: Option<PathBuf>,
-}
-
-fn calibrate_run(r: CalibratePy) -> Result<Finished> {
-    let CalibratePy { fit, effects: names, out } = r;
-    let request = CalibrateRequest {
-        data_path: fit.data.clone(),
-        actuator_file: fit.actuator.clone(),
-        rod: rod_overrides(fit.rod_fields.clone())?,
-        options: fit.solver.options(),
-        fit: fit.settings()?,
-        effects: effects(&names)?,
-        holdout: fit.holdout.clone(),
-        holdout_cable: fit.holdout_cable,
-        out,
-    };
-    let report = cablemap::calibrate::run(&request).map_err(calibrate_failure)?;
-    Ok((report.to_json_line(), report.to_string(), Vec::new()))
-}
-
 /// `cablemap calibrate`: fits the rod to measurements (planar) or the
 /// actuator to captures and 3-D markers (with `actuator`).
 #[pyfunction]
 pub(crate) fn calibrate(py: Python<'_>, request_json: &str) -> PyResult<Finished> {
-    let request: CalibratePy = super::from_json(request_json, "calibrate").map_err(|e| e.into_py(py))?;
-    detached(py, move || calibrate_run(request))
-}
-
-/// What `cablemap.diagnose` asks: the flags of `cablemap diagnose`.
-#[derive(Debug, Deserialize)]
-struct DiagnosePy {
-    #[serde(flatten)]
-    fit: FitPy,
-    alpha: f64,
-    threshold: f64,
-    margin: f64,
-    max_effects: usize,
-    /// The report directory (planar), the command's default when none.
-    out: Option<PathBuf>,
-    /// Write the report and its plots (`--no-report` when false).
-    report: bool,
-}
-
-fn diagnose_run(r: DiagnosePy) -> Result<Finished> {
-    let DiagnosePy { fit, alpha, threshold, margin, max_effects, out, report } = r;
-    let request = DiagnoseRequest {
-        data_path: fit.data.clone(),
-        actuator_file: fit.actuator.clone(),
-        rod: rod_overrides(fit.rod_fields.clone())?,
-        options: fit.solver.options(),
-        fit: fit.settings()?,
-        holdout: fit.holdout.clone(),
-        holdout_cable: fit.holdout_cable,
-        alpha,
-        threshold,
-        margin,
-        max_effects,
-        report_dir: report.then(|| out.clone().unwrap_or_else(|| DiagnoseRequest::default_report_dir(&fit.data))),
-    };
-    let done = cablemap::calibrate::diagnose::run(&request).map_err(calibrate_failure)?;
-    let pictures = done.pictures().iter().map(|p| p.display().to_string()).collect();
-    Ok((done.to_json_line(), done.to_string(), pictures))
+    let request: CalibrateRequest = super::from_json(request_json, "calibrate").map_err(|e| e.into_py(py))?;
+    detached(py, move || {
+        let report = cablemap::calibrate::run(&request).map_err(calibrate_failure)?;
+        Ok((report.to_json_line(), report.to_string(), Vec::new()))
+    })
 }
 
 /// `cablemap diagnose`: finds, names and adds the effect the model misses.
 #[pyfunction]
 pub(crate) fn diagnose(py: Python<'_>, request_json: &str) -> PyResult<Finished> {
-    let request: DiagnosePy = super::from_json(request_json, "diagnose").map_err(|e| e.into_py(py))?;
-    detached(py, move || diagnose_run(request))
-}
-
-/// What `cablemap.predict` asks: the flags of `cablemap predict`.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct PredictPy {
-    captures: PathBuf,
-    actuator: PathBuf,
-    markers: Option<PathBuf>,
-    #[serde(default)]
-    solver: SolverSettings,
+    let request: DiagnoseRequest = super::from_json(request_json, "diagnose").map_err(|e| e.into_py(py))?;
+    detached(py, move || {
+        let done = cablemap::calibrate::diagnose::run(&request).map_err(calibrate_failure)?;
+        let pictures = done.pictures().iter().map(|p| p.display().to_string()).collect();
+        Ok((done.to_json_line(), done.to_string(), pictures))
+    })
 }
 
 /// `cablemap predict`: the markers' errors of an actuator on captures, no fitting.
 #[pyfunction]
 pub(crate) fn predict(py: Python<'_>, request_json: &str) -> PyResult<Finished> {
-    let r: PredictPy = super::from_json(request_json, "predict").map_err(|e| e.into_py(py))?;
+    let request: PredictRequest = super::from_json(request_json, "predict").map_err(|e| e.into_py(py))?;
     detached(py, move || {
-        let request = PredictRequest { captures: r.captures, markers: r.markers, actuator: r.actuator, rod: RodOverrides::default(), options: r.solver.options() };
         let report = run_predict(&request).map_err(calibrate_failure)?;
         Ok((report.to_json_line(), report.to_string(), Vec::new()))
     })

@@ -142,6 +142,9 @@ pub enum InvalidRequest {
     /// A cable driven both by its tension and by its displacement.
     #[error("{}: both '{tension}' and '{displacement}' are given; cable {cable} is driven either by its tension or by its displacement", .path.display())]
     BothDrives { path: std::path::PathBuf, tension: String, displacement: String, cable: usize },
+    /// An effect of no known name.
+    #[error("--effect {name}: unknown effect; use one of {}", super::Effect::ALL.map(super::Effect::name).join(", "))]
+    UnknownEffect { name: String },
     /// A loss of no known name.
     #[error("--loss {name}: use huber or squares")]
     Loss { name: String },

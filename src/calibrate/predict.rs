@@ -10,11 +10,11 @@ use super::observations::captures::files::{read_actuator, read_actuator_set};
 use super::observations::captures::simulate::solve_captures;
 use super::{CalibrateError, Refused};
 use crate::model::RodOverrides;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::path::PathBuf;
 use crate::model::{Rod, LoadDirection, Routing};
-use crate::solver::{CentrelinePoint, Hold, Simulator, SolverOptions, TipPose};
+use crate::solver::{CentrelinePoint, Hold, Simulator, SolverOptions, SolverSettings, TipPose};
 use rayon::prelude::*;
 
 /// The model's answer for one row.
@@ -104,18 +104,22 @@ pub fn predict(
     Ok(out)
 }
 
-/// What `predict` needs.
-#[derive(Debug, Clone)]
+/// What `predict` needs; deserialises from the Python keywords' names.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct PredictRequest {
     /// The captures file.
     pub captures: PathBuf,
     /// The markers file (optional when the captures file has tip columns).
+    #[serde(default)]
     pub markers: Option<PathBuf>,
     /// The actuator file.
     pub actuator: PathBuf,
     /// Rod settings: refused, the rod is the actuator file's.
+    #[serde(rename = "rod_fields", default)]
     pub rod: RodOverrides,
     /// The 3-D solver's settings.
+    #[serde(rename = "solver", default, deserialize_with = "SolverSettings::deserialize_options")]
     pub options: SolverOptions,
 }
 

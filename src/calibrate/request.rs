@@ -9,7 +9,8 @@ use super::fit::Loss;
 use super::observations::measurements::Noise;
 use super::{CalibrateError, Effect, HeldError, InvalidRequest, NoiseError, Parameter, Refused};
 use crate::model::RodOverrides;
-use crate::solver::SolverOptions;
+use crate::solver::{SolverOptions, SolverSettings};
+use serde::{Deserialize, Deserializer};
 use std::path::{Path, PathBuf};
 
 /// The loss on the noise-whitened residuals, by name.
@@ -33,8 +34,9 @@ impl LossKind {
 }
 
 /// Settings every fit shares (calibrate and diagnose), as given; the kind
-/// of data fills what is left open.
-#[derive(Debug, Clone, PartialEq)]
+/// of data fills what is left open. Deserialises from the flags' names.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(default)]
 pub struct FitSettings {
     /// Noise of tip x, y, centreline points and markers (planar rows
     /// without their own), and the system's noise added to each 3-D
@@ -42,9 +44,11 @@ pub struct FitSettings {
     pub noise_mm: f64,
     /// Noise of the tip angle (planar rows without their own), degrees.
     pub noise_deg: f64,
-    /// Parameters held at a value instead of fitted.
+    /// Parameters held at a value instead of fitted (`--fix NAME=VALUE`, each).
+    #[serde(rename = "fix", deserialize_with = "held_items")]
     pub held: Vec<(Parameter, f64)>,
     /// The loss; `None`: Huber's for tip readings, squares for 3-D markers.
+    #[serde(deserialize_with = "loss_name")]
     pub loss: Option<LossKind>,
     /// Where Huber's loss turns linear, in σ.
     pub huber_k: f64,
@@ -55,6 +59,7 @@ pub struct FitSettings {
     /// Markers: off the planar centreline, or the 3-D markers of captures.
     pub markers: Option<PathBuf>,
     /// Weight of the tip angle in reported mm-equivalent RMS values, mm per degree.
+    #[serde(rename = "angle_weight")]
     pub angle_weight_mm_per_deg: f64,
 }
 
@@ -103,37 +108,44 @@ pub enum DataKind<'a> {
     },
 }
 
-/// Everything a calibration needs.
-#[derive(Debug, Clone)]
-pub struct CalibrateRequest {
+/// What every fit is given (calibrate and diagnose): the data, the
+/// actuator file that makes them captures, the rod's overrides, the
+/// solver's and the fit's settings and what is held out. Deserialises
+/// from the Python keywords' names, flat in each request.
+#[derive(Debug, Clone, Deserialize)]
+pub struct FitInput {
     /// The measurement file, or (with `actuator_file`) the captures file
     /// (CSV, or Parquet by its extension).
+    #[serde(rename = "data")]
     pub data_path: PathBuf,
     /// A whole actuator (rod, torsion, gravity, cables) as TOML: the data
     /// are captures with 3-D markers, and it is the start and everything
     /// not fitted.
+    #[serde(rename = "actuator", default)]
     pub actuator_file: Option<PathBuf>,
     /// Planar data: starting values and fixed parameters, overrides on the
-    /// rod file's, else the measurement file's, else the thesis's rod.
+    /// rod file's, else the measurement file's, else the thesis's rod
+    /// (validated here).
+    #[serde(rename = "rod_fields", default)]
     pub rod: RodOverrides,
     /// The solver's settings.
+    #[serde(rename = "solver", default, deserialize_with = "SolverSettings::deserialize_options")]
     pub options: SolverOptions,
     /// Noise, held parameters, loss, shapes.
+    #[serde(flatten)]
     pub fit: FitSettings,
-    /// Effects whose parameters are fitted with the rigidities.
-    pub effects: Vec<Effect>,
-    /// Planar data: a routing left out of the fit, whose error is reported.
+    /// Planar data: a routing left out of every fit, whose error is reported.
+    #[serde(default)]
     pub holdout: Option<String>,
     /// Captures: fit on those where this cable (1-based) does not pull,
-    /// predict the others.
+    /// predict (or, diagnosing, show the gap on) the others.
+    #[serde(default)]
     pub holdout_cable: Option<usize>,
-    /// Captures: where to write `calibrated.toml` and `fit.json`.
-    pub out: Option<PathBuf>,
 }
 
-impl CalibrateRequest {
-    /// A request on `data_path` with the defaults (planar unless an
-    /// actuator file is set).
+impl FitInput {
+    /// A fit of `data_path` with the defaults (planar unless an actuator
+    /// file is set).
     pub fn new(data_path: PathBuf) -> Self {
         Self {
             data_path,
@@ -141,17 +153,71 @@ impl CalibrateRequest {
             rod: RodOverrides::default(),
             options: SolverOptions::default(),
             fit: FitSettings::default(),
-            effects: Vec::new(),
             holdout: None,
             holdout_cable: None,
-            out: None,
         }
+    }
+
+    /// The kind of data, with what captures refuse, the markers' noise and
+    /// the held parameters planar data cannot hold checked.
+    fn check(&self) -> Result<DataKind<'_>, CalibrateError> {
+        let kind = match &self.actuator_file {
+            Some(actuator_file) => DataKind::Captures { actuator_file },
+            None => DataKind::Measurements,
+        };
+        let fit = &self.fit;
+        if let DataKind::Captures { .. } = kind {
+            if self.holdout.is_some() {
+                return Err(Refused::RoutingHoldoutOnCaptures.into());
+            }
+            if fit.centrelines.is_some() {
+                return Err(Refused::CentrelinesOnCaptures.into());
+            }
+            if !self.rod.is_empty() {
+                return Err(Refused::RodOnCaptures.into());
+            }
+            if !(fit.noise_mm.is_finite() && fit.noise_mm > 0.0) {
+                return Err(NoiseError::Markers { value: fit.noise_mm }.into());
+            }
+        }
+        if fit.max_iterations == 0 {
+            return Err(Refused::NoIterations.into());
+        }
+        if kind == DataKind::Measurements {
+            if let Some(&(p, _)) = fit.held.iter().find(|(p, _)| !p.is_planar()) {
+                return Err(CalibrateError::Held(HeldError::NotPlanar { name: p.name() }));
+            }
+        }
+        Ok(kind)
+    }
+}
+
+/// Everything a calibration needs.
+#[derive(Debug, Clone, Deserialize)]
+pub struct CalibrateRequest {
+    /// The data and the fit's settings.
+    #[serde(flatten)]
+    pub input: FitInput,
+    /// Effects whose parameters are fitted with the rigidities (by name,
+    /// each once).
+    #[serde(default, deserialize_with = "effect_names")]
+    pub effects: Vec<Effect>,
+    /// Captures: where to write `calibrated.toml` and `fit.json`.
+    #[serde(default)]
+    pub out: Option<PathBuf>,
+}
+
+impl CalibrateRequest {
+    /// A request on `data_path` with the defaults (planar unless an
+    /// actuator file is set).
+    pub fn new(data_path: PathBuf) -> Self {
+        Self { input: FitInput::new(data_path), effects: Vec::new(), out: None }
     }
 
     /// The kind of data, with the settings it refuses checked.
     pub fn check(&self) -> Result<DataKind<'_>, CalibrateError> {
-        let kind = check_fit(self.actuator_file.as_deref(), &self.fit, &self.rod, self.holdout.is_some())?;
-        if kind == DataKind::Measurements && (self.out.is_some() || self.holdout_cable.is_some()) {
+        let kind = self.input.check()?;
+        if kind == DataKind::Measurements && (self.out.is_some() || self.input.holdout_cable.is_some()) {
             return Err(Refused::CapturesSettingsOnMeasurements.into());
         }
         Ok(kind)
@@ -159,28 +225,11 @@ impl CalibrateRequest {
 }
 
 /// Everything a diagnosis needs.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Deserialize)]
 pub struct DiagnoseRequest {
-    /// The measurement file, or (with `actuator_file`) the captures file
-    /// (CSV, or Parquet by its extension).
-    pub data_path: PathBuf,
-    /// A whole actuator (rod, torsion, gravity, cables) as TOML: the data
-    /// are captures with 3-D markers, and it is the start and everything
-    /// not fitted.
-    pub actuator_file: Option<PathBuf>,
-    /// Planar data: starting values and fixed parameters, overrides on the
-    /// rod file's, else the measurement file's, else the thesis's rod
-    /// (validated here).
-    pub rod: RodOverrides,
-    /// The solver's settings.
-    pub options: SolverOptions,
-    /// Noise, held parameters, loss, shapes.
-    pub fit: FitSettings,
-    /// Planar data: routing left out of every fit; the gap on it is shown
-    /// before and after.
-    pub holdout: Option<String>,
-    /// Captures: those in which this cable (1-based) pulls are held out.
-    pub holdout_cable: Option<usize>,
+    /// The data and the fits' settings.
+    #[serde(flatten)]
+    pub input: FitInput,
     /// A model is consistent with the noise when the χ² test's p ≥ this.
     pub alpha: f64,
     /// BIC decrease an effect needs against the model without it.
@@ -189,37 +238,35 @@ pub struct DiagnoseRequest {
     pub margin: f64,
     /// Most effects added (forward-stepwise; at least 1).
     pub max_effects: usize,
-    /// Report directory (report.md and PNG pictures); none for no report.
-    pub report_dir: Option<PathBuf>,
+    /// Report directory (report.md and PNG pictures); with `write_report`
+    /// and none, [`DiagnoseRequest::default_report_dir`].
+    #[serde(default)]
+    pub out: Option<PathBuf>,
+    /// Write the report and its pictures (`--no-report` turns it off).
+    #[serde(rename = "report")]
+    pub write_report: bool,
 }
 
 impl DiagnoseRequest {
     /// A request on `data_path` with the defaults of `diagnose`: α = 1e-3,
     /// BIC threshold and margin 10, at most two effects, no report.
     pub fn new(data_path: PathBuf) -> Self {
-        Self {
-            data_path,
-            actuator_file: None,
-            rod: RodOverrides::default(),
-            options: SolverOptions::default(),
-            fit: FitSettings::default(),
-            holdout: None,
-            holdout_cable: None,
-            alpha: 1e-3,
-            threshold: 10.0,
-            margin: 10.0,
-            max_effects: 2,
-            report_dir: None,
-        }
+        Self { input: FitInput::new(data_path), alpha: 1e-3, threshold: 10.0, margin: 10.0, max_effects: 2, out: None, write_report: false }
     }
 
     /// The kind of data, with the settings it refuses checked.
     pub fn check(&self) -> Result<DataKind<'_>, CalibrateError> {
-        let kind = check_fit(self.actuator_file.as_deref(), &self.fit, &self.rod, self.holdout.is_some())?;
-        if kind == DataKind::Measurements && self.holdout_cable.is_some() {
+        let kind = self.input.check()?;
+        if kind == DataKind::Measurements && self.input.holdout_cable.is_some() {
             return Err(Refused::CableHoldoutOnMeasurements.into());
         }
         Ok(kind)
+    }
+
+    /// Where the report goes: `out`, else beside the data; none without
+    /// `write_report`.
+    pub fn report_dir(&self) -> Option<PathBuf> {
+        self.write_report.then(|| self.out.clone().unwrap_or_else(|| Self::default_report_dir(&self.input.data_path)))
     }
 
     /// The report directory when none is given: beside the data file, named
@@ -231,34 +278,30 @@ impl DiagnoseRequest {
     }
 }
 
-/// The checks calibrate and diagnose share: what captures refuse, the
-/// markers' noise and the held parameters planar data cannot hold.
-pub(crate) fn check_fit<'a>(actuator_file: Option<&'a Path>, fit: &FitSettings, rod: &RodOverrides, holdout: bool) -> Result<DataKind<'a>, CalibrateError> {
-    let kind = match actuator_file {
-        Some(actuator_file) => DataKind::Captures { actuator_file },
-        None => DataKind::Measurements,
-    };
-    if let DataKind::Captures { .. } = kind {
-        if holdout {
-            return Err(Refused::RoutingHoldoutOnCaptures.into());
-        }
-        if fit.centrelines.is_some() {
-            return Err(Refused::CentrelinesOnCaptures.into());
-        }
-        if !rod.is_empty() {
-            return Err(Refused::RodOnCaptures.into());
-        }
-        if !(fit.noise_mm.is_finite() && fit.noise_mm > 0.0) {
-            return Err(NoiseError::Markers { value: fit.noise_mm }.into());
+/// The effects of `names` (`--effect`, each; Python's `effects=`), each
+/// once, in order.
+pub fn effects_by_name(names: &[String]) -> Result<Vec<Effect>, InvalidRequest> {
+    let mut effects = Vec::new();
+    for name in names {
+        let effect = Effect::parse(name).ok_or_else(|| InvalidRequest::UnknownEffect { name: name.clone() })?;
+        if !effects.contains(&effect) {
+            effects.push(effect);
         }
     }
-    if fit.max_iterations == 0 {
-        return Err(Refused::NoIterations.into());
-    }
-    if kind == DataKind::Measurements {
-        if let Some(&(p, _)) = fit.held.iter().find(|(p, _)| !p.is_planar()) {
-            return Err(CalibrateError::Held(HeldError::NotPlanar { name: p.name() }));
-        }
-    }
-    Ok(kind)
+    Ok(effects)
+}
+
+/// Effects by name, each once.
+fn effect_names<'de, D: Deserializer<'de>>(deserializer: D) -> Result<Vec<Effect>, D::Error> {
+    effects_by_name(&Vec::<String>::deserialize(deserializer)?).map_err(serde::de::Error::custom)
+}
+
+/// Held parameters from their `NAME=VALUE` items (`--fix`, each).
+fn held_items<'de, D: Deserializer<'de>>(deserializer: D) -> Result<Vec<(Parameter, f64)>, D::Error> {
+    Vec::<String>::deserialize(deserializer)?.iter().map(|item| Parameter::parse_held(item)).collect::<Result<_, _>>().map_err(serde::de::Error::custom)
+}
+
+/// The loss by its name, or none.
+fn loss_name<'de, D: Deserializer<'de>>(deserializer: D) -> Result<Option<LossKind>, D::Error> {
+    Option::<String>::deserialize(deserializer)?.as_deref().map(LossKind::parse).transpose().map_err(serde::de::Error::custom)
 }

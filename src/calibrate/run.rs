@@ -161,12 +161,12 @@ pub fn run_observed(request: &CalibrateRequest, observe: &mut dyn FnMut(Calibrat
 }
 
 fn calibrate_measurements(request: &CalibrateRequest, observe: &mut dyn FnMut(CalibrateProgress)) -> Result<MeasurementsCalibration, CalibrateError> {
-    let data = &read_measurements(&request.data_path)?;
-    let actuator = request.rod.resolve(data.actuator.as_ref())?;
+    let data = &read_measurements(&request.input.data_path)?;
+    let actuator = request.input.rod.resolve(data.actuator.as_ref())?;
     actuator.validate()?;
-    let options = &request.options;
-    let (train, held) = split_holdout(data, request.holdout.as_deref())?;
-    let (spec, settings, start, held_effects) = request.fit.resolve(&actuator, data)?;
+    let options = &request.input.options;
+    let (train, held) = split_holdout(data, request.input.holdout.as_deref())?;
+    let (spec, settings, start, held_effects) = request.input.fit.resolve(&actuator, data)?;
     let mut effects = spec.effects();
     for &e in &request.effects {
         if !effects.contains(&e) {
@@ -348,16 +348,16 @@ fn fitted_names(fit: &FitResult<CapturesReport>) -> String {
 /// captures, reporting each accepted step to `observe`.
 fn calibrate_captures(request: &CalibrateRequest, actuator_file: &Path, observe: &mut dyn FnMut(CalibrateProgress)) -> Result<CapturesCalibration, CalibrateError> {
     let started = std::time::Instant::now();
-    let loss = request.fit.loss(LossKind::Squares)?;
+    let loss = request.input.fit.loss(LossKind::Squares)?;
     let mut base = read_actuator(actuator_file)?;
-    let set = read_actuator_set(&request.data_path, request.fit.markers.as_deref(), &base)?;
-    for &(p, v) in &request.fit.held {
+    let set = read_actuator_set(&request.input.data_path, request.input.fit.markers.as_deref(), &base)?;
+    for &(p, v) in &request.input.fit.held {
         if !(v.is_finite() && (matches!(p, Parameter::Effect(_)) || v > 0.0)) {
             return Err(CalibrateError::Held(crate::calibrate::HeldError::NotPositive { name: p.name(), value: v }));
         }
         p.set(&mut base, v);
     }
-    let is_held = |p: Parameter| request.fit.held.iter().any(|(h, _)| *h == p);
+    let is_held = |p: Parameter| request.input.fit.held.iter().any(|(h, _)| *h == p);
     if let Some(&e) = request.effects.iter().find(|&&e| is_held(Parameter::Effect(e))) {
         return Err(CalibrateError::FittedAndHeld { effect: e });
     }
@@ -366,16 +366,16 @@ fn calibrate_captures(request: &CalibrateRequest, actuator_file: &Path, observe:
         params.retain(|&p| p != Parameter::Density);
     }
     params.extend(request.effects.iter().map(|&e| Parameter::Effect(e)));
-    let (train, test) = set.hold_out_cable(request.holdout_cable, base.cables.len())?;
-    let spec = FitSpec { params, held: Vec::new(), loss, max_iterations: request.fit.max_iterations };
-    let fit = fit(&base, &Captures::new(&train, request.fit.noise_mm, &request.options), &spec, &mut |step| observe(CalibrateProgress::MarkerStep(step)))?;
+    let (train, test) = set.hold_out_cable(request.input.holdout_cable, base.cables.len())?;
+    let spec = FitSpec { params, held: Vec::new(), loss, max_iterations: request.input.fit.max_iterations };
+    let fit = fit(&base, &Captures::new(&train, request.input.fit.noise_mm, &request.input.options), &spec, &mut |step| observe(CalibrateProgress::MarkerStep(step)))?;
     let holdout = match &test {
-        Some(t) => Some(ErrorReport::of(t, &solve_captures(&fit.actuator, &request.options, t)?)),
+        Some(t) => Some(ErrorReport::of(t, &solve_captures(&fit.actuator, &request.input.options, t)?)),
         None => None,
     };
     let mut report = CapturesCalibration {
-        held: request.fit.held.iter().map(|(p, v)| (p.name().to_string(), *v)).collect(),
-        holdout_cable: request.holdout_cable,
+        held: request.input.fit.held.iter().map(|(p, v)| (p.name().to_string(), *v)).collect(),
+        holdout_cable: request.input.holdout_cable,
         holdout,
         captures_fitted: train.captures.len(),
         elapsed_s: started.elapsed().as_secs_f64(),

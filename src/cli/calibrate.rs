@@ -3,12 +3,12 @@
 //! RMS error per routing.
 
 use super::ActuatorArgs;
-use anyhow::bail;
-use cablemap::calibrate::{run_observed, CalibrateError, CalibrateRequest, Effect, FitSettings, HoldoutError, LossKind, Parameter};
+use cablemap::calibrate::request::{effects_by_name, FitInput};
+use cablemap::calibrate::{run_observed, CalibrateError, CalibrateRequest, FitSettings, HoldoutError, LossKind, Parameter};
 use cablemap::solver::SolverOptions;
 use clap::Args;
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Settings every fit shares (calibrate and diagnose).
 #[derive(Debug, Clone, Args)]
@@ -45,6 +45,20 @@ pub struct FitArgs {
 }
 
 impl FitArgs {
+    /// What the fit is given: the data (captures with `actuator_file`),
+    /// the rod and solver flags, these settings and what is held out.
+    pub fn input(&self, data: &Path, actuator_file: Option<&Path>, actuator: &ActuatorArgs, holdout: Option<&str>, holdout_cable: Option<usize>) -> anyhow::Result<FitInput> {
+        Ok(FitInput {
+            data_path: data.to_path_buf(),
+            actuator_file: actuator_file.map(Path::to_path_buf),
+            rod: actuator.overrides(),
+            options: actuator.solver_options(&SolverOptions::default()),
+            fit: self.settings()?,
+            holdout: holdout.map(str::to_string),
+            holdout_cable,
+        })
+    }
+
     /// The fit settings the flags describe.
     pub fn settings(&self) -> anyhow::Result<FitSettings> {
         let held = self.fix.iter().map(|item| Parameter::parse_held(item)).collect::<Result<Vec<_>, _>>()?;
@@ -106,32 +120,11 @@ pub struct CalibrateArgs {
     pub actuator: ActuatorArgs,
 }
 
-/// Parses effect names, naming the bad one.
-pub fn parse_effects(names: &[String]) -> anyhow::Result<Vec<Effect>> {
-    let mut out = Vec::new();
-    for n in names {
-        let Some(e) = Effect::parse(n) else {
-            let all: Vec<&str> = Effect::ALL.iter().map(|e| e.name()).collect();
-            bail!("--effect {n}: unknown effect; use one of {}", all.join(", "));
-        };
-        if !out.contains(&e) {
-            out.push(e);
-        }
-    }
-    Ok(out)
-}
-
 /// Runs `cablemap calibrate`.
 pub fn run(args: &CalibrateArgs) -> anyhow::Result<()> {
     let request = CalibrateRequest {
-        data_path: args.data.clone(),
-        actuator_file: args.spatial_actuator.clone(),
-        rod: args.actuator.overrides(),
-        options: args.actuator.solver_options(&SolverOptions::default()),
-        fit: args.fit.settings()?,
-        effects: parse_effects(&args.effects)?,
-        holdout: args.holdout.clone(),
-        holdout_cable: args.holdout_cable,
+        input: args.fit.input(&args.data, args.spatial_actuator.as_deref(), &args.actuator, args.holdout.as_deref(), args.holdout_cable)?,
+        effects: effects_by_name(&args.effects)?,
         out: args.out.clone(),
     };
     // Progress on stderr (stdout may be --json).

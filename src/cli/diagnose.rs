@@ -5,7 +5,6 @@ use super::calibrate::{with_flag, FitArgs};
 use super::ActuatorArgs;
 use cablemap::calibrate::diagnose::{self, DiagnoseRequest};
 use cablemap::calibrate::CalibrateError;
-use cablemap::solver::SolverOptions;
 use clap::Args;
 use std::io::Write;
 use std::path::PathBuf;
@@ -60,18 +59,13 @@ pub struct DiagnoseArgs {
 /// Runs `cablemap diagnose`.
 pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
     let request = DiagnoseRequest {
-        data_path: args.data.clone(),
-        actuator_file: args.spatial_actuator.clone(),
-        rod: args.actuator.overrides(),
-        options: args.actuator.solver_options(&SolverOptions::default()),
-        fit: args.fit.settings()?,
-        holdout: args.holdout.clone(),
-        holdout_cable: args.holdout_cable,
+        input: args.fit.input(&args.data, args.spatial_actuator.as_deref(), &args.actuator, args.holdout.as_deref(), args.holdout_cable)?,
         alpha: args.alpha,
         threshold: args.threshold,
         margin: args.margin,
         max_effects: args.max_effects,
-        report_dir: (!args.no_report).then(|| args.out.clone().unwrap_or_else(|| DiagnoseRequest::default_report_dir(&args.data))),
+        out: args.out.clone(),
+        write_report: !args.no_report,
     };
     let report = diagnose::run(&request).map_err(|e| match e {
         CalibrateError::ReportDir(_) => anyhow::Error::new(e).context("--out"),

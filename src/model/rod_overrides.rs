@@ -86,3 +86,64 @@ impl RodOverrides {
         Ok(self.apply(&base))
     }
 }
+
+/// The fields a [`RodOverrides`] deserialises from, besides the effects by
+/// their registry names: the rod flags of a command by their names
+/// (`gravity = false` for `--no-gravity`, `actuator_file` for
+/// `--actuator-file`), as the Python keywords say them.
+const OVERRIDE_FIELDS: [&str; 10] =
+    ["actuator_file", "length_mm", "radius_mm", "ea_n", "ga_n", "ei_n_mm2", "density_g_cm3", "gravity", "radius_profile_mm", "cable_anchor_mm"];
+
+impl<'de> serde::Deserialize<'de> for RodOverrides {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct Fields;
+        impl<'de> serde::de::Visitor<'de> for Fields {
+            type Value = RodOverrides;
+
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("the rod's fields by their names")
+            }
+
+            fn visit_map<A: serde::de::MapAccess<'de>>(self, mut map: A) -> Result<RodOverrides, A::Error> {
+                use serde::de::Error;
+                let mut o = RodOverrides::default();
+                while let Some(key) = map.next_key::<String>()? {
+                    let slot = match key.as_str() {
+                        "length_mm" => &mut o.length_mm,
+                        "radius_mm" => &mut o.radius_mm,
+                        "ea_n" => &mut o.ea_n,
+                        "ga_n" => &mut o.ga_n,
+                        "ei_n_mm2" => &mut o.ei_n_mm2,
+                        "density_g_cm3" => &mut o.density_g_cm3,
+                        "cable_anchor_mm" => &mut o.cable_anchor_mm,
+                        "actuator_file" => {
+                            o.file = Some(map.next_value()?);
+                            continue;
+                        }
+                        "gravity" => {
+                            o.no_gravity = !map.next_value::<bool>()?;
+                            continue;
+                        }
+                        "radius_profile_mm" => {
+                            o.radius_profile_mm = Some(map.next_value()?);
+                            continue;
+                        }
+                        _ => match crate::model::REGISTRY.iter().find(|i| i.name == key) {
+                            Some(info) => {
+                                o.effects.push((*info, map.next_value()?));
+                                continue;
+                            }
+                            None => {
+                                let known: Vec<&str> = OVERRIDE_FIELDS.iter().copied().chain(crate::model::REGISTRY.iter().map(|i| i.name)).collect();
+                                return Err(A::Error::custom(format!("unknown rod field {key:?}: the fields are {}", known.join(", "))));
+                            }
+                        },
+                    };
+                    *slot = Some(map.next_value()?);
+                }
+                Ok(o)
+            }
+        }
+        deserializer.deserialize_map(Fields)
+    }
+}

@@ -143,6 +143,12 @@ impl SolverSettings {
             ..Given::default()
         }
     }
+
+    /// A request's options from its `solver` object (for
+    /// `#[serde(deserialize_with = …)]`).
+    pub fn deserialize_options<'de, D: Deserializer<'de>>(deserializer: D) -> Result<SolverOptions, D::Error> {
+        Self::deserialize(deserializer).map(|s| s.options())
+    }
 }
 
 /// The `[solver]` table of a planar sweep spec: the planar backends' keys

@@ -31,18 +31,18 @@ pub fn run(request: &DiagnoseRequest) -> Result<DiagnoseReport, CalibrateError> 
 }
 
 fn diagnose_measurements(request: &DiagnoseRequest) -> Result<Diagnosis<MeasurementsReport>, CalibrateError> {
-    if let Some(dir) = &request.report_dir {
+    if let Some(dir) = &request.report_dir() {
         crate::io::check_outside_run_dir(dir, "the report directory")?;
     }
-    let data = read_measurements(&request.data_path)?;
-    let actuator = request.rod.resolve(data.actuator.as_ref())?;
+    let data = read_measurements(&request.input.data_path)?;
+    let actuator = request.input.rod.resolve(data.actuator.as_ref())?;
     actuator.validate()?;
-    let (fit, measurements, start, held_effects) = request.fit.resolve(&actuator, &data)?;
+    let (fit, measurements, start, held_effects) = request.input.fit.resolve(&actuator, &data)?;
     let spec = DiagnoseSpec {
         fit,
         settings: measurements,
-        options: request.options.clone(),
-        holdout: request.holdout.clone(),
+        options: request.input.options.clone(),
+        holdout: request.input.holdout.clone(),
         held_effects,
         threshold: request.threshold,
         margin: request.margin,
@@ -50,8 +50,8 @@ fn diagnose_measurements(request: &DiagnoseRequest) -> Result<Diagnosis<Measurem
         alpha: request.alpha,
     };
     let mut diagnosis = diagnose(&start, &data, &spec)?;
-    if let Some(dir) = &request.report_dir {
-        diagnosis.written = write_report(dir, &request.data_path, &data, &diagnosis, &spec)?;
+    if let Some(dir) = &request.report_dir() {
+        diagnosis.written = write_report(dir, &request.input.data_path, &data, &diagnosis, &spec)?;
     }
     Ok(diagnosis)
 }
@@ -60,24 +60,24 @@ fn diagnose_measurements(request: &DiagnoseRequest) -> Result<Diagnosis<Measurem
 /// report directory when asked for (refused first when inside a sweep run,
 /// before anything is read); the report's files are in `written`.
 fn diagnose_captures_request(request: &DiagnoseRequest, actuator_file: &Path) -> Result<Diagnosis<CapturesReport>, CalibrateError> {
-    if !request.fit.held.is_empty() {
+    if !request.input.fit.held.is_empty() {
         return Err(Refused::HeldInCapturesDiagnosis.into());
     }
-    let loss = request.fit.loss(LossKind::Squares)?;
-    if let Some(dir) = &request.report_dir {
+    let loss = request.input.fit.loss(LossKind::Squares)?;
+    if let Some(dir) = &request.report_dir() {
         crate::io::check_outside_run_dir(dir, "the report directory")?;
     }
     let base = read_actuator(actuator_file)?;
-    let set = read_actuator_set(&request.data_path, request.fit.markers.as_deref(), &base)?;
+    let set = read_actuator_set(&request.input.data_path, request.input.fit.markers.as_deref(), &base)?;
     let mut params: Vec<Parameter> = Parameter::BODY.to_vec();
     if !base.rod.gravity.enabled {
         params.retain(|&p| p != Parameter::Density);
     }
     let spec = DiagnoseSpec {
-        fit: FitSpec { params, held: Vec::new(), loss, max_iterations: request.fit.max_iterations },
-        settings: request.fit.noise_mm,
-        options: request.options.clone(),
-        holdout: request.holdout_cable,
+        fit: FitSpec { params, held: Vec::new(), loss, max_iterations: request.input.fit.max_iterations },
+        settings: request.input.fit.noise_mm,
+        options: request.input.options.clone(),
+        holdout: request.input.holdout_cable,
         held_effects: Vec::new(),
         threshold: request.threshold,
         margin: request.margin,
@@ -85,9 +85,9 @@ fn diagnose_captures_request(request: &DiagnoseRequest, actuator_file: &Path) ->
         alpha: request.alpha,
     };
     let mut d = diagnose_captures(&base, &set, &spec)?;
-    if let Some(dir) = &request.report_dir {
-        let sources = super::captures_report::ReportSources { captures: &request.data_path, markers: request.fit.markers.as_deref(), actuator: actuator_file };
-        d.written = super::captures_report::write_report(dir, sources, &set, &d, &request.options)?;
+    if let Some(dir) = &request.report_dir() {
+        let sources = super::captures_report::ReportSources { captures: &request.input.data_path, markers: request.input.fit.markers.as_deref(), actuator: actuator_file };
+        d.written = super::captures_report::write_report(dir, sources, &set, &d, &request.input.options)?;
     }
     Ok(d)
 }
