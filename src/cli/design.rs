@@ -2,8 +2,6 @@
 
 use super::{ActuatorArgs, LengthBasisArgs};
 use anyhow::Context;
-use cablemap::design::actuator::DesignActuator;
-use cablemap::design::targets::TargetSet;
 use cablemap::design::{self, DesignError, DesignRequest, SearchOptions, Target, Weights};
 use cablemap::solver::SolverOptions;
 use clap::Args;
@@ -77,25 +75,13 @@ pub struct DesignArgs {
 
 /// The design request the arguments describe.
 fn request(args: &DesignArgs) -> anyhow::Result<DesignRequest> {
-    let rod = args.actuator.resolve()?;
-    let actuator = match &args.design_actuator {
-        Some(path) => {
-            anyhow::ensure!(args.actuator.actuator_file.is_none(), "give the rod either in --actuator FILE's [rod] table or by --actuator-file, not both");
-            Some(DesignActuator::read(path, |rod| args.actuator.apply(rod)).context("--actuator")?)
-        }
-        None => None,
-    };
-    let targets = match &args.targets {
-        // The rod's length sets the targets' default weights.
-        Some(path) => Some(TargetSet::read(path, actuator.as_ref().map_or(rod.length_mm, |a| a.actuator.rod.length_mm)).context("--targets")?),
-        None => None,
-    };
     Ok(DesignRequest {
-        rod,
-        actuator,
+        rod: args.actuator.resolve()?,
+        actuator_file: args.design_actuator.clone(),
+        actuator_rod: args.actuator.overrides(),
         options: args.actuator.solver_options(&SolverOptions::default()),
         target: args.target.as_deref().map(Target::parse).transpose().context("--target")?,
-        targets,
+        targets: args.targets.clone(),
         weights: args.weights.as_deref().map(Weights::parse).transpose().context("--weights")?,
         tension_min_n: args.tension_min_n,
         tension_max_n: args.tension_max_n,
@@ -121,6 +107,8 @@ pub fn run(args: &DesignArgs) -> anyhow::Result<()> {
     let done = design::run(&request).map_err(|e| match e {
         DesignError::ExportDir { .. } => anyhow::Error::new(e).context("--out"),
         DesignError::NoStarts => anyhow::Error::new(e).context("--starts"),
+        DesignError::ActuatorFile { .. } => anyhow::Error::new(e).context("--actuator"),
+        DesignError::TargetsFile { .. } => anyhow::Error::new(e).context("--targets"),
         DesignError::Tolerance { .. } => anyhow::Error::new(e).context("--tolerance-pct"),
         DesignError::Mould(m) => super::mould::with_flag(m),
         e => anyhow::Error::new(e),

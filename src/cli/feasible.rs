@@ -1,8 +1,7 @@
 //! `cablemap feasible`: the map's verdict on a target (thesis §4.2).
 
-use cablemap::design::feasible_request::{FeasibleRequest, MapSource};
-use cablemap::design::targets::TargetSet;
-use cablemap::design::{Target, Weights};
+use cablemap::design::feasible_request::FeasibleRequest;
+use cablemap::design::{DesignError, Target, Weights};
 use clap::Args;
 use std::io::Write;
 use std::path::PathBuf;
@@ -41,23 +40,19 @@ pub struct FeasibleArgs {
 
 /// Runs `cablemap feasible`.
 pub fn run(args: &FeasibleArgs) -> anyhow::Result<()> {
-    // The rod's length only sets the targets' default weights; the map's own rod is the thesis's unless its spec says otherwise.
-    let length_mm = cablemap::model::Rod::default().length_mm;
-    let targets = args.targets.as_deref().map(|file| TargetSet::read(file, length_mm)).transpose().map_err(|e| anyhow::Error::new(e).context("--targets"))?;
-    let source = match (&args.map, &args.study) {
-        (Some(map), _) => MapSource::Map(map.clone()),
-        (None, Some(study)) => MapSource::Study(study.clone()),
-        (None, None) => anyhow::bail!("give --map MAP_DIR or --study DIR"),
-    };
     let request = FeasibleRequest {
-        source,
+        map: args.map.clone(),
+        study: args.study.clone(),
         target: args.target.as_deref().map(Target::parse).transpose()?,
-        targets,
+        targets: args.targets.clone(),
         weights: args.weights.as_deref().map(Weights::parse).transpose()?,
         length_basis: args.basis.length_basis,
         nearest: args.nearest,
     };
-    let report = cablemap::design::feasible_request::run(&request)?;
+    let report = cablemap::design::feasible_request::run(&request).map_err(|e| match e {
+        DesignError::TargetsFile { .. } => anyhow::Error::new(e).context("--targets"),
+        e => anyhow::Error::new(e),
+    })?;
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
     if args.json {

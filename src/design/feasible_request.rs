@@ -10,7 +10,7 @@ use super::target::{Target, Weights};
 use super::targets::TargetSet;
 use super::DesignError;
 use crate::shape::LengthBasis;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::path::PathBuf;
 
@@ -25,18 +25,28 @@ pub enum MapSource {
 
 /// Everything a feasibility check needs: a target against a map or a
 /// study's maps, or a targets file against a cable sweep's map.
-#[derive(Debug, Clone)]
+/// Deserialises from the Python keywords' names.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct FeasibleRequest {
-    /// The map, or the study's maps.
-    pub source: MapSource,
+    /// One feasibility map directory (`cablemap reduce` output).
+    #[serde(default)]
+    pub map: Option<PathBuf>,
+    /// A study directory (`cablemap study` output): every variant's map.
+    #[serde(default)]
+    pub study: Option<PathBuf>,
     /// The thesis's target.
+    #[serde(default, deserialize_with = "super::request::target_text")]
     pub target: Option<Target>,
-    /// A targets file's targets (with the map of a cable sweep).
-    pub targets: Option<TargetSet>,
+    /// A targets file (with the map of a cable sweep).
+    #[serde(default)]
+    pub targets: Option<PathBuf>,
     /// Weights of the distance to the nearest designs for `target`
     /// (checked against it here; the thesis's when none).
+    #[serde(default, deserialize_with = "super::request::weights_text")]
     pub weights: Option<Weights>,
     /// The length the target's coefficients are per unit of.
+    #[serde(default)]
     pub length_basis: LengthBasis,
     /// Nearest simulated designs to list.
     pub nearest: usize,
@@ -129,14 +139,22 @@ impl fmt::Display for FeasibleReport {
 }
 
 impl FeasibleRequest {
-    /// Refuses what the request cannot mean: both or neither of `target`
-    /// and `targets`, `targets` without one map, weights with `targets`.
-    pub fn check(&self) -> Result<(), DesignError> {
-        match (&self.target, &self.targets, &self.source) {
+    /// What the target is judged against, with what the request cannot
+    /// mean refused: both or neither of a map and a study, both or neither
+    /// of `target` and `targets`, `targets` without one map, weights with
+    /// `targets`.
+    pub fn check(&self) -> Result<MapSource, DesignError> {
+        let source = match (&self.map, &self.study) {
+            (Some(_), Some(_)) => return Err(DesignError::MapAndStudy),
+            (Some(map), None) => MapSource::Map(map.clone()),
+            (None, Some(study)) => MapSource::Study(study.clone()),
+            (None, None) => return Err(DesignError::NoMapOrStudy),
+        };
+        match (&self.target, &self.targets, &source) {
             (Some(_), Some(_), _) | (None, None, _) => Err(DesignError::TargetOrTargets),
             (None, Some(_), MapSource::Study(_)) => Err(DesignError::TargetsNeedMap),
             (None, Some(_), _) if self.weights.is_some() => Err(DesignError::TargetOnly { setting: TargetOnly::Weights }),
-            _ => Ok(()),
+            _ => Ok(source),
         }
     }
 }
@@ -144,10 +162,12 @@ impl FeasibleRequest {
 /// Runs `feasible`: the map's verdict on the target, or every study
 /// variant's, or a cable sweep's map on every target of a targets file.
 pub fn run(request: &FeasibleRequest) -> Result<FeasibleReport, DesignError> {
-    request.check()?;
-    let FeasibleRequest { source, target, targets, weights, length_basis, nearest } = request;
+    let source = &request.check()?;
+    let FeasibleRequest { target, targets, weights, length_basis, nearest, .. } = request;
     if let (Some(targets), MapSource::Map(dir)) = (targets, source) {
-        return Ok(FeasibleReport::Targets(super::reach::check(dir, targets, *length_basis, *nearest)?));
+        // The rod's length only sets the targets' default weights; the map's own rod is the thesis's unless its spec says otherwise.
+        let targets = TargetSet::read(targets, crate::model::Rod::default().length_mm)?;
+        return Ok(FeasibleReport::Targets(super::reach::check(dir, &targets, *length_basis, *nearest)?));
     }
     let target = target.as_ref().ok_or(DesignError::TargetOrTargets)?;
     let weights = &weights.clone().unwrap_or_default();

@@ -104,7 +104,16 @@ pub enum DesignError {
         /// Which.
         setting: request::TargetOnly,
     },
-    /// A targets file needs one map, a cable sweep's.
+    /// A rod file beside an actuator file, which holds the rod.
+    #[error("give the rod either in --actuator FILE's [rod] table or by --actuator-file, not both")]
+    RodTwice,
+    /// `feasible` with neither a map nor a study.
+    #[error("give --map MAP_DIR or --study DIR")]
+    NoMapOrStudy,
+    /// `feasible` with both a map and a study.
+    #[error("give --map or --study, not both")]
+    MapAndStudy,
+    /// `--targets` with a study: the map of a cable sweep answers a targets file.
     #[error("--targets needs --map: the map of a cable sweep")]
     TargetsNeedMap,
     /// The tolerance is not a finite percentage ≥ 0.

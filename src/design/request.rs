@@ -2,68 +2,126 @@
 //! of one planar cable for one target, or an actuator of 1–8 cables for a
 //! sequence of targets, decided from its input.
 
-use super::actuator::{DesignActuator, DEFAULT_TENSION_RANGE_N};
+use super::actuator::{default_tension_min_n, DesignActuator, DEFAULT_TENSION_MAX_N, DEFAULT_TENSION_RANGE_N};
 use super::map::MapDir;
 use super::objective::{Bounds, Objective};
 use super::search::SearchOptions;
 use super::target::{Target, Weights};
 use super::targets::TargetSet;
 use super::DesignError;
-use crate::model::{Rod, Routing};
-use crate::solver::SolverOptions;
-use crate::mould::MouldParams;
+use crate::model::{Actuator, Rod, RodOverrides, Routing};
+use crate::mould::{MouldParams, MouldSettings};
 use crate::shape::LengthBasis;
-use std::path::PathBuf;
+use crate::solver::{SolverOptions, SolverSettings};
+use serde::{Deserialize, Deserializer};
+use std::path::{Path, PathBuf};
 
-/// Everything a design needs: the thesis's design of one planar cable for
-/// one target (`target`), or an actuator of 1–8 cables for a sequence of
-/// targets or a trajectory (`targets`). The request decides which from its
-/// input and refuses, in [`DesignRequest::check`], the settings that do
-/// not apply to it.
-#[derive(Debug, Clone)]
+/// Everything a design needs, as given: the thesis's design of one planar
+/// cable for one target (`target`), or an actuator of 1–8 cables for a
+/// sequence of targets or a trajectory (`targets`). The request decides
+/// which from its input, refuses in [`DesignRequest::check`] the settings
+/// that do not apply to it, and reads its files
+/// ([`DesignRequest::design_actuator`], [`DesignRequest::target_set`]).
+/// Deserialises from the Python keywords' names.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct DesignRequest {
-    /// The rod (validated here); with `targets` and no `actuator`, the rod
-    /// of the one cable free in y that is designed.
+    /// The rod (validated here); with `targets` and no `actuator_file`, the
+    /// rod of the one cable free in y that is designed. Given as an
+    /// actuator without cables, torsion or gravity direction.
+    #[serde(rename = "actuator", deserialize_with = "rod_alone")]
     pub rod: Rod,
-    /// With `targets`: the actuator to design and what each cable may change.
-    pub actuator: Option<DesignActuator>,
+    /// With `targets`: the actuator to design and what each cable may
+    /// change (`--actuator FILE.toml`, [`DesignActuator`]).
+    #[serde(rename = "design_actuator", default)]
+    pub actuator_file: Option<PathBuf>,
+    /// Values set on `actuator_file`'s rod (the rod flags; a rod file is
+    /// refused: the rod is the file's `[rod]`).
+    #[serde(rename = "rod_fields", default)]
+    pub actuator_rod: RodOverrides,
     /// Solver settings.
+    #[serde(rename = "solver", default, deserialize_with = "SolverSettings::deserialize_options")]
     pub options: SolverOptions,
-    /// The thesis's target shape (one planar cable).
+    /// The thesis's target shape (one planar cable; `x=50,y=5,a0=-0.025`).
+    #[serde(default, deserialize_with = "target_text")]
     pub target: Option<Target>,
-    /// A sequence of targets or a trajectory (1–8 cables).
-    pub targets: Option<TargetSet>,
+    /// A targets file: a sequence of targets or a trajectory (1–8 cables).
+    #[serde(default)]
+    pub targets: Option<PathBuf>,
     /// Weights λ of eq. 3.17 for `target` (the thesis's when none).
+    #[serde(default, deserialize_with = "weights_text")]
     pub weights: Option<Weights>,
     /// Lower tension bound, N; the map's, else [`DEFAULT_TENSION_RANGE_N`], when none.
+    #[serde(default)]
     pub tension_min_n: Option<f64>,
     /// Upper tension bound, N; the map's, else [`DEFAULT_TENSION_RANGE_N`], when none.
+    #[serde(default)]
     pub tension_max_n: Option<f64>,
     /// Largest |y_i|, mm; the thesis's 0.999 r when none. With `moulds`, no
     /// more than the moulds can cast ([`MouldParams::max_castable_offset_mm`]).
+    #[serde(default)]
     pub max_offset_mm: Option<f64>,
     /// The length the target's coefficients are per unit of.
+    #[serde(default)]
     pub length_basis: LengthBasis,
     /// A feasibility map: with `target` its verdict, its nearest designs as
     /// seeds and its tension range; with `targets` (a cable sweep's map) its
     /// nearest designs' channels as seeds.
+    #[serde(default)]
     pub map: Option<PathBuf>,
     /// Starts refined to convergence ([`super::search::ROUTING_STARTS`] or [`super::search::SEQUENCE_STARTS`] when none).
+    #[serde(default)]
     pub starts: Option<usize>,
     /// Most solves per converging start (per target with `targets`).
+    #[serde(default = "default_max_evaluations", deserialize_with = "max_evaluations")]
     pub max_evaluations: usize,
     /// A component counts as met within this many percent (5, or each
     /// target's own `tolerance_pct`, when none).
+    #[serde(default)]
     pub tolerance_pct: Option<f64>,
     /// Export directory (design.json, channel files, pictures).
+    #[serde(default)]
     pub out: Option<PathBuf>,
     /// The moulds' parameters: with `write_moulds` the moulds written;
     /// without, the bound `cablemap mould` will need is named when this
     /// search allows more ([`DesignRequest::mould_bound_exceeded`]).
+    #[serde(default, deserialize_with = "MouldSettings::deserialize_params")]
     pub mould: MouldParams,
     /// With `out`: also write the printable moulds; the search then keeps
     /// the channels where they can cast them.
+    #[serde(rename = "moulds", default)]
     pub write_moulds: bool,
+}
+
+/// The rod of an actuator given without cables, torsion or gravity
+/// direction (a design's `rod`).
+fn rod_alone<'de, D: Deserializer<'de>>(deserializer: D) -> Result<Rod, D::Error> {
+    let actuator = Actuator::deserialize(deserializer)?;
+    if !actuator.cables.is_empty() || actuator.gj_n_mm2.is_some() || actuator.gravity_direction.is_some() {
+        return Err(serde::de::Error::custom(DesignError::ActuatorWithTarget));
+    }
+    Ok(actuator.rod)
+}
+
+/// A target from its text (`x=50,y=5,a0=-0.025`), the error named by its field.
+pub(crate) fn target_text<'de, D: Deserializer<'de>>(deserializer: D) -> Result<Option<Target>, D::Error> {
+    let text = Option::<String>::deserialize(deserializer)?;
+    text.as_deref().map(Target::parse).transpose().map_err(|e| serde::de::Error::custom(format!("target: {e}")))
+}
+
+/// Weights from their text (`a0=200`), the error named by its field.
+pub(crate) fn weights_text<'de, D: Deserializer<'de>>(deserializer: D) -> Result<Option<Weights>, D::Error> {
+    let text = Option::<String>::deserialize(deserializer)?;
+    text.as_deref().map(Weights::parse).transpose().map_err(|e| serde::de::Error::custom(format!("weights: {e}")))
+}
+
+fn default_max_evaluations() -> usize {
+    SearchOptions::default().max_evaluations
+}
+
+/// The most solves per start, the search's default when none.
+fn max_evaluations<'de, D: Deserializer<'de>>(deserializer: D) -> Result<usize, D::Error> {
+    Ok(Option::<usize>::deserialize(deserializer)?.unwrap_or_else(default_max_evaluations))
 }
 
 /// A setting that applies to the thesis's one-target design only: with
@@ -173,7 +231,7 @@ impl DesignRequest {
     pub fn check(&self) -> Result<(), DesignError> {
         match (&self.target, &self.targets) {
             (Some(_), Some(_)) | (None, None) => return Err(DesignError::TargetOrTargets),
-            (Some(_), None) if self.actuator.is_some() => return Err(DesignError::ActuatorWithTarget),
+            (Some(_), None) if self.actuator_file.is_some() => return Err(DesignError::ActuatorWithTarget),
             (None, Some(_)) => {
                 for (given, setting) in [
                     (self.weights.is_some(), TargetOnly::Weights),
@@ -188,6 +246,9 @@ impl DesignRequest {
             }
             _ => {}
         }
+        if self.actuator_file.is_some() && self.actuator_rod.file.is_some() {
+            return Err(DesignError::RodTwice);
+        }
         if self.starts == Some(0) {
             return Err(DesignError::NoStarts);
         }
@@ -195,6 +256,21 @@ impl DesignRequest {
             return Err(DesignError::Tolerance { tolerance_pct: t });
         }
         Ok(())
+    }
+
+    /// A targets request's actuator: the file's (its rod with
+    /// `actuator_rod` set), else the rod with one cable free in y (1 … 2 N,
+    /// the bounds of `target`).
+    pub fn design_actuator(&self) -> Result<DesignActuator, DesignError> {
+        match &self.actuator_file {
+            Some(path) => DesignActuator::read(path, |rod| self.actuator_rod.apply(rod)),
+            None => Ok(DesignActuator::planar(self.rod.clone(), default_tension_min_n(1), DEFAULT_TENSION_MAX_N, None)),
+        }
+    }
+
+    /// The targets file's targets, their default weights set by the rod of `design`.
+    pub fn target_set(&self, path: &Path, design: &DesignActuator) -> Result<TargetSet, DesignError> {
+        TargetSet::read(path, design.actuator.rod.length_mm)
     }
 
     /// The search settings, with `default_starts` when the request gives none.
@@ -250,7 +326,8 @@ mod tests {
             write_moulds: moulds.is_some(),
             mould: moulds.unwrap_or_default(),
             rod: Rod::default(),
-            actuator: None,
+            actuator_file: None,
+            actuator_rod: RodOverrides::default(),
             options: SolverOptions::default(),
             target: Some(Target::parse("x=50,y=5").unwrap()),
             targets: None,

@@ -4,7 +4,6 @@
 //! with the target, the design's files and moulds) or a sequence's
 //! ([`sequence_run`]).
 
-use super::actuator::{default_tension_min_n, DesignActuator, DEFAULT_TENSION_MAX_N};
 use super::feasible;
 use super::map::MapDir;
 use super::objective::compare;
@@ -16,10 +15,11 @@ use super::search::{self, ROUTING_STARTS};
 use super::sequence_report::SequenceRun;
 use super::sequence_run::{self, Sequence};
 use super::target::Target;
-use super::targets::{TargetSet, DEFAULT_TOLERANCE_PCT};
+use super::targets::DEFAULT_TOLERANCE_PCT;
 use super::DesignError;
 use crate::model::Routing;
 use crate::mould::{MouldParams, MouldSet};
+use std::path::Path;
 
 /// What a design returns: the thesis's one-target design, or a sequence's.
 #[derive(Debug, Clone)]
@@ -63,7 +63,7 @@ pub fn run(request: &DesignRequest) -> Result<DesignReport, DesignError> {
     request.check()?;
     match (&request.target, &request.targets) {
         (Some(target), _) => design_target(request, target).map(|r| DesignReport::Target(Box::new(r))),
-        (None, Some(targets)) => sequence_run::run(request, &sequence(request, targets)).map(|r| DesignReport::Sequence(Box::new(r))),
+        (None, Some(targets)) => sequence_run::run(request, &sequence(request, targets)?).map(|r| DesignReport::Sequence(Box::new(r))),
         (None, None) => Err(DesignError::TargetOrTargets),
     }
 }
@@ -105,17 +105,13 @@ fn design_target(request: &DesignRequest, target: &Target) -> Result<DesignRun, 
     Ok(DesignRun { objective, outcome, results, tolerance_pct, feasibility, record, out: request.out.clone(), exported, moulds })
 }
 
-/// A targets request's actuator: the file's, else the rod with one
-/// cable free in y (1 … 2 N, the bounds of `target`).
-fn sequence(request: &DesignRequest, targets: &TargetSet) -> Sequence {
-    let design = match &request.actuator {
-        Some(a) => a.clone(),
-        None => DesignActuator::planar(request.rod.clone(), default_tension_min_n(1), DEFAULT_TENSION_MAX_N, None),
-    };
-    let mut targets = targets.clone();
+/// A targets request's actuator ([`DesignRequest::design_actuator`]) and
+/// its targets, each within the request's tolerance when it gives one.
+fn sequence(request: &DesignRequest, targets: &Path) -> Result<Sequence, DesignError> {
+    let design = request.design_actuator()?;
+    let mut targets = request.target_set(targets, &design)?;
     if let Some(tol) = request.tolerance_pct {
         targets.targets.iter_mut().for_each(|t| t.tolerance_pct = tol);
     }
-    Sequence { design, targets }
+    Ok(Sequence { design, targets })
 }
-

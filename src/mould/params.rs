@@ -56,6 +56,12 @@ impl MouldSettings {
             ..d
         }
     }
+
+    /// A request's parameters from its `mould` object (for
+    /// `#[serde(deserialize_with = …)]`).
+    pub fn deserialize_params<'de, D: serde::Deserializer<'de>>(deserializer: D) -> Result<MouldParams, D::Error> {
+        Self::deserialize(deserializer).map(|s| s.params())
+    }
 }
 
 /// Refuses a size (a parameter or the body's) that is not finite or is
