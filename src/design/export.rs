@@ -3,7 +3,7 @@
 //! the achieved shape over the target.
 
 use super::objective::{Evaluation, Objective};
-use super::target::Component;
+use super::targets::Quantity;
 use super::record::DesignRecord;
 use super::DesignError;
 use crate::io::FileError;
@@ -201,10 +201,10 @@ pub fn shape_png(path: &Path, objective: &Objective, eval: &Evaluation) -> Resul
     let target_centreline = target.highest_order().map(|_| {
         let pose = &eval.pose;
         let to_deformed = 1.0 / objective.length_basis.factor_from_deformed(pose.length_mm, act.length_mm);
-        let a: Vec<f64> = (0..eval.a.len()).map(|k| to_deformed * target.get(Component::A(k)).unwrap_or(eval.a[k])).collect();
+        let a: Vec<f64> = (0..eval.a.len()).map(|k| to_deformed * target.get(Quantity::BendZ(k)).unwrap_or(eval.a[k])).collect();
         centreline_from_coefficients(&a, pose.length_mm, pose.base_angle_rad, 121)
     });
-    let tip = target.get(Component::TipX).zip(target.get(Component::TipY));
+    let tip = target.get(Quantity::TipX).zip(target.get(Quantity::TipY));
     let title = format!(
         "design: y = [{}] mm, τ = {:.3} N",
         eval.routing_mm.iter().map(|y| format!("{y:.2}")).collect::<Vec<_>>().join(", "),

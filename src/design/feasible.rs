@@ -6,7 +6,8 @@
 use super::map::{map_error, Cell, MapDesign, MapDir, MapMismatch, CELL_STATS_ORDER, MODES};
 use super::search::routing::Design;
 use super::search::SeedSource;
-use super::target::{Component, Target, Weights};
+use super::target::{target_key, Target, Weights};
+use super::targets::Quantity;
 use super::DesignError;
 use crate::model::Cable;
 use crate::shape::LengthBasis;
@@ -203,8 +204,8 @@ pub struct FeasibilityReport {
 /// basis is refused when the target has coefficients (no exact conversion exists).
 pub fn check(map: &MapDir, target: &Target, basis: LengthBasis, weights: &Weights, nearest: usize) -> Result<FeasibilityReport, DesignError> {
     check_length_basis(map, basis, target)?;
-    let x = target.get(Component::TipX);
-    let y = target.get(Component::TipY);
+    let x = target.get(Quantity::TipX);
+    let y = target.get(Quantity::TipY);
     let column = x.map(|x| cell_index(x, map.summary.x_min_mm, map.summary.cell_mm));
     let row = y.map(|y| cell_index(y, map.summary.y_min_mm, map.summary.cell_mm));
     let within = |c: &Cell, reach: i32| {
@@ -230,11 +231,11 @@ pub fn check(map: &MapDir, target: &Target, basis: LengthBasis, weights: &Weight
     let mut unchecked = Vec::new();
     let mut checked: Vec<(usize, f64)> = Vec::new();
     for (c, v) in &target.components {
-        if let Component::A(k) = c {
+        if let Quantity::BendZ(k) = c {
             if *k <= stats_order {
                 checked.push((*k, *v));
             } else {
-                unchecked.push(c.key());
+                unchecked.push(target_key(*c));
             }
         }
     }
@@ -348,11 +349,12 @@ fn cell_index(v: f64, min_mm: f64, cell_mm: f64) -> i32 {
 }
 
 /// The value of `component` in a map design (None for an order the map does not store).
-fn design_value(d: &MapDesign, component: Component) -> Option<f64> {
+fn design_value(d: &MapDesign, component: Quantity) -> Option<f64> {
     match component {
-        Component::TipX => Some(d.tip_x_mm),
-        Component::TipY => Some(d.tip_y_mm),
-        Component::A(k) => d.a.get(k).copied(),
+        Quantity::TipX => Some(d.tip_x_mm),
+        Quantity::TipY => Some(d.tip_y_mm),
+        Quantity::BendZ(k) => d.a.get(k).copied(),
+        _ => None,
     }
 }
 
@@ -388,8 +390,8 @@ fn mode_check(map: &MapDir, target: &Target, cell: Option<&Cell>) -> ModeCheck {
     let b = &map.summary.mode_boundaries;
     // The reducer's ranges() takes both coefficients; a missing one gets a
     // placeholder whose range is then ignored.
-    let i = target.get(Component::A(0)).map(|a0| b.ranges(a0, 0.0).0);
-    let j = target.get(Component::A(1)).map(|a1| b.ranges(0.0, a1).1);
+    let i = target.get(Quantity::BendZ(0)).map(|a0| b.ranges(a0, 0.0).0);
+    let j = target.get(Quantity::BendZ(1)).map(|a1| b.ranges(0.0, a1).1);
     let candidates: Vec<usize> =
         (0..MODES).filter(|m| i.is_none_or(|i| m / 3 == i) && j.is_none_or(|j| m % 3 == j)).collect();
     let mode = match (i, j) {
@@ -457,7 +459,7 @@ impl fmt::Display for FeasibilityReport {
 /// The command that designs for `target` with `map_dir`'s designs as seeds,
 /// ready to paste: `cablemap design --target x=…,a0=… --map MAP_DIR`.
 pub fn design_command(target: &Target, map_dir: &Path) -> String {
-    let components: Vec<String> = target.components.iter().map(|(c, v)| format!("{}={v}", c.key())).collect();
+    let components: Vec<String> = target.components.iter().map(|(c, v)| format!("{}={v}", target_key(*c))).collect();
     format!("cablemap design --target {} --map {}", components.join(","), shell_word(&map_dir.display().to_string()))
 }
 

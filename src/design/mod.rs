@@ -3,7 +3,8 @@
 //! cable and one target (`design --target`) and for several cables, targets
 //! or a trajectory (`design --targets`, docs/design.md).
 //!
-//! - [`target`]: the thesis's target (tip, curvature coefficients, weights);
+//! - [`target`]: the thesis's `--target` list and its weights, over the
+//!   same [`targets::Quantity`] as a targets file;
 //!   [`targets`]: a targets file (`[[target]]`, `[trajectory]`).
 //! - [`actuator`]: the actuator file with what each cable may change.
 //! - [`objective`]: eq. 3.17 of one planar cable as weighted residuals, and
@@ -42,11 +43,12 @@ pub mod target;
 pub mod targets;
 pub mod trajectory;
 
-pub use objective::{compare, Bounds, ComponentResult, Evaluation, Objective};
+pub use objective::{compare, Bounds, Evaluation, Objective};
 pub use search::{SearchOptions, SeedSource, StartReport, Termination};
 pub use request::DesignRequest;
 pub use run::{run, DesignReport};
-pub use target::{Component, Target, Weights};
+pub use target::{Target, Weights};
+pub use targets::{ComponentOutcome, Quantity};
 
 /// A target's tip farther from the clamp than the rod is long (its asked
 /// components alone): no design reaches it.

@@ -1,7 +1,8 @@
 //! The objective of eq. 3.17 as weighted residuals, and the bounds on the
 //! design variables (control points y_0…y_4 and tension τ).
 
-use super::target::{Component, Target, Weights};
+use super::target::{Target, Weights};
+use super::targets::{ComponentOutcome, Quantity};
 use super::DesignError;
 use crate::model::{ControlPoints, Rod, Routing};
 use crate::solver::{Simulator, SolveFailure, SolverOptions, TipPose};
@@ -70,11 +71,12 @@ pub struct Evaluation {
 
 impl Evaluation {
     /// The achieved value of `component` (None for an order not computed).
-    pub fn value(&self, component: Component) -> Option<f64> {
+    pub fn value(&self, component: Quantity) -> Option<f64> {
         match component {
-            Component::TipX => Some(self.pose.tip_x_mm),
-            Component::TipY => Some(self.pose.tip_y_mm),
-            Component::A(k) => self.a.get(k).copied(),
+            Quantity::TipX => Some(self.pose.tip_x_mm),
+            Quantity::TipY => Some(self.pose.tip_y_mm),
+            Quantity::BendZ(k) => self.a.get(k).copied(),
+            _ => None,
         }
     }
 }
@@ -174,42 +176,19 @@ impl Objective {
     }
 }
 
-/// Per-component comparison of a design with its target.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct ComponentResult {
-    /// Which component.
-    pub component: Component,
-    /// Requested value.
-    pub target: f64,
-    /// Achieved value.
-    pub achieved: f64,
-    /// 100 (achieved − target)/|target|, % (None for a zero target).
-    pub error_pct: Option<f64>,
-    /// Whether the component is met within the tolerance.
-    pub met: bool,
-}
-
 /// Compares `eval` with the objective's target. A component is met when its
 /// relative error is within `tolerance_pct`; a zero target is judged against
 /// a natural scale instead (the rod length L for positions, 1/L for
 /// curvature coefficients: one radian of bending over the rod).
-pub fn compare(objective: &Objective, eval: &Evaluation, tolerance_pct: f64) -> Vec<ComponentResult> {
+pub fn compare(objective: &Objective, eval: &Evaluation, tolerance_pct: f64) -> Vec<ComponentOutcome> {
     let length = objective.rod.length_mm;
     objective
         .target
         .components
         .iter()
-        .map(|&(component, target)| {
-            let achieved = eval.value(component).expect("order covers the target");
-            let error_pct = super::target::error_pct(achieved, target);
-            let met = match error_pct {
-                Some(e) => e.abs() <= tolerance_pct,
-                None => {
-                    let scale = if matches!(component, Component::A(_)) { 1.0 / length } else { length };
-                    (achieved - target).abs() <= tolerance_pct / 100.0 * scale
-                }
-            };
-            ComponentResult { component, target, achieved, error_pct, met }
+        .map(|&(quantity, target)| {
+            let achieved = eval.value(quantity).expect("order covers the target");
+            ComponentOutcome::judge(quantity, target, achieved, tolerance_pct, length)
         })
         .collect()
 }

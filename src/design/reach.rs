@@ -123,10 +123,8 @@ fn tip_reach(reach: &ReachTables, t: &ShapeTarget) -> TipReach {
 /// it asks for nothing in the plane).
 fn planar_target(t: &ShapeTarget) -> Option<(Target, Weights)> {
     let key = |q: &Quantity| match q {
-        Quantity::TipX => Some("x".to_string()),
-        Quantity::TipY => Some("y".to_string()),
-        Quantity::BendZ(k) if *k <= super::target::MAX_ORDER => Some(format!("a{k}")),
-        _ => None,
+        Quantity::BendZ(k) if *k > super::target::MAX_ORDER => None,
+        q => q.planar_key(),
     };
     let pairs: Vec<(String, f64, f64)> = t.components.iter().filter_map(|(q, v, w)| key(q).map(|k| (k, *v, *w))).collect();
     if pairs.is_empty() {

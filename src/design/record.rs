@@ -4,7 +4,9 @@
 
 use super::feasible::{FeasibilityReport, Verdict};
 use super::objective::{Bounds, Objective};
-use super::objective::{ComponentResult, Evaluation};
+use super::objective::Evaluation;
+use super::target::target_key;
+use super::targets::ComponentOutcome;
 use super::search::{routing, Found};
 use super::DesignError;
 use crate::model::routing::ControlPoints;
@@ -77,9 +79,9 @@ pub struct FeasibilityRecord {
 
 impl DesignRecord {
     /// The record of `outcome` for `objective`, with each component's result.
-    pub fn new(objective: &Objective, outcome: &Found<Evaluation>, results: &[ComponentResult]) -> Self {
+    pub fn new(objective: &Objective, outcome: &Found<Evaluation>, results: &[ComponentOutcome]) -> Self {
         let e = &outcome.solution;
-        let key_values = |f: &dyn Fn(&ComponentResult) -> f64| results.iter().map(|r| (r.component.key(), f(r))).collect();
+        let key_values = |f: &dyn Fn(&ComponentOutcome) -> f64| results.iter().map(|r| (target_key(r.quantity), f(r))).collect();
         DesignRecord {
             a: e.a.clone(),
             achieved: key_values(&|r| r.achieved),
@@ -87,7 +89,7 @@ impl DesignRecord {
             base_angle_rad: e.pose.base_angle_rad,
             bounds: objective.bounds.clone(),
             cost: outcome.cost,
-            error_pct: results.iter().map(|r| (r.component.key(), r.error_pct)).collect(),
+            error_pct: results.iter().map(|r| (target_key(r.quantity), r.error_pct)).collect(),
             feasibility: None,
             length_basis: objective.length_basis,
             length_mm: e.pose.length_mm,
@@ -114,8 +116,8 @@ impl DesignRecord {
             tip_angle_rad: e.pose.tip_angle_rad,
             tip_x_mm: e.pose.tip_x_mm,
             tip_y_mm: e.pose.tip_y_mm,
-            unmet: results.iter().filter(|r| !r.met).map(|r| r.component.key()).collect(),
-            weights: objective.target.components.iter().map(|(c, _)| (c.key(), objective.weights.get(*c))).collect(),
+            unmet: results.iter().filter(|r| !r.met).map(|r| target_key(r.quantity)).collect(),
+            weights: objective.target.components.iter().map(|(c, _)| (target_key(*c), objective.weights.get(*c))).collect(),
         }
     }
 

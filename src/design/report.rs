@@ -5,10 +5,10 @@
 
 use super::feasible::FeasibilityReport;
 use super::objective::Objective;
-use super::objective::{ComponentResult, Evaluation};
+use super::objective::Evaluation;
 use super::search::Found;
 use super::record::DesignRecord;
-use super::target::Component;
+use super::targets::ComponentOutcome;
 use crate::mould::MouldSummary;
 use std::fmt;
 use std::path::PathBuf;
@@ -21,7 +21,7 @@ pub struct DesignRun {
     /// The search's result.
     pub outcome: Found<Evaluation>,
     /// Each target component, achieved vs asked.
-    pub results: Vec<ComponentResult>,
+    pub results: Vec<ComponentOutcome>,
     /// A component counts as met within this many percent.
     pub tolerance_pct: f64,
     /// The map's verdict, when a map was given.
@@ -64,10 +64,10 @@ impl DesignRun {
         let col = 14;
         write!(f, "{:<10}", "")?;
         for r in results {
-            write!(f, "{:>col$}", format!("{} [{}]", r.component, r.component.unit()))?;
+            write!(f, "{:>col$}", format!("{} [{}]", r.quantity, r.quantity.unit()))?;
         }
         writeln!(f)?;
-        let digits = |r: &ComponentResult| if matches!(r.component, Component::A(_)) { 6 } else { 4 };
+        let digits = |r: &ComponentOutcome| if r.quantity.is_coefficient() { 6 } else { 4 };
         write!(f, "{:<10}", "Target")?;
         for r in results {
             write!(f, "{:>col$.*}", digits(r), r.target)?;
@@ -110,14 +110,14 @@ impl DesignRun {
             outcome.starts.len(),
             outcome.seconds
         )?;
-        let unmet: Vec<&ComponentResult> = self.results.iter().filter(|r| !r.met).collect();
+        let unmet: Vec<&ComponentOutcome> = self.results.iter().filter(|r| !r.met).collect();
         if unmet.is_empty() {
             writeln!(f, "verdict      every component met within {tolerance_pct}%")
         } else {
             writeln!(
                 f,
                 "verdict      NOT REACHABLE as asked: {} could not be met within {tolerance_pct}%; the design above is the closest achievable (least eq. 3.17 cost)",
-                unmet.iter().map(|r| r.component.to_string()).collect::<Vec<_>>().join(", ")
+                unmet.iter().map(|r| r.quantity.to_string()).collect::<Vec<_>>().join(", ")
             )
         }
     }

@@ -5,28 +5,13 @@
 use super::actuator::{ActuationBounds, DesignActuator};
 use super::search::StartReport;
 use super::sequence::{Achieved, Channel};
-use super::targets::{Quantity, ShapeTarget};
+use super::targets::{ComponentOutcome, Quantity, ShapeTarget};
 use super::trajectory;
 use crate::model::Actuator;
 use crate::shape::LengthBasis;
 use serde_json::json;
 use std::fmt;
 use std::path::PathBuf;
-
-/// One target component, asked vs achieved.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ComponentOutcome {
-    /// Which.
-    pub quantity: Quantity,
-    /// Asked.
-    pub target: f64,
-    /// Achieved.
-    pub achieved: f64,
-    /// 100 (achieved − target)/|target| (None for a zero target).
-    pub error_pct: Option<f64>,
-    /// Within the target's tolerance.
-    pub met: bool,
-}
 
 /// One target's design: its actuation and what it achieves.
 #[derive(Debug, Clone)]

@@ -15,9 +15,9 @@ use super::search::routing::RoutingProblem;
 use super::request::DesignRequest;
 use super::search::{self, SearchOptions, ROUTING_STARTS, SEQUENCE_STARTS};
 use super::sequence::{Achieved, Channel, Setup};
-use super::target::{error_pct, Target, Weights};
-use super::targets::{Quantity, ShapeTarget, TargetSet};
-use super::sequence_report::{ComponentOutcome, SequenceRun, TargetOutcome};
+use super::target::{Target, Weights};
+use super::targets::{ComponentOutcome, Quantity, ShapeTarget, TargetSet};
+use super::sequence_report::{SequenceRun, TargetOutcome};
 use super::TipBeyondReach;
 use super::{map_channels as map, sequence_export as export, trajectory, DesignError};
 use crate::model::Actuator;
@@ -58,15 +58,7 @@ pub fn check_reachable(design: &DesignActuator, targets: &TargetSet) -> Result<(
 fn compare(t: &ShapeTarget, a: &Achieved, length_mm: f64) -> Vec<ComponentOutcome> {
     t.components
         .iter()
-        .map(|&(quantity, target, _)| {
-            let achieved = a.value(quantity);
-            let error_pct = error_pct(achieved, target);
-            let met = match error_pct {
-                Some(e) => e.abs() <= t.tolerance_pct,
-                None => (achieved - target).abs() <= t.tolerance_pct / 100.0 * quantity.natural_scale(length_mm),
-            };
-            ComponentOutcome { quantity, target, achieved, error_pct, met }
-        })
+        .map(|&(quantity, target, _)| ComponentOutcome::judge(quantity, target, a.value(quantity), t.tolerance_pct, length_mm))
         .collect()
 }
 
@@ -110,12 +102,7 @@ fn planar_case(r: &Sequence, map: Option<&std::path::Path>) -> bool {
 /// the target's in-plane components and weights, the cable's bounds.
 fn routing_objective(design: &DesignActuator, r: &DesignRequest, t: &ShapeTarget) -> Result<Objective, DesignError> {
     let f = &design.freedom[0];
-    let key = |q: &Quantity| match q {
-        Quantity::TipX => Some("x".to_string()),
-        Quantity::TipY => Some("y".to_string()),
-        Quantity::BendZ(k) => Some(format!("a{k}")),
-        _ => None,
-    };
+    let key = Quantity::planar_key;
     let target = Target::parse(&t.components.iter().filter_map(|(q, v, _)| key(q).map(|k| format!("{k}={v}"))).collect::<Vec<_>>().join(","))?;
     let weights = Weights::parse(&t.components.iter().filter_map(|(q, _, w)| key(q).map(|k| format!("{k}={w}"))).collect::<Vec<_>>().join(","))?;
     let (lo, hi) = f.actuation.range();

@@ -1,78 +1,9 @@
 //! Design targets and weights of eq. 3.17: tip position (x_e, y_e) and
 //! Legendre curvature coefficients a_0 … a_n, any of them optional.
 
+use super::targets::Quantity;
 use super::DesignError;
 use serde::Serialize;
-use std::fmt;
-
-/// One scalar the designer can ask for.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
-pub enum Component {
-    /// Tip position along the clamp axis, mm.
-    TipX,
-    /// Tip position across the clamp axis, mm.
-    TipY,
-    /// Legendre curvature coefficient a_k, 1/mm.
-    A(usize),
-}
-
-impl Component {
-    /// The name used on the command line and in JSON (`x`, `y`, `a0`, `a1`, …).
-    pub fn key(&self) -> String {
-        match self {
-            Component::TipX => "x".into(),
-            Component::TipY => "y".into(),
-            Component::A(k) => format!("a{k}"),
-        }
-    }
-
-    /// Parses `x`, `y`, `a0`, `a1`, … (also `x_e`, `y_e`).
-    pub fn parse(key: &str) -> Option<Self> {
-        match key.trim() {
-            "x" | "x_e" | "xe" => Some(Component::TipX),
-            "y" | "y_e" | "ye" => Some(Component::TipY),
-            k => {
-                let digits = k.strip_prefix('a')?;
-                if digits.is_empty() || !digits.chars().all(|c| c.is_ascii_digit()) {
-                    return None;
-                }
-                // Orders beyond a few dozen are numerically meaningless for a
-                // 65 mm rod sampled at ~50 nodes; reject them as typos.
-                digits.parse::<usize>().ok().filter(|&k| k <= MAX_ORDER).map(Component::A)
-            }
-        }
-    }
-
-    /// The thesis's default weight (Ch. 5): λ_x = λ_y = 1, λ_0 = 100,
-    /// λ_1 = 50, λ_2 = 25. The thesis stops at order 2; higher orders get
-    /// λ_2's weight.
-    pub fn default_weight(&self) -> f64 {
-        match self {
-            Component::TipX | Component::TipY => 1.0,
-            Component::A(0) => 100.0,
-            Component::A(1) => 50.0,
-            Component::A(_) => 25.0,
-        }
-    }
-
-    /// Unit of the component, for tables.
-    pub fn unit(&self) -> &'static str {
-        match self {
-            Component::TipX | Component::TipY => "mm",
-            Component::A(_) => "1/mm",
-        }
-    }
-}
-
-impl fmt::Display for Component {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Component::TipX => write!(f, "x_e"),
-            Component::TipY => write!(f, "y_e"),
-            Component::A(k) => write!(f, "a_{k}"),
-        }
-    }
-}
 
 /// Highest Legendre order accepted in a target.
 pub const MAX_ORDER: usize = 12;
@@ -80,8 +11,14 @@ pub const MAX_ORDER: usize = 12;
 /// A design target: the requested components, in the order x, y, a_0, a_1, ….
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Target {
-    /// (component, target value) pairs, sorted, each component at most once.
-    pub components: Vec<(Component, f64)>,
+    /// (quantity, target value) pairs, sorted, each quantity at most once:
+    /// the tip in the plane and the in-plane bending coefficients.
+    pub components: Vec<(Quantity, f64)>,
+}
+
+/// The `--target` key of a quantity a target holds.
+pub(super) fn target_key(q: Quantity) -> String {
+    q.planar_key().expect("a --target asks for quantities in the plane only")
 }
 
 impl Target {
@@ -107,7 +44,7 @@ impl Target {
 
     /// Highest coefficient order asked for, if any coefficient is.
     pub fn highest_order(&self) -> Option<usize> {
-        self.components.iter().filter_map(|(c, _)| if let Component::A(k) = c { Some(*k) } else { None }).max()
+        self.components.iter().filter_map(|(c, _)| if let Quantity::BendZ(k) = c { Some(*k) } else { None }).max()
     }
 
     /// The order to compute and report: the highest coefficient given, or the
@@ -117,13 +54,13 @@ impl Target {
     }
 
     /// The target value of `component`, if requested.
-    pub fn get(&self, component: Component) -> Option<f64> {
+    pub fn get(&self, component: Quantity) -> Option<f64> {
         self.components.iter().find(|(c, _)| *c == component).map(|(_, v)| *v)
     }
 
     /// The target as a `{"x": …, "a0": …}` JSON object.
     pub fn to_json(&self) -> serde_json::Value {
-        serde_json::Value::Object(self.components.iter().map(|(c, v)| (c.key(), serde_json::json!(v))).collect())
+        serde_json::Value::Object(self.components.iter().map(|(c, v)| (target_key(*c), serde_json::json!(v))).collect())
     }
 }
 
@@ -131,14 +68,14 @@ impl Target {
 #[derive(Debug, Clone, PartialEq, Default, Serialize)]
 pub struct Weights {
     /// (component, λ) pairs for components whose weight was given explicitly.
-    overrides: Vec<(Component, f64)>,
+    overrides: Vec<(Quantity, f64)>,
 }
 
 impl Weights {
     /// Parses `x=1,y=1,a0=100,a1=50,a2=25` (any subset; others keep the
     /// thesis defaults). Weights must be finite and ≥ 0.
     pub fn parse(text: &str) -> Result<Self, DesignError> {
-        let mut overrides: Vec<(Component, f64)> = Vec::new();
+        let mut overrides: Vec<(Quantity, f64)> = Vec::new();
         let bad = |problem| DesignError::BadWeights { problem };
         for (key, component, value) in parse_pairs(text, List::Weights).map_err(bad)? {
             if !(value.is_finite() && value >= 0.0) {
@@ -151,8 +88,9 @@ impl Weights {
     }
 
     /// λ for `component`: the override, else the thesis default.
-    pub fn get(&self, component: Component) -> f64 {
-        self.overrides.iter().find(|(c, _)| *c == component).map_or(component.default_weight(), |(_, w)| *w)
+    pub fn get(&self, component: Quantity) -> f64 {
+        let default = component.thesis_weight().expect("a --target asks for the tip and coefficients only");
+        self.overrides.iter().find(|(c, _)| *c == component).map_or(default, |(_, w)| *w)
     }
 
     /// Checks that a weight was not given for a component the target omits
@@ -160,7 +98,7 @@ impl Weights {
     pub fn check_against(&self, target: &Target) -> Result<(), DesignError> {
         for (c, _) in &self.overrides {
             if target.get(*c).is_none() {
-                return Err(DesignError::BadWeights { problem: ListProblem::NotInTarget { key: c.key() } });
+                return Err(DesignError::BadWeights { problem: ListProblem::NotInTarget { key: target_key(*c) } });
             }
         }
         if target.components.iter().all(|(c, _)| self.get(*c) == 0.0) {
@@ -253,14 +191,14 @@ pub enum ListProblem {
 }
 
 /// Splits `KEY=VALUE,…` into (key, component, number).
-fn parse_pairs(text: &str, list: List) -> Result<Vec<(String, Component, f64)>, ListProblem> {
+fn parse_pairs(text: &str, list: List) -> Result<Vec<(String, Quantity, f64)>, ListProblem> {
     text.split(',')
         .map(str::trim)
         .filter(|s| !s.is_empty())
         .map(|item| {
             let (key, value) = item.split_once('=').ok_or_else(|| ListProblem::NotKeyValue { item: item.to_string(), list })?;
             let key = key.trim();
-            let component = Component::parse(key).ok_or_else(|| ListProblem::UnknownComponent { key: key.to_string() })?;
+            let component = Quantity::parse_planar_key(key).ok_or_else(|| ListProblem::UnknownComponent { key: key.to_string() })?;
             let number: f64 = value.trim().parse().map_err(|_| ListProblem::NotANumber { key: key.to_string(), value: value.trim().to_string(), list })?;
             Ok((key.to_string(), component, number))
         })
@@ -281,15 +219,15 @@ mod tests {
     fn parses_the_thesis_target() {
         let t = Target::parse("x=50,y=5,a0=-0.025,a1=-0.06,a2=0.015").unwrap();
         assert_eq!(t.components.len(), 5);
-        assert_eq!(t.get(Component::TipX), Some(50.0));
-        assert_eq!(t.get(Component::A(2)), Some(0.015));
+        assert_eq!(t.get(Quantity::TipX), Some(50.0));
+        assert_eq!(t.get(Quantity::BendZ(2)), Some(0.015));
         assert_eq!(t.order(), 2);
     }
 
     #[test]
     fn any_subset_and_order() {
         let t = Target::parse("a1=-0.06, x=3").unwrap();
-        assert_eq!(t.components, vec![(Component::TipX, 3.0), (Component::A(1), -0.06)]);
+        assert_eq!(t.components, vec![(Quantity::TipX, 3.0), (Quantity::BendZ(1), -0.06)]);
         assert_eq!(t.order(), 1);
         assert_eq!(Target::parse("x=1,y=2").unwrap().order(), 2);
     }
@@ -316,10 +254,10 @@ mod tests {
         let t = Target::parse("x=1,a0=0.01,a3=0.001").unwrap();
         let w = Weights::parse("a0=7").unwrap();
         w.check_against(&t).unwrap();
-        assert_eq!(w.get(Component::A(0)), 7.0);
-        assert_eq!(w.get(Component::TipX), 1.0);
-        assert_eq!(w.get(Component::A(1)), 50.0);
-        assert_eq!(w.get(Component::A(3)), 25.0);
+        assert_eq!(w.get(Quantity::BendZ(0)), 7.0);
+        assert_eq!(w.get(Quantity::TipX), 1.0);
+        assert_eq!(w.get(Quantity::BendZ(1)), 50.0);
+        assert_eq!(w.get(Quantity::BendZ(3)), 25.0);
         assert!(Weights::parse("y=2").unwrap().check_against(&t).is_err());
         assert!(Weights::parse("x=-1").is_err());
         assert!(Weights::parse("x=0,a0=0,a3=0").unwrap().check_against(&t).is_err());

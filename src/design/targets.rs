@@ -49,14 +49,22 @@ impl Quantity {
     /// L δ, about 1.1 mm per degree on the thesis rod), the thesis's
     /// λ_0 = 100, λ_1 = 50, λ_k = 25 for every series.
     pub fn default_weight(&self, length_mm: f64) -> f64 {
+        self.thesis_weight().unwrap_or(length_mm * length_mm)
+    }
+
+    /// The thesis's weight λ (Ch. 5) of a tip coordinate or a coefficient:
+    /// λ_x = λ_y = 1, λ_0 = 100, λ_1 = 50, λ_2 = 25 and λ_2's weight for
+    /// higher orders; none for the tangent, whose weight depends on the
+    /// rod's length.
+    pub fn thesis_weight(&self) -> Option<f64> {
         match self {
-            Quantity::TipX | Quantity::TipY | Quantity::TipZ => 1.0,
-            Quantity::Tangent(_) => length_mm * length_mm,
-            Quantity::BendZ(k) | Quantity::BendY(k) | Quantity::Twist(k) => match k {
+            Quantity::TipX | Quantity::TipY | Quantity::TipZ => Some(1.0),
+            Quantity::Tangent(_) => None,
+            Quantity::BendZ(k) | Quantity::BendY(k) | Quantity::Twist(k) => Some(match k {
                 0 => 100.0,
                 1 => 50.0,
                 _ => 25.0,
-            },
+            }),
         }
     }
 
@@ -69,6 +77,94 @@ impl Quantity {
             Quantity::Tangent(_) => 1.0,
             _ => 1.0 / length_mm,
         }
+    }
+
+    /// The key of an in-plane quantity in the thesis's `--target` list and
+    /// a one-target design.json (`x`, `y`, `a0`, `a1`, …); none for the
+    /// quantities out of the plane.
+    pub fn planar_key(&self) -> Option<String> {
+        match self {
+            Quantity::TipX => Some("x".into()),
+            Quantity::TipY => Some("y".into()),
+            Quantity::BendZ(k) => Some(format!("a{k}")),
+            _ => None,
+        }
+    }
+
+    /// Parses a `--target` key: `x`, `y`, `a0`, `a1`, … (also `x_e`, `y_e`).
+    pub fn parse_planar_key(key: &str) -> Option<Self> {
+        match key.trim() {
+            "x" | "x_e" | "xe" => Some(Quantity::TipX),
+            "y" | "y_e" | "ye" => Some(Quantity::TipY),
+            k => {
+                let digits = k.strip_prefix('a')?;
+                if digits.is_empty() || !digits.chars().all(|c| c.is_ascii_digit()) {
+                    return None;
+                }
+                // Orders beyond a few dozen are numerically meaningless for a
+                // 65 mm rod sampled at ~50 nodes; reject them as typos.
+                digits.parse::<usize>().ok().filter(|&k| k <= MAX_ORDER).map(Quantity::BendZ)
+            }
+        }
+    }
+
+    /// Whether it is a coefficient of a series (1/mm).
+    pub fn is_coefficient(&self) -> bool {
+        matches!(self, Quantity::BendZ(_) | Quantity::BendY(_) | Quantity::Twist(_))
+    }
+
+    /// Unit, for tables.
+    pub fn unit(&self) -> &'static str {
+        match self {
+            Quantity::TipX | Quantity::TipY | Quantity::TipZ => "mm",
+            Quantity::Tangent(_) => "1",
+            _ => "1/mm",
+        }
+    }
+}
+
+impl std::fmt::Display for Quantity {
+    /// The thesis's symbol: x_e, y_e, z_e for the tip, a_k for the in-plane
+    /// bending coefficients.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Quantity::TipX => write!(f, "x_e"),
+            Quantity::TipY => write!(f, "y_e"),
+            Quantity::TipZ => write!(f, "z_e"),
+            Quantity::Tangent(i) => write!(f, "t_{}", ["x", "y", "z"][*i]),
+            Quantity::BendZ(k) => write!(f, "a_{k}"),
+            Quantity::BendY(k) => write!(f, "a_bend_y_{k}"),
+            Quantity::Twist(k) => write!(f, "a_twist_{k}"),
+        }
+    }
+}
+
+/// One target component, asked vs achieved.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ComponentOutcome {
+    /// Which.
+    pub quantity: Quantity,
+    /// Asked.
+    pub target: f64,
+    /// Achieved.
+    pub achieved: f64,
+    /// 100 (achieved − target)/|target| (None for a zero target).
+    pub error_pct: Option<f64>,
+    /// Within the target's tolerance.
+    pub met: bool,
+}
+
+impl ComponentOutcome {
+    /// `achieved` against `target`: met when its relative error is within
+    /// `tolerance_pct`, a zero target judged against the quantity's natural
+    /// scale on a rod of `length_mm` instead.
+    pub fn judge(quantity: Quantity, target: f64, achieved: f64, tolerance_pct: f64, length_mm: f64) -> Self {
+        let error_pct = super::target::error_pct(achieved, target);
+        let met = match error_pct {
+            Some(e) => e.abs() <= tolerance_pct,
+            None => (achieved - target).abs() <= tolerance_pct / 100.0 * quantity.natural_scale(length_mm),
+        };
+        Self { quantity, target, achieved, error_pct, met }
     }
 }
 
