@@ -1,12 +1,9 @@
 //! Design targets and weights of eq. 3.17: tip position (x_e, y_e) and
 //! Legendre curvature coefficients a_0 … a_n, any of them optional.
 
-use super::targets::Quantity;
+pub use super::targets::{error_pct, Quantity, MAX_ORDER};
 use super::DesignError;
 use serde::Serialize;
-
-/// Highest Legendre order accepted in a target.
-pub const MAX_ORDER: usize = 12;
 
 /// A design target: the requested components, in the order x, y, a_0, a_1, ….
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -205,11 +202,6 @@ fn parse_pairs(text: &str, list: List) -> Result<Vec<(String, Quantity, f64)>, L
         .collect()
 }
 
-/// Relative error of an achieved value, %, in the thesis's convention
-/// (Table 5.1): 100 (achieved − target) / |target|. `None` for a zero target.
-pub fn error_pct(achieved: f64, target: f64) -> Option<f64> {
-    (target != 0.0).then(|| 100.0 * (achieved - target) / target.abs())
-}
 
 #[cfg(test)]
 mod tests {

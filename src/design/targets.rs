@@ -6,10 +6,18 @@
 //! solver (`a_bend_z`, `a_bend_y`, `a_twist`, the names `simulate --json`
 //! uses), with weights and a tolerance.
 
-use super::target::MAX_ORDER;
 use super::DesignError;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
+
+/// Highest Legendre order accepted in a target.
+pub const MAX_ORDER: usize = 12;
+
+/// Relative error of an achieved value, %, in the thesis's convention
+/// (Table 5.1): 100 (achieved − target) / |target|. `None` for a zero target.
+pub fn error_pct(achieved: f64, target: f64) -> Option<f64> {
+    (target != 0.0).then(|| 100.0 * (achieved - target) / target.abs())
+}
 
 /// One scalar a target can ask for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
@@ -159,7 +167,7 @@ impl ComponentOutcome {
     /// `tolerance_pct`, a zero target judged against the quantity's natural
     /// scale on a rod of `length_mm` instead.
     pub fn judge(quantity: Quantity, target: f64, achieved: f64, tolerance_pct: f64, length_mm: f64) -> Self {
-        let error_pct = super::target::error_pct(achieved, target);
+        let error_pct = error_pct(achieved, target);
         let met = match error_pct {
             Some(e) => e.abs() <= tolerance_pct,
             None => (achieved - target).abs() <= tolerance_pct / 100.0 * quantity.natural_scale(length_mm),

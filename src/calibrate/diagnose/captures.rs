@@ -28,8 +28,8 @@ use crate::calibrate::observations::captures::{Captures, CapturesReport};
 use crate::solver::SolverOptions;
 use crate::calibrate::Parameter;
 use crate::calibrate::observations::captures::simulate::solve_captures;
-use crate::calibrate::diagnose::criterion::{Candidate, NamedEffect};
-use crate::calibrate::diagnose::diagnosis::{fitted_effects, DiagnoseSpec, Diagnosis, DiagnosisKind, Signature};
+use crate::calibrate::diagnose::criterion::Candidate;
+use crate::calibrate::diagnose::diagnosis::{fitted_effects, DiagnoseSpec, Diagnosis, DiagnosisKind, Signature, VerdictJson};
 use crate::calibrate::diagnose::rounds::{self, Evidence, Judged, Model, Rounds, Search};
 use crate::calibrate::diagnose::Verdict;
 use crate::calibrate::{CalibrateError, Effect};
@@ -338,54 +338,26 @@ pub fn diagnose_captures(base: &Actuator, set: &CaptureSet, spec: &DiagnoseSpec<
 /// The `--json` object's fields.
 #[derive(Serialize)]
 struct Json<'a> {
-    verdict: Verdict,
-    reason: &'a str,
-    parameter_name: Option<&'static str>,
-    parameter: Option<f64>,
-    parameter_se: Option<f64>,
-    effects: &'a [NamedEffect],
-    partial_effects: &'a [NamedEffect],
-    ambiguous_between: &'a [Effect],
-    separating_measurement: &'a Option<String>,
-    candidates: &'a [Candidate],
-    second_round: &'a [Candidate],
+    #[serde(flatten)]
+    verdict: VerdictJson<'a>,
     not_candidates: &'a [String],
     baseline: FitSummary,
     extended: FitSummary,
     signature: &'a Option<Signature<CapturesReport>>,
     holdout_cable: Option<usize>,
-    holdout_rms_before: Option<f64>,
-    holdout_rms_after: Option<f64>,
-    criterion: &'a str,
-    alpha: f64,
     captures_fitted: usize,
     elapsed_s: f64,
 }
 
 impl Serialize for Diagnosis<CapturesReport> {
     fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        let first = self.first_named();
         Json {
-            verdict: self.verdict,
-            reason: &self.reason,
-            parameter_name: first.map(|n| n.parameter_name),
-            parameter: first.map(|n| n.parameter),
-            parameter_se: first.map(|n| n.parameter_se),
-            effects: &self.named,
-            partial_effects: &self.partial_effects,
-            ambiguous_between: &self.ambiguous_between,
-            separating_measurement: &self.separating_measurement,
-            candidates: &self.candidates,
-            second_round: &self.second_round,
+            verdict: self.verdict_json(),
             not_candidates: &self.not_candidates,
             baseline: summary(&self.baseline),
             extended: summary(&self.extended),
             signature: &self.signature,
             holdout_cable: self.holdout,
-            holdout_rms_before: self.holdout_rms_before,
-            holdout_rms_after: self.holdout_rms_after,
-            criterion: &self.criterion,
-            alpha: self.alpha,
             captures_fitted: self.fitted,
             elapsed_s: self.elapsed_s,
         }

@@ -152,6 +152,52 @@ impl<K: DiagnosisKind> Diagnosis<K> {
     }
 }
 
+/// The `--json` fields of every diagnosis: the verdict, its first named
+/// effect's parameter, the rounds, the rule and the hold-out gap; each
+/// kind adds its fits and what it holds out.
+#[derive(Serialize)]
+pub(super) struct VerdictJson<'a> {
+    verdict: Verdict,
+    reason: &'a str,
+    parameter_name: Option<&'static str>,
+    parameter: Option<f64>,
+    parameter_se: Option<f64>,
+    effects: &'a [NamedEffect],
+    partial_effects: &'a [NamedEffect],
+    ambiguous_between: &'a [Effect],
+    separating_measurement: &'a Option<String>,
+    candidates: &'a [Candidate],
+    second_round: &'a [Candidate],
+    criterion: &'a str,
+    alpha: f64,
+    holdout_rms_before: Option<f64>,
+    holdout_rms_after: Option<f64>,
+}
+
+impl<K: DiagnosisKind> Diagnosis<K> {
+    /// The `--json` fields every kind writes.
+    pub(super) fn verdict_json(&self) -> VerdictJson<'_> {
+        let first = self.first_named();
+        VerdictJson {
+            verdict: self.verdict,
+            reason: &self.reason,
+            parameter_name: first.map(|n| n.parameter_name),
+            parameter: first.map(|n| n.parameter),
+            parameter_se: first.map(|n| n.parameter_se),
+            effects: &self.named,
+            partial_effects: &self.partial_effects,
+            ambiguous_between: &self.ambiguous_between,
+            separating_measurement: &self.separating_measurement,
+            candidates: &self.candidates,
+            second_round: &self.second_round,
+            criterion: &self.criterion,
+            alpha: self.alpha,
+            holdout_rms_before: self.holdout_rms_before,
+            holdout_rms_after: self.holdout_rms_after,
+        }
+    }
+}
+
 /// The effects a fit added to the body, in the order of its parameters
 /// (the order they were added).
 pub fn fitted_effects<R: FitReport>(f: &FitResult<R>) -> Vec<Effect> {

@@ -4,13 +4,12 @@
 //! [`Display`]: std::fmt::Display
 
 use super::analysis::{model_name, ResidualDiagnostics};
-use super::criterion::{Candidate, NamedEffect};
-use super::diagnosis::{Diagnosis, Signature};
+use super::criterion::Candidate;
+use super::diagnosis::{Diagnosis, Signature, VerdictJson};
 use super::Verdict;
 use crate::calibrate::observations::captures::CapturesReport;
 use crate::calibrate::fit::FitResult;
 use crate::calibrate::observations::measurements::MeasurementsReport;
-use crate::calibrate::Effect;
 use serde::Serialize;
 use std::fmt;
 use std::path::PathBuf;
@@ -53,27 +52,14 @@ impl fmt::Display for DiagnoseReport {
 /// The `--json` object's fields.
 #[derive(Serialize)]
 struct Json<'a> {
-    verdict: Verdict,
-    reason: &'a str,
-    parameter_name: Option<&'static str>,
-    parameter: Option<f64>,
-    parameter_se: Option<f64>,
-    effects: &'a [NamedEffect],
-    partial_effects: &'a [NamedEffect],
-    ambiguous_between: &'a [Effect],
-    separating_measurement: &'a Option<String>,
-    candidates: &'a [Candidate],
-    second_round: &'a [Candidate],
-    criterion: &'a str,
-    alpha: f64,
+    #[serde(flatten)]
+    verdict: VerdictJson<'a>,
     baseline: &'a FitResult<MeasurementsReport>,
     extended: &'a FitResult<MeasurementsReport>,
     best: &'a FitResult<MeasurementsReport>,
     signature: &'a Option<Signature<MeasurementsReport>>,
     diagnostics: &'a ResidualDiagnostics,
     holdout: &'a Option<String>,
-    holdout_rms_before: Option<f64>,
-    holdout_rms_after: Option<f64>,
     not_identifiable: [&'static str; 1],
     report: Option<String>,
 }
@@ -81,29 +67,14 @@ struct Json<'a> {
 impl Serialize for Diagnosis<MeasurementsReport> {
     fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
         let d = self;
-        let first = d.first_named();
         Json {
-            verdict: d.verdict,
-            reason: &d.reason,
-            parameter_name: first.map(|n| n.parameter_name),
-            parameter: first.map(|n| n.parameter),
-            parameter_se: first.map(|n| n.parameter_se),
-            effects: &d.named,
-            partial_effects: &d.partial_effects,
-            ambiguous_between: &d.ambiguous_between,
-            separating_measurement: &d.separating_measurement,
-            candidates: &d.candidates,
-            second_round: &d.second_round,
-            criterion: &d.criterion,
-            alpha: d.alpha,
+            verdict: d.verdict_json(),
             baseline: &d.baseline,
             extended: &d.extended,
             best: &d.best,
             signature: &d.signature,
             diagnostics: &d.details.diagnostics,
             holdout: &d.holdout,
-            holdout_rms_before: d.holdout_rms_before,
-            holdout_rms_after: d.holdout_rms_after,
             not_identifiable: ["cable_stretch: under tension control the cable's stretch does not change the forces on the rod, so no tip reading can show it"],
             report: self.written.first().map(|p| p.display().to_string()),
         }
