@@ -59,14 +59,14 @@ pub fn reference_options() -> SolverOptions {
 /// off, each with `options` and, if `with_reference`, with
 /// [`reference_options`] right after on the same routings.
 pub fn bench_with_reference(
-    actuator: &Rod,
+    rod: &Rod,
     options: &SolverOptions,
     routings: &[ControlPoints],
     with_reference: bool,
 ) -> Result<Vec<BenchFigures>, crate::Error> {
     let mut rows = Vec::new();
     for gravity in [true, false] {
-        let mut a = actuator.clone();
+        let mut a = rod.clone();
         a.gravity.enabled = gravity;
         let label = if gravity { "gravity on" } else { "gravity off" };
         let mut row = bench_solver(&a, options, routings, 1.0, 2.0, 21, label)?;
@@ -103,7 +103,7 @@ pub fn sample_thesis_routings(count: usize, radius_mm: f64) -> Vec<ControlPoints
 /// Times continuation solves: for each routing, `tensions` evenly spaced
 /// from `tension_min_n` to `tension_max_n`.
 pub fn bench_solver(
-    actuator: &Rod,
+    rod: &Rod,
     options: &SolverOptions,
     routings: &[ControlPoints],
     tension_min_n: f64,
@@ -111,7 +111,7 @@ pub fn bench_solver(
     tensions: usize,
     label: &str,
 ) -> Result<BenchFigures, crate::Error> {
-    bench_ladder(actuator, options, routings, &evenly(tension_min_n, tension_max_n, tensions), false, label)
+    bench_ladder(rod, options, routings, &evenly(tension_min_n, tension_max_n, tensions), false, label)
 }
 
 /// Times displacement-driven solves: for each routing, `count`
@@ -119,7 +119,7 @@ pub fn bench_solver(
 /// tension found by Newton's method on the warm-started tension solves, as
 /// a displacement sweep steps it), a_0 … a_3 included.
 pub fn bench_displacement(
-    actuator: &Rod,
+    rod: &Rod,
     options: &SolverOptions,
     routings: &[ControlPoints],
     min_mm: f64,
@@ -127,7 +127,7 @@ pub fn bench_displacement(
     count: usize,
     label: &str,
 ) -> Result<BenchFigures, crate::Error> {
-    bench_ladder(actuator, options, routings, &evenly(min_mm, max_mm, count), true, label)
+    bench_ladder(rod, options, routings, &evenly(min_mm, max_mm, count), true, label)
 }
 
 /// `count` values evenly spaced from `min` to `max` (`min` alone for one).
@@ -138,19 +138,19 @@ fn evenly(min: f64, max: f64, count: usize) -> Vec<f64> {
 /// Times each routing solved through `ladder`: tensions, N, or (when
 /// `by_displacement`) displacements, mm, each tension found from the last.
 fn bench_ladder(
-    actuator: &Rod,
+    rod: &Rod,
     options: &SolverOptions,
     routings: &[ControlPoints],
     ladder: &[f64],
     by_displacement: bool,
     label: &str,
 ) -> Result<BenchFigures, crate::Error> {
-    let mut sim = Simulator::for_rod(actuator, options)?;
+    let mut sim = Simulator::for_rod(rod, options)?;
     let mut per_solve = Vec::with_capacity(routings.len());
     let mut a = [0.0; 4];
     let (mut passes, mut solves, mut failures) = (0u64, 0u64, 0usize);
     for y in routings {
-        let routing = Routing::for_actuator(y, actuator)?;
+        let routing = Routing::for_actuator(y, rod)?;
         let start = Instant::now();
         sim.set_routing(&routing);
         let mut tension = [0.0];

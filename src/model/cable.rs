@@ -260,11 +260,11 @@ impl Channel {
 /// points); an anchor outside (0, L]; two cables on
 /// the same path (identical control points: the spline is linear in them, so
 /// this is exactly "the same curve").
-pub fn validate(actuator: &Rod, cables: &[Cable]) -> Result<Vec<Channel>, ActuatorError> {
+pub fn validate(rod: &Rod, cables: &[Cable]) -> Result<Vec<Channel>, ActuatorError> {
     if cables.is_empty() || cables.len() > MAX_CABLES {
         return Err(ActuatorError::CableCount { count: cables.len(), max: MAX_CABLES });
     }
-    let (length, radius) = (actuator.length_mm, actuator.radius_mm);
+    let (length, radius) = (rod.length_mm, rod.radius_mm);
     let mut channels = Vec::with_capacity(cables.len());
     for (index, cable) in cables.iter().enumerate() {
         let cable_no = index + 1;
