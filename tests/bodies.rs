@@ -67,12 +67,20 @@ fn bad_bodies_get_errors_naming_where_and_what_to_do() {
     // RK4 knots the cable at the tip only.
     let (ok, _, stderr) = cablemap(&["simulate", "--routing", "0,1,1,1,1", "--tension", "1", "--cable-anchor-mm", "50", "--method", "rk4"]);
     assert!(!ok && stderr.contains("collocation"), "{stderr}");
-    // Moulds are for uniform cylinders.
+    // The two-part moulds are for uniform cylinders: a tapered body asked for them is refused;
+    // left to choose, it gets the printed body with lumens, as any actuator.
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("m");
-    let (ok, _, stderr) =
-        cablemap(&["mould", "--routing", "0,1,1,1,1", "--radius-profile-mm", "0:6,65:4", "--out", out.to_str().unwrap()]);
+    let (ok, _, stderr) = cablemap(&[
+        "mould", "--routing", "0,1,1,1,1", "--radius-profile-mm", "0:6,65:4", "--style", "two-part", "--out", out.to_str().unwrap(),
+    ]);
     assert!(!ok && stderr.contains("uniform cylinders") && stderr.contains("radius profile"), "{stderr}");
+    assert!(!out.exists());
+    let (ok, stdout, stderr) =
+        cablemap(&["mould", "--routing", "0,1,1,1,1", "--radius-profile-mm", "0:6,65:4", "--json", "--out", out.to_str().unwrap()]);
+    assert!(ok, "{stderr}");
+    let report: serde_json::Value = serde_json::from_str(stdout.trim()).unwrap();
+    assert_eq!(report["style"], "lumens", "{stdout}");
 }
 
 #[test]

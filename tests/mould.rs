@@ -239,7 +239,27 @@ fn mould_actuator_refuses_channels_too_close_naming_cables_s_and_gap() {
     assert!(!ok && stderr.contains("cable 2 leaves the bending plane"), "{stderr}");
     let (ok, _, stderr) = run(&["mould", "--cable", "y=1,1,1,1,1 tension=1 anchor=40", "--out", o]);
     assert!(!ok && stderr.contains("cable 1 knotted before the tip"), "{stderr}");
-    let (ok, _, stderr) = run(&["mould", "--routing", "0,0,0,0,0", "--style", "lumens", "--out", o]);
-    assert!(!ok && stderr.contains("--style"), "{stderr}");
     assert!(!Path::new(o).exists());
+}
+
+#[test]
+fn a_routing_is_the_actuator_with_that_one_planar_cable() {
+    // `--routing` and the same channel as `--cable` give the same files,
+    // in every style.
+    let dir = tempfile::tempdir().unwrap();
+    for style in ["auto", "lumens"] {
+        let a = dir.path().join(format!("routing-{style}"));
+        let b = dir.path().join(format!("cable-{style}"));
+        let (ok, ja, stderr) = run(&["mould", "--routing", "2,3,-1,2,1", "--style", style, "--json", "--out", a.to_str().unwrap()]);
+        assert!(ok, "{stderr}");
+        let (ok, jb, stderr) = run(&["mould", "--cable", "y=2,3,-1,2,1 tension=0", "--style", style, "--json", "--out", b.to_str().unwrap()]);
+        assert!(ok, "{stderr}");
+        assert_eq!(ja, jb, "{style}");
+        let mut names: Vec<_> = std::fs::read_dir(&a).unwrap().map(|e| e.unwrap().file_name()).collect();
+        names.sort();
+        assert!(names.len() >= 3, "{names:?}");
+        for name in names {
+            assert_eq!(std::fs::read(a.join(&name)).unwrap(), std::fs::read(b.join(&name)).unwrap(), "{style}: {name:?} differs");
+        }
+    }
 }

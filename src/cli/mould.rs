@@ -1,8 +1,8 @@
 //! `cablemap mould`: printable moulds (binary STL) for a routing or any actuator.
 
 use super::{parse_list, ActuatorArgs};
-use cablemap::model::{Rod, Routing};
-use cablemap::mould::{MouldError, MouldOptions, MouldParams, MouldSet, MouldSettings, MouldStyle};
+use cablemap::model::{Actuator, Cable, Rod, Routing};
+use cablemap::mould::{MouldError, MouldOptions, MouldParams, MouldSettings, MouldStyle};
 use anyhow::Context;
 use clap::Args;
 use std::io::Write;
@@ -42,7 +42,7 @@ impl MouldParamArgs {
     }
 }
 
-/// Which moulds `mould --actuator` makes (`--style`).
+/// Which moulds `mould` makes (`--style`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
 pub enum StyleArg {
     /// Two-part moulds for channels all in the bending plane on a uniform body, else lumens.
@@ -81,8 +81,8 @@ pub struct MouldArgs {
     /// A cable "y=Y0,..,Y4 [z=Z0,..,Z4] tension=T" (repeatable; replaces --actuator's cables).
     #[arg(long, value_name = "SPEC")]
     pub cable: Vec<String>,
-    /// With --actuator or --cable: two-part moulds (planar channels on a uniform body), a printed
-    /// body with lumens and its cores, or auto (two-part when the channels allow it).
+    /// Two-part moulds (planar channels on a uniform body), a printed body with lumens and its
+    /// cores, or auto (two-part when the channels allow it).
     #[arg(long, value_enum, default_value_t = StyleArg::Auto)]
     pub style: StyleArg,
     /// Directory for mould1.stl, mould2.stl, mould1.png, mould2.png, channel.csv, mould.json: new,
@@ -110,45 +110,11 @@ pub fn with_flag(e: MouldError) -> anyhow::Error {
     }
 }
 
-/// Runs `cablemap mould`.
+/// Runs `cablemap mould`: one library request ([`cablemap::mould::build`])
+/// for every cable's channel; a routing is the actuator with that one
+/// planar cable.
 pub fn run(args: &MouldArgs) -> anyhow::Result<()> {
-    if args.spatial_actuator.is_some() || !args.cable.is_empty() {
-        return run_actuator(args);
-    }
-    anyhow::ensure!(args.style == StyleArg::Auto, "--style is for --actuator or --cable (a routing gets the two-part moulds)");
-    let (ys, base) = match (&args.routing, &args.design) {
-        (Some(r), _) => (parse_list(r, "--routing")?, Rod::default()),
-        (None, Some(d)) => {
-            let file = cablemap::design::record::read_design_file(d).context("--design")?;
-            (file.routing_mm, file.actuator)
-        }
-        (None, None) => anyhow::bail!("give --routing y0,..,y4 or --design design.json"),
-    };
-    let actuator = args.actuator.apply(&base);
-    actuator.validate()?;
-    cablemap::mould::check_uniform_body(&actuator)?;
-    let routing = Routing::new(&ys, actuator.length_mm, actuator.radius_mm)?;
-    let summary = MouldSet::new(&routing, actuator.radius_mm, &args.mould.params())
-        .and_then(|set| set.write_dir(&args.out))
-        .map_err(with_flag)?;
-    let stdout = std::io::stdout();
-    let mut out = stdout.lock();
-    if args.json {
-        writeln!(out, "{}", serde_json::to_string(&summary)?)?;
-    } else {
-        write!(out, "{}", summary.report(&args.out))?;
-    }
-    Ok(())
-}
-
-/// `cablemap mould --actuator FILE` / `--cable …`: one library request
-/// ([`cablemap::mould::build`]) for every cable's channel.
-fn run_actuator(args: &MouldArgs) -> anyhow::Result<()> {
-    use cablemap::model::Cable;
-    let mut actuator = args.actuator.actuator(args.spatial_actuator.as_deref())?;
-    if !args.cable.is_empty() {
-        actuator.cables = args.cable.iter().map(|c| c.parse::<Cable>()).collect::<Result<_, _>>().context("--cable")?;
-    }
+    let actuator = moulded_actuator(args)?;
     let options = MouldOptions { params: args.mould.params(), style: args.style.style() };
     let report = cablemap::mould::build(&actuator, &options).and_then(|m| m.write_dir(&args.out)).map_err(with_flag)?;
     let stdout = std::io::stdout();
@@ -160,4 +126,28 @@ fn run_actuator(args: &MouldArgs) -> anyhow::Result<()> {
     }
     debug_assert!(report.style() != MouldStyle::Auto);
     Ok(())
+}
+
+/// The actuator whose channels are moulded, as the flags give it: a routing
+/// (`--routing`, or a design's) is one planar cable on the rod of the flags
+/// (or the design's), checked like any cable's channel.
+fn moulded_actuator(args: &MouldArgs) -> anyhow::Result<Actuator> {
+    let (ys, base) = match (&args.routing, &args.design) {
+        (Some(r), _) => (parse_list(r, "--routing")?, Rod::default()),
+        (None, Some(d)) => {
+            let file = cablemap::design::record::read_design_file(d).context("--design")?;
+            (file.routing_mm, file.actuator)
+        }
+        (None, None) => {
+            let mut actuator = args.actuator.actuator(args.spatial_actuator.as_deref())?;
+            if !args.cable.is_empty() {
+                actuator.cables = args.cable.iter().map(|c| c.parse::<Cable>()).collect::<Result<_, _>>().context("--cable")?;
+            }
+            return Ok(actuator);
+        }
+    };
+    let rod = args.actuator.apply(&base);
+    rod.validate()?;
+    let routing = Routing::new(&ys, rod.length_mm, rod.radius_mm)?;
+    Ok(Actuator::with_cables(rod, vec![Cable::planar(routing.control_points_mm().0, 0.0)]))
 }
