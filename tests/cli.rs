@@ -62,6 +62,26 @@ fn simulate_writes_csv_and_png() {
 }
 
 #[test]
+fn an_output_in_a_missing_folder_is_named_before_the_solve() {
+    let dir = tempfile::tempdir().unwrap();
+    for flag in ["--png", "--csv"] {
+        let path = dir.path().join("missing").join("x.out");
+        let (ok, stdout, stderr) = run(&["simulate", "--routing", "1,1,1,1,1", "--tension-n", "1", flag, path.to_str().unwrap()]);
+        assert!(!ok && stdout.is_empty(), "{flag}: {stdout}");
+        assert!(stderr.contains(flag) && stderr.contains("does not exist") && !stderr.contains("IoError"), "{flag}: {stderr}");
+    }
+}
+
+#[test]
+fn a_negative_tolerance_is_refused_for_targets_files_too() {
+    let dir = tempfile::tempdir().unwrap();
+    let targets = dir.path().join("t.toml");
+    std::fs::write(&targets, "[[target]]\ntip_mm = { x = 50, y = 5 }\n").unwrap();
+    let (ok, _, stderr) = run(&["design", "--targets", targets.to_str().unwrap(), "--tolerance-pct", "-1"]);
+    assert!(!ok && stderr.contains("--tolerance-pct") && stderr.contains("≥ 0 %"), "{stderr}");
+}
+
+#[test]
 fn bad_input_gets_a_clear_message_and_a_failure_exit() {
     let cases: &[(&[&str], &str)] = &[
         (&["simulate", "--routing", "1,2,3", "--tension", "1"], "exactly 5 control points"),

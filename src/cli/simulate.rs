@@ -85,6 +85,13 @@ pub enum CoefficientsArg {
 
 /// Runs `cablemap simulate`: fills the library's request and prints its report.
 pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
+    // The outputs are checked before the solve, so a path that cannot be
+    // written is named before any work is done.
+    for (flag, path) in [("--csv", &args.csv), ("--png", &args.png)] {
+        if let Some(path) = path {
+            cablemap::io::check_regular_or_new(path).with_context(|| format!("{flag} {}", path.display()))?;
+        }
+    }
     let mut actuator = args.actuator.actuator(args.spatial_actuator.as_deref())?;
     if !args.cable.is_empty() {
         actuator.cables = args.cable.iter().map(|c| c.parse::<Cable>()).collect::<Result<_, _>>().context("--cable")?;

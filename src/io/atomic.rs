@@ -184,7 +184,16 @@ pub fn write_atomic_in_run(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
 pub fn check_regular_or_new(path: &Path) -> std::io::Result<()> {
     let meta = match std::fs::symlink_metadata(path) {
         Ok(m) => m,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            let folder = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+            if folder.is_dir() {
+                return Ok(());
+            }
+            return Err(std::io::Error::new(
+                std::io::ErrorKind::NotFound,
+                format!("the folder {} does not exist: create it first, or give a path in an existing folder", folder.display()),
+            ));
+        }
         Err(e) => return Err(e),
     };
     let kind = file_kind(&meta.file_type());
